@@ -1,0 +1,44 @@
+"""Ready-made models, usable by name wherever a model file path is accepted."""
+
+from __future__ import annotations
+
+from typing import Callable
+
+from ..model.mechanism import Mechanism
+from . import classic, papers
+
+__all__ = ["names", "describe", "build", "REGISTRY"]
+
+#: name -> (builder, one-line description)
+REGISTRY: dict[str, tuple[Callable[[], Mechanism], str]] = {
+    "four-sps-cu": (papers.four_sps_cu, "Paper B: 4-SPS/CU parallel mechanism (3 rotations + Tz)"),
+    "three-rrr-sm": (papers.three_rrr_sm, "Paper C: 3-RRR actuated metamorphic spherical joint (7 modes)"),
+    "three-sps-smpu": (papers.three_sps_smpu, "Paper C: 3-SPS/SmPU metamorphic mechanism (8 modes, 3-6 DOF)"),
+    "five-cs-1": (lambda: papers.five_cs(1), "Paper A: 5-CS guidance linkage 1 (tables 1-3, 7) + 7 task positions"),
+    "five-cs-2": (lambda: papers.five_cs(2), "Paper A: 5-CS guidance linkage 2 (tables 4-6, 8) + 7 task positions"),
+    "five-cs-3": (lambda: papers.five_cs(3), "Paper A: 5-CS guidance linkage 3 (tables 10-13) + 7 task positions"),
+    "stewart-6sps": (classic.stewart_6sps, "Gough-Stewart platform 6-SPS, 6 DOF"),
+    "three-rps": (classic.three_rps, "3-RPS parallel mechanism, 2 rotations + 1 translation"),
+    "three-upu": (classic.three_upu, "Translational 3-UPU (Tsai), 3 translations"),
+    "delta": (classic.delta, "Delta robot (parallelograms as U-U pairs), 3 translations"),
+    "planar-4r": (classic.planar_4r, "Planar four-bar crank-rocker, 1 DOF"),
+    "bennett": (classic.bennett, "Bennett overconstrained spatial 4R, 1 DOF (classic G-K -2)"),
+    "rssr": (classic.rssr, "Spatial RSSR four-bar, 1 DOF + 1 passive spin"),
+}
+
+
+def names() -> list[str]:
+    return list(REGISTRY)
+
+
+def describe(name: str) -> str:
+    return REGISTRY[name][1]
+
+
+def build(name: str) -> Mechanism:
+    """Build a ready-made model by name (``KeyError`` listing the known names otherwise)."""
+    try:
+        builder = REGISTRY[name][0]
+    except KeyError:
+        raise KeyError(f"unknown ready-made model {name!r}; known: {', '.join(REGISTRY)}") from None
+    return builder()

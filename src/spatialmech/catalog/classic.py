@@ -1,0 +1,209 @@
+"""Classic mechanisms beyond the papers, as ready-made models."""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from ..geometry.rotations import euler_matrix, transform
+from ..model.joints import P, R, S, U
+from ..model.mechanism import Limb, Mechanism
+
+
+def _ring(radius: float, angles_deg, z: float = 0.0) -> np.ndarray:
+    a = np.deg2rad(np.asarray(angles_deg, dtype=float))
+    return np.stack([radius * np.cos(a), radius * np.sin(a), np.full_like(a, z)], axis=1)
+
+
+def _unit(v) -> np.ndarray:
+    v = np.asarray(v, dtype=float)
+    return v / np.linalg.norm(v)
+
+
+def stewart_6sps(rb: float = 1.0, rp: float = 0.6, h: float = 1.0) -> Mechanism:
+    """Gough-Stewart platform, 6-SPS with actuated legs: 6 DOF."""
+    B = _ring(rb, [15, 105, 135, 225, 255, 345])
+    A = _ring(rp, [40, 80, 160, 200, 280, 320], h)
+    limbs = []
+    for i in range(6):
+        d = A[i] - B[i]
+        L = float(np.linalg.norm(d))
+        limbs.append(
+            Limb(f"leg{i + 1}", (S(f"B{i + 1}", B[i]), P(f"L{i + 1}", B[i], d / L, actuated=True, offset=L), S(f"A{i + 1}", A[i])))
+        )
+    return Mechanism(
+        "stewart-6sps", tuple(limbs), platform_point=[0, 0, h],
+        description="Gough-Stewart platform (6-SPS), 6 DOF",
+    )
+
+
+def three_rps(rb: float = 0.3, rp: float = 0.15, h: float = 0.3) -> Mechanism:
+    """3-RPS: base revolute axes tangent to the base circle, actuated legs: 2 rotations + Tz."""
+    angs = [90, 210, 330]
+    B = _ring(rb, angs)
+    A = _ring(rp, angs, h)
+    limbs = []
+    for i, ang in enumerate(np.deg2rad(angs)):
+        t = np.array([-np.sin(ang), np.cos(ang), 0.0])
+        d = A[i] - B[i]
+        L = float(np.linalg.norm(d))
+        limbs.append(
+            Limb(f"leg{i + 1}", (R(f"R{i + 1}", B[i], t), P(f"L{i + 1}", B[i], d / L, actuated=True, offset=L), S(f"S{i + 1}", A[i])))
+        )
+    return Mechanism(
+        "three-rps", tuple(limbs), platform_point=[0, 0, h],
+        description="3-RPS parallel mechanism, 3 DOF (2 rotations + 1 translation, with parasitic motion)",
+    )
+
+
+def three_upu(rb: float = 0.3, rp: float = 0.1, h: float = 0.3) -> Mechanism:
+    """Translational 3-UPU (Tsai): in each leg the first base-U axis is parallel to the last
+    platform-U axis and the two middle axes are parallel: pure translation, 3 DOF."""
+    angs = [90, 210, 330]
+    B = _ring(rb, angs)
+    A = _ring(rp, angs, h)
+    limbs = []
+    for i, ang in enumerate(np.deg2rad(angs)):
+        a = np.array([-np.sin(ang), np.cos(ang), 0.0])
+        d = A[i] - B[i]
+        L = float(np.linalg.norm(d))
+        b = _unit(np.cross(d, a))
+        limbs.append(
+            Limb(
+                f"leg{i + 1}",
+                (U(f"UB{i + 1}", B[i], [a, b]), P(f"L{i + 1}", B[i], d / L, actuated=True, offset=L), U(f"UA{i + 1}", A[i], [b, a])),
+            )
+        )
+    return Mechanism(
+        "three-upu", tuple(limbs), platform_point=[0, 0, h],
+        description="Translational 3-UPU parallel mechanism (Tsai), 3 translations",
+    )
+
+
+def delta(rb: float = 0.2, arm: float = 0.2, rp: float = 0.05, h: float = -0.35) -> Mechanism:
+    """Delta robot with the forearm parallelogram replaced by its kinematic equivalent, two
+    universal joints with parallel inner axes (3-RUU): 3 translations."""
+    angs = [90, 210, 330]
+    B = _ring(rb, angs)
+    W = _ring(rp, angs, h)
+    limbs = []
+    for i, ang in enumerate(np.deg2rad(angs)):
+        r = np.array([np.cos(ang), np.sin(ang), 0.0])
+        a = np.array([-np.sin(ang), np.cos(ang), 0.0])
+        E = B[i] + arm * r
+        f = W[i] - E
+        c = _unit(np.cross(f, a))
+        limbs.append(
+            Limb(
+                f"arm{i + 1}",
+                (R(f"R{i + 1}", B[i], a, actuated=True), U(f"E{i + 1}", E, [a, c]), U(f"W{i + 1}", W[i], [c, a])),
+            )
+        )
+    return Mechanism(
+        "delta", tuple(limbs), platform_point=[0, 0, h],
+        description="Delta robot (parallelograms as equivalent U-U pairs, 3-RUU), 3 translations",
+    )
+
+
+def planar_4r(ground: float = 4.0, crank: float = 1.0, coupler: float = 3.5, rocker: float = 3.0, angle_deg: float = 60.0) -> Mechanism:
+    """Planar four-bar (Grashof crank-rocker by default); the coupler is the platform."""
+    z = np.array([0.0, 0.0, 1.0])
+    A0 = np.zeros(3)
+    B0 = np.array([ground, 0.0, 0.0])
+    t = np.deg2rad(angle_deg)
+    A1 = np.array([crank * np.cos(t), crank * np.sin(t), 0.0])
+    # B1: intersection of circles |B1 - A1| = coupler, |B1 - B0| = rocker (upper solution)
+    d = np.linalg.norm(B0 - A1)
+    if not abs(coupler - rocker) <= d <= coupler + rocker:
+        raise ValueError("planar_4r: the loop cannot be assembled at this crank angle")
+    x = (coupler**2 - rocker**2 + d**2) / (2 * d)
+    y = np.sqrt(coupler**2 - x**2)
+    e = (B0 - A1) / d
+    n = np.cross(z, e)
+    B1 = A1 + x * e + y * n
+    limbs = (
+        Limb("crank", (R("A0", A0, z, actuated=True), R("A1", A1, z))),
+        Limb("rocker", (R("B0", B0, z), R("B1", B1, z))),
+    )
+    return Mechanism(
+        "planar-4r", limbs, platform_point=A1,
+        description="Planar four-bar linkage (crank-rocker), 1 DOF; the coupler is the platform",
+    )
+
+
+def _rz(t):
+    return euler_matrix("zyx", [t, 0.0, 0.0])
+
+
+def _rx(t):
+    return euler_matrix("xyz", [t, 0.0, 0.0])
+
+
+def _T(R, p):
+    return transform(R, np.asarray(p, float))
+
+
+def bennett(a: float = 1.0, alpha_deg: float = 30.0, b: float = 1.5, theta1_deg: float = 60.0) -> Mechanism:
+    """Bennett linkage: link lengths a, b, a, b and twists alpha, beta, alpha, beta with
+    sin(alpha)/a = sin(beta)/b.  Assembled numerically at input angle ``theta1``; the coupler
+    (link 2) is the platform.  Classic Grübler-Kutzbach gives -2; its mobility is 1."""
+    al = np.deg2rad(alpha_deg)
+    s = b * np.sin(al) / a
+    if not 0 < s < 1:
+        raise ValueError("bennett: sin(beta) = b sin(alpha)/a must lie in (0, 1)")
+    be = np.arcsin(s)
+    params = [(a, al), (b, be), (a, al), (b, be)]
+    th1 = np.deg2rad(theta1_deg)
+
+    def chain(th):
+        T = np.eye(4)
+        frames = [T]
+        for t, (ai, ali) in zip(th, params):
+            T = T @ _T(_rz(t), [0, 0, 0]) @ _T(np.eye(3), [ai, 0, 0]) @ _T(_rx(ali), [0, 0, 0])
+            frames.append(T)
+        return frames
+
+    def resid(x):
+        T = chain([th1, *x])[-1]
+        return np.r_[T[:3, :3].ravel() - np.eye(3).ravel(), T[:3, 3]]
+
+    best = None
+    for guess in ([2.0, 2 * np.pi - th1, -2.0], [1.0, -th1, 1.0], [3.0, np.pi, 3.0], [-1.0, th1, -1.0]):
+        sol = least_squares(resid, guess, xtol=1e-15, ftol=1e-15, gtol=1e-15)
+        if np.linalg.norm(resid(sol.x)) < 1e-10:
+            frames = chain([th1, *sol.x])
+            axes = [f[:3, 2] for f in frames[:4]]
+            # reject the folded (degenerate) assemblies: all four axes must be distinct lines
+            if min(np.linalg.norm(np.cross(axes[i], axes[(i + 1) % 4])) for i in range(4)) > 1e-3:
+                best = frames
+                break
+    if best is None:  # pragma: no cover - the default parameters assemble
+        raise ValueError("bennett: could not assemble the loop at this input angle")
+    o = [f[:3, 3] for f in best[:4]]
+    zax = [_unit(f[:3, 2]) for f in best[:4]]
+    limbs = (
+        Limb("input", (R("J1", o[0], zax[0], actuated=True), R("J2", o[1], zax[1]))),
+        Limb("output", (R("J4", o[3], zax[3]), R("J3", o[2], zax[2]))),
+    )
+    return Mechanism(
+        "bennett", limbs, platform_point=o[2],
+        description="Bennett linkage (overconstrained spatial 4R): classic G-K -2, mobility 1",
+    )
+
+
+def rssr() -> Mechanism:
+    """Spatial RSSR four-bar: input crank about z, output rocker about x; the rocker is the
+    platform.  One passive freedom (coupler spin about the S-S line): mobility 1."""
+    X, Z = np.eye(3)[0], np.eye(3)[2]
+    A0 = np.zeros(3)
+    A1 = np.array([0.3, 0.0, 0.0])
+    B0 = np.array([0.0, 1.0, 0.5])
+    B1 = np.array([0.0, 1.0, -0.1])
+    limbs = (
+        Limb("input", (R("A0", A0, Z, actuated=True), S("A1", A1), S("B1", B1))),
+        Limb("output", (R("B0", B0, X),)),
+    )
+    return Mechanism(
+        "rssr", limbs, platform_point=B1,
+        description="Spatial RSSR four-bar linkage, 1 DOF (+1 passive coupler spin)",
+    )

@@ -1,0 +1,162 @@
+"""Rotations and rigid displacements.
+
+Euler angles are always given with an explicitly named sequence, following
+``scipy.spatial.transform.Rotation``: UPPER-CASE letters are *intrinsic* (rotations about the
+moving axes), lower-case letters *extrinsic* (about the fixed axes).  ``"ZXY"`` is therefore
+``Rz(a) Rx(b) Ry(c)`` as a matrix product.  The papers use:
+
+- paper A (5-CS), table 9: ``A = Rz(gamma) Rx(alpha) Ry(beta)`` -> ``"ZXY"`` with angles
+  ``(gamma, alpha, beta)``;
+- paper B (4-SPS/CU): ``T = Rz(gamma) Ry(beta) Rx(alpha)`` -> ``"ZYX"``, ``(gamma, beta, alpha)``;
+- paper C (3-RRR): ``R = Ry(beta) Rx(alpha) Rz(gamma)`` -> ``"YXZ"``, ``(beta, alpha, gamma)``.
+
+Rigid displacements are 4x4 homogeneous matrices; twists use the screw convention of
+:mod:`spatialmech.geometry.screws` (``(omega ; v)`` with ``v`` the velocity of the point at
+the origin, i.e. the moment ``r x omega``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from .validate import as_finite_array
+
+__all__ = [
+    "euler_matrix",
+    "matrix_euler",
+    "check_sequence",
+    "skew",
+    "transform",
+    "inverse_transform",
+    "exp_twist",
+    "log_transform",
+    "rotation_angle",
+]
+
+_AXES = set("xyzXYZ")
+
+
+def check_sequence(seq: str) -> str:
+    """Validate an Euler sequence name such as ``"ZXY"`` (intrinsic) or ``"zxy"`` (extrinsic)."""
+    if not isinstance(seq, str) or len(seq) != 3 or not set(seq) <= _AXES:
+        raise ValueError(
+            f"seq: expected three axis letters such as 'ZXY' (intrinsic) or 'zxy' (extrinsic), got {seq!r}"
+        )
+    if not (seq.isupper() or seq.islower()):
+        raise ValueError(f"seq: mixes intrinsic and extrinsic letters: {seq!r}")
+    if seq[0].lower() == seq[1].lower() or seq[1].lower() == seq[2].lower():
+        raise ValueError(f"seq: consecutive axes must differ, got {seq!r}")
+    return seq
+
+
+def euler_matrix(seq: str, angles, *, degrees: bool = False) -> np.ndarray:
+    """Rotation matrix (or stack) from Euler ``angles`` (..., 3) in the named sequence."""
+    check_sequence(seq)
+    a = as_finite_array(angles, "angles")
+    if a.shape[-1:] != (3,):
+        raise ValueError(f"angles: expected shape (..., 3), got {a.shape}")
+    flat = a.reshape(-1, 3)
+    R = Rotation.from_euler(seq, flat, degrees=degrees).as_matrix()
+    return R.reshape(a.shape[:-1] + (3, 3))
+
+
+def matrix_euler(seq: str, R, *, degrees: bool = False) -> np.ndarray:
+    """Euler angles of a rotation matrix (or stack) in the named sequence."""
+    check_sequence(seq)
+    R = as_finite_array(R, "R")
+    flat = R.reshape(-1, 3, 3)
+    a = Rotation.from_matrix(flat).as_euler(seq, degrees=degrees)
+    return a.reshape(R.shape[:-2] + (3,))
+
+
+def skew(v) -> np.ndarray:
+    """The 3x3 cross-product matrix ``[v]x`` (stacks allowed)."""
+    v = np.asarray(v, dtype=float)
+    z = np.zeros(v.shape[:-1])
+    return np.stack(
+        [
+            np.stack([z, -v[..., 2], v[..., 1]], -1),
+            np.stack([v[..., 2], z, -v[..., 0]], -1),
+            np.stack([-v[..., 1], v[..., 0], z], -1),
+        ],
+        -2,
+    )
+
+
+def transform(R, p) -> np.ndarray:
+    """4x4 displacement from a rotation matrix and a translation (stacks allowed)."""
+    R = np.asarray(R, dtype=float)
+    p = np.asarray(p, dtype=float)
+    shape = np.broadcast_shapes(R.shape[:-2], p.shape[:-1])
+    T = np.zeros(shape + (4, 4))
+    T[..., :3, :3] = R
+    T[..., :3, 3] = p
+    T[..., 3, 3] = 1.0
+    return T
+
+
+def inverse_transform(T) -> np.ndarray:
+    """Inverse of a rigid displacement without a general matrix inverse."""
+    T = np.asarray(T, dtype=float)
+    Rt = np.swapaxes(T[..., :3, :3], -1, -2)
+    return transform(Rt, -np.einsum("...ij,...j->...i", Rt, T[..., :3, 3]))
+
+
+def exp_twist(screw, theta) -> np.ndarray:
+    """``exp([$] theta)``: the displacement produced by moving ``theta`` along screw ``$``.
+
+    Closed form (Rodrigues / Modern Robotics eq. 3.88) for unit-direction screws, and pure
+    translation when the direction part is zero.  Broadcasts over leading axes of ``screw``
+    and ``theta``.
+    """
+    S = np.asarray(screw, dtype=float)
+    th = np.asarray(theta, dtype=float)
+    shape = np.broadcast_shapes(S.shape[:-1], th.shape)
+    S = np.broadcast_to(S, shape + (6,))
+    th = np.broadcast_to(th, shape)
+    w = S[..., :3]
+    v = S[..., 3:]
+    wn = np.linalg.norm(w, axis=-1)
+    rot = wn > 1e-12
+    # scale screws so that |w| = 1 where rotational; theta absorbs the magnitude
+    ws = np.where(rot[..., None], w / np.where(rot, wn, 1.0)[..., None], 0.0)
+    vs = np.where(rot[..., None], v / np.where(rot, wn, 1.0)[..., None], v)
+    t = np.where(rot, th * wn, th)
+    W = skew(ws)
+    W2 = W @ W
+    s = np.sin(t)[..., None, None]
+    c = (1.0 - np.cos(t))[..., None, None]
+    eye = np.eye(3)
+    R = eye + s * W + c * W2
+    G = t[..., None, None] * eye + c * W + (t[..., None, None] - s) * W2
+    p = np.einsum("...ij,...j->...i", G, vs)
+    return transform(R, p)
+
+
+def log_transform(T) -> np.ndarray:
+    """The twist ``xi`` (6,) with ``exp_twist(xi, 1) = T``, rotation angle in ``[0, pi]``."""
+    T = np.asarray(T, dtype=float)
+    flat = T.reshape(-1, 4, 4)
+    rv = Rotation.from_matrix(flat[:, :3, :3]).as_rotvec()
+    th = np.linalg.norm(rv, axis=-1)
+    out = np.zeros((flat.shape[0], 6))
+    for i in range(flat.shape[0]):
+        p = flat[i, :3, 3]
+        if th[i] < 1e-12:
+            out[i] = np.concatenate([np.zeros(3), p])
+            continue
+        w = rv[i] / th[i]
+        W = skew(w)
+        t = th[i]
+        Ginv = np.eye(3) / t - 0.5 * W + (1.0 / t - 0.5 / np.tan(t / 2.0)) * (W @ W)
+        out[i] = np.concatenate([w, Ginv @ p]) * t
+    return out.reshape(T.shape[:-2] + (6,))
+
+
+def rotation_angle(R) -> np.ndarray:
+    """Rotation angle in ``[0, pi]`` of a rotation matrix (stacks allowed)."""
+    R = np.asarray(R, dtype=float)
+    return np.linalg.norm(Rotation.from_matrix(R.reshape(-1, 3, 3)).as_rotvec(), axis=-1).reshape(
+        R.shape[:-2]
+    )

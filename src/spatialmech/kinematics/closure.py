@@ -1,0 +1,221 @@
+"""One closure formulation for every mechanism.
+
+A configuration is the vector ``q`` of all joint variables (every freedom of every limb, in
+:attr:`Mechanism.freedom_refs` order; zero at the reference) and the platform displacement
+``D`` (4x4).  Limb ``k`` closes when its product of exponentials equals the platform
+displacement: ``FK_k(q_k) = D``.  The residual of limb ``k`` is the twist
+``log(FK_k D^-1)`` (6,), zero at closure.
+
+Linearisation: ``FK_k(q + dq) ~ exp(J_k dq) FK_k`` with ``J_k`` the limb's *spatial* Jacobian
+(the joint twists at the current configuration, columns), and ``D_new = exp(V) D``; hence the
+closure Jacobian ``[blockdiag(J_k) | -1]`` acting on ``(dq_active, V)``.
+
+Only *active* freedoms (not locked) are unknowns; locked freedoms keep their value.
+Nondimensional forms (moments divided by the characteristic length ``L``; prismatic variables
+divided by ``L``) are used for rank decisions and convergence tests.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..geometry.rotations import exp_twist, inverse_transform, log_transform
+from ..geometry.screws import adjoint
+from ..model.mechanism import Mechanism
+
+__all__ = [
+    "Configuration",
+    "limb_slices",
+    "reference_screws",
+    "limb_forward",
+    "joint_twists",
+    "closure_residual",
+    "closure_jacobian",
+    "active_mask",
+    "correct",
+    "CorrectionResult",
+    "generic_configuration",
+]
+
+
+@dataclass(frozen=True, eq=False)
+class Configuration:
+    """Joint variables ``q`` (all freedoms) and platform displacement ``D`` (4x4)."""
+
+    q: np.ndarray
+    D: np.ndarray
+
+    @classmethod
+    def reference(cls, mech: Mechanism) -> "Configuration":
+        return cls(np.zeros(len(mech.freedom_refs)), np.eye(4))
+
+
+def limb_slices(mech: Mechanism) -> list[slice]:
+    """Slices of ``q`` belonging to each limb."""
+    out, start = [], 0
+    for li in range(len(mech.limbs)):
+        n = sum(1 for r in mech.freedom_refs if r.limb == li)
+        out.append(slice(start, start + n))
+        start += n
+    return out
+
+
+def reference_screws(mech: Mechanism) -> np.ndarray:
+    """Unit twists (n_freedoms, 6) of every freedom at the reference configuration."""
+    return np.array([r.freedom.screw for r in mech.freedom_refs])
+
+
+def active_mask(mech: Mechanism) -> np.ndarray:
+    return np.array([not r.freedom.locked for r in mech.freedom_refs])
+
+
+def limb_forward(screws: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Product of exponentials of one chain and its spatial Jacobian.
+
+    ``screws`` (m, 6) at the reference, ``q`` (m,).  Returns ``T`` (4x4) and ``J`` (6, m):
+    column ``i`` is the twist of freedom ``i`` at the current configuration,
+    ``Ad(exp(S1 q1) ... exp(S_{i-1} q_{i-1})) S_i``.
+    """
+    E = exp_twist(screws, q)  # (m, 4, 4)
+    T = np.eye(4)
+    J = np.empty((6, len(q)))
+    for i in range(len(q)):
+        J[:, i] = adjoint(T) @ screws[i]
+        T = T @ E[i]
+    return T, J
+
+
+def joint_twists(mech: Mechanism, config: Configuration) -> list[np.ndarray]:
+    """Per limb, the (6, m_k) twists of all its freedoms at ``config``."""
+    S = reference_screws(mech)
+    return [limb_forward(S[sl], config.q[sl])[1] for sl in limb_slices(mech)]
+
+
+def closure_residual(mech: Mechanism, config: Configuration) -> np.ndarray:
+    """Stacked limb residuals ``log(FK_k D^-1)`` (6 K,), SI units."""
+    S = reference_screws(mech)
+    Dinv = inverse_transform(config.D)
+    res = []
+    for sl in limb_slices(mech):
+        T, _ = limb_forward(S[sl], config.q[sl])
+        res.append(log_transform(T @ Dinv))
+    return np.concatenate(res)
+
+
+def closure_jacobian(mech: Mechanism, config: Configuration, *, active: np.ndarray | None = None):
+    """The closure Jacobian (6K, n_active + 6) in SI units and the residual (6K,)."""
+    S = reference_screws(mech)
+    if active is None:
+        active = active_mask(mech)
+    sls = limb_slices(mech)
+    K = len(sls)
+    n = len(config.q)
+    A = np.zeros((6 * K, n + 6))
+    Dinv = inverse_transform(config.D)
+    res = []
+    for k, sl in enumerate(sls):
+        T, J = limb_forward(S[sl], config.q[sl])
+        A[6 * k : 6 * k + 6, sl] = J
+        A[6 * k : 6 * k + 6, n:] = -np.eye(6)
+        res.append(log_transform(T @ Dinv))
+    cols = np.concatenate([active, np.ones(6, bool)])
+    return A[:, cols], np.concatenate(res)
+
+
+def _scales(mech: Mechanism, active: np.ndarray):
+    """Row and column scalings that make the closure system nondimensional."""
+    L = mech.characteristic_length
+    K = len(mech.limbs)
+    row = np.tile(np.r_[np.ones(3), np.full(3, 1.0 / L)], K)
+    lin = np.array([r.freedom.is_linear for r in mech.freedom_refs])[active]
+    col = np.r_[np.where(lin, L, 1.0), np.ones(3), np.full(3, L)]
+    return row, col
+
+
+@dataclass(frozen=True)
+class CorrectionResult:
+    config: Configuration
+    converged: bool
+    iterations: int
+    residual: float  # nondimensional norm
+
+
+def _apply_step(mech, config, active, step):
+    q = config.q.copy()
+    na = int(active.sum())
+    q[active] += step[:na]
+    D = exp_twist(step[na:], 1.0) @ config.D
+    return Configuration(q, D)
+
+
+def correct(
+    mech: Mechanism,
+    config: Configuration,
+    *,
+    active: np.ndarray | None = None,
+    tol: float = 1e-12,
+    max_iter: int = 50,
+) -> CorrectionResult:
+    """Gauss-Newton (minimum-norm) correction of ``config`` onto the closure manifold.
+
+    Returns the corrected configuration with ``converged`` and the final nondimensional
+    residual norm; never raises on non-convergence (the caller decides).
+    """
+    if active is None:
+        active = active_mask(mech)
+    row, col = _scales(mech, active)
+    for it in range(max_iter + 1):
+        A, r = closure_jacobian(mech, config, active=active)
+        rn = float(np.linalg.norm(row * r))
+        if rn < tol:
+            return CorrectionResult(config, True, it, rn)
+        if it == max_iter or not np.isfinite(rn):
+            break
+        As = row[:, None] * A * col[None, :]
+        x, *_ = np.linalg.lstsq(As, -(row * r), rcond=None)
+        config = _apply_step(mech, config, active, col * x)
+    return CorrectionResult(config, False, it, rn)
+
+
+def generic_configuration(
+    mech: Mechanism,
+    *,
+    active: np.ndarray | None = None,
+    seed: int = 0,
+    step: float = 0.1,
+    steps: int = 3,
+    start: Configuration | None = None,
+) -> Configuration:
+    """A configuration on the closure manifold near ``start`` (default: the reference),
+    reached by random steps along the manifold's tangent space, each corrected by Newton.
+
+    Random directions avoid the special (often singular) symmetric reference poses of
+    ready-made models.  ``step`` is nondimensional (radians, or lengths / L).  Raises
+    ``RuntimeError`` if a correction does not converge.
+    """
+    rng = np.random.default_rng(seed)
+    if active is None:
+        active = active_mask(mech)
+    config = start if start is not None else Configuration.reference(mech)
+    row, col = _scales(mech, active)
+    for _ in range(steps):
+        A, _ = closure_jacobian(mech, config, active=active)
+        As = row[:, None] * A * col[None, :]
+        _, sv, vt = np.linalg.svd(As)
+        r = int(np.sum(sv > 1e-9 * max(1.0, sv[0])))
+        N = vt[r:]
+        if N.shape[0] == 0:
+            break
+        c = rng.standard_normal(N.shape[0])
+        t = N.T @ c
+        t *= step / max(np.linalg.norm(t), 1e-300)
+        trial = _apply_step(mech, config, active, col * t)
+        res = correct(mech, trial, active=active)
+        if not res.converged:
+            raise RuntimeError(
+                f"generic configuration: Newton correction did not converge (residual {res.residual:.2e})"
+            )
+        config = res.config
+    return config

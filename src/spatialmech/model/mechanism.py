@@ -1,0 +1,251 @@
+"""Limbs, mechanisms, task poses and motion modes.
+
+A mechanism is a fixed base and a moving platform joined by limbs; each limb is a serial chain
+of joints from the base to the platform.  Multi-loop parallel mechanisms are the main case; a
+single-loop linkage is two limbs that meet at a chosen link (the "platform"), e.g. a four-bar
+is ``[input crank R, coupler R]`` + ``[output rocker R, coupler R]`` with the coupler as
+platform, or ``[R, S, S]`` + ``[R]`` for an RSSR with the output rocker as platform.
+
+Everything is described at the reference configuration: every joint variable is zero there
+and the platform frame is at ``platform_point`` with world-aligned axes.  A platform *pose*
+``(R, p)`` is the orientation of the platform frame and the position of its origin; its
+*displacement* from the reference is ``D = [[R, p - R p0], [0, 1]]``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from functools import cached_property
+from itertools import combinations
+from typing import Mapping
+
+import numpy as np
+
+from ..geometry.rotations import euler_matrix, transform
+from ..geometry.validate import as_finite_array
+from .joints import Freedom, Joint
+
+__all__ = ["Pose", "Mode", "Limb", "Mechanism", "FreedomRef"]
+
+
+@dataclass(frozen=True, eq=False)
+class Pose:
+    """A platform pose: orientation ``R`` (3x3) and position ``p`` of the platform frame."""
+
+    R: np.ndarray
+    p: np.ndarray
+    name: str = ""
+
+    def __post_init__(self):
+        R = as_finite_array(self.R, f"pose {self.name!r}.R", shape=(3, 3))
+        if np.max(np.abs(R @ R.T - np.eye(3))) > 1e-6 or np.linalg.det(R) < 0:
+            raise ValueError(f"pose {self.name!r}.R: not a rotation matrix (orthonormal, det +1)")
+        object.__setattr__(self, "R", R)
+        object.__setattr__(self, "p", as_finite_array(self.p, f"pose {self.name!r}.p", shape=(3,)))
+
+    @classmethod
+    def from_euler(cls, seq: str, angles, p, *, degrees: bool = False, name: str = "") -> "Pose":
+        """Pose from Euler angles in an explicitly named sequence (see :mod:`..geometry.rotations`)."""
+        return cls(euler_matrix(seq, angles, degrees=degrees), p, name)
+
+    def displacement(self, reference_point) -> np.ndarray:
+        """The 4x4 displacement of the platform from its reference pose."""
+        p0 = np.asarray(reference_point, dtype=float)
+        return transform(self.R, self.p - self.R @ p0)
+
+    @classmethod
+    def from_displacement(cls, D, reference_point, *, name: str = "") -> "Pose":
+        D = np.asarray(D, dtype=float)
+        return cls(D[:3, :3], D[:3, :3] @ np.asarray(reference_point, float) + D[:3, 3], name)
+
+
+@dataclass(frozen=True, eq=False)
+class Mode:
+    """A motion mode of a metamorphic mechanism: which lockable freedoms are driven.
+
+    Every lockable freedom not listed in ``driven`` is locked (its joint removed and its link
+    merged with the neighbour, for counting purposes).
+    """
+
+    name: str
+    driven: tuple[str, ...]
+    description: str = ""
+
+
+@dataclass(frozen=True, eq=False)
+class Limb:
+    """A serial chain of joints from the base (first) to the platform (last)."""
+
+    name: str
+    joints: tuple[Joint, ...]
+
+    def __post_init__(self):
+        object.__setattr__(self, "joints", tuple(self.joints))
+        if not self.joints:
+            raise ValueError(f"limb {self.name!r}: has no joints")
+
+    @property
+    def dof(self) -> int:
+        return sum(j.dof for j in self.joints)
+
+
+@dataclass(frozen=True)
+class FreedomRef:
+    """Where a freedom sits: its id (``"JOINT.freedom"``), limb, joint and freedom indices."""
+
+    id: str
+    limb: int
+    joint: int
+    index: int  # position within the joint
+    freedom: Freedom = field(compare=False)
+
+
+@dataclass(frozen=True, eq=False)
+class Mechanism:
+    """An immutable, validated description of a mechanism (see the module docstring)."""
+
+    name: str
+    limbs: tuple[Limb, ...]
+    platform_point: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    description: str = ""
+    modes: tuple[Mode, ...] = ()
+    positions: tuple[Pose, ...] = ()
+    aliases: Mapping[str, str] = field(default_factory=dict)
+    length_unit: str = "m"
+    source: str = ""
+    notes: str = ""
+
+    def __post_init__(self):
+        object.__setattr__(self, "limbs", tuple(self.limbs))
+        object.__setattr__(self, "modes", tuple(self.modes))
+        object.__setattr__(self, "positions", tuple(self.positions))
+        object.__setattr__(self, "aliases", dict(self.aliases))
+        object.__setattr__(
+            self, "platform_point", as_finite_array(self.platform_point, "platform_point", shape=(3,))
+        )
+        if not self.limbs:
+            raise ValueError("limbs: a mechanism needs at least one limb")
+        seen_l, seen_j = set(), set()
+        for i, limb in enumerate(self.limbs):
+            if limb.name in seen_l:
+                raise ValueError(f"limbs[{i}].name: duplicate limb name {limb.name!r}")
+            seen_l.add(limb.name)
+            for j, joint in enumerate(limb.joints):
+                if joint.name in seen_j:
+                    raise ValueError(f"limbs[{i}].joints[{j}].name: duplicate joint name {joint.name!r}")
+                seen_j.add(joint.name)
+        for a, target in self.aliases.items():
+            self.freedom(target)  # raises on unknown
+        lockable = {r.id for r in self.freedom_refs if r.freedom.lockable}
+        seen_m = set()
+        for k, mode in enumerate(self.modes):
+            if mode.name in seen_m:
+                raise ValueError(f"modes[{k}].name: duplicate mode name {mode.name!r}")
+            seen_m.add(mode.name)
+            for d in mode.driven:
+                fid = self.freedom(d).id
+                if fid not in lockable:
+                    raise ValueError(f"modes[{k}].driven: {d!r} is not a lockable freedom")
+
+    # ------------------------------------------------------------------ freedoms
+    @cached_property
+    def freedom_refs(self) -> tuple[FreedomRef, ...]:
+        """Every freedom of every joint, in limb/joint/chain order."""
+        out = []
+        for li, limb in enumerate(self.limbs):
+            for ji, joint in enumerate(limb.joints):
+                for fi, f in enumerate(joint.freedoms):
+                    out.append(FreedomRef(f"{joint.name}.{f.name}", li, ji, fi, f))
+        return tuple(out)
+
+    def freedom(self, name: str) -> FreedomRef:
+        """Look a freedom up by id (``"C1.rot"``), alias (``"rot1"``) or, for one-freedom
+        joints, by joint name (``"B1"``)."""
+        key = self.aliases.get(name, name)
+        for r in self.freedom_refs:
+            if r.id == key:
+                return r
+        matches = [r for r in self.freedom_refs if self.limbs[r.limb].joints[r.joint].name == key]
+        if len(matches) == 1:
+            return matches[0]
+        known = sorted(set(self.aliases) | {r.id for r in self.freedom_refs})
+        if len(matches) > 1:
+            raise KeyError(f"{name!r} names a joint with several freedoms: {[m.id for m in matches]}")
+        raise KeyError(f"unknown freedom {name!r}; known: {', '.join(known)}")
+
+    @property
+    def actuators(self) -> tuple[str, ...]:
+        return tuple(r.id for r in self.freedom_refs if r.freedom.actuated and not r.freedom.locked)
+
+    @property
+    def lockable(self) -> tuple[str, ...]:
+        return tuple(r.id for r in self.freedom_refs if r.freedom.lockable)
+
+    @property
+    def is_metamorphic(self) -> bool:
+        return bool(self.lockable)
+
+    @cached_property
+    def characteristic_length(self) -> float:
+        """RMS distance of the joint points from their centroid (1 if they all coincide).
+
+        Used to make screw-rank decisions and convergence tests independent of the length unit.
+        """
+        pts = np.array([j.point for limb in self.limbs for j in limb.joints] + [self.platform_point])
+        L = float(np.sqrt(np.mean(np.sum((pts - pts.mean(axis=0)) ** 2, axis=1))))
+        return L if L > 1e-12 else 1.0
+
+    # ------------------------------------------------------------------ modes
+    def all_modes(self) -> tuple[Mode, ...]:
+        """The declared modes, or every subset of the lockable freedoms when none are declared.
+
+        A mechanism without lockable freedoms has one mode, ``"default"``.
+        """
+        if self.modes:
+            return self.modes
+        lk = self.lockable
+        if not lk:
+            return (Mode("default", ()),)
+        out = []
+        for k in range(len(lk) + 1):
+            for sub in combinations(lk, k):
+                out.append(Mode("+".join(sub) if sub else "all-locked", tuple(sub)))
+        return tuple(out)
+
+    def mode(self, name: str) -> Mode:
+        for m in self.all_modes():
+            if m.name == name:
+                return m
+        raise KeyError(f"unknown mode {name!r}; modes: {', '.join(m.name for m in self.all_modes())}")
+
+    def in_mode(self, mode: Mode | str) -> "Mechanism":
+        """This mechanism with the lockable freedoms not driven in ``mode`` locked and the
+        driven ones actuated."""
+        if isinstance(mode, str):
+            mode = self.mode(mode)
+        driven = {self.freedom(d).id for d in mode.driven}
+        limbs = []
+        for limb in self.limbs:
+            joints = []
+            for joint in limb.joints:
+                for f in joint.freedoms:
+                    if f.lockable:
+                        fid = f"{joint.name}.{f.name}"
+                        on = fid in driven
+                        joint = joint.with_freedom(f.name, locked=not on, actuated=on)
+                joints.append(joint)
+            limbs.append(Limb(limb.name, tuple(joints)))
+        return replace(self, limbs=tuple(limbs), modes=(mode,))
+
+    def with_actuators(self, names) -> "Mechanism":
+        """This mechanism with exactly the named freedoms actuated (e.g. a driver choice)."""
+        ids = {self.freedom(n).id for n in names}
+        limbs = []
+        for limb in self.limbs:
+            joints = []
+            for joint in limb.joints:
+                for f in joint.freedoms:
+                    joint = joint.with_freedom(f.name, actuated=f"{joint.name}.{f.name}" in ids)
+                joints.append(joint)
+            limbs.append(Limb(limb.name, tuple(joints)))
+        return replace(self, limbs=tuple(limbs))
