@@ -263,10 +263,12 @@ def mobility(mech: Mechanism, mode: Mode | str | None = None, *, seed: int = 0) 
 
     notes = []
     if gk != M:
+        parts = [f"{lam} common constraint(s) (d = {d})" if lam else "",
+                 f"{v} redundant constraint(s)" if v else "",
+                 f"{xi} passive freedom(s)" if xi else ""]
         notes.append(
-            f"The classic Grübler-Kutzbach count (d = 6, no corrections) gives {gk}; it ignores "
-            f"the {lam} common constraint(s) (d = {d}), {v} redundant constraint(s) and {xi} "
-            "passive freedom(s) found from the screw systems."
+            f"The classic Grübler-Kutzbach count (d = 6, no corrections) gives {gk}; it ignores the "
+            + ", ".join(p for p in parts if p) + " found from the screw systems."
         )
     if M != dof_inst:
         notes.append(

@@ -7,7 +7,7 @@ from typing import Callable
 from ..model.mechanism import Mechanism
 from . import classic, papers
 
-__all__ = ["names", "describe", "build", "REGISTRY"]
+__all__ = ["names", "describe", "build", "resolve", "REGISTRY"]
 
 #: name -> (builder, one-line description)
 REGISTRY: dict[str, tuple[Callable[[], Mechanism], str]] = {
@@ -42,3 +42,25 @@ def build(name: str) -> Mechanism:
     except KeyError:
         raise KeyError(f"unknown ready-made model {name!r}; known: {', '.join(REGISTRY)}") from None
     return builder()
+
+
+def resolve(spec) -> Mechanism:
+    """A mechanism from a ready-made name, a file path, or a Mechanism (returned as is).
+
+    Raises :class:`~spatialmech.model.schema.ModelFileError` with a one-line message.
+    """
+    from pathlib import Path
+
+    from ..model.schema import ModelFileError, load
+
+    if isinstance(spec, Mechanism):
+        return spec
+    s = str(spec)
+    if s in REGISTRY:
+        return build(s)
+    p = Path(s)
+    if p.exists():
+        return load(p)
+    raise ModelFileError(
+        f"{s}: not a file and not a ready-made model (ready-made: {', '.join(REGISTRY)})"
+    )

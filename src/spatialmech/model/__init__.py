@@ -1,0 +1,10 @@
+"""Mechanism model: joints, limbs, mechanisms, poses, modes, and the TOML file format."""
+
+from .joints import JOINT_TYPES, C, Freedom, H, Joint, P, R, S, Sm, U, make_joint
+from .mechanism import Limb, Mechanism, Mode, Pose
+from .schema import ModelFileError, dump, dumps, load, loads
+
+__all__ = [
+    "JOINT_TYPES", "Freedom", "Joint", "make_joint", "R", "P", "H", "C", "U", "S", "Sm",
+    "Limb", "Mechanism", "Mode", "Pose", "ModelFileError", "load", "loads", "dump", "dumps",
+]

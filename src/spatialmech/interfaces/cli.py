@@ -1,0 +1,175 @@
+"""The ``spatialmech`` command line (click).  Thin: parse, call an analysis, print text or JSON.
+
+User errors (bad files, unknown names, impossible requests) print one line to stderr and exit
+with code 2; nothing here computes.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import click
+import numpy as np
+
+from .. import __version__, catalog
+from ..analysis.mobility import mobility, mobility_modes
+from ..model.schema import ModelFileError, dump
+
+
+class UserError(click.ClickException):
+    """One-line error, exit code 2."""
+
+    exit_code = 2
+
+    def show(self, file=None):
+        click.echo(f"error: {self.format_message()}", err=True, file=file)
+
+
+class _Group(click.Group):
+    """Turns the library's input errors into one-line messages with exit code 2."""
+
+    def invoke(self, ctx):
+        try:
+            return super().invoke(ctx)
+        except (ModelFileError, ValueError, KeyError) as e:
+            msg = e.args[0] if isinstance(e, KeyError) and e.args else str(e)
+            raise UserError(str(msg)) from None
+
+
+def _json_default(o):
+    if isinstance(o, np.ndarray):
+        return o.tolist()
+    if isinstance(o, (np.floating, np.integer, np.bool_)):
+        return o.item()
+    raise TypeError(f"not JSON serialisable: {type(o).__name__}")
+
+
+def emit_json(data) -> None:
+    click.echo(json.dumps(data, indent=2, default=_json_default, allow_nan=False))
+
+
+def _model(spec: str):
+    return catalog.resolve(spec)
+
+
+json_option = click.option("--json", "as_json", is_flag=True, help="Print machine-readable JSON.")
+
+
+@click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(__version__, prog_name="spatialmech")
+def cli():
+    """Kinematic analysis and synthesis of spatial linkages and parallel mechanisms.
+
+    MODEL arguments take a ready-made name (see `spatialmech models`) or a TOML file.
+
+    \b
+    Example:
+      spatialmech mobility four-sps-cu
+    """
+
+
+@cli.command()
+@json_option
+def models(as_json):
+    """List the ready-made models with a one-line description each.
+
+    \b
+    Example:
+      spatialmech models --json
+    """
+    rows = [{"name": n, "description": catalog.describe(n)} for n in catalog.names()]
+    if as_json:
+        emit_json(rows)
+        return
+    w = max(len(r["name"]) for r in rows)
+    for r in rows:
+        click.echo(f"{r['name']:<{w}}  {r['description']}")
+
+
+def _mobility_text(r) -> str:
+    lines = [
+        f"{r.mechanism}  mode {r.mode}" + (f"  (actuators: {', '.join(r.actuators)})" if r.actuators else ""),
+        f"  {r.formula()}",
+        f"  lambda = {r.lam} common constraints, d = {r.d}; t = {r.t}, k = {r.k}, v = t - k = {r.v};"
+        f" xi = {r.xi} passive",
+        f"  classic Grübler-Kutzbach (d = 6): {r.gk_classic}",
+        f"  instantaneous mobility (closure-Jacobian rank, generic configuration): {r.dof_instantaneous}",
+        f"  motion: {r.motion}  ({r.motion_class})",
+    ]
+    if r.constraint_wrenches:
+        lines.append("  platform constraint wrenches (f ; m):")
+        for w in r.constraint_wrenches:
+            lines.append("    (" + " ".join(f"{x:+.4g}" for x in w[:3]) + " ; " + " ".join(f"{x:+.4g}" for x in w[3:]) + ")")
+    lines.append(f"  {r.explanation}")
+    return "\n".join(lines)
+
+
+@cli.command(name="mobility")
+@click.argument("model")
+@click.option("--mode", default=None, help="Motion mode of a metamorphic mechanism (default: all modes).")
+@json_option
+def mobility_cmd(model, mode, as_json):
+    """Mobility by the modified Kutzbach-Grübler formula, checked numerically.
+
+    \b
+    Examples:
+      spatialmech mobility four-sps-cu
+      spatialmech mobility three-rrr-sm --mode R1+R4 --json
+      spatialmech mobility my-mechanism.toml
+    """
+    mech = _model(model)
+    if mode is not None:
+        results = [mobility(mech, mode)]
+        single = True
+    else:
+        results = mobility_modes(mech)
+        single = not mech.is_metamorphic
+    if as_json:
+        emit_json(results[0].to_dict() if single else [r.to_dict() for r in results])
+        return
+    click.echo("\n\n".join(_mobility_text(r) for r in results))
+
+
+@cli.command()
+@click.argument("model")
+@click.argument("file", type=click.Path(dir_okay=False, writable=True, path_type=Path))
+def export(model, file):
+    """Write a model (e.g. a ready-made one) as a TOML file to start your own from.
+
+    \b
+    Example:
+      spatialmech export rssr my-rssr.toml
+    """
+    mech = _model(model)
+    dump(mech, file)
+    click.echo(f"wrote {file}")
+
+
+@cli.command()
+@click.option("--out", "out", default="report", show_default=True, type=click.Path(file_okay=False, path_type=Path),
+              help="Directory for index.html and results.json.")
+@json_option
+def demo(out, as_json):
+    """Reproduce the papers' examples into a report (DIR/index.html, DIR/results.json).
+
+    \b
+    Example:
+      spatialmech demo --out report
+    """
+    from ..present.report import build_demo
+
+    results = build_demo(out, progress=not as_json)
+    if as_json:
+        emit_json(results)
+    else:
+        click.echo(f"report written to {out / 'index.html'} and {out / 'results.json'}")
+
+
+def main(argv=None):  # console-script entry point
+    try:
+        cli.main(args=argv, prog_name="spatialmech", standalone_mode=True)
+    except SystemExit as e:
+        if e.code not in (0, None):
+            sys.exit(e.code)

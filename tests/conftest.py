@@ -1,0 +1,22 @@
+import numpy as np
+import pytest
+from hypothesis import strategies as st
+from scipy.spatial.transform import Rotation
+
+from spatialmech.geometry.rotations import transform
+
+
+@pytest.fixture
+def rng():
+    return np.random.default_rng(12345)
+
+
+finite = st.floats(-10, 10, allow_nan=False, allow_infinity=False)
+vec3 = st.lists(finite, min_size=3, max_size=3).map(np.array)
+screw6 = st.lists(finite, min_size=6, max_size=6).map(np.array)
+seeds = st.integers(0, 2**32 - 1)
+
+
+def random_transform(seed: int) -> np.ndarray:
+    r = np.random.default_rng(seed)
+    return transform(Rotation.random(random_state=seed).as_matrix(), r.uniform(-5, 5, 3))

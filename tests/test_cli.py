@@ -1,0 +1,75 @@
+"""The command line: version, models, mobility JSON keys, errors."""
+
+import json
+
+import pytest
+from click.testing import CliRunner
+
+from spatialmech import __version__
+from spatialmech.interfaces.cli import cli
+
+KEYS = {"dof", "dof_instantaneous", "motion", "lambda", "d", "n", "g", "sum_f", "v", "xi"}
+
+
+def run(*args):
+    return CliRunner().invoke(cli, list(args), catch_exceptions=False)
+
+
+def test_version():
+    r = run("--version")
+    assert r.exit_code == 0 and __version__ in r.output
+
+
+def test_models_json_lists_every_required_model():
+    r = run("models", "--json")
+    names = {m["name"] for m in json.loads(r.output)}
+    assert {"four-sps-cu", "three-rrr-sm", "three-sps-smpu", "five-cs-1", "five-cs-2", "five-cs-3", "stewart-6sps",
+            "three-rps", "three-upu", "delta", "planar-4r", "bennett", "rssr"} <= names
+    assert all(m["description"] for m in json.loads(r.output))
+
+
+def test_mobility_json_single_mode():
+    d = json.loads(run("mobility", "four-sps-cu", "--json").output)
+    assert KEYS <= set(d)
+    assert (d["dof"], d["motion"], d["xi"], d["lambda"]) == (4, "RxRyRzTz", 4, 0)
+
+
+def test_mobility_json_metamorphic_lists_modes():
+    d = json.loads(run("mobility", "three-rrr-sm", "--json").output)
+    assert isinstance(d, list) and len(d) == 7
+    for m in d:
+        assert KEYS | {"mode", "actuators"} <= set(m)
+    one = json.loads(run("mobility", "three-rrr-sm", "--mode", "R4+R7", "--json").output)
+    assert isinstance(one, dict) and one["dof"] == 2 and one["mode"] == "R4+R7"
+
+
+def test_mobility_text_shows_the_breakdown():
+    out = run("mobility", "bennett").output
+    assert "M = d(n - g - 1) + sum f + v - xi = 3(4 - 4 - 1) + 4 + 0 - 0 = 1" in out
+    assert "classic Grübler-Kutzbach (d = 6): -2" in out
+
+
+@pytest.mark.parametrize(
+    "args, msg",
+    [(["mobility", "no-such-model"], "not a file and not a ready-made model"),
+     (["mobility", "three-rrr-sm", "--mode", "X"], "unknown mode 'X'")],
+)
+def test_user_errors_exit_2_with_one_line(args, msg):
+    r = CliRunner().invoke(cli, args)
+    assert r.exit_code == 2
+    assert msg in r.output and r.output.count("\n") == 1
+
+
+def test_export_then_mobility_of_the_file(tmp_path):
+    f = tmp_path / "b.toml"
+    assert run("export", "bennett", str(f)).exit_code == 0
+    d = json.loads(run("mobility", str(f), "--json").output)
+    assert d["dof"] == 1 and d["gk_classic"] == -2
+
+
+def test_demo_writes_report(tmp_path):
+    r = run("demo", "--out", str(tmp_path / "rep"), "--json")
+    assert r.exit_code == 0
+    data = json.loads((tmp_path / "rep" / "results.json").read_text())
+    assert all(c["reproduced"] for c in data["claims"])
+    assert (tmp_path / "rep" / "index.html").read_text().startswith("<!doctype html>")

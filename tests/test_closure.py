@@ -1,0 +1,66 @@
+"""The closure engine: POE Jacobians against finite differences, Newton onto the manifold."""
+
+import numpy as np
+import pytest
+
+from spatialmech import catalog
+from spatialmech.geometry.rotations import exp_twist, inverse_transform, log_transform
+from spatialmech.kinematics.closure import (
+    Configuration,
+    closure_residual,
+    correct,
+    generic_configuration,
+    limb_forward,
+    limb_slices,
+    reference_screws,
+)
+
+
+@pytest.mark.parametrize("name", ["stewart-6sps", "five-cs-1", "bennett", "three-upu"])
+def test_spatial_jacobian_matches_finite_differences(name, rng):
+    mech = catalog.build(name)
+    S = reference_screws(mech)
+    for sl in limb_slices(mech):
+        q = rng.uniform(-0.5, 0.5, sl.stop - sl.start)
+        T, J = limb_forward(S[sl], q)
+        h = 1e-6
+        for i in range(len(q)):
+            dq = np.zeros_like(q); dq[i] = h
+            Tp, _ = limb_forward(S[sl], q + dq)
+            Tm, _ = limb_forward(S[sl], q - dq)
+            # spatial twist: dT T^-1
+            V = (log_transform(Tp @ inverse_transform(T)) - log_transform(Tm @ inverse_transform(T))) / (2 * h)
+            assert np.allclose(V, J[:, i], atol=1e-6)
+
+
+def test_reference_configuration_is_closed():
+    for name in catalog.names():
+        mech = catalog.build(name)
+        assert np.allclose(closure_residual(mech, Configuration.reference(mech)), 0, atol=1e-12), name
+
+
+@pytest.mark.parametrize("name", ["four-sps-cu", "five-cs-2", "rssr", "planar-4r", "three-rrr-sm"])
+def test_generic_configuration_is_on_the_manifold_and_away_from_reference(name):
+    mech = catalog.build(name)
+    if mech.is_metamorphic:
+        mech = mech.in_mode(mech.all_modes()[-1])
+    c = generic_configuration(mech, seed=3)
+    assert np.linalg.norm(closure_residual(mech, c)) < 1e-10 * max(1.0, mech.characteristic_length)
+    assert np.linalg.norm(c.q) > 1e-3
+
+
+def test_newton_correction_converges_quadratically_from_a_perturbation():
+    mech = catalog.build("stewart-6sps")
+    c0 = generic_configuration(mech, seed=1)
+    bumped = Configuration(c0.q + 0.01, exp_twist(np.array([0, 0, 1, 0.01, 0, 0]), 0.01) @ c0.D)
+    res = correct(mech, bumped)
+    assert res.converged and res.iterations <= 6
+    assert res.residual < 1e-12
+
+
+def test_newton_reports_non_convergence_instead_of_raising():
+    mech = catalog.build("planar-4r")
+    # with every joint held, a crank angle that the rocker cannot follow has no closure
+    q = np.zeros(len(mech.freedom_refs)); q[0] = 0.3
+    res = correct(mech, Configuration(q, np.eye(4)), active=np.zeros(len(q), bool), max_iter=20)
+    assert not res.converged and res.residual > 1e-3
