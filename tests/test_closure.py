@@ -64,3 +64,29 @@ def test_newton_reports_non_convergence_instead_of_raising():
     q = np.zeros(len(mech.freedom_refs)); q[0] = 0.3
     res = correct(mech, Configuration(q, np.eye(4)), active=np.zeros(len(q), bool), max_iter=20)
     assert not res.converged and res.residual > 1e-3
+
+
+def test_inverse_position_with_the_platform_held():
+    mech = catalog.build("stewart-6sps")
+    target = generic_configuration(mech, seed=5)
+    res = correct(mech, Configuration(np.zeros(len(target.q)), target.D), fix_platform=True)
+    assert res.converged
+    assert np.allclose(res.config.D, target.D)
+    # leg lengths (slides) agree with the target's
+    from spatialmech.kinematics.closure import joint_points
+    pa = joint_points(mech, res.config)
+    pb = joint_points(mech, target)
+    for a, b in zip(pa, pb):
+        assert np.allclose(a, b, atol=1e-9)
+
+
+def test_joint_points_follow_the_platform():
+    mech = catalog.build("four-sps-cu")
+    c = generic_configuration(mech, seed=2)
+    from spatialmech.kinematics.closure import joint_points
+    pts = joint_points(mech, c)
+    # each leg's last joint (S on the platform) is the displaced reference point
+    for limb, p in zip(mech.limbs[:4], pts[:4]):
+        A0 = limb.joints[-1].point
+        assert np.allclose(p[-1], c.D[:3, :3] @ A0 + c.D[:3, 3], atol=1e-10)
+        assert np.allclose(p[0], limb.joints[0].point)  # base joints stay put

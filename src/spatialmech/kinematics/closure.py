@@ -37,6 +37,7 @@ __all__ = [
     "correct",
     "CorrectionResult",
     "generic_configuration",
+    "joint_points",
 ]
 
 
@@ -142,11 +143,11 @@ class CorrectionResult:
     residual: float  # nondimensional norm
 
 
-def _apply_step(mech, config, active, step):
+def _apply_step(mech, config, active, step, fix_platform=False):
     q = config.q.copy()
     na = int(active.sum())
     q[active] += step[:na]
-    D = exp_twist(step[na:], 1.0) @ config.D
+    D = config.D if fix_platform else exp_twist(step[na:], 1.0) @ config.D
     return Configuration(q, D)
 
 
@@ -155,17 +156,22 @@ def correct(
     config: Configuration,
     *,
     active: np.ndarray | None = None,
+    fix_platform: bool = False,
     tol: float = 1e-12,
     max_iter: int = 50,
 ) -> CorrectionResult:
     """Gauss-Newton (minimum-norm) correction of ``config`` onto the closure manifold.
 
-    Returns the corrected configuration with ``converged`` and the final nondimensional
-    residual norm; never raises on non-convergence (the caller decides).
+    ``active`` selects the joint variables that may move (default: every unlocked freedom;
+    pass a mask without the actuators for forward position).  ``fix_platform`` holds the
+    platform displacement (inverse position).  Returns the corrected configuration with
+    ``converged`` and the final nondimensional residual norm; never raises on
+    non-convergence (the caller decides).
     """
     if active is None:
         active = active_mask(mech)
     row, col = _scales(mech, active)
+    ncols = int(active.sum()) + (0 if fix_platform else 6)
     for it in range(max_iter + 1):
         A, r = closure_jacobian(mech, config, active=active)
         rn = float(np.linalg.norm(row * r))
@@ -173,10 +179,36 @@ def correct(
             return CorrectionResult(config, True, it, rn)
         if it == max_iter or not np.isfinite(rn):
             break
-        As = row[:, None] * A * col[None, :]
+        As = (row[:, None] * A * col[None, :])[:, :ncols]
         x, *_ = np.linalg.lstsq(As, -(row * r), rcond=None)
-        config = _apply_step(mech, config, active, col * x)
+        step = col[:ncols] * x
+        config = _apply_step(mech, config, active, np.r_[step, np.zeros(6)] if fix_platform else step, fix_platform)
     return CorrectionResult(config, False, it, rn)
+
+
+def joint_points(mech: Mechanism, config: Configuration) -> list[np.ndarray]:
+    """Per limb, the (n_joints, 3) positions of its joint points at ``config``.
+
+    A joint's point moves with the link before it: it is displaced by the product of
+    exponentials of every freedom that precedes the joint in its limb.  Together with the
+    platform point ``D p0`` this is what a drawing of the mechanism needs.
+    """
+    S = reference_screws(mech)
+    out = []
+    for li, sl in enumerate(limb_slices(mech)):
+        refs = [r for r in mech.freedom_refs if r.limb == li]
+        E = exp_twist(S[sl], config.q[sl])
+        T = np.eye(4)
+        pts = []
+        seen = set()
+        for k, r in enumerate(refs):
+            if r.joint not in seen:
+                seen.add(r.joint)
+                p = mech.limbs[li].joints[r.joint].point
+                pts.append(T[:3, :3] @ p + T[:3, 3])
+            T = T @ E[k]
+        out.append(np.array(pts))
+    return out
 
 
 def generic_configuration(
