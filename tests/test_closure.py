@@ -90,3 +90,34 @@ def test_joint_points_follow_the_platform():
         A0 = limb.joints[-1].point
         assert np.allclose(p[-1], c.D[:3, :3] @ A0 + c.D[:3, 3], atol=1e-10)
         assert np.allclose(p[0], limb.joints[0].point)  # base joints stay put
+
+
+@pytest.mark.parametrize("name", ["stewart-6sps", "five-cs-3", "rssr"])
+def test_chain_jacobian_with_ball_joints_matches_finite_differences(name, rng):
+    from spatialmech.kinematics.closure import chain_forward, limb_chains
+    mech = catalog.build(name)
+    for ch in limb_chains(mech):
+        q = rng.uniform(-1.2, 1.2, len(ch.screws))
+        T, J = chain_forward(ch, q)
+        h = 1e-6
+        for i in range(len(q)):
+            dq = np.zeros_like(q); dq[i] = h
+            Tp, _ = chain_forward(ch, q + dq)
+            Tm, _ = chain_forward(ch, q - dq)
+            V = (log_transform(Tp @ inverse_transform(T)) - log_transform(Tm @ inverse_transform(T))) / (2 * h)
+            assert np.allclose(V, J[:, i], atol=1e-6)
+
+
+def test_ball_joint_has_no_gimbal_lock_at_ninety_degrees():
+    from spatialmech.geometry.screws import rank
+    from spatialmech.kinematics.closure import chain_forward, limb_chains, recentre_balls
+    mech = catalog.build("rssr")
+    ch = limb_chains(mech)[0]  # R, S, S
+    q = np.zeros(len(ch.screws)); q[2] = np.pi / 2  # S about its y axis by 90 degrees
+    _, J = chain_forward(ch, q)
+    assert rank(J[:, 1:4].T) == 3
+    # re-centring a rotation vector beyond pi keeps the displacement
+    q2 = np.zeros(len(mech.freedom_refs)); q2[1:4] = [2.5, -2.0, 1.0]
+    q3 = recentre_balls(mech, q2)
+    assert np.linalg.norm(q3[1:4]) < np.pi
+    assert np.allclose(chain_forward(ch, q2[:7])[0], chain_forward(ch, q3[:7])[0])

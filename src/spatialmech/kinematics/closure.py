@@ -21,7 +21,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..geometry.rotations import exp_twist, inverse_transform, log_transform
+from scipy.spatial.transform import Rotation
+
+from ..geometry.rotations import exp_twist, inverse_transform, log_transform, skew, transform
 from ..geometry.screws import adjoint
 from ..model.mechanism import Mechanism
 
@@ -30,6 +32,10 @@ __all__ = [
     "limb_slices",
     "reference_screws",
     "limb_forward",
+    "Chain",
+    "limb_chains",
+    "chain_forward",
+    "recentre_balls",
     "joint_twists",
     "closure_residual",
     "closure_jacobian",
@@ -73,7 +79,7 @@ def active_mask(mech: Mechanism) -> np.ndarray:
 
 
 def limb_forward(screws: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Product of exponentials of one chain and its spatial Jacobian.
+    """Product of exponentials of a chain of one-freedom screws and its spatial Jacobian.
 
     ``screws`` (m, 6) at the reference, ``q`` (m,).  Returns ``T`` (4x4) and ``J`` (6, m):
     column ``i`` is the twist of freedom ``i`` at the current configuration,
@@ -88,26 +94,110 @@ def limb_forward(screws: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndar
     return T, J
 
 
+@dataclass(frozen=True, eq=False)
+class Chain:
+    """One limb as a chain: its freedoms' reference screws and its ball (S) joints.
+
+    An ``S`` joint's three variables are the components, on its three axes, of a rotation
+    vector about its centre (exponential coordinates): singular only at a rotation of 2 pi
+    (and re-centred beyond pi), unlike three serial rotations (gimbal lock at 90 degrees).
+    ``Sm`` joints stay three serial, individually lockable rotations (paper C's model).
+    """
+
+    screws: np.ndarray
+    balls: tuple[tuple[int, np.ndarray, np.ndarray], ...]  # (first index, centre, axes as columns)
+
+
+def limb_chains(mech: Mechanism) -> list[Chain]:
+    """The :class:`Chain` of every limb, in limb order."""
+    S = reference_screws(mech)
+    out = []
+    for li, sl in enumerate(limb_slices(mech)):
+        balls = []
+        k = 0
+        for joint in mech.limbs[li].joints:
+            if joint.type == "S":
+                balls.append((k, joint.point, np.array([f.direction for f in joint.freedoms]).T))
+            k += len(joint.freedoms)
+        out.append(Chain(S[sl], tuple(balls)))
+    return out
+
+
+def _left_jacobian_so3(phi: np.ndarray) -> np.ndarray:
+    th = float(np.linalg.norm(phi))
+    W = skew(phi)
+    if th < 1e-6:
+        return np.eye(3) + 0.5 * W + (W @ W) / 6.0
+    return np.eye(3) + (1 - np.cos(th)) / th**2 * W + (th - np.sin(th)) / th**3 * (W @ W)
+
+
+def chain_forward(chain: Chain, q: np.ndarray, *, prefixes: bool = False):
+    """Forward kinematics of a :class:`Chain`: ``T`` (4x4) and spatial Jacobian ``J`` (6, m).
+
+    With ``prefixes=True`` also returns the displacement applied to each freedom's body
+    *before* it moves (used to place joint points).
+    """
+    m = len(q)
+    J = np.empty((6, m))
+    T = np.eye(4)
+    pre = np.empty((m, 4, 4)) if prefixes else None
+    ball_at = {b[0]: b for b in chain.balls}
+    i = 0
+    while i < m:
+        if i in ball_at:
+            _, c, A = ball_at[i]
+            phi = A @ q[i : i + 3]
+            Rb = Rotation.from_rotvec(phi).as_matrix()
+            W = _left_jacobian_so3(phi) @ A  # spatial angular velocity per unit rate, columns
+            Ad = adjoint(T)
+            for j in range(3):
+                J[:, i + j] = Ad @ np.r_[W[:, j], np.cross(c, W[:, j])]
+                if prefixes:
+                    pre[i + j] = T
+            T = T @ transform(Rb, c - Rb @ c)
+            i += 3
+        else:
+            J[:, i] = adjoint(T) @ chain.screws[i]
+            if prefixes:
+                pre[i] = T
+            T = T @ exp_twist(chain.screws[i], q[i])
+            i += 1
+    return (T, J, pre) if prefixes else (T, J)
+
+
+def recentre_balls(mech: Mechanism, q: np.ndarray) -> np.ndarray:
+    """Replace every S joint's rotation vector longer than pi by the equivalent shorter one."""
+    q = q.copy()
+    start = 0
+    for ch in limb_chains(mech):
+        for k, _, A in ch.balls:
+            sl = slice(start + k, start + k + 3)
+            phi = A @ q[sl]
+            th = np.linalg.norm(phi)
+            if th > np.pi:
+                phi = phi * (1 - 2 * np.pi / th)
+                q[sl] = A.T @ phi
+        start += len(ch.screws)
+    return q
+
+
 def joint_twists(mech: Mechanism, config: Configuration) -> list[np.ndarray]:
     """Per limb, the (6, m_k) twists of all its freedoms at ``config``."""
-    S = reference_screws(mech)
-    return [limb_forward(S[sl], config.q[sl])[1] for sl in limb_slices(mech)]
+    return [chain_forward(ch, config.q[sl])[1] for ch, sl in zip(limb_chains(mech), limb_slices(mech))]
 
 
 def closure_residual(mech: Mechanism, config: Configuration) -> np.ndarray:
     """Stacked limb residuals ``log(FK_k D^-1)`` (6 K,), SI units."""
-    S = reference_screws(mech)
     Dinv = inverse_transform(config.D)
     res = []
-    for sl in limb_slices(mech):
-        T, _ = limb_forward(S[sl], config.q[sl])
+    for ch, sl in zip(limb_chains(mech), limb_slices(mech)):
+        T, _ = chain_forward(ch, config.q[sl])
         res.append(log_transform(T @ Dinv))
     return np.concatenate(res)
 
 
 def closure_jacobian(mech: Mechanism, config: Configuration, *, active: np.ndarray | None = None):
     """The closure Jacobian (6K, n_active + 6) in SI units and the residual (6K,)."""
-    S = reference_screws(mech)
     if active is None:
         active = active_mask(mech)
     sls = limb_slices(mech)
@@ -116,8 +206,8 @@ def closure_jacobian(mech: Mechanism, config: Configuration, *, active: np.ndarr
     A = np.zeros((6 * K, n + 6))
     Dinv = inverse_transform(config.D)
     res = []
-    for k, sl in enumerate(sls):
-        T, J = limb_forward(S[sl], config.q[sl])
+    for k, (ch, sl) in enumerate(zip(limb_chains(mech), sls)):
+        T, J = chain_forward(ch, config.q[sl])
         A[6 * k : 6 * k + 6, sl] = J
         A[6 * k : 6 * k + 6, n:] = -np.eye(6)
         res.append(log_transform(T @ Dinv))
@@ -148,7 +238,7 @@ def _apply_step(mech, config, active, step, fix_platform=False):
     na = int(active.sum())
     q[active] += step[:na]
     D = config.D if fix_platform else exp_twist(step[na:], 1.0) @ config.D
-    return Configuration(q, D)
+    return Configuration(recentre_balls(mech, q), D)
 
 
 def correct(
@@ -189,24 +279,21 @@ def correct(
 def joint_points(mech: Mechanism, config: Configuration) -> list[np.ndarray]:
     """Per limb, the (n_joints, 3) positions of its joint points at ``config``.
 
-    A joint's point moves with the link before it: it is displaced by the product of
-    exponentials of every freedom that precedes the joint in its limb.  Together with the
-    platform point ``D p0`` this is what a drawing of the mechanism needs.
+    A joint's point moves with the link before it: it is displaced by every freedom that
+    precedes the joint in its limb.  Together with the platform point ``D p0`` this is what a
+    drawing of the mechanism needs.
     """
-    S = reference_screws(mech)
     out = []
-    for li, sl in enumerate(limb_slices(mech)):
+    for li, (ch, sl) in enumerate(zip(limb_chains(mech), limb_slices(mech))):
+        _, _, pre = chain_forward(ch, config.q[sl], prefixes=True)
         refs = [r for r in mech.freedom_refs if r.limb == li]
-        E = exp_twist(S[sl], config.q[sl])
-        T = np.eye(4)
         pts = []
         seen = set()
         for k, r in enumerate(refs):
             if r.joint not in seen:
                 seen.add(r.joint)
                 p = mech.limbs[li].joints[r.joint].point
-                pts.append(T[:3, :3] @ p + T[:3, 3])
-            T = T @ E[k]
+                pts.append(pre[k, :3, :3] @ p + pre[k, :3, 3])
         out.append(np.array(pts))
     return out
 
