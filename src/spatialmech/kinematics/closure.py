@@ -231,6 +231,7 @@ class CorrectionResult:
     converged: bool
     iterations: int
     residual: float  # nondimensional norm
+    stationary: bool = False  # steps vanished without closure: a least-squares minimum
 
 
 def _apply_step(mech, config, active, step, fix_platform=False):
@@ -271,6 +272,8 @@ def correct(
             break
         As = (row[:, None] * A * col[None, :])[:, :ncols]
         x, *_ = np.linalg.lstsq(As, -(row * r), rcond=None)
+        if np.linalg.norm(x) < 1e-13 * max(1.0, rn):
+            return CorrectionResult(config, False, it, rn, stationary=True)
         step = col[:ncols] * x
         config = _apply_step(mech, config, active, np.r_[step, np.zeros(6)] if fix_platform else step, fix_platform)
     return CorrectionResult(config, False, it, rn)

@@ -1,0 +1,239 @@
+"""The complete Jacobian (Joshi & Tsai 2002; paper A section 2) for any choice of actuators.
+
+Rows are wrenches acting on the platform twist ``$p = (omega ; v)``:
+
+- *constraint rows*: a basis of each limb's constraint-wrench system (the screws reciprocal to
+  all of the limb's joint twists); ``W $p = 0``;
+- *actuation rows*: for an actuated freedom ``a`` of limb ``k``, a wrench reciprocal to every
+  other twist of limb ``k`` and not in the limb's constraint system, divided by its reciprocal
+  product with ``$a`` (paper A eqs 13, 19), so that ``W_a $p = qdot_a``.
+
+Stored as ``matrix = W DELTA`` (each wrench with its halves swapped), so that the plain matrix
+product gives the reciprocal products: ``J $p = (0, ..., 0, qdot_actuators)``; the wrenches
+themselves are :attr:`CompleteJacobian.wrenches`.  With as many rows as platform freedoms plus
+constraints (6 for a mechanism whose actuators control it fully), ``DJ = det J``.
+
+Signs.  For a limb with exactly five joint twists the constraint wrench is the cofactor
+reciprocal (paper A eq 8), a polynomial in the twists: its sign is continuous along a path,
+so the sign of ``DJ`` is comparable between configurations of the same mechanism and driver
+(its magnitude is not).  Limbs with two or more constraint wrenches get a deterministic
+basis, or one aligned with a ``reference`` Jacobian (projection of the reference rows onto
+the current system) when following a path.  The actuation rows are unique up to constraint
+components (which do not change the determinant) once divided by ``W . $a``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..geometry import screws as sc
+from ..model.mechanism import Mechanism
+from .closure import Configuration, joint_twists, limb_slices
+
+__all__ = ["CompleteJacobian", "complete_jacobian", "limb_constraint_wrenches", "actuation_wrench"]
+
+
+@dataclass(frozen=True, eq=False)
+class CompleteJacobian:
+    """The complete Jacobian at one configuration."""
+
+    matrix: np.ndarray  # (rows, 6): W DELTA, so that matrix @ twist = (0.., qdot)
+    constraint_rows: int
+    constraint_limbs: tuple[int, ...]  # limb index of each constraint row
+    actuators: tuple[str, ...]
+    inverse_singular: tuple[str, ...]  # actuators whose actuation wrench does not exist here
+    length_scale: float
+
+    @property
+    def wrenches(self) -> np.ndarray:
+        """The constraint then actuation wrenches ``(f ; m)``, one per row."""
+        return sc.swap(self.matrix)
+
+    @property
+    def actuation(self) -> np.ndarray:
+        return self.matrix[self.constraint_rows :]
+
+    @property
+    def constraints(self) -> np.ndarray:
+        return self.matrix[: self.constraint_rows]
+
+    @property
+    def is_square(self) -> bool:
+        return self.matrix.shape[0] == 6
+
+    @property
+    def det(self) -> float | None:
+        """``det J`` (paper A's DJ) when square; only its sign is comparable between configurations."""
+        return float(np.linalg.det(self.matrix)) if self.is_square else None
+
+    def singular_values(self) -> np.ndarray:
+        """Singular values of the nondimensional, row-normalised Jacobian (scale-free)."""
+        M = sc.nondimensional(self.wrenches, self.length_scale)  # wrench moments / L
+        n = np.linalg.norm(M, axis=1, keepdims=True)
+        M = M / np.where(n > 0, n, 1.0)
+        return np.linalg.svd(M, compute_uv=False)
+
+    @property
+    def sigma_min(self) -> float:
+        """Smallest singular value of the scale-free Jacobian: 0 at a singularity."""
+        sv = self.singular_values()
+        return float(sv[-1]) if self.matrix.shape[0] >= 6 else 0.0
+
+    @property
+    def condition(self) -> float:
+        """Inverse condition number (sigma_min / sigma_max) of the scale-free Jacobian, in [0, 1]."""
+        sv = self.singular_values()
+        return float(sv[-1] / sv[0]) if sv.size and sv[0] > 0 and self.matrix.shape[0] >= 6 else 0.0
+
+    def to_dict(self) -> dict:
+        return {
+            "matrix": self.matrix.tolist(),
+            "wrenches": self.wrenches.tolist(),
+            "constraint_rows": self.constraint_rows,
+            "constraint_limbs": list(self.constraint_limbs),
+            "actuators": list(self.actuators),
+            "inverse_singular": list(self.inverse_singular),
+            "det": self.det,
+            "sigma_min": self.sigma_min,
+            "condition": self.condition,
+        }
+
+
+def _nd(W: np.ndarray, L: float) -> np.ndarray:
+    """Wrench to nondimensional coordinates: force part as is, moment divided by L."""
+    return sc.nondimensional(W, L)
+
+
+def _from_nd(W: np.ndarray, L: float) -> np.ndarray:
+    out = np.array(W, dtype=float, copy=True)
+    out[..., 3:] *= L
+    return out
+
+
+def limb_constraint_wrenches(twists: np.ndarray, *, length_scale: float = 1.0, reference: np.ndarray | None = None) -> np.ndarray:
+    """Constraint wrenches (c, 6) of a limb with joint twists ``twists`` (m, 6).
+
+    Five twists: the sign-continuous cofactor reciprocal.  Otherwise a basis of the reciprocal
+    system, aligned with ``reference`` (c, 6) when given (projection onto the current system),
+    else in reduced row-echelon form (deterministic).
+    """
+    T = np.atleast_2d(np.asarray(twists, dtype=float))
+    L = float(length_scale)
+    if T.shape[0] == 5:
+        w = sc.cofactor_reciprocal(sc.nondimensional(T, L))  # in nd wrench coordinates
+        if np.linalg.norm(w) > 1e-12:
+            return _from_nd(w[None, :] / np.linalg.norm(w), L)
+    W = sc.reciprocal_basis(T, length_scale=L)
+    if W.shape[0] == 0:
+        return W
+    Wn = _nd(W, L)
+    Q, _ = np.linalg.qr(Wn.T)  # orthonormal basis of the system (columns), nd
+    if reference is not None and reference.shape == W.shape:
+        P = _nd(reference, L) @ Q @ Q.T
+        if np.linalg.matrix_rank(P, tol=1e-9) == W.shape[0]:
+            return _from_nd(P, L)
+    # deterministic: reduced row echelon form of the nd basis
+    A = Q.T.copy()
+    r = 0
+    for c in range(6):
+        if r == A.shape[0]:
+            break
+        piv = r + int(np.argmax(np.abs(A[r:, c])))
+        if abs(A[piv, c]) < 1e-9:
+            continue
+        A[[r, piv]] = A[[piv, r]]
+        A[r] /= A[r, c]
+        for i in range(A.shape[0]):
+            if i != r:
+                A[i] -= A[i, c] * A[r]
+        r += 1
+    return _from_nd(A, L)
+
+
+def actuation_wrench(twists: np.ndarray, index: int, constraints: np.ndarray, *, length_scale: float = 1.0):
+    """Actuation wrench of freedom ``index`` of a limb, normalised so that ``W . $a = 1``.
+
+    Returns ``None`` when it does not exist (the actuated twist depends on the others: an
+    inverse, or serial, singularity).
+    """
+    T = np.atleast_2d(np.asarray(twists, dtype=float))
+    L = float(length_scale)
+    others = np.delete(T, index, axis=0)
+    R = sc.reciprocal_basis(others, length_scale=L) if others.shape[0] else np.eye(6)
+    Rn = _nd(R, L)
+    if constraints.shape[0]:
+        Cn = _nd(constraints, L)
+        Qc, _ = np.linalg.qr(Cn.T)
+        Rn = Rn - (Rn @ Qc) @ Qc.T
+    if Rn.shape[0] == 0:
+        return None
+    u, s, vt = np.linalg.svd(Rn)
+    if s[0] < 1e-9:
+        return None
+    w = _from_nd(vt[0], L)
+    prod = sc.reciprocal_product(w, T[index])
+    scale = np.linalg.norm(_nd(w, L)) * np.linalg.norm(sc.nondimensional(T[index], L))
+    if abs(prod) < 1e-9 * max(scale, 1e-300):
+        return None
+    return w / prod
+
+
+def complete_jacobian(
+    mech: Mechanism,
+    config: Configuration,
+    actuators=None,
+    *,
+    reference: CompleteJacobian | None = None,
+) -> CompleteJacobian:
+    """The complete Jacobian of ``mech`` at ``config`` with the given actuators.
+
+    ``actuators``: freedom names or aliases (default: the mechanism's actuated freedoms).
+    ``reference``: a Jacobian at a nearby configuration of the same mechanism and actuators,
+    to keep multi-wrench constraint bases continuous along a path.
+    """
+    if actuators is None:
+        act_ids = list(mech.actuators)
+    else:
+        if isinstance(actuators, str):
+            actuators = [actuators]
+        act_ids = [mech.freedom(a).id for a in actuators]
+    if len(set(act_ids)) != len(act_ids):
+        raise ValueError(f"actuators: repeated freedom in {list(actuators)}")
+    L = mech.characteristic_length
+    twists = joint_twists(mech, config)
+    refs = mech.freedom_refs
+    by_id = {r.id: r for r in refs}
+    sls = limb_slices(mech)
+    rows, limbs_of_rows = [], []
+    per_limb_constraints = []
+    ref_rows = {}
+    if reference is not None:
+        for k in set(reference.constraint_limbs):
+            ref_rows[k] = reference.constraints[[i for i, kk in enumerate(reference.constraint_limbs) if kk == k]]
+    active_idx = []
+    for k, sl in enumerate(sls):
+        idx = [i for i in range(sl.start, sl.stop) if not refs[i].freedom.locked]
+        active_idx.append(idx)
+        T = twists[k][:, [i - sl.start for i in idx]].T
+        W = limb_constraint_wrenches(T, length_scale=L, reference=ref_rows.get(k))
+        per_limb_constraints.append((T, W))
+        for w in W:
+            rows.append(w)
+            limbs_of_rows.append(k)
+    n_c = len(rows)
+    singular = []
+    for a in act_ids:
+        r = by_id[a]
+        if r.freedom.locked:
+            raise ValueError(f"actuators: {a} is locked in this mode")
+        T, W = per_limb_constraints[r.limb]
+        col = active_idx[r.limb].index(refs.index(r))
+        w = actuation_wrench(T, col, W, length_scale=L)
+        if w is None:
+            singular.append(a)
+            w = np.zeros(6)
+        rows.append(w)
+    M = sc.swap(np.array(rows)) if rows else np.zeros((0, 6))
+    return CompleteJacobian(M, n_c, tuple(limbs_of_rows), tuple(act_ids), tuple(singular), L)

@@ -1,0 +1,386 @@
+"""Position analysis on the general closure engine: inverse, forward, and poses onto the manifold.
+
+- :func:`inverse_position`: platform pose -> every limb's joint values; all real solutions
+  (multi-start Gauss-Newton per limb, deduplicated by the limb's joint geometry), with joint
+  limits checked and positive-dimensional (passive) solution sets reported.
+- :func:`forward_position`: actuator values -> platform pose from a seed with a convergence
+  status; ``all_solutions=True`` searches many seeds (random walks along the closure manifold)
+  and deduplicates, and says how it searched.
+- :func:`configuration_at_pose`: the closed configuration nearest to a given (possibly
+  inexact, e.g. printed and rounded) platform pose, with the pose error it implies.
+
+Actuator values are physical values (``offset + q``: a leg length, an angle in radians).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..geometry.rotations import inverse_transform, log_transform, rotation_angle
+from ..model.mechanism import Mechanism, Pose
+from .closure import (
+    Configuration,
+    active_mask,
+    chain_forward,
+    correct,
+    generic_configuration,
+    joint_points,
+    limb_chains,
+    limb_slices,
+    recentre_balls,
+)
+
+__all__ = [
+    "PoseFit",
+    "configuration_at_pose",
+    "LimbSolutions",
+    "InverseResult",
+    "inverse_position",
+    "ForwardSolution",
+    "ForwardResult",
+    "forward_position",
+    "freedom_values",
+    "within_limits",
+    "platform_pose",
+]
+
+
+def platform_pose(mech: Mechanism, config: Configuration, name: str = "") -> Pose:
+    """The platform pose ``(R, p)`` of a configuration."""
+    return Pose.from_displacement(config.D, mech.platform_point, name=name)
+
+
+def freedom_values(mech: Mechanism, q) -> np.ndarray:
+    """Physical values ``offset + q`` of every freedom (m or rad)."""
+    return np.array([r.freedom.offset for r in mech.freedom_refs]) + np.asarray(q, dtype=float)
+
+
+def _in_range(value: float, lim, rotational: bool) -> bool:
+    lo, hi = lim
+    if lo <= value <= hi:
+        return True
+    if rotational:  # an angle also stands for its 2 pi equivalents
+        k = np.round((0.5 * (lo + hi) - value) / (2 * np.pi))
+        return lo <= value + 2 * np.pi * k <= hi
+    return False
+
+
+def within_limits(mech: Mechanism, q, indices=None) -> list[str]:
+    """Ids of the freedoms (among ``indices``) whose value violates its limits."""
+    vals = freedom_values(mech, q)
+    bad = []
+    for i, r in enumerate(mech.freedom_refs):
+        if indices is not None and i not in indices:
+            continue
+        f = r.freedom
+        if f.limits is not None and not _in_range(vals[i], f.limits, f.kind != "P"):
+            bad.append(r.id)
+    return bad
+
+
+# ------------------------------------------------------------------------------ pose fit
+@dataclass(frozen=True, eq=False)
+class PoseFit:
+    """A closed configuration fitted to a requested pose."""
+
+    config: Configuration
+    converged: bool
+    exact: bool  # the requested pose itself closes (within tolerance)
+    position_error: float  # platform point distance, length unit
+    angle_error: float  # rad
+    ik_residual: float  # nondimensional closure residual with the platform held at the request
+
+    def to_dict(self) -> dict:
+        return {
+            "converged": self.converged,
+            "exact": self.exact,
+            "position_error": self.position_error,
+            "angle_error_deg": float(np.degrees(self.angle_error)),
+            "ik_residual": self.ik_residual,
+        }
+
+
+def configuration_at_pose(mech: Mechanism, pose: Pose, *, start: Configuration | None = None, tol: float = 1e-10) -> PoseFit:
+    """The closed configuration nearest to ``pose``.
+
+    First the limbs are solved with the platform held at the pose (least squares if the pose
+    cannot be reached exactly, as with rounded printed data), then the platform is released
+    and the configuration corrected onto the closure manifold by minimum-norm steps.  The
+    pose error between the request and the result is returned, never hidden.
+    """
+    D = pose.displacement(mech.platform_point)
+    q0 = start.q if start is not None else np.zeros(len(mech.freedom_refs))
+    ik = correct(mech, Configuration(q0, D), fix_platform=True, max_iter=100)
+    res = ik if ik.converged else correct(mech, ik.config, max_iter=100)
+    Dn = res.config.D
+    p_req = pose.p
+    p_got = Dn[:3, :3] @ mech.platform_point + Dn[:3, 3]
+    ang = float(rotation_angle(Dn[:3, :3] @ pose.R.T))
+    return PoseFit(res.config, res.converged, ik.converged and ik.residual < tol, float(np.linalg.norm(p_got - p_req)), ang, ik.residual)
+
+
+# ------------------------------------------------------------------------------ inverse
+@dataclass(frozen=True, eq=False)
+class LimbSolutions:
+    limb: str
+    solutions: tuple[np.ndarray, ...]  # joint variables q of the limb's freedoms, one per solution
+    residuals: tuple[float, ...]
+    reachable: bool
+    passive_dim: int  # dimension of the solution set (0: finitely many)
+    violations: tuple[tuple[str, ...], ...]  # per solution, freedoms outside their limits
+
+    def to_dict(self, mech: Mechanism, first: int) -> dict:
+        refs = mech.freedom_refs
+        sols = []
+        for q, res, bad in zip(self.solutions, self.residuals, self.violations):
+            vals = {}
+            for j, qj in enumerate(q):
+                r = refs[first + j]
+                v = r.freedom.offset + qj
+                vals[r.id] = float(np.degrees(v)) if r.freedom.kind != "P" else float(v)
+            sols.append({"values": vals, "residual": res, "outside_limits": list(bad)})
+        return {"limb": self.limb, "reachable": self.reachable, "passive_dim": self.passive_dim,
+                "solutions": sols, "units": "rotations in degrees, slides in length units"}
+
+
+@dataclass(frozen=True, eq=False)
+class InverseResult:
+    pose: Pose
+    limbs: tuple[LimbSolutions, ...]
+    config: Configuration | None  # the first solution of every limb, when all are reachable
+    search: dict = field(default_factory=dict)
+
+    @property
+    def reachable(self) -> bool:
+        return all(l.reachable for l in self.limbs)
+
+    def actuator_values(self, mech: Mechanism) -> dict[str, float]:
+        if self.config is None:
+            raise ValueError("pose: not reachable; no actuator values")
+        vals = freedom_values(mech, self.config.q)
+        return {r.id: float(vals[i]) for i, r in enumerate(mech.freedom_refs) if r.id in mech.actuators}
+
+    def to_dict(self, mech: Mechanism) -> dict:
+        firsts = [sl.start for sl in limb_slices(mech)]
+        d = {"reachable": self.reachable, "limbs": [l.to_dict(mech, f) for l, f in zip(self.limbs, firsts)],
+             "search": self.search}
+        if self.config is not None:
+            d["actuators"] = {k: (float(np.degrees(v)) if mech.freedom(k).freedom.kind != "P" else v)
+                              for k, v in self.actuator_values(mech).items()}
+        return d
+
+
+def _limb_gn(chain, D, q, lin, L, tol=1e-12, max_iter=60):
+    Dinv = inverse_transform(D)
+    colscale = np.where(lin, L, 1.0)
+    row = np.r_[np.ones(3), np.full(3, 1.0 / L)]
+    rn = np.inf
+    for _ in range(max_iter):
+        T, J = chain_forward(chain, q)
+        r = log_transform(T @ Dinv)
+        rn = float(np.linalg.norm(row * r))
+        if rn < tol:
+            return q, rn, True
+        x, *_ = np.linalg.lstsq(row[:, None] * J * colscale[None, :], -(row * r), rcond=None)
+        if np.linalg.norm(x) < 1e-14:
+            break
+        q = q + colscale * x
+    return q, rn, rn < tol
+
+
+def _signature(chain, q, points) -> np.ndarray:
+    """Geometry of a limb's solution: every freedom's twist (axis placement)."""
+    _, J = chain_forward(chain, q)
+    return J.T.ravel()
+
+
+def inverse_position(
+    mech: Mechanism,
+    pose: Pose,
+    *,
+    all_solutions: bool = False,
+    n_seeds: int = 48,
+    seed: int = 0,
+    start: Configuration | None = None,
+    tol: float = 1e-10,
+) -> InverseResult:
+    """Joint values of every limb for a platform pose.
+
+    Single solution: Gauss-Newton from ``start`` (default: the reference).  ``all_solutions``:
+    also ``n_seeds`` random starts per limb; solutions are distinct when the limb's joint
+    twists differ (so passive spins, which leave the geometry unchanged up to that freedom,
+    are not counted twice); ``passive_dim > 0`` says the solution set is a continuum.
+    """
+    D = pose.displacement(mech.platform_point)
+    L = mech.characteristic_length
+    rng = np.random.default_rng(seed)
+    q_start = start.q if start is not None else np.zeros(len(mech.freedom_refs))
+    out = []
+    q_all = np.zeros(len(mech.freedom_refs))
+    all_ok = True
+    for li, (ch, sl) in enumerate(zip(limb_chains(mech), limb_slices(mech))):
+        refs = mech.freedom_refs[sl]
+        lin = np.array([r.freedom.kind == "P" for r in refs])
+        locked = np.array([r.freedom.locked for r in refs])
+        starts = [q_start[sl].copy()]
+        if all_solutions:
+            for _ in range(n_seeds):
+                qs = np.where(lin, rng.uniform(-1, 1, len(refs)) * L, rng.uniform(-np.pi, np.pi, len(refs)))
+                starts.append(np.where(locked, q_start[sl], qs))
+        sols, res, sigs = [], [], []
+        best = (None, np.inf)
+        for q0 in starts:
+            q, rn, ok = _limb_gn(ch, D, q0.astype(float), lin, L, tol=tol)
+            if not ok:
+                if rn < best[1]:
+                    best = (q, rn)
+                continue
+            sig = _signature(ch, q, None)
+            scale = np.r_[np.ones(3), np.full(3, 1.0 / L)]
+            sig_n = (sig.reshape(-1, 6) * scale).ravel()
+            if any(np.linalg.norm(sig_n - s2) < 1e-6 for s2 in sigs):
+                continue
+            sigs.append(sig_n)
+            sols.append(q)
+            res.append(rn)
+        reachable = bool(sols)
+        if not reachable:
+            all_ok = False
+            sols = [best[0]] if best[0] is not None else []
+            res = [best[1]]
+        passive = 0
+        if sols:
+            _, J = chain_forward(ch, sols[0])
+            passive = int(J.shape[1] - np.linalg.matrix_rank(J * np.r_[np.ones(3), np.full(3, 1 / L)][:, None], tol=1e-9))
+            q_all[sl] = sols[0]
+        idx = range(sl.start, sl.stop)
+        viol = tuple(tuple(within_limits(mech, np.r_[q_all[: sl.start], s, q_all[sl.stop :]], indices=set(idx))) for s in sols)
+        out.append(LimbSolutions(mech.limbs[li].name, tuple(sols), tuple(float(r) for r in res), reachable, passive, viol))
+    config = Configuration(recentre_balls(mech, q_all), D) if all_ok else None
+    search = {"method": "Gauss-Newton per limb", "starts_per_limb": 1 + (n_seeds if all_solutions else 0), "seed": seed,
+              "tolerance": tol, "distinct_by": "joint twists (axis placement) of the limb"}
+    return InverseResult(pose, tuple(out), config, search)
+
+
+# ------------------------------------------------------------------------------ forward
+@dataclass(frozen=True, eq=False)
+class ForwardSolution:
+    config: Configuration
+    pose: Pose
+    converged: bool
+    residual: float
+    iterations: int
+    outside_limits: tuple[str, ...]
+
+    def to_dict(self, mech: Mechanism) -> dict:
+        from ..geometry.rotations import matrix_euler
+
+        return {
+            "converged": self.converged,
+            "residual": self.residual,
+            "iterations": self.iterations,
+            "position": self.pose.p.tolist(),
+            "rotation_matrix": self.pose.R.tolist(),
+            "euler_ZYX_deg": matrix_euler("ZYX", self.pose.R, degrees=True).tolist(),
+            "outside_limits": list(self.outside_limits),
+            "within_limits": not self.outside_limits,
+        }
+
+
+@dataclass(frozen=True, eq=False)
+class ForwardResult:
+    solutions: tuple[ForwardSolution, ...]
+    search: dict
+
+    @property
+    def converged(self) -> bool:
+        return bool(self.solutions) and self.solutions[0].converged
+
+    def to_dict(self, mech: Mechanism) -> dict:
+        return {"solutions": [s.to_dict(mech) for s in self.solutions], "search": self.search}
+
+
+def _actuator_q(mech: Mechanism, values) -> dict[int, float]:
+    acts = list(mech.actuators)
+    if isinstance(values, dict):
+        items = {mech.freedom(k).id: float(v) for k, v in values.items()}
+        missing = set(acts) - set(items)
+        if missing:
+            raise ValueError(f"actuators: missing values for {sorted(missing)}")
+        extra = set(items) - set(acts)
+        if extra:
+            raise ValueError(f"actuators: {sorted(extra)} are not actuated in this mechanism (actuators: {acts})")
+    else:
+        vals = np.asarray(values, dtype=float).ravel()
+        if vals.size != len(acts):
+            raise ValueError(f"actuators: expected {len(acts)} values ({', '.join(acts)}), got {vals.size}")
+        items = dict(zip(acts, vals))
+    out = {}
+    for k, v in items.items():
+        if not np.isfinite(v):
+            raise ValueError(f"actuators: value of {k} is not finite")
+        r = mech.freedom(k)
+        out[mech.freedom_refs.index(r)] = v - r.freedom.offset
+    return out
+
+
+def _fk_from(mech, config, targets, mask, max_iter):
+    q = config.q.copy()
+    for i, v in targets.items():
+        q[i] = v
+    res = correct(mech, Configuration(q, config.D), active=mask, max_iter=max_iter)
+    return res
+
+
+def forward_position(
+    mech: Mechanism,
+    actuator_values,
+    *,
+    start: Configuration | None = None,
+    all_solutions: bool = False,
+    n_seeds: int = 200,
+    seed: int = 0,
+    max_iter: int = 60,
+) -> ForwardResult:
+    """Platform pose(s) for given actuator values (physical units, in ``mech.actuators`` order
+    or a dict by name).
+
+    From ``start`` (default: the reference) by Gauss-Newton with the actuators held; with
+    ``all_solutions``, also from ``n_seeds`` configurations reached by random walks along the
+    closure manifold (actuators free), deduplicated by the joint points of every limb.
+    Non-converged runs are reported (``converged = False``), never returned as solutions of
+    the all-solutions search.
+    """
+    targets = _actuator_q(mech, actuator_values)
+    mask = active_mask(mech)
+    for i in targets:
+        mask[i] = False
+    L = mech.characteristic_length
+    first = _fk_from(mech, start or Configuration.reference(mech), targets, mask, max_iter)
+    runs = [first]
+    if all_solutions:
+        rng = np.random.default_rng(seed)
+        for s in range(n_seeds):
+            try:
+                c = generic_configuration(mech, seed=int(rng.integers(2**31)), step=float(rng.uniform(0.3, 1.2)), steps=4)
+            except RuntimeError:
+                continue
+            runs.append(_fk_from(mech, c, targets, mask, max_iter))
+    sols, sigs = [], []
+    for k, r in enumerate(runs):
+        if not r.converged and not (k == 0 and not all_solutions):
+            continue
+        sig = np.concatenate([p.ravel() for p in joint_points(mech, r.config)] + [r.config.D[:3, :3].ravel() * L, r.config.D[:3, 3]])
+        if r.converged and any(np.linalg.norm(sig - s2) < 1e-6 * L for s2 in sigs):
+            continue
+        sigs.append(sig)
+        sols.append(ForwardSolution(r.config, platform_pose(mech, r.config), r.converged, r.residual, r.iterations,
+                                    tuple(within_limits(mech, r.config.q))))
+    search = {"method": "Gauss-Newton with the actuators held" + (", multi-start" if all_solutions else ""),
+              "seeds": 1 + (n_seeds if all_solutions else 0), "seed": seed if all_solutions else None,
+              "converged_runs": sum(r.converged for r in runs), "distinct": sum(s.converged for s in sols),
+              "seeding": "random walks along the closure manifold with the actuators free" if all_solutions else "start configuration",
+              "distinct_by": "joint points of every limb and the platform pose (tolerance 1e-6 L)"}
+    return ForwardResult(tuple(sols), search)
