@@ -118,7 +118,7 @@ def exp_twist(screw, theta) -> np.ndarray:
     w = S[..., :3]
     v = S[..., 3:]
     wn = np.linalg.norm(w, axis=-1)
-    rot = wn > 1e-12
+    rot = wn > 0.0  # Rodrigues is exact for small angles: only a zero rotation is a translation
     # scale screws so that |w| = 1 where rotational; theta absorbs the magnitude
     ws = np.where(rot[..., None], w / np.where(rot, wn, 1.0)[..., None], 0.0)
     vs = np.where(rot[..., None], v / np.where(rot, wn, 1.0)[..., None], v)

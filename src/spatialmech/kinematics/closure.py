@@ -17,6 +17,7 @@ divided by ``L``) are used for rank decisions and convergence tests.
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
 
 import numpy as np
@@ -108,8 +109,15 @@ class Chain:
     balls: tuple[tuple[int, np.ndarray, np.ndarray], ...]  # (first index, centre, axes as columns)
 
 
+_CHAINS: "weakref.WeakKeyDictionary[Mechanism, list[Chain]]" = weakref.WeakKeyDictionary()
+
+
 def limb_chains(mech: Mechanism) -> list[Chain]:
-    """The :class:`Chain` of every limb, in limb order."""
+    """The :class:`Chain` of every limb, in limb order (cached per mechanism)."""
+    try:
+        return _CHAINS[mech]
+    except KeyError:
+        pass
     S = reference_screws(mech)
     out = []
     for li, sl in enumerate(limb_slices(mech)):
@@ -120,6 +128,7 @@ def limb_chains(mech: Mechanism) -> list[Chain]:
                 balls.append((k, joint.point, np.array([f.direction for f in joint.freedoms]).T))
             k += len(joint.freedoms)
         out.append(Chain(S[sl], tuple(balls)))
+    _CHAINS[mech] = out
     return out
 
 
@@ -131,38 +140,109 @@ def _left_jacobian_so3(phi: np.ndarray) -> np.ndarray:
     return np.eye(3) + (1 - np.cos(th)) / th**2 * W + (th - np.sin(th)) / th**3 * (W @ W)
 
 
-def chain_forward(chain: Chain, q: np.ndarray, *, prefixes: bool = False):
+def _cross(a, b):
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+
+
+def _rodrigues(W: np.ndarray, W2: np.ndarray, t: float) -> np.ndarray:
+    return np.eye(3) + np.sin(t) * W + (1.0 - np.cos(t)) * W2
+
+
+class _Fast:
+    """Per-chain precomputed data for scalar forward kinematics (no stacking overhead)."""
+
+    def __init__(self, chain: "Chain"):
+        S = chain.screws
+        self.m = len(S)
+        self.w = [S[i, :3].copy() for i in range(self.m)]
+        self.v = [S[i, 3:].copy() for i in range(self.m)]
+        self.rot = [float(np.linalg.norm(S[i, :3])) > 1e-12 for i in range(self.m)]
+        self.W = [skew(S[i, :3]) for i in range(self.m)]
+        self.W2 = [Wi @ Wi for Wi in self.W]
+        self.ball = {b[0]: (b[1], b[2]) for b in chain.balls}
+
+
+_FAST: "weakref.WeakKeyDictionary[Chain, _Fast]" = weakref.WeakKeyDictionary()
+
+
+def chain_forward(chain: Chain, q: np.ndarray, *, prefixes: bool = False, local: bool = False):
     """Forward kinematics of a :class:`Chain`: ``T`` (4x4) and spatial Jacobian ``J`` (6, m).
 
+    ``local=False``: ``J`` holds the derivatives with respect to ``q``.  ``local=True``: for S
+    joints, the columns are instead the rotations about the joint's reference axes (moved by
+    the preceding freedoms), the local coordinates in which :func:`_apply_step` composes
+    rotation increments; they do not depend on how the joint's rotation is parametrised.
     With ``prefixes=True`` also returns the displacement applied to each freedom's body
     *before* it moves (used to place joint points).
     """
-    m = len(q)
+    f = _FAST.get(chain)
+    if f is None:
+        f = _FAST[chain] = _Fast(chain)
+    m = f.m
     J = np.empty((6, m))
-    T = np.eye(4)
+    R = np.eye(3)
+    p = np.zeros(3)
     pre = np.empty((m, 4, 4)) if prefixes else None
-    ball_at = {b[0]: b for b in chain.balls}
     i = 0
     while i < m:
-        if i in ball_at:
-            _, c, A = ball_at[i]
+        if i in f.ball:
+            c, A = f.ball[i]
             phi = A @ q[i : i + 3]
-            Rb = Rotation.from_rotvec(phi).as_matrix()
-            W = _left_jacobian_so3(phi) @ A  # spatial angular velocity per unit rate, columns
-            Ad = adjoint(T)
+            th = float(np.sqrt(phi @ phi))
+            if th > 1e-12:
+                K = skew(phi / th)
+                Rb = _rodrigues(K, K @ K, th)
+            else:
+                Rb = np.eye(3)
+            Wc = A if local else _left_jacobian_so3(phi) @ A
             for j in range(3):
-                J[:, i + j] = Ad @ np.r_[W[:, j], np.cross(c, W[:, j])]
+                d = R @ Wc[:, j]
+                J[:3, i + j] = d
+                J[3:, i + j] = R @ _cross(c, Wc[:, j]) + _cross(p, d)
                 if prefixes:
-                    pre[i + j] = T
-            T = T @ transform(Rb, c - Rb @ c)
+                    pre[i + j] = transform(R, p)
+            # T <- T [Rb, c - Rb c]
+            p = R @ (c - Rb @ c) + p
+            R = R @ Rb
             i += 3
+            continue
+        d = R @ f.w[i]
+        J[:3, i] = d
+        J[3:, i] = R @ f.v[i] + _cross(p, d)
+        if prefixes:
+            pre[i] = transform(R, p)
+        t = float(q[i])
+        if f.rot[i]:
+            Ri = _rodrigues(f.W[i], f.W2[i], t)
+            st, ct = np.sin(t), 1.0 - np.cos(t)
+            pi = t * f.v[i] + ct * (f.W[i] @ f.v[i]) + (t - st) * (f.W2[i] @ f.v[i])
+            p = R @ pi + p
+            R = R @ Ri
         else:
-            J[:, i] = adjoint(T) @ chain.screws[i]
-            if prefixes:
-                pre[i] = T
-            T = T @ exp_twist(chain.screws[i], q[i])
-            i += 1
+            p = R @ (t * f.v[i]) + p
+        i += 1
+    T = np.eye(4)
+    T[:3, :3] = R
+    T[:3, 3] = p
     return (T, J, pre) if prefixes else (T, J)
+
+
+def _log_single(T: np.ndarray) -> np.ndarray:
+    """``log_transform`` for one 4x4 displacement, fast away from a half turn."""
+    R = T[:3, :3]
+    c = (np.trace(R) - 1.0) / 2.0
+    if c < -0.999:
+        return log_transform(T)
+    w_raw = np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
+    sn = 0.5 * float(np.sqrt(w_raw @ w_raw))
+    th = float(np.arctan2(sn, c))  # accurate for small angles, unlike arccos
+    p = T[:3, 3]
+    if th < 1e-8:
+        return np.r_[0.5 * w_raw, p]
+    w = w_raw / (2.0 * sn)
+    W = skew(w)
+    Ginv = np.eye(3) / th - 0.5 * W + (1.0 / th - 0.5 / np.tan(th / 2.0)) * (W @ W)
+    return np.r_[w * th, (Ginv @ p) * th]
 
 
 def recentre_balls(mech: Mechanism, q: np.ndarray) -> np.ndarray:
@@ -183,7 +263,7 @@ def recentre_balls(mech: Mechanism, q: np.ndarray) -> np.ndarray:
 
 def joint_twists(mech: Mechanism, config: Configuration) -> list[np.ndarray]:
     """Per limb, the (6, m_k) twists of all its freedoms at ``config``."""
-    return [chain_forward(ch, config.q[sl])[1] for ch, sl in zip(limb_chains(mech), limb_slices(mech))]
+    return [chain_forward(ch, config.q[sl], local=True)[1] for ch, sl in zip(limb_chains(mech), limb_slices(mech))]
 
 
 def closure_residual(mech: Mechanism, config: Configuration) -> np.ndarray:
@@ -192,7 +272,7 @@ def closure_residual(mech: Mechanism, config: Configuration) -> np.ndarray:
     res = []
     for ch, sl in zip(limb_chains(mech), limb_slices(mech)):
         T, _ = chain_forward(ch, config.q[sl])
-        res.append(log_transform(T @ Dinv))
+        res.append(_log_single(T @ Dinv))
     return np.concatenate(res)
 
 
@@ -207,10 +287,10 @@ def closure_jacobian(mech: Mechanism, config: Configuration, *, active: np.ndarr
     Dinv = inverse_transform(config.D)
     res = []
     for k, (ch, sl) in enumerate(zip(limb_chains(mech), sls)):
-        T, J = chain_forward(ch, config.q[sl])
+        T, J = chain_forward(ch, config.q[sl], local=True)
         A[6 * k : 6 * k + 6, sl] = J
         A[6 * k : 6 * k + 6, n:] = -np.eye(6)
-        res.append(log_transform(T @ Dinv))
+        res.append(_log_single(T @ Dinv))
     cols = np.concatenate([active, np.ones(6, bool)])
     return A[:, cols], np.concatenate(res)
 
@@ -234,12 +314,33 @@ class CorrectionResult:
     stationary: bool = False  # steps vanished without closure: a least-squares minimum
 
 
+def _ball_groups(mech: Mechanism) -> list[tuple[int, np.ndarray]]:
+    """(first global index, axes as columns) of every S joint."""
+    out, start = [], 0
+    for ch in limb_chains(mech):
+        for k, _, A in ch.balls:
+            out.append((start + k, A))
+        start += len(ch.screws)
+    return out
+
+
 def _apply_step(mech, config, active, step, fix_platform=False):
-    q = config.q.copy()
+    """Retraction: add a local-coordinate step (see ``chain_forward(local=True)``)."""
+    dq = np.zeros_like(config.q)
     na = int(active.sum())
-    q[active] += step[:na]
-    D = config.D if fix_platform else exp_twist(step[na:], 1.0) @ config.D
-    return Configuration(recentre_balls(mech, q), D)
+    dq[active] = step[:na]
+    q = config.q + dq
+    for i, A in _ball_groups(mech):
+        sl = slice(i, i + 3)
+        R_old = Rotation.from_rotvec(A @ config.q[sl])
+        q[sl] = A.T @ (Rotation.from_rotvec(A @ dq[sl]) * R_old).as_rotvec()
+    if fix_platform:
+        D = config.D
+    else:
+        D = exp_twist(step[na:], 1.0) @ config.D
+        U, _, Vt = np.linalg.svd(D[:3, :3])  # keep the rotation orthonormal (no drift)
+        D[:3, :3] = U @ Vt
+    return Configuration(q, D)
 
 
 def correct(

@@ -1,0 +1,452 @@
+"""Pseudo-arclength continuation of one-dimensional solution curves.
+
+The core (:func:`track`) follows the curve ``F(x) = 0``, ``F: R^(n+1) -> R^n`` (or a curve on a
+manifold given by a *problem*: residual, Jacobian in local coordinates, retraction), with
+
+- Keller's predictor-corrector: Euler predictor along the unit tangent, Newton corrector on
+  the hyperplane orthogonal to the tangent at distance ``h``;
+- step-size control: growth after easy corrections, halving after a rejection;
+- guards against jumping to another branch: the corrector must contract, end close to the
+  predicted point, and the new tangent must turn by less than ``max_turn`` — otherwise the
+  step is halved and retried; below ``h_min`` the tracker stops and says why;
+- events: sign changes of monitor functions (e.g. ``DJ`` of each driver) located by bisection
+  on the step length to ``event_tol``;
+- loop closure: the curve is closed when it crosses the hyperplane through the start point,
+  orthogonal to the start tangent, close to the start.
+
+The mechanism problems (:class:`MotionProblem`, :class:`ActuatorPathProblem`) turn a mechanism
+into such a curve: a one-degree-of-freedom motion, or the configurations along a path of
+actuator values (forward position by continuation).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable, Protocol
+
+import numpy as np
+
+from ..geometry.rotations import exp_twist, inverse_transform, log_transform
+from ..model.mechanism import Mechanism
+from scipy.spatial.transform import Rotation
+
+from .closure import Configuration, _apply_step, _ball_groups, _scales, active_mask, closure_jacobian
+
+__all__ = [
+    "CurveProblem",
+    "EuclideanProblem",
+    "MotionProblem",
+    "ActuatorPathProblem",
+    "Event",
+    "TrackResult",
+    "track",
+    "trace_motion",
+]
+
+
+class CurveProblem(Protocol):
+    """What :func:`track` needs.  ``x`` is any state; local coordinates are vectors of size
+    ``n + 1`` (nondimensional)."""
+
+    def residual(self, x) -> np.ndarray: ...
+
+    def jacobian(self, x) -> np.ndarray: ...
+
+    def retract(self, x, dx: np.ndarray): ...
+
+    def difference(self, x, y) -> np.ndarray:  # local coordinates of y relative to x
+        ...
+
+    def tangent(self, x) -> np.ndarray: ...
+
+
+def _null_tangent(A: np.ndarray) -> np.ndarray:
+    _, _, vt = np.linalg.svd(A, full_matrices=True)
+    return vt[-1]
+
+
+def _observable_tangent(A: np.ndarray, n_obs: int) -> np.ndarray:
+    """Unit tangent of a curve whose Jacobian ``A`` may also vanish on passive directions (those
+    that leave the last ``n_obs`` coordinates, e.g. the platform twist, at rest): the null
+    vector with the largest observable part, which has no passive component."""
+    _, sv, vt = np.linalg.svd(A, full_matrices=True)
+    r = int(np.sum(sv > 1e-9 * max(1.0, sv[0]))) if sv.size else 0
+    N = vt[r:]
+    if N.shape[0] == 1:
+        return N[0]
+    u, _, _ = np.linalg.svd(N[:, -n_obs:])
+    t = u[:, 0] @ N
+    return t / np.linalg.norm(t)
+
+
+@dataclass
+class EuclideanProblem:
+    """``F: R^(n+1) -> R^n`` given as callables (``J`` optional: finite differences)."""
+
+    F: Callable[[np.ndarray], np.ndarray]
+    J: Callable[[np.ndarray], np.ndarray] | None = None
+
+    def residual(self, x):
+        return np.asarray(self.F(x), dtype=float)
+
+    def jacobian(self, x):
+        if self.J is not None:
+            return np.asarray(self.J(x), dtype=float)
+        h = 1e-7
+        f0 = self.residual(x)
+        return np.stack([(self.residual(x + h * e) - f0) / h for e in np.eye(len(x))], axis=1)
+
+    def retract(self, x, dx):
+        return np.asarray(x, dtype=float) + dx
+
+    def difference(self, x, y):
+        return np.asarray(y, dtype=float) - np.asarray(x, dtype=float)
+
+    def tangent(self, x):
+        return _null_tangent(self.jacobian(x))
+
+
+@dataclass(frozen=True)
+class Event:
+    """A located zero of a monitor function along the curve."""
+
+    name: str
+    s: float  # arc length (nondimensional) from the start
+    x: object
+    step: int  # index of the accepted point after which it lies
+    value_before: float
+    value_after: float
+
+
+@dataclass
+class TrackResult:
+    points: list
+    s: np.ndarray
+    tangents: list
+    monitors: dict[str, np.ndarray]
+    events: list[Event]
+    closed: bool
+    status: str  # "closed", "max_arc", "stopped", "h_min: ..." (failure, with the reason)
+    rejected: int = 0
+    corrector_iterations: int = 0
+    min_monitor: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def ok(self) -> bool:
+        return self.status in ("closed", "max_arc", "stopped")
+
+
+def _frame(A: np.ndarray, t: np.ndarray):
+    """Row-space projection ``P`` and passive null directions ``G`` of ``A`` at a point, such that
+    ``[P A; G; t]`` is square.  Kept fixed while a step is checked."""
+    U, sv, vt = np.linalg.svd(A, full_matrices=True)
+    r = int(np.sum(sv > 1e-9 * max(1.0, sv[0]))) if sv.size else 0
+    P = U[:, :r].T
+    N = vt[r:]
+    Nt = N - np.outer(N @ t, t)  # null directions other than the tangent
+    if Nt.shape[0] > 1:
+        _, s2, w = np.linalg.svd(Nt)
+        G = w[: Nt.shape[0] - 1]
+    else:
+        G = np.zeros((0, A.shape[1]))
+    return P, G
+
+
+def _orientation(A: np.ndarray, t: np.ndarray, frame) -> float:
+    """Sign of ``det [P A; G; t]``: constant along a regular branch with a continuously oriented
+    tangent; it flips when a step crosses to another branch (Keller's test)."""
+    P, G = frame
+    M = np.vstack([P @ A, G, t[None, :]])
+    if M.shape[0] != M.shape[1]:
+        return 0.0
+    sign, _ = np.linalg.slogdet(M)
+    return float(sign)
+
+
+def _correct_on_plane(problem, xp, t, tol, max_iter, contraction=0.6):
+    """Newton on F(x) = 0 with the correction orthogonal to ``t``; returns (x, ok, iters, moved)."""
+    moved = 0.0
+    prev = np.inf
+    for it in range(max_iter):
+        r = problem.residual(xp)
+        rn = float(np.linalg.norm(r))
+        if rn < tol:
+            return xp, True, it, moved
+        A = problem.jacobian(xp)
+        M = np.vstack([A, t[None, :]])
+        d, *_ = np.linalg.lstsq(M, np.r_[-r, 0.0], rcond=None)
+        dn = float(np.linalg.norm(d))
+        if it > 0 and dn > contraction * prev:
+            return xp, False, it, moved
+        prev = dn
+        moved += dn
+        xp = problem.retract(xp, d)
+    return xp, float(np.linalg.norm(problem.residual(xp))) < tol, max_iter, moved
+
+
+def track(
+    problem,
+    x0,
+    *,
+    direction: np.ndarray | None = None,
+    h0: float = 0.02,
+    h_min: float = 1e-7,
+    h_max: float = 0.2,
+    max_arc: float = 50.0,
+    max_steps: int = 20000,
+    tol: float = 1e-11,
+    max_turn_deg: float = 15.0,
+    monitors: dict[str, Callable] | None = None,
+    event_tol: float = 1e-10,
+    detect_closure: bool = True,
+    stop: Callable | None = None,
+    progress: Callable[[float], None] | None = None,
+) -> TrackResult:
+    """Follow the solution curve of ``problem`` from ``x0`` (which must lie on it).
+
+    ``direction``: local-coordinate vector giving the sense of travel (the tangent is oriented
+    to have a positive component on it).  ``monitors``: name -> function(x) whose sign changes
+    are located as :class:`Event` s.  ``stop(x, s)``: return True to stop after a point.
+    Arc length is measured in the problem's (nondimensional) local coordinates.
+    """
+    monitors = monitors or {}
+    t = problem.tangent(x0)
+    t = t / np.linalg.norm(t)
+    if direction is not None and float(t @ direction) < 0:
+        t = -t
+    t0 = t.copy()
+    xs, ss, ts = [x0], [0.0], [t]
+    mon = {k: [float(f(x0))] for k, f in monitors.items()}
+    events: list[Event] = []
+    x, s, h = x0, 0.0, h0
+    A_x = problem.jacobian(x0)
+    frame = _frame(A_x, t)
+    orient = _orientation(A_x, t, frame)
+    flips = 0
+    rejected = 0
+    total_iters = 0
+    cos_max = np.cos(np.radians(max_turn_deg))
+    status = "max_arc"
+    closed = False
+    steps = 0
+    while s < max_arc and steps < max_steps:
+        h = min(h, h_max, max_arc - s + 1e-15)
+        xp = problem.retract(x, h * t)
+        xn, ok, iters, moved = _correct_on_plane(problem, xp, t, tol, 12)
+        total_iters += iters
+        tn = None
+        if ok and moved < 0.5 * h:
+            tn = problem.tangent(xn)
+            tn = tn / np.linalg.norm(tn)
+            if float(tn @ t) < 0:
+                tn = -tn
+            A_n = problem.jacobian(xn)
+            if float(tn @ t) < cos_max:
+                ok = False
+            elif orient != 0.0:
+                if _orientation(A_n, tn, frame) != orient:
+                    ok = False  # the step crossed to another branch
+                    flips += 1
+        else:
+            ok = False
+        if not ok:
+            rejected += 1
+            h *= 0.5
+            if h < h_min:
+                why = "an orientation flip (a bifurcation point or a crossing branch)" if flips else "a singular point"
+                status = f"h_min: no acceptable step above {h_min:g} at arc length {s:.6g}: {why}"
+                break
+            continue
+        # accept
+        s_new = s + h
+        vals = {k: float(f(xn)) for k, f in monitors.items()}
+        for k in monitors:
+            a, b = mon[k][-1], vals[k]
+            if np.sign(a) != np.sign(b) and a != 0:
+                events.append(_locate(problem, x, t, h, monitors[k], k, a, b, s, len(xs) - 1, tol, event_tol))
+        if detect_closure and s_new > 4 * h0 and len(xs) > 3:
+            d_prev = problem.difference(x0, x)
+            d_new = problem.difference(x0, xn)
+            g0, g1 = float(t0 @ d_prev), float(t0 @ d_new)
+            if g0 < 0 <= g1 and np.linalg.norm(d_new) < 3 * h + 1e-9 and float(tn @ t0) > 0:
+                # land exactly on the start point's plane: the last point is the start again
+                gfun = lambda y: float(t0 @ problem.difference(x0, y))
+                ev = _locate(problem, x, t, h, gfun, "closure", g0, g1, s, len(xs) - 1, tol, event_tol)
+                closed = True
+                xs.append(ev.x); ss.append(ev.s); ts.append(tn)
+                for k, f in monitors.items():
+                    mon[k].append(float(f(ev.x)))
+                # an event at the closing point is the start point met again: not a new one
+                events = [e for e in events if e.s < ev.s - max(event_tol, 1e-9)]
+                status = "closed"
+                s = ev.s
+                break
+        xs.append(xn); ss.append(s_new); ts.append(tn)
+        for k in monitors:
+            mon[k].append(vals[k])
+        x, t, s = xn, tn, s_new
+        frame = _frame(A_n, tn)
+        orient = _orientation(A_n, tn, frame)
+        steps += 1
+        if progress is not None:
+            progress(s)
+        if iters <= 2:
+            h *= 1.5
+        elif iters >= 5:
+            h *= 0.7
+        if stop is not None and stop(x, s):
+            status = "stopped"
+            break
+    mons = {k: np.array(v) for k, v in mon.items()}
+    return TrackResult(xs, np.array(ss), ts, mons, events, closed, status, rejected, total_iters,
+                       {k: float(np.min(np.abs(v))) for k, v in mons.items()})
+
+
+def _locate(problem, x, t, h, f, name, fa, fb, s, step, tol, event_tol):
+    """Bisection on the step length from ``x`` for the zero of monitor ``f``."""
+    lo, hi = 0.0, h
+    flo = fa
+    best = None
+    for _ in range(80):
+        mid = 0.5 * (lo + hi)
+        xm, ok, _, _ = _correct_on_plane(problem, problem.retract(x, mid * t), t, tol, 20)
+        fm = float(f(xm))
+        best = (mid, xm)
+        if not ok:
+            break
+        if np.sign(fm) == np.sign(flo):
+            lo, flo = mid, fm
+        else:
+            hi = mid
+        if hi - lo < event_tol:
+            break
+    mid, xm = best
+    return Event(name, s + mid, xm, step, fa, fb)
+
+
+# --------------------------------------------------------------------------- mechanisms
+class _MechanismBase:
+    def __init__(self, mech: Mechanism, active: np.ndarray):
+        self.mech = mech
+        self.active = active
+        self.row, self.col = _scales(mech, active)
+        self.na = int(active.sum())
+        self.L = mech.characteristic_length
+        refs = mech.freedom_refs
+        self.kinds = np.array([r.freedom.kind for r in refs])[active]
+
+    def _closure(self, config):
+        A, r = closure_jacobian(self.mech, config, active=self.active)
+        return self.row[:, None] * A * self.col[None, :], self.row * r
+
+    def _config_step(self, config, dx):
+        return _apply_step(self.mech, config, self.active, self.col * dx)
+
+    def _config_diff(self, a: Configuration, b: Configuration) -> np.ndarray:
+        dq_all = b.q - a.q
+        for i, A in _ball_groups(self.mech):  # relative rotation of each S joint
+            sl = slice(i, i + 3)
+            rel = Rotation.from_rotvec(A @ b.q[sl]) * Rotation.from_rotvec(A @ a.q[sl]).inv()
+            dq_all[sl] = A.T @ rel.as_rotvec()
+        dq = dq_all[self.active]
+        rot = self.kinds != "P"
+        dq = np.where(rot, (dq + np.pi) % (2 * np.pi) - np.pi, dq)
+        V = log_transform(b.D @ inverse_transform(a.D))
+        return np.r_[dq, V] / self.col
+
+
+class MotionProblem(_MechanismBase):
+    """The motion of a mechanism with one platform degree of freedom (actuators free), as a
+    curve in (joint variables, platform twist) local coordinates.  Passive freedoms (e.g. the
+    spin of an SPS leg) are removed from the tangent, so the curve is one-dimensional."""
+
+    def __init__(self, mech: Mechanism):
+        super().__init__(mech, active_mask(mech))
+
+    def residual(self, x):
+        return self._closure(x)[1]
+
+    def jacobian(self, x):
+        return self._closure(x)[0]
+
+    def retract(self, x, dx):
+        return self._config_step(x, dx)
+
+    def difference(self, x, y):
+        return self._config_diff(x, y)
+
+    def tangent(self, x):
+        return _observable_tangent(self.jacobian(x), 6)
+
+
+class ActuatorPathProblem(_MechanismBase):
+    """Forward position along a path of actuator values ``a(lam)``, ``lam`` in [0, 1]: the curve
+    of configurations in (free joint variables, platform twist, lam).  Turning points in ``lam``
+    are singular (direct-kinematics) configurations; the tracker passes them and reports them."""
+
+    def __init__(self, mech: Mechanism, path: Callable[[float], np.ndarray], path_derivative: Callable[[float], np.ndarray] | None = None):
+        mask = active_mask(mech)
+        self.act_idx = [mech.freedom_refs.index(mech.freedom(a)) for a in mech.actuators]
+        self.offsets = np.array([mech.freedom_refs[i].freedom.offset for i in self.act_idx])
+        for i in self.act_idx:
+            mask[i] = False
+        super().__init__(mech, mask)
+        self.path = path
+        self.dpath = path_derivative
+
+    def _q_with(self, x):
+        config, lam = x
+        q = config.q.copy()
+        q[self.act_idx] = np.asarray(self.path(lam), dtype=float) - self.offsets
+        return Configuration(q, config.D)
+
+    def residual(self, x):
+        return self._closure(self._q_with(x))[1]
+
+    def jacobian(self, x):
+        config, lam = x
+        c = self._q_with(x)
+        A, _ = self._closure(c)
+        # derivative with respect to lam through the actuated joint twists
+        full, _ = closure_jacobian(self.mech, c, active=np.ones(len(c.q), bool))
+        if self.dpath is not None:
+            da = np.asarray(self.dpath(lam), dtype=float)
+        else:
+            e = 1e-7
+            da = (np.asarray(self.path(lam + e)) - np.asarray(self.path(lam - e))) / (2 * e)
+        col = full[:, self.act_idx] @ da
+        return np.c_[A, self.row * col]
+
+    def retract(self, x, dx):
+        config, lam = x
+        return (self._config_step(config, dx[:-1]), lam + float(dx[-1]))
+
+    def difference(self, x, y):
+        return np.r_[self._config_diff(x[0], y[0]), y[1] - x[1]]
+
+    def tangent(self, x):
+        return _observable_tangent(self.jacobian(x), 7)
+
+
+def trace_motion(
+    mech: Mechanism,
+    start: Configuration,
+    *,
+    increasing: str | None = None,
+    monitors: dict[str, Callable[[Configuration], float]] | None = None,
+    **kw,
+) -> TrackResult:
+    """Follow the one-degree-of-freedom motion of ``mech`` from ``start`` until it closes.
+
+    ``increasing``: a freedom name whose variable should increase at the start (sets the
+    sense of travel).  Extra keyword arguments go to :func:`track`.
+    """
+    prob = MotionProblem(mech)
+    direction = None
+    if increasing is not None:
+        r = mech.freedom(increasing)
+        i = mech.freedom_refs.index(r)
+        idx = list(np.flatnonzero(prob.active))
+        direction = np.zeros(prob.na + 6)
+        direction[idx.index(i)] = 1.0
+    return track(prob, start, direction=direction, monitors=monitors, **kw)
