@@ -167,6 +167,11 @@ def demo(out, as_json):
         click.echo(f"report written to {out / 'index.html'} and {out / 'results.json'}")
 
 
+from .cmd_synth import synth  # noqa: E402  (commands defined in their own modules)
+
+cli.add_command(synth)
+
+
 def main(argv=None):  # console-script entry point
     try:
         cli.main(args=argv, prog_name="spatialmech", standalone_mode=True)

@@ -1,0 +1,28 @@
+"""Synthesis: task positions -> dyads -> linkages (paper D: four-position RCCC by solution regions).
+
+Modules: :mod:`.tasks` (task positions, the ready-made ``rccc-four-positions``),
+:mod:`.burmester` (spherical Burmester curves), :mod:`.dyads` (CC/RC dyads, solution lines),
+:mod:`.regions` (solution regions 1 and 2), :mod:`.rccc` (the pipeline and the closure check),
+:mod:`.figures` (Matplotlib figures written to files).  See ``docs/synthesis.md``.
+
+Quick example::
+
+    >>> from spatialmech.synthesis import get_task, synthesize_rccc
+    >>> res = synthesize_rccc(get_task("rccc-four-positions"), samples=120)
+    >>> res.linkage_type, res.defects
+    ('crank-rocker', 0)
+"""
+
+from .burmester import BurmesterCurves, burmester_curves, center_point, circle_point, poles
+from .dyads import Dyad, SolutionLine, direction_residuals, rc_dyad_three_positions, solution_line
+from .rccc import RCCCResult, assemble, check_linkage, interior_pick, synthesize_rccc
+from .regions import Region1, Region2, classify_spherical_4r, solution_region_1, solution_region_2
+from .tasks import TaskPositions, get_task, load_task, loads_task, mccarthy_matrix, resolve_task, task_names
+
+__all__ = [
+    "TaskPositions", "get_task", "load_task", "loads_task", "mccarthy_matrix", "resolve_task", "task_names",
+    "BurmesterCurves", "burmester_curves", "center_point", "circle_point", "poles",
+    "Dyad", "SolutionLine", "direction_residuals", "solution_line", "rc_dyad_three_positions",
+    "Region1", "Region2", "classify_spherical_4r", "solution_region_1", "solution_region_2",
+    "RCCCResult", "assemble", "check_linkage", "interior_pick", "synthesize_rccc",
+]
