@@ -167,9 +167,12 @@ def demo(out, as_json):
         click.echo(f"report written to {out / 'index.html'} and {out / 'results.json'}")
 
 
-from .cmd_synth import synth  # noqa: E402  (commands defined in their own modules)
+from .cmd_kinematics import fk, ik, jacobian  # noqa: E402  (commands defined in their own modules)
+from .cmd_synth import synth  # noqa: E402
+from .cmd_view import view  # noqa: E402
 
-cli.add_command(synth)
+for _cmd in (ik, fk, jacobian, synth, view):
+    cli.add_command(_cmd)
 
 
 def main(argv=None):  # console-script entry point

@@ -17,6 +17,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from ..geometry.rotations import inverse_transform, log_transform, rotation_angle
 from ..model.mechanism import Mechanism, Pose
@@ -44,6 +45,7 @@ __all__ = [
     "freedom_values",
     "within_limits",
     "platform_pose",
+    "wrap_rotations",
 ]
 
 
@@ -172,13 +174,17 @@ class InverseResult:
         return d
 
 
-def _limb_gn(chain, D, q, lin, L, tol=1e-12, max_iter=60):
+def _limb_gn(chain, D, q, lin, L, tol=1e-12, max_iter=60, hold=None):
+    """Gauss-Newton for one limb with the platform held at ``D``, in local coordinates (S
+    joints updated by composing rotations); freedoms in the ``hold`` mask keep their value."""
     Dinv = inverse_transform(D)
     colscale = np.where(lin, L, 1.0)
+    if hold is not None:
+        colscale = np.where(hold, 0.0, colscale)
     row = np.r_[np.ones(3), np.full(3, 1.0 / L)]
     rn = np.inf
     for _ in range(max_iter):
-        T, J = chain_forward(chain, q)
+        T, J = chain_forward(chain, q, local=True)
         r = log_transform(T @ Dinv)
         rn = float(np.linalg.norm(row * r))
         if rn < tol:
@@ -186,14 +192,51 @@ def _limb_gn(chain, D, q, lin, L, tol=1e-12, max_iter=60):
         x, *_ = np.linalg.lstsq(row[:, None] * J * colscale[None, :], -(row * r), rcond=None)
         if np.linalg.norm(x) < 1e-14:
             break
-        q = q + colscale * x
+        dq = colscale * x
+        q_new = q + dq
+        for k, _, A in chain.balls:
+            sl = slice(k, k + 3)
+            q_new[sl] = A.T @ (Rotation.from_rotvec(A @ dq[sl]) * Rotation.from_rotvec(A @ q[sl])).as_rotvec()
+        q = q_new
     return q, rn, rn < tol
 
 
-def _signature(chain, q, points) -> np.ndarray:
-    """Geometry of a limb's solution: every freedom's twist (axis placement)."""
-    _, J = chain_forward(chain, q)
-    return J.T.ravel()
+def _signature(chain, q, L) -> np.ndarray:
+    """Geometry of a limb's solution, nondimensional: every one-freedom joint's line (its twist
+    up to sign, so a universal joint's flipped cross (t1 + pi, pi - t2) counts once) and every
+    S joint's centre (its axes are a parametrisation, not geometry)."""
+    _, J, pre = chain_forward(chain, q, prefixes=True, local=True)
+    scale = np.r_[np.ones(3), np.full(3, 1.0 / L)]
+    ball = {k: c for k, c, _ in chain.balls}
+    parts = []
+    i = 0
+    while i < J.shape[1]:
+        if i in ball:
+            c = ball[i]
+            parts.append((pre[i, :3, :3] @ c + pre[i, :3, 3]) / L)
+            i += 3
+            continue
+        col = J[:, i] * scale
+        lead = int(np.argmax(np.abs(col) > 1e-9))
+        parts.append(col * (np.sign(col[lead]) or 1.0))
+        i += 1
+    return np.concatenate(parts)
+
+
+def wrap_rotations(mech: Mechanism, q, indices=None) -> np.ndarray:
+    """Joint variables with every rotation's value ``offset + q`` wrapped to (-pi, pi]
+    (S joints keep their rotation vectors)."""
+    q = np.array(q, dtype=float, copy=True)
+    refs = mech.freedom_refs
+    idx = range(len(q)) if indices is None else indices
+    for k, i in enumerate(idx):
+        r = refs[i]
+        if r.freedom.kind == "R" and mech.limbs[r.limb].joints[r.joint].type != "S":
+            v = r.freedom.offset + q[k]
+            q[k] = (v + np.pi) % (2 * np.pi) - np.pi - r.freedom.offset
+            if q[k] + r.freedom.offset <= -np.pi:
+                q[k] += 2 * np.pi
+    return q
 
 
 def inverse_position(
@@ -237,9 +280,8 @@ def inverse_position(
                 if rn < best[1]:
                     best = (q, rn)
                 continue
-            sig = _signature(ch, q, None)
-            scale = np.r_[np.ones(3), np.full(3, 1.0 / L)]
-            sig_n = (sig.reshape(-1, 6) * scale).ravel()
+            q = wrap_rotations(mech, q, range(sl.start, sl.stop))
+            sig_n = _signature(ch, q, L)
             if any(np.linalg.norm(sig_n - s2) < 1e-6 for s2 in sigs):
                 continue
             sigs.append(sig_n)
@@ -326,12 +368,47 @@ def _actuator_q(mech: Mechanism, values) -> dict[int, float]:
     return out
 
 
-def _fk_from(mech, config, targets, mask, max_iter):
+def _pose_seed(mech: Mechanism, rng: np.random.Generator, targets: dict[int, float]) -> Configuration:
+    """A start for the assembly-mode search: a random platform pose (any orientation, position
+    within a few characteristic lengths, mirrored through the base half of the time) with every
+    limb solved for it in the least-squares sense from random joint values, its actuators held
+    at their target values."""
+    from ..geometry.rotations import transform
+    from scipy.spatial.transform import Rotation as _R
+
+    L = mech.characteristic_length
+    p0 = mech.platform_point
+    if rng.random() < 0.5:  # any orientation
+        R = _R.random(random_state=int(rng.integers(2**31))).as_matrix()
+    else:  # near the reference orientation (mirror-image modes keep it)
+        R = _R.from_rotvec(rng.normal(scale=0.3, size=3)).as_matrix()
+    p = p0 * (1 if rng.random() < 0.5 else -1) + rng.normal(scale=L, size=3)
+    D = transform(R, p - R @ p0)
+    q = np.zeros(len(mech.freedom_refs))
+    for ch, sl in zip(limb_chains(mech), limb_slices(mech)):
+        refs = mech.freedom_refs[sl]
+        lin = np.array([r.freedom.kind == "P" for r in refs])
+        q0 = np.where(lin, rng.uniform(-1, 1, len(refs)) * L, rng.uniform(-np.pi, np.pi, len(refs)))
+        hold = np.zeros(len(refs), bool)
+        for i, v in targets.items():
+            if sl.start <= i < sl.stop:
+                q0[i - sl.start] = v
+                hold[i - sl.start] = True
+        q[sl] = _limb_gn(ch, D, q0, lin, L, max_iter=30, hold=hold)[0]
+    return Configuration(q, D)
+
+
+def _fk_from(mech, config, targets, mask, max_iter, patience=None):
     q = config.q.copy()
     for i, v in targets.items():
         q[i] = v
-    res = correct(mech, Configuration(q, config.D), active=mask, max_iter=max_iter)
-    return res
+    c = Configuration(q, config.D)
+    if patience is not None:  # abandon starts that are not converging after a few steps
+        res = correct(mech, c, active=mask, max_iter=patience)
+        if res.converged or res.residual > 1e-3:
+            return res
+        c = res.config
+    return correct(mech, c, active=mask, max_iter=max_iter)
 
 
 def forward_position(
@@ -363,11 +440,14 @@ def forward_position(
     if all_solutions:
         rng = np.random.default_rng(seed)
         for s in range(n_seeds):
-            try:
-                c = generic_configuration(mech, seed=int(rng.integers(2**31)), step=float(rng.uniform(0.3, 1.2)), steps=4)
-            except RuntimeError:
-                continue
-            runs.append(_fk_from(mech, c, targets, mask, max_iter))
+            if s % 2 == 0:
+                c = _pose_seed(mech, rng, targets)
+            else:
+                try:
+                    c = generic_configuration(mech, seed=int(rng.integers(2**31)), step=float(rng.uniform(0.3, 1.2)), steps=4)
+                except RuntimeError:
+                    continue
+            runs.append(_fk_from(mech, c, targets, mask, max_iter, patience=12))
     sols, sigs = [], []
     for k, r in enumerate(runs):
         if not r.converged and not (k == 0 and not all_solutions):
@@ -381,6 +461,7 @@ def forward_position(
     search = {"method": "Gauss-Newton with the actuators held" + (", multi-start" if all_solutions else ""),
               "seeds": 1 + (n_seeds if all_solutions else 0), "seed": seed if all_solutions else None,
               "converged_runs": sum(r.converged for r in runs), "distinct": sum(s.converged for s in sols),
-              "seeding": "random walks along the closure manifold with the actuators free" if all_solutions else "start configuration",
+              "seeding": ("random platform poses with least-squares limb solutions, and random walks along the closure "
+                          "manifold with the actuators free, alternately") if all_solutions else "start configuration",
               "distinct_by": "joint points of every limb and the platform pose (tolerance 1e-6 L)"}
     return ForwardResult(tuple(sols), search)

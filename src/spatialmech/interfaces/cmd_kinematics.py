@@ -1,0 +1,207 @@
+"""CLI commands of the position / Jacobian analyses: ``ik``, ``fk``, ``jacobian``.
+
+Poses at the command line: ``--xyz X Y Z`` (the platform point, length unit of the model) and
+``--euler SEQ A1 A2 A3`` (an explicitly named sequence, angles in degrees; upper case =
+intrinsic); or ``--position N`` for a model's built-in task positions (numbered from 1).
+Rotational actuator values are in degrees, slides in the model's length unit.
+"""
+
+from __future__ import annotations
+
+import click
+import numpy as np
+
+from .. import catalog
+from ..geometry.rotations import euler_matrix, matrix_euler
+from ..kinematics.jacobian import complete_jacobian
+from ..kinematics.position import configuration_at_pose, forward_position, inverse_position
+from ..model.mechanism import Mechanism, Pose
+from .cli import emit_json, json_option
+
+pose_options = [
+    click.option("--xyz", nargs=3, type=float, default=None, help="Platform point position X Y Z (model length unit)."),
+    click.option("--euler", "euler", nargs=4, type=(str, float, float, float), default=None,
+                 help="Orientation: SEQ A1 A2 A3, angles in degrees (e.g. ZYX 30 -5 10; upper case = intrinsic)."),
+    click.option("--position", "position", type=int, default=None, help="Built-in task position number (from 1)."),
+]
+
+
+def with_pose(f):
+    for opt in reversed(pose_options):
+        f = opt(f)
+    return f
+
+
+def resolve_pose(mech: Mechanism, xyz, euler, position) -> Pose:
+    if position is not None:
+        if xyz is not None or euler is not None:
+            raise ValueError("--position: give either --position or --xyz/--euler, not both")
+        if not mech.positions:
+            raise ValueError(f"--position: {mech.name} has no built-in task positions")
+        if not 1 <= position <= len(mech.positions):
+            raise ValueError(f"--position: expected 1..{len(mech.positions)}, got {position}")
+        return mech.positions[position - 1]
+    if xyz is None and euler is None:
+        raise ValueError("--xyz/--euler: give a pose (or --position N)")
+    p = np.asarray(xyz if xyz is not None else mech.platform_point, dtype=float)
+    if euler is None:
+        R = np.eye(3)
+    else:
+        seq, *ang = euler
+        R = euler_matrix(seq, ang, degrees=True)
+    return Pose(R, p, "requested")
+
+
+def _fmt_value(mech: Mechanism, fid: str, v: float) -> str:
+    f = mech.freedom(fid).freedom
+    return f"{v:.6g} {mech.length_unit}" if f.kind == "P" else f"{np.degrees(v):.6g} deg"
+
+
+@click.command()
+@click.argument("model")
+@with_pose
+@click.option("--all", "all_solutions", is_flag=True, help="Search every real solution of every limb.")
+@json_option
+def ik(model, xyz, euler, position, all_solutions, as_json):
+    """Inverse position: joint values of every limb for a platform pose.
+
+    \b
+    Examples:
+      spatialmech ik four-sps-cu --xyz 0 0 0.12 --euler ZYX 34.38 -5.73 11.46
+      spatialmech ik five-cs-1 --position 3 --json
+      spatialmech ik delta --xyz 0.02 0.01 -0.33 --all
+    """
+    mech = catalog.resolve(model)
+    pose = resolve_pose(mech, xyz, euler, position)
+    res = inverse_position(mech, pose, all_solutions=all_solutions)
+    if as_json:
+        emit_json(res.to_dict(mech))
+        return
+    click.echo(f"{mech.name}: pose {'reachable' if res.reachable else 'NOT reachable'}")
+    for limb in res.to_dict(mech)["limbs"]:
+        extra = f", solution set of dimension {limb['passive_dim']} (passive freedoms)" if limb["passive_dim"] else ""
+        click.echo(f"  {limb['limb']}: {len(limb['solutions'])} solution(s){extra}" + ("" if limb["reachable"] else " [least-squares, not closed]"))
+        for k, sol in enumerate(limb["solutions"]):
+            vals = ", ".join(f"{fid}={v:.6g}" for fid, v in sol["values"].items())
+            lim = f"  outside limits: {', '.join(sol['outside_limits'])}" if sol["outside_limits"] else ""
+            click.echo(f"    [{k + 1}] {vals}  (residual {sol['residual']:.1e}){lim}")
+    if res.config is not None:
+        click.echo("  actuators: " + ", ".join(f"{k} = {_fmt_value(mech, k, v)}" for k, v in res.actuator_values(mech).items()))
+    click.echo("  (rotations in degrees, slides in " + mech.length_unit + ")")
+
+
+@click.command()
+@click.argument("model")
+@click.option("--actuators", "values", required=True, help="Comma-separated actuator values in mechanism order (degrees / length).")
+@click.option("--all", "all_solutions", is_flag=True, help="Search all real assembly modes (multi-start).")
+@click.option("--seeds", default=200, show_default=True, help="Number of starts for --all.")
+@json_option
+def fk(model, values, all_solutions, seeds, as_json):
+    """Forward position: platform pose(s) for actuator values.
+
+    \b
+    Examples:
+      spatialmech fk stewart-6sps --actuators 1.2,1.2,1.2,1.2,1.2,1.2
+      spatialmech fk four-sps-cu --actuators 0.21,0.25,0.22,0.19 --all --json
+    """
+    mech = catalog.resolve(model)
+    try:
+        raw = [float(x) for x in values.split(",") if x.strip()]
+    except ValueError:
+        raise ValueError(f"--actuators: expected comma-separated numbers, got {values!r}") from None
+    acts = mech.actuators
+    if len(raw) != len(acts):
+        raise ValueError(f"--actuators: {mech.name} has {len(acts)} actuators ({', '.join(acts)}), got {len(raw)} values")
+    vals = [v if mech.freedom(a).freedom.kind == "P" else np.radians(v) for a, v in zip(acts, raw)]
+    res = forward_position(mech, vals, all_solutions=all_solutions, n_seeds=seeds)
+    if as_json:
+        emit_json(res.to_dict(mech))
+        return
+    if not res.solutions or not any(s.converged for s in res.solutions):
+        raise ValueError(f"actuators: no assembly found (Newton did not converge; residual {res.solutions[0].residual:.2e}); try --all")
+    click.echo(f"{mech.name}: {res.search['distinct']} assembly mode(s) found ({res.search['method']}, {res.search['seeds']} start(s))")
+    for k, s in enumerate(res.solutions):
+        if not s.converged:
+            continue
+        e = matrix_euler("ZYX", s.pose.R, degrees=True)
+        lim = "within limits" if not s.outside_limits else "outside limits: " + ", ".join(s.outside_limits)
+        click.echo(f"  [{k + 1}] position {np.array2string(s.pose.p, precision=6)}  ZYX (deg) {np.array2string(e, precision=4)}  {lim}")
+
+
+def _candidate_drivers(mech: Mechanism) -> list[str]:
+    """Drivers for a DJ table: every freedom of each limb's base joint, by alias when one exists."""
+    alias_of = {v: k for k, v in mech.aliases.items()}
+    out = []
+    for li, limb in enumerate(mech.limbs):
+        j = limb.joints[0]
+        for f in j.freedoms:
+            fid = f"{j.name}.{f.name}"
+            out.append(alias_of.get(fid, fid))
+    return out
+
+
+@click.command()
+@click.argument("model")
+@with_pose
+@click.option("--driver", "drivers", multiple=True, help="Actuated freedom(s) (repeatable; default: the model's actuators).")
+@click.option("--dj-table", is_flag=True, help="DJ at every built-in task position for every base-joint driver.")
+@json_option
+def jacobian(model, xyz, euler, position, drivers, dj_table, as_json):
+    """Complete Jacobian (constraint + actuation wrenches), its determinant and conditioning.
+
+    \b
+    Examples:
+      spatialmech jacobian five-cs-1 --position 3 --driver rot1
+      spatialmech jacobian five-cs-3 --dj-table --json
+      spatialmech jacobian four-sps-cu --xyz 0 0 0.12 --euler ZYX 34.38 -5.73 11.46
+    """
+    mech = catalog.resolve(model)
+    if dj_table:
+        if not mech.positions:
+            raise ValueError(f"--dj-table: {mech.name} has no built-in task positions")
+        cands = list(drivers) or _candidate_drivers(mech)
+        prev, fits = None, []
+        for P in mech.positions:
+            fit = configuration_at_pose(mech, P, start=prev)
+            if not fit.converged:
+                raise ValueError(f"position {P.name}: no closed configuration near it (residual {fit.ik_residual:.2e})")
+            fits.append(fit)
+            prev = fit.config
+        rows = []
+        for d in cands:
+            dj = [complete_jacobian(mech, f.config, [d]).det for f in fits]
+            signs = [int(np.sign(x)) for x in dj]
+            rows.append({"driver": d, "dj": dj, "signs": signs, "keeps_sign": len(set(signs)) == 1 and 0 not in signs})
+        data = {"model": mech.name, "positions": [p.name for p in mech.positions],
+                "pose_fit": [f.to_dict() for f in fits], "drivers": rows,
+                "note": "DJ magnitudes are not comparable between drivers; only signs along one driver are."}
+        if as_json:
+            emit_json(data)
+            return
+        click.echo(f"{mech.name}: sign of DJ at {', '.join(data['positions'])}")
+        for r in rows:
+            click.echo(f"  {r['driver']:>8s}  " + " ".join("+" if s > 0 else ("-" if s < 0 else "0") for s in r["signs"])
+                       + ("   keeps its sign" if r["keeps_sign"] else "   changes sign"))
+        worst = max(fits, key=lambda f: f.position_error)
+        click.echo(f"  printed poses fitted onto the closure: largest error {worst.position_error:.3g} {mech.length_unit},"
+                   f" {np.degrees(max(f.angle_error for f in fits)):.3g} deg")
+        return
+    pose = resolve_pose(mech, xyz, euler, position)
+    fit = configuration_at_pose(mech, pose)
+    if not fit.converged:
+        raise ValueError(f"pose: no closed configuration near it (residual {fit.ik_residual:.2e})")
+    J = complete_jacobian(mech, fit.config, list(drivers) or None)
+    if as_json:
+        emit_json({**J.to_dict(), "pose_fit": fit.to_dict()})
+        return
+    click.echo(f"{mech.name}: complete Jacobian (rows: {J.constraint_rows} constraint, {len(J.actuators)} actuation"
+               f" [{', '.join(J.actuators)}]); J $p = (0, qdot)")
+    for row in J.matrix:
+        click.echo("  [" + " ".join(f"{x:+.5e}" for x in row) + "]")
+    if J.det is not None:
+        click.echo(f"  det J = {J.det:+.6e}")
+    click.echo(f"  scale-free sigma_min = {J.sigma_min:.4g}, 1/condition = {J.condition:.4g}")
+    if J.inverse_singular:
+        click.echo(f"  inverse (serial) singular for: {', '.join(J.inverse_singular)}")
+    if not fit.exact:
+        click.echo(f"  note: the pose was fitted onto the closure (error {fit.position_error:.3g} {mech.length_unit}, {np.degrees(fit.angle_error):.3g} deg)")

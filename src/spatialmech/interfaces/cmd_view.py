@@ -1,0 +1,72 @@
+"""``spatialmech view``: write the interactive 3-D viewer page of a model.
+
+Thin: resolve the model, compute the motion, write the page (:mod:`..present.viewer`).
+Register it in the main group with ``cli.add_command(view)``.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import click
+
+from .. import catalog
+from ..model.schema import ModelFileError
+
+__all__ = ["view", "MOTIONS"]
+
+#: Motions the command can compute.  "demo": :func:`..present.motion.sample_motion`, a closed
+#: loop along the closure manifold from the reference configuration (not the tracker).
+MOTIONS = ("demo",)
+
+
+class _Error(click.ClickException):
+    """One line ``error: ...`` on stderr (exit code 2 for bad input, 1 for a failed computation)."""
+
+    def __init__(self, message: str, code: int = 2):
+        super().__init__(message)
+        self.exit_code = code
+
+    def show(self, file=None):
+        click.echo(f"error: {self.format_message()}", err=True, file=file)
+
+
+@click.command(name="view")
+@click.argument("model")
+@click.option("--motion", type=click.Choice(MOTIONS), default="demo", show_default=True,
+              help="Motion to animate (demo: a short loop along the closure manifold from the reference "
+                   "configuration; a demonstration, not the continuation tracker).")
+@click.option("--out", "out", required=True, type=click.Path(dir_okay=False, path_type=Path),
+              help="The HTML file to write (self-contained: plotly.js is inlined, it opens offline).")
+@click.option("--frames", type=click.IntRange(min=2), default=60, show_default=True,
+              help="Number of configurations (animation frames).")
+@click.option("--json", "as_json", is_flag=True, help='Print {"out", "frames", "bytes"} as JSON.')
+def view(model, motion, out, frames, as_json):
+    """Write an interactive 3-D viewer of MODEL (base, platform, limbs, joint axes, task
+    positions) animated along a motion, with a slider and play / pause buttons.
+
+    \b
+    Examples:
+      spatialmech view four-sps-cu --out four-sps-cu.html
+      spatialmech view five-cs-1 --frames 120 --out five-cs-1.html --json
+    """
+    from ..present.motion import sample_motion
+    from ..present.viewer import write_viewer
+
+    try:
+        mech = catalog.resolve(model)
+        configs = sample_motion(mech, n=frames)
+    except (ModelFileError, ValueError) as e:
+        raise _Error(str(e)) from None
+    except RuntimeError as e:
+        raise _Error(str(e), code=1) from None
+    title = f"{mech.name}: {motion} motion, {len(configs)} configurations (a demonstration loop, not the tracker)"
+    try:
+        written = write_viewer(out, mech, configs, title=title, task_positions=mech.positions)
+    except OSError as e:
+        raise _Error(f"--out: cannot write {out}: {e.strerror or e}") from None
+    if as_json:
+        click.echo(json.dumps(written.to_dict(), indent=2))
+    else:
+        click.echo(f"wrote {written.out} ({written.frames} frames, {written.bytes} bytes)")

@@ -1,0 +1,177 @@
+"""A demonstration motion for the 3-D viewer: a short loop along the closure manifold.
+
+This is **not** the continuation tracker (``kinematics/tracking.py``): it does no
+driver-controlled tracking, no branch or singularity handling and no step-size control beyond
+halving a failed step.  It exists so that the viewer (:mod:`.viewer`) has something honest to
+animate for any model: every configuration it returns satisfies the closure equations of
+:mod:`..kinematics.closure` (checked by :func:`..kinematics.closure.correct`), and the viewer
+accepts any list of :class:`~..kinematics.closure.Configuration` so that tracked paths can be
+shown the same way.
+
+The walk
+--------
+At a configuration ``x`` on the manifold, the tangent space is the null space of the
+*nondimensional* closure Jacobian (rows: rotations in rad, translations divided by the
+characteristic length ``L``; columns: joint rotations in rad, slides / ``L``, platform twist
+``(w ; v / L)``).  One direction ``t0`` is chosen at the start, inside the part of the tangent
+space that moves the platform (the largest platform motion for a one-parameter manifold, a
+seeded random combination of the platform-moving directions otherwise).  Along the walk the
+direction is the projection of the previous one onto the current tangent space (so it never
+flips), scaled so that its platform part ``(w ; v / L)`` has unit norm: the walk parameter
+``s`` is therefore a pseudo arc length of the platform, nondimensional (rad, or length / L).
+
+Frame ``i`` of ``n`` sits at ``s_i = amplitude * sin(2 pi i / n)``: from the start out to
+``+amplitude``, back through the start to ``-amplitude`` and back.  Configurations are computed
+once per distinct ``s`` by predictor (``x + ds t``) and Newton corrector
+(:func:`~..kinematics.closure.correct`), walking outwards from the start on each side, so the
+loop closes exactly (frame ``i`` and frame ``n/2 - i`` are the same configuration).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..kinematics.closure import (
+    Configuration,
+    _apply_step,
+    _scales,
+    active_mask,
+    closure_jacobian,
+    correct,
+)
+from ..geometry.validate import as_finite_array
+from ..model.mechanism import Mechanism
+
+__all__ = ["sample_motion", "tangent_space"]
+
+#: Relative singular-value threshold for the rank of the nondimensional closure Jacobian
+#: (the same as :func:`..kinematics.closure.generic_configuration`).
+RANK_RTOL = 1e-9
+#: Largest predictor step (nondimensional platform motion) before a Newton correction.
+MAX_STEP = 0.05
+#: Smallest step tried after halving a step whose correction failed.
+MIN_STEP = 1e-4
+
+
+def tangent_space(mech: Mechanism, config: Configuration, *, active: np.ndarray | None = None):
+    """Orthonormal basis of the tangent space of the closure manifold at ``config``.
+
+    Returns ``N`` (k, n_active + 6): rows span the null space of the nondimensional closure
+    Jacobian, in nondimensional coordinates (joint rotations in rad, slides / L, platform twist
+    ``(w ; v / L)``, the last six columns).  Multiply by the column scaling of
+    :func:`..kinematics.closure.correct` to get SI steps.
+    """
+    if active is None:
+        active = active_mask(mech)
+    row, col = _scales(mech, active)
+    A, _ = closure_jacobian(mech, config, active=active)
+    As = row[:, None] * A * col[None, :]
+    _, sv, vt = np.linalg.svd(As)
+    r = int(np.sum(sv > RANK_RTOL * max(1.0, sv[0] if sv.size else 0.0)))
+    return vt[r:]
+
+
+def _initial_direction(N: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """A tangent direction (nondimensional) that moves the platform, platform part of norm 1."""
+    Np = N[:, -6:]  # platform part of each null vector (k, 6)
+    U, sv, _ = np.linalg.svd(Np, full_matrices=False)
+    moving = int(np.sum(sv > 1e-8))
+    if moving == 0:
+        raise ValueError(
+            "mech: no motion of the closure manifold moves the platform (a structure, or only idle "
+            "spins at this configuration); nothing to animate"
+        )
+    c = U[:, 0] if moving == 1 else U[:, :moving] @ rng.standard_normal(moving)
+    t = N.T @ c
+    return t / np.linalg.norm(t[-6:])
+
+
+def _walk(mech, start, t0, targets, active, col):
+    """Configurations at the walk parameters ``targets`` (monotone away from 0), from ``start``."""
+    out = []
+    x, s, t = start, 0.0, t0
+    for target in targets:
+        while abs(target - s) > 1e-15:
+            ds = float(np.clip(target - s, -MAX_STEP, MAX_STEP))
+            while True:
+                N = tangent_space(mech, x, active=active)
+                tt = N.T @ (N @ t)  # keep the direction: project the previous one
+                pn = float(np.linalg.norm(tt[-6:]))
+                if pn < 1e-6:
+                    raise RuntimeError(
+                        f"sample_motion: the walk direction stopped moving the platform at s = {s:.4g} "
+                        "(a singularity); use a smaller amplitude"
+                    )
+                tt = tt / pn
+                res = correct(mech, _apply_step(mech, x, active, col * (ds * tt)), active=active)
+                if res.converged:
+                    break
+                ds /= 2.0
+                if abs(ds) < MIN_STEP:
+                    raise RuntimeError(
+                        f"sample_motion: Newton correction did not converge at s = {s:.4g} "
+                        f"(residual {res.residual:.2e}); use a smaller amplitude"
+                    )
+            x, s, t = res.config, s + ds, tt
+        out.append(x)
+    return out
+
+
+def sample_motion(
+    mech: Mechanism,
+    *,
+    n: int = 60,
+    amplitude: float = 0.35,
+    seed: int = 0,
+    start: Configuration | None = None,
+) -> list[Configuration]:
+    """A closed demonstration loop of ``n`` configurations on the closure manifold.
+
+    ``amplitude`` is the largest platform excursion along the walk, nondimensional: radians
+    for rotations, lengths divided by :attr:`Mechanism.characteristic_length` for
+    translations, measured as the pseudo arc length of the platform twist ``(w ; v / L)``
+    (default 0.35, about 20 degrees of rotation).  ``seed`` picks the direction when the
+    mechanism has several platform-moving freedoms.  ``start`` defaults to the reference
+    configuration (every joint variable zero).  See the module docstring for the method; this
+    is a demonstration motion for the viewer, not the continuation tracker.
+
+    Raises ``ValueError`` for bad arguments or when nothing moves the platform, and
+    ``RuntimeError`` when a Newton correction fails even after step halving (e.g. the loop
+    would cross a singularity); it never returns a configuration that does not close.
+
+    Example: ``sample_motion(catalog.build("bennett"), n=8)`` returns 8 configurations, the
+    first the reference and ``configs[1] is configs[3]`` (the loop runs out and back).
+    """
+    if not isinstance(mech, Mechanism):
+        raise ValueError(f"mech: expected a Mechanism, got {type(mech).__name__}")
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 2:
+        raise ValueError(f"n: expected an integer number of frames >= 2, got {n!r}")
+    amplitude = float(amplitude)
+    if not np.isfinite(amplitude) or amplitude <= 0:
+        raise ValueError(f"amplitude: expected a positive finite number, got {amplitude!r}")
+    active = active_mask(mech)
+    _, col = _scales(mech, active)
+    if start is None:
+        x0 = Configuration.reference(mech)
+    elif not isinstance(start, Configuration):
+        raise ValueError(f"start: expected a Configuration, got {type(start).__name__}")
+    else:
+        x0 = Configuration(
+            as_finite_array(start.q, "start.q", shape=(len(mech.freedom_refs),)),
+            as_finite_array(start.D, "start.D", shape=(4, 4)),
+        )
+    res0 = correct(mech, x0, active=active)
+    if not res0.converged:
+        raise ValueError(f"start: not on (or near) the closure manifold (residual {res0.residual:.2e})")
+    x0 = res0.config
+    t0 = _initial_direction(tangent_space(mech, x0, active=active), np.random.default_rng(seed))
+
+    s = amplitude * np.sin(2.0 * np.pi * np.arange(n) / n)
+    s = np.where(np.abs(s) < 1e-12 * amplitude, 0.0, s)
+    keys = np.round(s / amplitude, 12)
+    pos = np.unique(keys[keys > 0])  # increasing
+    neg = np.unique(keys[keys < 0])[::-1]  # decreasing
+    at = {0.0: x0}
+    at.update(zip(pos.tolist(), _walk(mech, x0, t0, amplitude * pos, active, col)))
+    at.update(zip(neg.tolist(), _walk(mech, x0, t0, amplitude * neg, active, col)))
+    return [at[float(k)] for k in keys]

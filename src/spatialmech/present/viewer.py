@@ -1,0 +1,456 @@
+"""The interactive 3-D viewer: a self-contained HTML page (plotly, JavaScript inlined).
+
+Three layers, each usable alone:
+
+* :func:`drawing` -- pure geometry of one configuration (NumPy arrays, world frame, SI /
+  the model's length unit): limb polylines, base and platform outlines, joint-axis segments,
+  joint centres and the platform frame.  No plotting.
+* :func:`viewer_figure` -- a ``plotly.graph_objects.Figure`` with one animation frame per
+  configuration, a slider and play / pause buttons, the task positions (platform point + a
+  small frame each) and the singular points as markers, equal axis scales, a legend.
+* :func:`viewer_html` / :func:`write_viewer` -- the page, with ``plotly.min.js`` from the
+  installed plotly package inlined (it opens offline; nothing is fetched from a CDN).
+
+What is drawn (conventions of :mod:`..kinematics.closure`): at a configuration ``(q, D)`` the
+joint points are :func:`~..kinematics.closure.joint_points`; the platform point is
+``D[:3, :3] p0 + D[:3, 3]`` and the platform frame's axes are the columns of ``D[:3, :3]`` (the
+platform frame is world-aligned at the reference).  A joint axis is the direction part of the
+freedom's current twist (``s`` of ``(s ; s0)``; the moment part ``s0`` for a prismatic
+freedom, whose twist is ``(0 ; v)``), drawn as a segment centred on the joint point for R, P,
+H, C and U joints; S joints are drawn as balls.  The base and platform are the convex outlines
+of the first / last joint points of the limbs (in their best-fit plane); thin lines join the
+platform point to the platform outline's corners (the platform is one rigid body).  When two consecutive
+R, H, C or U joints of a limb share their centre (a spherical linkage such as paper C's
+3-RRR), the link
+between them is drawn as a great-circle arc from the first joint's axis to the second's, on a
+sphere whose radius grows with the limb index -- links of a spherical linkage are rigid
+bodies carrying two axes through the centre, so the arc moves rigidly with the link.
+
+Lengths are in the model's ``length_unit`` (labelled on the axes); nothing here converts
+angles.  Example::
+
+    from spatialmech import catalog
+    from spatialmech.present.motion import sample_motion
+    from spatialmech.present.viewer import write_viewer
+    mech = catalog.build("bennett")
+    write_viewer("bennett.html", mech, sample_motion(mech, n=40))   # ViewerFile(frames=40, ...)
+"""
+
+from __future__ import annotations
+
+import html as _html
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+import plotly.graph_objects as go
+from scipy.spatial import ConvexHull
+
+from ..geometry.validate import as_finite_array
+from ..kinematics.closure import Configuration, joint_points, joint_twists
+from ..model.mechanism import Mechanism, Pose
+
+__all__ = ["Drawing", "ViewerFile", "drawing", "viewer_figure", "viewer_html", "write_viewer", "DIV_ID"]
+
+#: ``id`` of the plotly graph ``<div>`` in the page (the browser test reads it).
+DIV_ID = "spatialmech-viewer"
+#: Joint types whose axes are drawn as segments.
+AXIS_JOINTS = ("R", "P", "H", "C", "U")
+#: Joint types whose coincident-centre links are drawn as arcs (rotations about fixed axes).
+ARC_JOINTS = ("R", "H", "C", "U")
+#: Drawing sizes as fractions of the drawing scale (the characteristic length).
+AXIS_HALF = 0.18
+FRAME_LEN = 0.3
+ARC_RADIUS0, ARC_RADIUS_STEP = 0.35, 0.2
+#: Joint centres closer than this fraction of the scale are "the same point".
+COINCIDENT = 1e-9
+_PALETTE = ("#1f77b4", "#2ca02c", "#9467bd", "#8c564b", "#e377c2", "#17becf", "#bcbd22", "#7f7f7f")
+_FRAME_COLOURS = ("#d62728", "#2ca02c", "#1f77b4")  # platform frame x, y, z
+
+
+@dataclass(frozen=True, eq=False)
+class Drawing:
+    """The geometry of one configuration, world frame, model length unit.
+
+    ``limbs``: per limb a (k, 3) polyline; ``base`` / ``platform``: closed outlines (k, 3)
+    (a single point or a segment when the points are degenerate); ``axes``: (m, 2, 3) joint
+    axis segments; ``joints``: (j, 3) joint centres with ``joint_names``; ``platform_point``
+    (3,); ``platform_frame``: (3, 3) columns = platform x, y, z axes (unit vectors).
+    """
+
+    limbs: tuple[np.ndarray, ...]
+    base: np.ndarray
+    platform: np.ndarray
+    axes: np.ndarray
+    joints: np.ndarray
+    joint_names: tuple[str, ...]
+    platform_point: np.ndarray
+    platform_frame: np.ndarray
+    scale: float
+
+    def points(self) -> np.ndarray:
+        """Every drawn point (for bounding boxes and finiteness checks)."""
+        parts = [*self.limbs, self.base, self.platform, self.axes.reshape(-1, 3), self.joints,
+                 self.platform_point[None, :], self.platform_point + FRAME_LEN * self.scale * self.platform_frame.T]
+        return np.vstack(parts)
+
+    def to_dict(self) -> dict:
+        return {
+            "limbs": [l.tolist() for l in self.limbs],
+            "base": self.base.tolist(),
+            "platform": self.platform.tolist(),
+            "axes": self.axes.tolist(),
+            "joints": self.joints.tolist(),
+            "joint_names": list(self.joint_names),
+            "platform_point": self.platform_point.tolist(),
+            "platform_frame": self.platform_frame.tolist(),
+            "scale": self.scale,
+        }
+
+
+@dataclass(frozen=True)
+class ViewerFile:
+    """What :func:`write_viewer` wrote."""
+
+    out: str
+    frames: int
+    bytes: int
+
+    def to_dict(self) -> dict:
+        return {"out": self.out, "frames": self.frames, "bytes": self.bytes}
+
+
+# ---------------------------------------------------------------------------- geometry
+def _outline_order(points: np.ndarray, scale: float) -> np.ndarray:
+    """Indices of a closed outline through ``points`` (n, 3): the convex hull in their best-fit
+    plane; a segment along the principal direction when they are (nearly) collinear."""
+    n = len(points)
+    if n == 0:
+        return np.zeros(0, int)
+    # drop coincident points (keep the first of each)
+    keep = []
+    for i in range(n):
+        if all(np.linalg.norm(points[i] - points[j]) > COINCIDENT * scale for j in keep):
+            keep.append(i)
+    keep = np.array(keep)
+    if len(keep) == 1:
+        return keep
+    P = points[keep] - points[keep].mean(axis=0)
+    _, sv, vt = np.linalg.svd(P, full_matrices=False)
+    if len(keep) == 2 or sv[1] <= 1e-6 * sv[0]:
+        t = P @ vt[0]
+        return keep[[int(np.argmin(t)), int(np.argmax(t))]]
+    hull = ConvexHull(P @ vt[:2].T)
+    return keep[hull.vertices]  # counter-clockwise in the plane
+
+
+def _closed(points: np.ndarray, order: np.ndarray) -> np.ndarray:
+    pts = points[order]
+    return np.vstack([pts, pts[:1]]) if len(order) > 2 else pts
+
+
+def _arc(centre, a, b, radius, n=12) -> np.ndarray:
+    """Great-circle arc from direction ``a`` to direction ``b`` (unit) at ``radius``."""
+    ang = float(np.arccos(np.clip(a @ b, -1.0, 1.0)))
+    if ang < 1e-9 or np.pi - ang < 1e-9:
+        return centre + radius * np.array([a, b])
+    t = np.linspace(0.0, 1.0, n)[:, None]
+    w = (np.sin((1 - t) * ang) * a + np.sin(t * ang) * b) / np.sin(ang)
+    return centre + radius * w
+
+
+def _freedom_direction(kind: str, twist: np.ndarray) -> np.ndarray:
+    d = twist[3:] if kind == "P" else twist[:3]
+    return d / np.linalg.norm(d)
+
+
+def _check_config(mech: Mechanism, config, name: str) -> None:
+    if not isinstance(config, Configuration):
+        raise ValueError(f"{name}: expected a Configuration, got {type(config).__name__}")
+    as_finite_array(config.q, f"{name}.q", shape=(len(mech.freedom_refs),))
+    as_finite_array(config.D, f"{name}.D", shape=(4, 4))
+
+
+def _platform_order(mech: Mechanism) -> np.ndarray:
+    ref = Configuration.reference(mech)
+    last = np.array([p[-1] for p in joint_points(mech, ref)])
+    return _outline_order(last, mech.characteristic_length)
+
+
+def drawing(mech: Mechanism, config: Configuration) -> Drawing:
+    """The geometry of ``mech`` at ``config`` (see the module docstring for what is drawn).
+
+    Pure and cheap (a product of exponentials per limb).  Raises ``ValueError`` when the
+    configuration does not match the mechanism or contains NaN.
+    """
+    _check_config(mech, config, "config")
+    s = mech.characteristic_length
+    pts = joint_points(mech, config)
+    tw = joint_twists(mech, config)
+    R, p = config.D[:3, :3], config.D[:3, 3]
+    pp = R @ mech.platform_point + p
+
+    limbs, axes, centres, names = [], [], [], []
+    for li, limb in enumerate(mech.limbs):
+        refs = [(k, r) for k, r in enumerate(r for r in mech.freedom_refs if r.limb == li)]
+        by_joint: dict[int, list] = {}
+        for k, r in refs:
+            by_joint.setdefault(r.joint, []).append((r.freedom.kind, tw[li][:, k]))
+        P = pts[li]
+        for j, joint in enumerate(limb.joints):
+            centres.append(P[j])
+            names.append(joint.name)
+            if joint.type in AXIS_JOINTS:
+                seen = []
+                for kind, twist in by_joint[j]:
+                    d = _freedom_direction(kind, twist)
+                    if any(abs(d @ e) > 1 - 1e-9 for e in seen):
+                        continue  # C joint: rotation and slide share the axis
+                    seen.append(d)
+                    axes.append([P[j] - AXIS_HALF * s * d, P[j] + AXIS_HALF * s * d])
+        # the limb polyline, with arcs for links between joints that share their centre
+        rho = (ARC_RADIUS0 + ARC_RADIUS_STEP * li) * s
+        path = [P[0]]
+        for j in range(len(limb.joints) - 1):
+            piece = [P[j], P[j + 1]]
+            out_f, in_f = by_joint[j][-1], by_joint[j + 1][0]
+            if (
+                np.linalg.norm(P[j + 1] - P[j]) <= COINCIDENT * s
+                and {limb.joints[j].type, limb.joints[j + 1].type} <= set(ARC_JOINTS)
+                and out_f[0] != "P" and in_f[0] != "P"
+            ):  # a link of a spherical linkage: spoke, arc, spoke
+                a, b = _freedom_direction(*out_f), _freedom_direction(*in_f)
+                piece = [P[j], *_arc(P[j], a, b, rho), P[j + 1]]
+            path.extend(piece[1:])
+        limbs.append(np.array(path))
+
+    first = np.array([P[0] for P in pts])
+    last = np.array([P[-1] for P in pts])
+    order = _platform_order(mech)  # from the reference: the same corners at every configuration
+    return Drawing(
+        limbs=tuple(limbs),
+        base=_closed(first, _outline_order(first, s)),
+        platform=_closed(last, order),
+        axes=np.array(axes).reshape(-1, 2, 3),
+        joints=np.array(centres),
+        joint_names=tuple(names),
+        platform_point=pp,
+        platform_frame=R.copy(),
+        scale=s,
+    )
+
+
+# ---------------------------------------------------------------------------- figure
+def _segments(segs: np.ndarray) -> tuple[list, list, list]:
+    """(m, 2, 3) segments as x, y, z lists with ``None`` gaps (one plotly trace)."""
+    xs, ys, zs = [], [], []
+    for a, b in segs:
+        xs += [a[0], b[0], None]
+        ys += [a[1], b[1], None]
+        zs += [a[2], b[2], None]
+    return xs, ys, zs
+
+
+def _xyz(points: np.ndarray) -> dict:
+    points = np.asarray(points, float).reshape(-1, 3)
+    return {"x": points[:, 0].tolist(), "y": points[:, 1].tolist(), "z": points[:, 2].tolist()}
+
+
+def _frame_segments(origin: np.ndarray, R: np.ndarray, length: float, axis: int) -> np.ndarray:
+    return np.array([[origin, origin + length * R[:, axis]]])
+
+
+def _animated(d: Drawing, fill: bool) -> list:
+    """The traces that move, in a fixed order; styles are given only in the first frame."""
+    out = [go.Scatter3d(**_xyz(d.platform))]
+    x, y, z = _segments(np.array([[d.platform_point, q] for q in d.platform[: max(1, len(d.platform) - 1)]]))
+    out.append(go.Scatter3d(x=x, y=y, z=z))
+    if fill:
+        out.append(go.Mesh3d(**_xyz(d.platform[:-1])))
+    out += [go.Scatter3d(**_xyz(l)) for l in d.limbs]
+    x, y, z = _segments(d.axes)
+    out.append(go.Scatter3d(x=x, y=y, z=z))
+    out.append(go.Scatter3d(**_xyz(d.joints)))
+    for k in range(3):
+        x, y, z = _segments(_frame_segments(d.platform_point, d.platform_frame, FRAME_LEN * d.scale, k))
+        out.append(go.Scatter3d(x=x, y=y, z=z))
+    return out
+
+
+def _style_animated(traces: list, d: Drawing, mech: Mechanism, fill: bool) -> None:
+    i = 0
+    traces[i].update(mode="lines", name="platform", line=dict(color="#ff7f0e", width=6), legendgroup="platform")
+    i += 1
+    traces[i].update(mode="lines", name="platform body (platform point to its joints)", legendgroup="platform",
+                     showlegend=False, line=dict(color="#ff7f0e", width=2), hoverinfo="skip")
+    i += 1
+    if fill:
+        n = len(d.platform) - 1
+        traces[i].update(i=[0] * (n - 2), j=list(range(1, n - 1)), k=list(range(2, n)), color="#ff7f0e",
+                         opacity=0.35, name="platform", legendgroup="platform", showlegend=False, hoverinfo="skip")
+        i += 1
+    for li, limb in enumerate(mech.limbs):
+        traces[i].update(mode="lines", name=f"limb {limb.name}", line=dict(color=_PALETTE[li % len(_PALETTE)], width=7))
+        i += 1
+    traces[i].update(mode="lines", name="joint axes (R, P, H, C, U)", line=dict(color="#333333", width=4))
+    i += 1
+    traces[i].update(mode="markers", name="joints", marker=dict(size=4, color="#333333"), text=list(d.joint_names),
+                     hovertemplate="%{text}<br>(%{x:.4g}, %{y:.4g}, %{z:.4g})<extra></extra>")
+    i += 1
+    for k, c in enumerate(_FRAME_COLOURS):
+        traces[i].update(mode="lines", name="platform frame (x red, y green, z blue)", line=dict(color=c, width=6),
+                         legendgroup="platform frame", showlegend=k == 0)
+        i += 1
+
+
+def _singular_point(mech: Mechanism, item, k: int) -> np.ndarray:
+    if isinstance(item, Configuration):
+        _check_config(mech, item, f"singular_points[{k}]")
+        return item.D[:3, :3] @ mech.platform_point + item.D[:3, 3]
+    return as_finite_array(item, f"singular_points[{k}]", shape=(3,))
+
+
+def viewer_figure(
+    mech: Mechanism,
+    configs: Sequence[Configuration],
+    *,
+    title: str | None = None,
+    task_positions: Sequence[Pose] = (),
+    singular_points: Sequence = (),
+) -> go.Figure:
+    """The animated plotly figure of ``mech`` along ``configs`` (one frame per configuration).
+
+    ``task_positions``: platform poses (:class:`Pose`, e.g. ``mech.positions``) shown as the
+    platform point and a small frame each, labelled with the pose name.  ``singular_points``:
+    platform points (3-vectors, world frame) or :class:`Configuration` objects (their platform
+    point is drawn).  Pure: builds the figure, writes nothing.  Raises ``ValueError`` on an
+    empty or mismatched ``configs`` and on NaN anywhere.
+    """
+    if not isinstance(mech, Mechanism):
+        raise ValueError(f"mech: expected a Mechanism, got {type(mech).__name__}")
+    configs = list(configs)
+    if not configs:
+        raise ValueError("configs: at least one configuration is needed")
+    for k, c in enumerate(configs):
+        _check_config(mech, c, f"configs[{k}]")
+    poses = list(task_positions)
+    for k, pz in enumerate(poses):
+        if not isinstance(pz, Pose):
+            raise ValueError(f"task_positions[{k}]: expected a Pose, got {type(pz).__name__}")
+    sing = np.array([_singular_point(mech, x, k) for k, x in enumerate(singular_points)]).reshape(-1, 3)
+
+    order = _platform_order(mech)
+    draws = [drawing(mech, c) for c in configs]
+    d0 = draws[0]
+    s = d0.scale
+    fill = len(order) >= 3
+
+    static = []
+    static.append(go.Scatter3d(**_xyz(d0.base), mode="lines", name="base", line=dict(color="#555555", width=6),
+                               legendgroup="base"))
+    if len(d0.base) >= 4:
+        n = len(d0.base) - 1
+        static.append(go.Mesh3d(**_xyz(d0.base[:-1]), i=[0] * (n - 2), j=list(range(1, n - 1)), k=list(range(2, n)),
+                                color="#999999", opacity=0.3, name="base", legendgroup="base", hoverinfo="skip"))
+    path = np.array([d.platform_point for d in draws])
+    static.append(go.Scatter3d(**_xyz(path), mode="lines", name="platform point path",
+                               line=dict(color="#ff7f0e", width=2, dash="dot")))
+    extra = [path]
+    if poses:
+        P = np.array([pz.p for pz in poses])
+        static.append(go.Scatter3d(**_xyz(P), mode="markers+text", name="task positions",
+                                   text=[pz.name or f"#{k + 1}" for k, pz in enumerate(poses)],
+                                   marker=dict(size=5, color="#000000", symbol="diamond"), legendgroup="task"))
+        for k, c in enumerate(_FRAME_COLOURS):
+            segs = np.concatenate([_frame_segments(pz.p, pz.R, 0.6 * FRAME_LEN * s, k) for pz in poses])
+            x, y, z = _segments(segs)
+            static.append(go.Scatter3d(x=x, y=y, z=z, mode="lines", line=dict(color=c, width=3), legendgroup="task",
+                                       name="task frames", showlegend=False, hoverinfo="skip"))
+            extra.append(segs.reshape(-1, 3))
+    if len(sing):
+        static.append(go.Scatter3d(**_xyz(sing), mode="markers", name="singular points",
+                                   marker=dict(size=6, color="#d62728", symbol="x")))
+        extra.append(sing)
+
+    first = _animated(d0, fill)
+    _style_animated(first, d0, mech, fill)
+    anim_idx = list(range(len(static), len(static) + len(first)))
+    frames = [go.Frame(data=_animated(d, fill), traces=anim_idx, name=str(k)) for k, d in enumerate(draws)]
+
+    allp = np.vstack([d.points() for d in draws] + extra)
+    lo, hi = allp.min(axis=0), allp.max(axis=0)
+    centre, half = (lo + hi) / 2, max(float(np.max(hi - lo)) / 2 * 1.08, 1e-9 * s, 1e-12)
+    unit = mech.length_unit
+    scene = dict(aspectmode="cube")
+    for ax, c in zip("xyz", centre):
+        scene[f"{ax}axis"] = dict(range=[c - half, c + half], title=f"{ax} [{unit}]", autorange=False)
+
+    anim = dict(mode="immediate", frame=dict(duration=0, redraw=True), transition=dict(duration=0))
+    fig = go.Figure(data=static + first, frames=frames)
+    fig.update_layout(
+        title=title if title is not None else f"{mech.name}: {len(configs)} configurations",
+        scene=scene,
+        legend=dict(itemsizing="constant"),
+        margin=dict(l=0, r=0, t=40, b=0),
+        uirevision="spatialmech",
+        updatemenus=[dict(
+            type="buttons", direction="left", x=0.0, y=0.0, xanchor="left", yanchor="top", pad=dict(t=50, r=10),
+            showactive=False,
+            buttons=[
+                dict(label="Play", method="animate",
+                     args=[None, dict(mode="immediate", fromcurrent=True, frame=dict(duration=60, redraw=True),
+                                      transition=dict(duration=0))]),
+                dict(label="Pause", method="animate", args=[[None], anim]),
+            ],
+        )],
+        sliders=[dict(
+            active=0, x=0.12, len=0.88, y=0.0, yanchor="top", pad=dict(t=40, b=10),
+            currentvalue=dict(prefix="configuration ", visible=True),
+            steps=[dict(label=str(k), method="animate", args=[[str(k)], anim]) for k in range(len(configs))],
+        )],
+    )
+    return fig
+
+
+def viewer_html(
+    mech: Mechanism,
+    configs: Sequence[Configuration],
+    *,
+    title: str | None = None,
+    task_positions: Sequence[Pose] = (),
+    singular_points: Sequence = (),
+    full_html: bool = True,
+    include_plotlyjs: bool | str = True,
+) -> str:
+    """The viewer page as a string: plotly.min.js inlined (``include_plotlyjs=True``, works
+    offline), the figure of :func:`viewer_figure` in a ``<div id="spatialmech-viewer">``, not
+    auto-playing.  ``full_html=False`` gives an embeddable ``<div>`` (for a report that embeds
+    several viewers, inline the JavaScript once and pass ``include_plotlyjs=False`` after)."""
+    fig = viewer_figure(mech, configs, title=title, task_positions=task_positions, singular_points=singular_points)
+    page = fig.to_html(
+        include_plotlyjs=include_plotlyjs, full_html=full_html, auto_play=False, div_id=DIV_ID,
+        default_height="92vh", config={"displaylogo": False, "responsive": True},
+    )
+    if full_html:
+        name = _html.escape(title if title is not None else mech.name)
+        page = page.replace("<head>", f"<head><title>{name}</title>", 1)
+    return page
+
+
+def write_viewer(
+    path,
+    mech: Mechanism,
+    configs: Sequence[Configuration],
+    *,
+    title: str | None = None,
+    task_positions: Sequence[Pose] = (),
+    singular_points: Sequence = (),
+) -> ViewerFile:
+    """Write :func:`viewer_html` (a full, self-contained page) to ``path`` (UTF-8)."""
+    configs = list(configs)
+    page = viewer_html(mech, configs, title=title, task_positions=task_positions, singular_points=singular_points)
+    data = page.encode("utf-8")
+    p = Path(path)
+    p.write_bytes(data)
+    return ViewerFile(str(p), len(configs), len(data))

@@ -1,0 +1,118 @@
+"""Position analysis on the general engine: inverse/forward round trips, all solutions, errors."""
+
+import json
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import spatialmech as sm
+from spatialmech import catalog
+from spatialmech.interfaces.cli import cli
+from spatialmech.kinematics.closure import generic_configuration
+from spatialmech.kinematics.position import (
+    forward_position,
+    freedom_values,
+    inverse_position,
+    platform_pose,
+)
+
+STEWART = catalog.build("stewart-6sps")
+DELTA = catalog.build("delta")
+
+
+@settings(max_examples=15, deadline=None)
+@given(st.integers(0, 10_000))
+def test_stewart_inverse_then_forward_round_trip(seed):
+    target = generic_configuration(STEWART, seed=seed, step=0.25)
+    pose = platform_pose(STEWART, target)
+    inv = inverse_position(STEWART, pose)
+    assert inv.reachable
+    legs = list(inv.actuator_values(STEWART).values())
+    fwd = forward_position(STEWART, legs, start=sm.kinematics.closure.Configuration.reference(STEWART))
+    assert fwd.converged
+    assert np.allclose(fwd.solutions[0].pose.p, pose.p, atol=1e-9)
+    assert np.allclose(fwd.solutions[0].pose.R, pose.R, atol=1e-9)
+
+
+def test_delta_inverse_finds_both_elbows_of_every_arm():
+    pose = sm.Pose(np.eye(3), [0.02, 0.01, -0.33])
+    inv = inverse_position(DELTA, pose, all_solutions=True)
+    assert inv.reachable
+    assert [len(l.solutions) for l in inv.limbs] == [2, 2, 2]
+    # the two elbow solutions have different actuator angles
+    for l in inv.limbs:
+        assert abs(l.solutions[0][0] - l.solutions[1][0]) > 0.5
+
+
+def test_passive_spin_is_reported_as_a_continuum():
+    pose = platform_pose(STEWART, generic_configuration(STEWART, seed=1))
+    inv = inverse_position(STEWART, pose, all_solutions=True, n_seeds=8)
+    assert all(l.passive_dim == 1 and len(l.solutions) == 1 for l in inv.limbs)
+
+
+def test_unreachable_pose_is_reported_not_hidden():
+    pose = sm.Pose(np.eye(3), [0.0, 0.0, -3.0])  # far below the delta's reach
+    inv = inverse_position(DELTA, pose)
+    assert not inv.reachable and inv.config is None
+    with pytest.raises(ValueError, match="not reachable"):
+        inv.actuator_values(DELTA)
+
+
+def test_forward_all_finds_several_assembly_modes_of_the_stewart_platform():
+    legs = freedom_values(STEWART, np.zeros(len(STEWART.freedom_refs)))[[3 + 7 * k for k in range(6)]]
+    res = forward_position(STEWART, legs, all_solutions=True, n_seeds=40, seed=1)
+    poses = [s.pose for s in res.solutions if s.converged]
+    assert res.search["distinct"] >= 2  # at least the home pose and its mirror image below the base
+    assert any(np.allclose(p.p, [0, 0, 1.0], atol=1e-9) for p in poses)
+    assert any(p.p[2] < 0 for p in poses)
+
+
+def test_forward_bad_inputs():
+    with pytest.raises(ValueError, match="actuators: expected 6 values"):
+        forward_position(STEWART, [1.0, 1.0])
+    with pytest.raises(ValueError, match="not finite"):
+        forward_position(STEWART, [1.0, np.nan, 1, 1, 1, 1])
+    res = forward_position(STEWART, [10.0] * 6, max_iter=15)  # legs far too long to close from home
+    assert not res.converged or np.linalg.norm(res.solutions[0].pose.p) > 5
+
+
+def run(*args):
+    return CliRunner().invoke(cli, list(args))
+
+
+def test_cli_dj_table_json_layout():
+    r = run("jacobian", "five-cs-3", "--dj-table", "--json")
+    assert r.exit_code == 0, r.output
+    d = json.loads(r.output)
+    rows = {x["driver"]: x for x in d["drivers"]}
+    assert set(rows) == {f"rot{i}" for i in range(1, 6)} | {f"slide{i}" for i in range(1, 6)}
+    assert all(len(x["dj"]) == 7 and len(x["signs"]) == 7 for x in rows.values())
+    assert {k for k, x in rows.items() if x["keeps_sign"]} == {"rot1", "rot2"}
+
+
+def test_cli_ik_fk_jacobian():
+    r = run("ik", "four-sps-cu", "--xyz", "0", "0", "0.12", "--euler", "ZYX", "34.38", "-5.73", "11.46", "--json")
+    assert r.exit_code == 0, r.output
+    legs = json.loads(r.output)["actuators"]
+    r2 = run("fk", "four-sps-cu", "--actuators", ",".join(str(v) for v in legs.values()), "--all", "--seeds", "80", "--json")
+    sols = json.loads(r2.output)["solutions"]
+    assert any(abs(s["position"][2] - 0.12) < 1e-9 for s in sols)
+    r3 = run("jacobian", "five-cs-1", "--position", "3", "--driver", "rot1", "--json")
+    d = json.loads(r3.output)
+    assert len(d["matrix"]) == 6 and d["det"] is not None
+
+
+@pytest.mark.parametrize(
+    "args, msg",
+    [(["fk", "stewart-6sps", "--actuators", "1,1"], "has 6 actuators"),
+     (["ik", "five-cs-1", "--position", "9"], "expected 1..7"),
+     (["ik", "stewart-6sps", "--position", "1"], "no built-in task positions"),
+     (["ik", "stewart-6sps", "--xyz", "0", "0", "1", "--euler", "ZZX", "0", "0", "0"], "seq"),
+     (["jacobian", "five-cs-1", "--position", "2", "--driver", "rot9"], "unknown freedom 'rot9'")],
+)
+def test_cli_kinematics_errors(args, msg):
+    r = run(*args)
+    assert r.exit_code == 2 and msg in r.output
