@@ -32,6 +32,8 @@ __all__ = [
     "exp_twist",
     "log_transform",
     "rotation_angle",
+    "rotvec_matrix",
+    "matrix_rotvec",
 ]
 
 _AXES = set("xyzXYZ")
@@ -73,6 +75,9 @@ def matrix_euler(seq: str, R, *, degrees: bool = False) -> np.ndarray:
 def skew(v) -> np.ndarray:
     """The 3x3 cross-product matrix ``[v]x`` (stacks allowed)."""
     v = np.asarray(v, dtype=float)
+    if v.ndim == 1:  # fast path for one vector
+        x, y, z = v
+        return np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
     z = np.zeros(v.shape[:-1])
     return np.stack(
         [
@@ -152,6 +157,30 @@ def log_transform(T) -> np.ndarray:
         Ginv = np.eye(3) / t - 0.5 * W + (1.0 / t - 0.5 / np.tan(t / 2.0)) * (W @ W)
         out[i] = np.concatenate([w, Ginv @ p]) * t
     return out.reshape(T.shape[:-2] + (6,))
+
+
+def rotvec_matrix(phi) -> np.ndarray:
+    """Rotation matrix of one rotation vector (Rodrigues), without scipy's per-call overhead."""
+    phi = np.asarray(phi, dtype=float)
+    th = float(np.sqrt(phi @ phi))
+    if th < 1e-12:
+        return np.eye(3) + skew(phi)
+    K = skew(phi / th)
+    return np.eye(3) + np.sin(th) * K + (1.0 - np.cos(th)) * (K @ K)
+
+
+def matrix_rotvec(R) -> np.ndarray:
+    """Rotation vector (angle in [0, pi]) of one rotation matrix."""
+    R = np.asarray(R, dtype=float)
+    c = (np.trace(R) - 1.0) / 2.0
+    if c < -0.999:  # near a half turn: scipy's robust branch
+        return Rotation.from_matrix(R).as_rotvec()
+    w = np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
+    sn = 0.5 * float(np.sqrt(w @ w))
+    th = float(np.arctan2(sn, c))
+    if th < 1e-12:
+        return 0.5 * w
+    return w * (th / (2.0 * sn))
 
 
 def rotation_angle(R) -> np.ndarray:

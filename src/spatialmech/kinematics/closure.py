@@ -24,7 +24,15 @@ import numpy as np
 
 from scipy.spatial.transform import Rotation
 
-from ..geometry.rotations import exp_twist, inverse_transform, log_transform, skew, transform
+from ..geometry.rotations import (
+    exp_twist,
+    inverse_transform,
+    log_transform,
+    matrix_rotvec,
+    rotvec_matrix,
+    skew,
+    transform,
+)
 from ..geometry.screws import adjoint
 from ..model.mechanism import Mechanism
 
@@ -314,13 +322,19 @@ class CorrectionResult:
     stationary: bool = False  # steps vanished without closure: a least-squares minimum
 
 
+_BALLS: "weakref.WeakKeyDictionary[Mechanism, list]" = weakref.WeakKeyDictionary()
+
+
 def _ball_groups(mech: Mechanism) -> list[tuple[int, np.ndarray]]:
-    """(first global index, axes as columns) of every S joint."""
+    """(first global index, axes as columns) of every S joint (cached per mechanism)."""
+    if mech in _BALLS:
+        return _BALLS[mech]
     out, start = [], 0
     for ch in limb_chains(mech):
         for k, _, A in ch.balls:
             out.append((start + k, A))
         start += len(ch.screws)
+    _BALLS[mech] = out
     return out
 
 
@@ -332,8 +346,8 @@ def _apply_step(mech, config, active, step, fix_platform=False):
     q = config.q + dq
     for i, A in _ball_groups(mech):
         sl = slice(i, i + 3)
-        R_old = Rotation.from_rotvec(A @ config.q[sl])
-        q[sl] = A.T @ (Rotation.from_rotvec(A @ dq[sl]) * R_old).as_rotvec()
+        R_new = rotvec_matrix(A @ dq[sl]) @ rotvec_matrix(A @ config.q[sl])
+        q[sl] = A.T @ matrix_rotvec(R_new)
     if fix_platform:
         D = config.D
     else:

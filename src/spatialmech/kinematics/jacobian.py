@@ -237,3 +237,32 @@ def complete_jacobian(
         rows.append(w)
     M = sc.swap(np.array(rows)) if rows else np.zeros((0, 6))
     return CompleteJacobian(M, n_c, tuple(limbs_of_rows), tuple(act_ids), tuple(singular), L)
+
+
+def driver_determinants(mech: Mechanism, config: Configuration, drivers) -> np.ndarray:
+    """``det J`` for each single driver in ``drivers`` at one configuration, sharing the
+    constraint rows (one twist evaluation for all drivers).  Equal to
+    ``complete_jacobian(mech, config, [d]).det`` for each ``d``; ``nan`` where J is not square
+    (a mechanism with redundant constraints) — use the driver rate along the motion instead."""
+    L = mech.characteristic_length
+    twists = joint_twists(mech, config)
+    refs = mech.freedom_refs
+    sls = limb_slices(mech)
+    cons, per_limb, active_idx = [], [], []
+    for k, sl in enumerate(sls):
+        idx = [i for i in range(sl.start, sl.stop) if not refs[i].freedom.locked]
+        active_idx.append(idx)
+        T = twists[k][:, [i - sl.start for i in idx]].T
+        W = limb_constraint_wrenches(T, length_scale=L)
+        per_limb.append((T, W))
+        cons.extend(W)
+    out = np.full(len(drivers), np.nan)
+    if len(cons) != 5:
+        return out
+    C = sc.swap(np.array(cons))
+    for n, d in enumerate(drivers):
+        r = mech.freedom(d)
+        T, W = per_limb[r.limb]
+        w = actuation_wrench(T, active_idx[r.limb].index(refs.index(r)), W, length_scale=L)
+        out[n] = 0.0 if w is None else float(np.linalg.det(np.vstack([C, sc.swap(w)])))
+    return out

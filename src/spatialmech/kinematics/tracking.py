@@ -197,6 +197,7 @@ def track(
     tol: float = 1e-11,
     max_turn_deg: float = 15.0,
     monitors: dict[str, Callable] | None = None,
+    vector_monitor: tuple[list[str], Callable] | None = None,
     event_tol: float = 1e-10,
     detect_closure: bool = True,
     stop: Callable | None = None,
@@ -206,10 +207,24 @@ def track(
 
     ``direction``: local-coordinate vector giving the sense of travel (the tangent is oriented
     to have a positive component on it).  ``monitors``: name -> function(x) whose sign changes
-    are located as :class:`Event` s.  ``stop(x, s)``: return True to stop after a point.
+    are located as :class:`Event` s; ``vector_monitor = (names, f)`` evaluates several at once
+    (``f(x)`` returns one value per name).  ``stop(x, s)``: return True to stop after a point.
     Arc length is measured in the problem's (nondimensional) local coordinates.
     """
-    monitors = monitors or {}
+    monitors = dict(monitors or {})
+    if vector_monitor is not None:
+        vnames, vfun = vector_monitor
+        cache = {}
+
+        def _vec(x, _f=vfun):
+            key = id(x)
+            if key not in cache:
+                cache.clear()
+                cache[key] = (x, np.asarray(_f(x), dtype=float))
+            return cache[key][1]
+
+        for k, nm in enumerate(vnames):
+            monitors[nm] = (lambda x, _k=k: float(_vec(x)[_k]))
     t = problem.tangent(x0)
     t = t / np.linalg.norm(t)
     if direction is not None and float(t @ direction) < 0:
@@ -303,21 +318,33 @@ def track(
 
 
 def _locate(problem, x, t, h, f, name, fa, fb, s, step, tol, event_tol):
-    """Bisection on the step length from ``x`` for the zero of monitor ``f``."""
-    lo, hi = 0.0, h
-    flo = fa
+    """Zero of monitor ``f`` on the step of length ``h`` from ``x`` along ``t``: Illinois
+    (modified regula falsi) on the step length, each trial point corrected onto the curve."""
+    lo, hi, flo, fhi = 0.0, h, fa, fb
     best = None
-    for _ in range(80):
-        mid = 0.5 * (lo + hi)
+    side = 0
+    for _ in range(60):
+        if flo != fhi:
+            mid = hi - fhi * (hi - lo) / (fhi - flo)
+            if not (lo < mid < hi):
+                mid = 0.5 * (lo + hi)
+        else:
+            mid = 0.5 * (lo + hi)
         xm, ok, _, _ = _correct_on_plane(problem, problem.retract(x, mid * t), t, tol, 20)
         fm = float(f(xm))
         best = (mid, xm)
-        if not ok:
+        if not ok or fm == 0.0:
             break
         if np.sign(fm) == np.sign(flo):
             lo, flo = mid, fm
+            if side == -1:
+                fhi *= 0.5
+            side = -1
         else:
-            hi = mid
+            hi, fhi = mid, fm
+            if side == 1:
+                flo *= 0.5
+            side = 1
         if hi - lo < event_tol:
             break
     mid, xm = best
