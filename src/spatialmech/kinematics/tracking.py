@@ -72,6 +72,8 @@ def _observable_tangent(A: np.ndarray, n_obs: int) -> np.ndarray:
     _, sv, vt = np.linalg.svd(A, full_matrices=True)
     r = int(np.sum(sv > 1e-9 * max(1.0, sv[0]))) if sv.size else 0
     N = vt[r:]
+    if N.shape[0] == 0:
+        raise RuntimeError("no tangent: the mechanism cannot move at this configuration (rigid)")
     if N.shape[0] == 1:
         return N[0]
     u, _, _ = np.linalg.svd(N[:, -n_obs:])
@@ -116,6 +118,15 @@ class Event:
     step: int  # index of the accepted point after which it lies
     value_before: float
     value_after: float
+    value: float = 0.0  # the monitor at the located point
+    bracket: tuple[float, float] = (0.0, 0.0)  # monitor values at the ends of the final bracket
+
+    @property
+    def kind(self) -> str:
+        """``"zero"``, or ``"pole"`` when the sign changed through infinity: both values of the
+        final (tiny) bracket are larger than both ends of the step."""
+        lo = min(abs(self.bracket[0]), abs(self.bracket[1]))
+        return "pole" if lo > max(abs(self.value_before), abs(self.value_after)) else "zero"
 
 
 @dataclass
@@ -321,6 +332,7 @@ def _locate(problem, x, t, h, f, name, fa, fb, s, step, tol, event_tol):
     """Zero of monitor ``f`` on the step of length ``h`` from ``x`` along ``t``: Illinois
     (modified regula falsi) on the step length, each trial point corrected onto the curve."""
     lo, hi, flo, fhi = 0.0, h, fa, fb
+    true_lo, true_hi = fa, fb  # actual values (Illinois scales flo/fhi)
     best = None
     side = 0
     for _ in range(60):
@@ -336,19 +348,19 @@ def _locate(problem, x, t, h, f, name, fa, fb, s, step, tol, event_tol):
         if not ok or fm == 0.0:
             break
         if np.sign(fm) == np.sign(flo):
-            lo, flo = mid, fm
+            lo, flo, true_lo = mid, fm, fm
             if side == -1:
                 fhi *= 0.5
             side = -1
         else:
-            hi, fhi = mid, fm
+            hi, fhi, true_hi = mid, fm, fm
             if side == 1:
                 flo *= 0.5
             side = 1
         if hi - lo < event_tol:
             break
     mid, xm = best
-    return Event(name, s + mid, xm, step, fa, fb)
+    return Event(name, s + mid, xm, step, fa, fb, float(f(xm)), (float(true_lo), float(true_hi)))
 
 
 # --------------------------------------------------------------------------- mechanisms

@@ -24,7 +24,7 @@ from ..geometry.rotations import check_sequence
 from .joints import Joint, make_joint
 from .mechanism import Limb, Mechanism, Mode, Pose
 
-__all__ = ["ModelFileError", "load", "loads", "dump", "dumps", "to_dict", "from_dict", "FORMAT_VERSION"]
+__all__ = ["ModelFileError", "load", "loads", "dump", "dumps", "to_dict", "from_dict", "load_positions", "FORMAT_VERSION"]
 
 FORMAT_VERSION = 1
 
@@ -315,3 +315,34 @@ def dumps(mech: Mechanism) -> str:
 
 def dump(mech: Mechanism, path: str | Path) -> None:
     Path(path).write_text(dumps(mech), encoding="utf-8")
+
+
+class _PositionsFile(_Strict):
+    positions: Annotated[list[PoseSpec], Len(1)]
+    length_unit: str = "m"
+
+
+def load_positions(path: str | Path) -> tuple[Pose, ...]:
+    """Task positions from a TOML file with ``[[positions]]`` tables (``point`` and either
+    ``euler = {seq, angles_deg}`` or ``matrix``), as in a mechanism file."""
+    path = Path(path)
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except OSError as e:
+        raise ModelFileError(f"{path}: cannot read: {e.strerror}") from None
+    except tomllib.TOMLDecodeError as e:
+        raise ModelFileError(f"{path}: not valid TOML: {e}") from None
+    try:
+        spec = _PositionsFile.model_validate(data)
+    except ValidationError as e:
+        err = e.errors()[0]
+        raise ModelFileError(f"{path}: {_loc(err['loc'])}: {err['msg']}") from None
+    try:
+        return tuple(_pose(p, f"positions[{i}]") if p.name else replace_name(_pose(p, f"positions[{i}]"), f"P{i + 1}")
+                     for i, p in enumerate(spec.positions))
+    except ModelFileError as e:
+        raise ModelFileError(f"{path}: {e}") from None
+
+
+def replace_name(pose: Pose, name: str) -> Pose:
+    return Pose(pose.R, pose.p, name)

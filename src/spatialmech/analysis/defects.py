@@ -1,0 +1,642 @@
+"""Defect judgement of one-degree-of-freedom rigid-body guidance linkages (paper A, sections 2.3,
+4, 5, 6), for any 1-DOF mechanism (5-CS, planar/spherical 4R, RSSR, RCCC, ...).
+
+Procedure (paper A fig 5, made general):
+
+1. every task position is fitted onto the closure manifold (the printed poses are rounded: the
+   pose error of each fit is reported);
+2. ``DJ`` (the determinant of the complete Jacobian for one driver; or, where the complete
+   Jacobian is not square because of redundant constraints, the sign-continuous cofactor of
+   the closure Jacobian without the driver's column, which vanishes at the same points) is
+   evaluated at every position for every candidate driver;
+3. the circuit through position 1 is traced with the continuation tracker until it closes,
+   locating every zero of every driver's DJ (a *branch point*: the driver reaches a turning
+   point there; sign changes through a pole of DJ — where the driver's own limb is serially
+   singular and the output turns back while the driver moves on — are counted apart); a position lies on the traced circuit when the curve passes through its
+   fitted configuration (to ``on_curve_tol``, nondimensional), which also gives its arc
+   length; positions not on it get circuits of their own, traced the same way;
+4. verdicts: circuit defect (positions on several circuits), order defect (positions not met
+   in their order along the circuit, in either direction), branch defect per driver (DJ zero
+   between the first and the last position along the path), usable drivers, and, when none is
+   usable but there is no circuit or order defect, a multi-drive plan that switches drivers
+   inside intervals free of their singularities (paper A section 6);
+5. robustness: the smallest scale-free singular value along the path (distance to the nearest
+   singularity of the linkage and of each usable/planned driver) and, optionally, a seeded
+   Monte-Carlo check of the verdicts against perturbations of the data at its printed
+   precision.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from ..geometry import screws as sc
+from ..kinematics.closure import Configuration, _scales, active_mask, closure_jacobian
+from ..kinematics.jacobian import complete_jacobian, driver_determinants
+from ..kinematics.position import PoseFit, configuration_at_pose, freedom_values, platform_pose
+from ..kinematics.tracking import MotionProblem, TrackResult, track
+from ..model.joints import make_joint
+from ..model.mechanism import Limb, Mechanism, Pose
+
+__all__ = [
+    "candidate_drivers",
+    "BranchPoint",
+    "DriverVerdict",
+    "PlanStep",
+    "DefectResult",
+    "defect_analysis",
+    "dj_function",
+    "perturbed",
+]
+
+
+def candidate_drivers(mech: Mechanism) -> list[str]:
+    """Every freedom of each limb's base joint (the natural actuator places), by alias when the
+    model defines one (``rot1`` ... ``slide5`` for the 5-CS)."""
+    alias_of = {v: k for k, v in mech.aliases.items()}
+    out = []
+    for limb in mech.limbs:
+        j = limb.joints[0]
+        for f in j.freedoms:
+            if not f.locked:
+                fid = f"{j.name}.{f.name}"
+                out.append(alias_of.get(fid, fid))
+    return out
+
+
+def dj_function(mech: Mechanism, drivers: list[str], reference: Configuration):
+    """A function ``config -> array of DJ per driver`` whose signs are comparable between
+    configurations.  The complete-Jacobian determinant when it is square (paper A), else the
+    cofactor of the nondimensional closure Jacobian without the driver's column, its rows
+    projected on the row space at ``reference`` (sign-continuous, zero at the same points)."""
+    test = driver_determinants(mech, reference, drivers)
+    if np.all(np.isfinite(test)):
+        return (lambda c: driver_determinants(mech, c, drivers)), "complete Jacobian determinant"
+    active = active_mask(mech)
+    row, col = _scales(mech, active)
+    A0, _ = closure_jacobian(mech, reference, active=active)
+    A0 = row[:, None] * A0 * col[None, :]
+    U, sv, _ = np.linalg.svd(A0)
+    r = int(np.sum(sv > 1e-9 * sv[0]))
+    P = U[:, :r].T
+    idx = list(np.flatnonzero(active))
+    cols = [idx.index(mech.freedom_refs.index(mech.freedom(d))) for d in drivers]
+
+    def f(c):
+        A, _ = closure_jacobian(mech, c, active=active)
+        B = P @ (row[:, None] * A * col[None, :])
+        out = np.empty(len(cols))
+        for n, j in enumerate(cols):
+            M = np.delete(B, j, axis=1)
+            out[n] = np.linalg.det(M) if M.shape[0] == M.shape[1] else np.nan
+        return out
+
+    return f, "cofactor of the closure Jacobian without the driver (redundant constraints)"
+
+
+@dataclass(frozen=True)
+class BranchPoint:
+    """A zero of a driver's DJ along a traced circuit: the driver reaches a turning point."""
+
+    driver: str
+    circuit: int
+    arc: float  # nondimensional arc length from the circuit's first position
+    between: tuple[int, int] | None  # positions (from 1) it lies between along the path
+    point: tuple[float, float, float]  # platform point there
+    driver_value: float  # the driver's value there (rad or length)
+
+    def to_dict(self, rotational: bool) -> dict:
+        return {
+            "driver": self.driver,
+            "circuit": self.circuit,
+            "arc": self.arc,
+            "between": list(self.between) if self.between else None,
+            "platform_point": list(self.point),
+            "driver_value": float(np.degrees(self.driver_value)) if rotational else self.driver_value,
+            "driver_value_unit": "deg" if rotational else "length",
+        }
+
+
+@dataclass(frozen=True)
+class DriverVerdict:
+    driver: str
+    dj: tuple[float, ...]
+    signs: tuple[int, ...]
+    keeps_sign: bool
+    branch_points: tuple[BranchPoint, ...]  # on the path from the first to the last position
+    circuit_branch_points: tuple[BranchPoint, ...]  # everywhere on the traced circuit(s)
+    branch_defect: bool
+    usable: bool
+    min_sigma_on_path: float | None = None  # scale-free distance to this driver's singularity
+    inverse_singular_points: int = 0  # DJ poles on the circuit(s): the driver's limb is serially singular
+
+    def to_dict(self, rotational: bool) -> dict:
+        return {
+            "driver": self.driver,
+            "dj": list(self.dj),
+            "signs": list(self.signs),
+            "keeps_sign": self.keeps_sign,
+            "branch_points": [b.to_dict(rotational) for b in self.branch_points],
+            "circuit_branch_points": [b.to_dict(rotational) for b in self.circuit_branch_points],
+            "branch_defect": self.branch_defect,
+            "usable": self.usable,
+            "min_sigma_on_path": self.min_sigma_on_path,
+            "inverse_singular_points": self.inverse_singular_points,
+        }
+
+
+@dataclass(frozen=True)
+class PlanStep:
+    driver: str
+    start_arc: float
+    end_arc: float
+    switch_window: tuple[float, float] | None  # arc interval in which to switch to the next driver
+    switch_between: tuple[int, int] | None  # positions bracketing the window's middle
+
+    def to_dict(self) -> dict:
+        return {
+            "driver": self.driver,
+            "from": self.start_arc,
+            "to": self.end_arc,
+            "switch_window": list(self.switch_window) if self.switch_window else None,
+            "switch_between": list(self.switch_between) if self.switch_between else None,
+        }
+
+
+@dataclass(frozen=True, eq=False)
+class DefectResult:
+    mechanism: str
+    drivers: tuple[DriverVerdict, ...]
+    circuits: tuple[tuple[int, ...], ...]
+    circuit_closed: tuple[bool, ...]
+    circuit_status: tuple[str, ...]
+    circuit_defect: bool
+    order_defect: bool
+    order: tuple[int, ...]  # positions of the first circuit in the order they are met
+    direction: int  # +1: the path runs along the traced direction; -1: against it
+    position_arcs: tuple[float | None, ...]  # along the first circuit, from position 1, along the path
+    path_length: float | None
+    usable_drivers: tuple[str, ...]
+    plan: tuple[PlanStep, ...] | None
+    fits: tuple[PoseFit, ...]
+    dj_method: str
+    min_closure_sigma: float | None  # scale-free closeness of the path to a singularity of the linkage
+    min_closure_sigma_between: tuple[int, int] | None
+    membership: tuple = ()
+    tolerances: dict = field(default_factory=dict)
+    robustness: dict = field(default_factory=dict)
+    traces: tuple = ()  # TrackResult per circuit (for figures; not serialised)
+    rotational: dict = field(default_factory=dict)
+
+    def to_dict(self) -> dict:
+        return {
+            "mechanism": self.mechanism,
+            "circuits": [list(c) for c in self.circuits],
+            "circuit_closed": list(self.circuit_closed),
+            "circuit_status": list(self.circuit_status),
+            "order_defect": self.order_defect,
+            "circuit_defect": self.circuit_defect,
+            "order": list(self.order),
+            "path_direction": self.direction,
+            "position_arcs": list(self.position_arcs),
+            "path_length": self.path_length,
+            "drivers": [d.to_dict(self.rotational.get(d.driver, True)) for d in self.drivers],
+            "usable_drivers": list(self.usable_drivers),
+            "plan": [p.to_dict() for p in self.plan] if self.plan is not None else None,
+            "pose_fit": [f.to_dict() for f in self.fits],
+            "dj_method": self.dj_method,
+            "min_closure_sigma_on_path": self.min_closure_sigma,
+            "min_closure_sigma_between": list(self.min_closure_sigma_between) if self.min_closure_sigma_between else None,
+            "membership": list(self.membership),
+            "tolerances": self.tolerances,
+            "robustness": self.robustness,
+            "units": {"arc": "nondimensional arc length of the tracked curve (joint rad, lengths / L)"},
+        }
+
+
+# ----------------------------------------------------------------------------- helpers
+def _project(problem: MotionProblem, tr: TrackResult, config: Configuration, tol: float):
+    """Arc length of ``config`` on the traced curve, or ``None`` when it is not on it."""
+    d = np.array([np.linalg.norm(problem.difference(x, config)) for x in tr.points])
+    k0 = int(np.argmin(d))
+    best = (np.inf, None)
+    for k in {max(0, k0 - 1), k0, min(len(tr.points) - 1, k0 + 1)}:
+        x, t = tr.points[k], tr.tangents[k]
+        a = float(t @ problem.difference(x, config))
+        from ..kinematics.tracking import _correct_on_plane
+
+        xs, ok, _, _ = _correct_on_plane(problem, problem.retract(x, a * t), t, 1e-11, 30)
+        if not ok:
+            continue
+        dist = float(np.linalg.norm(problem.difference(xs, config)))
+        if dist < best[0]:
+            best = (dist, tr.s[k] + a)
+    return best[1] if best[0] < tol else None
+
+
+def _pose_of(mech: Mechanism, x: Configuration):
+    D = x.D
+    return D[:3, :3], D[:3, :3] @ mech.platform_point + D[:3, 3]
+
+
+def _pose_distance(mech, prob, tr: TrackResult, pose: Pose, pose_tol: float, angle_tol: float):
+    """Distance of a printed pose from a traced curve, normalised by the tolerances
+    (``hypot(|dp| / pose_tol, dtheta / angle_tol)``), refined along the curve between samples.
+    Returns (normalised distance, arc, |dp|, dtheta)."""
+    from ..geometry.rotations import rotation_angle
+    from ..kinematics.tracking import _correct_on_plane
+
+    def meas(x):
+        R, p = _pose_of(mech, x)
+        dp = float(np.linalg.norm(p - pose.p))
+        th = float(rotation_angle(R @ pose.R.T))
+        return float(np.hypot(dp / pose_tol, th / angle_tol)), dp, th
+
+    vals = [meas(x)[0] for x in tr.points]
+    k0 = int(np.argmin(vals))
+    best = (vals[k0], float(tr.s[k0]), *meas(tr.points[k0])[1:])
+    for k in (k0 - 1, k0):
+        if k < 0 or k + 1 >= len(tr.points):
+            continue
+        x, t, h = tr.points[k], tr.tangents[k], float(tr.s[k + 1] - tr.s[k])
+        g = (np.sqrt(5) - 1) / 2
+        lo, hi = 0.0, h
+        cache = {}
+
+        def at(a):
+            if a not in cache:
+                xa, ok, _, _ = _correct_on_plane(prob, prob.retract(x, a * t), t, 1e-11, 20)
+                cache[a] = meas(xa) if ok else (np.inf, np.inf, np.inf)
+            return cache[a]
+
+        for _ in range(30):
+            a1, a2 = hi - g * (hi - lo), lo + g * (hi - lo)
+            if at(a1)[0] < at(a2)[0]:
+                hi = a2
+            else:
+                lo = a1
+        a = 0.5 * (lo + hi)
+        m = at(a)
+        if m[0] < best[0]:
+            best = (m[0], float(tr.s[k] + a), m[1], m[2])
+    return best
+
+
+def _cover(D: np.ndarray) -> list[int]:
+    """Fewest circuits (rows) covering every position (column) within tolerance (D <= 1); ties
+    broken by the smallest total distance.  Positions no circuit covers keep their own."""
+    from itertools import combinations
+
+    nC, nP = D.shape
+    need = [j for j in range(nP) if np.any(D[:, j] <= 1.0)]
+    for size in range(1, nC + 1):
+        best = None
+        for sub in combinations(range(nC), size):
+            if all(np.any(D[list(sub), j] <= 1.0) for j in need):
+                cost = sum(np.min(D[list(sub), j]) for j in need)
+                if best is None or cost < best[0]:
+                    best = (cost, list(sub))
+        if best is not None:
+            chosen = best[1]
+            for j in range(nP):  # positions out of tolerance everywhere: their own circuit
+                if j not in need:
+                    chosen.append(int(np.argmin(D[:, j])))
+            return sorted(set(chosen))
+    return list(range(nC))
+
+
+def _trace(mech, start, names, djf, max_arc, h0, progress):
+    prob = MotionProblem(mech)
+    tr = track(prob, start, vector_monitor=(names, djf), max_arc=max_arc, h0=h0, event_tol=1e-9,
+               progress=progress)
+    return prob, tr
+
+
+def _between(arc: float, arcs: list[float]) -> tuple[int, int] | None:
+    """Positions (from 1) whose arcs bracket ``arc`` on the path (arcs sorted along the path)."""
+    for j in range(len(arcs) - 1):
+        if arcs[j] <= arc <= arcs[j + 1]:
+            return (j + 1, j + 2)
+    return None
+
+
+def _plan(drivers: list[str], zeros: dict[str, list[float]], a: float, b: float, arcs: list[float]):
+    """Fewest driver switches covering the path [a, b] with no driver passing its own DJ zero.
+
+    Greedy: from the current arc, take the driver that goes furthest before its next zero;
+    it must be switched before that zero, after the last zero of the next driver."""
+    steps = []
+    c = a
+    current = None
+    guard = 0
+    while guard < 20:
+        guard += 1
+        reach = {}
+        for d in drivers:
+            nxt = [z for z in zeros[d] if z > c + 1e-12]
+            reach[d] = min(nxt) if nxt else np.inf
+        if current is None:
+            current = max(drivers, key=lambda d: reach[d])
+        r = reach[current]
+        if r >= b:
+            steps.append([current, c, b, None])
+            return steps
+        # next driver: regular on (w, its next zero) with w < r
+        best, best_reach, best_lo = None, -np.inf, None
+        for d in drivers:
+            if d == current:
+                continue
+            before = [z for z in zeros[d] if z < r]
+            lo = max([c] + before)
+            if lo >= r:
+                continue
+            nxt = [z for z in zeros[d] if z > lo + 1e-12]
+            rd = min(nxt) if nxt else np.inf
+            # furthest reach first; on a tie the widest switching window
+            if rd > best_reach or (rd == best_reach and best_lo is not None and lo < best_lo):
+                best, best_reach, best_lo = d, rd, lo
+        if best is None or best_reach <= r:
+            return None
+        c_new = 0.5 * (best_lo + r)  # switch in the middle of the window
+        steps.append([current, c, c_new, (best_lo, r)])
+        c = c_new
+        current = best
+    return None
+
+
+def perturbed(mech: Mechanism, positions, rng: np.random.Generator, length: float, angle_deg: float):
+    """A copy of ``mech`` and ``positions`` with every joint point and axis and every position
+    perturbed uniformly within the printed precision (``length``; axes by ``length`` per
+    component then normalised; position angles by ``angle_deg`` about each axis)."""
+    from scipy.spatial.transform import Rotation
+
+    def jitter(v):
+        return np.asarray(v, float) + rng.uniform(-length, length, 3)
+
+    limbs = []
+    for limb in mech.limbs:
+        joints = []
+        for j in limb.joints:
+            fs = j.freedoms
+            kw = dict(point=jitter(j.point), pitch=fs[0].pitch,
+                      actuated=[f.name for f in fs if f.actuated], lockable=[f.name for f in fs if f.lockable],
+                      locked=[f.name for f in fs if f.locked],
+                      limits={f.name: f.limits for f in fs if f.limits is not None} or None,
+                      offset={f.name: f.offset for f in fs if f.offset}, freedom_names=[f.name for f in fs])
+            if j.type in ("R", "P", "H", "C"):
+                ax = jitter(fs[0].direction)
+                kw["axis"] = ax / np.linalg.norm(ax)
+            elif j.type == "U":
+                a1 = jitter(fs[0].direction); a1 /= np.linalg.norm(a1)
+                a2 = jitter(fs[1].direction); a2 -= (a2 @ a1) * a1; a2 /= np.linalg.norm(a2)
+                kw["axes"] = [a1, a2]
+            else:
+                kw["axes"] = [f.direction for f in fs]
+            joints.append(make_joint(j.type, j.name, **kw))
+        limbs.append(Limb(limb.name, tuple(joints)))
+    new_pos = []
+    for P in positions:
+        dR = Rotation.from_rotvec(np.radians(rng.uniform(-angle_deg, angle_deg, 3))).as_matrix()
+        new_pos.append(Pose(dR @ P.R, jitter(P.p), P.name))
+    return replace(mech, limbs=tuple(limbs), positions=tuple(new_pos)), new_pos
+
+
+# ----------------------------------------------------------------------------- analysis
+def defect_analysis(
+    mech: Mechanism,
+    positions=None,
+    *,
+    drivers=None,
+    on_curve_tol: float = 1e-6,
+    pose_tol: float | None = None,
+    angle_tol_deg: float = 1.0,
+    max_arc: float = 400.0,
+    h0: float = 0.02,
+    monte_carlo: int = 0,
+    seed: int = 0,
+    precision: float = 5e-4,
+    angle_precision_deg: float = 0.05,
+    sigma_along_path: bool = True,
+    progress=None,
+) -> DefectResult:
+    """Defect judgement of a 1-DOF linkage for its task positions (default: the model's own).
+
+    A printed position belongs to a circuit when the circuit passes within ``pose_tol`` (length;
+    default 2 % of the characteristic length) and ``angle_tol_deg`` of it (combined as
+    ``hypot(dp / pose_tol, dtheta / angle_tol) <= 1``); among the traced circuits the fewest
+    that hold every position are kept.  ``progress(message)`` is called with short status
+    strings while it works.
+    """
+    say = progress or (lambda msg: None)
+    if pose_tol is None:
+        pose_tol = 0.02 * mech.characteristic_length
+    positions = tuple(positions if positions is not None else mech.positions)
+    if len(positions) < 2:
+        raise ValueError("positions: a defect analysis needs at least two task positions")
+    drivers = list(drivers) if drivers is not None else candidate_drivers(mech)
+    if not drivers:
+        raise ValueError("drivers: no candidate drivers")
+    for d in drivers:
+        mech.freedom(d)  # raises on unknown names
+    say("fitting the task positions onto the closure")
+    fits, prev = [], None
+    for P in positions:
+        fit = configuration_at_pose(mech, P, start=prev)
+        if not fit.converged:
+            raise ValueError(f"positions: {P.name or 'a position'} has no closed configuration near it "
+                             f"(residual {fit.ik_residual:.2e}): is it reachable by this linkage?")
+        fits.append(fit)
+        prev = fit.config
+    djf, dj_method = dj_function(mech, drivers, fits[0].config)
+    dj_pos = np.array([djf(f.config) for f in fits])  # (positions, drivers)
+
+    # circuits: trace until every fitted position lies on a traced curve
+    n = len(positions)
+    traces, problems = [], []
+    for j in range(n):
+        if any(_project(pr, tr, fits[j].config, on_curve_tol) is not None for pr, tr in zip(problems, traces)):
+            continue
+        say(f"tracing the circuit through position {j + 1}")
+        prob, tr = _trace(mech, fits[j].config, drivers, djf, max_arc, h0, None)
+        traces.append(tr)
+        problems.append(prob)
+    # membership by pose tolerance (printed data are rounded), fewest circuits
+    say("assigning the positions to circuits")
+    Dm = np.empty((len(traces), n))
+    meas = {}
+    for c, (pr, tr) in enumerate(zip(problems, traces)):
+        for j, P in enumerate(positions):
+            # exactly on the curve (the fitted configuration itself): unambiguous, even where the
+            # platform takes the same pose twice on a circuit; else the nearest pose on the curve
+            a = 0.0 if tr.points[0] is fits[j].config else _project(pr, tr, fits[j].config, on_curve_tol)
+            if a is not None:
+                meas[c, j] = (0.0, float(a), fits[j].position_error, fits[j].angle_error)
+            else:
+                meas[c, j] = _pose_distance(mech, pr, tr, P, pose_tol, np.radians(angle_tol_deg))
+            Dm[c, j] = meas[c, j][0]
+    chosen = _cover(Dm)
+    circuit_of = [min(chosen, key=lambda c: Dm[c, j]) for j in range(n)]
+    order_c = sorted(chosen, key=lambda c: min(j for j in range(n) if circuit_of[j] == c))
+    traces = [traces[c] for c in order_c]
+    problems_o = [problems[c] for c in order_c]
+    remap = {c: k for k, c in enumerate(order_c)}
+    circuit_of = [remap[c] for c in circuit_of]
+    circuits = [tuple(j + 1 for j in range(n) if circuit_of[j] == k) for k in range(len(order_c))]
+    arcs_on = [meas[order_c[0], j][1] if circuit_of[j] == 0 else None for j in range(n)]
+    membership = [{"position": j + 1, "circuit": circuit_of[j] + 1,
+                   "distance": {"position": meas[order_c[circuit_of[j]], j][2],
+                                "angle_deg": float(np.degrees(meas[order_c[circuit_of[j]], j][3]))},
+                   # other traced circuits that also pass within tolerance: kept ones by number, the
+                   # ones the fewest-circuits cover dropped as "extra"
+                   "also_within_tolerance_of": [remap[c] + 1 if c in remap else "extra" for c in range(len(Dm))
+                                                if c != order_c[circuit_of[j]] and Dm[c, j] <= 1.0]}
+                  for j in range(n)]
+    closed = [tr.closed for tr in traces]
+    statuses = [tr.status for tr in traces]
+    problems = problems_o
+    circuit_defect = len(circuits) > 1
+
+    # order and direction along the first circuit
+    tr0 = traces[0]
+    S = tr0.s[-1] if tr0.closed else None
+    on0 = [i for i in range(n) if circuit_of[i] == 0]
+    fwd = [arcs_on[i] % S if S else arcs_on[i] for i in on0]
+    order_f = [on0[k] + 1 for k in np.argsort(fwd, kind="stable")]
+    bwd = [((S - a) % S) if S else -a for a in [arcs_on[i] for i in on0]]
+    order_b = [on0[k] + 1 for k in np.argsort(bwd, kind="stable")]
+    expected = [i + 1 for i in on0]
+    if order_f == expected:
+        direction, order, path_arcs = 1, order_f, sorted(fwd)
+    elif order_b == expected:
+        direction, order, path_arcs = -1, order_b, sorted(bwd)
+    else:
+        direction, order, path_arcs = 1, order_f, sorted(fwd)
+    order_defect = order != expected
+    pos_arcs = [None] * n
+    for i in on0:
+        a = arcs_on[i]
+        pos_arcs[i] = (a % S if S else a) if direction == 1 else (((S - a) % S) if S else -a)
+
+    # branch points
+    L = mech.characteristic_length
+
+    def to_path(arc_traced: float) -> float:
+        if direction == 1:
+            return arc_traced % S if S else arc_traced
+        return ((S - arc_traced) % S) if S else -arc_traced
+
+    verdicts = []
+    path_end = path_arcs[-1] if path_arcs else 0.0
+    zeros_on_path = {}
+    for di, d in enumerate(drivers):
+        r = mech.freedom(d)
+        idx = mech.freedom_refs.index(r)
+        all_bp, path_bp = [], []
+        poles = 0
+        for k, tr in enumerate(traces):
+            for e in tr.events:
+                if e.name != d:
+                    continue
+                if e.kind == "pole":  # DJ through infinity: the driver's limb is serially
+                    poles += 1        # singular (the output turns back); the driver moves on
+                    continue
+                c = e.x
+                p = c.D[:3, :3] @ mech.platform_point + c.D[:3, 3]
+                val = float(freedom_values(mech, c.q)[idx])
+                if k == 0:
+                    pa = to_path(e.s)
+                    bp = BranchPoint(d, k + 1, float(pa), _between(pa, path_arcs), tuple(map(float, p)), val)
+                    if 0.0 < pa < path_end and not circuit_defect:
+                        path_bp.append(bp)
+                else:
+                    bp = BranchPoint(d, k + 1, float(e.s), None, tuple(map(float, p)), val)
+                all_bp.append(bp)
+        all_bp.sort(key=lambda b: (b.circuit, b.arc))
+        path_bp.sort(key=lambda b: b.arc)
+        zeros_on_path[d] = [b.arc for b in path_bp]
+        signs = tuple(int(x) for x in np.sign(dj_pos[:, di]))
+        keeps = len(set(signs)) == 1 and 0 not in signs
+        # with one circuit, the path decides (a sign change through a pole is no branch point)
+        branch_defect = (not keeps) if circuit_defect else bool(path_bp)
+        usable = not circuit_defect and not order_defect and not branch_defect
+        verdicts.append(DriverVerdict(d, tuple(map(float, dj_pos[:, di])), signs, keeps, tuple(path_bp), tuple(all_bp),
+                                      branch_defect, usable, inverse_singular_points=poles))
+    usable = tuple(v.driver for v in verdicts if v.usable)
+
+    plan = None
+    if not usable and not circuit_defect and not order_defect:
+        raw = _plan(drivers, zeros_on_path, 0.0, path_end, path_arcs)
+        if raw is not None:
+            plan = tuple(PlanStep(d, float(a), float(b), (float(w[0]), float(w[1])) if w else None,
+                                  _between(0.5 * (w[0] + w[1]), path_arcs) if w else None) for d, a, b, w in raw)
+
+    # closeness to singularities along the path
+    min_sig, min_between = None, None
+    if sigma_along_path and not circuit_defect:
+        say("measuring the distance to singularities along the path")
+        path_pts = [(to_path(s), x) for s, x in zip(tr0.s, tr0.points) if 0.0 <= to_path(s) <= path_end]
+        prob0 = problems[0]
+        sig = []
+        for a, x in path_pts:
+            sv = np.linalg.svd(prob0.jacobian(x), compute_uv=False)
+            sig.append((float(sv[-1] / sv[0]), a))
+        if sig:
+            mval, marc = min(sig)
+            min_sig, min_between = mval, _between(marc, path_arcs)
+        watch = set(usable) | ({s.driver for s in plan} if plan else set())
+        new = []
+        for v in verdicts:
+            if v.driver in watch:
+                vals = [complete_jacobian(mech, x, [v.driver]).sigma_min for _, x in path_pts]
+                v = replace(v, min_sigma_on_path=float(min(vals)) if vals else None)
+            new.append(v)
+        verdicts = new
+
+    rot = {d: mech.freedom(d).freedom.kind != "P" for d in drivers}
+    result = DefectResult(
+        mechanism=mech.name, drivers=tuple(verdicts), circuits=tuple(circuits), circuit_closed=tuple(closed),
+        circuit_status=tuple(statuses), circuit_defect=circuit_defect, order_defect=order_defect, order=tuple(order),
+        direction=direction, position_arcs=tuple(pos_arcs), path_length=float(path_end) if not circuit_defect else None,
+        usable_drivers=usable, plan=plan, fits=tuple(fits), dj_method=dj_method, min_closure_sigma=min_sig,
+        min_closure_sigma_between=min_between, traces=tuple(traces), rotational=rot, membership=tuple(membership),
+        tolerances={"pose": pose_tol, "angle_deg": angle_tol_deg, "on_curve": on_curve_tol},
+    )
+    if monte_carlo:
+        result = replace(result, robustness=_monte_carlo(mech, positions, result, monte_carlo, seed, precision,
+                                                         angle_precision_deg, drivers, max_arc, h0, say))
+    return result
+
+
+def _verdict_key(r: DefectResult):
+    return (r.circuit_defect, r.order_defect, tuple(sorted(r.usable_drivers)),
+            tuple(sorted(v.driver for v in r.drivers if v.keeps_sign)))
+
+
+def _monte_carlo(mech, positions, base, n, seed, precision, angle_deg, drivers, max_arc, h0, say):
+    rng = np.random.default_rng(seed)
+    key0 = _verdict_key(base)
+    same, failures, keys = 0, 0, []
+    for k in range(n):
+        say(f"Monte-Carlo sample {k + 1}/{n}")
+        m2, pos2 = perturbed(mech, positions, rng, precision, angle_deg)
+        try:
+            r = defect_analysis(m2, pos2, drivers=drivers, max_arc=max_arc, h0=h0, sigma_along_path=False)
+        except (ValueError, RuntimeError):
+            failures += 1
+            continue
+        keys.append(_verdict_key(r))
+        same += _verdict_key(r) == key0
+    return {
+        "samples": n,
+        "seed": seed,
+        "precision_length": precision,
+        "precision_angle_deg": angle_deg,
+        "same_verdict": same,
+        "failed": failures,
+        "fraction_same": same / n if n else None,
+        "verdict": {"circuit_defect": key0[0], "order_defect": key0[1], "usable_drivers": list(key0[2])},
+        "other_verdicts": [{"circuit_defect": k[0], "order_defect": k[1], "usable_drivers": list(k[2])}
+                           for k in keys if k != key0],
+    }

@@ -1,0 +1,156 @@
+"""CLI command ``workspace``: orientation / position workspace under joint limits.
+
+Angles at the command line are in degrees, lengths in the model's length unit (m).  ``--at``
+takes ``name=value`` pairs separated by commas: ``x, y, z`` (m) and ``alpha, beta, gamma``
+(deg), with ``R = Rz(gamma) Ry(beta) Rx(alpha)`` (intrinsic "ZYX", paper B eq 7).
+"""
+
+from __future__ import annotations
+
+import sys
+
+import click
+import numpy as np
+
+from .. import catalog
+from ..analysis.workspace import (
+    COORDINATES,
+    WorkspaceLimits,
+    default_limits,
+    orientation_workspace,
+    pose_checker,
+    position_workspace,
+)
+from .cli import UserError, emit_json, json_option
+
+_ANGLES = ("alpha", "beta", "gamma")
+#: Largest grid (poses) the slow general kernel accepts from the CLI unless --max-poses says more.
+GENERAL_MAX_POSES = 4000
+
+
+def parse_at(text: str | None) -> dict[str, float]:
+    """``"z=0.1,alpha=5"`` -> ``{"z": 0.1, "alpha": radians(5)}`` (SI inside)."""
+    out: dict[str, float] = {}
+    if not text:
+        return out
+    for part in text.split(","):
+        part = part.strip()
+        if not part:
+            continue
+        if "=" not in part:
+            raise ValueError(f"--at: expected name=value pairs separated by commas, got {part!r}")
+        k, v = (s.strip() for s in part.split("=", 1))
+        if k not in COORDINATES:
+            raise ValueError(f"--at: unknown coordinate {k!r}; expected one of {', '.join(COORDINATES)}")
+        try:
+            val = float(v)
+        except ValueError:
+            raise ValueError(f"--at: {k} expects a number, got {v!r}") from None
+        if not np.isfinite(val):
+            raise ValueError(f"--at: {k} must be finite, got {v!r}")
+        out[k] = float(np.radians(val)) if k in _ANGLES else val
+    return out
+
+
+def _text(res) -> str:
+    d = res.to_dict()
+    lines = [f"{res.mechanism}: {res.kind} workspace ({res.path} path"
+             + (f": {res.path_reason}" if res.path_reason else "") + ")",
+             "fixed: " + ", ".join(f"{k}={v:.6g}" for k, v in d["fixed"].items()),
+             f"orientation: {d['orientation_sequence']}"]
+    for c in res.free:
+        u = "deg" if c in _ANGLES else "m"
+        for key, label in ((f"{c}_{u}", "alone"), (f"{c}_{u}_set", "whole set")):
+            if d[key] is None:
+                lines.append(f"  {c:5s} {label:9s}: empty")
+                continue
+            lo_l, hi_l = d["extents_active_limits"][key]
+            lines.append(f"  {c:5s} {label:9s}: [{d[key][0]:.4f}, {d[key][1]:.4f}] {u}   limits: {lo_l} / {hi_l}")
+    lines.append(f"volume: {res.volume:.6g} {res.volume_unit}")
+    lines.append("active limits (boundary points): " + ", ".join(f"{k} {v}" for k, v in res.active_limits.items()))
+    lines.append(f"{res.n_poses} poses checked in {res.seconds:.2f} s; tolerance "
+                 + ", ".join(f"{k}={v:.3g}" for k, v in d["tolerance"].items()))
+    return "\n".join(lines)
+
+
+@click.command()
+@click.argument("model")
+@click.option("--orientation", "kind", flag_value="orientation", default=True,
+              help="Orientation workspace at a fixed position (default).")
+@click.option("--position", "kind", flag_value="position", help="Position workspace at a fixed orientation.")
+@click.option("--at", "at", default=None,
+              help="Fixed coordinates, e.g. z=0.1 or alpha=0,beta=0,gamma=0 (m, deg).")
+@click.option("--step-deg", type=float, default=2.0, show_default=True, help="Grid step of the angles (deg).")
+@click.option("--tol-deg", type=float, default=1e-3, show_default=True, help="Boundary tolerance of the angles (deg).")
+@click.option("--step", "step_m", type=float, default=None, help="Grid step of positions (m; default L/40).")
+@click.option("--tol", "tol_m", type=float, default=None, help="Boundary tolerance of positions (m; default L*1e-6).")
+@click.option("--method", type=click.Choice(["auto", "closed-form", "general"]), default="auto", show_default=True,
+              help="Pose-check kernel: vectorised closed form, or per-pose inverse position.")
+@click.option("--link-diameter", type=float, default=None,
+              help="Link capsule diameter (m) for the interference check (default: the paper's, or none).")
+@click.option("--no-interference", is_flag=True, help="Skip the link interference check.")
+@click.option("--max-poses", type=int, default=None,
+              help=f"Largest grid accepted (default: unlimited; {GENERAL_MAX_POSES} on the general path).")
+@click.option("--plot", "plot", type=click.Path(dir_okay=False), default=None, help="Write a figure (.png/.svg/.pdf).")
+@json_option
+def workspace(model, kind, at, step_deg, tol_deg, step_m, tol_m, method, link_diameter, no_interference,
+              max_poses, plot, as_json):
+    """Workspace under joint limits (strokes, joint cones, link interference), sampled and refined
+    at the boundary by bisection.
+
+    \b
+    JSON keys: alpha_deg, beta_deg, gamma_deg ([min, max] of one angle alone, others fixed),
+    alpha_deg_set, ... (extents over the whole set), volume (+ volume_unit), active_limits
+    (boundary points per limit), path (closed-form or general).
+    \b
+    Examples:
+      spatialmech workspace four-sps-cu --orientation --at z=0.1
+      spatialmech workspace four-sps-cu --position --at alpha=0,beta=0,gamma=0 --json
+      spatialmech workspace four-sps-cu --at z=0.1 --step-deg 3 --plot ws.png
+    """
+    try:
+        mech = catalog.resolve(model)
+        fixed = parse_at(at)
+        limits = default_limits(mech)
+        if link_diameter is not None or no_interference:
+            if link_diameter is not None and not (np.isfinite(link_diameter) and link_diameter >= 0):
+                raise ValueError(f"--link-diameter: expected a non-negative number of metres, got {link_diameter}")
+            limits = WorkspaceLimits(limits.cones, None if no_interference else link_diameter,
+                                     limits.freedom_limits, limits.source)
+        for name, v in (("--step-deg", step_deg), ("--tol-deg", tol_deg)):
+            if not (np.isfinite(v) and v > 0):
+                raise ValueError(f"{name}: must be a positive number of degrees, got {v}")
+        path_kind = pose_checker(mech, limits, method=method).path
+        if max_poses is None and path_kind == "general":
+            max_poses = GENERAL_MAX_POSES
+        kw = dict(at=fixed, limits=limits, method=method, max_poses=max_poses)
+        if kind == "orientation":
+            run = lambda progress: orientation_workspace(  # noqa: E731
+                mech, step=np.radians(step_deg), tol=np.radians(tol_deg), progress=progress, **kw)
+        else:
+            run = lambda progress: position_workspace(mech, step=step_m, tol=tol_m, progress=progress, **kw)  # noqa: E731
+        if as_json:
+            res = run(None)
+        else:
+            with click.progressbar(length=1, label="checking poses", file=sys.stderr,
+                                   show_pos=True) as bar:
+                def progress(n):
+                    bar.length = max(bar.length, bar.pos + n)
+                    bar.update(n)
+                res = run(progress)
+        if plot:
+            from ..analysis.workspace_plot import write_workspace_plot
+
+            write_workspace_plot(res, plot)
+    except (ValueError, KeyError) as e:
+        msg = e.args[0] if isinstance(e, KeyError) and e.args else str(e)
+        raise UserError(str(msg)) from None
+    if as_json:
+        d = res.to_dict()
+        if plot:
+            d["plot"] = str(plot)
+        emit_json(d)
+        return
+    click.echo(_text(res))
+    if plot:
+        click.echo(f"plot written to {plot}")
