@@ -65,11 +65,3 @@ def test_export_then_mobility_of_the_file(tmp_path):
     assert run("export", "bennett", str(f)).exit_code == 0
     d = json.loads(run("mobility", str(f), "--json").output)
     assert d["dof"] == 1 and d["gk_classic"] == -2
-
-
-def test_demo_writes_report(tmp_path):
-    r = run("demo", "--out", str(tmp_path / "rep"), "--json")
-    assert r.exit_code == 0
-    data = json.loads((tmp_path / "rep" / "results.json").read_text())
-    assert all(c["reproduced"] for c in data["claims"])
-    assert (tmp_path / "rep" / "index.html").read_text().startswith("<!doctype html>")

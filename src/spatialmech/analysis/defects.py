@@ -42,6 +42,8 @@ from ..model.mechanism import Limb, Mechanism, Pose
 
 __all__ = [
     "candidate_drivers",
+    "DJTable",
+    "dj_table",
     "BranchPoint",
     "DriverVerdict",
     "PlanStep",
@@ -186,6 +188,7 @@ class DefectResult:
     min_closure_sigma_between: tuple[int, int] | None
     membership: tuple = ()
     tolerances: dict = field(default_factory=dict)
+    table: "DJTable | None" = None
     robustness: dict = field(default_factory=dict)
     traces: tuple = ()  # TrackResult per circuit (for figures; not serialised)
     rotational: dict = field(default_factory=dict)
@@ -214,6 +217,81 @@ class DefectResult:
             "robustness": self.robustness,
             "units": {"arc": "nondimensional arc length of the tracked curve (joint rad, lengths / L)"},
         }
+
+
+@dataclass(frozen=True, eq=False)
+class DJTable:
+    """``DJ`` (det of the complete Jacobian) at a mechanism's task positions, per driver.
+
+    ``dj`` (n_drivers, n_positions): only the signs along one row are comparable;
+    ``sigma_min`` the scale-free smallest singular value (0 at a singularity); ``fits`` the
+    closed configurations fitted to the (rounded, printed) positions, with their errors.
+    """
+
+    model: str
+    positions: tuple[str, ...]
+    drivers: tuple[str, ...]
+    dj: np.ndarray
+    sigma_min: np.ndarray
+    fits: tuple[PoseFit, ...]
+
+    @property
+    def signs(self) -> np.ndarray:
+        return np.sign(self.dj).astype(int)
+
+    def keeps_sign(self, driver: str) -> bool:
+        s = self.signs[self.drivers.index(driver)]
+        return bool(np.all(s == s[0]) and s[0] != 0)
+
+    def changes(self, driver: str) -> list[int]:
+        """Indices ``k`` where the sign changes between positions ``k`` and ``k + 1``."""
+        s = self.signs[self.drivers.index(driver)]
+        return [int(k) for k in np.flatnonzero(s[1:] != s[:-1])]
+
+    def to_dict(self) -> dict:
+        return {
+            "model": self.model,
+            "positions": list(self.positions),
+            "drivers": list(self.drivers),
+            "dj": self.dj.tolist(),
+            "signs": self.signs.tolist(),
+            "sigma_min": self.sigma_min.tolist(),
+            "keeps_sign": {d: self.keeps_sign(d) for d in self.drivers},
+            "pose_fit": [f.to_dict() for f in self.fits],
+            "note": "DJ magnitudes are not comparable between drivers; only signs along one driver are.",
+        }
+
+
+def dj_table(mech: Mechanism, drivers=None, positions=None) -> DJTable:
+    """DJ at every task position of ``mech`` for each driver (default :func:`candidate_drivers`).
+
+    The positions are fitted onto the closure in order, each fit starting from the previous
+    one (:func:`configuration_at_pose`).  Raises ``ValueError`` when the model has no task
+    positions or a position cannot be fitted.
+
+    Example: ``dj_table(catalog.build("five-cs-3")).keeps_sign("rot1")`` is True (paper A
+    fig 15).
+    """
+    positions = tuple(positions if positions is not None else mech.positions)
+    if not positions:
+        raise ValueError(f"mech: {mech.name} has no task positions")
+    drivers = tuple(drivers) if drivers is not None else tuple(candidate_drivers(mech))
+    fits, prev = [], None
+    for P in positions:
+        fit = configuration_at_pose(mech, P, start=prev)
+        if not fit.converged:
+            raise ValueError(f"positions: {P.name or 'a position'} has no closed configuration near it "
+                             f"(residual {fit.ik_residual:.2e}): is it reachable by this linkage?")
+        fits.append(fit)
+        prev = fit.config
+    djf, _ = dj_function(mech, list(drivers), fits[0].config)
+    dj = np.array([djf(f.config) for f in fits]).T
+    sig = np.empty_like(dj)
+    for i, d in enumerate(drivers):
+        for k, f in enumerate(fits):
+            sig[i, k] = complete_jacobian(mech, f.config, [d]).sigma_min
+    return DJTable(mech.name, tuple(p.name for p in positions), drivers, dj, sig, tuple(fits))
+
 
 
 # ----------------------------------------------------------------------------- helpers
@@ -440,17 +518,11 @@ def defect_analysis(
         raise ValueError("drivers: no candidate drivers")
     for d in drivers:
         mech.freedom(d)  # raises on unknown names
-    say("fitting the task positions onto the closure")
-    fits, prev = [], None
-    for P in positions:
-        fit = configuration_at_pose(mech, P, start=prev)
-        if not fit.converged:
-            raise ValueError(f"positions: {P.name or 'a position'} has no closed configuration near it "
-                             f"(residual {fit.ik_residual:.2e}): is it reachable by this linkage?")
-        fits.append(fit)
-        prev = fit.config
+    say("fitting the task positions onto the closure; DJ at every position")
+    table = dj_table(mech, drivers, positions)
+    fits = list(table.fits)
     djf, dj_method = dj_function(mech, drivers, fits[0].config)
-    dj_pos = np.array([djf(f.config) for f in fits])  # (positions, drivers)
+    dj_pos = table.dj.T  # (positions, drivers)
 
     # circuits: trace until every fitted position lies on a traced curve
     n = len(positions)
@@ -601,7 +673,7 @@ def defect_analysis(
         direction=direction, position_arcs=tuple(pos_arcs), path_length=float(path_end) if not circuit_defect else None,
         usable_drivers=usable, plan=plan, fits=tuple(fits), dj_method=dj_method, min_closure_sigma=min_sig,
         min_closure_sigma_between=min_between, traces=tuple(traces), rotational=rot, membership=tuple(membership),
-        tolerances={"pose": pose_tol, "angle_deg": angle_tol_deg, "on_curve": on_curve_tol},
+        tolerances={"pose": pose_tol, "angle_deg": angle_tol_deg, "on_curve": on_curve_tol}, table=table,
     )
     if monte_carlo:
         result = replace(result, robustness=_monte_carlo(mech, positions, result, monte_carlo, seed, precision,

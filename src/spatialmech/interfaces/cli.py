@@ -16,15 +16,7 @@ import numpy as np
 from .. import __version__, catalog
 from ..analysis.mobility import mobility, mobility_modes
 from ..model.schema import ModelFileError, dump
-
-
-class UserError(click.ClickException):
-    """One-line error, exit code 2."""
-
-    exit_code = 2
-
-    def show(self, file=None):
-        click.echo(f"error: {self.format_message()}", err=True, file=file)
+from .common import UserError, emit_json, json_option  # noqa: F401  (re-exported)
 
 
 class _Group(click.Group):
@@ -38,23 +30,10 @@ class _Group(click.Group):
             raise UserError(str(msg)) from None
 
 
-def _json_default(o):
-    if isinstance(o, np.ndarray):
-        return o.tolist()
-    if isinstance(o, (np.floating, np.integer, np.bool_)):
-        return o.item()
-    raise TypeError(f"not JSON serialisable: {type(o).__name__}")
-
-
-def emit_json(data) -> None:
-    click.echo(json.dumps(data, indent=2, default=_json_default, allow_nan=False))
-
-
 def _model(spec: str):
     return catalog.resolve(spec)
 
 
-json_option = click.option("--json", "as_json", is_flag=True, help="Print machine-readable JSON.")
 
 
 @click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
@@ -149,10 +128,12 @@ def export(model, file):
 
 @cli.command()
 @click.option("--out", "out", default="report", show_default=True, type=click.Path(file_okay=False, path_type=Path),
-              help="Directory for index.html and results.json.")
+              help="Directory for index.html, results.json and figures/.")
 @json_option
 def demo(out, as_json):
-    """Reproduce the papers' examples into a report (DIR/index.html, DIR/results.json).
+    """Reproduce the four papers' examples into a report: DIR/index.html (self-contained, opens
+    offline), DIR/results.json (every number) and DIR/figures/.  Each claim of a paper is a row:
+    the paper's value, ours, reproduced or not and why.  Progress on stderr; about 10 s.
 
     \b
     Example:
@@ -164,14 +145,47 @@ def demo(out, as_json):
     if as_json:
         emit_json(results)
     else:
+        s = results["summary"]
+        click.echo(f"report written to {out / 'index.html'} and {out / 'results.json'}: {s['claims']} claims, "
+                   f"{s['reproduced']} reproduced, {s['reproduced after correction']} after correction, "
+                   f"{s['not reproduced']} not reproduced")
+
+
+@cli.command()
+@click.argument("model")
+@click.option("--out", "out", default=None, type=click.Path(file_okay=False, path_type=Path),
+              help="Directory for index.html, results.json and figures/ (default: report-NAME).")
+@click.option("--no-trace", is_flag=True, help="Skip the continuation trace of a one-degree-of-freedom motion.")
+@json_option
+def report(model, out, no_trace, as_json):
+    """Every analysis that applies to one model, as a report like `demo`: mobility of every
+    mode, the complete Jacobian, DJ at the task positions, the traced motion (1 DOF) and an
+    interactive 3-D viewer.
+
+    \b
+    Examples:
+      spatialmech report bennett --out bennett-report
+      spatialmech report my-rssr.toml --json
+    """
+    from ..present.report import build_model_report
+
+    mech = _model(model)
+    out = out if out is not None else Path(f"report-{mech.name}")
+    results = build_model_report(mech, out, progress=not as_json, trace=not no_trace)
+    if as_json:
+        emit_json(results)
+    else:
         click.echo(f"report written to {out / 'index.html'} and {out / 'results.json'}")
 
 
 from .cmd_kinematics import fk, ik, jacobian  # noqa: E402  (commands defined in their own modules)
 from .cmd_synth import synth  # noqa: E402
 from .cmd_view import view  # noqa: E402
+from .cmd_defects import defects  # noqa: E402
+from .cmd_workspace import workspace  # noqa: E402
+from .cmd_singularity import singularity_cmd  # noqa: E402
 
-for _cmd in (ik, fk, jacobian, synth, view):
+for _cmd in (ik, fk, jacobian, synth, view, defects, workspace, singularity_cmd):
     cli.add_command(_cmd)
 
 

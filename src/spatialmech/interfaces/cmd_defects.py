@@ -11,7 +11,7 @@ import numpy as np
 from .. import catalog
 from ..analysis.defects import defect_analysis
 from ..model.schema import load_positions
-from .cli import emit_json, json_option
+from .common import emit_json, json_option
 
 
 @click.command()

@@ -13,10 +13,11 @@ import numpy as np
 
 from .. import catalog
 from ..geometry.rotations import euler_matrix, matrix_euler
+from ..analysis.defects import dj_table as compute_dj_table
 from ..kinematics.jacobian import complete_jacobian
 from ..kinematics.position import configuration_at_pose, forward_position, inverse_position
 from ..model.mechanism import Mechanism, Pose
-from .cli import emit_json, json_option
+from .common import emit_json, json_option
 
 pose_options = [
     click.option("--xyz", nargs=3, type=float, default=None, help="Platform point position X Y Z (model length unit)."),
@@ -128,18 +129,6 @@ def fk(model, values, all_solutions, seeds, as_json):
         click.echo(f"  [{k + 1}] position {np.array2string(s.pose.p, precision=6)}  ZYX (deg) {np.array2string(e, precision=4)}  {lim}")
 
 
-def _candidate_drivers(mech: Mechanism) -> list[str]:
-    """Drivers for a DJ table: every freedom of each limb's base joint, by alias when one exists."""
-    alias_of = {v: k for k, v in mech.aliases.items()}
-    out = []
-    for li, limb in enumerate(mech.limbs):
-        j = limb.joints[0]
-        for f in j.freedoms:
-            fid = f"{j.name}.{f.name}"
-            out.append(alias_of.get(fid, fid))
-    return out
-
-
 @click.command()
 @click.argument("model")
 @with_pose
@@ -159,19 +148,11 @@ def jacobian(model, xyz, euler, position, drivers, dj_table, as_json):
     if dj_table:
         if not mech.positions:
             raise ValueError(f"--dj-table: {mech.name} has no built-in task positions")
-        cands = list(drivers) or _candidate_drivers(mech)
-        prev, fits = None, []
-        for P in mech.positions:
-            fit = configuration_at_pose(mech, P, start=prev)
-            if not fit.converged:
-                raise ValueError(f"position {P.name}: no closed configuration near it (residual {fit.ik_residual:.2e})")
-            fits.append(fit)
-            prev = fit.config
-        rows = []
-        for d in cands:
-            dj = [complete_jacobian(mech, f.config, [d]).det for f in fits]
-            signs = [int(np.sign(x)) for x in dj]
-            rows.append({"driver": d, "dj": dj, "signs": signs, "keeps_sign": len(set(signs)) == 1 and 0 not in signs})
+        t = compute_dj_table(mech, list(drivers) or None)
+        fits = t.fits
+        rows = [{"driver": d, "dj": [float(x) for x in t.dj[i]], "signs": [int(x) for x in t.signs[i]],
+                 "keeps_sign": t.keeps_sign(d), "sigma_min": [float(x) for x in t.sigma_min[i]]}
+                for i, d in enumerate(t.drivers)]
         data = {"model": mech.name, "positions": [p.name for p in mech.positions],
                 "pose_fit": [f.to_dict() for f in fits], "drivers": rows,
                 "note": "DJ magnitudes are not comparable between drivers; only signs along one driver are."}

@@ -21,7 +21,7 @@ from ..analysis.workspace import (
     pose_checker,
     position_workspace,
 )
-from .cli import UserError, emit_json, json_option
+from .common import UserError, emit_json, json_option
 
 _ANGLES = ("alpha", "beta", "gamma")
 #: Largest grid (poses) the slow general kernel accepts from the CLI unless --max-poses says more.

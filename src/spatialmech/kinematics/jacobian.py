@@ -45,6 +45,7 @@ class CompleteJacobian:
     actuators: tuple[str, ...]
     inverse_singular: tuple[str, ...]  # actuators whose actuation wrench does not exist here
     length_scale: float
+    transmission: tuple[float, ...] = ()  # per actuator, |W . $a| / (|W| |$a|): 0 at an inverse singularity
 
     @property
     def wrenches(self) -> np.ndarray:
@@ -98,6 +99,7 @@ class CompleteJacobian:
             "det": self.det,
             "sigma_min": self.sigma_min,
             "condition": self.condition,
+            "transmission": list(self.transmission),
         }
 
 
@@ -152,11 +154,14 @@ def limb_constraint_wrenches(twists: np.ndarray, *, length_scale: float = 1.0, r
     return _from_nd(A, L)
 
 
-def actuation_wrench(twists: np.ndarray, index: int, constraints: np.ndarray, *, length_scale: float = 1.0):
+def actuation_wrench(twists: np.ndarray, index: int, constraints: np.ndarray, *, length_scale: float = 1.0,
+                     with_transmission: bool = False):
     """Actuation wrench of freedom ``index`` of a limb, normalised so that ``W . $a = 1``.
 
     Returns ``None`` when it does not exist (the actuated twist depends on the others: an
-    inverse, or serial, singularity).
+    inverse, or serial, singularity).  With ``with_transmission`` returns ``(W, tau)`` where
+    ``tau = |W . $a| / (|W| |$a|)`` (nondimensional, in [0, 1]) is the transmission index: 0 at
+    an inverse singularity, where ``W`` itself is ``None``.
     """
     T = np.atleast_2d(np.asarray(twists, dtype=float))
     L = float(length_scale)
@@ -168,16 +173,17 @@ def actuation_wrench(twists: np.ndarray, index: int, constraints: np.ndarray, *,
         Qc, _ = np.linalg.qr(Cn.T)
         Rn = Rn - (Rn @ Qc) @ Qc.T
     if Rn.shape[0] == 0:
-        return None
+        return (None, 0.0) if with_transmission else None
     u, s, vt = np.linalg.svd(Rn)
     if s[0] < 1e-9:
-        return None
+        return (None, 0.0) if with_transmission else None
     w = _from_nd(vt[0], L)
     prod = sc.reciprocal_product(w, T[index])
     scale = np.linalg.norm(_nd(w, L)) * np.linalg.norm(sc.nondimensional(T[index], L))
+    tau = abs(prod) / (L * max(scale, 1e-300))  # product of nd screws = product / L
     if abs(prod) < 1e-9 * max(scale, 1e-300):
-        return None
-    return w / prod
+        return (None, 0.0) if with_transmission else None
+    return (w / prod, float(tau)) if with_transmission else w / prod
 
 
 def complete_jacobian(
@@ -224,19 +230,21 @@ def complete_jacobian(
             limbs_of_rows.append(k)
     n_c = len(rows)
     singular = []
+    trans = []
     for a in act_ids:
         r = by_id[a]
         if r.freedom.locked:
             raise ValueError(f"actuators: {a} is locked in this mode")
         T, W = per_limb_constraints[r.limb]
         col = active_idx[r.limb].index(refs.index(r))
-        w = actuation_wrench(T, col, W, length_scale=L)
+        w, tau = actuation_wrench(T, col, W, length_scale=L, with_transmission=True)
+        trans.append(tau)
         if w is None:
             singular.append(a)
             w = np.zeros(6)
         rows.append(w)
     M = sc.swap(np.array(rows)) if rows else np.zeros((0, 6))
-    return CompleteJacobian(M, n_c, tuple(limbs_of_rows), tuple(act_ids), tuple(singular), L)
+    return CompleteJacobian(M, n_c, tuple(limbs_of_rows), tuple(act_ids), tuple(singular), L, tuple(trans))
 
 
 def driver_determinants(mech: Mechanism, config: Configuration, drivers) -> np.ndarray:

@@ -1,135 +1,415 @@
-"""The reproduction report: ``results.json`` and a self-contained ``index.html``.
+"""The reproduction report (``spatialmech demo``) and the one-model report (``spatialmech report``).
 
-Each paper claim is a row: what the paper says, what the project computes, whether it
-reproduces, and why not when it does not.  This module only gathers and renders; the numbers
-come from the analyses.
+A report is a list of :class:`Section` s.  A section holds
+
+- claim rows (:class:`Claim`): what a paper says, what spatialmech computes, the verdict
+  (``reproduced``, ``reproduced after correction`` or ``not reproduced``), why, the numbers
+  behind it (``evidence``) and the test of the suite that asserts it;
+- tables (:class:`Table`), figures (:class:`~.figures.ReportFigure`, Matplotlib PNGs) and
+  interactive 3-D viewers (:class:`Viewer`, plotly; see :mod:`.viewer`).
+
+Each paper's section is built by one function, ``section(progress)`` of
+:mod:`.paper_a` ... :mod:`.paper_d` (listed in :data:`DEMO_SECTIONS`); to add a claim or a
+figure, add it there.  The functions only call the library's analyses; this module only
+assembles and renders:
+
+- ``DIR/results.json``: every number of every table and claim (JSON, no NaN);
+- ``DIR/index.html``: one self-contained page (figures as base64 PNG, plotly.js inlined once
+  from the installed plotly package; no external URL anywhere in the markup), opens offline;
+- ``DIR/figures/*.png``: the figures as files.
+
+Progress goes to stderr (a bar on a terminal, one line per step otherwise); nothing is cached
+between runs.  Example::
+
+    from spatialmech.present.report import build_demo
+    data = build_demo("report")          # ~30 s; data["summary"] counts the verdicts
 """
 
 from __future__ import annotations
 
 import html
-import sys
+import importlib
 import json
-from dataclasses import asdict, dataclass
+import sys
+import time
+from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Callable, Sequence
 
-import click
+import numpy as np
 
-from .. import __version__, catalog
-from ..analysis.mobility import mobility_modes
-from ..catalog.papers import THREE_RRR_TABLE2, THREE_SPS_SMPU_MODES
+from .figures import ReportFigure
+
+__all__ = [
+    "VERDICTS",
+    "Claim",
+    "Table",
+    "Viewer",
+    "Section",
+    "Progress",
+    "DEMO_SECTIONS",
+    "build_demo",
+    "build_model_report",
+    "write_report",
+    "render_html",
+]
+
+#: The three verdicts of a claim row.
+VERDICTS = ("reproduced", "reproduced after correction", "not reproduced")
+
+#: The sections of the demo report, in order: ``module:function`` in :mod:`spatialmech.present`,
+#: each ``function(progress) -> Section``.
+DEMO_SECTIONS = (
+    "paper_a:section",
+    "paper_b:section",
+    "paper_c:section",
+    "paper_d:section",
+    "models:section",
+)
+
+
+def _jsonable(o):
+    """JSON conversion of NumPy scalars/arrays and tuples (``json.dumps(default=...)``)."""
+    if isinstance(o, np.ndarray):
+        return o.tolist()
+    if isinstance(o, (np.floating, np.integer, np.bool_)):
+        return o.item()
+    raise TypeError(f"not JSON serialisable: {type(o).__name__}")
 
 
 @dataclass(frozen=True)
 class Claim:
+    """One claim of a paper checked by the project.
+
+    ``paper_value``: what the paper states (text, as printed, translated); ``ours``: what the
+    project's analysis gives (text with numbers and units); ``evidence``: the numbers behind
+    ``ours`` (JSON-serialisable); ``note``: why it does (not) reproduce; ``test``: the test
+    of the suite that asserts the same thing (``file::function``).
+    """
+
     paper: str
     claim: str
     paper_value: str
     ours: str
-    reproduced: bool
+    verdict: str
+    note: str = ""
+    evidence: dict = field(default_factory=dict)
+    test: str = ""
+
+    def __post_init__(self):
+        if self.verdict not in VERDICTS:
+            raise ValueError(f"verdict: expected one of {VERDICTS}, got {self.verdict!r}")
+
+    @property
+    def reproduced(self) -> bool:
+        """True unless the verdict is ``not reproduced``."""
+        return self.verdict != "not reproduced"
+
+    def to_dict(self) -> dict:
+        return {
+            "paper": self.paper,
+            "claim": self.claim,
+            "paper_value": self.paper_value,
+            "ours": self.ours,
+            "verdict": self.verdict,
+            "reproduced": self.reproduced,
+            "note": self.note,
+            "evidence": self.evidence,
+            "test": self.test,
+        }
+
+
+@dataclass(frozen=True)
+class Table:
+    """A table of numbers: ``rows`` are tuples in the order of ``columns``."""
+
+    title: str
+    columns: tuple[str, ...]
+    rows: tuple[tuple, ...]
     note: str = ""
 
+    def __post_init__(self):
+        for k, r in enumerate(self.rows):
+            if len(r) != len(self.columns):
+                raise ValueError(f"rows[{k}]: expected {len(self.columns)} values ({', '.join(self.columns)}), got {len(r)}")
 
-def _same_motion(a: str, b: str) -> bool:
-    """Motion names compared as sets of elementary motions (order-free: 'RzRy' == 'RyRz')."""
-    split = lambda s: sorted(s[i : i + 2] for i in range(0, len(s), 2))
-    return split(a) == split(b)
-
-
-def mobility_claims(results: dict[str, list]) -> list[Claim]:
-    """The papers' mobility claims checked against computed results (by model name)."""
-    claims = []
-    r = results["four-sps-cu"][0]
-    ours = f"n={r.n}, g={r.g}, sum f={r.sum_f}, lambda={r.lam}, v={r.v}, xi={r.xi}, M={r.dof} ({r.motion})"
-    ok = (r.n, r.g, r.sum_f, r.lam, r.v, r.xi, r.dof) == (11, 14, 32, 0, 0, 4, 4) and _same_motion(r.motion, "RxRyRzTz")
-    claims.append(Claim("B", "4-SPS/CU mobility (eq 4, section 3)", "n=11, g=14, sum f=32, lambda=0, v=0, xi=4, M=4 (3R + Tz)", ours, ok))
-    by_mode = {x.mode: x for x in results["three-rrr-sm"]}
-    for driven, motion in THREE_RRR_TABLE2.items():
-        x = by_mode["+".join(driven)]
-        ok = x.dof == len(driven) and _same_motion(x.motion, motion) and x.d == 3
-        note = "table 2 prints R7 -> Rx; R7 drives Rz (typo, conventions.md)" if driven == ("R7",) else ""
-        claims.append(
-            Claim("C", f"3-RRR metamorphic joint, drive {'+'.join(driven)} (table 2, eqs 10/13/16)",
-                  f"M={len(driven)}, {motion}", f"M={x.dof} ({x.d}({x.n}-{x.g}-1)+{x.sum_f}+{x.v}-{x.xi}), {x.motion}", ok, note)
-        )
-    by_mode = {x.mode: x for x in results["three-sps-smpu"]}
-    for driven, motion in THREE_SPS_SMPU_MODES.items():
-        x = by_mode["+".join(driven) if driven else "Sm-locked"]
-        ok = x.dof == 3 + len(driven) and _same_motion(x.motion, motion)
-        claims.append(
-            Claim("C", f"3-SPS/SmPU, Sm rotations driven: {', '.join(driven) or 'none'} (section 5)",
-                  f"{3 + len(driven)} DOF, {motion}", f"{x.dof} DOF, {x.motion}", ok,
-                  "generic dimensions (the paper gives none)")
-        )
-    for k in (1, 2, 3):
-        x = results[f"five-cs-{k}"][0]
-        claims.append(Claim("A", f"5-CS linkage {k} is a one-degree-of-freedom linkage", "1", f"{x.dof} (instantaneous {x.dof_instantaneous})", x.dof == 1 == x.dof_instantaneous))
-    return claims
+    def to_dict(self) -> dict:
+        return {"title": self.title, "columns": list(self.columns), "rows": [list(r) for r in self.rows], "note": self.note}
 
 
-def _table(rows: list[dict], cols: list[str]) -> str:
-    head = "".join(f"<th>{html.escape(c)}</th>" for c in cols)
-    body = "".join(
-        "<tr>" + "".join(f"<td>{html.escape(str(r.get(c, '')))}</td>" for c in cols) + "</tr>" for r in rows
-    )
-    return f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
+@dataclass(frozen=True, eq=False)
+class Viewer:
+    """An interactive 3-D viewer to embed: ``configs`` along a motion of ``mech``
+    (see :func:`.viewer.viewer_figure` for ``task_positions`` and ``singular_points``)."""
+
+    title: str
+    mech: object = field(repr=False)
+    configs: tuple = field(repr=False)
+    task_positions: tuple = field(default=(), repr=False)
+    singular_points: tuple = field(default=(), repr=False)
+    note: str = ""
+
+    def to_dict(self) -> dict:
+        return {"title": self.title, "model": self.mech.name, "frames": len(self.configs),
+                "task_positions": len(self.task_positions), "singular_points": len(self.singular_points),
+                "note": self.note}
 
 
+@dataclass(frozen=True)
+class Section:
+    """One section of a report (one paper, one model, ...)."""
+
+    key: str
+    title: str
+    intro: str = ""
+    claims: tuple[Claim, ...] = ()
+    tables: tuple[Table, ...] = ()
+    figures: tuple[ReportFigure, ...] = ()
+    viewers: tuple[Viewer, ...] = ()
+    pending: tuple[str, ...] = ()  # analyses of the paper not (yet) in the report
+    data: dict = field(default_factory=dict)  # extra numbers (JSON-serialisable)
+
+    def to_dict(self) -> dict:
+        return {
+            "key": self.key,
+            "title": self.title,
+            "intro": self.intro,
+            "claims": [c.to_dict() for c in self.claims],
+            "tables": [t.to_dict() for t in self.tables],
+            "figures": [f.to_dict() for f in self.figures],
+            "viewers": [v.to_dict() for v in self.viewers],
+            "pending": list(self.pending),
+            "data": self.data,
+        }
+
+
+# ------------------------------------------------------------------------------ progress
+class Progress:
+    """Progress of a report on ``file`` (stderr): ``progress("label")`` announces the next step.
+
+    On a terminal: a bar over ``total`` steps with the current label; otherwise one line per
+    step with the elapsed time.  ``enabled=False`` prints nothing.
+    """
+
+    def __init__(self, total: int, *, enabled: bool = True, file=None, label: str = "spatialmech"):
+        self.total = max(int(total), 1)
+        self.enabled = enabled
+        self.file = file if file is not None else sys.stderr
+        self.label = label
+        self.count = 0
+        self.t0 = time.perf_counter()
+        self.tty = bool(getattr(self.file, "isatty", lambda: False)())
+
+    @property
+    def elapsed(self) -> float:
+        return time.perf_counter() - self.t0
+
+    def __call__(self, step: str) -> None:
+        self.count += 1
+        if not self.enabled:
+            return
+        n = min(self.count, self.total)
+        if self.tty:
+            width = 24
+            done = int(width * n / self.total)
+            line = f"\r{self.label} [{'#' * done}{'-' * (width - done)}] {n}/{self.total} {self.elapsed:5.1f} s  {step[:60]:<60}"
+            self.file.write(line)
+        else:
+            self.file.write(f"[{n:2d}/{self.total} {self.elapsed:6.1f} s] {step}\n")
+        self.file.flush()
+
+    def close(self) -> None:
+        if self.enabled:
+            end = f"done in {self.elapsed:.1f} s"
+            self.file.write((f"\r{self.label}: {end}{' ' * 90}\n") if self.tty else f"{self.label}: {end}\n")
+            self.file.flush()
+
+
+def _section_function(spec: str) -> tuple[Callable, int]:
+    mod_name, fn_name = spec.split(":")
+    mod = importlib.import_module(f"{__package__}.{mod_name}")
+    return getattr(mod, fn_name), int(getattr(mod, "STEPS", 1))
+
+
+# ------------------------------------------------------------------------------ rendering
 _CSS = """
-body{font-family:system-ui,sans-serif;margin:2em auto;max-width:1100px;color:#222}
-table{border-collapse:collapse;margin:1em 0;font-size:14px}
-td,th{border:1px solid #ccc;padding:4px 8px;text-align:left;vertical-align:top}
-th{background:#f3f3f3} .ok{color:#176f2c;font-weight:bold} .no{color:#b3261e;font-weight:bold}
-code{background:#f5f5f5;padding:0 3px}
+body{font-family:system-ui,-apple-system,Segoe UI,sans-serif;margin:1.5em auto;max-width:1180px;color:#222;padding:0 1em}
+h1{margin-bottom:.2em} h2{border-bottom:2px solid #ddd;padding-bottom:.2em;margin-top:2em}
+table{border-collapse:collapse;margin:.6em 0 1.2em;font-size:13px}
+td,th{border:1px solid #ccc;padding:3px 7px;text-align:left;vertical-align:top}
+th{background:#f3f3f3} td.num{text-align:right;font-variant-numeric:tabular-nums}
+.v-reproduced{color:#176f2c;font-weight:bold} .v-corrected{color:#8a5a00;font-weight:bold}
+.v-not{color:#b3261e;font-weight:bold} .small{font-size:12px;color:#555}
+code{background:#f5f5f5;padding:0 3px} figure{margin:1em 0} figure img{max-width:100%;border:1px solid #eee}
+figcaption{font-size:13px;color:#444} .pending{background:#fff8e1;padding:.4em .8em;border-left:3px solid #f0c36d}
+.viewer{border:1px solid #ddd;margin:1em 0}
 """
 
+_VERDICT_CLASS = {"reproduced": "v-reproduced", "reproduced after correction": "v-corrected", "not reproduced": "v-not"}
 
-def render_html(data: dict) -> str:
-    claims = data["claims"]
-    crow = "".join(
-        f"<tr><td>{html.escape(c['paper'])}</td><td>{html.escape(c['claim'])}</td><td>{html.escape(c['paper_value'])}</td>"
-        f"<td>{html.escape(c['ours'])}</td><td class='{'ok' if c['reproduced'] else 'no'}'>"
-        f"{'reproduced' if c['reproduced'] else 'NOT reproduced'}</td><td>{html.escape(c['note'])}</td></tr>"
-        for c in claims
+
+def _fmt(v) -> str:
+    if isinstance(v, bool) or v is None:
+        return str(v)
+    if isinstance(v, (float, np.floating)):
+        v = float(v)
+        if v == 0.0:
+            return "0"
+        a = abs(v)
+        return f"{v:.4g}" if 1e-3 <= a < 1e5 else f"{v:.3e}"
+    if isinstance(v, (list, tuple)):
+        return ", ".join(_fmt(x) for x in v)
+    return str(v)
+
+
+def _table_html(t: Table) -> str:
+    head = "".join(f"<th>{html.escape(c)}</th>" for c in t.columns)
+    body = "".join(
+        "<tr>" + "".join(
+            f"<td class='num'>{html.escape(_fmt(x))}</td>" if isinstance(x, (int, float, np.number)) and not isinstance(x, bool)
+            else f"<td>{html.escape(_fmt(x))}</td>" for x in r) + "</tr>"
+        for r in t.rows
     )
-    mob_rows = [
-        {"model": m, **{k: v for k, v in r.items() if k in ("mode", "dof", "dof_instantaneous", "gk_classic", "motion", "lambda", "d", "n", "g", "sum_f", "v", "xi")}}
-        for m, rs in data["mobility"].items() for r in rs
-    ]
-    cols = ["model", "mode", "dof", "dof_instantaneous", "gk_classic", "motion", "lambda", "d", "n", "g", "sum_f", "v", "xi"]
-    n_ok = sum(c["reproduced"] for c in claims)
-    return f"""<!doctype html><html><head><meta charset="utf-8"><title>spatialmech reproduction report</title>
-<style>{_CSS}</style></head><body>
-<h1>spatialmech reproduction report</h1>
-<p>spatialmech {html.escape(data['version'])}. {n_ok} of {len(claims)} claims reproduced.</p>
-<h2>Claims of the papers</h2>
-<table><thead><tr><th>paper</th><th>claim</th><th>paper</th><th>spatialmech</th><th>verdict</th><th>note</th></tr></thead>
-<tbody>{crow}</tbody></table>
-<h2>Mobility of every ready-made model</h2>
-<p>Modified Kutzbach-Grübler formula <code>M = d(n - g - 1) + &Sigma;f + v - &xi;</code> from the limbs' screw
-systems at the reference configuration; <code>dof_instantaneous</code> is the independent numerical check
-(rank of the loop-closure Jacobian at a generic configuration); <code>gk_classic</code> the uncorrected count.</p>
-{_table(mob_rows, cols)}
-</body></html>
-"""
+    note = f"<p class='small'>{html.escape(t.note)}</p>" if t.note else ""
+    return f"<h3>{html.escape(t.title)}</h3><table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>{note}"
 
 
-def build_demo(out: Path, *, progress: bool = True) -> dict:
-    """Run every reproduction and write ``out/results.json`` and ``out/index.html``."""
+def _claims_html(claims: Sequence[Claim]) -> str:
+    rows = []
+    for c in claims:
+        test = f"<div class='small'>test: <code>{html.escape(c.test)}</code></div>" if c.test else ""
+        rows.append(
+            f"<tr><td>{html.escape(c.claim)}</td><td>{html.escape(c.paper_value)}</td><td>{html.escape(c.ours)}</td>"
+            f"<td class='{_VERDICT_CLASS[c.verdict]}'>{html.escape(c.verdict)}</td><td>{html.escape(c.note)}{test}</td></tr>"
+        )
+    return ("<table><thead><tr><th>claim</th><th>paper</th><th>spatialmech</th><th>verdict</th><th>why / evidence</th>"
+            "</tr></thead><tbody>" + "".join(rows) + "</tbody></table>")
+
+
+def _viewer_html(v: Viewer, div_id: str) -> str:
+    from .viewer import viewer_figure
+
+    fig = viewer_figure(v.mech, list(v.configs), title=v.title, task_positions=v.task_positions,
+                        singular_points=v.singular_points)
+    div = fig.to_html(include_plotlyjs=False, full_html=False, auto_play=False, div_id=div_id,
+                      default_height="640px", config={"displaylogo": False, "responsive": True})
+    note = f"<p class='small'>{html.escape(v.note)}</p>" if v.note else ""
+    return f"<div class='viewer'>{div}</div>{note}"
+
+
+def summary(sections: Sequence[Section]) -> dict:
+    """Counts of the verdicts, overall and per section."""
+    out = {"claims": 0, **{v: 0 for v in VERDICTS}, "by_section": {}}
+    for s in sections:
+        per = {v: sum(c.verdict == v for c in s.claims) for v in VERDICTS}
+        out["by_section"][s.key] = {"claims": len(s.claims), **per}
+        out["claims"] += len(s.claims)
+        for v in VERDICTS:
+            out[v] += per[v]
+    return out
+
+
+def render_html(title: str, sections: Sequence[Section], data: dict) -> str:
+    """The self-contained page (plotly.js inlined once if any section has a viewer)."""
+    s = data["summary"]
+    toc = "".join(
+        f"<li><a href='#{html.escape(sec.key)}'>{html.escape(sec.title)}</a>"
+        + (f" ({s['by_section'][sec.key]['claims']} claims: {s['by_section'][sec.key]['reproduced']} reproduced,"
+           f" {s['by_section'][sec.key]['reproduced after correction']} after correction,"
+           f" {s['by_section'][sec.key]['not reproduced']} not reproduced)" if sec.claims else "")
+        + "</li>"
+        for sec in sections
+    )
+    parts = []
+    n_view = 0
+    for sec in sections:
+        parts.append(f"<h2 id='{html.escape(sec.key)}'>{html.escape(sec.title)}</h2>")
+        if sec.intro:
+            parts.append("".join(f"<p>{html.escape(p)}</p>" for p in sec.intro.split("\n\n")))
+        if sec.claims:
+            parts.append(_claims_html(sec.claims))
+        if sec.pending:
+            parts.append("<div class='pending'><b>Not (yet) in this report:</b><ul>"
+                         + "".join(f"<li>{html.escape(p)}</li>" for p in sec.pending) + "</ul></div>")
+        for t in sec.tables:
+            parts.append(_table_html(t))
+        for f in sec.figures:
+            parts.append(
+                f"<figure><img alt='{html.escape(f.title)}' src='{f.data_uri()}'><figcaption><b>{html.escape(f.title)}.</b> "
+                f"{html.escape(f.caption)} <span class='small'>(figures/{html.escape(f.name)})</span></figcaption></figure>"
+            )
+        for v in sec.viewers:
+            n_view += 1
+            parts.append(f"<h3>{html.escape(v.title)}</h3>" + _viewer_html(v, f"spatialmech-viewer-{n_view}"))
+    js = ""
+    if n_view:
+        from plotly.offline import get_plotlyjs
+
+        js = f"<script type='text/javascript'>{get_plotlyjs()}</script>"
+    head = (f"<p>spatialmech {html.escape(data['version'])}; generated in {data['elapsed_s']:.1f} s. "
+            f"{s['claims']} claims: {s['reproduced']} reproduced, {s['reproduced after correction']} reproduced after "
+            f"correction, {s['not reproduced']} not reproduced (each with the reason). Every number is in "
+            f"<code>results.json</code>; the figures are also in <code>figures/</code>.</p>")
+    return (f"<!doctype html><html><head><meta charset='utf-8'><title>{html.escape(title)}</title>"
+            f"<style>{_CSS}</style>{js}</head><body><h1>{html.escape(title)}</h1>{head}<ul>{toc}</ul>"
+            + "".join(parts) + "</body></html>\n")
+
+
+def write_report(out, title: str, sections: Sequence[Section], elapsed: float, extra: dict | None = None) -> dict:
+    """Write ``out/results.json``, ``out/index.html`` and ``out/figures/*.png``; return the data."""
+    from .. import __version__
+
     out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    names = catalog.names()
-    results = {}
-    with click.progressbar(names, label="mobility", file=sys.stderr, hidden=not progress,
-                           item_show_func=lambda n: n or "") as bar:
-        for name in bar:
-            results[name] = mobility_modes(catalog.build(name))
-    claims = mobility_claims(results)
+    (out / "figures").mkdir(parents=True, exist_ok=True)
+    names = [f.name for sec in sections for f in sec.figures]
+    dup = {n for n in names if names.count(n) > 1}
+    if dup:
+        raise ValueError(f"figures: duplicate file names {sorted(dup)}")
+    for sec in sections:
+        for f in sec.figures:
+            (out / "figures" / f.name).write_bytes(f.png)
     data = {
+        "title": title,
         "version": __version__,
-        "claims": [asdict(c) for c in claims],
-        "mobility": {n: [r.to_dict() for r in rs] for n, rs in results.items()},
+        "elapsed_s": round(float(elapsed), 2),
+        "verdicts": list(VERDICTS),
+        "summary": summary(sections),
+        "claims": [c.to_dict() for sec in sections for c in sec.claims],
+        "sections": [sec.to_dict() for sec in sections],
+        **(extra or {}),
     }
-    (out / "results.json").write_text(json.dumps(data, indent=2), encoding="utf-8")
-    (out / "index.html").write_text(render_html(data), encoding="utf-8")
+    text = json.dumps(data, indent=1, default=_jsonable, allow_nan=False)
+    (out / "results.json").write_text(text, encoding="utf-8")
+    data = json.loads(text)
+    (out / "index.html").write_text(render_html(title, sections, data), encoding="utf-8")
+    return data
+
+
+# ------------------------------------------------------------------------------ entry points
+def build_demo(out, *, progress: bool = True, sections: Sequence[str] = DEMO_SECTIONS) -> dict:
+    """Reproduce every paper's examples and write the report into ``out`` (see module docstring).
+
+    ``sections``: ``module:function`` specs (default :data:`DEMO_SECTIONS`).  Returns the data
+    written to ``results.json``.
+    """
+    fns = [_section_function(s) for s in sections]
+    bar = Progress(sum(n for _, n in fns), enabled=progress, label="spatialmech demo")
+    built = [fn(bar) for fn, _ in fns]
+    data = write_report(out, "spatialmech reproduction report", built, bar.elapsed)
+    bar.close()
+    return data
+
+
+def build_model_report(model, out, *, progress: bool = True, trace: bool = True) -> dict:
+    """Every analysis that applies to one model (ready-made name, TOML file or Mechanism),
+    written like the demo into ``out`` (see :func:`.models.model_section`).  ``trace=False``
+    skips the continuation trace of a one-degree-of-freedom motion."""
+    from .. import catalog
+    from . import models
+
+    mech = catalog.resolve(model)
+    bar = Progress(models.MODEL_STEPS, enabled=progress, label=f"spatialmech report {mech.name}")
+    sec = models.model_section(mech, bar, trace=trace)
+    data = write_report(out, f"spatialmech report: {mech.name}", [sec], bar.elapsed, {"model": mech.name})
+    bar.close()
     return data

@@ -1,0 +1,34 @@
+"""Forward position of a Gough-Stewart platform: assembly modes for one set of leg lengths.
+
+The leg lengths come from the inverse position of a chosen pose.  A multi-start forward search
+(general closure engine) finds that pose again and other assembly modes; each is checked
+against the closed-form SPS leg lengths |R a_i + p - b_i|, and so is its mirror image in the
+base plane (the same leg lengths with the platform below the base).
+"""
+
+import numpy as np
+
+import spatialmech as sm
+from spatialmech.kinematics.closed_forms import sps
+from spatialmech.kinematics.position import forward_position, inverse_position
+
+mech = sm.load_model("stewart-6sps")
+pose = sm.Pose.from_euler("ZYX", [12, -6, 4], [0.03, -0.02, 1.05], degrees=True)   # Rz(12) Ry(-6) Rx(4), metres
+legs = np.array(list(inverse_position(mech, pose).actuator_values(mech).values()))
+print("leg lengths [m]:", np.round(legs, 6))
+
+res = forward_position(mech, legs, all_solutions=True, n_seeds=40, seed=2)
+modes = [s for s in res.solutions if s.converged]
+print(f"{len(modes)} assembly modes found ({res.search['seeds']} starts; a multi-start search cannot prove completeness)")
+for s in modes:
+    print("  platform point", np.round(s.pose.p, 4), "| within limits" if not s.outside_limits else "| outside limits")
+
+base = np.array([limb.joints[0].point for limb in mech.limbs])                       # b_i, world frame
+plat = np.array([limb.joints[-1].point for limb in mech.limbs]) - mech.platform_point  # a_i, platform frame
+M = np.diag([1.0, 1.0, -1.0])                                                         # reflection in z = 0
+assert np.allclose(base[:, 2], 0.0)
+assert any(np.allclose(s.pose.p, pose.p, atol=1e-8) and np.allclose(s.pose.R, pose.R, atol=1e-8) for s in modes)
+assert len(modes) >= 2
+for s in modes:
+    assert np.allclose(sps.leg_lengths(s.pose.R, s.pose.p, base, plat), legs, atol=1e-8)
+    assert np.allclose(sps.leg_lengths(M @ s.pose.R @ M, M @ s.pose.p, base, plat), legs, atol=1e-8)

@@ -1,0 +1,309 @@
+"""Singularity analysis for any mechanism (paper B section 5, made general).
+
+At a configuration, with the actuators locked, the platform is held by the constraint wrenches
+of the limbs and the actuation wrenches of the actuators: the rows of the complete Jacobian
+(:mod:`spatialmech.kinematics.jacobian`).  The analysis reports
+
+- ``rank`` of that wrench system (6 when the platform is held) and which kind of singularity
+  it is: *inverse* (serial: an actuation wrench does not exist, the actuator can move with
+  the platform at rest), *constraint* (the limbs' constraint wrenches lose rank: the
+  platform gains a freedom it should not have), *direct* (parallel: constraint and actuation
+  wrenches together lose rank: an uncontrolled platform twist), or none;
+- the uncontrolled platform twist (the null space of ``J``) and, for an inverse singularity,
+  the actuator that moves with the platform at rest;
+- the smallest singular value of the scale-free Jacobian (distance to a direct or constraint
+  singularity) and each actuator's transmission index ``|W . $a| / (|W| |$a|)`` (distance to
+  an inverse singularity: 0 there);
+- the line geometry of the wrench system when its members are lines (forces), by Grassmann's
+  varieties (:mod:`spatialmech.geometry.line_geometry`), with witnesses;
+- whether the uncontrolled motion is *finite* (a self-motion with the actuators locked: the
+  motion can be followed by the continuation tracker with the actuators held) or only
+  instantaneous.
+
+:func:`singularity_slice` maps ``sign(det J)`` and ``sigma_min`` over a 2-D slice of a pose
+parametrisation: the singularity loci are its zero contours.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from typing import Callable
+
+import numpy as np
+
+from ..geometry import screws as sc
+from ..geometry.line_geometry import classify_lines
+from ..kinematics.closure import Configuration, active_mask, closure_jacobian
+from ..kinematics.jacobian import CompleteJacobian, complete_jacobian
+from ..kinematics.position import configuration_at_pose
+from ..kinematics.tracking import MotionProblem, track
+from ..model.mechanism import Limb, Mechanism, Pose
+
+__all__ = ["SingularityResult", "singularity", "singularity_at_pose", "SliceResult", "singularity_slice", "locked_actuators"]
+
+
+@dataclass(frozen=True, eq=False)
+class SingularityResult:
+    rank: int
+    expected_rank: int
+    kind: str  # "none", "inverse", "constraint", "direct", or a combination "direct+inverse"
+    sigma_min: float
+    condition: float
+    transmission: tuple[float, ...]
+    twist: tuple[tuple[float, ...], ...]  # uncontrolled platform twists (omega ; v), SI
+    inverse_actuators: tuple[str, ...]
+    constraint_rank: int
+    constraint_rank_generic: int
+    line_geometry: dict | None
+    self_motion: dict | None
+    jacobian: CompleteJacobian
+    explanation: str
+
+    def to_dict(self) -> dict:
+        return {
+            "rank": self.rank,
+            "expected_rank": self.expected_rank,
+            "kind": self.kind,
+            "singular": self.kind != "none",
+            "sigma_min": self.sigma_min,
+            "condition": self.condition,
+            "transmission": dict(zip(self.jacobian.actuators, self.transmission)),
+            "twist": [list(t) for t in self.twist],
+            "twist_convention": "(omega ; v), v = velocity of the point at the origin (SI)",
+            "inverse_actuators": list(self.inverse_actuators),
+            "constraint_rank": self.constraint_rank,
+            "constraint_rank_generic": self.constraint_rank_generic,
+            "line_geometry": self.line_geometry,
+            "self_motion": self.self_motion,
+            "wrenches": self.jacobian.wrenches.tolist(),
+            "actuators": list(self.jacobian.actuators),
+            "explanation": self.explanation,
+        }
+
+
+def locked_actuators(mech: Mechanism, actuators=None) -> Mechanism:
+    """The mechanism with its actuators locked (the structure that must hold the platform)."""
+    ids = {mech.freedom(a).id for a in (actuators if actuators is not None else mech.actuators)}
+    limbs = []
+    for limb in mech.limbs:
+        joints = []
+        for j in limb.joints:
+            for f in j.freedoms:
+                if f"{j.name}.{f.name}" in ids:
+                    j = j.with_freedom(f.name, locked=True, actuated=False)
+            joints.append(j)
+        limbs.append(Limb(limb.name, tuple(joints)))
+    return replace(mech, limbs=tuple(limbs), modes=())
+
+
+def _is_line(w: np.ndarray, L: float, tol: float = 1e-7) -> bool:
+    f, m = w[:3], w[3:]
+    nf = np.linalg.norm(f)
+    return nf > 1e-12 and abs(f @ m) <= tol * nf * max(np.linalg.norm(m), L * nf)
+
+
+def _as_unit_line(w: np.ndarray) -> np.ndarray:
+    f = w[:3]
+    n = np.linalg.norm(f)
+    line = w / n
+    # remove the tiny pitch left by rounding so the line validates exactly
+    s, m = line[:3], line[3:]
+    return np.r_[s, m - (s @ m) * s]
+
+
+def _generic_constraint_rank(mech: Mechanism) -> int:
+    from ..analysis.mobility import mobility
+
+    r = mobility(mech) if not mech.is_metamorphic or len(mech.all_modes()) == 1 else None
+    return (6 - r.dof - 0) if r is not None else -1
+
+
+def _self_motion(mech: Mechanism, config: Configuration, actuators, arc: float) -> dict:
+    """Follow the motion of the mechanism with its actuators locked, if there is one."""
+    locked = locked_actuators(mech, actuators)
+    prob = MotionProblem(locked)
+    try:
+        tr = track(prob, config, max_arc=arc, h0=min(0.01, arc / 10), detect_closure=True, max_steps=400)
+    except RuntimeError as e:
+        return {"finite": False, "reason": str(e)}
+    if not tr.points or tr.s[-1] < 0.5 * arc and not tr.closed:
+        return {"finite": False, "reason": tr.status, "arc": float(tr.s[-1]) if len(tr.s) else 0.0}
+    p0 = config.D[:3, :3] @ mech.platform_point + config.D[:3, 3]
+    end = tr.points[-1]
+    p1 = end.D[:3, :3] @ mech.platform_point + end.D[:3, 3]
+    from ..geometry.rotations import rotation_angle
+
+    ang = float(rotation_angle(end.D[:3, :3] @ config.D[:3, :3].T))
+    return {
+        "finite": True,
+        "arc": float(tr.s[-1]),
+        "closed": bool(tr.closed),
+        "platform_point_moved": float(np.linalg.norm(p1 - p0)),
+        "platform_rotated_deg": float(np.degrees(ang)),
+        "end_platform_point": p1.tolist(),
+        "status": tr.status,
+    }
+
+
+def singularity(
+    mech: Mechanism,
+    config: Configuration,
+    actuators=None,
+    *,
+    rtol: float = 1e-7,
+    self_motion_arc: float = 0.3,
+) -> SingularityResult:
+    """Singularity analysis of ``mech`` at a (closed) configuration with the given actuators."""
+    J = complete_jacobian(mech, config, actuators)
+    L = mech.characteristic_length
+    W = J.wrenches
+    nd = sc.nondimensional(W, L)
+    norms = np.linalg.norm(nd, axis=1, keepdims=True)
+    nd = nd / np.where(norms > 0, norms, 1.0)
+    sv = np.linalg.svd(nd, compute_uv=False) if nd.size else np.zeros(0)
+    rank = int(np.sum(sv > rtol * max(1.0, sv[0] if sv.size else 1.0)))
+    c_rows = nd[: J.constraint_rows]
+    c_rank = int(np.linalg.matrix_rank(c_rows, tol=rtol)) if c_rows.size else 0
+    generic = _generic_constraint_rank(mech)
+    expected = min(6, J.matrix.shape[0])
+    kinds = []
+    if J.inverse_singular:
+        kinds.append("inverse")
+    if generic >= 0 and c_rank < generic:
+        kinds.append("constraint")
+    if rank < expected and not J.inverse_singular and "constraint" not in kinds:
+        kinds.append("direct")
+    elif rank < expected and "constraint" in kinds:
+        pass
+    kind = "+".join(kinds) if kinds else "none"
+    # uncontrolled twists: matrix @ V = 0 (in nondimensional twist coordinates)
+    M = sc.nondimensional(J.wrenches, L)
+    M = sc.swap(M)  # rows act on (omega ; v / L)
+    twist = ()
+    if rank < 6:
+        _, s2, vt = np.linalg.svd(M if M.size else np.zeros((1, 6)))
+        r2 = int(np.sum(s2 > rtol * max(1.0, s2[0]))) if s2.size else 0
+        N = vt[r2:].copy()
+        N[:, 3:] *= L
+        out = []
+        for n in N:  # unit angular part, or unit translation for a pure translation
+            w = np.linalg.norm(n[:3])
+            n = n / (w if w > 1e-9 else np.linalg.norm(n))
+            out.append(tuple(float(x) for x in np.where(np.abs(n) < 1e-12, 0.0, n)))
+        twist = tuple(out)
+    # line geometry of the wrench system when every wrench is a line
+    lg = None
+    if W.shape[0] and all(_is_line(w, L) for w in W):
+        lines = np.array([_as_unit_line(w) for w in W])
+        lg = classify_lines(lines, length_scale=L).to_dict()
+    # finite or instantaneous?
+    sm = None
+    if kind != "none" and "inverse" not in kinds:
+        sm = _self_motion(mech, config, actuators if actuators is not None else list(J.actuators), self_motion_arc)
+    parts = []
+    if kind == "none":
+        parts.append(f"Not singular: the wrench system has rank {rank} (scale-free sigma_min {J.sigma_min:.3g}).")
+    else:
+        if "inverse" in kinds:
+            parts.append(f"Inverse (serial) singularity: no actuation wrench for {', '.join(J.inverse_singular)}; "
+                         "the actuator can move while the platform stays at rest.")
+        if "constraint" in kinds:
+            parts.append(f"Constraint singularity: the limbs' constraint wrenches have rank {c_rank} instead of {generic}.")
+        if "direct" in kinds:
+            parts.append(f"Direct (parallel) singularity: with the actuators locked the wrench system has rank {rank} < {expected}; "
+                         "the platform has an uncontrolled twist.")
+        if sm is not None:
+            parts.append("The uncontrolled motion is finite (a self-motion with the actuators locked)." if sm.get("finite")
+                         else "The uncontrolled motion is only instantaneous.")
+    if lg is not None:
+        parts.append(f"Line geometry: rank {lg['rank']}, {lg['case']}.")
+    return SingularityResult(rank, expected, kind, float(J.sigma_min), float(J.condition), tuple(J.transmission), twist, tuple(J.inverse_singular),
+                             c_rank, generic, lg, sm, J, " ".join(parts))
+
+
+def singularity_at_pose(mech: Mechanism, pose: Pose, actuators=None, **kw) -> SingularityResult:
+    """Singularity analysis at a platform pose (fitted onto the closure first)."""
+    fit = configuration_at_pose(mech, pose)
+    if not fit.converged or not fit.exact:
+        raise ValueError(f"pose: not reachable exactly (nearest closed pose is {fit.position_error:.3g} away); "
+                         "singularities are analysed at closed configurations")
+    return singularity(mech, fit.config, actuators, **kw)
+
+
+@dataclass(frozen=True, eq=False)
+class SliceResult:
+    names: tuple[str, str]
+    u: np.ndarray
+    v: np.ndarray
+    det: np.ndarray  # (len(v), len(u)); nan where not reachable
+    sigma_min: np.ndarray
+    fixed: dict = field(default_factory=dict)
+    units: tuple[str, str] = ("", "")
+
+    def to_dict(self) -> dict:
+        clean = lambda a: [[None if not np.isfinite(x) else float(x) for x in row] for row in a]
+        return {"axes": list(self.names), "units": list(self.units), "u": self.u.tolist(), "v": self.v.tolist(),
+                "det": clean(self.det), "sign": clean(np.sign(self.det)), "sigma_min": clean(self.sigma_min),
+                "fixed": self.fixed, "sign_changes_along_u": int(np.sum(np.abs(np.diff(np.sign(np.nan_to_num(self.det)), axis=1)) > 0))}
+
+
+def singularity_slice(
+    mech: Mechanism,
+    pose_of: Callable[[float, float], Pose],
+    u: np.ndarray,
+    v: np.ndarray,
+    *,
+    names=("u", "v"),
+    units=("", ""),
+    actuators=None,
+    fixed: dict | None = None,
+    progress=None,
+) -> SliceResult:
+    """``det J`` and the scale-free ``sigma_min`` over a grid ``pose_of(u_i, v_j)``.
+
+    Each grid row is solved by continuation from its neighbour (so the assembly stays the same);
+    unreachable poses are ``nan``.  The singularity loci are the zero contours of ``det``.
+    """
+    u = np.asarray(u, float)
+    v = np.asarray(v, float)
+    det = np.full((len(v), len(u)), np.nan)
+    sig = np.full((len(v), len(u)), np.nan)
+    prev_row = None
+    for j, vj in enumerate(v):
+        prev = prev_row
+        for i, ui in enumerate(u):
+            fit = configuration_at_pose(mech, pose_of(ui, vj), start=prev)
+            if not (fit.converged and fit.exact):
+                continue
+            J = complete_jacobian(mech, fit.config, actuators)
+            det[j, i] = J.det if J.det is not None else np.nan
+            sig[j, i] = J.sigma_min
+            prev = fit.config
+            if i == 0:
+                prev_row = fit.config
+        if progress:
+            progress(j + 1, len(v))
+    return SliceResult(tuple(names), u, v, det, sig, dict(fixed or {}), tuple(units))
+
+
+def slice_figure(res: SliceResult, title: str = ""):
+    """Sign of ``det J`` with its zero contours (the singularity loci) and ``sigma_min``."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    f = Figure(figsize=(11, 4.6), dpi=110)
+    FigureCanvasAgg(f)
+    ax1, ax2 = f.subplots(1, 2)
+    U, V = np.meshgrid(res.u, res.v)
+    ax1.pcolormesh(U, V, np.sign(res.det), cmap="coolwarm", vmin=-1.5, vmax=1.5, shading="auto")
+    if np.nanmin(res.det) < 0 < np.nanmax(res.det):
+        ax1.contour(U, V, np.nan_to_num(res.det), levels=[0.0], colors="k", linewidths=1.5)
+    ax1.set_title("sign of det J (red +, blue -); black: det J = 0")
+    c = ax2.pcolormesh(U, V, np.log10(np.maximum(res.sigma_min, 1e-12)), cmap="viridis", shading="auto")
+    f.colorbar(c, ax=ax2, label="log10 sigma_min (scale-free)")
+    ax2.set_title("distance to a singularity")
+    for ax in (ax1, ax2):
+        ax.set_xlabel(f"{res.names[0]} ({res.units[0]})")
+        ax.set_ylabel(f"{res.names[1]} ({res.units[1]})")
+    f.suptitle(title or "singularity loci")
+    return f

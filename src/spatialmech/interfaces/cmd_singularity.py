@@ -1,0 +1,126 @@
+"""CLI: ``spatialmech singularity`` (kind, rank, uncontrolled twist, line geometry, loci)."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import click
+import numpy as np
+
+from .. import catalog
+from ..analysis.singularity import singularity, singularity_slice, slice_figure
+from ..geometry.rotations import euler_matrix
+from ..kinematics.closure import Configuration
+from ..kinematics.position import configuration_at_pose
+from ..model.mechanism import Pose
+from .cmd_kinematics import resolve_pose, with_pose
+from .common import emit_json, json_option
+
+_SLICE_NAMES = ("x", "y", "z", "a1", "a2", "a3")
+
+
+def _parse_slice(text: str):
+    axes = []
+    for part in text.split(","):
+        bits = part.strip().split(":")
+        if len(bits) != 4 or bits[0] not in _SLICE_NAMES:
+            raise ValueError(f"--slice: expected NAME:MIN:MAX:N,NAME:MIN:MAX:N with NAME in {', '.join(_SLICE_NAMES)}, got {part!r}")
+        try:
+            lo, hi, n = float(bits[1]), float(bits[2]), int(bits[3])
+        except ValueError:
+            raise ValueError(f"--slice: bad numbers in {part!r}") from None
+        if n < 2 or n > 400:
+            raise ValueError(f"--slice: N must be 2..400, got {n}")
+        axes.append((bits[0], np.linspace(lo, hi, n)))
+    if len(axes) != 2 or axes[0][0] == axes[1][0]:
+        raise ValueError("--slice: give exactly two different axes")
+    return axes
+
+
+@click.command(name="singularity")
+@click.argument("model")
+@with_pose
+@click.option("--reference", is_flag=True, help="Analyse the model's reference configuration.")
+@click.option("--driver", "drivers", multiple=True, help="Actuated freedom(s) (default: the model's actuators).")
+@click.option("--slice", "slice_spec", default=None,
+              help="Loci on a 2-D slice around the pose: NAME:MIN:MAX:N,NAME:MIN:MAX:N with NAME in x,y,z (length) "
+                   "or a1,a2,a3 (the --euler angles, degrees).")
+@click.option("--plot", "plot", type=click.Path(dir_okay=False, path_type=Path), default=None, help="PNG of the slice.")
+@json_option
+def singularity_cmd(model, xyz, euler, position, reference, drivers, slice_spec, plot, as_json):
+    """Singularity analysis at a pose: rank of the wrench system, kind (inverse, direct,
+    constraint), uncontrolled twist, line geometry of the wrenches, finite self-motion.
+
+    \b
+    Examples:
+      spatialmech singularity four-sps-cu --reference
+      spatialmech singularity four-sps-cu --xyz 0 0 0.12 --euler ZYX 34.38 -5.73 11.46 --json
+      spatialmech singularity four-sps-cu --xyz 0 0 0.12 --euler ZYX 20 0 0 \\
+          --slice a2:-30:30:25,a3:-30:30:25 --plot loci.png
+    """
+    mech = catalog.resolve(model)
+    acts = list(drivers) or None
+    if slice_spec is not None:
+        if euler is None or xyz is None:
+            raise ValueError("--slice: give the base pose with --xyz and --euler")
+        (n1, g1), (n2, g2) = _parse_slice(slice_spec)
+        seq, *ang = euler
+
+        def pose_of(u, v):
+            vals = {"x": xyz[0], "y": xyz[1], "z": xyz[2], "a1": ang[0], "a2": ang[1], "a3": ang[2]}
+            vals[n1], vals[n2] = u, v
+            R = euler_matrix(seq, [vals["a1"], vals["a2"], vals["a3"]], degrees=True)
+            return Pose(R, [vals["x"], vals["y"], vals["z"]])
+
+        bar = None if as_json else click.progressbar(length=len(g2), label="slice", file=sys.stderr)
+        prog = (lambda j, n: bar.update(1)) if bar else None
+        units = tuple("deg" if n.startswith("a") else mech.length_unit for n in (n1, n2))
+        res = singularity_slice(mech, pose_of, g1, g2, names=(n1, n2), units=units, actuators=acts,
+                                fixed={"xyz": list(xyz), "euler": [seq, *ang]}, progress=prog)
+        if bar:
+            bar.render_finish()
+        if plot is not None:
+            slice_figure(res, f"{mech.name}: singularity loci ({seq}, angles in degrees)").savefig(plot)
+        d = res.to_dict()
+        if as_json:
+            emit_json(d)
+            return
+        det = res.det
+        finite = np.isfinite(det)
+        click.echo(f"{mech.name}: det J over {n1} x {n2} ({len(g1)} x {len(g2)} poses, {int(finite.sum())} reachable): "
+                   f"{int(np.sum(det[finite] > 0))} positive, {int(np.sum(det[finite] < 0))} negative, "
+                   f"smallest sigma_min {np.nanmin(res.sigma_min):.3g}")
+        if plot is not None:
+            click.echo(f"  wrote {plot}")
+        return
+    if reference:
+        config = Configuration.reference(mech)
+    else:
+        pose = resolve_pose(mech, xyz, euler, position)
+        fit = configuration_at_pose(mech, pose)
+        if not fit.converged:
+            raise ValueError(f"pose: no closed configuration near it (residual {fit.ik_residual:.2e})")
+        config = fit.config
+    r = singularity(mech, config, acts)
+    if as_json:
+        emit_json(r.to_dict())
+        return
+    click.echo(f"{mech.name}: {r.kind if r.kind != 'none' else 'not singular'}; wrench-system rank {r.rank} of {r.expected_rank}; "
+               f"scale-free sigma_min {r.sigma_min:.3g}")
+    for t in r.twist:
+        click.echo("  uncontrolled twist (omega ; v): (" + " ".join(f"{x:+.4g}" for x in t[:3]) + " ; "
+                   + " ".join(f"{x:+.4g}" for x in t[3:]) + ")")
+    if r.line_geometry:
+        lg = r.line_geometry
+        click.echo(f"  line geometry of the {len(r.jacobian.wrenches)} wrenches: rank {lg['rank']}, {lg['case']}: {lg['description']}")
+        for c in lg.get("circuits", [])[:4]:
+            click.echo(f"    dependent subset {c.get('indices')}: {c.get('case')}: {c.get('description')}")
+    if r.self_motion:
+        sm_ = r.self_motion
+        if sm_.get("finite"):
+            click.echo(f"  finite self-motion with the actuators locked: platform point moved {sm_['platform_point_moved']:.4g} "
+                       f"{mech.length_unit} and turned {sm_['platform_rotated_deg']:.3g} deg over arc {sm_['arc']:.3g}")
+        else:
+            click.echo("  the uncontrolled motion is only instantaneous")
+    click.echo(f"  {r.explanation}")

@@ -1,0 +1,354 @@
+"""Report section of paper B (seed 002): the 4-SPS/CU parallel mechanism.
+
+Built on :mod:`spatialmech.kinematics.closed_forms.four_sps_cu` (pose ``phi = (z, alpha,
+beta, gamma)`` in m and rad, ``R = Rz(gamma) Ry(beta) Rx(alpha)``, Euler "ZYX" with angles
+``(gamma, beta, alpha)``), cross-checked against the general closure engine, and on
+:func:`spatialmech.analysis.mobility.mobility`.
+
+Claims: mobility (eq 4), inverse position (eq 8: wrong as printed for legs 1, 3, 4; right
+with the corrections of conventions.md), velocity and acceleration (eqs 9-13, symbols
+corrected), forward position (assembly modes), and the paper's "no singularity" statement,
+which does not hold (every pose with ``alpha = beta = 0`` is singular, with a finite
+self-motion).  The line-geometry singular cases (section 5) and the workspace (section 6)
+come from their own analyses and are listed as pending until they are added here.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .. import catalog
+from ..analysis.mobility import mobility
+from ..kinematics.closed_forms import four_sps_cu as k
+from ..kinematics.closure import Configuration, correct
+from ..kinematics.jacobian import complete_jacobian
+from ..model.mechanism import Pose
+from . import figures as F
+from .report import Claim, Section, Table, Viewer
+
+__all__ = ["eq8_printed", "eq8_corrected", "trajectory", "section", "STEPS", "EXAMPLE_POSE"]
+
+#: Progress steps announced by :func:`section`.
+STEPS = 7
+#: Pose (z [m], alpha, beta, gamma [rad]) whose leg lengths have four real assembly modes.
+EXAMPLE_POSE = (0.12, 0.2, -0.1, 0.6)
+#: Random sample of the CU range and +-30 deg angles used for the eq-8 and det J statistics.
+SAMPLE_SIZE = 50_000
+SAMPLE_SEED = 2
+
+
+def eq8_printed(phi, a: float = k.PAPER_B.a, b: float = k.PAPER_B.b) -> np.ndarray:
+    """Paper B eq 8 **exactly as printed** (seed 002, section 4.1): leg lengths (..., 4) in m.
+
+    Wrong for legs 1, 3 and 4 (conventions.md); kept to measure by how much.  The pose is
+    ``phi = (z, alpha, beta, gamma)``."""
+    z, al, be, ga = np.moveaxis(np.asarray(phi, float), -1, 0)
+    sa, ca, sb, cb, sg, cg = np.sin(al), np.cos(al), np.sin(be), np.cos(be), np.sin(ga), np.cos(ga)
+    l1 = (a*cg*cb - a*cg*sb*sa + a*sg*ca - b)**2 + (a*sg*cb - a*ca*cg - a*ca*sb*sg + b)**2 + (-a*sb - a*sa*cb + z)**2  # noqa: E226,E501
+    l2 = (a*cg*cb + a*cg*sb*sa - a*sg*ca - b)**2 + (a*sg*cb + a*ca*cg + a*sa*sb*sg - b)**2 + (-a*sb + a*sa*cb + z)**2  # noqa: E226,E501
+    l3 = (-a*cg*cb + a*cg*sb*sa - a*sg*ca + b)**2 + (-a*sg*cb + a*sa*sg + a*sa*sb*sg - b)**2 + (a*sb + a*sa*cb + z)**2  # noqa: E226,E501
+    l4 = (-a*cg*cb - a*cg*sb*sa + a*sg*ca + b)**2 + (-a*sg*cb - a*ca*cg - a*sa*sb*sg - b)**2 + (a*sb - a*sa*cb + z)**2  # noqa: E226,E501
+    return np.sqrt(np.stack([l1, l2, l3, l4], axis=-1))
+
+
+def eq8_corrected(phi, a: float = k.PAPER_B.a, b: float = k.PAPER_B.b) -> np.ndarray:
+    """Eq 8 with the three corrections of conventions.md (l1 Y term ``ca sb sg -> sa sb sg``;
+    l3 Y term ``a sa sg -> a ca cg``; l4 Y term ``-b -> +b``): equals ``|T A_i - B_i|``."""
+    z, al, be, ga = np.moveaxis(np.asarray(phi, float), -1, 0)
+    sa, ca, sb, cb, sg, cg = np.sin(al), np.cos(al), np.sin(be), np.cos(be), np.sin(ga), np.cos(ga)
+    l1 = (a*cg*cb - a*cg*sb*sa + a*sg*ca - b)**2 + (a*sg*cb - a*ca*cg - a*sa*sb*sg + b)**2 + (-a*sb - a*sa*cb + z)**2  # noqa: E226,E501
+    l2 = (a*cg*cb + a*cg*sb*sa - a*sg*ca - b)**2 + (a*sg*cb + a*ca*cg + a*sa*sb*sg - b)**2 + (-a*sb + a*sa*cb + z)**2  # noqa: E226,E501
+    l3 = (-a*cg*cb + a*cg*sb*sa - a*sg*ca + b)**2 + (-a*sg*cb + a*ca*cg + a*sa*sb*sg - b)**2 + (a*sb + a*sa*cb + z)**2  # noqa: E226,E501
+    l4 = (-a*cg*cb - a*cg*sb*sa + a*sg*ca + b)**2 + (-a*sg*cb - a*ca*cg - a*sa*sb*sg + b)**2 + (a*sb - a*sa*cb + z)**2  # noqa: E226,E501
+    return np.sqrt(np.stack([l1, l2, l3, l4], axis=-1))
+
+
+def trajectory(t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A demonstration trajectory ``phi(t)``, its rate and acceleration (..., 4), t in s:
+    ``z = 0.2 + 0.02 sin(2 pi t / T)`` m, ``alpha = 0.25 cos(w t)``, ``beta = 0.25 sin(w t)``,
+    ``gamma = 0.3 sin(w t)`` rad, ``w = pi`` rad/s (a cone that never meets ``alpha = beta = 0``,
+    where the mechanism is singular)."""
+    t = np.asarray(t, float)
+    w = np.pi
+    s, c, s2, c2 = np.sin(w * t), np.cos(w * t), np.sin(2 * w * t), np.cos(2 * w * t)
+    phi = np.stack([0.2 + 0.02 * s2, 0.25 * c, 0.25 * s, 0.3 * s], axis=-1)
+    dphi = np.stack([0.04 * w * c2, -0.25 * w * s, 0.25 * w * c, 0.3 * w * c], axis=-1)
+    ddphi = np.stack([-0.08 * w * w * s2, -0.25 * w * w * c, -0.25 * w * w * s, -0.3 * w * w * s], axis=-1)
+    return phi, dphi, ddphi
+
+
+def _sigma_min(phi) -> np.ndarray:
+    """Smallest singular value of ``Jx`` with the angle columns divided by b (scale-free)."""
+    g = k.PAPER_B
+    scale = np.array([1.0, 1.0 / g.length_scale, 1.0 / g.length_scale, 1.0 / g.length_scale])
+    return np.linalg.svd(k.jacobian_x(phi) * scale, compute_uv=False)[..., -1]
+
+
+def _engine_legs(mech, phi) -> np.ndarray:
+    """Leg lengths of the general closure engine (inverse position with the platform held)."""
+    D = Pose.from_euler("ZYX", [phi[3], phi[2], phi[1]], [0, 0, phi[0]]).displacement(mech.platform_point)
+    res = correct(mech, Configuration(np.zeros(len(mech.freedom_refs)), D), fix_platform=True)
+    if not res.converged:
+        raise RuntimeError(f"closure engine did not converge at phi = {phi}")
+    ids = [f"L{i}.slide" for i in range(1, 5)]
+    return np.array([r.freedom.offset + res.config.q[i] for i, r in enumerate(mech.freedom_refs) if r.id in ids])
+
+
+def section(progress=lambda step: None) -> Section:
+    """Paper B's section of the demo report (see the module docstring)."""
+    g = k.PAPER_B
+    claims, tables, figs, data = [], [], [], {}
+    progress("paper B: mobility and inverse position (eq 8)")
+    mech = catalog.build("four-sps-cu")
+    m = mobility(mech)
+    ok = (m.n, m.g, m.sum_f, m.lam, m.v, m.xi, m.dof) == (11, 14, 32, 0, 0, 4, 4) and sorted(m.motion[i:i + 2] for i in range(0, len(m.motion), 2)) == ["Rx", "Ry", "Rz", "Tz"]
+    claims.append(Claim("B", "Mobility by the modified Kutzbach-Grübler formula (eq 4, section 3)",
+                        "n=11, g=14, sum f=32, lambda=0, v=0, xi=4, M=4 (3R + Tz)",
+                        f"{m.formula()}; lambda={m.lam}, t={m.t}, k={m.k}, v={m.v}, xi={m.xi}; {m.motion}; "
+                        f"instantaneous {m.dof_instantaneous}", "reproduced" if ok else "not reproduced",
+                        "v = t - k (paper C prints k - t; equal here since t = k)", m.to_dict(),
+                        "tests/test_mobility.py"))
+
+    rng = np.random.default_rng(SAMPLE_SEED)
+    phi = np.column_stack([rng.uniform(*g.z_limits, SAMPLE_SIZE), rng.uniform(-np.pi / 6, np.pi / 6, (SAMPLE_SIZE, 3))])
+    legs = k.leg_lengths(phi)
+    err_printed = np.abs(eq8_printed(phi) - legs).max(axis=0)
+    home = np.array([0.2, 0.0, 0.0, 0.0])
+    err_home = np.abs(eq8_printed(home) - k.leg_lengths(home))
+    err_corr = float(np.abs(eq8_corrected(phi) - legs).max())
+    claims.append(Claim("B", "Inverse position, eq 8 as printed: leg lengths l_i from the pose (z, alpha, beta, gamma)",
+                        "eq 8 (printed)",
+                        f"legs 1..4 off by up to {', '.join(f'{e:.3g}' for e in err_printed)} m over {SAMPLE_SIZE} poses "
+                        f"(z in CU range, angles within +-30 deg); at the home pose legs 3, 4 off by {err_home[2]:.4f}, "
+                        f"{err_home[3]:.4f} m", "not reproduced",
+                        "typos in the Y terms of legs 1, 3, 4; leg 2 is right (error < 1e-15 m). Computed instead: "
+                        "l_i = |T A_i - B_i|", {"max_error_per_leg_m": err_printed, "home_error_per_leg_m": err_home},
+                        "tests/test_four_sps_cu_kinematics.py::test_printed_eq8_is_wrong_for_legs_1_3_4"))
+    eng = np.array([_engine_legs(mech, p) for p in phi[:4]])
+    err_engine = float(np.abs(eng - legs[:4]).max())
+    claims.append(Claim("B", "Inverse position, eq 8 with the three corrections of conventions.md",
+                        "eq 8", f"corrected eq 8 = |T A_i - B_i| to {err_corr:.1e} m over {SAMPLE_SIZE} poses; the "
+                        f"general closure engine gives the same legs to {err_engine:.1e} m",
+                        "reproduced after correction",
+                        "l1 Y term: ca sb sg -> sa sb sg; l3 Y term: a sa sg -> a ca cg; l4 Y term: -b -> +b",
+                        {"max_error_m": err_corr, "engine_vs_closed_form_m": err_engine},
+                        "tests/test_four_sps_cu_kinematics.py::test_conventions_corrections_repair_eq8"))
+
+    progress("paper B: velocity and acceleration along a trajectory (eqs 9-13)")
+    t = np.linspace(0.0, 2.0, 201)
+    P, dP, ddP = trajectory(t)
+    l = k.leg_lengths(P)
+    ld = k.inverse_velocity(P, dP)
+    ldd = k.inverse_acceleration(P, dP, ddP)
+    h = 1e-6
+    fd = (k.leg_lengths(trajectory(t + h)[0]) - k.leg_lengths(trajectory(t - h)[0])) / (2 * h)
+    fdd = (k.inverse_velocity(*trajectory(t + h)[:2]) - k.inverse_velocity(*trajectory(t - h)[:2])) / (2 * h)
+    v_err = float(np.abs(ld - fd).max())
+    a_err = float(np.abs(ldd - fdd).max())
+    back_v = float(np.abs(k.forward_velocity(P, ld) - dP).max())
+    back_a = float(np.abs(k.forward_acceleration(P, ld, ldd) - ddP).max())
+    claims.append(Claim("B", "Velocity and acceleration (eqs 9-13): L l' = J phi', phi' = J^-1 L l', "
+                        "phi'' = Jx^-1 (l'' - Jx' phi')", "eqs 9-13 (symbols garbled in eqs 10-13)",
+                        f"along a 2 s trajectory (201 samples): l' vs central differences of l {v_err:.1e} m/s, "
+                        f"l'' vs differences of l' {a_err:.1e} m/s^2; forward velocity / acceleration recover phi', "
+                        f"phi'' to {back_v:.1e}, {back_a:.1e}", "reproduced after correction",
+                        "eqs 10-13 garble the symbols; the relations used are those of conventions.md (Jx = L^-1 J)",
+                        {"velocity_fd_error": v_err, "acceleration_fd_error": a_err, "forward_velocity_error": back_v,
+                         "forward_acceleration_error": back_a},
+                        "tests/test_four_sps_cu_kinematics.py::test_inverse_acceleration_against_trajectory"))
+    fig = F.new_figure((10.0, 3.6))
+    ax1, ax2 = fig.add_subplot(1, 2, 1), fig.add_subplot(1, 2, 2)
+    F.curves(ax1, t, {f"l{i + 1}": l[:, i] for i in range(4)}, xlabel="t [s]", ylabel="leg length [m]",
+             title="leg lengths (eq 8 corrected)")
+    F.curves(ax2, t, {f"l{i + 1}'": ld[:, i] for i in range(4)}, xlabel="t [s]", ylabel="leg rate [m/s]",
+             title="leg rates (eq 9)", zero_line=True)
+    figs.append(F.to_png(fig, "paper_b_trajectory.png", "4-SPS/CU: leg lengths and rates along a trajectory",
+                         "phi(t): z = 0.2 + 0.02 sin(2 pi t) m, alpha = 0.25 cos(pi t), beta = 0.25 sin(pi t), "
+                         "gamma = 0.3 sin(pi t) rad (R = Rz(gamma) Ry(beta) Rx(alpha)). Leg limits 0.1-0.4 m."))
+    data["trajectory"] = {"t_s": t[::10], "phi": P[::10], "legs_m": l[::10], "leg_rates_m_s": ld[::10]}
+
+    progress("paper B: singularities (alpha = beta = 0, det J sign map)")
+    zg, gg = np.meshgrid(np.linspace(*g.z_limits, 23), np.linspace(-np.pi, np.pi, 73))
+    flat = np.stack([zg.ravel(), 0 * zg.ravel(), 0 * zg.ravel(), gg.ravel()], axis=-1)
+    sig_flat = float(_sigma_min(flat).max())
+    sig_sample = _sigma_min(phi)
+    detJ = np.linalg.det(k.jacobian_x(phi))
+    frac_neg = float(np.mean(detJ < 0))
+    J0 = complete_jacobian(mech, Configuration.reference(mech))
+    l0 = float(k.leg_lengths(home)[0])
+    gam = np.linspace(-np.pi, np.pi, 721)
+    z2 = l0 ** 2 - 2 * g.a ** 2 - 2 * g.b ** 2 + 4 * g.a * g.b * np.cos(gam)
+    real = z2 > 0
+    zs = np.sqrt(z2[real])
+    self_legs = k.leg_lengths(np.stack([zs, 0 * zs, 0 * zs, gam[real]], axis=-1))
+    self_err = float(np.abs(self_legs - l0).max())
+    in_cu = (zs >= g.z_limits[0]) & (zs <= g.z_limits[1])
+    g_span = np.degrees([gam[real][in_cu].min(), gam[real][in_cu].max()])
+    claims.append(Claim("B", "No singularity inside the workspace when the parameters are chosen well (section 5)",
+                        "no singular configuration",
+                        f"every pose with alpha = beta = 0 is singular: scale-free sigma_min(Jx) <= {sig_flat:.1e} over "
+                        f"z x gamma; the general complete Jacobian at the home pose has sigma_min {J0.sigma_min:.1e}; with "
+                        f"the legs locked at l = {l0:.4f} m the platform keeps the self-motion "
+                        f"z^2 = l^2 - 2a^2 - 2b^2 + 4ab cos(gamma) (legs constant to {self_err:.1e} m, gamma from "
+                        f"{g_span[0]:.1f} to {g_span[1]:.1f} deg within the CU limits); det J takes both signs in the "
+                        f"sampled workspace ({100 * frac_neg:.1f}% negative)", "not reproduced",
+                        "for this symmetric geometry the four leg lines meet on the Z axis whenever alpha = beta = 0, "
+                        "and surfaces det J = 0 cross the workspace (figure); forward position must not start there",
+                        {"max_sigma_min_alpha_beta_zero": sig_flat, "engine_sigma_min_home": J0.sigma_min,
+                         "self_motion_leg_error_m": self_err, "self_motion_gamma_deg_in_cu_limits": g_span,
+                         "fraction_det_negative": frac_neg, "min_sigma_min_sample": float(sig_sample.min())},
+                        "tests/test_four_sps_cu_kinematics.py::test_every_pose_with_alpha_beta_zero_is_singular"))
+    fig = F.new_figure((10.5, 4.0))
+    ang = np.radians(np.linspace(-40, 40, 161))
+    A, B = np.meshgrid(ang, ang)
+    for col, gamma in enumerate((0.0, 0.6)):
+        grid = np.stack([np.full_like(A, 0.2), A, B, np.full_like(A, gamma)], axis=-1)
+        d = np.linalg.det(k.jacobian_x(grid)) / g.b ** 3
+        F.scalar_field(fig.add_subplot(1, 2, col + 1), np.degrees(ang), np.degrees(ang), d,
+                       xlabel="alpha [deg]", ylabel="beta [deg]", label="det Jx / b^3",
+                       title=f"z = 0.2 m, gamma = {np.degrees(gamma):.0f} deg", cmap="coolwarm")
+    figs.append(F.to_png(fig, "paper_b_det_map.png", "4-SPS/CU: det Jx over (alpha, beta) and its zero set (red)",
+                         "Jx = dl/dphi (eq 9, corrected), R = Rz(gamma) Ry(beta) Rx(alpha). The red curves are "
+                         "singularity loci crossing the workspace; alpha = beta = 0 is always on them."))
+
+    progress("paper B: forward position (all assembly modes of an example)")
+    lx = k.leg_lengths(EXAMPLE_POSE)
+    res = k.forward_all(lx)
+    ph = res.phis
+    found = bool(np.any(np.all(np.abs(ph - np.asarray(EXAMPLE_POSE)) < 1e-9, axis=1)))
+    claims.append(Claim("B", "Forward position: the pose from the four leg lengths (section 4)", "solved numerically",
+                        f"legs {np.round(lx, 6).tolist()} m of phi = {EXAMPLE_POSE}: {len(res.solutions)} real assembly "
+                        f"modes ({res.n_within_limits} within the leg and CU limits), the pose itself among them: "
+                        f"{found}; largest residual {max(s.residual for s in res.solutions):.1e} m",
+                        "reproduced" if found and all(s.converged for s in res.solutions) else "not reproduced",
+                        "multi-seed Levenberg-Marquardt (512 Halton seeds); every mode has a mirror image below the base",
+                        res.to_dict(), "tests/test_four_sps_cu_kinematics.py::test_multiple_assembly_modes_claim"))
+    tables.append(Table("Assembly modes of the example legs (forward_all)",
+                        ("z [m]", "alpha [deg]", "beta [deg]", "gamma [deg]", "within limits", "sigma_min", "residual [m]"),
+                        tuple((float(s.phi[0]), *np.degrees(s.phi[1:]).tolist(), s.within_limits, s.sigma_min, s.residual)
+                              for s in res.solutions),
+                        "Limits checked: leg lengths 0.1-0.4 m and CU length 0.08-0.3 m (joint angles of eqs 18-21: "
+                        "workspace analysis)."))
+
+    progress("paper B: singular cases by line geometry (section 5)")
+    c2, t2 = _singular_case_claims()
+    claims.extend(c2)
+    tables.append(t2)
+    progress("paper B: orientation workspace at z = 0.1 m (section 6)")
+    c3, f3, d3 = _workspace_claim()
+    claims.append(c3)
+    figs.append(f3)
+    data["workspace"] = d3
+
+    progress("paper B: 3-D viewer")
+    from .motion import sample_motion
+
+    viewers = (Viewer("Paper B, 4-SPS/CU: a demonstration loop from the home pose", mech,
+                      tuple(sample_motion(mech, n=48)), note="A short loop along the closure manifold (not a tracked "
+                      "trajectory); the home pose alpha = beta = 0 is singular."),)
+    return Section(
+        "paper-b", "Paper B: 4-SPS/CU parallel mechanism",
+        "Four actuated SPS legs and a passive CU limb (3 rotations + translation along Z). a = 0.1 m, b = 0.2 m, "
+        "legs 0.1-0.4 m, CU 0.08-0.3 m. Pose phi = (z, alpha, beta, gamma), R = Rz(gamma) Ry(beta) Rx(alpha) "
+        "(Euler 'ZYX' with angles (gamma, beta, alpha)); SI units.",
+        tuple(claims), tuple(tables), tuple(figs), viewers,
+        data=data)
+
+
+def _line(d, p):
+    d = np.asarray(d, float) / np.linalg.norm(d)
+    return np.r_[d, np.cross(np.asarray(p, float), d)]
+
+
+def _case_c_lines(P14, P23):
+    """Leg lines through the base points of paper B (b = 0.2) and the meeting points P14 (legs 1,
+    4) and P23 (legs 2, 3), plus the CU forces along X and Y through (0, 0, 0.2)."""
+    from ..catalog.papers import four_sps_cu_points
+
+    _, B = four_sps_cu_points(0.1, 0.2)
+    legs = [_line(P - Bi, Bi) for Bi, P in zip(B, (P14, P23, P23, P14))]
+    u = np.array([0.0, 0.0, 0.2])
+    return np.array(legs + [_line([1, 0, 0], u), _line([0, 1, 0], u)])
+
+
+def _singular_case_claims():
+    """Paper B's singular cases (a), (b), (c), found by the singularity analysis at the poses."""
+    from ..analysis.singularity import singularity, singularity_at_pose
+    from ..catalog.papers import four_sps_cu
+    from ..geometry.line_geometry import classify_lines
+    from ..kinematics.closure import Configuration
+    from ..model.mechanism import Pose
+
+    out, rows = [], []
+    ma = four_sps_cu(a=0.15, b=0.15, z0=0.2)
+    ra = singularity(ma, Configuration.reference(ma), self_motion_arc=0.05)
+    par = [c for c in ra.line_geometry["circuits"] if c["case"] == "parallel"]
+    out.append(Claim("B", "Singular case (a): the four leg lines parallel (section 5, fig 3a)", "singular",
+                     f"with a = b = 0.15 m at alpha = beta = gamma = 0: {ra.kind} singularity, rank {ra.rank}; the legs "
+                     f"form a '{par[0]['case'] if par else '?'}' set; the 6 lines are a '{ra.line_geometry['case']}'",
+                     "reproduced" if ra.rank == 5 and par else "not reproduced",
+                     "needs a = b (paper B's a = 0.1, b = 0.2 cannot have parallel legs)",
+                     {"rank": ra.rank, "kind": ra.kind, "line_geometry": ra.line_geometry["case"]},
+                     "tests/test_singularity.py::test_paper_B_case_a_parallel_legs_needs_a_equal_b"))
+    rows.append(("(a) a = b, home", ra.kind, ra.rank, ra.line_geometry["case"], par[0]["case"] if par else "-"))
+    mb = catalog.build("four-sps-cu")
+    rb = singularity(mb, Configuration.reference(mb), self_motion_arc=0.3)
+    conc = [c for c in rb.line_geometry["circuits"] if c["case"] == "concurrent"]
+    pt = conc[0]["witnesses"]["point"] if conc else None
+    out.append(Claim("B", "Singular case (b): the four leg lines through one point (section 5, fig 3b)", "singular",
+                     f"at the home pose (z = 0.2 m, alpha = beta = gamma = 0): {rb.kind}, rank {rb.rank}; legs concurrent at "
+                     f"{np.round(pt, 6).tolist() if pt is not None else '?'} = (0, 0, z b / (b - a)); finite self-motion: "
+                     f"{rb.self_motion['finite']}", "reproduced" if conc and rb.rank == 5 else "not reproduced",
+                     "found by the analysis itself, with the uncontrolled twist (rotation about Z)",
+                     {"point": pt, "twist": [list(t) for t in rb.twist], "self_motion": rb.self_motion},
+                     "tests/test_singularity.py::test_paper_B_case_b_leg_lines_concurrent_on_the_z_axis"))
+    rows.append(("(b) home pose", rb.kind, rb.rank, rb.line_geometry["case"], "concurrent at " + str(np.round(pt, 4).tolist())))
+    rg = singularity_at_pose(mb, Pose.from_euler("ZYX", [0.5, 0, 0], [0, 0, 0.2]), self_motion_arc=0.05)
+    rows.append(("alpha = beta = 0, gamma = 28.6 deg", rg.kind, rg.rank, rg.line_geometry["case"],
+                 "legs on a regulus (not concurrent)"))
+    worded = classify_lines(_case_c_lines(np.array([0.03, 0.05, 0.45]), np.array([0.03, -0.12, 0.45])), length_scale=0.2)
+    true_c = classify_lines(_case_c_lines(np.array([0.05, 0.03, 0.45]), np.array([-0.12, 0.03, 0.45])), length_scale=0.2)
+    tc = true_c.find_circuit("two-pencils-sharing-a-line")
+    out.append(Claim("B", "Singular case (c): legs 1, 4 and 2, 3 meet at points on the intersection line of planes "
+                     "A1A2B2B1 and A4A3B3B4 (section 5, fig 3c)", "singular",
+                     f"as worded the six lines keep rank {worded.rank} ({worded.case}): not singular; with the meeting "
+                     f"points in the planes of the two pencils (A1A4B4B1, A2A3B3B2) the rank is {true_c.rank}: legs "
+                     f"'{tc.case if tc else '?'}'", "reproduced after correction",
+                     "the planes are swapped in the paper; with its square platform no pose realises either case "
+                     "(platform points chosen on the constructed lines)",
+                     {"worded_rank": worded.rank, "corrected_rank": true_c.rank},
+                     "tests/test_line_geometry.py::test_paper_b_case_c_true_condition_drops_the_rank"))
+    rows.append(("(c) as worded", "-", worded.rank, worded.case, "skew quadrilateral"))
+    rows.append(("(c) corrected", "-", true_c.rank, true_c.case, tc.case if tc else "-"))
+    table = Table("Singular configurations of the 4-SPS/CU: wrench-system rank and line geometry (4 legs + 2 CU forces)",
+                  ("configuration", "kind", "rank", "6 lines", "legs"), tuple(rows),
+                  "Every alpha = beta = 0 pose is singular; for gamma != 0 the legs lie on a regulus rather than "
+                  "meeting in a point (the paper's case (b) is the gamma = 0 instance).")
+    return out, table
+
+
+def _workspace_claim():
+    from ..analysis.workspace import orientation_workspace
+    from ..analysis.workspace_plot import workspace_figure
+
+    mech = catalog.build("four-sps-cu")
+    res = orientation_workspace(mech, at={"z": 0.1}, step=np.radians(4.0))
+    d = res.to_dict()
+    a, b_, g = d["alpha_deg"], d["beta_deg"], d["gamma_deg"]
+    closed = np.degrees(np.arctan(0.1 / 0.2))
+    gam = np.degrees(np.arccos((0.4 ** 2 - 2 * 0.01 - 2 * 0.04 - 0.01) / (4 * 0.1 * 0.2)))
+    ok = abs(a[1] - closed) < 0.01 and abs(g[1] - gam) < 0.01
+    claim = Claim("B", "Orientation workspace at z = 0.1 m: alpha_max = beta_max = 48 deg, gamma_max = 65 deg (section 6, fig 5)",
+                  "48 / 48 / 65 deg",
+                  f"alpha {a[0]:.2f}..{a[1]:.2f}, beta {b_[0]:.2f}..{b_[1]:.2f}, gamma {g[0]:.2f}..{g[1]:.2f} deg "
+                  f"(each alone; the whole set has the same extents); active limits: {', '.join(sorted(d['active_limits']))[:160]}",
+                  "not reproduced",
+                  f"the stated model gives alpha, beta = +-atan(z/b) = +-{closed:.2f} deg (platform-side spherical-joint "
+                  f"cone of eq 18) and gamma = +-{gam:.2f} deg (maximum leg length 0.4 m); no reading of eqs 18-22 tried "
+                  "gives 48/48/65 (docs/workspace.md)" + ("" if ok else "; WARNING: closed forms not matched"),
+                  {k: d[k] for k in ("alpha_deg", "beta_deg", "gamma_deg", "alpha_deg_set", "beta_deg_set", "gamma_deg_set", "volume")},
+                  "tests/test_workspace.py")
+    fig = workspace_figure(res)
+    png = F.to_png(fig, "paper_b_workspace.png", "4-SPS/CU orientation workspace at z = 0.1 m",
+                   "Feasible (alpha, beta, gamma) under the limits of eqs 18-22, with the active limit at the boundary.")
+    return claim, png, d

@@ -1,0 +1,345 @@
+"""The reproduction report (``spatialmech demo``), the one-model report (``spatialmech report``),
+and the documentation: every command and Python snippet in docs/ runs."""
+
+import json
+import re
+import shlex
+from html.parser import HTMLParser
+from io import BytesIO, StringIO
+from pathlib import Path
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from matplotlib.image import imread
+
+from spatialmech import catalog
+from spatialmech.interfaces.cli import cli
+from spatialmech.kinematics.closed_forms import four_sps_cu as k
+from spatialmech.kinematics.closure import Configuration
+from spatialmech.kinematics.jacobian import complete_jacobian
+from spatialmech.kinematics.position import configuration_at_pose, freedom_values
+from spatialmech.kinematics.tracking import trace_motion
+from spatialmech.present import paper_b
+from spatialmech.analysis.defects import dj_table
+from spatialmech.present.report import VERDICTS, Claim, Progress, Table, build_demo, build_model_report
+
+ROOT = Path(__file__).parent.parent
+DOCS = sorted((ROOT / "docs").glob("*.md"))
+#: Pages of the user guide that must contain runnable blocks.
+MY_PAGES = ("index.md", "kinematics.md", "viewer.md", "report.md", "file-format.md", "synthesis.md")
+
+
+def run(*args):
+    return CliRunner().invoke(cli, list(args), catch_exceptions=False)
+
+
+@pytest.fixture(scope="module")
+def demo(tmp_path_factory):
+    out = tmp_path_factory.mktemp("demo")
+    data = build_demo(out, progress=False)
+    return out, data
+
+
+# ------------------------------------------------------------------ the demo report
+def _claim(data, paper, text):
+    hits = [c for c in data["claims"] if c["paper"] == paper and text in c["claim"]]
+    assert len(hits) == 1, (paper, text, [c["claim"] for c in hits])
+    return hits[0]
+
+
+def test_demo_claims_and_their_verdicts(demo):
+    """Every claim of the four papers that the report covers, with the verdict the analyses give.
+    Not reproduced (conventions.md, with evidence in the rows): paper B's printed eq 8 and its
+    'no singularity' statement, paper D's example directions of eqs 28 and 30."""
+    _, data = demo
+    by_paper = {p: [c for c in data["claims"] if c["paper"] == p] for p in "ABCD"}
+    assert {p: len(v) for p, v in by_paper.items()} == {"A": 13, "B": 10, "C": 18, "D": 6}
+    not_repr = {(c["paper"], c["claim"].split(":")[0].split(" (")[0]) for c in data["claims"] if not c["reproduced"]}
+    assert not_repr == {("B", "Inverse position, eq 8 as printed"), ("B", "No singularity inside the workspace when the parameters are chosen well"),
+                        ("B", "Orientation workspace at z = 0.1 m"), ("D", "Example m1"), ("D", "Example m2")}
+    assert all(c["verdict"] == "reproduced" for c in by_paper["A"])
+    corrected = {(c["paper"], c["claim"][:24]) for c in data["claims"] if c["verdict"] == "reproduced after correction"}
+    assert corrected == {("B", "Inverse position, eq 8 w"), ("B", "Velocity and acceleratio"), ("C", "3-RRR metamorphic joint,"),
+                         ("B", "Singular case (c): legs "), ("C", "Eq 21: closed-form actua")}
+    s = data["summary"]
+    assert s["claims"] == 47 and s["reproduced"] + s["reproduced after correction"] + s["not reproduced"] == 47
+    for c in data["claims"]:
+        assert c["verdict"] in VERDICTS and c["reproduced"] == (c["verdict"] != "not reproduced")
+        assert c["paper_value"] and c["ours"] and c["evidence"], c["claim"]
+        if not c["reproduced"]:
+            assert c["note"], c["claim"]  # says why
+
+
+def test_every_claim_names_an_existing_test(demo):
+    _, data = demo
+    for c in data["claims"]:
+        assert c["test"], c["claim"]
+        file, _, fn = c["test"].partition("::")
+        text = (ROOT / file).read_text(encoding="utf-8")
+        if fn:
+            assert f"def {fn}(" in text, c["test"]
+
+
+def test_demo_numbers_match_the_analyses(demo):
+    """Spot checks of results.json against the analyses called directly (not via the report)."""
+    _, data = demo
+    sec = {s["key"]: s for s in data["sections"]}
+    # paper A, linkage 3: the signs of DJ at P4 for every driver
+    mech = catalog.build("five-cs-3")
+    prev = None
+    for P in mech.positions[:4]:
+        fit = configuration_at_pose(mech, P, start=prev)
+        prev = fit.config
+    table = sec["paper-a"]["data"]["five-cs-3"]["dj_table"]
+    for i, d in enumerate(table["drivers"]):
+        assert table["signs"][i][3] == np.sign(complete_jacobian(mech, prev, [d]).det)
+    # paper B: the example's leg lengths and the eq-8 error of leg 4 at the home pose
+    ev = _claim(data, "B", "eq 8 as printed")["evidence"]
+    assert ev["home_error_per_leg_m"][3] == pytest.approx(0.1292, abs=1e-4)
+    fwd = _claim(data, "B", "Forward position")["evidence"]
+    assert np.allclose(fwd["leg_lengths_m"], k.leg_lengths(paper_b.EXAMPLE_POSE), atol=1e-15)
+    assert fwd["n_solutions"] == 4 and fwd["n_within_limits"] == 2
+    # paper D: the RCCC errors of docs/synthesis.md
+    rc = _claim(data, "D", "guides the coupler")["evidence"]
+    assert np.allclose(rc["position_errors"], [2.686, 0.209, 2.800], atol=2e-3)
+    m1 = _claim(data, "D", "Example m1")["evidence"]["residuals"]["u0,v"]
+    assert np.allclose(m1, [-0.2439, -0.3600, -0.3934], atol=1e-4)
+
+
+def test_tables_are_rectangular_and_json_has_no_nan(demo):
+    out, data = demo
+    text = (out / "results.json").read_text(encoding="utf-8")
+    json.loads(text, parse_constant=lambda c: pytest.fail(f"non-finite number {c} in results.json"))
+    n_tables = 0
+    for s in data["sections"]:
+        for t in s["tables"]:
+            n_tables += 1
+            assert t["rows"] and all(len(r) == len(t["columns"]) for r in t["rows"]), t["title"]
+    assert n_tables >= 9
+
+
+class _Tags(HTMLParser):
+    """Collects the attributes of every start tag (script contents are data, not tags)."""
+
+    def __init__(self):
+        super().__init__()
+        self.attrs = []
+        self.tags = []
+
+    def handle_starttag(self, tag, attrs):
+        self.tags.append(tag)
+        self.attrs += [(tag, k, v or "") for k, v in attrs]
+
+
+def test_index_html_is_self_contained(demo):
+    out, data = demo
+    page = (out / "index.html").read_text(encoding="utf-8")
+    assert page.startswith("<!doctype html>")
+    p = _Tags()
+    p.feed(page)
+    links = [(t, k, v) for t, k, v in p.attrs if k in ("src", "href")]
+    external = [x for x in links if re.match(r"\s*(https?:)?//", x[2])]
+    assert not external, external[:3]
+    imgs = [v for t, k, v in links if t == "img"]
+    n_fig = sum(len(s["figures"]) for s in data["sections"])
+    assert n_fig >= 10 and len(imgs) == n_fig and all(v.startswith("data:image/png;base64,") for v in imgs)
+    assert p.tags.count("script") >= 2 and "<link" not in page.split("<body>")[0]
+    ids = re.findall(r'id="(spatialmech-viewer-\d+)"', page)
+    n_view = sum(len(s["viewers"]) for s in data["sections"])
+    assert n_view == 5 and len(set(ids)) == n_view
+    assert page.count("Plotly.newPlot") >= n_view
+    for c in data["claims"]:
+        assert c["verdict"] in page
+
+
+def test_figure_files_are_non_blank_pngs(demo):
+    out, data = demo
+    for s in data["sections"]:
+        for f in s["figures"]:
+            raw = (out / f["file"]).read_bytes()
+            assert raw[:8] == b"\x89PNG\r\n\x1a\n"
+            img = imread(BytesIO(raw), format="png")
+            assert img.shape[0] > 200 and img.shape[1] > 300
+            assert img[..., :3].std() > 0.05, f["file"]  # not a blank canvas
+
+
+def test_cli_demo_help_shows_an_example():
+    r = CliRunner().invoke(cli, ["demo", "--help"])
+    assert r.exit_code == 0 and "spatialmech demo --out report" in r.output
+
+
+# ------------------------------------------------------------------ building blocks
+def test_claim_and_table_reject_bad_input():
+    with pytest.raises(ValueError, match="verdict"):
+        Claim("A", "c", "1", "1", "maybe")
+    with pytest.raises(ValueError, match=r"rows\[1\]"):
+        Table("t", ("a", "b"), ((1, 2), (1,)))
+
+
+def test_progress_lines_and_silence():
+    buf = StringIO()
+    p = Progress(2, file=buf, label="x")
+    p("first")
+    p("second")
+    p.close()
+    lines = buf.getvalue().splitlines()
+    assert lines[0].startswith("[ 1/2") and lines[0].endswith("first") and lines[-1].startswith("x: done in")
+    quiet = StringIO()
+    q = Progress(1, file=quiet, enabled=False)
+    q("step")
+    q.close()
+    assert quiet.getvalue() == ""
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.floats(0.08, 0.3), st.floats(-3, 3), st.floats(-1.5, 1.5), st.floats(-3, 3))
+def test_eq8_corrected_equals_the_leg_lengths_and_printed_leg2_is_right(z, al, be, ga):
+    phi = np.array([z, al, be, ga])
+    assert np.allclose(paper_b.eq8_corrected(phi), k.leg_lengths(phi), atol=1e-14)
+    assert paper_b.eq8_printed(phi)[1] == pytest.approx(k.leg_lengths(phi)[1], abs=1e-14)
+
+
+def test_trajectory_rates_are_its_derivatives():
+    t = np.linspace(0, 2, 41)
+    h = 1e-6
+    phi, dphi, ddphi = paper_b.trajectory(t)
+    assert np.allclose((paper_b.trajectory(t + h)[0] - paper_b.trajectory(t - h)[0]) / (2 * h), dphi, atol=1e-8)
+    assert np.allclose((paper_b.trajectory(t + h)[1] - paper_b.trajectory(t - h)[1]) / (2 * h), ddphi, atol=1e-6)
+    assert np.min(np.hypot(phi[:, 1], phi[:, 2])) > 0.2  # never at the singular alpha = beta = 0
+
+
+def test_dj_table_semantics_and_errors():
+    t = dj_table(catalog.build("five-cs-1"), ["rot1", "rot5"])
+    assert t.changes("rot1") == [5] and t.changes("rot5") == [2]
+    assert not t.keeps_sign("rot1")
+    assert t.dj.shape == (2, 7) and np.all(t.sigma_min > 0)
+    json.dumps(t.to_dict())
+    with pytest.raises(ValueError, match="mech: stewart-6sps has no task positions"):
+        dj_table(catalog.build("stewart-6sps"))
+
+
+def test_rssr_dj_poles_are_the_rocker_limit_positions():
+    """Along the RSSR's motion DJ of the crank changes sign twice without a singularity: it passes
+    through infinity where the rocker (the platform) stops and reverses while the crank turns."""
+    m = catalog.build("rssr")
+    tr = trace_motion(m, Configuration.reference(m), increasing="A0",
+                      monitors={"DJ": lambda c: complete_jacobian(m, c).det or 0.0})  # None: not square
+    kinds = [{"kind": e.kind, "sigma_min": complete_jacobian(m, e.x).sigma_min} for e in tr.events]
+    assert [e["kind"] for e in kinds] == ["pole", "pole"]
+    i = [r.id for r in m.freedom_refs].index("B0.rot")
+    rocker = np.array([freedom_values(m, c.q)[i] for c in tr.points])
+    at_events = sorted(freedom_values(m, e.x.q)[i] for e in tr.events)
+    # the events are the rocker's extremes: within 1e-4 rad of the sampled ones, and beyond them
+    assert at_events == pytest.approx([rocker.min(), rocker.max()], abs=1e-4)
+    assert at_events[0] <= rocker.min() + 1e-12 and at_events[1] >= rocker.max() - 1e-12
+    assert min(e["sigma_min"] for e in kinds) > 0.1
+
+
+def test_dj_zeros_of_five_cs_2_are_singular():
+    m = catalog.build("five-cs-2")
+    tr = trace_motion(m, Configuration.reference(m), increasing="rot1",
+                      monitors={"rot1": lambda c: complete_jacobian(m, c, ["rot1"]).det})
+    kinds = [{"kind": e.kind, "sigma_min": complete_jacobian(m, e.x, ["rot1"]).sigma_min} for e in tr.events]
+    assert len(kinds) == 2 and all(e["kind"] == "zero" and e["sigma_min"] < 1e-6 for e in kinds)
+
+
+# ------------------------------------------------------------------ the one-model report
+RSSR_TOML = """
+name = "my-rssr"
+length_unit = "m"
+platform_point = [0.0, 1.0, -0.1]
+[[limbs]]
+name = "input"
+joints = [
+  { name = "A0", type = "R", point = [0, 0, 0], axis = [0, 0, 1], actuated = true },
+  { name = "A1", type = "S", point = [0.3, 0, 0] },
+  { name = "B1", type = "S", point = [0, 1, -0.1] },
+]
+[[limbs]]
+name = "output"
+joints = [ { name = "B0", type = "R", point = [0, 1, 0.5], axis = [1, 0, 0] } ]
+"""
+
+
+def test_model_report_of_a_user_file(tmp_path):
+    f = tmp_path / "my-rssr.toml"
+    f.write_text(RSSR_TOML, encoding="utf-8")
+    out = tmp_path / "rep"
+    r = run("report", str(f), "--out", str(out))
+    assert r.exit_code == 0, r.output
+    data = json.loads((out / "results.json").read_text())
+    sec = data["sections"][0]
+    assert data["model"] == "my-rssr" and sec["data"]["mobility"][0]["dof"] == 1
+    assert sec["data"]["trace"]["closed"] and len(sec["data"]["trace"]["events"]) == 2
+    assert sec["viewers"][0]["frames"] == 60 and (out / "figures" / "motion.png").exists()
+    assert 'id="spatialmech-viewer-1"' in (out / "index.html").read_text()
+
+
+def test_model_report_of_a_multi_dof_model_with_positions(tmp_path):
+    data = build_model_report("four-sps-cu", tmp_path, progress=False)
+    sec = data["sections"][0]
+    assert "trace" not in sec["data"] and sec["viewers"][0]["frames"] == 48
+    J = sec["data"]["jacobian_reference"]
+    assert J["sigma_min"] < 1e-9  # the home pose alpha = beta = 0 is singular
+
+
+def test_model_report_dj_table_of_a_paper_linkage(tmp_path):
+    data = build_model_report("five-cs-1", tmp_path, progress=False, trace=False)
+    t = data["sections"][0]["data"]["dj_table"]
+    assert len(t["drivers"]) == 10 and not any(t["keeps_sign"].values())
+
+
+def test_report_command_errors_are_one_line():
+    r = CliRunner().invoke(cli, ["report", "no-such-model"])
+    assert r.exit_code == 2 and r.output.count("\n") == 1 and r.output.startswith("error: ")
+    h = CliRunner().invoke(cli, ["report", "--help"])
+    assert h.exit_code == 0 and "spatialmech report bennett --out bennett-report" in h.output
+
+
+# ------------------------------------------------------------------ the documentation runs
+def _blocks(text: str, lang: str) -> list[str]:
+    return re.findall(rf"```{lang}\n(.*?)```", text, flags=re.S)
+
+
+#: Commands run as ``--help`` only: the demo (tested above) and multi-start searches.
+def _cheap(args: list[str]) -> list[str]:
+    if args[0] == "demo" or "--all" in args:
+        return [args[0], "--help"]
+    return args
+
+
+@pytest.mark.parametrize("page", DOCS, ids=[p.name for p in DOCS])
+def test_docs_commands_and_python_run(page, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    text = page.read_text(encoding="utf-8")
+    ran = 0
+    for block in _blocks(text, "sh"):
+        for line in block.splitlines():
+            line = line.split(" #")[0].strip()
+            if not line.startswith("spatialmech "):
+                continue
+            args = _cheap(shlex.split(line)[1:])
+            r = CliRunner().invoke(cli, args, catch_exceptions=False)
+            assert r.exit_code == 0, f"{page.name}: {line}\n{r.output}"
+            ran += 1
+    ns: dict = {}
+    for block in _blocks(text, "python"):
+        exec(compile(block, f"{page.name}:python", "exec"), ns)
+        ran += 1
+    for block in _blocks(text, "toml"):
+        if "[[limbs]]" in block and "{...}" not in block and block.lstrip().startswith("name"):
+            from spatialmech import loads
+
+            assert loads(block).limbs
+            ran += 1
+    if page.name in MY_PAGES:
+        assert ran, f"{page.name}: no runnable block"
+
+
+def test_examples_readme_lists_every_example():
+    readme = (ROOT / "examples" / "README.md").read_text(encoding="utf-8")
+    for p in (ROOT / "examples").glob("*.py"):
+        assert f"({p.name})" in readme, p.name
