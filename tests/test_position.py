@@ -97,11 +97,14 @@ def test_cli_ik_fk_jacobian():
     r = run("ik", "four-sps-cu", "--xyz", "0", "0", "0.12", "--euler", "ZYX", "34.38", "-5.73", "11.46", "--json")
     assert r.exit_code == 0, r.output
     legs = json.loads(r.output)["actuators"]
-    r2 = run("fk", "four-sps-cu", "--actuators", ",".join(str(v) for v in legs.values()), "--all", "--seeds", "80", "--json")
-    sols = json.loads(r2.output)["solutions"]
-    assert any(abs(s["position"][2] - 0.12) < 1e-9 for s in sols)
-    r3 = run("jacobian", "five-cs-1", "--position", "3", "--driver", "rot1", "--json")
-    d = json.loads(r3.output)
+    r2 = run("fk", "four-sps-cu", "--actuators", ",".join(str(v) for v in legs.values()), "--all", "--json")
+    d2 = json.loads(r2.output)
+    assert "closed form" in d2["method"]  # the model is paper B's layout: the closed-form search is used
+    assert len(d2["solutions"]) == 4 and sum(s["within_limits"] for s in d2["solutions"]) == 2
+    r3 = run("fk", "four-sps-cu", "--actuators", ",".join(str(v) for v in legs.values()), "--json")  # one Newton solve
+    assert json.loads(r3.output)["solutions"][0]["converged"]
+    r4 = run("jacobian", "five-cs-1", "--position", "3", "--driver", "rot1", "--json")
+    d = json.loads(r4.output)
     assert len(d["matrix"]) == 6 and d["det"] is not None
 
 
@@ -116,3 +119,21 @@ def test_cli_ik_fk_jacobian():
 def test_cli_kinematics_errors(args, msg):
     r = run(*args)
     assert r.exit_code == 2 and msg in r.output
+
+
+def test_general_forward_all_agrees_with_the_closed_form_of_the_4sps_cu():
+    """Every assembly mode the general engine finds is one of the closed form's (cross-check)."""
+    from spatialmech.kinematics.closed_forms import four_sps_cu as k4
+    from spatialmech.geometry.rotations import matrix_euler
+
+    m = catalog.build("four-sps-cu")
+    assert k4.geometry_of(m) is not None and k4.geometry_of(STEWART) is None
+    legs = k4.leg_lengths([0.12, 0.2, -0.1, 0.6])
+    closed = k4.forward_all(legs).phis
+    gen = forward_position(m, legs, all_solutions=True, n_seeds=60, seed=1)
+    found = [s for s in gen.solutions if s.converged]
+    assert len(found) >= 2
+    for s in found:
+        g, b, a = matrix_euler("ZYX", s.pose.R)
+        phi = np.array([s.pose.p[2], a, b, g])
+        assert np.min(np.max(np.abs(closed - phi), axis=1)) < 1e-7

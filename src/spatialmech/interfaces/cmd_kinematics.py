@@ -114,6 +114,23 @@ def fk(model, values, all_solutions, seeds, as_json):
     if len(raw) != len(acts):
         raise ValueError(f"--actuators: {mech.name} has {len(acts)} actuators ({', '.join(acts)}), got {len(raw)} values")
     vals = [v if mech.freedom(a).freedom.kind == "P" else np.radians(v) for a, v in zip(acts, raw)]
+    from ..kinematics.closed_forms import four_sps_cu as k4
+
+    geom = k4.geometry_of(mech) if all_solutions else None
+    if geom is not None:  # the closed form of this limb layout: faster and more thorough
+        fa = k4.forward_all(np.asarray(vals), geometry=geom)
+        d = fa.to_dict()
+        d["method"] = "closed form of the 4-SPS/CU (kinematics/closed_forms/four_sps_cu.py)"
+        if as_json:
+            emit_json(d)
+            return
+        click.echo(f"{mech.name}: {len(fa.solutions)} assembly mode(s) found ({fa.n_within_limits} within the leg and CU "
+                   f"limits; closed-form multi-start, {fa.search.n_seeds} seeds)")
+        for n, s_ in enumerate(fa.solutions):
+            z, al, be, ga = s_.phi
+            click.echo(f"  [{n + 1}] z = {z:.6f} m, alpha = {np.degrees(al):.4f}, beta = {np.degrees(be):.4f}, "
+                       f"gamma = {np.degrees(ga):.4f} deg ('ZYX')  {'within limits' if s_.within_limits else 'outside limits'}")
+        return
     res = forward_position(mech, vals, all_solutions=all_solutions, n_seeds=seeds)
     if as_json:
         emit_json(res.to_dict(mech))

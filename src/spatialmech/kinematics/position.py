@@ -405,7 +405,7 @@ def _fk_from(mech, config, targets, mask, max_iter, patience=None):
     c = Configuration(q, config.D)
     if patience is not None:  # abandon starts that are not converging after a few steps
         res = correct(mech, c, active=mask, max_iter=patience)
-        if res.converged or res.residual > 1e-3:
+        if res.converged or res.residual > 1e-1:
             return res
         c = res.config
     return correct(mech, c, active=mask, max_iter=max_iter)

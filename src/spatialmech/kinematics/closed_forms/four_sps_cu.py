@@ -922,3 +922,30 @@ def forward_all(
         hits=tuple(hits[i] for i in order),
     )
     return ForwardAllResult(l.copy(), tuple(sols[i] for i in order), search)
+
+
+def geometry_of(mech) -> FourSpsCuGeometry | None:
+    """The closed-form geometry of a mechanism when it *is* a 4-SPS/CU of paper B's layout (same
+    joint screws as ``catalog.papers.four_sps_cu(a, b, z0)`` with its limits), else ``None``.
+
+    Lets general commands use the closed forms on a matching model (e.g. a file exported from
+    the ready-made one) and fall back to the general engine on anything else."""
+    from ...catalog.papers import four_sps_cu as build
+    from ..closure import reference_screws
+
+    try:
+        if len(mech.limbs) != 5 or [len(l.joints) for l in mech.limbs] != [3, 3, 3, 3, 2]:
+            return None
+        A1 = mech.limbs[0].joints[2].point
+        B1 = mech.limbs[0].joints[0].point
+        a, b, z0 = float(A1[0]), float(B1[0]), float(A1[2])
+        ref = build(a=a, b=b, z0=z0)
+        if not np.allclose(reference_screws(ref), reference_screws(mech), atol=1e-12):
+            return None
+        legs = mech.limbs[0].joints[1].freedoms[0].limits
+        cu = mech.limbs[4].joints[0].freedoms[1].limits
+        if legs is None or cu is None:
+            return None
+        return FourSpsCuGeometry(a=a, b=b, leg_limits=tuple(legs), z_limits=tuple(cu))
+    except (IndexError, ValueError):
+        return None
