@@ -94,3 +94,25 @@ def test_forward_position_by_continuation_along_actuator_path():
     fk = forward_position(m, a1, start=last)
     assert fk.converged
     assert np.allclose(fk.solutions[0].config.D, target.D, atol=1e-8)
+
+
+def test_tracking_benchmark_smoke():
+    import runpy
+    from pathlib import Path
+
+    bench = runpy.run_path(str(Path(__file__).parent.parent / "benchmarks" / "bench_tracking.py"))
+    out = bench["main"](["--quick", "--json"])
+    assert out["scipy_root_ok"] and out["dj_evaluations_per_s"] > 0 and out["tracker_path_status"] == "stopped"
+
+
+def test_linkage3_near_singular_stretch_is_crossed_without_jumps():
+    """Between P3 and P4 linkage 3 passes close to a singularity (sigma ~ 4e-4): with large steps
+    allowed, consecutive tracked points stay close (no jump to another branch) and the circuit
+    still closes on its start."""
+    m = catalog.build("five-cs-3")
+    r = trace_motion(m, Configuration.reference(m), increasing="rot1", h_max=0.5, max_arc=400)
+    assert r.closed
+    pts = np.array([c.D[:3, :3] @ m.platform_point + c.D[:3, 3] for c in r.points])
+    steps = np.linalg.norm(np.diff(pts, axis=0), axis=1)
+    ds = np.diff(r.s)
+    assert np.all(steps <= 3 * m.characteristic_length * ds + 1e-9)  # the platform point moves with the arc

@@ -472,13 +472,14 @@ def trace_motion(
     start: Configuration,
     *,
     increasing: str | None = None,
+    sense: int = 1,
     monitors: dict[str, Callable[[Configuration], float]] | None = None,
     **kw,
 ) -> TrackResult:
     """Follow the one-degree-of-freedom motion of ``mech`` from ``start`` until it closes.
 
-    ``increasing``: a freedom name whose variable should increase at the start (sets the
-    sense of travel).  Extra keyword arguments go to :func:`track`.
+    ``increasing``: a freedom name whose variable should increase at the start (``sense=-1``:
+    decrease), which sets the sense of travel.  Extra keyword arguments go to :func:`track`.
     """
     prob = MotionProblem(mech)
     direction = None
@@ -487,5 +488,5 @@ def trace_motion(
         i = mech.freedom_refs.index(r)
         idx = list(np.flatnonzero(prob.active))
         direction = np.zeros(prob.na + 6)
-        direction[idx.index(i)] = 1.0
+        direction[idx.index(i)] = 1.0 if sense >= 0 else -1.0
     return track(prob, start, direction=direction, monitors=monitors, **kw)
