@@ -114,7 +114,8 @@ def mobility_cmd(model, mode, as_json):
 @cli.command()
 @click.argument("model")
 @click.argument("file", type=click.Path(dir_okay=False, writable=True, path_type=Path))
-def export(model, file):
+@json_option
+def export(model, file, as_json):
     """Write a model (e.g. a ready-made one) as a TOML file to start your own from.
 
     \b
@@ -123,7 +124,10 @@ def export(model, file):
     """
     mech = _model(model)
     dump(mech, file)
-    click.echo(f"wrote {file}")
+    if as_json:
+        emit_json({"model": mech.name, "out": str(file), "bytes": file.stat().st_size})
+    else:
+        click.echo(f"wrote {file}")
 
 
 @cli.command()

@@ -131,7 +131,13 @@ def fk(model, values, all_solutions, seeds, as_json):
             click.echo(f"  [{n + 1}] z = {z:.6f} m, alpha = {np.degrees(al):.4f}, beta = {np.degrees(be):.4f}, "
                        f"gamma = {np.degrees(ga):.4f} deg ('ZYX')  {'within limits' if s_.within_limits else 'outside limits'}")
         return
-    res = forward_position(mech, vals, all_solutions=all_solutions, n_seeds=seeds)
+    if all_solutions and not as_json:
+        import sys
+
+        with click.progressbar(length=seeds, label="assembly modes", file=sys.stderr) as bar:
+            res = forward_position(mech, vals, all_solutions=True, n_seeds=seeds, progress=lambda k, n: bar.update(1))
+    else:
+        res = forward_position(mech, vals, all_solutions=all_solutions, n_seeds=seeds)
     if as_json:
         emit_json(res.to_dict(mech))
         return

@@ -420,6 +420,7 @@ def forward_position(
     n_seeds: int = 200,
     seed: int = 0,
     max_iter: int = 60,
+    progress=None,
 ) -> ForwardResult:
     """Platform pose(s) for given actuator values (physical units, in ``mech.actuators`` order
     or a dict by name).
@@ -448,6 +449,8 @@ def forward_position(
                 except RuntimeError:
                     continue
             runs.append(_fk_from(mech, c, targets, mask, max_iter, patience=12))
+            if progress is not None:
+                progress(s + 1, n_seeds)
     sols, sigs = [], []
     for k, r in enumerate(runs):
         if not r.converged and not (k == 0 and not all_solutions):
