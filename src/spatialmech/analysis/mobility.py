@@ -129,25 +129,10 @@ def _canonical(W: np.ndarray, L: float) -> np.ndarray:
     a unit direction (or a unit moment for a pure couple/translation)."""
     if W.shape[0] == 0:
         return W
-    A = sc.nondimensional(W, L)
-    A = A.copy()
-    rows, cols = A.shape
-    r = 0
-    for c in range(cols):
-        if r == rows:
-            break
-        piv = r + int(np.argmax(np.abs(A[r:, c])))
-        if abs(A[piv, c]) < 1e-9:
-            continue
-        A[[r, piv]] = A[[piv, r]]
-        A[r] /= A[r, c]
-        for i in range(rows):
-            if i != r:
-                A[i] -= A[i, c] * A[r]
-        r += 1
+    A = sc.rref(sc.nondimensional(W, L))
     A[:, 3:] *= L
     out = []
-    for w in A[:r]:
+    for w in A:
         n = np.linalg.norm(w[:3])
         w = w / (n if n > 1e-12 else np.linalg.norm(w[3:]))
         w = np.where(np.abs(w) < 1e-12, 0.0, w)

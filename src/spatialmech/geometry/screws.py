@@ -47,6 +47,7 @@ __all__ = [
     "cofactor_reciprocal",
     "intersection",
     "contains",
+    "rref",
 ]
 
 #: The reciprocal-product matrix ``[[0, I3], [I3, 0]]``.
@@ -239,6 +240,29 @@ def cofactor_reciprocal(screws) -> np.ndarray:
         cols.append((-1) ** j * np.linalg.det(minor))
     y = np.stack(cols, axis=-1)
     return swap(y)
+
+
+def rref(A, *, tol: float = 1e-9) -> np.ndarray:
+    """Reduced row-echelon form of the rows of ``A`` (zero rows dropped): a deterministic,
+    readable basis of their span (e.g. a constraint system given as forces along x and y
+    rather than an arbitrary SVD basis).  Pass nondimensional screws (see
+    :func:`nondimensional`) so that the pivot tolerance is scale-free."""
+    A = np.array(A, dtype=float, copy=True)
+    rows, cols = A.shape
+    r = 0
+    for c in range(cols):
+        if r == rows:
+            break
+        piv = r + int(np.argmax(np.abs(A[r:, c])))
+        if abs(A[piv, c]) < tol:
+            continue
+        A[[r, piv]] = A[[piv, r]]
+        A[r] /= A[r, c]
+        for i in range(rows):
+            if i != r:
+                A[i] -= A[i, c] * A[r]
+        r += 1
+    return A[:r]
 
 
 def intersection(A, B, *, length_scale: float = 1.0, rtol: float = RANK_RTOL) -> np.ndarray:

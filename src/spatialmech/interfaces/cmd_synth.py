@@ -12,15 +12,9 @@ from pathlib import Path
 import click
 import numpy as np
 
+from ..serialize import json_default
+
 __all__ = ["synth"]
-
-
-def _default(o):
-    if isinstance(o, np.ndarray):
-        return o.tolist()
-    if isinstance(o, (np.floating, np.integer, np.bool_)):
-        return o.item()
-    raise TypeError(f"not JSON serialisable: {type(o).__name__}")
 
 
 @click.group()
@@ -70,7 +64,7 @@ def rccc(task, as_json, plot_dir, save_file, pick, samples):
         write_all(res, plot_dir)
     d = res.to_dict()
     if as_json:
-        click.echo(json.dumps(d, indent=2, default=_default, allow_nan=False))
+        click.echo(json.dumps(d, indent=2, default=json_default, allow_nan=False))
         return
     u = t.length_unit
     lines = [

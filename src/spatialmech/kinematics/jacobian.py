@@ -137,20 +137,7 @@ def limb_constraint_wrenches(twists: np.ndarray, *, length_scale: float = 1.0, r
         if np.linalg.matrix_rank(P, tol=1e-9) == W.shape[0]:
             return _from_nd(P, L)
     # deterministic: reduced row echelon form of the nd basis
-    A = Q.T.copy()
-    r = 0
-    for c in range(6):
-        if r == A.shape[0]:
-            break
-        piv = r + int(np.argmax(np.abs(A[r:, c])))
-        if abs(A[piv, c]) < 1e-9:
-            continue
-        A[[r, piv]] = A[[piv, r]]
-        A[r] /= A[r, c]
-        for i in range(A.shape[0]):
-            if i != r:
-                A[i] -= A[i, c] * A[r]
-        r += 1
+    A = sc.rref(Q.T)
     return _from_nd(A, L)
 
 

@@ -38,6 +38,8 @@ from typing import Callable, Sequence
 
 import numpy as np
 
+from ..serialize import json_default
+
 from .figures import ReportFigure
 
 __all__ = [
@@ -66,15 +68,6 @@ DEMO_SECTIONS = (
     "paper_d:section",
     "models:section",
 )
-
-
-def _jsonable(o):
-    """JSON conversion of NumPy scalars/arrays and tuples (``json.dumps(default=...)``)."""
-    if isinstance(o, np.ndarray):
-        return o.tolist()
-    if isinstance(o, (np.floating, np.integer, np.bool_)):
-        return o.item()
-    raise TypeError(f"not JSON serialisable: {type(o).__name__}")
 
 
 @dataclass(frozen=True)
@@ -378,7 +371,7 @@ def write_report(out, title: str, sections: Sequence[Section], elapsed: float, e
         "sections": [sec.to_dict() for sec in sections],
         **(extra or {}),
     }
-    text = json.dumps(data, indent=1, default=_jsonable, allow_nan=False)
+    text = json.dumps(data, indent=1, default=json_default, allow_nan=False)
     (out / "results.json").write_text(text, encoding="utf-8")
     data = json.loads(text)
     (out / "index.html").write_text(render_html(title, sections, data), encoding="utf-8")
