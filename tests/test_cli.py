@@ -65,3 +65,25 @@ def test_export_then_mobility_of_the_file(tmp_path):
     assert run("export", "bennett", str(f)).exit_code == 0
     d = json.loads(run("mobility", str(f), "--json").output)
     assert d["dof"] == 1 and d["gk_classic"] == -2
+
+
+def test_pose_option_equals_xyz_euler():
+    a = json.loads(run("ik", "four-sps-cu", "--pose", "0,0,0.12,ZYX,34.38,-5.73,11.46", "--json").output)
+    b = json.loads(run("ik", "four-sps-cu", "--xyz", "0", "0", "0.12", "--euler", "ZYX", "34.38", "-5.73", "11.46", "--json").output)
+    assert a["actuators"] == b["actuators"]
+    r = CliRunner().invoke(cli, ["singularity", "four-sps-cu", "--pose", "0,0,0.12,ZYX,1,2"])
+    assert r.exit_code == 2 and "--pose" in r.output
+
+
+def test_view_traces_a_one_dof_mechanism_and_marks_singular_points(tmp_path):
+    out = tmp_path / "b.html"
+    r = CliRunner().invoke(cli, ["view", "planar-4r", "--motion", "trace", "--frames", "12", "--out", str(out), "--json"])
+    assert r.exit_code == 0, r.output
+    d = json.loads(r.output)
+    assert d["frames"] == 12 and out.stat().st_size > 100_000
+    from spatialmech.present.motion import traced_motion
+    from spatialmech import catalog
+
+    m = catalog.build("planar-4r")
+    configs, sing = traced_motion(m, frames=12)
+    assert len(configs) == 12 and sing == ()  # a Grashof crank never reaches a branch point

@@ -20,6 +20,8 @@ from ..model.mechanism import Mechanism, Pose
 from .common import emit_json, json_option
 
 pose_options = [
+    click.option("--pose", "pose_text", default=None,
+                 help="X,Y,Z,SEQ,A1,A2,A3 in one option: platform point (length) and Euler angles (deg), e.g. 0,0,0.12,ZYX,34.38,-5.73,11.46."),
     click.option("--xyz", nargs=3, type=float, default=None, help="Platform point position X Y Z (model length unit)."),
     click.option("--euler", "euler", nargs=4, type=(str, float, float, float), default=None,
                  help="Orientation: SEQ A1 A2 A3, angles in degrees (e.g. ZYX 30 -5 10; upper case = intrinsic)."),
@@ -28,9 +30,34 @@ pose_options = [
 
 
 def with_pose(f):
+    """Add the pose options; the command receives ``xyz, euler, position`` (``--pose`` is parsed
+    into ``xyz`` and ``euler``)."""
+    import functools
+
+    @functools.wraps(f)
+    def wrapper(*args, pose_text=None, xyz=None, euler=None, **kw):
+        if pose_text is not None:
+            if xyz is not None or euler is not None:
+                raise ValueError("--pose: give either --pose or --xyz/--euler, not both")
+            xyz, euler = parse_pose(pose_text)
+        return f(*args, xyz=xyz, euler=euler, **kw)
+
     for opt in reversed(pose_options):
-        f = opt(f)
-    return f
+        wrapper = opt(wrapper)
+    return wrapper
+
+
+def parse_pose(text: str):
+    """``"X,Y,Z,SEQ,A1,A2,A3"`` -> ((x, y, z), (seq, a1, a2, a3)), angles in degrees."""
+    parts = [p.strip() for p in text.split(",")]
+    if len(parts) != 7:
+        raise ValueError(f"--pose: expected X,Y,Z,SEQ,A1,A2,A3 (7 comma-separated values), got {len(parts)}")
+    try:
+        xyz = tuple(float(v) for v in parts[:3])
+        ang = tuple(float(v) for v in parts[4:])
+    except ValueError:
+        raise ValueError(f"--pose: expected numbers for X,Y,Z and A1,A2,A3, got {text!r}") from None
+    return xyz, (parts[3], *ang)
 
 
 def resolve_pose(mech: Mechanism, xyz, euler, position) -> Pose:
@@ -69,6 +96,7 @@ def ik(model, xyz, euler, position, all_solutions, as_json):
     \b
     Examples:
       spatialmech ik four-sps-cu --xyz 0 0 0.12 --euler ZYX 34.38 -5.73 11.46
+      spatialmech ik four-sps-cu --pose 0,0,0.12,ZYX,34.38,-5.73,11.46 --json
       spatialmech ik five-cs-1 --position 3 --json
       spatialmech ik delta --xyz 0.02 0.01 -0.33 --all
     """

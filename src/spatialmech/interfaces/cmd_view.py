@@ -16,9 +16,12 @@ from ..model.schema import ModelFileError
 
 __all__ = ["view", "MOTIONS"]
 
-#: Motions the command can compute.  "demo": :func:`..present.motion.sample_motion`, a closed
-#: loop along the closure manifold from the reference configuration (not the tracker).
-MOTIONS = ("demo",)
+#: Motions the command can compute.  "trace": the whole circuit of a one-degree-of-freedom
+#: mechanism through its reference configuration, followed by the continuation tracker, with the
+#: zeros of DJ (branch points of the first actuator) marked as singular points; "demo":
+#: :func:`..present.motion.sample_motion`, a short loop along the closure manifold (any mobility);
+#: "auto": trace when the mechanism has one degree of freedom, else demo.
+MOTIONS = ("auto", "trace", "demo")
 
 
 class _Error(click.ClickException):
@@ -34,9 +37,9 @@ class _Error(click.ClickException):
 
 @click.command(name="view")
 @click.argument("model")
-@click.option("--motion", type=click.Choice(MOTIONS), default="demo", show_default=True,
-              help="Motion to animate (demo: a short loop along the closure manifold from the reference "
-                   "configuration; a demonstration, not the continuation tracker).")
+@click.option("--motion", type=click.Choice(MOTIONS), default="auto", show_default=True,
+              help="Motion to animate: trace (1 DOF: the whole circuit by continuation, singular points marked), "
+                   "demo (a short loop along the closure manifold, any mobility), auto (trace if 1 DOF).")
 @click.option("--out", "out", required=True, type=click.Path(dir_okay=False, path_type=Path),
               help="The HTML file to write (self-contained: plotly.js is inlined, it opens offline).")
 @click.option("--frames", type=click.IntRange(min=2), default=60, show_default=True,
@@ -50,20 +53,30 @@ def view(model, motion, out, frames, as_json):
     Examples:
       spatialmech view four-sps-cu --out four-sps-cu.html
       spatialmech view five-cs-1 --frames 120 --out five-cs-1.html --json
+      spatialmech view bennett --motion trace --out bennett.html
     """
-    from ..present.motion import sample_motion
+    from ..present.motion import sample_motion, traced_motion
     from ..present.viewer import write_viewer
 
+    singular = ()
     try:
         mech = catalog.resolve(model)
-        configs = sample_motion(mech, n=frames)
-    except (ModelFileError, ValueError) as e:
-        raise _Error(str(e)) from None
+        if motion == "auto":
+            from ..analysis.mobility import mobility
+
+            motion = "trace" if (not mech.is_metamorphic and mobility(mech).dof_instantaneous == 1) else "demo"
+        if motion == "trace":
+            configs, singular = traced_motion(mech, frames=frames)
+            title = f"{mech.name}: the traced circuit ({len(configs)} frames); x: DJ zeros of {', '.join(mech.actuators[:1]) or '-'}"
+        else:
+            configs = sample_motion(mech, n=frames)
+            title = f"{mech.name}: a demonstration loop, {len(configs)} configurations (not the tracker)"
+    except (ModelFileError, ValueError, KeyError) as e:
+        raise _Error(str(e.args[0] if isinstance(e, KeyError) else e)) from None
     except RuntimeError as e:
         raise _Error(str(e), code=1) from None
-    title = f"{mech.name}: {motion} motion, {len(configs)} configurations (a demonstration loop, not the tracker)"
     try:
-        written = write_viewer(out, mech, configs, title=title, task_positions=mech.positions)
+        written = write_viewer(out, mech, configs, title=title, task_positions=mech.positions, singular_points=singular)
     except OSError as e:
         raise _Error(f"--out: cannot write {out}: {e.strerror or e}") from None
     if as_json:

@@ -175,3 +175,27 @@ def sample_motion(
     at.update(zip(pos.tolist(), _walk(mech, x0, t0, amplitude * pos, active, col)))
     at.update(zip(neg.tolist(), _walk(mech, x0, t0, amplitude * neg, active, col)))
     return [at[float(k)] for k in keys]
+
+
+def traced_motion(mech: Mechanism, *, frames: int = 60, start: Configuration | None = None):
+    """The circuit of a one-degree-of-freedom mechanism through ``start`` (default: the reference),
+    followed by the continuation tracker and subsampled to ``frames`` configurations, with the
+    platform points where DJ of the first actuator vanishes (its branch points).
+
+    Raises ``RuntimeError`` when the tracker cannot follow the motion."""
+    from ..analysis.defects import dj_function
+    from ..kinematics.tracking import trace_motion
+
+    start = start if start is not None else Configuration.reference(mech)
+    acts = list(mech.actuators[:1])
+    mon = None
+    if acts:
+        f, _ = dj_function(mech, acts, start)
+        mon = (acts, f)
+    tr = trace_motion(mech, start, increasing=acts[0] if acts else None, vector_monitor=mon, max_arc=400)
+    if not tr.ok:
+        raise RuntimeError(f"the tracker stopped: {tr.status}")
+    idx = np.unique(np.linspace(0, len(tr.points) - 1, min(frames, len(tr.points))).round().astype(int))
+    configs = [tr.points[i] for i in idx]
+    sing = tuple(e.x for e in tr.events if e.kind == "zero")
+    return configs, sing
