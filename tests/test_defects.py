@@ -172,6 +172,9 @@ def test_monte_carlo_on_an_overconstrained_linkage_reports_lost_mobility(fourbar
 
 def test_bad_inputs(fourbar):
     m, poses = fourbar
+    st = catalog.build("stewart-6sps")
+    with pytest.raises(ValueError, match="one-degree-of-freedom linkages; stewart-6sps has 6"):
+        defect_analysis(st, [sm.Pose(np.eye(3), [0, 0, 1.0]), sm.Pose(np.eye(3), [0, 0, 1.1])])
     with pytest.raises(ValueError, match="at least two task positions"):
         defect_analysis(m, poses[:1])
     with pytest.raises(KeyError, match="unknown freedom"):

@@ -513,6 +513,13 @@ def defect_analysis(
     positions = tuple(positions if positions is not None else mech.positions)
     if len(positions) < 2:
         raise ValueError("positions: a defect analysis needs at least two task positions")
+    from .mobility import mobility
+
+    if mech.is_metamorphic and len(mech.all_modes()) > 1:
+        raise ValueError(f"mechanism: {mech.name} is metamorphic; analyse one mode (mech.in_mode(name))")
+    dof = mobility(mech).dof_instantaneous
+    if dof != 1:
+        raise ValueError(f"mechanism: the defect analysis is for one-degree-of-freedom linkages; {mech.name} has {dof}")
     drivers = list(drivers) if drivers is not None else candidate_drivers(mech)
     if not drivers:
         raise ValueError("drivers: no candidate drivers")
