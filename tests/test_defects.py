@@ -141,7 +141,7 @@ def test_scrambled_positions_give_an_order_defect(fourbar):
 
 def rccc():
     """A small RCCC guidance linkage (coupler as platform): 1 DOF, not overconstrained."""
-    z, x = np.array([0, 0, 1.0]), np.array([1.0, 0, 0])
+    z = np.array([0, 0, 1.0])
     a1 = np.array([0.2, 0.3, 0.93]); a1 /= np.linalg.norm(a1)
     b0 = np.array([0.1, 0.9, 0.2]); b0 /= np.linalg.norm(b0)
     b1 = np.array([0.8, 0.1, 0.4]); b1 /= np.linalg.norm(b1)

@@ -32,10 +32,9 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..geometry import screws as sc
 from ..kinematics.closure import Configuration, _scales, active_mask, closure_jacobian
 from ..kinematics.jacobian import complete_jacobian, driver_determinants
-from ..kinematics.position import PoseFit, configuration_at_pose, freedom_values, platform_pose
+from ..kinematics.position import PoseFit, configuration_at_pose, freedom_values
 from ..kinematics.tracking import MotionProblem, TrackResult, track
 from ..model.joints import make_joint
 from ..model.mechanism import Limb, Mechanism, Pose
@@ -599,7 +598,6 @@ def defect_analysis(
         pos_arcs[i] = (a % S if S else a) if direction == 1 else (((S - a) % S) if S else -a)
 
     # branch points
-    L = mech.characteristic_length
 
     def to_path(arc_traced: float) -> float:
         if direction == 1:

@@ -33,7 +33,7 @@ import numpy as np
 
 from ..geometry import screws as sc
 from ..geometry.line_geometry import classify_lines
-from ..kinematics.closure import Configuration, active_mask, closure_jacobian
+from ..kinematics.closure import Configuration
 from ..kinematics.jacobian import CompleteJacobian, complete_jacobian
 from ..kinematics.position import configuration_at_pose
 from ..kinematics.tracking import MotionProblem, track

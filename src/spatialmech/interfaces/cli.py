@@ -6,12 +6,10 @@ with code 2; nothing here computes.
 
 from __future__ import annotations
 
-import json
 import sys
 from pathlib import Path
 
 import click
-import numpy as np
 
 from .. import __version__, catalog
 from ..analysis.mobility import mobility, mobility_modes

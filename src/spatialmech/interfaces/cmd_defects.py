@@ -2,11 +2,9 @@
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 import click
-import numpy as np
 
 from .. import catalog
 from ..analysis.defects import defect_analysis

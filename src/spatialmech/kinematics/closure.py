@@ -22,7 +22,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from scipy.spatial.transform import Rotation
 
 from ..geometry.rotations import (
     exp_twist,

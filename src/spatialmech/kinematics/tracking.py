@@ -26,7 +26,7 @@ from typing import Callable, Protocol
 
 import numpy as np
 
-from ..geometry.rotations import exp_twist, inverse_transform, log_transform
+from ..geometry.rotations import inverse_transform, log_transform
 from ..model.mechanism import Mechanism
 from scipy.spatial.transform import Rotation
 

@@ -18,18 +18,13 @@ order, branch points along the path, the dual-drive plan, closeness to singulari
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 
 import numpy as np
 
 from .. import catalog
 from ..analysis.mobility import mobility
-from ..kinematics.closure import Configuration
-from ..kinematics.jacobian import complete_jacobian
-from ..kinematics.position import PoseFit, configuration_at_pose
 from ..analysis.defects import DJTable, defect_analysis
 from .defect_figures import write_defect_figures
-from ..model.mechanism import Mechanism
 from . import figures as F
 from .report import Claim, Section, Table, Viewer
 

@@ -88,7 +88,7 @@ def section(progress=lambda step: None) -> Section:
         claims.append(Claim(
             "D", f"Example {label} (eq {eq}): axis directions of the input and output dyads",
             ", ".join(f"{k} = {v}" for k, v in ex.items()),
-            f"direction-equation residuals u0^T(C_j^T - I)v: "
+            "direction-equation residuals u0^T(C_j^T - I)v: "
             + "; ".join(f"({k}): {', '.join(f'{x:+.3f}' for x in r)}" for k, r in resid.items())
             + f"; the printed circle points are {off[0]:.1f} and {off[1]:.1f} deg off the computed curve{extra}",
             "not reproduced",

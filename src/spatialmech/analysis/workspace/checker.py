@@ -1,0 +1,383 @@
+"""Vectorised pose checking: margins of every limit for stacks of poses (closed form or general)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+from ...model.mechanism import Mechanism, Pose
+from .limits import (  # noqa: F401
+    COORDINATES,
+    ConeLimit,
+    ORIENTATION_SEQUENCE,
+    PAPER_B_LINK_DIAMETERS,
+    WorkspaceLimits,
+    _BOX,
+    _CLOSURE,
+    _ORIENTATION,
+    _POSITION,
+    default_limits,
+    paper_b_limits,
+)
+
+
+# ------------------------------------------------------------------------------ geometry kernels
+def segment_distance(p1, q1, p2, q2) -> np.ndarray:
+    """Minimum distance (...,) between the segments ``p1 q1`` and ``p2 q2`` (..., 3), vectorised.
+
+    Closest points of two segments (Ericson, *Real-Time Collision Detection*, 5.1.9), with the
+    parallel and degenerate cases handled.  Example: the segments ``(0,0,0)-(1,0,0)`` and
+    ``(0.5,1,-1)-(0.5,1,1)`` are 1 apart.
+    """
+    p1, q1, p2, q2 = (np.asarray(v, dtype=float) for v in (p1, q1, p2, q2))
+    d1, d2, r = q1 - p1, q2 - p2, p1 - p2
+    a = np.einsum("...i,...i->...", d1, d1)
+    e = np.einsum("...i,...i->...", d2, d2)
+    b = np.einsum("...i,...i->...", d1, d2)
+    c = np.einsum("...i,...i->...", d1, r)
+    f = np.einsum("...i,...i->...", d2, r)
+    tiny = 1e-300
+    a_ = np.maximum(a, tiny)
+    e_ = np.maximum(e, tiny)
+    denom = a * e - b * b
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s = np.where(denom > 1e-12 * a_ * e_, np.clip((b * f - c * e) / np.maximum(denom, tiny), 0.0, 1.0), 0.0)
+        t = (b * s + f) / e_
+        s = np.where(t < 0.0, np.clip(-c / a_, 0.0, 1.0), np.where(t > 1.0, np.clip((b - c) / a_, 0.0, 1.0), s))
+        t = np.clip(t, 0.0, 1.0)
+        # degenerate segments (a point): Ericson's special cases
+        deg_a, deg_e = a <= 1e-300, e <= 1e-300
+        s = np.where(deg_e & ~deg_a, np.clip(-c / a_, 0.0, 1.0), s)
+        t = np.where(deg_e, 0.0, t)
+        t = np.where(deg_a & ~deg_e, np.clip(f / e_, 0.0, 1.0), t)
+        s = np.where(deg_a, 0.0, s)
+    diff = (p1 + s[..., None] * d1) - (p2 + t[..., None] * d2)
+    return np.linalg.norm(diff, axis=-1)
+
+
+def _cone_angles(direction: np.ndarray, axis: np.ndarray) -> np.ndarray:
+    """Angle (rad) between ``direction`` (n, 3) and the unit ``axis`` (n, 3) or (3,):
+    ``atan2(|d x a|, d . a)``, accurate near 0 and pi (unlike ``arccos``)."""
+    ax = np.broadcast_to(axis, direction.shape)
+    return np.arctan2(np.linalg.norm(np.cross(direction, ax), axis=-1), np.einsum("...i,...i->...", direction, ax))
+
+
+@dataclass(frozen=True)
+class _Link:
+    limb: int
+    ends: tuple[int, int]  # joint indices of the two ends (base side first)
+
+
+def _links(mech: Mechanism, points: list[np.ndarray]) -> list[_Link]:
+    """Links of every limb: segments between consecutive distinct joint points (reference)."""
+    out = []
+    L = mech.characteristic_length
+    for li, pts in enumerate(points):
+        keep = [0]
+        for j in range(1, len(pts)):
+            if np.linalg.norm(pts[j] - pts[keep[-1]]) > 1e-9 * L:
+                keep.append(j)
+        out += [_Link(li, (keep[k], keep[k + 1])) for k in range(len(keep) - 1)]
+    return out
+
+
+def _link_of_joint(links: list[_Link], limb: int, joint: int) -> int:
+    """Index of the link a cone limit at ``joint`` refers to: at the limb's first joint the link
+    leaving it towards the platform, elsewhere the link arriving at it from the base side."""
+    mine = [k for k, lk in enumerate(links) if lk.limb == limb]
+    if not mine:
+        raise ValueError(f"cones: the limb of joint #{joint} has no link (all its joints coincide)")
+    if joint == 0:
+        return mine[0]
+    for k in mine:
+        lo, hi = links[k].ends
+        if lo < joint <= hi:
+            return k
+    return mine[-1] if joint > links[mine[-1]].ends[1] else mine[0]
+
+
+# ------------------------------------------------------------------------------ pose checker
+@dataclass(frozen=True, eq=False)
+class PoseChecker:
+    """Named margins (>= 0 inside every limit) for stacks of platform poses.
+
+    ``margins(R, p)`` -> (n, m) array for ``R`` (n, 3, 3), ``p`` (n, 3) (the platform point);
+    ``names[k]`` names margin ``k`` (e.g. ``"L1.slide max"``, ``"A1 cone"``,
+    ``"interference leg1/cu"``, ``"closure"``); ``scales[k]`` makes margins comparable (m
+    margins divided by the characteristic length, rad margins by 1).  ``path`` is
+    ``"closed-form"`` (vectorised) or ``"general"`` (per-pose inverse position).
+    """
+
+    mechanism: Mechanism
+    limits: WorkspaceLimits
+    path: str
+    names: tuple[str, ...]
+    scales: np.ndarray
+    _fn: Callable = field(repr=False)
+    reason: str = ""
+    pinned: dict = field(default_factory=dict)  # position coordinates fixed by a limb (closed form)
+    _feasible_fn: Callable | None = field(default=None, repr=False)
+
+    def margins(self, R, p) -> np.ndarray:
+        R = np.asarray(R, dtype=float).reshape(-1, 3, 3)
+        p = np.asarray(p, dtype=float).reshape(-1, 3)
+        return self._fn(R, p)
+
+    def feasible(self, R, p) -> np.ndarray:
+        """``True`` where every margin is >= 0 (the closed form skips the interference check
+        where another limit already fails)."""
+        if self._feasible_fn is not None:
+            R = np.asarray(R, dtype=float).reshape(-1, 3, 3)
+            p = np.asarray(p, dtype=float).reshape(-1, 3)
+            return self._feasible_fn(R, p)
+        return np.all(self.margins(R, p) >= 0.0, axis=-1)
+
+    def violated(self, R, p) -> list[str]:
+        """Name of the most violated limit (scaled margins) of each pose, ``""`` if feasible."""
+        m = self.margins(R, p) / self.scales
+        k = np.argmin(m, axis=-1)
+        return [self.names[i] if m[j, i] < 0 else "" for j, i in enumerate(k)]
+
+
+def _freedom_margin_names(mech: Mechanism, idx: list[int]) -> list[str]:
+    refs = mech.freedom_refs
+    return [f"{refs[i].id} {side}" for i in idx for side in ("min", "max")]
+
+
+def _freedom_margins(vals: np.ndarray, los: np.ndarray, his: np.ndarray, rot: np.ndarray) -> np.ndarray:
+    """(n, 2k) margins ``value - lo``, ``hi - value``; rotations wrapped to the range centre."""
+    mid = 0.5 * (los + his)
+    wrapped = vals + 2 * np.pi * np.round((mid - vals) / (2 * np.pi))
+    v = np.where(rot, wrapped, vals)
+    out = np.empty(v.shape[:-1] + (2 * v.shape[-1],))
+    out[..., 0::2] = v - los
+    out[..., 1::2] = his - v
+    return out
+
+
+def _common(mech: Mechanism, limits: WorkspaceLimits, ref_points: list[np.ndarray]):
+    """Links, cone (limb, link, cone) triples, capsule pairs, freedom-limit indices."""
+    L = mech.characteristic_length
+    links = _links(mech, ref_points)
+    joint_at = {j.name: (li, ji) for li, limb in enumerate(mech.limbs) for ji, j in enumerate(limb.joints)}
+    cones = []
+    for c in limits.cones:
+        if c.joint not in joint_at:
+            raise ValueError(f"cones: {mech.name} has no joint {c.joint!r}")
+        li, ji = joint_at[c.joint]
+        if mech.limbs[li].joints[ji].type not in ("S", "U", "Sm"):
+            raise ValueError(f"cones: joint {c.joint!r} is a {mech.limbs[li].joints[ji].type} joint, not S or U")
+        cones.append((c, _link_of_joint(links, li, ji)))
+    pairs = []
+    for i in range(len(links)):
+        for j in range(i + 1, len(links)):
+            a, b = links[i], links[j]
+            if a.limb == b.limb:
+                continue
+            da, db = limits.diameter(mech.limbs[a.limb].name), limits.diameter(mech.limbs[b.limb].name)
+            if da is None or db is None:
+                continue
+            ends_a = [ref_points[a.limb][k] for k in a.ends]
+            ends_b = [ref_points[b.limb][k] for k in b.ends]
+            if min(np.linalg.norm(x - y) for x in ends_a for y in ends_b) < 1e-9 * L:
+                continue  # links joined at a common joint
+            pairs.append((i, j, 0.5 * (da + db)))
+    fl = [k for k, r in enumerate(mech.freedom_refs) if limits.freedom_limits and r.freedom.limits is not None]
+    names = _freedom_margin_names(mech, fl)
+    names += [c.name for c, _ in cones]
+    names += [f"interference {mech.limbs[links[i].limb].name}/{mech.limbs[links[j].limb].name}" for i, j, _ in pairs]
+    scale = [L if mech.freedom_refs[k].freedom.kind == "P" else 1.0 for k in fl for _ in (0, 1)]
+    scale += [1.0] * len(cones) + [L] * len(pairs)
+    return links, cones, pairs, fl, names, scale
+
+
+def _cone_margins(seg_a, seg_b, R, cones):
+    """Cone margins ``max_angle - angle`` (rad) from link end points ``seg_a``/``seg_b`` (n, n_links, 3)."""
+    cols = []
+    for c, k in cones:
+        axis = np.asarray(c.axis)
+        ax = np.einsum("nij,j->ni", R, axis) if c.frame == "platform" else axis
+        cols.append(c.max_angle - _cone_angles(seg_b[:, k] - seg_a[:, k], ax))
+    return cols
+
+
+def _pair_margins(seg_a, seg_b, pairs):
+    """Capsule margins ``distance - (d_i + d_j) / 2`` (m) of the link pairs."""
+    return [segment_distance(seg_a[:, i], seg_b[:, i], seg_a[:, j], seg_b[:, j]) - clearance for i, j, clearance in pairs]
+
+
+def _closed_form_plan(mech: Mechanism):
+    """Per limb ``("leg", B, A_local, l_ref, slide index)`` or ``("cu", c, k, u_local, s_ref, slide
+    index)``; or a string saying why the closed form does not apply."""
+    p0 = mech.platform_point
+    L = mech.characteristic_length
+    plan = []
+    first = 0
+    for limb in mech.limbs:
+        types = [j.type for j in limb.joints]
+        nf = sum(len(j.freedoms) for j in limb.joints)
+        limited = {f"{j.name}.{f.name}" for j in limb.joints for f in j.freedoms if f.limits is not None}
+        if any(f.locked for j in limb.joints for f in j.freedoms):
+            return f"limb {limb.name}: has locked freedoms"
+        if types in (["S", "P", "S"], ["U", "P", "S"]):
+            Bp, Pj, Aj = limb.joints
+            d = Aj.point - Bp.point
+            ln = float(np.linalg.norm(d))
+            if ln < 1e-12 * L or np.linalg.norm(np.cross(Pj.freedoms[0].direction, d / ln)) > 1e-9:
+                return f"limb {limb.name}: the prismatic joint is not along the leg"
+            if limited - {f"{Pj.name}.slide"}:
+                return f"limb {limb.name}: limits on rotations of its end joints"
+            plan.append(("leg", Bp.point, Aj.point - p0, ln, first + len(Bp.freedoms)))
+        elif types == ["C", "U"]:
+            Cj, Uj = limb.joints
+            k = Cj.freedoms[0].direction
+            if limited - {f"{Cj.name}.slide"}:
+                return f"limb {limb.name}: limits on its rotations"
+            s_ref = float(np.dot(Uj.point - Cj.point, k))
+            plan.append(("cu", Cj.point, k, Uj.point - p0, s_ref, first + 1))
+        else:
+            return f"limb {limb.name}: joints {'-'.join(types)} have no closed form here"
+        first += nf
+    return plan
+
+
+def pose_checker(mech: Mechanism, limits: WorkspaceLimits | None = None, *, method: str = "auto",
+                 general_seeds: int = 6) -> PoseChecker:
+    """The pose-check kernel of ``mech``: ``method`` ``"auto"`` (closed form when every limb is
+    S-P-S, U-P-S or C-U, else general), ``"closed-form"`` or ``"general"``.
+
+    The general kernel solves each pose by :func:`..kinematics.position.inverse_position` from
+    the reference configuration; when that assembly violates a limit it also searches every
+    limb's other assemblies (``general_seeds`` random starts per limb) and keeps, per limb, one
+    that violates the fewest freedom limits (limbs are independent once the pose is fixed).
+    """
+    if method not in ("auto", "closed-form", "general"):
+        raise ValueError(f"method: expected 'auto', 'closed-form' or 'general', got {method!r}")
+    limits = default_limits(mech) if limits is None else limits
+    if not isinstance(limits, WorkspaceLimits):
+        raise ValueError(f"limits: expected a WorkspaceLimits, got {type(limits).__name__}")
+    from ...kinematics.closure import Configuration, joint_points
+
+    ref_points = joint_points(mech, Configuration.reference(mech))
+    links, cones, pairs, fl, names, scale = _common(mech, limits, ref_points)
+    plan = _closed_form_plan(mech) if method != "general" else "general kernel requested"
+    if isinstance(plan, str) and method == "closed-form":
+        raise ValueError(f"method: no closed form for {mech.name}: {plan}")
+    refs = mech.freedom_refs
+    los = np.array([refs[k].freedom.limits[0] for k in fl])
+    his = np.array([refs[k].freedom.limits[1] for k in fl])
+    rot = np.array([refs[k].freedom.kind != "P" for k in fl], dtype=bool)
+    offs = np.array([r.freedom.offset for r in refs])
+    L = mech.characteristic_length
+    n_links = len(links)
+    names = names + [_CLOSURE]
+    scale = np.array(scale + [L])
+
+    if not isinstance(plan, str):
+        slot = {k: i for i, k in enumerate(fl)}
+        link_of_limb = {lk.limb: k for k, lk in enumerate(links)}
+
+        def fn_pre(R, p):
+            n = R.shape[0]
+            seg_a = np.empty((n, n_links, 3))
+            seg_b = np.empty((n, n_links, 3))
+            vals = np.zeros((n, len(fl)))
+            closure = np.full(n, 1e-9 * L)
+            for li, item in enumerate(plan):
+                if item[0] == "leg":
+                    _, Bp, Aloc, lref, fi = item
+                    A = np.einsum("nij,j->ni", R, Aloc) + p
+                    length = np.linalg.norm(A - Bp, axis=-1)
+                    a_end, b_end = np.broadcast_to(Bp, A.shape), A
+                    if fi in slot:
+                        vals[:, slot[fi]] = offs[fi] + length - lref
+                else:
+                    _, c, k, uloc, sref, fi = item
+                    u = np.einsum("nij,j->ni", R, uloc) + p
+                    rel = u - c
+                    s = rel @ k
+                    closure -= np.linalg.norm(rel - s[:, None] * k, axis=-1)
+                    a_end, b_end = np.broadcast_to(c, u.shape), u
+                    if fi in slot:
+                        vals[:, slot[fi]] = offs[fi] + s - sref
+                if li in link_of_limb:
+                    seg_a[:, link_of_limb[li]] = a_end
+                    seg_b[:, link_of_limb[li]] = b_end
+            cols = [_freedom_margins(vals, los, his, rot)] if fl else []
+            cols += [c[:, None] for c in _cone_margins(seg_a, seg_b, R, cones)]
+            return np.concatenate(cols + [closure[:, None]], axis=1), seg_a, seg_b
+
+        n_pre = len(names) - 1 - len(pairs)
+
+        def fn(R, p):
+            pre, seg_a, seg_b = fn_pre(R, p)
+            out = np.empty((R.shape[0], len(names)))
+            out[:, :n_pre] = pre[:, :-1]
+            out[:, -1] = pre[:, -1]
+            for k, col in enumerate(_pair_margins(seg_a, seg_b, pairs)):
+                out[:, n_pre + k] = col
+            return out
+
+        def fn_feasible(R, p):
+            pre, seg_a, seg_b = fn_pre(R, p)
+            ok = np.all(pre >= 0.0, axis=1)
+            live = np.flatnonzero(ok)  # interference (the costly part) only where the rest holds
+            if live.size and pairs:
+                for col in _pair_margins(seg_a[live], seg_b[live], pairs):
+                    ok[live[col < 0.0]] = False
+            return ok
+
+        pinned = {}
+        for item in plan:
+            if item[0] == "cu" and np.linalg.norm(item[3]) < 1e-12 * L:
+                axis_k = np.flatnonzero(np.abs(np.abs(item[2]) - 1.0) < 1e-12)
+                if axis_k.size == 1:
+                    pinned.update({_POSITION[i]: float(item[1][i]) for i in range(3) if i != axis_k[0]})
+        return PoseChecker(mech, limits, "closed-form", tuple(names), scale, fn, "", pinned, fn_feasible)
+
+    from ...kinematics.closure import limb_slices
+    from ...kinematics.position import inverse_position
+
+    def _general_row(config, R1):
+        vals = offs + config.q
+        pts = joint_points(mech, config)
+        seg_a = np.array([[pts[lk.limb][lk.ends[0]] for lk in links]]).reshape(1, n_links, 3)
+        seg_b = np.array([[pts[lk.limb][lk.ends[1]] for lk in links]]).reshape(1, n_links, 3)
+        cols = [_freedom_margins(vals[fl][None], los, his, rot)] if fl else []
+        cols += [c[:, None] for c in _cone_margins(seg_a, seg_b, R1, cones)]
+        cols += [c[:, None] for c in _pair_margins(seg_a, seg_b, pairs)]
+        cols.append(np.array([[1e-9 * L]]))  # reachable: the same closure margin as the closed form
+        return np.concatenate(cols, axis=1)[0]
+
+    def fn_general(R, p):
+        n = R.shape[0]
+        out = np.empty((n, len(names)))
+        for i in range(n):
+            pose = Pose(R[i], p[i])
+            res = inverse_position(mech, pose)
+            best = None
+            if res.reachable and res.config is not None:
+                best = _general_row(res.config, R[i : i + 1])
+                if np.all(best >= 0.0):
+                    out[i] = best
+                    continue
+            # another assembly of some limb (e.g. a leg flipped through its base joint, with a
+            # negative slide) may satisfy the limits: search every limb's solutions
+            alt = inverse_position(mech, pose, all_solutions=True, n_seeds=general_seeds)
+            if alt.reachable:
+                q = np.zeros(len(refs))
+                for sl, lsol in zip(limb_slices(mech), alt.limbs):
+                    k = min(range(len(lsol.solutions)), key=lambda j: len(lsol.violations[j]))
+                    q[sl] = lsol.solutions[k]
+                row = _general_row(Configuration(q, pose.displacement(mech.platform_point)), R[i : i + 1])
+                if best is None or np.min(row / scale) > np.min(best / scale):
+                    best = row
+            if best is None:
+                best = np.ones(len(names))  # only the closure margin decides
+                best[-1] = -L
+            out[i] = best
+        return out
+
+    return PoseChecker(mech, limits, "general", tuple(names), scale, fn_general, plan, {})
