@@ -35,8 +35,8 @@ def test_complete_jacobian_against_finite_motion():
     c0 = generic_configuration(mech, seed=1)
     t = _tangent(mech, c0)
     h = 1e-6
-    from spatialmech.kinematics.closure import _apply_step
-    c1 = correct(mech, _apply_step(mech, c0, active_mask(mech), h * t)).config
+    from spatialmech.kinematics.closure import retract
+    c1 = correct(mech, retract(mech, c0, active_mask(mech), h * t)).config
     V = log_transform(c1.D @ inverse_transform(c0.D)) / h
     dq = (c1.q - c0.q) / h
     J = complete_jacobian(mech, c0, ["slide2"])

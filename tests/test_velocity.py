@@ -7,7 +7,7 @@ from hypothesis import strategies as st
 
 from spatialmech import catalog
 from spatialmech.geometry.rotations import euler_matrix, exp_twist, inverse_transform, log_transform
-from spatialmech.kinematics.closure import Configuration, _apply_step, active_mask, correct, generic_configuration
+from spatialmech.kinematics.closure import Configuration, retract, active_mask, correct, generic_configuration
 from spatialmech.kinematics.velocity import (
     euler_rate_matrix,
     forward_acceleration,
@@ -58,7 +58,7 @@ def test_five_cs_forward_velocity_along_the_motion():
     # step along the motion by the predicted rates and check the platform moved as V says
     h = 1e-6
     step = np.r_[qd[active_mask(m)], V] * h
-    c1 = correct(m, _apply_step(m, c0, active_mask(m), step)).config
+    c1 = correct(m, retract(m, c0, active_mask(m), step)).config
     Vfd = log_transform(c1.D @ inverse_transform(c0.D)) / h
     assert np.linalg.norm(Vfd - V) < 1e-4 * np.linalg.norm(V)
 

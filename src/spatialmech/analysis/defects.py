@@ -32,7 +32,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..kinematics.closure import Configuration, _scales, active_mask, closure_jacobian
+from ..kinematics.closure import Configuration, closure_scales, active_mask, closure_jacobian
 from ..kinematics.jacobian import complete_jacobian, driver_determinants
 from ..kinematics.position import PoseFit, configuration_at_pose, freedom_values
 from ..kinematics.tracking import MotionProblem, TrackResult, track
@@ -76,7 +76,7 @@ def dj_function(mech: Mechanism, drivers: list[str], reference: Configuration):
     if np.all(np.isfinite(test)):
         return (lambda c: driver_determinants(mech, c, drivers)), "complete Jacobian determinant"
     active = active_mask(mech)
-    row, col = _scales(mech, active)
+    row, col = closure_scales(mech, active)
     A0, _ = closure_jacobian(mech, reference, active=active)
     A0 = row[:, None] * A0 * col[None, :]
     U, sv, _ = np.linalg.svd(A0)

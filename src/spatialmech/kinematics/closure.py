@@ -52,6 +52,8 @@ __all__ = [
     "CorrectionResult",
     "generic_configuration",
     "joint_points",
+    "retract",
+    "closure_scales",
 ]
 
 
@@ -177,7 +179,7 @@ def chain_forward(chain: Chain, q: np.ndarray, *, prefixes: bool = False, local:
 
     ``local=False``: ``J`` holds the derivatives with respect to ``q``.  ``local=True``: for S
     joints, the columns are instead the rotations about the joint's reference axes (moved by
-    the preceding freedoms), the local coordinates in which :func:`_apply_step` composes
+    the preceding freedoms), the local coordinates in which :func:`retract` composes
     rotation increments; they do not depend on how the joint's rotation is parametrised.
     With ``prefixes=True`` also returns the displacement applied to each freedom's body
     *before* it moves (used to place joint points).
@@ -302,8 +304,9 @@ def closure_jacobian(mech: Mechanism, config: Configuration, *, active: np.ndarr
     return A[:, cols], np.concatenate(res)
 
 
-def _scales(mech: Mechanism, active: np.ndarray):
-    """Row and column scalings that make the closure system nondimensional."""
+def closure_scales(mech: Mechanism, active: np.ndarray):
+    """Row and column scalings that make the closure system nondimensional: moment rows divided
+    by the characteristic length ``L``, prismatic and platform-translation columns times ``L``."""
     L = mech.characteristic_length
     K = len(mech.limbs)
     row = np.tile(np.r_[np.ones(3), np.full(3, 1.0 / L)], K)
@@ -337,7 +340,7 @@ def _ball_groups(mech: Mechanism) -> list[tuple[int, np.ndarray]]:
     return out
 
 
-def _apply_step(mech, config, active, step, fix_platform=False):
+def retract(mech, config, active, step, fix_platform=False):
     """Retraction: add a local-coordinate step (see ``chain_forward(local=True)``)."""
     dq = np.zeros_like(config.q)
     na = int(active.sum())
@@ -375,7 +378,7 @@ def correct(
     """
     if active is None:
         active = active_mask(mech)
-    row, col = _scales(mech, active)
+    row, col = closure_scales(mech, active)
     ncols = int(active.sum()) + (0 if fix_platform else 6)
     for it in range(max_iter + 1):
         A, r = closure_jacobian(mech, config, active=active)
@@ -389,7 +392,7 @@ def correct(
         if np.linalg.norm(x) < 1e-13 * max(1.0, rn):
             return CorrectionResult(config, False, it, rn, stationary=True)
         step = col[:ncols] * x
-        config = _apply_step(mech, config, active, np.r_[step, np.zeros(6)] if fix_platform else step, fix_platform)
+        config = retract(mech, config, active, np.r_[step, np.zeros(6)] if fix_platform else step, fix_platform)
     return CorrectionResult(config, False, it, rn)
 
 
@@ -435,7 +438,7 @@ def generic_configuration(
     if active is None:
         active = active_mask(mech)
     config = start if start is not None else Configuration.reference(mech)
-    row, col = _scales(mech, active)
+    row, col = closure_scales(mech, active)
     for _ in range(steps):
         A, _ = closure_jacobian(mech, config, active=active)
         As = row[:, None] * A * col[None, :]
@@ -447,7 +450,7 @@ def generic_configuration(
         c = rng.standard_normal(N.shape[0])
         t = N.T @ c
         t *= step / max(np.linalg.norm(t), 1e-300)
-        trial = _apply_step(mech, config, active, col * t)
+        trial = retract(mech, config, active, col * t)
         res = correct(mech, trial, active=active)
         if not res.converged:
             raise RuntimeError(

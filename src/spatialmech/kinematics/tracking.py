@@ -30,7 +30,7 @@ from ..geometry.rotations import inverse_transform, log_transform
 from ..model.mechanism import Mechanism
 from scipy.spatial.transform import Rotation
 
-from .closure import Configuration, _apply_step, _ball_groups, _scales, active_mask, closure_jacobian
+from .closure import Configuration, retract, _ball_groups, closure_scales, active_mask, closure_jacobian
 
 __all__ = [
     "CurveProblem",
@@ -368,7 +368,7 @@ class _MechanismBase:
     def __init__(self, mech: Mechanism, active: np.ndarray):
         self.mech = mech
         self.active = active
-        self.row, self.col = _scales(mech, active)
+        self.row, self.col = closure_scales(mech, active)
         self.na = int(active.sum())
         self.L = mech.characteristic_length
         refs = mech.freedom_refs
@@ -379,7 +379,7 @@ class _MechanismBase:
         return self.row[:, None] * A * self.col[None, :], self.row * r
 
     def _config_step(self, config, dx):
-        return _apply_step(self.mech, config, self.active, self.col * dx)
+        return retract(self.mech, config, self.active, self.col * dx)
 
     def _config_diff(self, a: Configuration, b: Configuration) -> np.ndarray:
         dq_all = b.q - a.q

@@ -33,8 +33,8 @@ import numpy as np
 
 from ..kinematics.closure import (
     Configuration,
-    _apply_step,
-    _scales,
+    retract,
+    closure_scales,
     active_mask,
     closure_jacobian,
     correct,
@@ -63,7 +63,7 @@ def tangent_space(mech: Mechanism, config: Configuration, *, active: np.ndarray 
     """
     if active is None:
         active = active_mask(mech)
-    row, col = _scales(mech, active)
+    row, col = closure_scales(mech, active)
     A, _ = closure_jacobian(mech, config, active=active)
     As = row[:, None] * A * col[None, :]
     _, sv, vt = np.linalg.svd(As)
@@ -103,7 +103,7 @@ def _walk(mech, start, t0, targets, active, col):
                         "(a singularity); use a smaller amplitude"
                     )
                 tt = tt / pn
-                res = correct(mech, _apply_step(mech, x, active, col * (ds * tt)), active=active)
+                res = correct(mech, retract(mech, x, active, col * (ds * tt)), active=active)
                 if res.converged:
                     break
                 ds /= 2.0
@@ -150,7 +150,7 @@ def sample_motion(
     if not np.isfinite(amplitude) or amplitude <= 0:
         raise ValueError(f"amplitude: expected a positive finite number, got {amplitude!r}")
     active = active_mask(mech)
-    _, col = _scales(mech, active)
+    _, col = closure_scales(mech, active)
     if start is None:
         x0 = Configuration.reference(mech)
     elif not isinstance(start, Configuration):

@@ -8,18 +8,11 @@ from typing import Callable
 import numpy as np
 
 from ...model.mechanism import Mechanism, Pose
-from .limits import (  # noqa: F401
-    COORDINATES,
-    ConeLimit,
-    ORIENTATION_SEQUENCE,
-    PAPER_B_LINK_DIAMETERS,
+from .limits import (
     WorkspaceLimits,
-    _BOX,
     _CLOSURE,
-    _ORIENTATION,
     _POSITION,
     default_limits,
-    paper_b_limits,
 )
 
 

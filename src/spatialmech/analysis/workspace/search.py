@@ -12,33 +12,17 @@ from scipy.optimize import minimize
 from ...geometry.rotations import euler_matrix
 from ...geometry.validate import as_finite_array
 from ...model.mechanism import Mechanism
-from .limits import (  # noqa: F401
+from .limits import (
     COORDINATES,
-    ConeLimit,
     ORIENTATION_SEQUENCE,
-    PAPER_B_LINK_DIAMETERS,
     WorkspaceLimits,
     _BOX,
-    _CLOSURE,
     _ORIENTATION,
     _POSITION,
-    default_limits,
-    paper_b_limits,
 )
-from .checker import (  # noqa: F401
+from .checker import (
     PoseChecker,
-    _Link,
-    _closed_form_plan,
-    _common,
-    _cone_angles,
-    _cone_margins,
-    _freedom_margin_names,
-    _freedom_margins,
-    _link_of_joint,
-    _links,
-    _pair_margins,
     pose_checker,
-    segment_distance,
 )
 
 
