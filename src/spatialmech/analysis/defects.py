@@ -35,7 +35,7 @@ import numpy as np
 from ..kinematics.closure import Configuration, closure_scales, active_mask, closure_jacobian
 from ..kinematics.jacobian import complete_jacobian, driver_determinants
 from ..kinematics.position import PoseFit, configuration_at_pose, freedom_values
-from ..kinematics.tracking import MotionProblem, TrackResult, track
+from ..kinematics.tracking import MotionProblem, TrackResult, correct_on_hyperplane, track
 from ..model.joints import make_joint
 from ..model.mechanism import Limb, Mechanism, Pose
 
@@ -302,9 +302,7 @@ def _project(problem: MotionProblem, tr: TrackResult, config: Configuration, tol
     for k in {max(0, k0 - 1), k0, min(len(tr.points) - 1, k0 + 1)}:
         x, t = tr.points[k], tr.tangents[k]
         a = float(t @ problem.difference(x, config))
-        from ..kinematics.tracking import _correct_on_plane
-
-        xs, ok, _, _ = _correct_on_plane(problem, problem.retract(x, a * t), t, 1e-11, 30)
+        xs, ok, _, _ = correct_on_hyperplane(problem, problem.retract(x, a * t), t, 1e-11, 30)
         if not ok:
             continue
         dist = float(np.linalg.norm(problem.difference(xs, config)))
@@ -323,7 +321,6 @@ def _pose_distance(mech, prob, tr: TrackResult, pose: Pose, pose_tol: float, ang
     (``hypot(|dp| / pose_tol, dtheta / angle_tol)``), refined along the curve between samples.
     Returns (normalised distance, arc, |dp|, dtheta)."""
     from ..geometry.rotations import rotation_angle
-    from ..kinematics.tracking import _correct_on_plane
 
     def meas(x):
         R, p = _pose_of(mech, x)
@@ -344,7 +341,7 @@ def _pose_distance(mech, prob, tr: TrackResult, pose: Pose, pose_tol: float, ang
 
         def at(a):
             if a not in cache:
-                xa, ok, _, _ = _correct_on_plane(prob, prob.retract(x, a * t), t, 1e-11, 20)
+                xa, ok, _, _ = correct_on_hyperplane(prob, prob.retract(x, a * t), t, 1e-11, 20)
                 cache[a] = meas(xa) if ok else (np.inf, np.inf, np.inf)
             return cache[a]
 

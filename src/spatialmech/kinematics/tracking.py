@@ -41,6 +41,7 @@ __all__ = [
     "TrackResult",
     "track",
     "trace_motion",
+    "correct_on_hyperplane",
 ]
 
 
@@ -174,8 +175,11 @@ def _orientation(A: np.ndarray, t: np.ndarray, frame) -> float:
     return float(sign)
 
 
-def _correct_on_plane(problem, xp, t, tol, max_iter, contraction=0.6):
-    """Newton on F(x) = 0 with the correction orthogonal to ``t``; returns (x, ok, iters, moved)."""
+def correct_on_hyperplane(problem, xp, t, tol, max_iter, contraction=0.6):
+    """Newton on ``F(x) = 0`` with every correction orthogonal to ``t`` (the pseudo-arclength
+    corrector; also used to land on a curve at a given distance along a tangent).  Returns
+    ``(x, converged, iterations, total correction length)``; it stops early when the corrections
+    stop contracting."""
     moved = 0.0
     prev = np.inf
     for it in range(max_iter):
@@ -258,7 +262,7 @@ def track(
     while s < max_arc and steps < max_steps:
         h = min(h, h_max, max_arc - s + 1e-15)
         xp = problem.retract(x, h * t)
-        xn, ok, iters, moved = _correct_on_plane(problem, xp, t, tol, 12)
+        xn, ok, iters, moved = correct_on_hyperplane(problem, xp, t, tol, 12)
         total_iters += iters
         tn = None
         if ok and moved < 0.5 * h:
@@ -342,7 +346,7 @@ def _locate(problem, x, t, h, f, name, fa, fb, s, step, tol, event_tol):
                 mid = 0.5 * (lo + hi)
         else:
             mid = 0.5 * (lo + hi)
-        xm, ok, _, _ = _correct_on_plane(problem, problem.retract(x, mid * t), t, tol, 20)
+        xm, ok, _, _ = correct_on_hyperplane(problem, problem.retract(x, mid * t), t, tol, 20)
         fm = float(f(xm))
         best = (mid, xm)
         if not ok or fm == 0.0:
