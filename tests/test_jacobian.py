@@ -120,3 +120,10 @@ def test_printed_positions_are_inconsistent_by_a_reported_amount():
     # the rounded tables do not close exactly: the nearest closed pose is off, and says so
     assert not fit.exact
     assert 0.05 < fit.position_error < 0.5
+
+
+def test_pose_fit_does_not_stop_in_a_wrong_local_minimum():
+    # from the reference, linkage 2's P5 once converged to a configuration 2.3 units / 42 deg away
+    mech = catalog.build("five-cs-2")
+    fit = configuration_at_pose(mech, mech.positions[4])
+    assert fit.converged and fit.position_error < 0.05 and np.degrees(fit.angle_error) < 0.5

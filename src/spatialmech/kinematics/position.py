@@ -104,23 +104,50 @@ class PoseFit:
         }
 
 
-def configuration_at_pose(mech: Mechanism, pose: Pose, *, start: Configuration | None = None, tol: float = 1e-10) -> PoseFit:
+def configuration_at_pose(
+    mech: Mechanism,
+    pose: Pose,
+    *,
+    start: Configuration | None = None,
+    tol: float = 1e-10,
+    restart_tol: float = 1e-3,
+    n_restarts: int = 12,
+    seed: int = 0,
+) -> PoseFit:
     """The closed configuration nearest to ``pose``.
 
-    First the limbs are solved with the platform held at the pose (least squares if the pose
-    cannot be reached exactly, as with rounded printed data), then the platform is released
-    and the configuration corrected onto the closure manifold by minimum-norm steps.  The
-    pose error between the request and the result is returned, never hidden.
+    First every limb is solved with the platform held at the pose (least squares if the pose
+    cannot be reached exactly, as with rounded printed data), from ``start`` (default: the
+    reference); a limb whose residual stays above ``restart_tol`` (nondimensional) is solved
+    again from ``n_restarts`` seeded random starts and the best kept (a start far from the pose
+    can stop in a wrong local minimum).  Then the platform is released and the configuration
+    corrected onto the closure manifold by minimum-norm steps.  The pose error between the
+    request and the result is returned, never hidden.
     """
     D = pose.displacement(mech.platform_point)
-    q0 = start.q if start is not None else np.zeros(len(mech.freedom_refs))
-    ik = correct(mech, Configuration(q0, D), fix_platform=True, max_iter=100)
+    L = mech.characteristic_length
+    q = (start.q if start is not None else np.zeros(len(mech.freedom_refs))).astype(float).copy()
+    rng = np.random.default_rng(seed)
+    for ch, sl in zip(limb_chains(mech), limb_slices(mech)):
+        refs = mech.freedom_refs[sl]
+        lin = np.array([r.freedom.kind == "P" for r in refs])
+        hold = np.array([r.freedom.locked for r in refs])
+        qk, rn, _ = _limb_gn(ch, D, q[sl].copy(), lin, L, tol=tol, max_iter=100, hold=hold)
+        if rn > restart_tol:
+            for _ in range(n_restarts):
+                q0 = np.where(lin, rng.uniform(-1, 1, len(refs)) * L, rng.uniform(-np.pi, np.pi, len(refs)))
+                q0 = np.where(hold, q[sl], q0)
+                qt, rt, _ = _limb_gn(ch, D, q0, lin, L, tol=tol, max_iter=100, hold=hold)
+                if rt < rn:
+                    qk, rn = qt, rt
+        q[sl] = qk
+    ik = correct(mech, Configuration(q, D), fix_platform=True, max_iter=100)
     res = ik if ik.converged else correct(mech, ik.config, max_iter=100)
     Dn = res.config.D
-    p_req = pose.p
     p_got = Dn[:3, :3] @ mech.platform_point + Dn[:3, 3]
     ang = float(rotation_angle(Dn[:3, :3] @ pose.R.T))
-    return PoseFit(res.config, res.converged, ik.converged and ik.residual < tol, float(np.linalg.norm(p_got - p_req)), ang, ik.residual)
+    return PoseFit(res.config, res.converged, ik.converged and ik.residual < tol,
+                   float(np.linalg.norm(p_got - pose.p)), ang, ik.residual)
 
 
 # ------------------------------------------------------------------------------ inverse
@@ -432,6 +459,8 @@ def forward_position(
     the all-solutions search.
     """
     targets = _actuator_q(mech, actuator_values)
+    if all_solutions and (int(n_seeds) != n_seeds or n_seeds < 1):
+        raise ValueError(f"n_seeds: expected a positive number of starts, got {n_seeds}")
     mask = active_mask(mech)
     for i in targets:
         mask[i] = False

@@ -1,6 +1,7 @@
-"""Synthesis: task positions -> dyads -> linkages (paper D: four-position RCCC by solution regions).
+"""Synthesis: task positions -> dyads -> linkages (paper D: four-position RCCC by solution regions;
+paper A: seven-position CS dyads and 5-CS linkages).
 
-Modules: :mod:`.tasks` (task positions, the ready-made ``rccc-four-positions``),
+Modules: :mod:`.cs_dyads` (paper A section 3), :mod:`.tasks` (task positions, the ready-made ``rccc-four-positions``),
 :mod:`.burmester` (spherical Burmester curves), :mod:`.dyads` (CC/RC dyads, solution lines),
 :mod:`.regions` (solution regions 1 and 2), :mod:`.rccc` (the pipeline and the closure check),
 :mod:`.figures` (Matplotlib figures written to files).  See ``docs/synthesis.md``.
@@ -13,6 +14,7 @@ Quick example::
     ('crank-rocker', 0)
 """
 
+from .cs_dyads import CSDyad, CSFamily, assemble_5cs, check_5cs, paper_a_check, synthesize_cs
 from .burmester import BurmesterCurves, burmester_curves, center_point, circle_point, poles
 from .dyads import Dyad, SolutionLine, direction_residuals, rc_dyad_three_positions, solution_line
 from .rccc import RCCCResult, assemble, check_linkage, interior_pick, synthesize_rccc
@@ -25,4 +27,5 @@ __all__ = [
     "Dyad", "SolutionLine", "direction_residuals", "solution_line", "rc_dyad_three_positions",
     "Region1", "Region2", "classify_spherical_4r", "solution_region_1", "solution_region_2",
     "RCCCResult", "assemble", "check_linkage", "interior_pick", "synthesize_rccc",
+    "CSDyad", "CSFamily", "synthesize_cs", "assemble_5cs", "check_5cs", "paper_a_check",
 ]

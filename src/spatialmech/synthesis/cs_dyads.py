@@ -1,0 +1,915 @@
+"""Seven-position synthesis of CS dyads and 5-CS linkages (paper A, section 3, eqs 22-26).
+
+A CS dyad joins the base to the platform: a cylindrical joint C on the base (unit axis ``u``
+through ``B1``) and a spherical joint S whose centre ``M`` is fixed in the platform.  Over the
+task positions ``j = 1..7`` (platform displacements ``D_j`` from position 1, ``D_1 = I``):
+
+- eq 22: ``B_j = B1 + s_j u`` (``s_j`` the slide of the C joint, ``s_1 = 0``);
+- eq 23: ``M_j = D_j M1`` (homogeneous coordinates: ``M_j = R_j M1 + t_j``);
+- eq 24: ``|M_j - B_j|^2 = |M_1 - B_1|^2``, ``j = 2..7`` (6 equations: constant link length);
+- eq 25: ``u . (M_j - B_j) = 0``, ``j = 1..7`` (7 equations: the link is perpendicular to the
+  C axis);
+- eq 26: ``u . u = 1``.
+
+Unknowns ``x = (B1, M1, u, s_2..s_7)``: 15; equations: 14.  Eq 25 at ``j = 1`` pins ``B1`` to the
+foot of the perpendicular from ``M1`` to the axis, so there is no gauge freedom left (sliding
+``B1`` along ``u`` would break it), and the Jacobian has full rank 14 at generic solutions: the
+solution set is a curve (paper: "infinitely many CS dyads", a one-parameter family).  The same
+count, geometrically: the seven points ``M_j(M1)`` must lie on one circular cylinder, the C
+axis being its axis: ``3 (M1) + 5 (cylinder: axis 4 + radius 1) - 7 = 1``.  Every dyad appears
+twice in ``x``-space, as ``(u, s)`` and ``(-u, -s)``; branches are deduplicated up to that flip.
+
+Method (general for any seven positions):
+
+1. seeded multi-start least squares (:func:`scipy.optimize.least_squares`) from random dyads
+   around the task lands on the solution curve;
+2. each new start is followed both ways by the project's pseudo-arclength continuation
+   (:func:`spatialmech.kinematics.tracking.track` on an
+   :class:`~spatialmech.kinematics.tracking.EuclideanProblem` ``F: R^15 -> R^14``), until the
+   branch closes or leaves a box of ``extent`` task scales around the task;
+3. "choose dyads with small slides" (paper A, section 1): the points of the family with the
+   smallest ``max_j |s_j|`` (local minima refined along the curve), greedily picked so that
+   they are well separated along the family;
+4. any five dyads form a 5-CS linkage (:func:`assemble_5cs`), checked by solving its closure
+   at the seven positions and by its mobility (:func:`check_5cs`).
+
+Internally the unknowns are nondimensional (points relative to the centroid of the task
+points, lengths divided by the task scale ``L`` = RMS distance of the task points from their
+centroid); everything returned is in the task's length unit.  Angles in radians inside,
+``*_deg`` keys in degrees.
+
+Example (paper A table 9)::
+
+    >>> from spatialmech.catalog.papers import five_cs_positions
+    >>> fam = synthesize_cs(five_cs_positions(), seed=0)
+    >>> len(fam.branches), [round(p.max_abs_slide, 2) for p in fam.picks]
+    (9, [5.3, 9.76, 10.9, 11.18, 11.81])
+    >>> check_5cs(assemble_5cs(fam.task, fam.picks)).dof
+    1
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Sequence
+
+import numpy as np
+from scipy.optimize import least_squares, minimize_scalar
+
+from ..geometry.rotations import inverse_transform, rotation_angle, transform
+from ..geometry.validate import as_finite_array, as_unit_vector
+from ..kinematics.tracking import EuclideanProblem, correct_on_hyperplane, track
+from ..model.joints import C as Cjoint
+from ..model.joints import S as Sjoint
+from ..model.mechanism import Limb, Mechanism, Pose
+
+__all__ = [
+    "N_POSITIONS",
+    "CSTask",
+    "CSDyad",
+    "CSBranch",
+    "CSFamily",
+    "Projection",
+    "FiveCSCheck",
+    "PaperACheck",
+    "cs_task",
+    "dyad_residual",
+    "dyad_jacobian",
+    "dyad_from_limb",
+    "solve_dyad",
+    "project_dyad",
+    "synthesize_cs",
+    "trace_branch",
+    "pick_small_slides",
+    "assemble_5cs",
+    "check_5cs",
+    "paper_a_check",
+]
+
+#: Number of task positions of the method (15 unknowns, 14 equations).
+N_POSITIONS = 7
+_NX = 15  # unknowns
+_NF = 14  # equations
+_TOL = 1e-11  # nondimensional residual of a solution
+
+
+# ------------------------------------------------------------------------------ the task
+@dataclass(frozen=True, eq=False)
+class CSTask:
+    """Seven task poses with their displacements from position 1 and the internal scaling.
+
+    ``poses`` are the platform poses as given (``R_j``, the platform point ``p_j``);
+    ``D[j] = T_j T_1^-1`` (4x4, ``T_j = transform(R_j, p_j)``) maps a platform point at
+    position 1 to its place at position ``j`` (eq 23; ``D[0] = I``).  ``centre`` and
+    ``scale`` define the nondimensional coordinates ``(X - centre) / scale``.
+    """
+
+    poses: tuple[Pose, ...]
+    D: np.ndarray
+    centre: np.ndarray
+    scale: float
+
+    @property
+    def n(self) -> int:
+        return len(self.poses)
+
+    @property
+    def relative_poses(self) -> tuple[Pose, ...]:
+        """The poses relative to position 1: ``Pose(R_j R_1^T, p_j)`` (the mechanism's reference
+        configuration is position 1; equal to ``poses`` when ``R_1 = I``, as in table 9)."""
+        R1 = self.poses[0].R
+        return tuple(Pose(P.R @ R1.T, P.p, name=P.name or f"P{j + 1}") for j, P in enumerate(self.poses))
+
+    @property
+    def reference_point(self) -> np.ndarray:
+        return self.poses[0].p
+
+    def nondim_D(self) -> np.ndarray:
+        """``D`` in nondimensional coordinates."""
+        c, L = self.centre, self.scale
+        R = self.D[:, :3, :3]
+        t = (self.D[:, :3, 3] + np.einsum("jab,b->ja", R, c) - c) / L
+        out = self.D.copy()
+        out[:, :3, 3] = t
+        return out
+
+    def to_dict(self) -> dict:
+        return {
+            "positions": [
+                {"name": P.name, "point": P.p.tolist(),
+                 "rotation_vector_deg": np.degrees(_rotvec(P.R)).tolist()}
+                for P in self.poses
+            ],
+            "scale": self.scale,
+            "centre": self.centre.tolist(),
+        }
+
+
+def _rotvec(R: np.ndarray) -> np.ndarray:
+    from scipy.spatial.transform import Rotation
+
+    return Rotation.from_matrix(R).as_rotvec()
+
+
+def cs_task(task_poses: Sequence[Pose] | CSTask) -> CSTask:
+    """Validate seven platform poses and build the :class:`CSTask` (``ValueError`` naming
+    ``task_poses`` otherwise)."""
+    if isinstance(task_poses, CSTask):
+        return task_poses
+    poses = tuple(task_poses)
+    if len(poses) != N_POSITIONS:
+        raise ValueError(
+            f"task_poses: seven-position CS synthesis needs exactly {N_POSITIONS} poses, got {len(poses)}"
+            " (fewer leave a surface of dyads, more leave finitely many or none)"
+        )
+    for j, P in enumerate(poses):
+        if not isinstance(P, Pose):
+            raise ValueError(f"task_poses[{j}]: expected a Pose, got {type(P).__name__}")
+    T = np.array([transform(P.R, P.p) for P in poses])
+    T1inv = inverse_transform(T[0])
+    D = T @ T1inv
+    pts = np.array([P.p for P in poses])
+    centre = pts.mean(axis=0)
+    scale = float(np.sqrt(np.mean(np.sum((pts - centre) ** 2, axis=1))))
+    rot = max(float(rotation_angle(P.R @ poses[0].R.T)) for P in poses)
+    if scale < 1e-12 and rot < 1e-12:
+        raise ValueError("task_poses: all seven poses coincide")
+    if scale < 1e-12:
+        scale = 1.0
+    return CSTask(poses, D, centre, scale)
+
+
+# ------------------------------------------------------------------------------ equations
+def _split(x: np.ndarray):
+    return x[..., 0:3], x[..., 3:6], x[..., 6:9], x[..., 9:15]
+
+
+def _link_vectors(x: np.ndarray, D: np.ndarray):
+    """``d_j = M_j - B_j`` for every position: shape (..., 7, 3), and the slides (..., 7)."""
+    B1, M1, u, s = _split(x)
+    s_all = np.concatenate([np.zeros(s.shape[:-1] + (1,)), s], axis=-1)
+    Mj = np.einsum("jab,...b->...ja", D[:, :3, :3], M1) + D[:, :3, 3]
+    d = Mj - B1[..., None, :] - s_all[..., :, None] * u[..., None, :]
+    return d, s_all
+
+
+def dyad_residual(x, D) -> np.ndarray:
+    """Residual of eqs 24-26 (paper A) for dyads ``x = (B1, M1, u, s2..s7)``.
+
+    ``x``: (..., 15); ``D``: (7, 4, 4) displacements from position 1.  Returns (..., 14):
+    ``|d_j|^2 - |d_1|^2`` (j = 2..7, eq 24), ``u . d_j`` (j = 1..7, eq 25), ``u . u - 1``
+    (eq 26), with ``d_j = D_j M1 - B1 - s_j u``.  Units: the coordinates of ``x`` and ``D``
+    (length^2, length, 1).  Vectorised over leading axes.
+    """
+    x = np.asarray(x, dtype=float)
+    D = np.asarray(D, dtype=float)
+    d, _ = _link_vectors(x, D)
+    u = x[..., 6:9]
+    n2 = np.einsum("...ja,...ja->...j", d, d)
+    e24 = n2[..., 1:] - n2[..., :1]
+    e25 = np.einsum("...ja,...a->...j", d, u)
+    e26 = np.einsum("...a,...a->...", u, u)[..., None] - 1.0
+    return np.concatenate([e24, e25, e26], axis=-1)
+
+
+def dyad_jacobian(x, D) -> np.ndarray:
+    """Jacobian of :func:`dyad_residual` with respect to ``x``: (..., 14, 15)."""
+    x = np.asarray(x, dtype=float)
+    D = np.asarray(D, dtype=float)
+    d, s_all = _link_vectors(x, D)
+    u = x[..., 6:9]
+    R = D[:, :3, :3]
+    lead = x.shape[:-1]
+    J = np.zeros(lead + (_NF, _NX))
+    # derivatives of d_j: dM1 -> R_j, dB1 -> -I, du -> -s_j I, ds_j -> -u (j >= 2)
+    gM = 2 * np.einsum("...ja,jab->...jb", d, R)  # grad of |d_j|^2 wrt M1
+    gB = -2 * d
+    gu = -2 * s_all[..., None] * d
+    J[..., 0:6, 0:3] = gB[..., 1:, :] - gB[..., :1, :]
+    J[..., 0:6, 3:6] = gM[..., 1:, :] - gM[..., :1, :]
+    J[..., 0:6, 6:9] = gu[..., 1:, :] - gu[..., :1, :]
+    for k in range(6):  # d|d_{k+2}|^2 / ds_{k+2} = -2 d . u
+        J[..., k, 9 + k] = -2 * np.einsum("...a,...a->...", d[..., k + 1, :], u)
+    # eq 25: u . d_j
+    J[..., 6:13, 0:3] = -u[..., None, :]
+    J[..., 6:13, 3:6] = np.einsum("...a,jab->...jb", u, R)
+    J[..., 6:13, 6:9] = d - s_all[..., None] * u[..., None, :]
+    uu = np.einsum("...a,...a->...", u, u)
+    for k in range(6):
+        J[..., 7 + k, 9 + k] = -uu
+    J[..., 13, 6:9] = 2 * u
+    return J
+
+
+# ------------------------------------------------------------------------------ dyads
+@dataclass(frozen=True, eq=False)
+class CSDyad:
+    """One CS dyad (task length unit): C axis ``u`` (unit) through ``B1`` (the foot of the
+    perpendicular from ``M1``: the C joint at position 1), S centre ``M1`` at position 1,
+    ``slides[j]`` = ``s_{j+1}`` (``slides[0] = 0``), link length ``|M1 - B1|``, and the
+    largest residual of eqs 24-25 over the positions (length unit)."""
+
+    u: np.ndarray
+    B1: np.ndarray
+    M1: np.ndarray
+    slides: np.ndarray
+    link_length: float
+    residual: float
+
+    @property
+    def max_abs_slide(self) -> float:
+        return float(np.max(np.abs(self.slides)))
+
+    @property
+    def vector(self) -> np.ndarray:
+        """``x = (B1, M1, u, s2..s7)`` in the task's length unit."""
+        return np.r_[self.B1, self.M1, self.u, self.slides[1:]]
+
+    def flipped(self) -> "CSDyad":
+        """The same dyad with ``u -> -u`` (slides change sign)."""
+        return CSDyad(-self.u, self.B1, self.M1, -self.slides, self.link_length, self.residual)
+
+    def to_dict(self) -> dict:
+        return {
+            "u": self.u.tolist(),
+            "B1": self.B1.tolist(),
+            "M1": self.M1.tolist(),
+            "link_length": self.link_length,
+            "slides": self.slides.tolist(),
+            "max_abs_slide": self.max_abs_slide,
+            "residual": self.residual,
+        }
+
+
+def _dyad_errors(x_phys: np.ndarray, task: CSTask) -> float:
+    """Largest |eq 24| (as a length difference) and |eq 25| of a dyad in the task unit."""
+    d, _ = _link_vectors(x_phys, task.D)
+    n = np.linalg.norm(d, axis=-1)
+    u = x_phys[6:9]
+    return float(max(np.max(np.abs(n - n[0])), np.max(np.abs(d @ u)), abs(u @ u - 1.0)))
+
+
+def _to_phys(task: CSTask, y: np.ndarray) -> np.ndarray:
+    c, L = task.centre, task.scale
+    y = np.asarray(y, dtype=float)
+    return np.concatenate([y[..., 0:3] * L + c, y[..., 3:6] * L + c, y[..., 6:9], y[..., 9:15] * L], axis=-1)
+
+
+def _to_nondim(task: CSTask, x: np.ndarray) -> np.ndarray:
+    c, L = task.centre, task.scale
+    x = np.asarray(x, dtype=float)
+    return np.concatenate([(x[..., 0:3] - c) / L, (x[..., 3:6] - c) / L, x[..., 6:9], x[..., 9:15] / L], axis=-1)
+
+
+def _dyad(task: CSTask, x_phys: np.ndarray) -> CSDyad:
+    B1, M1, u, s = _split(np.asarray(x_phys, dtype=float))
+    return CSDyad(
+        u=np.array(u), B1=np.array(B1), M1=np.array(M1), slides=np.r_[0.0, s],
+        link_length=float(np.linalg.norm(M1 - B1)), residual=_dyad_errors(x_phys, task),
+    )
+
+
+def dyad_from_limb(task_poses, u, B1, M1, slides=None) -> CSDyad:
+    """A :class:`CSDyad` from given (e.g. printed) limb data: ``u`` is normalised, ``slides``
+    (7 values, ``s_1`` first, or 6 values ``s_2..s_7``) default to the feet of the
+    perpendiculars from ``M_j`` (least-squares slides).  ``residual`` says how far the data is
+    from satisfying eqs 24-25."""
+    task = cs_task(task_poses)
+    u = as_unit_vector(u, "u", normalize=True)
+    B1 = as_finite_array(B1, "B1", shape=(3,))
+    M1 = as_finite_array(M1, "M1", shape=(3,))
+    if slides is None:
+        Mj = task.D[:, :3, :3] @ M1 + task.D[:, :3, 3]
+        s = (Mj - B1) @ u
+        s = s - s[0]
+    else:
+        s = as_finite_array(slides, "slides")
+        if s.shape == (6,):
+            s = np.r_[0.0, s]
+        if s.shape != (7,):
+            raise ValueError(f"slides: expected 7 values (s1..s7) or 6 (s2..s7), got shape {s.shape}")
+    return _dyad(task, np.r_[B1, M1, u, s[1:]])
+
+
+# ------------------------------------------------------------------------------ solving
+def _problem(task: CSTask) -> EuclideanProblem:
+    Dn = task.nondim_D()
+    return EuclideanProblem(lambda y: dyad_residual(y, Dn), lambda y: dyad_jacobian(y, Dn))
+
+
+def _random_guesses(task: CSTask, n: int, rng: np.random.Generator) -> np.ndarray:
+    """Random nondimensional dyads near the task: M1 normal around the task centroid (1.5 task
+    scales), a random axis at a log-uniform distance in [0.1, 5] task scales (dyads with long
+    links are found too), slides = feet of the perpendiculars (only the cylinder condition is
+    off)."""
+    Dn = task.nondim_D()
+    out = np.empty((n, _NX))
+    for i in range(n):
+        M1 = rng.normal(scale=1.5, size=3)
+        u = rng.normal(size=3)
+        u /= np.linalg.norm(u)
+        w = np.cross(u, rng.normal(size=3))
+        w /= np.linalg.norm(w)
+        B1 = M1 - np.exp(rng.uniform(np.log(0.1), np.log(5.0))) * w
+        Mj = Dn[:, :3, :3] @ M1 + Dn[:, :3, 3]
+        s = (Mj - B1) @ u
+        out[i] = np.r_[B1, M1, u, s[1:] - s[0]]
+    return out
+
+
+def solve_dyad(task_poses, x0, *, nondimensional: bool = False) -> tuple[np.ndarray, bool, float]:
+    """Least squares on eqs 24-26 from ``x0`` (15 values; physical units unless
+    ``nondimensional``).  Returns ``(x, converged, residual norm)`` in the same units;
+    ``converged`` means a nondimensional residual below 1e-11."""
+    task = cs_task(task_poses)
+    x0 = as_finite_array(x0, "x0", shape=(_NX,))
+    y0 = x0 if nondimensional else _to_nondim(task, x0)
+    prob = _problem(task)
+    sol = least_squares(prob.residual, y0, jac=prob.jacobian, method="trf", xtol=1e-15, ftol=1e-15, gtol=1e-15,
+                        max_nfev=200)
+    y = sol.x
+    y, ok, _, _ = _newton_min_norm(prob, y)
+    rn = float(np.linalg.norm(prob.residual(y)))
+    return (y if nondimensional else _to_phys(task, y)), bool(ok and rn < _TOL), rn
+
+
+def _newton_min_norm(prob, y, tol=_TOL, max_iter=30):
+    """Gauss-Newton with minimum-norm steps onto ``F = 0`` (the nearest point to first order)."""
+    for it in range(max_iter):
+        r = prob.residual(y)
+        if np.linalg.norm(r) < tol:
+            return y, True, it, 0.0
+        dy, *_ = np.linalg.lstsq(prob.jacobian(y), -r, rcond=None)
+        y = y + dy
+    return y, bool(np.linalg.norm(prob.residual(y)) < tol), max_iter, 0.0
+
+
+def _flip(y: np.ndarray) -> np.ndarray:
+    z = np.array(y, dtype=float, copy=True)
+    z[..., 6:9] *= -1
+    z[..., 9:15] *= -1
+    return z
+
+
+def _polyline_distance(P: np.ndarray, y: np.ndarray) -> float:
+    """Distance from ``y`` to the polyline through the rows of ``P``."""
+    if len(P) == 1:
+        return float(np.linalg.norm(P[0] - y))
+    a, b = P[:-1], P[1:]
+    ab = b - a
+    t = np.clip(np.einsum("ka,ka->k", y - a, ab) / np.maximum(np.einsum("ka,ka->k", ab, ab), 1e-300), 0, 1)
+    q = a + t[:, None] * ab
+    return float(np.min(np.linalg.norm(q - y, axis=1)))
+
+
+# ------------------------------------------------------------------------------ the family
+@dataclass(frozen=True, eq=False)
+class CSBranch:
+    """One connected piece of the family (in the tracked sense of ``u``).
+
+    ``points``: (K, 15) dyads ``x = (B1, M1, u, s2..s7)`` in the task unit; ``arc``: (K,)
+    nondimensional arc length along the curve; ``closed``: the branch is a loop; ``ends``: why
+    tracking stopped at each end ("closed", "left the box", "h_min: ..." = a singular point,
+    "max_arc")."""
+
+    points: np.ndarray
+    arc: np.ndarray
+    closed: bool
+    ends: tuple[str, str]
+    residual: float  # largest nondimensional residual over the points
+
+    @property
+    def max_abs_slide(self) -> np.ndarray:
+        return np.max(np.abs(self.points[:, 9:15]), axis=1)
+
+    @property
+    def link_length(self) -> np.ndarray:
+        return np.linalg.norm(self.points[:, 3:6] - self.points[:, 0:3], axis=1)
+
+    def sample(self, n: int) -> np.ndarray:
+        """Indices of ``n`` points spread evenly in arc length (both ends included)."""
+        n = max(2, int(n))
+        if len(self.arc) <= n:
+            return np.arange(len(self.arc))
+        targets = np.linspace(self.arc[0], self.arc[-1], n)
+        return np.unique(np.clip(np.searchsorted(self.arc, targets), 0, len(self.arc) - 1))
+
+    def to_dict(self, samples: int | None = None) -> dict:
+        idx = np.arange(len(self.arc)) if samples is None else self.sample(samples)
+        P = self.points[idx]
+        return {
+            "closed": self.closed,
+            "ends": list(self.ends),
+            "n_points": int(len(self.arc)),
+            "arc_length": float(self.arc[-1] - self.arc[0]),
+            "residual": self.residual,
+            "min_max_abs_slide": float(np.min(self.max_abs_slide)),
+            "points": [
+                {"arc": float(self.arc[i]), "u": p[6:9].tolist(), "B1": p[0:3].tolist(), "M1": p[3:6].tolist(),
+                 "link_length": float(np.linalg.norm(p[3:6] - p[0:3])),
+                 "slides": [0.0] + p[9:15].tolist(), "max_abs_slide": float(np.max(np.abs(p[9:15])))}
+                for i, p in zip(idx, P)
+            ],
+        }
+
+
+@dataclass(frozen=True, eq=False)
+class CSFamily:
+    """The one-parameter family of CS dyads of seven positions, and the picked dyads.
+
+    ``starts``: how many random starts were tried / converged / were new; ``picks``: dyads with
+    the smallest ``max |slide|``, well separated along the family (see
+    :func:`pick_small_slides`)."""
+
+    task: CSTask
+    branches: tuple[CSBranch, ...]
+    picks: tuple[CSDyad, ...]
+    starts: dict
+    extent: float
+
+    @property
+    def n_points(self) -> int:
+        return int(sum(len(b.arc) for b in self.branches))
+
+    def all_points(self) -> np.ndarray:
+        return np.concatenate([b.points for b in self.branches]) if self.branches else np.zeros((0, _NX))
+
+    def dyad(self, branch: int, index: int) -> CSDyad:
+        return _dyad(self.task, self.branches[branch].points[index])
+
+    def to_dict(self, samples: int | None = 40) -> dict:
+        """JSON-ready: about ``samples`` points in all, spread over the branches by arc length
+        (``None``: every tracked point)."""
+        total = sum(float(b.arc[-1] - b.arc[0]) for b in self.branches) or 1.0
+        brs = []
+        for b in self.branches:
+            n = None if samples is None else max(2, int(round(samples * float(b.arc[-1] - b.arc[0]) / total)))
+            brs.append(b.to_dict(n))
+        return {
+            "method": "paper A eqs 22-26: 15 unknowns (B1, M1, u, s2..s7), 14 equations -> a curve of dyads",
+            "task": self.task.to_dict(),
+            "length_unit": "task unit",
+            "extent": self.extent,
+            "starts": dict(self.starts),
+            "n_branches": len(self.branches),
+            "branches": brs,
+            "picks": [p.to_dict() for p in self.picks],
+        }
+
+
+def _trace(prob, y0, *, h_max, max_arc, box):
+    """Track both ways from ``y0``; returns (points, arc, closed, ends)."""
+    def out(y, s):
+        return bool(np.max(np.abs(y[:6])) > box or np.max(np.abs(y[9:])) > box)
+
+    kw = dict(h0=0.01, h_max=h_max, h_min=1e-9, max_arc=max_arc, tol=_TOL, stop=out, max_steps=20000)
+    t0 = prob.tangent(y0)
+    fwd = track(prob, y0, direction=t0, **kw)
+
+    def why(r):
+        if r.status == "stopped":
+            return "left the box"
+        return r.status
+
+    if fwd.closed:
+        P = np.array(fwd.points)
+        return P, np.asarray(fwd.s), True, ("closed", "closed")
+    bwd = track(prob, y0, direction=-t0, **kw)
+    if bwd.closed:  # unlikely: closing only in one sense
+        P = np.array(bwd.points)
+        return P[::-1], -np.asarray(bwd.s)[::-1], True, ("closed", "closed")
+    P = np.concatenate([np.array(bwd.points)[::-1], np.array(fwd.points)[1:]])
+    s = np.concatenate([-np.asarray(bwd.s)[::-1], np.asarray(fwd.s)[1:]])
+    return P, s, False, (why(bwd), why(fwd))
+
+
+def trace_branch(task_poses, dyad: CSDyad, *, extent: float = 8.0, h_max: float = 0.05,
+                 max_arc: float = 200.0) -> CSBranch:
+    """The branch of the family through (the dyad nearest to) ``dyad``: ``dyad`` is first
+    solved onto the family by least squares, then tracked both ways (see :func:`synthesize_cs`
+    for ``extent``, ``h_max``, ``max_arc``).  ``ValueError`` if it does not converge."""
+    task = cs_task(task_poses)
+    y, ok, rn = solve_dyad(task, _to_nondim(task, dyad.vector), nondimensional=True)
+    if not ok:
+        raise ValueError(f"dyad: least squares from it did not reach the family (residual {rn:.3g})")
+    P, s, closed, ends = _trace(_problem(task), y, h_max=h_max, max_arc=max_arc, box=extent)
+    res = float(np.max(np.linalg.norm(dyad_residual(P, task.nondim_D()), axis=-1)))
+    return CSBranch(_to_phys(task, P), s - s[0], closed, ends, res)
+
+
+def synthesize_cs(
+    task_poses,
+    *,
+    n_starts: int = 60,
+    seed: int = 0,
+    pick: int = 5,
+    extent: float = 8.0,
+    h_max: float = 0.05,
+    max_arc: float = 200.0,
+) -> CSFamily:
+    """Paper A's seven-position CS dyad synthesis (section 3, eqs 22-26) for any seven poses.
+
+    ``task_poses``: seven :class:`~spatialmech.model.Pose` (platform orientation and the
+    platform point's position; position 1 is the mechanism's reference).  ``n_starts`` random
+    starts (generator seeded with ``seed``) are solved by least squares; every start not on an
+    already traced branch (up to the ``u -> -u`` flip) is tracked both ways until its branch
+    closes or leaves the box ``|coordinate| <= extent`` (nondimensional: task scales from the
+    centroid of the task points; slides too).  ``h_max``: largest continuation step
+    (nondimensional).  ``pick``: how many small-slide dyads to pick (0: none).
+
+    Raises ``ValueError`` for bad input or when no start converges (the status is in the
+    message).
+    """
+    task = cs_task(task_poses)
+    if not (isinstance(n_starts, (int, np.integer)) and n_starts >= 1):
+        raise ValueError(f"n_starts: expected a positive integer, got {n_starts!r}")
+    if not (isinstance(pick, (int, np.integer)) and pick >= 0):
+        raise ValueError(f"pick: expected a non-negative integer, got {pick!r}")
+    for nm, v in (("extent", extent), ("h_max", h_max), ("max_arc", max_arc)):
+        if not (np.isfinite(v) and v > 0):
+            raise ValueError(f"{nm}: expected a positive finite number, got {v!r}")
+    rng = np.random.default_rng(seed)
+    prob = _problem(task)
+    branches_nd: list[tuple] = []
+    converged = new = 0
+    for y0 in _random_guesses(task, n_starts, rng):
+        y, ok, _ = solve_dyad(task, y0, nondimensional=True)
+        if not ok or np.max(np.abs(y[:6])) > extent or np.max(np.abs(y[9:])) > extent:
+            continue
+        converged += 1
+        near = 0.4 * h_max
+        if any(min(_polyline_distance(b[0], y), _polyline_distance(b[0], _flip(y))) < near for b in branches_nd):
+            continue
+        new += 1
+        branches_nd.append(_trace(prob, y, h_max=h_max, max_arc=max_arc, box=extent))
+    if not branches_nd:
+        raise ValueError(f"task_poses: no CS dyad found from {n_starts} random starts (seed {seed}) within extent {extent}")
+    branches = []
+    for P, s, closed, ends in branches_nd:
+        res = float(np.max(np.linalg.norm(dyad_residual(P, task.nondim_D()), axis=-1)))
+        branches.append(CSBranch(_to_phys(task, P), s - s[0], closed, ends, res))
+    branches.sort(key=lambda b: float(np.min(b.max_abs_slide)))
+    fam = CSFamily(task, tuple(branches), (), {"tried": int(n_starts), "converged": converged, "new_branches": new,
+                                              "seed": int(seed)}, float(extent))
+    if pick:
+        fam = CSFamily(task, fam.branches, pick_small_slides(fam, pick), fam.starts, fam.extent)
+    return fam
+
+
+# ------------------------------------------------------------------------------ picking
+def _refine_min_slide(task: CSTask, prob, y: np.ndarray, t: np.ndarray, half: float) -> np.ndarray:
+    """Minimise ``max |s_j|`` along the curve near ``y`` (tangent ``t``) over ``[-half, half]``."""
+    L = task.scale
+
+    def at(sig):
+        z, ok, _, _ = correct_on_hyperplane(prob, y + sig * t, t, _TOL, 30)
+        return z, ok
+
+    def g(sig):
+        z, ok = at(sig)
+        return float(np.max(np.abs(z[9:]))) * L if ok else np.inf
+
+    opt = minimize_scalar(g, bounds=(-half, half), method="bounded", options={"xatol": 1e-9})
+    z, ok = at(float(opt.x))
+    return z if ok and g(float(opt.x)) <= g(0.0) else y
+
+
+def pick_small_slides(family: CSFamily, n: int = 5, *, separation: float = 1.0) -> tuple[CSDyad, ...]:
+    """The ``n`` dyads of the family with the smallest ``max_j |s_j|``, well separated.
+
+    Candidates, in this order of preference: the interior local minima of ``max |s|`` along
+    each branch, each refined continuously along the curve (bounded Brent on the arc length,
+    every trial point corrected onto the curve), sorted by their value; then every tracked
+    point, sorted by its value.  Greedy: take the best candidate, skip any closer than
+    ``separation`` to a picked one (nondimensional distance in ``(B1, M1, u, s)``, task scales,
+    up to the ``u`` flip), repeat.  Fewer than ``n`` are returned when the family is too short.
+    Each picked ``u`` has its largest component positive (the same dyad as ``-u``, ``-s``).
+    """
+    if not (isinstance(n, (int, np.integer)) and n >= 0):
+        raise ValueError(f"n: expected a non-negative integer, got {n!r}")
+    if not (np.isfinite(separation) and separation >= 0):
+        raise ValueError(f"separation: expected a non-negative number, got {separation!r}")
+    task = family.task
+    prob = _problem(task)
+    minima, others = [], []
+    for b in family.branches:
+        Y = _to_nondim(task, b.points)
+        g = np.max(np.abs(Y[:, 9:]), axis=1)
+        K = len(Y)
+        for i in range(K):
+            others.append((float(g[i]), Y[i]))
+            if b.closed:
+                lo, hi = g[(i - 1) % (K - 1)], g[(i + 1) % (K - 1)]
+            elif 0 < i < K - 1:
+                lo, hi = g[i - 1], g[i + 1]
+            else:
+                continue  # an open end is where the box cut the branch
+            if g[i] <= lo and g[i] <= hi:
+                half = max(float(np.linalg.norm(Y[min(i + 1, K - 1)] - Y[max(i - 1, 0)])), 1e-6)
+                z = _refine_min_slide(task, prob, Y[i], prob.tangent(Y[i]), half)
+                minima.append((float(np.max(np.abs(z[9:]))), z))
+    minima.sort(key=lambda c: c[0])
+    others.sort(key=lambda c: c[0])
+    picked: list[np.ndarray] = []
+    for _, y in minima + others:
+        if len(picked) >= n:
+            break
+        if all(min(np.linalg.norm(y - p), np.linalg.norm(_flip(y) - p)) >= separation for p in picked):
+            picked.append(y)
+    # the sign of u is a convention: the largest component of u positive
+    picked = [_flip(y) if y[6 + int(np.argmax(np.abs(y[6:9])))] < 0 else y for y in picked]
+    return tuple(_dyad(task, _to_phys(task, y)) for y in picked)
+
+
+# ------------------------------------------------------------------------------ projection
+@dataclass(frozen=True, eq=False)
+class Projection:
+    """The dyad of the family nearest to given (printed) limb data, in the printed units:
+    minimises ``|x - x_printed|`` over ``(B1, M1, u, s2..s7)`` (u normalised first) subject to
+    eqs 24-26.  ``distance`` = that norm; ``*_change`` = the parts of it (length unit; the
+    axis change in degrees); ``slide_change`` = max ``|s_j - s_j printed|``."""
+
+    printed: CSDyad
+    fitted: CSDyad
+    distance: float
+    B1_change: float
+    M1_change: float
+    axis_change_deg: float
+    slide_change: float
+    link_length_change: float
+    converged: bool
+
+    def to_dict(self) -> dict:
+        return {
+            "printed": self.printed.to_dict(),
+            "fitted": self.fitted.to_dict(),
+            "distance": self.distance,
+            "B1_change": self.B1_change,
+            "M1_change": self.M1_change,
+            "axis_change_deg": self.axis_change_deg,
+            "slide_change": self.slide_change,
+            "link_length_change": self.link_length_change,
+            "converged": self.converged,
+        }
+
+
+def project_dyad(task_poses, dyad: CSDyad, *, max_iter: int = 100) -> Projection:
+    """Nearest point of the dyad family to ``dyad`` (e.g. a printed limb from
+    :func:`dyad_from_limb`), by Gauss-Newton for the orthogonal projection onto the solution
+    manifold: ``x_{k+1} = x0 - J^+ (F(x_k) - J (x_k - x0))`` in the printed (physical)
+    coordinates, so every printed number weighs the same."""
+    task = cs_task(task_poses)
+    x0 = dyad.vector
+    D = task.D
+    L = task.scale
+    w_eq = np.r_[np.full(6, 1.0 / L**2), np.full(7, 1.0 / L), 1.0]  # equation scaling only
+    x = x0.copy()
+    ok = False
+    for _ in range(max_iter):
+        F = w_eq * dyad_residual(x, D)
+        J = w_eq[:, None] * dyad_jacobian(x, D)
+        x_new = x0 + np.linalg.lstsq(J, -(F - J @ (x - x0)), rcond=None)[0] * 1.0
+        step = float(np.linalg.norm(x_new - x))
+        x = x_new
+        if step < 1e-13 * max(1.0, float(np.linalg.norm(x0))):
+            ok = True
+            break
+    ok = ok and float(np.linalg.norm(w_eq * dyad_residual(x, D))) < 1e-10
+    fit = _dyad(task, x)
+    return Projection(
+        printed=dyad,
+        fitted=fit,
+        distance=float(np.linalg.norm(x - x0)),
+        B1_change=float(np.linalg.norm(fit.B1 - dyad.B1)),
+        M1_change=float(np.linalg.norm(fit.M1 - dyad.M1)),
+        axis_change_deg=float(np.degrees(np.arccos(np.clip(fit.u @ dyad.u, -1, 1)))),
+        slide_change=float(np.max(np.abs(fit.slides - dyad.slides))),
+        link_length_change=abs(fit.link_length - dyad.link_length),
+        converged=bool(ok),
+    )
+
+
+# ------------------------------------------------------------------------------ 5-CS linkages
+def assemble_5cs(task_poses, dyads: Sequence[CSDyad], *, name: str = "five-cs-synthesised", length_unit: str = "unit") -> Mechanism:
+    """The 5-CS linkage of five dyads, built exactly like :func:`spatialmech.catalog.papers.five_cs`:
+    limbs ``limb1..limb5`` = [C ``C{i}`` (axis ``u``, point ``B1``), S ``S{i}`` at ``M1``], the
+    rotation of C1 actuated, aliases ``rot{i}``/``slide{i}``; ``platform_point`` = the task
+    point of position 1; reference configuration = position 1 (all joint variables 0);
+    ``positions`` = the task poses relative to position 1."""
+    task = cs_task(task_poses)
+    dyads = tuple(dyads)
+    if len(dyads) != 5:
+        raise ValueError(f"dyads: a 5-CS linkage needs exactly 5 dyads, got {len(dyads)}")
+    limbs, aliases = [], {}
+    for i, dy in enumerate(dyads):
+        if not isinstance(dy, CSDyad):
+            raise ValueError(f"dyads[{i}]: expected a CSDyad, got {type(dy).__name__}")
+        limbs.append(Limb(f"limb{i + 1}", (
+            Cjoint(f"C{i + 1}", dy.B1, dy.u, normalize=True, actuated=["rot"] if i == 0 else False),
+            Sjoint(f"S{i + 1}", dy.M1),
+        )))
+        aliases[f"rot{i + 1}"] = f"C{i + 1}.rot"
+        aliases[f"slide{i + 1}"] = f"C{i + 1}.slide"
+    return Mechanism(
+        name=name,
+        limbs=tuple(limbs),
+        platform_point=task.reference_point,
+        description="5-CS rigid-body guidance linkage synthesised for seven positions (paper A section 3)",
+        positions=task.relative_poses,
+        aliases=aliases,
+        length_unit=length_unit,
+        source="spatialmech.synthesis.cs_dyads (paper A eqs 22-26)",
+        notes="Reference configuration = task position 1 (slides zero). Drivers rot1..rot5 / slide1..slide5.",
+    )
+
+
+@dataclass(frozen=True, eq=False)
+class FiveCSCheck:
+    """A 5-CS linkage checked at its task positions: for each position the closed configuration
+    nearest to the task pose (:func:`~spatialmech.kinematics.position.configuration_at_pose`),
+    its position error (length unit) and angle error (rad), whether the pose itself closes
+    (``exact``), the C slides found (``slides[j, i]``, limb i at position j) and their
+    difference from the dyads' slides when given; the mobility (dof) of the linkage."""
+
+    position_errors: np.ndarray
+    angle_errors: np.ndarray
+    ik_residuals: np.ndarray
+    exact: np.ndarray
+    converged: np.ndarray
+    slides: np.ndarray
+    slide_errors: np.ndarray | None
+    dof: int
+    dof_instantaneous: int
+
+    @property
+    def max_pose_error(self) -> float:
+        return float(max(np.max(self.position_errors), np.max(self.angle_errors)))
+
+    @property
+    def ok(self) -> bool:
+        return bool(np.all(self.exact) and self.dof == 1 and self.dof_instantaneous == 1)
+
+    def to_dict(self) -> dict:
+        return {
+            "position_errors": self.position_errors.tolist(),
+            "angle_errors_deg": np.degrees(self.angle_errors).tolist(),
+            "ik_residuals": self.ik_residuals.tolist(),
+            "exact": self.exact.tolist(),
+            "converged": self.converged.tolist(),
+            "slides": self.slides.tolist(),
+            "max_slide_error": None if self.slide_errors is None else float(np.max(np.abs(self.slide_errors))),
+            "dof": self.dof,
+            "dof_instantaneous": self.dof_instantaneous,
+            "ok": self.ok,
+        }
+
+
+def _cs_start(mech: Mechanism, pose: Pose):
+    """Closed-form joint values of a mechanism of C-S limbs at a pose (the start of the pose
+    fit; Gauss-Newton from all-zero joint values can stop at a wrong local minimum when a C
+    rotation is near 180 degrees).  Per limb: slide ``s = u . (M_j - M1)``, rotation = signed
+    angle about ``u`` from ``M1 - B1`` to ``M_j - B1 - s u`` (perpendicular parts), S rotation
+    vector of ``R_u(theta)^T R``.  ``None`` when a limb is not [C, S]."""
+    from scipy.spatial.transform import Rotation
+
+    from ..kinematics.closure import Configuration
+
+    D = pose.displacement(mech.platform_point)
+    q = []
+    for lb in mech.limbs:
+        if [j.type for j in lb.joints] != ["C", "S"]:
+            return None
+        c, sj = lb.joints
+        u = c.freedoms[0].direction
+        B1, M1 = c.point, sj.point
+        Mj = D[:3, :3] @ M1 + D[:3, 3]
+        s = float(u @ (Mj - M1))
+        a = (M1 - B1) - (u @ (M1 - B1)) * u
+        b = (Mj - B1 - s * u) - (u @ (Mj - B1 - s * u)) * u
+        th = float(np.arctan2(u @ np.cross(a, b), a @ b))
+        Rs = Rotation.from_rotvec(-th * u).as_matrix() @ D[:3, :3]
+        A = np.array([f.direction for f in sj.freedoms]).T
+        q += [th, s, *(A.T @ Rotation.from_matrix(Rs).as_rotvec())]
+    return Configuration(np.array(q), D)
+
+
+def check_5cs(mech: Mechanism, dyads: Sequence[CSDyad] | None = None) -> FiveCSCheck:
+    """Solve ``mech`` (from :func:`assemble_5cs` or the catalog) at each of its positions and
+    compute its mobility (see :class:`FiveCSCheck`)."""
+    from ..analysis.mobility import mobility
+    from ..kinematics.position import configuration_at_pose, freedom_values
+
+    if not mech.positions:
+        raise ValueError(f"mech: {mech.name} has no task positions to check")
+    ids = [r.id for r in mech.freedom_refs]
+    sl_idx = [ids.index(f"{lb.joints[0].name}.slide") for lb in mech.limbs]
+    pe, ae, ik, ex, cv, sl = [], [], [], [], [], []
+    for P in mech.positions:
+        fit = configuration_at_pose(mech, P, start=_cs_start(mech, P))
+        pe.append(fit.position_error)
+        ae.append(fit.angle_error)
+        ik.append(fit.ik_residual)
+        ex.append(fit.exact)
+        cv.append(fit.converged)
+        sl.append(freedom_values(mech, fit.config.q)[sl_idx])
+    sl = np.array(sl)
+    errs = None
+    if dyads is not None:
+        errs = sl - np.array([d.slides for d in dyads]).T
+    mob = mobility(mech)
+    return FiveCSCheck(np.array(pe), np.array(ae), np.array(ik), np.array(ex), np.array(cv), sl, errs, int(mob.dof),
+                       int(mob.dof_instantaneous))
+
+
+# ------------------------------------------------------------------------------ paper A claims
+@dataclass(frozen=True, eq=False)
+class PaperACheck:
+    """Paper A's section 3 claims on the data of table 9 and linkages 1-3 (tables 1-13).
+
+    ``printed``: per linkage, per limb, the printed limb as a dyad (its ``residual`` = largest
+    |eq 24| as a length difference and |eq 25|, from the 3-decimal rounding); ``projections``:
+    each printed limb projected onto the family; ``refitted``: each paper linkage rebuilt from
+    its projected limbs, checked at the seven positions; ``family`` and ``synthesised``: the
+    family of table 9 and the check of the 5-CS from its five picked dyads."""
+
+    printed: dict
+    projections: dict
+    refitted: dict
+    family: CSFamily
+    synthesised: FiveCSCheck
+
+    def to_dict(self) -> dict:
+        return {
+            "printed_residuals": {k: [d.residual for d in v] for k, v in self.printed.items()},
+            "projections": {k: [p.to_dict() for p in v] for k, v in self.projections.items()},
+            "refitted": {k: v.to_dict() for k, v in self.refitted.items()},
+            "family": self.family.to_dict(samples=20),
+            "synthesised": self.synthesised.to_dict(),
+        }
+
+
+def paper_a_check(*, n_starts: int = 60, seed: int = 0, refit: bool = True,
+                  family: CSFamily | None = None) -> PaperACheck:
+    """Everything needed for paper A's section 3 claims (see :class:`PaperACheck`); ``family``:
+    a family of table 9 already synthesised with five picks (else it is synthesised here)."""
+    from ..catalog.papers import five_cs_data, five_cs_positions
+
+    poses = five_cs_positions()
+    task = cs_task(poses)
+    data = five_cs_data()["linkages"]
+    printed, proj, refitted = {}, {}, {}
+    for k in sorted(data):
+        lk = data[k]
+        dys = tuple(
+            dyad_from_limb(task, lk["u"][i], lk["B1"][i], lk["M_by_position"][0][i], lk["s"][i]) for i in range(5)
+        )
+        printed[k] = dys
+        proj[k] = tuple(project_dyad(task, d) for d in dys)
+        if refit:
+            fitted = tuple(p.fitted for p in proj[k])
+            refitted[k] = check_5cs(assemble_5cs(task, fitted, name=f"five-cs-{k}-refitted"), fitted)
+    fam = family if family is not None else synthesize_cs(task, n_starts=n_starts, seed=seed, pick=5)
+    if len(fam.picks) != 5:
+        raise ValueError(f"family: expected 5 picked dyads, got {len(fam.picks)}")
+    synth = check_5cs(assemble_5cs(task, fam.picks), fam.picks)
+    return PaperACheck(printed, proj, refitted, fam, synth)
