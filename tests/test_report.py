@@ -56,7 +56,7 @@ def test_demo_claims_and_their_verdicts(demo):
     'no singularity' statement, paper D's example directions of eqs 28 and 30."""
     _, data = demo
     by_paper = {p: [c for c in data["claims"] if c["paper"] == p] for p in "ABCD"}
-    assert {p: len(v) for p, v in by_paper.items()} == {"A": 13, "B": 10, "C": 18, "D": 6}
+    assert {p: len(v) for p, v in by_paper.items()} == {"A": 17, "B": 10, "C": 18, "D": 6}
     not_repr = {(c["paper"], c["claim"].split(":")[0].split(" (")[0]) for c in data["claims"] if not c["reproduced"]}
     assert not_repr == {("B", "Inverse position, eq 8 as printed"), ("B", "No singularity inside the workspace when the parameters are chosen well"),
                         ("B", "Orientation workspace at z = 0.1 m"), ("D", "Example m1"), ("D", "Example m2")}
@@ -65,7 +65,7 @@ def test_demo_claims_and_their_verdicts(demo):
     assert corrected == {("B", "Inverse position, eq 8 w"), ("B", "Velocity and acceleratio"), ("C", "3-RRR metamorphic joint,"),
                          ("B", "Singular case (c): legs "), ("C", "Eq 21: closed-form actua")}
     s = data["summary"]
-    assert s["claims"] == 47 and s["reproduced"] + s["reproduced after correction"] + s["not reproduced"] == 47
+    assert s["claims"] == 51 and s["reproduced"] + s["reproduced after correction"] + s["not reproduced"] == 51
     for c in data["claims"]:
         assert c["verdict"] in VERDICTS and c["reproduced"] == (c["verdict"] != "not reproduced")
         assert c["paper_value"] and c["ours"] and c["evidence"], c["claim"]
