@@ -506,6 +506,13 @@ def defect_analysis(
     say = progress or (lambda msg: None)
     if pose_tol is None:
         pose_tol = 0.02 * mech.characteristic_length
+    for name, v in (("pose_tol", pose_tol), ("angle_tol_deg", angle_tol_deg)):
+        if not (np.isfinite(v) and v > 0):
+            raise ValueError(f"{name}: expected a positive finite number, got {v}")
+    if not (np.isfinite(precision) and precision >= 0):
+        raise ValueError(f"precision: expected a finite number >= 0, got {precision}")
+    if int(monte_carlo) != monte_carlo or monte_carlo < 0:
+        raise ValueError(f"monte_carlo: expected a number of samples >= 0, got {monte_carlo}")
     positions = tuple(positions if positions is not None else mech.positions)
     if len(positions) < 2:
         raise ValueError("positions: a defect analysis needs at least two task positions")

@@ -202,6 +202,8 @@ def mobility(mech: Mechanism, mode: Mode | str | None = None, *, seed: int = 0) 
                 f"mode: {mech.name} is metamorphic with modes {', '.join(m.name for m in modes)}; name one"
             )
         mode = modes[0]
+    if isinstance(mode, str) and not mech.is_metamorphic:
+        mode = mech.mode(mode)  # KeyError naming the modes for an unknown name
     m = mech.in_mode(mode) if mech.is_metamorphic else mech
     mode_obj = m.modes[0] if m.modes else (mode if isinstance(mode, Mode) else Mode(str(mode), ()))
     L = m.characteristic_length

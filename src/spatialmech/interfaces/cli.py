@@ -17,15 +17,43 @@ from ..model.schema import ModelFileError, dump
 from .common import UserError, emit_json, json_option  # noqa: F401  (re-exported)
 
 
+def _one_line_usage(e: click.UsageError) -> UserError:
+    """A click usage error (bad option, missing argument, value out of range) as one line."""
+    where = e.ctx.command_path if e.ctx is not None else "spatialmech"
+    return UserError(f"{e.format_message()} (see '{where} --help')")
+
+
 class _Group(click.Group):
-    """Turns the library's input errors into one-line messages with exit code 2."""
+    """Turns the library's input errors into one-line messages: exit code 2 for bad input (also
+    click's usage errors and files that cannot be read or written), 1 for a failed computation."""
+
+    def make_context(self, info_name, args, parent=None, **extra):
+        try:
+            return super().make_context(info_name, args, parent=parent, **extra)
+        except click.exceptions.NoArgsIsHelpError:
+            raise
+        except click.UsageError as e:
+            raise _one_line_usage(e) from None
 
     def invoke(self, ctx):
         try:
             return super().invoke(ctx)
+        except (click.exceptions.NoArgsIsHelpError, click.exceptions.Exit, click.exceptions.Abort):
+            raise  # --help, --version, Ctrl-C: click's own (Exit and Abort are RuntimeErrors)
+        except click.UsageError as e:
+            raise _one_line_usage(e) from None
         except (ModelFileError, ValueError, KeyError) as e:
             msg = e.args[0] if isinstance(e, KeyError) and e.args else str(e)
             raise UserError(str(msg)) from None
+        except BrokenPipeError:
+            raise  # stdout closed early (``| head``): click exits quietly
+        except OSError as e:
+            name = e.filename if e.filename is not None else ""
+            raise UserError(f"{name}: {e.strerror or e}" if name else str(e.strerror or e)) from None
+        except RuntimeError as e:
+            err = UserError(f"the computation failed: {e}")
+            err.exit_code = 1
+            raise err from None
 
 
 def _model(spec: str):
@@ -135,7 +163,7 @@ def export(model, file, as_json):
 def demo(out, as_json):
     """Reproduce the four papers' examples into a report: DIR/index.html (self-contained, opens
     offline), DIR/results.json (every number) and DIR/figures/.  Each claim of a paper is a row:
-    the paper's value, ours, reproduced or not and why.  Progress on stderr; about 10 s.
+    the paper's value, ours, reproduced or not and why.  Progress on stderr; about 45 s.
 
     \b
     Example:
@@ -143,6 +171,7 @@ def demo(out, as_json):
     """
     from ..present.report import build_demo
 
+    out.mkdir(parents=True, exist_ok=True)  # fail now on an unwritable --out, not after the work
     results = build_demo(out, progress=not as_json)
     if as_json:
         emit_json(results)
@@ -173,6 +202,7 @@ def report(model, out, no_trace, as_json):
 
     mech = _model(model)
     out = out if out is not None else Path(f"report-{mech.name}")
+    out.mkdir(parents=True, exist_ok=True)  # fail now on an unwritable --out, not after the work
     results = build_model_report(mech, out, progress=not as_json, trace=not no_trace)
     if as_json:
         emit_json(results)

@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import click
+import numpy as np
 
 from .. import catalog
 from ..analysis.defects import defect_analysis
@@ -55,9 +56,17 @@ def defects(model, positions_file, drivers, pose_tol, angle_tol_deg, monte_carlo
     click.echo(f"  circuit defect: {'YES' if res.circuit_defect else 'no'}   order defect: {'YES' if res.order_defect else 'no'}"
                + ("" if res.circuit_defect else f"   (positions met in order {', '.join(f'P{j}' for j in res.order)})"))
     click.echo(f"  DJ: {res.dj_method}; membership tolerance {res.tolerances['pose']:.3g} {mech.length_unit}, {res.tolerances['angle_deg']:g} deg")
+    names = [p.name for p in (positions if positions is not None else mech.positions)]
+    for j, f in enumerate(res.fits):
+        if np.hypot(f.position_error / res.tolerances["pose"], np.degrees(f.angle_error) / res.tolerances["angle_deg"]) > 1:
+            click.echo(f"  note: the pose of {names[j] or f'P{j + 1}'} is {f.position_error:.3g} {mech.length_unit} and "
+                       f"{np.degrees(f.angle_error):.3g} deg from the nearest closed configuration (beyond the "
+                       "membership tolerance); the analysis uses that configuration")
     for v in res.drivers:
         signs = " ".join("+" if s > 0 else ("-" if s < 0 else "0") for s in v.signs)
-        where = ", ".join(f"P{b.between[0]}-P{b.between[1]}" if b.between else "?" for b in v.branch_points)
+        spans = [f"P{b.between[0]}-P{b.between[1]}" if b.between else "?" for b in v.branch_points]
+        where = ", ".join(x + (f" x{spans.count(x)}" if spans.count(x) > 1 else "")
+                          for x in dict.fromkeys(spans))  # "P6-P7 x2": two zeros between P6 and P7
         verdict = "usable" if v.usable else ("branch defect" + (f" ({where})" if where else "") if v.branch_defect else "not usable")
         extra = f"  min sigma on path {v.min_sigma_on_path:.2e}" if v.min_sigma_on_path is not None else ""
         click.echo(f"  {v.driver:>8s}  {signs}   {verdict}{extra}")

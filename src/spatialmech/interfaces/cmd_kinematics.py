@@ -80,6 +80,21 @@ def resolve_pose(mech: Mechanism, xyz, euler, position) -> Pose:
     return Pose(R, p, "requested")
 
 
+#: Scale-free smallest singular value below which a configuration is reported as singular.
+SINGULAR_SIGMA = 1e-9
+
+
+def _deg(a: float, ndigits: int = 4) -> float:
+    """Degrees rounded to ``ndigits``, without a negative zero (``-0.0000``) from round-off."""
+    return round(float(np.degrees(a)), ndigits) + 0.0
+
+
+def _num(v, fmt: str) -> str:
+    """``"0, -0.01, 1.05"``: components rounded to ``fmt``, round-off (< 1e-12) shown as 0."""
+    v = np.where(np.abs(np.asarray(v, float)) < 1e-12, 0.0, np.asarray(v, float))
+    return ", ".join(format(float(x) + 0.0, fmt) for x in v)
+
+
 def _fmt_value(mech: Mechanism, fid: str, v: float) -> str:
     f = mech.freedom(fid).freedom
     return f"{v:.6g} {mech.length_unit}" if f.kind == "P" else f"{np.degrees(v):.6g} deg"
@@ -103,8 +118,15 @@ def ik(model, xyz, euler, position, all_solutions, as_json):
     mech = catalog.resolve(model)
     pose = resolve_pose(mech, xyz, euler, position)
     res = inverse_position(mech, pose, all_solutions=all_solutions)
+    # A model's task positions are printed (rounded) data: say how far the nearest closed
+    # configuration is instead of leaving a bare "not reachable".
+    fit = configuration_at_pose(mech, pose) if (position is not None and not res.reachable) else None
     if as_json:
-        emit_json(res.to_dict(mech))
+        d = res.to_dict(mech)
+        if fit is not None:
+            d["pose_fit"] = {**fit.to_dict(), "note": f"P{position} is printed (rounded) data; pose_fit is the "
+                             "nearest closed configuration (configuration_at_pose), position_error in the model's length unit"}
+        emit_json(d)
         return
     click.echo(f"{mech.name}: pose {'reachable' if res.reachable else 'NOT reachable'}")
     for limb in res.to_dict(mech)["limbs"]:
@@ -117,13 +139,18 @@ def ik(model, xyz, euler, position, all_solutions, as_json):
     if res.config is not None:
         click.echo("  actuators: " + ", ".join(f"{k} = {_fmt_value(mech, k, v)}" for k, v in res.actuator_values(mech).items()))
     click.echo("  (rotations in degrees, slides in " + mech.length_unit + ")")
+    if fit is not None and fit.converged:
+        click.echo(f"  note: task position {position} is printed (rounded) data; the nearest closed configuration is "
+                   f"{fit.position_error:.3g} {mech.length_unit} and {np.degrees(fit.angle_error):.3g} deg from it "
+                   "(`spatialmech jacobian --position N` uses that configuration)")
 
 
 @click.command()
 @click.argument("model")
 @click.option("--actuators", "values", required=True, help="Comma-separated actuator values in mechanism order (degrees / length).")
 @click.option("--all", "all_solutions", is_flag=True, help="Search all real assembly modes (multi-start).")
-@click.option("--seeds", default=200, show_default=True, help="Number of starts for --all.")
+@click.option("--seeds", type=click.IntRange(min=1), default=None,
+              help="Number of starts for --all (default: 200; 512 on the 4-SPS/CU closed form).")
 @json_option
 def fk(model, values, all_solutions, seeds, as_json):
     """Forward position: platform pose(s) for actuator values.
@@ -146,7 +173,7 @@ def fk(model, values, all_solutions, seeds, as_json):
 
     geom = k4.geometry_of(mech) if all_solutions else None
     if geom is not None:  # the closed form of this limb layout: faster and more thorough
-        fa = k4.forward_all(np.asarray(vals), geometry=geom)
+        fa = k4.forward_all(np.asarray(vals), geometry=geom, **({} if seeds is None else {"n_seeds": seeds}))
         d = fa.to_dict()
         d["method"] = "closed form of the 4-SPS/CU (kinematics/closed_forms/four_sps_cu.py)"
         if as_json:
@@ -156,9 +183,16 @@ def fk(model, values, all_solutions, seeds, as_json):
                    f"limits; closed-form multi-start, {fa.search.n_seeds} seeds)")
         for n, s_ in enumerate(fa.solutions):
             z, al, be, ga = s_.phi
-            click.echo(f"  [{n + 1}] z = {z:.6f} m, alpha = {np.degrees(al):.4f}, beta = {np.degrees(be):.4f}, "
-                       f"gamma = {np.degrees(ga):.4f} deg ('ZYX')  {'within limits' if s_.within_limits else 'outside limits'}")
+            sing = f"  singular (sigma_min {s_.sigma_min:.1e})" if s_.sigma_min < SINGULAR_SIGMA else ""
+            click.echo(f"  [{n + 1}] z = {round(float(z), 6) + 0.0:.6f} m, alpha = {_deg(al):.4f}, beta = {_deg(be):.4f}, "
+                       f"gamma = {_deg(ga):.4f} deg ('ZYX')  {'within limits' if s_.within_limits else 'outside limits'}{sing}")
+        n_sing = sum(s_.sigma_min < SINGULAR_SIGMA for s_ in fa.solutions)
+        if n_sing:
+            click.echo(f"  warning: {n_sing} of these poses are singular (scale-free sigma_min < {SINGULAR_SIGMA:g}): "
+                       "the locked mechanism has a self-motion there, and singular poses found by different starts "
+                       "are samples of a continuum, not distinct assembly modes")
         return
+    seeds = 200 if seeds is None else seeds
     if all_solutions and not as_json:
         import sys
 
@@ -177,7 +211,8 @@ def fk(model, values, all_solutions, seeds, as_json):
             continue
         e = matrix_euler("ZYX", s.pose.R, degrees=True)
         lim = "within limits" if not s.outside_limits else "outside limits: " + ", ".join(s.outside_limits)
-        click.echo(f"  [{k + 1}] position {np.array2string(s.pose.p, precision=6)}  ZYX (deg) {np.array2string(e, precision=4)}  {lim}")
+        click.echo(f"  [{k + 1}] platform point ({_num(s.pose.p, '.6g')}) {mech.length_unit}, "
+                   f"ZYX angles ({_num(e, '.4f')}) deg  {lim}")
 
 
 @click.command()
@@ -233,6 +268,9 @@ def jacobian(model, xyz, euler, position, drivers, dj_table, as_json):
     if J.det is not None:
         click.echo(f"  det J = {J.det:+.6e}")
     click.echo(f"  scale-free sigma_min = {J.sigma_min:.4g}, 1/condition = {J.condition:.4g}")
+    if J.sigma_min < SINGULAR_SIGMA:
+        click.echo(f"  SINGULAR configuration (sigma_min < {SINGULAR_SIGMA:g}): det J is round-off; "
+                   "`spatialmech singularity` gives its kind and the uncontrolled twist")
     if J.inverse_singular:
         click.echo(f"  inverse (serial) singular for: {', '.join(J.inverse_singular)}")
     if not fit.exact:

@@ -32,6 +32,8 @@ def _parse_slice(text: str):
             raise ValueError(f"--slice: bad numbers in {part!r}") from None
         if n < 2 or n > 400:
             raise ValueError(f"--slice: N must be 2..400, got {n}")
+        if not (np.isfinite(lo) and np.isfinite(hi)):
+            raise ValueError(f"--slice: MIN and MAX must be finite, got {part!r}")
         axes.append((bits[0], np.linspace(lo, hi, n)))
     if len(axes) != 2 or axes[0][0] == axes[1][0]:
         raise ValueError("--slice: give exactly two different axes")
@@ -80,6 +82,9 @@ def singularity_cmd(model, xyz, euler, position, reference, drivers, slice_spec,
                                 fixed={"xyz": list(xyz), "euler": [seq, *ang]}, progress=prog)
         if bar:
             bar.render_finish()
+        if not np.isfinite(res.det).any():
+            raise ValueError(f"--slice: no pose of the {n1} x {n2} slice closes (the mechanism cannot assemble "
+                             "at any of them); move or narrow the slice")
         if plot is not None:
             slice_figure(res, f"{mech.name}: singularity loci ({seq}, angles in degrees)").savefig(plot)
         d = res.to_dict()
@@ -120,7 +125,8 @@ def singularity_cmd(model, xyz, euler, position, reference, drivers, slice_spec,
         sm_ = r.self_motion
         if sm_.get("finite"):
             click.echo(f"  finite self-motion with the actuators locked: platform point moved {sm_['platform_point_moved']:.4g} "
-                       f"{mech.length_unit} and turned {sm_['platform_rotated_deg']:.3g} deg over arc {sm_['arc']:.3g}")
+                       f"{mech.length_unit} and turned {sm_['platform_rotated_deg']:.3g} deg over a traced arc of "
+                       f"{sm_['arc']:.3g} (nondimensional)")
         else:
             click.echo("  the uncontrolled motion is only instantaneous")
     click.echo(f"  {r.explanation}")

@@ -132,19 +132,33 @@ def workspace(model, kind, at, step_deg, tol_deg, step_m, tol_m, method, link_di
         if as_json:
             res = run(None)
         else:
-            with click.progressbar(length=1, label="checking poses", file=sys.stderr,
-                                   show_pos=True) as bar:
-                def progress(n):
-                    bar.length = max(bar.length, bar.pos + n)
-                    bar.update(n)
+            bars = []  # opened at the first progress report: no progress line before an input error
+
+            def progress(n):
+                if not bars:
+                    bars.append(click.progressbar(length=1, label="checking poses", file=sys.stderr, show_pos=True))
+                    bars[0].__enter__()
+                bar = bars[0]
+                bar.length = max(bar.length, bar.pos + n)
+                bar.update(n)
+            try:
                 res = run(progress)
+            finally:
+                if bars:
+                    bars[0].__exit__(None, None, None)
         if plot:
             from ..analysis.workspace_plot import write_workspace_plot
 
             write_workspace_plot(res, plot)
     except (ValueError, KeyError) as e:
-        msg = e.args[0] if isinstance(e, KeyError) and e.args else str(e)
-        raise UserError(str(msg)) from None
+        msg = str(e.args[0] if isinstance(e, KeyError) and e.args else e)
+        # the library names its arguments; say which command-line option to change
+        msg = msg.replace("max_poses =", "--max-poses =")
+        for arg, opt in (("step", "--step-deg" if kind == "orientation" else "--step"),
+                         ("tol", "--tol-deg" if kind == "orientation" else "--tol")):
+            if msg.startswith(arg + ":"):
+                msg = f"{opt} ({arg})" + msg[len(arg):]
+        raise UserError(msg) from None
     if as_json:
         d = res.to_dict()
         if plot:
