@@ -137,3 +137,23 @@ def test_general_forward_all_agrees_with_the_closed_form_of_the_4sps_cu():
         g, b, a = matrix_euler("ZYX", s.pose.R)
         phi = np.array([s.pose.p[2], a, b, g])
         assert np.min(np.max(np.abs(closed - phi), axis=1)) < 1e-7
+
+
+def test_inverse_prefers_solutions_within_limits_or_the_least_violation():
+    m = catalog.build("four-sps-cu")
+    far = inverse_position(m, sm.Pose(np.eye(3), [0, 0, 2.0]))
+    legs = list(far.actuator_values(m).values())
+    assert all(l > 0 for l in legs)  # not the leg flipped through its base joint (-2.005 m)
+    near = inverse_position(m, sm.Pose.from_euler("ZYX", [10, 5, 5], [0, 0, 0.2], degrees=True))
+    assert all(not v for l in near.limbs for v in l.violations)
+
+
+def test_wrong_configuration_and_multi_dof_trace_are_clear_errors():
+    from spatialmech.kinematics.closure import Configuration
+    from spatialmech.kinematics.jacobian import complete_jacobian
+    from spatialmech.kinematics.tracking import trace_motion
+
+    with pytest.raises(ValueError, match="config.q: stewart-6sps has 42 joint variables"):
+        complete_jacobian(STEWART, Configuration(np.zeros(3), np.eye(4)))
+    with pytest.raises(ValueError, match="one-degree-of-freedom motions; stewart-6sps has 6"):
+        trace_motion(STEWART, Configuration.reference(STEWART))

@@ -52,6 +52,7 @@ __all__ = [
     "CorrectionResult",
     "generic_configuration",
     "joint_points",
+    "check_configuration",
     "retract",
     "closure_scales",
 ]
@@ -67,6 +68,17 @@ class Configuration:
     @classmethod
     def reference(cls, mech: Mechanism) -> "Configuration":
         return cls(np.zeros(len(mech.freedom_refs)), np.eye(4))
+
+
+def check_configuration(mech: Mechanism, config: Configuration) -> None:
+    """``ValueError`` naming the problem when ``config`` does not belong to ``mech``."""
+    q = np.asarray(config.q)
+    if q.shape != (len(mech.freedom_refs),):
+        raise ValueError(f"config.q: {mech.name} has {len(mech.freedom_refs)} joint variables, got shape {q.shape}")
+    if np.asarray(config.D).shape != (4, 4):
+        raise ValueError(f"config.D: expected a 4x4 displacement, got shape {np.asarray(config.D).shape}")
+    if not (np.all(np.isfinite(q)) and np.all(np.isfinite(config.D))):
+        raise ValueError("config: contains NaN or infinity")
 
 
 def limb_slices(mech: Mechanism) -> list[slice]:
@@ -272,11 +284,13 @@ def recentre_balls(mech: Mechanism, q: np.ndarray) -> np.ndarray:
 
 def joint_twists(mech: Mechanism, config: Configuration) -> list[np.ndarray]:
     """Per limb, the (6, m_k) twists of all its freedoms at ``config``."""
+    check_configuration(mech, config)
     return [chain_forward(ch, config.q[sl], local=True)[1] for ch, sl in zip(limb_chains(mech), limb_slices(mech))]
 
 
 def closure_residual(mech: Mechanism, config: Configuration) -> np.ndarray:
     """Stacked limb residuals ``log(FK_k D^-1)`` (6 K,), SI units."""
+    check_configuration(mech, config)
     Dinv = inverse_transform(config.D)
     res = []
     for ch, sl in zip(limb_chains(mech), limb_slices(mech)):
@@ -287,6 +301,7 @@ def closure_residual(mech: Mechanism, config: Configuration) -> np.ndarray:
 
 def closure_jacobian(mech: Mechanism, config: Configuration, *, active: np.ndarray | None = None):
     """The closure Jacobian (6K, n_active + 6) in SI units and the residual (6K,)."""
+    check_configuration(mech, config)
     if active is None:
         active = active_mask(mech)
     sls = limb_slices(mech)

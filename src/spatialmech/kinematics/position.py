@@ -201,6 +201,24 @@ class InverseResult:
         return d
 
 
+def _violation(mech: Mechanism, sl: slice, q_limb) -> float:
+    """How far a limb's values lie outside their limits (nondimensional: slides / L, angles in rad)."""
+    L = mech.characteristic_length
+    total = 0.0
+    for r, q in zip(mech.freedom_refs[sl], q_limb):
+        f = r.freedom
+        if f.limits is None:
+            continue
+        v = f.offset + q
+        lo, hi = f.limits
+        if f.kind != "P" and not lo <= v <= hi:  # an angle stands for its 2 pi equivalents
+            k = np.round((0.5 * (lo + hi) - v) / (2 * np.pi))
+            v = v + 2 * np.pi * k
+        d = max(lo - v, v - hi, 0.0)
+        total += d / L if f.kind == "P" else d
+    return total
+
+
 def _limb_gn(chain, D, q, lin, L, tol=1e-12, max_iter=60, hold=None):
     """Gauss-Newton for one limb with the platform held at ``D``, in local coordinates (S
     joints updated by composing rotations); freedoms in the ``hold`` mask keep their value."""
@@ -314,6 +332,25 @@ def inverse_position(
             sigs.append(sig_n)
             sols.append(q)
             res.append(rn)
+        idx_l = set(range(sl.start, sl.stop))
+
+        def _outside(qs):
+            return within_limits(mech, np.r_[q_all[: sl.start], qs, q_all[sl.stop :]], indices=idx_l)
+
+        if not all_solutions and sols and _outside(sols[0]):
+            # the solution nearest the start violates a limit (e.g. a leg flipped through its base
+            # joint far from the reference): prefer one within the limits, else the least violation
+            best_v = _violation(mech, sl, sols[0])
+            for _ in range(n_seeds):
+                qs0 = np.where(lin, rng.uniform(-1, 1, len(refs)) * L, rng.uniform(-np.pi, np.pi, len(refs)))
+                qs, rn, ok = _limb_gn(ch, D, np.where(locked, q_start[sl], qs0), lin, L, tol=tol)
+                if ok:
+                    qs = wrap_rotations(mech, qs, range(sl.start, sl.stop))
+                    v = _violation(mech, sl, qs)
+                    if v < best_v - 1e-12:
+                        sols, res, best_v = [qs], [rn], v
+                    if v == 0.0:
+                        break
         reachable = bool(sols)
         if not reachable:
             all_ok = False

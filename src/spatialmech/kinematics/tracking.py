@@ -486,6 +486,16 @@ def trace_motion(
     decrease), which sets the sense of travel.  Extra keyword arguments go to :func:`track`.
     """
     prob = MotionProblem(mech)
+    A = prob.jacobian(start)
+    sv = np.linalg.svd(A, compute_uv=False)
+    r = int(np.sum(sv > 1e-9 * max(1.0, sv[0])))
+    N = np.linalg.svd(A, full_matrices=True)[2][r:]
+    if N.shape[0] > 1:  # more than one direction moves the platform: not a 1-DOF motion
+        u, s2, _ = np.linalg.svd(N[:, -6:])
+        dof = int(np.sum(s2 > 1e-7))
+        if dof > 1:
+            raise ValueError(f"mechanism: trace_motion follows one-degree-of-freedom motions; {mech.name} has {dof} "
+                             "here (lock or drive the others: an ActuatorPathProblem follows a path of actuator values)")
     direction = None
     if increasing is not None:
         r = mech.freedom(increasing)
