@@ -55,7 +55,7 @@ def loop_leg_lengths(poses: list, a: float, b: float) -> list:
         r10, r11 = cb * sg, sa * sb * sg + cg * ca
         r20, r21 = -sb, cb * sa
         legs = []
-        for (ax, ay), (bx, by) in zip(A, B):
+        for (ax, ay), (bx, by) in zip(A, B, strict=True):
             dx = r00 * ax + r01 * ay - bx
             dy = r10 * ax + r11 * ay - by
             dz = r20 * ax + r21 * ay + z

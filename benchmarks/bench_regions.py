@@ -31,7 +31,7 @@ def run(samples: int = 360, naive_cells: int = 2000, seed: int = 0) -> dict:
     agree = 0
     for i, k in cells:
         T, D = classify_spherical_4r(task.C, curves.u[i], curves.v[i], curves.u[k], curves.v[k])
-        agree += int(T == region.type[i, k] and D == region.defects[i, k])
+        agree += int(region.type[i, k] == T and region.defects[i, k] == D)
     t_naive = time.perf_counter() - t0
     return {
         "cells": region.n_cells,

@@ -69,7 +69,8 @@ def main(argv=None):
         prev = configuration_at_pose(mech, P, start=prev).config
         fits.append(prev)
     out = {}
-    djf = lambda c: driver_determinants(mech, c, drivers)
+    def djf(c):
+        return driver_determinants(mech, c, drivers)
     if not args.quick:
         t = time.perf_counter()
         tr = trace_motion(mech, fits[0], increasing="rot1", max_arc=400, vector_monitor=(drivers, djf))
@@ -86,7 +87,7 @@ def main(argv=None):
     t_ours = time.perf_counter() - t
     steps = max(4, len(tr.points)) if not args.quick else 4
     t = time.perf_counter()
-    cfgs, nfev, ok = scipy_tracker(mech, fits[0], i_rot1, target if not args.quick else fits[0].q[i_rot1] + 0.05, steps)
+    _cfgs, nfev, ok = scipy_tracker(mech, fits[0], i_rot1, target if not args.quick else fits[0].q[i_rot1] + 0.05, steps)
     t_scipy = time.perf_counter() - t
     out.update({
         "path": "P1 -> P7 of five-cs-3, driver rot1 (monotonic there)",

@@ -5,11 +5,10 @@ figs 15-16): with any other driver the linkage would pass a singularity (a branc
 between two positions.
 """
 
-from spatialmech import catalog
-from spatialmech.analysis.defects import dj_table
+import spatialmech as sm
 
-mech = catalog.build("five-cs-3")
-table = dj_table(mech)
+mech = sm.load_model("five-cs-3")
+table = sm.dj_table(mech)
 print(f"{mech.name}: sign of DJ at {', '.join(table.positions)}")
 for i, d in enumerate(table.drivers):
     signs = " ".join("+" if s > 0 else "-" for s in table.signs[i])

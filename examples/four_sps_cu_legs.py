@@ -7,13 +7,15 @@ lengths are eq 8 corrected (l_i = |T A_i - B_i|); Jx = dl/dphi is eq 9's L^-1 J.
 
 import numpy as np
 
-from spatialmech.kinematics.closed_forms import four_sps_cu as k
+import spatialmech as sm
+
+k = sm.closed_forms.four_sps_cu                  # the paper-B closed forms, vectorised
 
 t = np.linspace(0.0, 2.0, 9)
 phi = np.stack([0.2 + 0.02 * np.sin(2 * np.pi * t), 0.25 * np.cos(np.pi * t), 0.25 * np.sin(np.pi * t),
                 0.3 * np.sin(np.pi * t)], axis=-1)
 legs = k.leg_lengths(phi)                        # (9, 4), vectorised over the poses
-for ti, l in zip(t, legs):
+for ti, l in zip(t, legs, strict=True):
     print(f"t = {ti:4.2f} s  legs [m] = {np.round(l, 5)}")
 
 Jx = k.jacobian_x(phi)                           # (9, 4, 4)

@@ -8,10 +8,10 @@ for three positions, approximate for four).
 
 import numpy as np
 
-from spatialmech.synthesis import get_task, synthesize_rccc
+import spatialmech as sm
 
-task = get_task("rccc-four-positions")
-res = synthesize_rccc(task)
+res = sm.synth_rccc("rccc-four-positions")
+task = res.task
 u = task.length_unit
 print(f"spherical 4R: {res.linkage_type}, defects: {res.defects}")
 print(f"input slides replaced by the R joint: {np.round(res.slides, 3)} {u}")

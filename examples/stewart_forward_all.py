@@ -9,17 +9,17 @@ base plane (the same leg lengths with the platform below the base).
 import numpy as np
 
 import spatialmech as sm
-from spatialmech.kinematics.closed_forms import sps
-from spatialmech.kinematics.position import forward_position, inverse_position
+
+sps = sm.closed_forms.sps                                                            # |R a_i + p - b_i|
 
 mech = sm.load_model("stewart-6sps")
 pose = sm.Pose.from_euler("ZYX", [12, -6, 4], [0.03, -0.02, 1.05], degrees=True)   # Rz(12) Ry(-6) Rx(4), metres
-legs = np.array(list(inverse_position(mech, pose).actuator_values(mech).values()))
+legs = np.array(list(sm.ik(mech, pose).actuators.values()))
 print("leg lengths [m]:", np.round(legs, 6))
 
-res = forward_position(mech, legs, all_solutions=True, n_seeds=40, seed=2)
-modes = [s for s in res.solutions if s.converged]
-print(f"{len(modes)} assembly modes found ({res.search['seeds']} starts; a multi-start search cannot prove completeness)")
+res = sm.fk(mech, legs, all_solutions=True, seeds=40, seed=2)
+modes = [s for s in res.result.solutions if s.converged]
+print(f"{len(modes)} assembly modes found ({res.result.search['seeds']} starts; a multi-start search cannot prove completeness)")
 for s in modes:
     print("  platform point", np.round(s.pose.p, 4), "| within limits" if not s.outside_limits else "| outside limits")
 

@@ -4,15 +4,15 @@ import numpy as np
 import pytest
 from hypothesis import settings
 from hypothesis import strategies as st
+from scipy.spatial.transform import Rotation
+
+from spatialmech.geometry.rotations import transform
 
 # No per-example deadline (machines differ in load); in CI the examples are derandomised so a
 # run is reproducible (locally they stay random, to keep finding new cases).
 settings.register_profile("spatialmech", deadline=None)
 settings.register_profile("spatialmech-ci", deadline=None, derandomize=True)
 settings.load_profile("spatialmech-ci" if os.environ.get("CI") else "spatialmech")
-from scipy.spatial.transform import Rotation
-
-from spatialmech.geometry.rotations import transform
 
 
 @pytest.fixture

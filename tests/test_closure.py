@@ -25,7 +25,8 @@ def test_spatial_jacobian_matches_finite_differences(name, rng):
         T, J = limb_forward(S[sl], q)
         h = 1e-6
         for i in range(len(q)):
-            dq = np.zeros_like(q); dq[i] = h
+            dq = np.zeros_like(q)
+            dq[i] = h
             Tp, _ = limb_forward(S[sl], q + dq)
             Tm, _ = limb_forward(S[sl], q - dq)
             # spatial twist: dT T^-1
@@ -61,7 +62,8 @@ def test_newton_correction_converges_quadratically_from_a_perturbation():
 def test_newton_reports_non_convergence_instead_of_raising():
     mech = catalog.build("planar-4r")
     # with every joint held, a crank angle that the rocker cannot follow has no closure
-    q = np.zeros(len(mech.freedom_refs)); q[0] = 0.3
+    q = np.zeros(len(mech.freedom_refs))
+    q[0] = 0.3
     res = correct(mech, Configuration(q, np.eye(4)), active=np.zeros(len(q), bool), max_iter=20)
     assert not res.converged and res.residual > 1e-3
 
@@ -76,7 +78,7 @@ def test_inverse_position_with_the_platform_held():
     from spatialmech.kinematics.closure import joint_points
     pa = joint_points(mech, res.config)
     pb = joint_points(mech, target)
-    for a, b in zip(pa, pb):
+    for a, b in zip(pa, pb, strict=True):
         assert np.allclose(a, b, atol=1e-9)
 
 
@@ -86,7 +88,7 @@ def test_joint_points_follow_the_platform():
     from spatialmech.kinematics.closure import joint_points
     pts = joint_points(mech, c)
     # each leg's last joint (S on the platform) is the displaced reference point
-    for limb, p in zip(mech.limbs[:4], pts[:4]):
+    for limb, p in zip(mech.limbs[:4], pts[:4], strict=True):
         A0 = limb.joints[-1].point
         assert np.allclose(p[-1], c.D[:3, :3] @ A0 + c.D[:3, 3], atol=1e-10)
         assert np.allclose(p[0], limb.joints[0].point)  # base joints stay put
@@ -101,7 +103,8 @@ def test_chain_jacobian_with_ball_joints_matches_finite_differences(name, rng):
         T, J = chain_forward(ch, q)
         h = 1e-6
         for i in range(len(q)):
-            dq = np.zeros_like(q); dq[i] = h
+            dq = np.zeros_like(q)
+            dq[i] = h
             Tp, _ = chain_forward(ch, q + dq)
             Tm, _ = chain_forward(ch, q - dq)
             V = (log_transform(Tp @ inverse_transform(T)) - log_transform(Tm @ inverse_transform(T))) / (2 * h)
@@ -113,11 +116,13 @@ def test_ball_joint_has_no_gimbal_lock_at_ninety_degrees():
     from spatialmech.kinematics.closure import chain_forward, limb_chains, recentre_balls
     mech = catalog.build("rssr")
     ch = limb_chains(mech)[0]  # R, S, S
-    q = np.zeros(len(ch.screws)); q[2] = np.pi / 2  # S about its y axis by 90 degrees
+    q = np.zeros(len(ch.screws))
+    q[2] = np.pi / 2  # S about its y axis by 90 degrees
     _, J = chain_forward(ch, q)
     assert rank(J[:, 1:4].T) == 3
     # re-centring a rotation vector beyond pi keeps the displacement
-    q2 = np.zeros(len(mech.freedom_refs)); q2[1:4] = [2.5, -2.0, 1.0]
+    q2 = np.zeros(len(mech.freedom_refs))
+    q2[1:4] = [2.5, -2.0, 1.0]
     q3 = recentre_balls(mech, q2)
     assert np.linalg.norm(q3[1:4]) < np.pi
     assert np.allclose(chain_forward(ch, q2[:7])[0], chain_forward(ch, q3[:7])[0])

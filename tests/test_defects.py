@@ -1,5 +1,6 @@
 """Defect judgement: every claim of paper A (linkages 1-3), and the same code on a four-bar."""
 
+import itertools
 import json
 
 import numpy as np
@@ -41,18 +42,21 @@ def test_candidate_drivers_of_the_five_cs_are_the_ten_c_freedoms():
                                                              "rot4", "slide4", "rot5", "slide5"]
 
 
+@pytest.mark.slow
 def test_paper_A_linkage1_every_driver_changes_sign_figs_6_7(linkage1):
     assert all(not v.keeps_sign for v in linkage1.drivers)
 
 
+@pytest.mark.slow
 def test_paper_A_linkage1_one_circuit_no_order_defect_fig_11(linkage1):
     assert linkage1.circuits == ((1, 2, 3, 4, 5, 6, 7),)
     assert not linkage1.circuit_defect and not linkage1.order_defect
     assert linkage1.circuit_closed == (True,)
     arcs = linkage1.position_arcs
-    assert all(a < b for a, b in zip(arcs, arcs[1:]))
+    assert all(a < b for a, b in itertools.pairwise(arcs))
 
 
+@pytest.mark.slow
 def test_paper_A_linkage1_K2_of_rot1_between_P6_P7_and_K1_of_rot5_between_P3_P4(linkage1):
     d = by_driver(linkage1)
     assert [b.between for b in d["rot1"].branch_points] == [(6, 7)]
@@ -60,6 +64,7 @@ def test_paper_A_linkage1_K2_of_rot1_between_P6_P7_and_K1_of_rot5_between_P3_P4(
     assert not linkage1.usable_drivers
 
 
+@pytest.mark.slow
 def test_paper_A_linkage1_dual_drive_rot1_then_rot5_switching_between_K1_and_K2_fig_14(linkage1):
     plan = linkage1.plan
     assert plan is not None and [s.driver for s in plan] == ["rot1", "rot5"]
@@ -72,20 +77,24 @@ def test_paper_A_linkage1_dual_drive_rot1_then_rot5_switching_between_K1_and_K2_
     assert plan[1].end_arc == pytest.approx(linkage1.path_length)
 
 
+@pytest.mark.slow
 def test_paper_A_linkage2_slides_3_4_5_keep_sign_figs_8_9(linkage2):
     assert {v.driver for v in linkage2.drivers if v.keeps_sign} == {"slide3", "slide4", "slide5"}
 
 
+@pytest.mark.slow
 def test_paper_A_linkage2_circuit_defect_three_circuits_fig_10(linkage2):
     assert linkage2.circuit_defect
     assert linkage2.circuits == ((1,), (2, 3), (4, 5, 6, 7))
     assert not linkage2.usable_drivers and linkage2.plan is None
 
 
+@pytest.mark.slow
 def test_paper_A_linkage3_rot1_rot2_keep_sign_others_change_figs_15_16(linkage3):
     assert {v.driver for v in linkage3.drivers if v.keeps_sign} == {"rot1", "rot2"}
 
 
+@pytest.mark.slow
 def test_paper_A_linkage3_usable_one_circuit_in_order_no_dj_zero_figs_17_19(linkage3):
     assert linkage3.circuits == ((1, 2, 3, 4, 5, 6, 7),) and not linkage3.order_defect
     d = by_driver(linkage3)
@@ -93,6 +102,7 @@ def test_paper_A_linkage3_usable_one_circuit_in_order_no_dj_zero_figs_17_19(link
     assert set(linkage3.usable_drivers) == {"rot1", "rot2"}
 
 
+@pytest.mark.slow
 def test_paper_A_linkage3_passes_close_to_a_singularity_between_P3_and_P4(linkage3):
     # reported, not hidden: the smallest scale-free singular value of the closure Jacobian on the path
     assert linkage3.min_closure_sigma_between == (3, 4)
@@ -100,6 +110,7 @@ def test_paper_A_linkage3_passes_close_to_a_singularity_between_P3_and_P4(linkag
     assert 0 < by_driver(linkage3)["rot1"].min_sigma_on_path < 1e-2
 
 
+@pytest.mark.slow
 def test_dj_zeros_sit_where_the_driver_turns(linkage1):
     """Along a tracked path DJ changes sign exactly where the driver reaches a turning point."""
     mech = catalog.build("five-cs-1")
@@ -142,15 +153,19 @@ def test_scrambled_positions_give_an_order_defect(fourbar):
 def rccc():
     """A small RCCC guidance linkage (coupler as platform): 1 DOF, not overconstrained."""
     z = np.array([0, 0, 1.0])
-    a1 = np.array([0.2, 0.3, 0.93]); a1 /= np.linalg.norm(a1)
-    b0 = np.array([0.1, 0.9, 0.2]); b0 /= np.linalg.norm(b0)
-    b1 = np.array([0.8, 0.1, 0.4]); b1 /= np.linalg.norm(b1)
+    a1 = np.array([0.2, 0.3, 0.93])
+    a1 /= np.linalg.norm(a1)
+    b0 = np.array([0.1, 0.9, 0.2])
+    b0 /= np.linalg.norm(b0)
+    b1 = np.array([0.8, 0.1, 0.4])
+    b1 /= np.linalg.norm(b1)
     return sm.Mechanism("rccc-test", [
         sm.Limb("input", [sm.R("A0", [0, 0, 0], z, actuated=True), sm.C("A1", [1.0, 0, 0.2], a1)]),
         sm.Limb("output", [sm.C("B0", [3.0, 0.5, 0], b0), sm.C("B1", [2.2, 1.8, 0.6], b1)]),
     ], platform_point=[1.6, 1.0, 0.4])
 
 
+@pytest.mark.slow
 def test_monte_carlo_is_seeded_and_reports():
     m = rccc()
     tr = trace_motion(m, Configuration.reference(m), increasing="A0", max_arc=60)
@@ -181,8 +196,9 @@ def test_bad_inputs(fourbar):
         defect_analysis(m, poses, drivers=["nope"])
 
 
+@pytest.mark.slow
 def test_cli_json_layout_and_positions_file(fourbar, tmp_path):
-    m, poses = fourbar
+    _m, poses = fourbar
     f = tmp_path / "pos.toml"
     lines = []
     for p in poses:
@@ -201,4 +217,4 @@ def test_cli_json_layout_and_positions_file(fourbar, tmp_path):
     for key in ("driver", "signs", "branch_points", "circuit_branch_points", "branch_defect", "usable"):
         assert key in drv["A0"]
     assert d["circuits"] == [[1, 2, 3, 4, 5, 6]] and d["usable_drivers"] == ["A0"]
-    assert len(list((tmp_path / "figs").glob("*.png"))) == 4
+    assert len(list((tmp_path / "figs").glob("*.png"))) == 4 and len(d["figures"]) == 4

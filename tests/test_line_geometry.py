@@ -43,7 +43,8 @@ def lines_in_system(system, n, rng):
     out = []
     while len(out) < n:
         u, v = rng.standard_normal(len(B)) @ B, rng.standard_normal(len(B)) @ B
-        k = lambda x, y: x[:3] @ y[3:] + y[:3] @ x[3:]
+        def k(x, y):
+            return x[:3] @ y[3:] + y[:3] @ x[3:]
         a, b, c = k(v, v) / 2, k(u, v), k(u, u) / 2
         disc = b * b - 4 * a * c
         if disc < 0 or abs(a) < 1e-9:
@@ -109,10 +110,13 @@ def test_coplanar_lines_rank_3_with_their_plane(seed):
     rng = np.random.default_rng(seed)
     T = random_transform(seed)
     n = unit(rng)
-    e1 = unit(rng); e1 -= n * (n @ e1); e1 /= np.linalg.norm(e1)
+    e1 = unit(rng)
+    e1 -= n * (n @ e1)
+    e1 /= np.linalg.norm(e1)
     e2 = np.cross(n, e1)
     q = rng.uniform(-1, 1, 3)
-    pts = lambda: q + rng.uniform(-1, 1) * e1 + rng.uniform(-1, 1) * e2
+    def pts():
+        return q + rng.uniform(-1, 1) * e1 + rng.uniform(-1, 1) * e2
     L = np.array([through(pts(), pts()) for _ in range(4)])
     for lines, nn, qq in ((L, n, q), (moved(T, L), T[:3, :3] @ n, move_point(T, q))):
         g = classify_lines(lines, length_scale=L0)
@@ -128,7 +132,8 @@ def test_rank_2_and_rank_1_sets(seed):
     rng = np.random.default_rng(seed)
     T = random_transform(seed)
     p, n = rng.uniform(-1, 1, 3), unit(rng)
-    inplane = lambda: np.cross(n, unit(rng))
+    def inplane():
+        return np.cross(n, unit(rng))
     pencil = np.array([line(inplane(), p) for _ in range(3)])
     d = inplane()
     par_pencil = np.array([line(d, p + k * np.cross(n, d)) for k in (0.0, 0.3, -0.7)])
@@ -153,8 +158,10 @@ def test_two_planar_pencils_sharing_a_line(seed):
     P, Q = rng.uniform(-1, 1, 3), rng.uniform(-1, 1, 3)
     u = (Q - P) / np.linalg.norm(Q - P)
     w1, w2 = unit(rng), unit(rng)
-    in1 = lambda: np.cross(u, w1) * rng.uniform(0.5, 1) + u * rng.uniform(-1, 1)
-    in2 = lambda: np.cross(u, w2) * rng.uniform(0.5, 1) + u * rng.uniform(-1, 1)
+    def in1():
+        return np.cross(u, w1) * rng.uniform(0.5, 1) + u * rng.uniform(-1, 1)
+    def in2():
+        return np.cross(u, w2) * rng.uniform(0.5, 1) + u * rng.uniform(-1, 1)
     L = np.array([line(in1(), P), line(in1(), P), line(in2(), Q), line(in2(), Q)])
     T = random_transform(seed)
     for lines, PP, QQ in ((L, P, Q), (moved(T, L), move_point(T, P), move_point(T, Q))):
@@ -262,7 +269,8 @@ def test_complexes_and_general_sets(seed):
     v = unit(rng)
     perp = np.array([line(np.cross(v, unit(rng)), rng.uniform(-1, 1, 3)) for _ in range(5)])
     h = rng.uniform(0.1, 0.5) * rng.choice([-1, 1])
-    W = A.copy(); W[3:] += h * A[:3]
+    W = A.copy()
+    W[3:] += h * A[:3]
     general_complex = lines_in_system(sc.reciprocal_basis(W[None, :]), 5, rng)
     g = classify_lines(moved(T, special), length_scale=L0)
     assert (g.rank, g.case) == (5, "special-complex")
@@ -289,7 +297,8 @@ def test_classification_does_not_depend_on_the_unit_of_length(seed, k):
     w, w2 = unit(rng), unit(rng)
     L = np.array([line(np.cross(u, w) + u * 0.3, P), line(np.cross(u, w) - u, P),
                   line(np.cross(u, w2) + u, Q), line(np.cross(u, w2) - u * 0.2, Q)])
-    Lk = L.copy(); Lk[:, 3:] *= k
+    Lk = L.copy()
+    Lk[:, 3:] *= k
     g, gk = classify_lines(L, length_scale=1.0), classify_lines(Lk, length_scale=k)
     assert g.case == gk.case == "two-pencils-sharing-a-line"
     assert np.allclose(gk.witnesses["pencils"][0]["point"], k * g.witnesses["pencils"][0]["point"], atol=1e-8 * k)
@@ -328,7 +337,7 @@ def paper_b_lines(a, b, z, alpha=0.0, beta=0.0, gamma=0.0):
     T = euler_matrix("ZYX", [gamma, beta, alpha])
     U = np.array([0.0, 0.0, z])
     legs = [through(B[i], T @ A[i] + U) for i in range(4)]
-    return np.array(legs + [line([1, 0, 0], U), line([0, 1, 0], U)])
+    return np.array([*legs, line([1, 0, 0], U), line([0, 1, 0], U)])
 
 
 def test_paper_b_lines_agree_with_the_mechanism_model():
@@ -398,7 +407,7 @@ def _case_c_lines(P14, P23, u=(0.0, 0.0, 0.2)):
     _, B = four_sps_cu_points(0.1, 0.2)
     u = np.asarray(u, float)
     legs = [through(B[0], P14), through(B[1], P23), through(B[2], P23), through(B[3], P14)]
-    return np.array(legs + [line([1, 0, 0], u), line([0, 1, 0], u)])
+    return np.array([*legs, line([1, 0, 0], u), line([0, 1, 0], u)])
 
 
 def test_paper_b_case_c_true_condition_drops_the_rank():
@@ -420,7 +429,7 @@ def test_paper_b_case_c_true_condition_drops_the_rank():
     assert [p["lines"] for p in pens] == [[0, 3], [1, 2]]
     assert np.allclose(pens[0]["point"], P14, atol=1e-12) and np.allclose(pens[1]["point"], P23, atol=1e-12)
     _, B = four_sps_cu_points(0.1, 0.2)
-    for p, (i, j) in zip(pens, [(0, 3), (1, 2)]):  # plane A_i A_j B_j B_i contains B_i, B_j
+    for p, (i, j) in zip(pens, [(0, 3), (1, 2)], strict=True):  # plane A_i A_j B_j B_i contains B_i, B_j
         n, c0 = p["plane"]["normal"], p["plane"]["offset"]
         assert abs(n @ B[i] - c0) < 1e-12 and abs(n @ B[j] - c0) < 1e-12
 

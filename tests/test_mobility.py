@@ -107,7 +107,7 @@ def test_disagreement_at_a_special_reference_configuration_is_reported():
 
 
 def test_motion_type_names_and_classes():
-    X, Y, Z = np.eye(3)
+    _X, _Y, Z = np.eye(3)
     assert motion_type([np.r_[Z, 0, 0, 0], np.r_[0, 0, 0, Z]], [0, 0, 0]) == ("RzTz", "1R1T")
     # a rotation about z through (1, 0, 0) seen from the origin is not a pure Rz there
     assert motion_type([np.r_[Z, np.cross([1, 0, 0], Z)]], [0, 0, 0]) == ("1R", "1R")

@@ -52,7 +52,7 @@ def test_every_ready_made_model_round_trips_through_toml(name):
         (f.freedom.actuated, f.freedom.lockable, f.freedom.limits, f.freedom.offset) for f in m2.freedom_refs
     ]
     assert [m.name for m in m.all_modes()] == [m.name for m in m2.all_modes()]
-    for p, q in zip(m.positions, m2.positions):
+    for p, q in zip(m.positions, m2.positions, strict=True):
         assert np.allclose(p.R, q.R, atol=1e-12) and np.allclose(p.p, q.p)
 
 
@@ -90,7 +90,8 @@ def test_bad_files_give_one_line_errors_naming_the_field(kind):
     assert "\n" not in str(e.value)
 
 
-@pytest.mark.parametrize("kind", ["unknown joint type", "NaN", "malformed TOML"])
+@pytest.mark.parametrize("kind", ["unknown joint type", pytest.param("NaN", marks=pytest.mark.slow),
+                                  pytest.param("malformed TOML", marks=pytest.mark.slow)])  # a subprocess each
 def test_cli_reports_bad_files_in_one_line_with_exit_code_2(kind, tmp_path):
     text, msg = BAD[kind]
     f = tmp_path / "bad.toml"

@@ -30,7 +30,8 @@ def test_reciprocal_basis_is_reciprocal_and_complementary(seed, m):
     rng = np.random.default_rng(seed)
     # m screws of random rank r <= m: combinations of r random lines
     r = int(rng.integers(1, m + 1))
-    lines = np.array([sc.axis_screw(d / np.linalg.norm(d), p) for d, p in zip(rng.normal(size=(r, 3)), rng.normal(size=(r, 3)) * 3)])
+    dirs, pts = rng.normal(size=(r, 3)), rng.normal(size=(r, 3)) * 3
+    lines = np.array([sc.axis_screw(d / np.linalg.norm(d), p) for d, p in zip(dirs, pts, strict=True)])
     S = rng.normal(size=(m, r)) @ lines
     W = sc.reciprocal_basis(S, length_scale=3.0)
     assert W.shape == (6 - sc.rank(S, length_scale=3.0), 6)
@@ -42,10 +43,11 @@ def test_reciprocal_basis_is_reciprocal_and_complementary(seed, m):
 def test_reciprocal_basis_scale_aware():
     # the same geometry in millimetres and in metres has the same constraint system size
     rng = np.random.default_rng(1)
-    d = rng.normal(size=(5, 3)); d /= np.linalg.norm(d, axis=1, keepdims=True)
+    d = rng.normal(size=(5, 3))
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
     p = rng.normal(size=(5, 3))
-    S_m = np.array([sc.axis_screw(di, pi) for di, pi in zip(d, p)])
-    S_mm = np.array([sc.axis_screw(di, 1000 * pi) for di, pi in zip(d, p)])
+    S_m = np.array([sc.axis_screw(di, pi) for di, pi in zip(d, p, strict=True)])
+    S_mm = np.array([sc.axis_screw(di, 1000 * pi) for di, pi in zip(d, p, strict=True)])
     assert sc.rank(S_m, length_scale=1.0) == 5
     assert sc.rank(S_mm, length_scale=1000.0) == 5
     assert sc.reciprocal_basis(S_mm, length_scale=1000.0).shape == (1, 6)

@@ -89,6 +89,7 @@ def test_inverse_singularity_of_the_rssr_at_the_rocker_limit():
     assert r.kind.startswith("inverse") and r.transmission[0] < 1e-9
 
 
+@pytest.mark.slow
 def test_slice_det_changes_sign_across_the_workspace():
     res = singularity_slice(M, lambda u, v: pose(0.12, np.radians(v), np.radians(u), np.radians(20)),
                             np.linspace(-20, 20, 9), np.linspace(-20, 20, 9))
@@ -97,13 +98,15 @@ def test_slice_det_changes_sign_across_the_workspace():
     assert res.sigma_min[4, 4] < 1e-10  # alpha = beta = 0 in the middle
 
 
+@pytest.mark.slow
 def test_cli_singularity_json_keys_and_errors(tmp_path):
-    r = CliRunner().invoke(cli, ["singularity", "four-sps-cu", "--xyz", "0", "0", "0.12", "--euler", "ZYX", "34.38", "-5.73", "11.46", "--json"])
+    r = CliRunner().invoke(cli, ["singularity", "four-sps-cu", "--xyz", "0", "0", "0.12",
+                                 "--euler", "ZYX", "34.38", "-5.73", "11.46", "--json"])
     assert r.exit_code == 0, r.output
     d = json.loads(r.output)
     for k in ("rank", "kind", "line_geometry", "twist"):
         assert k in d
-    assert d["kind"] == "none" and d["rank"] == 6
+    assert d["kind"] == "none" and d["rank"] == 6 and d["result"] == "singularity"
     r = CliRunner().invoke(cli, ["singularity", "four-sps-cu", "--reference", "--json"])
     assert json.loads(r.output)["kind"] == "direct"
     p = tmp_path / "loci.png"

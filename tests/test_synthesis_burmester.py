@@ -92,7 +92,8 @@ def test_cubic_coefficients_reproduce_the_determinant(task, rng):
 def _roots_on_great_circle(K, m):
     """Number of real points of the cubic on the great circle normal to m (a projective line):
     independent of the tracer, from the cubic restricted to the circle."""
-    a = np.cross(m, [0.3, -0.5, 0.8]); a /= np.linalg.norm(a)
+    a = np.cross(m, [0.3, -0.5, 0.8])
+    a /= np.linalg.norm(a)
     b = np.cross(m, a)
     th = np.array([0.0, 0.5, 1.0, 1.5])
     V = np.stack([np.cos(th) ** (3 - i) * np.sin(th) ** i for i in range(4)], axis=-1)
@@ -114,6 +115,7 @@ def _crossings(curves, m):
     return n
 
 
+@pytest.mark.slow
 @settings(max_examples=6, deadline=None)
 @given(seeds)
 def test_tracing_finds_every_real_branch_including_ovals(seed):
@@ -124,7 +126,8 @@ def test_tracing_finds_every_real_branch_including_ovals(seed):
     assert np.max(np.abs(burmester_det(c.K_circle, c.u))) < 1e-12
     rng = np.random.default_rng(seed)
     for _ in range(8):
-        m = rng.normal(size=3); m /= np.linalg.norm(m)
+        m = rng.normal(size=3)
+        m /= np.linalg.norm(m)
         assert _crossings(c, m) == _roots_on_great_circle(c.K_circle, m)
 
 

@@ -29,6 +29,7 @@ def interior(task):
     return synthesize_rccc(task, pick="interior", samples=120, stride=1)
 
 
+@pytest.mark.slow
 def test_rccc_closure_reproduces_the_four_orientations_to_1e_9(best, interior):
     """Done-when item: with the input R angle held at the spherical 4R's value, the RCCC's
     closure (Gauss-Newton, every other joint and the coupler free) converges at positions 2-4 and
@@ -40,6 +41,7 @@ def test_rccc_closure_reproduces_the_four_orientations_to_1e_9(best, interior):
             assert np.linalg.norm(closure_residual(res.linkage, cfg)) < 1e-9
 
 
+@pytest.mark.slow
 def test_rccc_best_pick_is_a_defect_free_crank_rocker_with_small_slides(best, task):
     """Measured (table 1, 120 samples per branch): the best RC input dyad among defect-free
     crank-rockers leaves max |slide| = 2.8 mm (paper: 'approximate for four positions'); the
@@ -53,6 +55,7 @@ def test_rccc_best_pick_is_a_defect_free_crank_rocker_with_small_slides(best, ta
     assert np.allclose(best.slides, best.input_dyad.fixed_slides(task), atol=1e-9)
 
 
+@pytest.mark.slow
 def test_interior_pick_is_worse_for_the_r_joint_than_the_best_pick(best, interior):
     """The most interior crank-rocker (like the paper's m1) needs a larger input slide than the
     search over the Burmester curve."""
@@ -60,6 +63,7 @@ def test_interior_pick_is_worse_for_the_r_joint_than_the_best_pick(best, interio
     assert interior.max_abs_slide > best.max_abs_slide
 
 
+@pytest.mark.slow
 def test_exact_4c_for_four_positions(best, task):
     """The same dyads with a C joint at the input: positions and orientations exact (1e-9)."""
     din = replace(best.input_dyad, kind="CC")
@@ -70,6 +74,7 @@ def test_exact_4c_for_four_positions(best, task):
     assert sm.mobility(mech).dof == 2
 
 
+@pytest.mark.slow
 def test_saved_rccc_loads_back_with_mobility_one(best, tmp_path):
     f = tmp_path / "rccc.toml"
     sm.dump(best.linkage, f)
@@ -80,14 +85,16 @@ def test_saved_rccc_loads_back_with_mobility_one(best, tmp_path):
     assert len(m.positions) == 4
 
 
+@pytest.mark.slow
 def test_result_to_dict_is_json(best):
     d = json.loads(json.dumps(best.to_dict()))
-    for key in ("input_dyad", "output_dyad", "max_abs_slide", "slides", "position_errors",
+    for key in ("input_dyad", "output_dyad", "max_abs_slide_len", "slides_len", "position_errors_len",
                 "orientation_errors_deg", "linkage"):
         assert key in d
-    assert len(d["slides"]) == len(d["position_errors"]) == len(d["orientation_errors_deg"]) == 3
+    assert len(d["slides_len"]) == len(d["position_errors_len"]) == len(d["orientation_errors_deg"]) == 3
 
 
+@pytest.mark.slow
 def test_cli_synth_rccc_json_save_and_plot(tmp_path):
     from spatialmech.interfaces.cmd_synth import synth
 
@@ -95,7 +102,8 @@ def test_cli_synth_rccc_json_save_and_plot(tmp_path):
                                    "--plot", str(tmp_path / "figs")])
     assert r.exit_code == 0, r.output
     d = json.loads(r.output)
-    assert d["max_abs_slide"] == pytest.approx(max(abs(s) for s in d["slides"]))
+    assert d["command"] == "synth rccc" and d["length_unit"] == "mm"
+    assert d["max_abs_slide_len"] == pytest.approx(max(abs(s) for s in d["slides_len"]))
     assert max(d["orientation_errors_deg"]) < 1e-7
     assert sm.mobility(sm.load(tmp_path / "m.toml")).dof == 1
     figs = sorted(p.name for p in (tmp_path / "figs").iterdir())
@@ -118,6 +126,7 @@ def test_cli_user_errors_raise_value_or_key_errors(tmp_path):
     assert isinstance(r.exception, ValueError) and "needs exactly 4 positions, got 3" in str(r.exception)
 
 
+@pytest.mark.slow
 def test_region_benchmark_smoke():
     import importlib.util
     from pathlib import Path

@@ -25,8 +25,11 @@ def brute_classify(C, u_in, v_in, u_out, v_out, n=720):
     F = A @ B.T - cb             # F[theta, psi]
     dB = np.cross(v_out, B)      # dB/dpsi
     Fpsi = A @ dB.T
-    Fr = np.roll(F, -1, 0); Fc = np.roll(F, -1, 1); Frc = np.roll(Fr, -1, 1)
-    mn = np.minimum(np.minimum(F, Fr), np.minimum(Fc, Frc)); mx = np.maximum(np.maximum(F, Fr), np.maximum(Fc, Frc))
+    Fr = np.roll(F, -1, 0)
+    Fc = np.roll(F, -1, 1)
+    Frc = np.roll(Fr, -1, 1)
+    mn = np.minimum(np.minimum(F, Fr), np.minimum(Fc, Frc))
+    mx = np.maximum(np.maximum(F, Fr), np.maximum(Fc, Frc))
     zero = (mn <= 0) & (mx >= 0)
     in_crank = bool(np.all(zero.any(axis=1)))
     out_crank = bool(np.all(zero.any(axis=0)))
@@ -35,34 +38,43 @@ def brute_classify(C, u_in, v_in, u_out, v_out, n=720):
         # merge across wrap
         parent = list(range(k+1))
         def find(a):
-            while parent[a]!=a: parent[a]=parent[parent[a]]; a=parent[a]
+            while parent[a] != a:
+                parent[a] = parent[parent[a]]
+                a = parent[a]
             return a
         def union(a,b):
-            if a and b: parent[find(a)] = find(b)
+            if a and b:
+                parent[find(a)] = find(b)
         for i in range(n):
             for di in (-1,0,1):
-                union(lab[i,0], lab[(i+di)%n,-1]); union(lab[0,i], lab[-1,(i+di)%n])
+                union(lab[i,0], lab[(i+di)%n,-1])
+                union(lab[0,i], lab[-1,(i+di)%n])
         roots = np.array([find(i) for i in range(k + 1)])
         return roots[lab]
     circ = label_periodic(zero)
     br = label_periodic(zero & (Fpsi > 0)) * 1 + label_periodic(zero & (Fpsi <= 0)) * 100000
     Cs = np.concatenate([np.eye(3)[None], C])
     def ang(axis, x0, x):
-        a = x0 - (x0@axis)*axis; b = x - (x@axis)*axis
+        a = x0 - (x0@axis)*axis
+        b = x - (x@axis)*axis
         return np.mod(np.arctan2(axis @ np.cross(a, b), a @ b), 2*np.pi)
-    tj = np.array([ang(v_in, u_in, Cj@u_in) for Cj in Cs]); pj = np.array([ang(v_out, u_out, Cj@u_out) for Cj in Cs])
+    tj = np.array([ang(v_in, u_in, Cj@u_in) for Cj in Cs])
+    pj = np.array([ang(v_out, u_out, Cj@u_out) for Cj in Cs])
     def cell(t, p):
-        i = int(np.floor(t/(2*np.pi)*n)) % n; k = int(np.floor(p/(2*np.pi)*n)) % n
+        i = int(np.floor(t/(2*np.pi)*n)) % n
+        k = int(np.floor(p/(2*np.pi)*n)) % n
         # nearest zero cell in a small window
         best=None
         for di in range(-2,3):
             for dk in range(-2,3):
-                ii=(i+di)%n; kk=(k+dk)%n
+                ii=(i+di)%n
+                kk=(k+dk)%n
                 if zero[ii,kk]:
                     dd=di*di+dk*dk
-                    if best is None or dd<best[0]: best=(dd,ii,kk)
+                    if best is None or dd < best[0]:
+                        best = (dd, ii, kk)
         return best[1], best[2]
-    cells = [cell(t,p) for t,p in zip(tj,pj)]
+    cells = [cell(t,p) for t,p in zip(tj,pj, strict=True)]
     circuits = [circ[c] for c in cells]
     branches = [br[c] for c in cells]
     circuit_defect = len(set(circuits))>1
@@ -70,13 +82,15 @@ def brute_classify(C, u_in, v_in, u_out, v_out, n=720):
     order_defect = False
     if not circuit_defect and not branch_defect:
         if in_crank:
-            ph = np.mod(tj[1:]-tj[0], 2*np.pi); d = np.diff(ph)
+            ph = np.mod(tj[1:]-tj[0], 2*np.pi)
+            d = np.diff(ph)
             order_defect = not (np.all(d>0) or np.all(d<0))
         else:
             lab = branches[0]
             cols = np.flatnonzero(~(br==lab).any(axis=1))
             ref = th[cols[len(cols)//2]]
-            ph = np.mod(tj-ref, 2*np.pi); d=np.diff(ph)
+            ph = np.mod(tj-ref, 2*np.pi)
+            d=np.diff(ph)
             order_defect = not (np.all(d>0) or np.all(d<0))
     typ = {(True,False):0,(False,True):1,(True,True):2,(False,False):3}[(in_crank,out_crank)]
     return typ, circuit_defect*1 + branch_defect*2 + order_defect*4
@@ -97,6 +111,7 @@ def region(task, curves):
     return solution_region_1(task, curves)
 
 
+@pytest.mark.slow
 def test_region1_classification_matches_brute_force_grid(task, curves, region):
     """Type and circuit/branch/order defects of cells of every kind agree with an independent
     classification on a 720 x 720 grid of the (input, output) angle torus: crank = the zero set

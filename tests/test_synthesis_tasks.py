@@ -110,7 +110,8 @@ def test_bad_task_files_give_one_line_errors_naming_the_field(text, message):
 
 def test_identical_positions_are_rejected():
     t = get_task("rccc-four-positions")
-    R = t.R.copy(); p = t.p.copy()
+    R = t.R.copy()
+    p = t.p.copy()
     R[2], p[2] = R[0], p[0]
     with pytest.raises(ValueError, match=r"positions\[2\]: identical to positions\[0\]"):
         TaskPositions(R, p)
@@ -118,7 +119,7 @@ def test_identical_positions_are_rejected():
 
 def test_fewer_than_four_positions_are_rejected_by_four_position_synthesis():
     t = get_task("rccc-four-positions").subset([0, 1, 2])
-    with pytest.raises(ValueError, match="positions: .*needs exactly 4 positions, got 3"):
+    with pytest.raises(ValueError, match=r"positions: .*needs exactly 4 positions, got 3"):
         burmester_curves(t)
     with pytest.raises(ValueError, match="needs exactly 4 positions, got 3"):
         synthesize_rccc(t)
@@ -128,10 +129,12 @@ def test_fewer_than_four_positions_are_rejected_by_four_position_synthesis():
 
 def test_nan_and_non_orthonormal_matrices_are_rejected():
     t = get_task("rccc-four-positions")
-    p = t.p.copy(); p[1, 0] = np.nan
-    with pytest.raises(ValueError, match="positions.p: contains NaN"):
+    p = t.p.copy()
+    p[1, 0] = np.nan
+    with pytest.raises(ValueError, match=r"positions\.p: contains NaN"):
         TaskPositions(t.R, p)
-    R = t.R.copy(); R[3] *= 1.01
+    R = t.R.copy()
+    R[3] *= 1.01
     with pytest.raises(ValueError, match=r"positions\[3\].matrix: not orthonormal"):
         TaskPositions(R, t.p)
     with pytest.raises(ValueError, match="latitude: contains NaN"):
@@ -141,6 +144,7 @@ def test_nan_and_non_orthonormal_matrices_are_rejected():
 def test_same_orientation_twice_makes_burmester_degenerate():
     """A pure translation between two positions: every direction solves the direction equations."""
     t = get_task("rccc-four-positions")
-    R = t.R.copy(); R[3] = R[1]
+    R = t.R.copy()
+    R[3] = R[1]
     with pytest.raises(ValueError, match="same orientation"):
         burmester_curves(TaskPositions(R, t.p))

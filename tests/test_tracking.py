@@ -57,7 +57,8 @@ def test_planar_four_bar_crank_turns_fully_rocker_oscillates():
     assert max(np.linalg.norm(closure_residual(m, c)) for c in r.points) < 1e-9
 
 
-@pytest.mark.parametrize("name, driver", [("rssr", "A0"), ("bennett", "J1"), ("five-cs-2", "rot1")])
+@pytest.mark.parametrize("name, driver", [("rssr", "A0"), pytest.param("bennett", "J1", marks=pytest.mark.slow),
+                                          pytest.param("five-cs-2", "rot1", marks=pytest.mark.slow)])
 def test_mechanism_circuits_close(name, driver):
     m = catalog.build(name)
     r = trace_motion(m, Configuration.reference(m), increasing=driver, max_arc=200)
@@ -67,9 +68,11 @@ def test_mechanism_circuits_close(name, driver):
     assert max(np.linalg.norm(closure_residual(m, c)) for c in r.points[::5]) < 1e-8 * m.characteristic_length
 
 
+@pytest.mark.slow
 def test_dj_events_along_linkage2_match_sign_changes():
     m = catalog.build("five-cs-2")
-    dj = lambda c: complete_jacobian(m, c, ["rot1"]).det
+    def dj(c):
+        return complete_jacobian(m, c, ["rot1"]).det
     r = trace_motion(m, Configuration.reference(m), increasing="rot1", monitors={"rot1": dj})
     signs = np.sign(r.monitors["rot1"])
     assert len(r.events) == int(np.sum(signs[1:] != signs[:-1]))
@@ -96,6 +99,7 @@ def test_forward_position_by_continuation_along_actuator_path():
     assert np.allclose(fk.solutions[0].config.D, target.D, atol=1e-8)
 
 
+@pytest.mark.slow
 def test_tracking_benchmark_smoke():
     import runpy
     from pathlib import Path
@@ -105,6 +109,7 @@ def test_tracking_benchmark_smoke():
     assert out["scipy_root_ok"] and out["dj_evaluations_per_s"] > 0 and out["tracker_path_status"] == "stopped"
 
 
+@pytest.mark.slow
 def test_linkage3_near_singular_stretch_is_crossed_without_jumps():
     """Between P3 and P4 linkage 3 passes close to a singularity (sigma ~ 4e-4): with large steps
     allowed, consecutive tracked points stay close (no jump to another branch) and the circuit

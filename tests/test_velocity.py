@@ -39,7 +39,8 @@ def test_stewart_inverse_velocity_and_acceleration_against_finite_differences(se
     c0 = generic_configuration(STEWART, seed=seed, step=0.2)
     V, A = rng.normal(size=6) * 0.3, rng.normal(size=6) * 0.3
     h = 1e-4
-    D = lambda t: exp_twist(V * t + 0.5 * A * t * t, 1.0) @ c0.D  # a smooth platform path
+    def D(t):
+        return exp_twist(V * t + 0.5 * A * t * t, 1.0) @ c0.D  # a smooth platform path
     # the spatial twist and its derivative of this path at t = 0
     Vs = (log_transform(D(h) @ inverse_transform(D(0))) - log_transform(D(-h) @ inverse_transform(D(0)))) / (2 * h)
     qm, q0, qp = (_legs(STEWART, _ik_at(STEWART, c0, D(t)).q) for t in (-h, 0.0, h))

@@ -113,7 +113,7 @@ def test_demo_motion_start_off_the_manifold_is_refused():
     cs = sample_motion(mech, start=Configuration(q, np.eye(4)), n=4)
     assert np.linalg.norm(closure_residual(mech, cs[0])) < CLOSE_TOL
     q[1] = np.nan
-    with pytest.raises(ValueError, match="^start.q: contains NaN"):
+    with pytest.raises(ValueError, match=r"^start\.q: contains NaN"):
         sample_motion(mech, start=Configuration(q, np.eye(4)), n=4)
 
 
@@ -124,9 +124,10 @@ def test_demo_motion_reports_failed_corrections(monkeypatch):
 
     real = motion.correct
     mech = catalog.build("bennett")
-    failing = lambda m, c, **kw: CorrectionResult(c, False, 50, 1.0)
+    def failing(m, c, **kw):
+        return CorrectionResult(c, False, 50, 1.0)
     monkeypatch.setattr(motion, "correct", failing)
-    with pytest.raises(ValueError, match="^start: not on"):
+    with pytest.raises(ValueError, match=r"^start: not on"):
         sample_motion(mech, n=4)
     calls = []
 
@@ -145,7 +146,7 @@ def test_demo_motion_of_a_structure_is_refused():
     """Two R joints with different axes hold the platform: nothing can move."""
     ez, ex = np.eye(3)[2], np.eye(3)[0]
     mech = Mechanism("locked", (Limb("a", (R("A", np.zeros(3), ez),)), Limb("b", (R("B", np.ones(3), ex),))))
-    with pytest.raises(ValueError, match="^mech: no motion"):
+    with pytest.raises(ValueError, match=r"^mech: no motion"):
         sample_motion(mech, n=4)
 
 
@@ -157,7 +158,8 @@ def test_drawing_four_sps_cu_reference():
     mech = catalog.build("four-sps-cu")
     d = drawing(mech, Configuration.reference(mech))
     assert len(d.limbs) == 5
-    side = lambda poly: np.linalg.norm(np.diff(poly, axis=0), axis=1)
+    def side(poly):
+        return np.linalg.norm(np.diff(poly, axis=0), axis=1)
     assert d.base.shape == (5, 3) and np.allclose(side(d.base), 0.4, atol=1e-12)
     assert d.platform.shape == (5, 3) and np.allclose(side(d.platform), 0.2, atol=1e-12)
     assert np.allclose(d.platform[:, 2], 0.2) and np.allclose(d.base[:, 2], 0.0)
@@ -220,7 +222,7 @@ def test_drawing_invariants_at_generic_configurations(seed):
     assert np.allclose(d.base, ref.base)
     assert np.allclose(d.platform_frame.T @ d.platform_frame, np.eye(3), atol=1e-12)
     pts = joint_points(mech, c)
-    for poly, p in zip(d.limbs, pts):
+    for poly, p in zip(d.limbs, pts, strict=True):
         assert np.allclose(poly[0], p[0]) and np.allclose(poly[-1], p[-1])
 
 
@@ -336,9 +338,11 @@ def test_cli_view_json(tmp_path):
     r = CliRunner().invoke(view, ["three-rrr-sm", "--frames", "6", "--out", str(out), "--json"])
     assert r.exit_code == 0, r.output
     d = json.loads(r.output)
-    assert d == {"out": str(out), "frames": 6, "bytes": out.stat().st_size}
+    assert d == {"schema_version": "2", "command": "view", "model": "three-rrr-sm", "length_unit": "m",
+                 "out": str(out), "frames": 6, "bytes": out.stat().st_size, "motion": "demo"}
 
 
+@pytest.mark.slow
 def test_cli_view_text_and_task_positions(tmp_path):
     out = tmp_path / "a.html"
     r = CliRunner().invoke(view, ["five-cs-2", "--frames", "4", "--out", str(out)])

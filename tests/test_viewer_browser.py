@@ -16,6 +16,9 @@ from spatialmech import catalog
 from spatialmech.present.motion import sample_motion
 from spatialmech.present.viewer import DIV_ID, viewer_figure, write_viewer
 
+#: A browser start and WebGL rendering take tens of seconds: not part of the quick loop.
+pytestmark = pytest.mark.slow
+
 CHROMIUM = os.environ.get("SPATIALMECH_CHROMIUM", "/usr/bin/chromium")
 CHROMEDRIVER = os.environ.get("SPATIALMECH_CHROMEDRIVER", "/usr/bin/chromedriver")
 #: Flags for Chromium as root without network (the project's CI machines).

@@ -54,6 +54,7 @@ def poses(ang, z=0.1):
 
 
 # ------------------------------------------------------------------ paper B, section 6
+@pytest.mark.slow
 def test_paper_b_alpha_beta_alone_are_the_platform_cone_atan_z_over_b(ws_z01):
     """Claim checked against the closed form: alpha, beta alone in +-atan(z/b) = +-26.565 deg,
     the platform-side spherical cone (eq 18) active.  The paper's 48 deg does NOT reproduce."""
@@ -67,6 +68,7 @@ def test_paper_b_alpha_beta_alone_are_the_platform_cone_atan_z_over_b(ws_z01):
     assert abs(exact - 48.0) > 20  # the printed alpha_max = 48 deg is far from the model
 
 
+@pytest.mark.slow
 def test_paper_b_gamma_alone_is_the_maximum_leg_length(ws_z01):
     """gamma alone in +-128.682 deg (leg length 0.4 m active); the paper's 65 deg does NOT reproduce."""
     exact = np.degrees(gamma_leg_limit(0.1))
@@ -77,6 +79,7 @@ def test_paper_b_gamma_alone_is_the_maximum_leg_length(ws_z01):
     assert e.hi_limit.startswith("L")
 
 
+@pytest.mark.slow
 def test_paper_b_whole_set_has_the_same_extents(ws_z01):
     """Over the whole 3-D set the extents equal the single-angle ones (conventions.md)."""
     for c in ("alpha", "beta", "gamma"):
@@ -84,6 +87,7 @@ def test_paper_b_whole_set_has_the_same_extents(ws_z01):
         assert abs(s.lo - a.lo) <= np.radians(TOL_DEG) and abs(s.hi - a.hi) <= np.radians(TOL_DEG)
 
 
+@pytest.mark.slow
 def test_paper_b_extents_at_another_height():
     """The closed forms hold at z = 0.15 m too: atan(0.15/0.2) = 36.870 deg, gamma 117.953 deg."""
     ws = orientation_workspace(MECH, at={"z": 0.15}, step=np.radians(6))
@@ -91,6 +95,7 @@ def test_paper_b_extents_at_another_height():
     assert abs(np.degrees(ws.alone["gamma"].hi) - np.degrees(gamma_leg_limit(0.15))) <= TOL_DEG
 
 
+@pytest.mark.slow
 def test_boundary_pose_has_the_leg_perpendicular_to_the_platform_normal(ws_z01):
     """Independent check of the eq 18 reading: at alpha = atan(z/b) the leg of A1 (or A2) lies in
     the platform plane direction, i.e. at 90 deg to the platform normal R e_z."""
@@ -114,6 +119,7 @@ def test_position_workspace_is_the_cu_stroke_on_the_z_axis():
     assert abs(ws.volume - 0.22) <= 2 * tol and ws.volume_unit == "m"
 
 
+@pytest.mark.slow
 def test_interference_is_active_somewhere_but_not_at_the_extents(ws_z01):
     """Link capsules of 0.01 m (eq 22): legs 1/2, 1/4, 2/3, 3/4 touch on part of the boundary at
     large gamma with tilt, but the extents are set by the cone and leg-length limits."""
@@ -126,6 +132,7 @@ def test_interference_is_active_somewhere_but_not_at_the_extents(ws_z01):
     assert not any("interference" in k for k in no_caps.active_limits)
 
 
+@pytest.mark.slow
 def test_volume_converges_with_the_grid(ws_z01):
     """Line integration of refined lengths: the volume at 5 deg and at 3.6 deg agree within 2 %."""
     fine = orientation_workspace(MECH, at={"z": 0.1}, step=np.radians(3.6), polish=False)
@@ -133,6 +140,7 @@ def test_volume_converges_with_the_grid(ws_z01):
     assert "rad^3" in ws_z01.volume_unit
 
 
+@pytest.mark.slow
 def test_polish_recovers_the_extent_when_no_grid_line_passes_through_it():
     """With bounds that keep beta = 0 off the grid, the grid lines miss the extreme pose; the
     SLSQP polish + bisection still gives atan(z/b) to the tolerance (without: > 0.2 deg off)."""
@@ -162,6 +170,7 @@ def test_kernel_legs_match_the_paper_b_closed_form(z, ang):
     assert abs(m[ck.names.index("U5 cone")] - (np.pi / 2 - np.arctan2(np.hypot(n[0], n[1]), n[2]))) < 1e-12
 
 
+@pytest.mark.slow
 def test_vectorised_kernel_equals_a_per_pose_loop_and_chunking_does_not_matter(rng):
     ck = pose_checker(MECH, paper_b_limits())
     ang = rng.uniform([-0.6, -0.6, -2.4], [0.6, 0.6, 2.4], (3000, 3))
@@ -175,6 +184,7 @@ def test_vectorised_kernel_equals_a_per_pose_loop_and_chunking_does_not_matter(r
     assert np.array_equal(a.feasible, b.feasible) and a.volume == b.volume
 
 
+@pytest.mark.slow
 def test_general_kernel_agrees_with_the_closed_form(rng):
     """Per-pose inverse position + joint points give the same margins on feasible poses and the
     same verdict everywhere (infeasible poses may differ in which assembly was tried)."""
@@ -189,6 +199,7 @@ def test_general_kernel_agrees_with_the_closed_form(rng):
     assert np.max(np.abs(mc[fc] - mg[fc])) < 1e-9
 
 
+@pytest.mark.slow
 def test_general_path_workspace_matches_on_a_slice():
     """The slow fallback on a 1-D slice (alpha = beta = 0) finds the gamma leg-length limit."""
     ws = orientation_workspace(MECH, at={"z": 0.1, "alpha": 0.0, "beta": 0.0}, step=np.radians(30),
@@ -217,6 +228,7 @@ def test_stewart_closed_form_with_a_cone_and_capsules():
     assert ws.alone["z"].lo_limit.startswith("B") and ws.alone["z"].lo_limit.endswith("cone")
 
 
+@pytest.mark.slow
 @settings(max_examples=40, deadline=None)
 @given(st.lists(st.floats(-1, 1), min_size=12, max_size=12))
 def test_segment_distance_is_the_convex_minimum(v):
@@ -238,51 +250,57 @@ def test_segment_distance_examples():
 
 # ------------------------------------------------------------------ errors and results
 def test_bad_inputs_name_the_argument():
-    with pytest.raises(ValueError, match="^at"):
+    with pytest.raises(ValueError, match=r"^at"):
         orientation_workspace(MECH, at={"q": 1.0})
-    with pytest.raises(ValueError, match="^at.z"):
+    with pytest.raises(ValueError, match=r"^at\.z"):
         orientation_workspace(MECH, at={"z": float("nan")})
-    with pytest.raises(ValueError, match="^step"):
+    with pytest.raises(ValueError, match=r"^step"):
         orientation_workspace(MECH, step=-1.0)
-    with pytest.raises(ValueError, match="^method"):
+    with pytest.raises(ValueError, match=r"^method"):
         pose_checker(catalog.build("three-rps"), method="closed-form")
-    with pytest.raises(ValueError, match="^cones"):
+    with pytest.raises(ValueError, match=r"^cones"):
         pose_checker(MECH, WorkspaceLimits((ConeLimit("L1"),)))
-    with pytest.raises(ValueError, match="^max_angle"):
+    with pytest.raises(ValueError, match=r"^max_angle"):
         ConeLimit("A1", max_angle=4.0)
-    with pytest.raises(ValueError, match="^bounds.alpha"):
+    with pytest.raises(ValueError, match=r"^bounds\.alpha"):
         orientation_workspace(MECH, bounds={"alpha": (1.0, -1.0)})
-    with pytest.raises(ValueError, match="^step"):
+    with pytest.raises(ValueError, match=r"^step"):
         orientation_workspace(MECH, at={"z": 0.1}, method="general", step=np.radians(5), max_poses=100)
 
 
+@pytest.mark.slow
 def test_to_dict_is_json_and_labelled(ws_z01):
     d = json.loads(json.dumps(ws_z01.to_dict(boundary=True)))
     for c in ("alpha", "beta", "gamma"):
-        assert len(d[f"{c}_deg"]) == 2 and len(d[f"{c}_deg_set"]) == 2
-    assert d["path"] == "closed-form" and d["volume"] > 0 and "rad^3" in d["volume_unit"]
-    assert len(d["boundary_points"]) == len(d["boundary_limits"]) == sum(d["active_limits"].values())
+        assert len(d["extents"][f"{c}_deg"]["alone"]) == 2 and len(d["extents"][f"{c}_deg"]["set"]) == 2
+    # the volume in cubic degrees: the Python attribute is in rad^3
+    assert d["path"] == "closed-form" and d["volume_deg3"] == pytest.approx(ws_z01.volume * np.degrees(1.0) ** 3)
+    assert "rad^3" in ws_z01.volume_unit and "volume" not in d
+    assert len(d["boundary_points_deg"]) == len(d["boundary_limits"]) == sum(d["active_limits"].values())
 
 
+@pytest.mark.slow
 def test_plot_writes_a_png(tmp_path, ws_z01):
     from spatialmech.analysis.workspace_plot import write_workspace_plot
 
     out = write_workspace_plot(ws_z01, tmp_path / "ws.png")
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    with pytest.raises(ValueError, match="^plot"):
+    with pytest.raises(ValueError, match=r"^plot"):
         write_workspace_plot(ws_z01, tmp_path / "ws.txt")
 
 
 # ------------------------------------------------------------------ CLI
+@pytest.mark.slow
 def test_cli_orientation_json_keys(tmp_path):
     r = CliRunner().invoke(workspace, ["four-sps-cu", "--orientation", "--at", "z=0.1", "--step-deg", "6",
                                        "--json", "--plot", str(tmp_path / "w.png")])
     assert r.exit_code == 0, r.output
     d = json.loads(r.output)
-    for key in ("alpha_deg", "beta_deg", "gamma_deg", "alpha_deg_set", "beta_deg_set", "gamma_deg_set",
-                "volume", "active_limits"):
+    assert set(d["extents"]) == {"alpha_deg", "beta_deg", "gamma_deg"}
+    for key in ("volume_deg3", "active_limits", "plot", "fixed"):
         assert key in d
-    assert d["alpha_deg"][1] == pytest.approx(np.degrees(np.arctan(0.5)), abs=TOL_DEG)
+    assert d["fixed"] == {"x_len": 0.0, "y_len": 0.0, "z_len": 0.1} and d["length_unit"] == "m"
+    assert d["extents"]["alpha_deg"]["alone"][1] == pytest.approx(np.degrees(np.arctan(0.5)), abs=TOL_DEG)
     assert d["gamma_deg"][1] == pytest.approx(np.degrees(gamma_leg_limit(0.1)), abs=TOL_DEG)
     assert (tmp_path / "w.png").exists()
 
@@ -299,6 +317,7 @@ def test_cli_position_text_and_errors():
 
 
 # ------------------------------------------------------------------ benchmark smoke test
+@pytest.mark.slow
 def test_workspace_benchmark_runs_with_a_tiny_size():
     path = Path(__file__).resolve().parents[1] / "benchmarks" / "bench_workspace.py"
     spec = importlib.util.spec_from_file_location("bench_workspace", path)

@@ -5,22 +5,67 @@ Conventions (written once, see docs/conventions.md): screws are ``(direction ; m
 plots), always labelled; Euler sequences always named explicitly (``"ZXY"`` intrinsic,
 ``"zxy"`` extrinsic, as in ``scipy.spatial.transform``).
 
+Every analysis by a short name (one page: docs/api.md; the functions are in
+:mod:`spatialmech.api`): ``sm.load_model``, ``sm.mobility``, ``sm.ik``, ``sm.fk``,
+``sm.jacobian``, ``sm.velocity``, ``sm.singularity``, ``sm.workspace``, ``sm.track``,
+``sm.defects``, ``sm.synth_rccc``, ``sm.synth_cs``, ``sm.report``, ``sm.view``.  Each takes a
+:class:`Mechanism`, a ready-made model name or a TOML file path, checks its arguments
+(``TypeError``, :class:`InputError`) and returns a result whose ``to_dict()`` is its JSON.
+
 Quick example::
 
     >>> import spatialmech as sm
-    >>> mech = sm.load_model("four-sps-cu")
-    >>> r = sm.mobility(mech)
+    >>> r = sm.mobility("four-sps-cu")
     >>> (r.dof, r.motion)
     (4, 'RxRyRzTz')
+    >>> sm.ik("four-sps-cu", ([0, 0, 0.12], ("ZYX", 34.38, -5.73, 11.46)), degrees=True).reachable
+    True
 """
 
 from importlib.metadata import PackageNotFoundError, version
 
-from .analysis.mobility import mobility, mobility_modes
-from .catalog import resolve as load_model
-from .model import (
-    C, H, Limb, Mechanism, Mode, ModelFileError, P, Pose, R, S, Sm, U, dump, dumps, load, loads,
+from . import results
+from .api import (
+    defects,
+    dj_table,
+    fk,
+    ik,
+    jacobian,
+    load_model,
+    mobility,
+    mobility_modes,
+    models,
+    report,
+    singularity,
+    synth_cs,
+    synth_rccc,
+    track,
+    velocity,
+    view,
+    workspace,
 )
+from .errors import ConvergenceError, InputError, SearchTooLargeError, SpatialmechError, UnknownNameError
+from .kinematics.closure import Configuration
+from .model import (
+    C,
+    H,
+    Joint,
+    Limb,
+    Mechanism,
+    Mode,
+    ModelFileError,
+    P,
+    Pose,
+    R,
+    S,
+    Sm,
+    U,
+    dump,
+    dumps,
+    load,
+    loads,
+)
+from .results import Progress, TrackStatus
 
 try:
     __version__ = version("spatialmech")
@@ -28,6 +73,58 @@ except PackageNotFoundError:  # pragma: no cover
     __version__ = "0+unknown"
 
 __all__ = [
-    "__version__", "load_model", "mobility", "mobility_modes", "Mechanism", "Limb", "Mode", "Pose",
-    "R", "P", "H", "C", "U", "S", "Sm", "load", "loads", "dump", "dumps", "ModelFileError",
+    "C",
+    "Configuration",
+    "ConvergenceError",
+    "H",
+    "InputError",
+    "Joint",
+    "Limb",
+    "Mechanism",
+    "Mode",
+    "ModelFileError",
+    "P",
+    "Pose",
+    "Progress",
+    "R",
+    "S",
+    "SearchTooLargeError",
+    "Sm",
+    "SpatialmechError",
+    "TrackStatus",
+    "U",
+    "UnknownNameError",
+    "__version__",
+    "closed_forms",
+    "defects",
+    "dj_table",
+    "dump",
+    "dumps",
+    "fk",
+    "ik",
+    "jacobian",
+    "load",
+    "load_model",
+    "loads",
+    "mobility",
+    "mobility_modes",
+    "models",
+    "report",
+    "results",
+    "singularity",
+    "synth_cs",
+    "synth_rccc",
+    "track",
+    "velocity",
+    "view",
+    "workspace",
 ]
+
+
+def __getattr__(name: str):
+    """``sm.closed_forms``: the closed-form kernels (imported on first use: they load scipy.stats)."""
+    if name == "closed_forms":
+        import importlib
+
+        return importlib.import_module(".kinematics.closed_forms", __name__)
+    raise AttributeError(f"module 'spatialmech' has no attribute {name!r}")

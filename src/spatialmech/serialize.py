@@ -1,10 +1,236 @@
-"""JSON output of results: NumPy scalars and arrays become plain numbers and lists."""
+"""JSON output of results: one envelope, one unit rule (docs/json.md), NumPy to plain values.
+
+Every JSON document spatialmech writes for a command (``--json``) is an object
+
+    {"schema_version": "2", "command": "fk", "model": "four-sps-cu", "length_unit": "m", ...}
+
+built by :func:`envelope` around a result's ``to_dict()``.  The unit rule: a number's unit is
+named by the nearest enclosing key that ends with a unit suffix (:data:`UNIT_SUFFIXES`: ``_deg``
+degrees, ``_len`` the document's top-level ``length_unit``, ...), or that key is one of the
+documented unit-free quantities (:data:`UNIT_FREE_KEYS`: counts, indices, nondimensional
+numbers) or screws (:data:`SCREW_KEYS`: ``(direction ; moment)`` 6-vectors, the moment in
+``length_unit``).  Angles are degrees in JSON, radians only inside the Python API.
+:func:`unit_rule_violations` checks a document mechanically.
+
+    >>> import numpy as np
+    >>> d = envelope("fk", "demo", {"pose": pose_dict(np.eye(3), [0, 0, 0.1])}, length_unit="m")
+    >>> d["schema_version"], d["pose"]["euler_sequence"], d["pose"]["position_len"]
+    ('2', 'ZYX', [0.0, 0.0, 0.1])
+    >>> unit_rule_violations(d)
+    []
+    >>> for problem in unit_rule_violations({"solutions": [{"angle": 0.5, "point": [1, 2, 3]}]}):
+    ...     print(problem)
+    solutions[].angle: an angle without the '_deg' suffix
+    solutions[].angle: a number under a key with no unit suffix (or a documented unit-free key)
+    solutions[].point: a number under a key with no unit suffix (or a documented unit-free key)
+"""
 
 from __future__ import annotations
 
+import re
+from collections.abc import Mapping
+
 import numpy as np
 
-__all__ = ["json_default"]
+__all__ = [
+    "EMBEDDED_KEYS",
+    "JSON_EULER_SEQUENCE",
+    "SCHEMA_VERSION",
+    "SCREW_KEYS",
+    "UNIT_FREE_KEYS",
+    "UNIT_FREE_MAPS",
+    "UNIT_SUFFIXES",
+    "envelope",
+    "freedom_values_dict",
+    "json_default",
+    "pose_dict",
+    "unit_rule_violations",
+]
+
+#: Version of the JSON layout (the envelope, the unit rule and every command's fields).
+SCHEMA_VERSION = "2"
+
+#: The Euler sequence of every pose in JSON (intrinsic Z, then Y, then X: R = Rz(a1) Ry(a2) Rx(a3)).
+JSON_EULER_SEQUENCE = "ZYX"
+
+#: Unit suffixes of JSON keys: the key's numbers (and every number nested under it) are in this unit.
+UNIT_SUFFIXES: dict[str, str] = {
+    "_deg": "degrees",
+    "_deg2": "square degrees (area in two Euler-angle coordinates)",
+    "_deg3": "cubic degrees (volume in Euler-angle coordinates)",
+    "_len": "the document's length_unit",
+    "_len2": "square of the document's length_unit",
+    "_len3": "cube of the document's length_unit",
+    "_len_per_s": "length_unit per second",
+    "_len_per_s2": "length_unit per second squared",
+    "_s": "seconds",
+}
+
+#: Keys whose numbers have no unit, with their meaning: counts, indices, signs, nondimensional
+#: quantities.  (docs/json.md lists them; tests/test_json_schema.py checks the two agree.)
+UNIT_FREE_KEYS: dict[str, str] = {
+    # counts and sizes
+    "active_limits": "refined boundary points bounded by each limit",
+    "bytes": "size of the written file, in bytes",
+    "claims": "number of claims (report summary)",
+    "constraint_rank": "rank of the limbs' constraint wrenches",
+    "constraint_rank_generic": "that rank at a generic configuration",
+    "constraint_rows": "number of constraint rows of the complete Jacobian",
+    "crossings_stepped_over": "singular points stepped over while tracing a self-motion",
+    "d": "order of the screw system (mobility formula)",
+    "defects": "defect count or bit mask of a spherical four-bar (synth rccc)",
+    "dof": "degrees of freedom",
+    "dof_instantaneous": "instantaneous degrees of freedom (rank of the closure Jacobian)",
+    "expected_rank": "rank of a non-singular wrench system",
+    "failed": "Monte-Carlo samples whose analysis failed",
+    "frames": "number of configurations (animation frames)",
+    "g": "number of joints (mobility formula)",
+    "gk_classic": "classic Grübler-Kutzbach count",
+    "hits": "starts that reached each solution",
+    "inconsistent": "number of claims whose own consistency check failed (report summary)",
+    "inverse_singular_points": "poles of DJ on a traced circuit",
+    "iterations": "solver iterations",
+    "k": "k of the mobility formula (docs/mobility.md)",
+    "lambda": "common constraints (mobility formula)",
+    "limb_constraints": "constraint wrenches per limb",
+    "max_iter": "iteration limit",
+    "members": "converged starts that one result stands for",
+    "n": "number of links (mobility formula)",
+    "n_branches": "number of branches",
+    "n_converged": "number of converged starts",
+    "n_distinct": "number of distinct solutions",
+    "n_grid": "grid points sampled",
+    "n_grid_feasible": "feasible grid points",
+    "n_new_branches": "starts that found a new branch",
+    "n_points": "number of points",
+    "n_poses_checked": "poses checked",
+    "n_seeds": "number of starts",
+    "n_solutions": "number of solutions found",
+    "n_tried": "number of starts tried",
+    "n_within_limits": "solutions within the limits",
+    "not reproduced": "claims not reproduced (report summary)",
+    "passive": "passive freedoms per limb",
+    "passive_dim": "dimension of a limb's solution set",
+    "rank": "rank of a screw system",
+    "n_regular": "regular assembly modes found",
+    "reproduced": "claims reproduced (report summary)",
+    "reproduced after correction": "claims reproduced after a correction (report summary)",
+    "same_verdict": "Monte-Carlo samples with the same verdict",
+    "samples": "number of samples",
+    "seed": "seed of a random or quasi-random sequence",
+    "n_self_motion_sets": "self-motion sets found",
+    "n_singular": "isolated singular roots found",
+    "singular_points": "singular points marked in a viewer",
+    "starts_per_limb": "starts of the inverse-position search per limb",
+    "sum_f": "sum of the joint freedoms (mobility formula)",
+    "t": "t of the mobility formula; a curve parameter in synthesis data",
+    "task_positions": "task positions shown in a viewer",
+    "traced_samples": "points of a traced curve",
+    "v": "v = t - k of the mobility formula; a unit direction in synthesis data (paper D)",
+    "xi": "passive freedoms (mobility formula)",
+    # indices and signs
+    "also_within_tolerance_of": "other circuits passing within tolerance of a position (numbers)",
+    "between": "the two task positions (numbered from 1) a point lies between",
+    "branch_point_arcs": "arcs (nondimensional) of the DJ zeros, by name",
+    "sign_changes_after": "positions (from 0) after which DJ changes sign, by driver",
+    "circuit": "circuit number (from 1)",
+    "circuits": "task positions (numbered from 1) on each circuit",
+    "constraint_limbs": "limb index of each constraint row",
+    "indices": "line indices (input order)",
+    "lines": "line indices (input order)",
+    "min_closure_sigma_between": "the two task positions bracketing the closest approach to a singularity",
+    "order": "task positions in the order they are met",
+    "path_direction": "+1: the path runs along the traced direction, -1: against it",
+    "position_number": "task position number (from 1)",
+    "sign": "sign of det J (+1, -1, 0)",
+    "sign_changes_along_u": "sign changes of det J along the first slice axis",
+    "signs": "signs of DJ (+1, -1, 0)",
+    "switch_between": "the two task positions bracketing a driver switch",
+    # nondimensional quantities
+    "arc": "arc length along a traced curve, nondimensional (joint rad, lengths / characteristic length)",
+    "arc_length": "arc length of a traced curve, nondimensional",
+    "center_cubic": "coefficients of the center-point cubic (unit vectors)",
+    "center_direction": "unit direction of a center-point pole (paper D)",
+    "center_points": "center-point unit vectors (Burmester curves)",
+    "circle_cubic": "coefficients of the circle-point cubic (unit vectors)",
+    "circle_direction": "unit direction of a circle-point pole (paper D)",
+    "circle_points": "circle-point unit vectors (Burmester curves)",
+    "condition": "inverse condition number sigma_min / sigma_max, in [0, 1]",
+    "corrected_rank": "rank of the wrench system as corrected (paper B case (c))",
+    "engine_sigma_min_home": "scale-free sigma_min of the general engine at the home pose",
+    "eq22_max_fd_error": "largest error of eq 22's Jacobian against finite differences (rad per rad)",
+    "forward_acceleration_error": "largest error of the recovered phi'' (a round-off check; z in length/s^2, angles in rad/s^2)",
+    "forward_velocity_error": "largest error of the recovered phi' (a round-off check; z in length/s, angles in rad/s)",
+    "fraction_det_negative": "fraction of sampled poses with det J < 0",
+    "max_det_poles": "largest |det| of the Burmester equations at the poles (unit vectors)",
+    "max_det_samples": "largest |det| of the Burmester equations at the traced samples (unit vectors)",
+    "max_direction_residual": "largest residual of the direction equations (unit vectors)",
+    "max_fd_error": "largest error against finite differences (rad per rad)",
+    "max_sigma_min_on_singular_set": "largest scale-free sigma_min on the singular set alpha = beta = 0",
+    "min_sigma_min_sample": "smallest scale-free sigma_min over the sampled poses",
+    "residuals": "residuals of the direction equations (unit vectors), by name",
+    "worded_rank": "rank of the wrench system as the paper words it (paper B case (c))",
+    "curve_parameter": "parameter along a Burmester curve",
+    "dP1_dh": "rate of a solution-line point per unit of h",
+    "dP2_dh": "rate of a solution-line point per unit of h",
+    "dedup_tol": "distance (nondimensional) below which two solutions are one",
+    "det": "determinant of the complete Jacobian as printed (only its sign is comparable)",
+    "direction": "unit direction vector",
+    "dj": "DJ = det of the complete Jacobian (only signs along one driver are comparable)",
+    "extent": "size of the search box, in task scales",
+    "fraction_same": "fraction of Monte-Carlo samples with the same verdict",
+    "from": "arc (nondimensional) where a plan step starts; lower end of a tolerance range",
+    "ik_residual": "nondimensional closure residual of a pose fit",
+    "ik_residuals": "nondimensional closure residuals of pose fits",
+    "min_closure_sigma_on_path": "scale-free closeness of the path to a singularity of the linkage",
+    "min_sigma_on_path": "scale-free closeness of the path to a singularity of a driver",
+    "normal": "unit normal of a plane",
+    "on_curve": "nondimensional on-curve tolerance",
+    "path_length": "arc length of the path from the first to the last position, nondimensional",
+    "platform_frame": "columns: the platform's x, y, z unit vectors",
+    "pose_error": "nondimensional pose error (rad, and length / characteristic length)",
+    "position_arcs": "arc of each task position along the first circuit, nondimensional",
+    "residual": "nondimensional residual (lengths divided by the characteristic length, angles in rad)",
+    "rotation_matrix": "a 3x3 rotation matrix (rows)",
+    "sigma_min": "scale-free smallest singular value (0 at a singularity)",
+    "singular_below": "sigma_min below which a configuration is reported singular",
+    "slide_beta": "rate of the slides per unit of h",
+    "switch_window": "arc interval (nondimensional) in which to switch drivers",
+    "to": "arc (nondimensional) where a plan step ends; upper end of a tolerance range",
+    "tol": "nondimensional tolerance",
+    "tolerance": "nondimensional tolerance",
+    "trace_sigma_min": "smallest and largest sigma_min along a traced motion",
+    "transmission": "transmission index per actuator, in [0, 1]",
+    "u": "unit direction of a C joint axis (paper A) or moving axis (paper D)",
+    "traced_arc": "arc length of a traced self-motion, nondimensional",
+    # table cells (their units are in the column titles)
+    "rows": "table cells; the table's columns name their units",
+}
+
+#: Unit-free keys that hold a map by name (actuator, limit, monomial) of unit-free numbers; any
+#: other object under a unit-free key names the units of its own fields.
+UNIT_FREE_MAPS: frozenset[str] = frozenset({"active_limits", "branch_point_arcs", "center_cubic", "circle_cubic",
+                                            "residuals", "sign_changes_after", "signs", "trace_sigma_min",
+                                            "transmission"})
+
+#: Keys holding screws: ``(direction ; moment)`` 6-vectors (or matrices of them) whose direction
+#: part is unit-free and whose moment part is in ``length_unit`` (the Jacobian ``matrix`` rows
+#: are the wrenches swapped, ``(moment ; direction)``, acting on twists ``(omega ; v)``).
+SCREW_KEYS: dict[str, str] = {
+    "axis": "a joint or cone axis as a unit direction (3), or a Plücker line (6)",
+    "common_line": "a Plücker line",
+    "constraint_wrenches": "constraint wrenches of the platform",
+    "directrices": "Plücker lines",
+    "line": "a Plücker line",
+    "matrix": "rows of the complete Jacobian, (moment ; direction)",
+    "transversals": "Plücker lines",
+    "twist": "uncontrolled platform twists (omega ; v)",
+    "wrenches": "wrenches of the complete Jacobian, (direction ; moment)",
+}
+
+#: Keys holding a whole document of another format, whose units that format defines (a model in
+#: the TOML file format of docs/file-format.md); the unit rule does not look inside them.
+EMBEDDED_KEYS: frozenset[str] = frozenset({"linkage"})
 
 
 def json_default(o):
@@ -13,4 +239,159 @@ def json_default(o):
         return o.tolist()
     if isinstance(o, (np.floating, np.integer, np.bool_)):
         return o.item()
+    if hasattr(o, "value") and isinstance(getattr(o, "value", None), str):  # a str enum member
+        return o.value
     raise TypeError(f"not JSON serialisable: {type(o).__name__}")
+
+
+def envelope(command: str, model: str | None, payload: Mapping, *, length_unit: str | None = None) -> dict:
+    """The JSON document of one command: ``schema_version``, ``command``, ``model`` (``None``
+    where no model applies), ``length_unit`` (the unit of every ``*_len`` field; ``None`` when
+    the document has none), then the payload's fields (a payload may not redefine these four)."""
+    if not isinstance(command, str) or not command:
+        raise TypeError(f"command: expected a command name, got {command!r}")
+    if model is not None and not isinstance(model, str):
+        raise TypeError(f"model: expected a model name or None, got {type(model).__name__}")
+    if length_unit is not None and not isinstance(length_unit, str):
+        raise TypeError(f"length_unit: expected a unit name or None, got {type(length_unit).__name__}")
+    head = {"schema_version": SCHEMA_VERSION, "command": command, "model": model, "length_unit": length_unit}
+    clash = sorted(set(head) & set(payload))
+    if clash:
+        raise ValueError(f"payload: must not define the envelope's keys {clash}")
+    return {**head, **payload}
+
+
+def _clean(v: float) -> float:
+    """A float without round-off noise below 1e-12 of 1 and without negative zero."""
+    v = float(v)
+    return 0.0 if abs(v) < 1e-15 else v + 0.0
+
+
+def pose_dict(R, p, *, sequence: str = JSON_EULER_SEQUENCE) -> dict:
+    """A pose in JSON: ``position_len`` (the platform point), ``euler_sequence``, ``euler_deg``
+    (angles of that named sequence, degrees) and the ``rotation_matrix`` itself."""
+    from .geometry.rotations import matrix_euler
+
+    R = np.asarray(R, dtype=float)
+    return {
+        "position_len": [_clean(x) for x in np.asarray(p, dtype=float)],
+        "euler_sequence": sequence,
+        "euler_deg": [_clean(x) for x in matrix_euler(sequence, R, degrees=True)],
+        "rotation_matrix": [[_clean(x) for x in row] for row in R],
+    }
+
+
+def freedom_values_dict(mech, values: Mapping[str, float], prefix: str) -> dict:
+    """Values of freedoms (SI inside: rad or length) as two JSON maps by freedom id:
+    ``{prefix}_deg`` (rotations, degrees) and ``{prefix}_len`` (slides, length unit)."""
+    deg: dict[str, float] = {}
+    ln: dict[str, float] = {}
+    for fid, v in values.items():
+        if mech.freedom(fid).freedom.kind == "P":
+            ln[fid] = float(v)
+        else:
+            deg[fid] = float(np.degrees(v))
+    return {f"{prefix}_deg": deg, f"{prefix}_len": ln}
+
+
+#: Keys naming an angle: they must carry a degree suffix wherever they hold numbers.
+_ANGLE_WORD = re.compile(r"(^|_)(angle|angles|alpha|beta|gamma|theta|phi|psi|euler|rotation|rotated|twist_angle)(_|$)")
+
+
+def _unit_of(key: str) -> str | None:
+    if key in UNIT_FREE_KEYS or key in SCREW_KEYS:
+        return "unit-free"
+    for suffix in sorted(UNIT_SUFFIXES, key=len, reverse=True):
+        if key.endswith(suffix):
+            return "suffix"
+    return None
+
+
+def _field(path: str) -> str:
+    """``"a[3].b[0][1]"`` -> ``"a[].b"``: a field's path, without list positions."""
+    return re.sub(r"(\[\])+$", "", re.sub(r"\[\d+\]", "[]", path))
+
+
+def _is_number(x) -> bool:
+    return isinstance(x, (int, float)) and not isinstance(x, bool)
+
+
+def _has_number(x) -> bool:
+    if _is_number(x):
+        return True
+    if isinstance(x, Mapping):
+        return any(_has_number(v) for v in x.values())
+    if isinstance(x, (list, tuple)):
+        return any(_has_number(v) for v in x)
+    return False
+
+
+def _numbers_only(x) -> bool:
+    """Numbers, ``None``, strings and (nested) lists of them: no objects with named fields."""
+    if isinstance(x, Mapping):
+        return False
+    if isinstance(x, (list, tuple)):
+        return all(_numbers_only(v) for v in x)
+    return True
+
+
+def unit_rule_violations(doc) -> list[str]:
+    """Where a JSON document breaks the unit rule of docs/json.md (empty when it follows it).
+
+    - Every number (not a bool) sits under a key that names its unit: the key holding it (through
+      lists) ends with a unit suffix (:data:`UNIT_SUFFIXES`) or is a documented unit-free or screw
+      key (:data:`UNIT_FREE_KEYS`, :data:`SCREW_KEYS`).  A key with a unit suffix names the unit of
+      everything beneath it (e.g. ``"actuators_len": {"L1.slide": 0.2}``); so does a unit-free
+      key of :data:`UNIT_FREE_MAPS` holding a map by name of numbers (``"transmission":
+      {"L1.slide": 0.8}``); any other object under a unit-free key names its fields' units.
+    - A key that names an angle (``angle``, ``alpha``, ``euler`` ...) ends with ``_deg`` (or
+      lies under a ``_deg`` key: ``"gap_deg": {"alpha": 0.1}``).
+    - No key ends with ``_rad`` (angles are degrees in JSON).
+    - A ``*_len`` field has a ``length_unit`` declared: at the top level or on an enclosing
+      object (a report's sections, which span models in different units, declare their own).
+    - Keys in :data:`EMBEDDED_KEYS` (a model file) are not looked into.
+    """
+    problems: list[str] = []
+    undeclared_len: list[str] = []
+    degree_suffixes = ("_deg", "_deg2", "_deg3")
+
+    def walk(x, path: str, decided: str | None, in_degrees: bool, declared: bool) -> None:
+        # decided: "all" (a unit suffix above, or a flat map under a unit-free key), "direct" (the
+        # numbers directly under a unit-free key), or None; in_degrees: the suffix above is a degree
+        # one; declared: an enclosing object declares length_unit
+        if isinstance(x, Mapping):
+            unit = x.get("length_unit")
+            declared = declared or (isinstance(unit, str) and bool(unit))
+            for k, v in x.items():
+                k = str(k)
+                here = f"{path}.{k}" if path else k
+                if k in EMBEDDED_KEYS:
+                    continue
+                if k.endswith(("_rad", "_radians", "_rad_per_s")):
+                    problems.append(f"{_field(here)}: radians in JSON (angles are degrees, '_deg')")
+                kind = _unit_of(k)
+                if "_len" in k and kind == "suffix" and not declared:
+                    undeclared_len.append(_field(here))
+                if (_ANGLE_WORD.search(k) and kind is None and not in_degrees and not k.endswith(degree_suffixes)
+                        and _has_number(v)):
+                    problems.append(f"{_field(here)}: an angle without the '_deg' suffix")
+                if kind == "suffix":
+                    walk(v, here, "all", k.endswith(degree_suffixes), declared)
+                elif kind == "unit-free":
+                    flat_map = k in UNIT_FREE_MAPS and isinstance(v, Mapping) and all(_numbers_only(w) for w in v.values())
+                    walk(v, here, "all" if flat_map else "direct", False, declared)
+                else:
+                    walk(v, here, decided if decided == "all" else None, in_degrees and decided == "all", declared)
+        elif isinstance(x, (list, tuple)):
+            for i, v in enumerate(x):
+                walk(v, f"{path}[{i}]", decided, in_degrees, declared)
+        elif _is_number(x) and decided is None:
+            problems.append(f"{_field(path)}: a number under a key with no unit suffix (or a documented unit-free key)")
+
+    walk(doc, "", None, False, False)
+    problems = list(dict.fromkeys(problems))  # one line per field, not per list item
+    if undeclared_len:
+        fields = list(dict.fromkeys(undeclared_len))
+        problems.append(f"length_unit: *_len fields ({', '.join(fields[:3])}{' ...' if len(fields) > 3 else ''}) "
+                        "without a length_unit declared at the top level or on an enclosing object")
+    return problems

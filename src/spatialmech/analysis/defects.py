@@ -12,7 +12,8 @@ Procedure (paper A fig 5, made general):
 3. the circuit through position 1 is traced with the continuation tracker until it closes,
    locating every zero of every driver's DJ (a *branch point*: the driver reaches a turning
    point there; sign changes through a pole of DJ — where the driver's own limb is serially
-   singular and the output turns back while the driver moves on — are counted apart); a position lies on the traced circuit when the curve passes through its
+   singular and the output turns back while the driver moves on — are counted apart); a
+   position lies on the traced circuit when the curve passes through its
    fitted configuration (to ``on_curve_tol``, nondimensional), which also gives its arc
    length; positions not on it get circuits of their own, traced the same way;
 4. verdicts: circuit defect (positions on several circuits), order defect (positions not met
@@ -29,26 +30,30 @@ Procedure (paper A fig 5, made general):
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from typing import cast
 
 import numpy as np
 
-from ..kinematics.closure import Configuration, closure_scales, active_mask, closure_jacobian
+from ..errors import InputError
+from ..kinematics.closure import Configuration, active_mask, closure_jacobian, closure_scales
 from ..kinematics.jacobian import complete_jacobian, driver_determinants
 from ..kinematics.position import PoseFit, configuration_at_pose, freedom_values
 from ..kinematics.tracking import MotionProblem, TrackResult, correct_on_hyperplane, track
 from ..model.joints import make_joint
+from ..geometry.tolerances import current as current_tolerances
 from ..model.mechanism import Limb, Mechanism, Pose
+from ..results import Progress, Steps, TrackStatus
 
 __all__ = [
-    "candidate_drivers",
-    "DJTable",
-    "dj_table",
     "BranchPoint",
+    "DJTable",
+    "DefectResult",
     "DriverVerdict",
     "PlanStep",
-    "DefectResult",
+    "candidate_drivers",
     "defect_analysis",
     "dj_function",
+    "dj_table",
     "perturbed",
 ]
 
@@ -80,9 +85,9 @@ def dj_function(mech: Mechanism, drivers: list[str], reference: Configuration):
     A0, _ = closure_jacobian(mech, reference, active=active)
     A0 = row[:, None] * A0 * col[None, :]
     U, sv, _ = np.linalg.svd(A0)
-    r = int(np.sum(sv > 1e-9 * sv[0]))
+    r = int(np.sum(sv > current_tolerances().rank * sv[0]))
     P = U[:, :r].T
-    idx = list(np.flatnonzero(active))
+    idx = np.flatnonzero(active).tolist()
     cols = [idx.index(mech.freedom_refs.index(mech.freedom(d))) for d in drivers]
 
     def f(c):
@@ -109,14 +114,17 @@ class BranchPoint:
     driver_value: float  # the driver's value there (rad or length)
 
     def to_dict(self, rotational: bool) -> dict:
+        """JSON (docs/json.md): ``driver_value_deg`` for a rotational driver, else
+        ``driver_value_len``; ``platform_point_len``; ``arc`` nondimensional."""
+        value = {"driver_value_deg": float(np.degrees(self.driver_value))} if rotational else {
+            "driver_value_len": float(self.driver_value)}
         return {
             "driver": self.driver,
             "circuit": self.circuit,
             "arc": self.arc,
             "between": list(self.between) if self.between else None,
-            "platform_point": list(self.point),
-            "driver_value": float(np.degrees(self.driver_value)) if rotational else self.driver_value,
-            "driver_value_unit": "deg" if rotational else "length",
+            "platform_point_len": [float(x) for x in self.point],
+            **value,
         }
 
 
@@ -157,6 +165,7 @@ class PlanStep:
     switch_between: tuple[int, int] | None  # positions bracketing the window's middle
 
     def to_dict(self) -> dict:
+        """JSON (docs/json.md): arcs (``from``, ``to``, ``switch_window``) nondimensional."""
         return {
             "driver": self.driver,
             "from": self.start_arc,
@@ -172,7 +181,7 @@ class DefectResult:
     drivers: tuple[DriverVerdict, ...]
     circuits: tuple[tuple[int, ...], ...]
     circuit_closed: tuple[bool, ...]
-    circuit_status: tuple[str, ...]
+    circuit_status: tuple[TrackStatus, ...]
     circuit_defect: bool
     order_defect: bool
     order: tuple[int, ...]  # positions of the first circuit in the order they are met
@@ -187,7 +196,7 @@ class DefectResult:
     min_closure_sigma_between: tuple[int, int] | None
     membership: tuple = ()
     tolerances: dict = field(default_factory=dict)
-    table: "DJTable | None" = None
+    table: DJTable | None = None
     robustness: dict = field(default_factory=dict)
     traces: tuple = ()  # TrackResult per circuit (for figures; not serialised)
     rotational: dict = field(default_factory=dict)
@@ -211,11 +220,23 @@ class DefectResult:
             "dj_method": self.dj_method,
             "min_closure_sigma_on_path": self.min_closure_sigma,
             "min_closure_sigma_between": list(self.min_closure_sigma_between) if self.min_closure_sigma_between else None,
-            "membership": list(self.membership),
-            "tolerances": self.tolerances,
-            "robustness": self.robustness,
-            "units": {"arc": "nondimensional arc length of the tracked curve (joint rad, lengths / L)"},
+            "membership": [_membership_json(m) for m in self.membership],
+            "tolerances": _renamed(self.tolerances, {"pose": "pose_len"}),
+            "robustness": _renamed(self.robustness, {"precision_length": "precision_len"}),
+            "arc_note": "arc: nondimensional arc length of the tracked curve (joint rad, lengths / L)",
         }
+
+
+def _renamed(d: dict, names: dict[str, str]) -> dict:
+    """``d`` with keys renamed for JSON (units in the key names, docs/json.md)."""
+    return {names.get(k, k): v for k, v in d.items()}
+
+
+def _membership_json(m: dict) -> dict:
+    out = _renamed(m, {"position": "position_number"})
+    if isinstance(out.get("distance"), dict):
+        out["distance"] = _renamed(out["distance"], {"position": "position_len"})
+    return out
 
 
 @dataclass(frozen=True, eq=False)
@@ -248,14 +269,16 @@ class DJTable:
         return [int(k) for k in np.flatnonzero(s[1:] != s[:-1])]
 
     def to_dict(self) -> dict:
+        """JSON (docs/json.md): per driver its ``dj`` and ``signs`` at the positions, whether it
+        keeps its sign, and the scale-free ``sigma_min``; the pose fits of the positions."""
         return {
-            "model": self.model,
+            "mechanism": self.model,
             "positions": list(self.positions),
-            "drivers": list(self.drivers),
-            "dj": self.dj.tolist(),
-            "signs": self.signs.tolist(),
-            "sigma_min": self.sigma_min.tolist(),
-            "keeps_sign": {d: self.keeps_sign(d) for d in self.drivers},
+            "drivers": [
+                {"driver": d, "dj": [float(x) for x in self.dj[i]], "signs": [int(x) for x in self.signs[i]],
+                 "keeps_sign": self.keeps_sign(d), "sigma_min": [float(x) for x in self.sigma_min[i]]}
+                for i, d in enumerate(self.drivers)
+            ],
             "pose_fit": [f.to_dict() for f in self.fits],
             "note": "DJ magnitudes are not comparable between drivers; only signs along one driver are.",
         }
@@ -273,13 +296,13 @@ def dj_table(mech: Mechanism, drivers=None, positions=None) -> DJTable:
     """
     positions = tuple(positions if positions is not None else mech.positions)
     if not positions:
-        raise ValueError(f"mech: {mech.name} has no task positions")
+        raise InputError(f"mech: {mech.name} has no task positions")
     drivers = tuple(drivers) if drivers is not None else tuple(candidate_drivers(mech))
     fits, prev = [], None
     for P in positions:
         fit = configuration_at_pose(mech, P, start=prev)
         if not fit.converged:
-            raise ValueError(f"positions: {P.name or 'a position'} has no closed configuration near it "
+            raise InputError(f"positions: {P.name or 'a position'} has no closed configuration near it "
                              f"(residual {fit.ik_residual:.2e}): is it reachable by this linkage?")
         fits.append(fit)
         prev = fit.config
@@ -337,9 +360,9 @@ def _pose_distance(mech, prob, tr: TrackResult, pose: Pose, pose_tol: float, ang
         x, t, h = tr.points[k], tr.tangents[k], float(tr.s[k + 1] - tr.s[k])
         g = (np.sqrt(5) - 1) / 2
         lo, hi = 0.0, h
-        cache = {}
+        cache: dict[float, tuple[float, float, float]] = {}
 
-        def at(a):
+        def at(a, x=x, t=t, cache=cache):
             if a not in cache:
                 xa, ok, _, _ = correct_on_hyperplane(prob, prob.retract(x, a * t), t, 1e-11, 20)
                 cache[a] = meas(xa) if ok else (np.inf, np.inf, np.inf)
@@ -423,7 +446,7 @@ def _plan(drivers: list[str], zeros: dict[str, list[float]], a: float, b: float,
             if d == current:
                 continue
             before = [z for z in zeros[d] if z < r]
-            lo = max([c] + before)
+            lo = max([c, *before])
             if lo >= r:
                 continue
             nxt = [z for z in zeros[d] if z > lo + 1e-12]
@@ -431,7 +454,7 @@ def _plan(drivers: list[str], zeros: dict[str, list[float]], a: float, b: float,
             # furthest reach first; on a tie the widest switching window
             if rd > best_reach or (rd == best_reach and best_lo is not None and lo < best_lo):
                 best, best_reach, best_lo = d, rd, lo
-        if best is None or best_reach <= r:
+        if best is None or best_lo is None or best_reach <= r:  # best_lo is set with best
             return None
         c_new = 0.5 * (best_lo + r)  # switch in the middle of the window
         steps.append([current, c, c_new, (best_lo, r)])
@@ -463,8 +486,11 @@ def perturbed(mech: Mechanism, positions, rng: np.random.Generator, length: floa
                 ax = jitter(fs[0].direction)
                 kw["axis"] = ax / np.linalg.norm(ax)
             elif j.type == "U":
-                a1 = jitter(fs[0].direction); a1 /= np.linalg.norm(a1)
-                a2 = jitter(fs[1].direction); a2 -= (a2 @ a1) * a1; a2 /= np.linalg.norm(a2)
+                a1 = jitter(fs[0].direction)
+                a1 /= np.linalg.norm(a1)
+                a2 = jitter(fs[1].direction)
+                a2 -= (a2 @ a1) * a1
+                a2 /= np.linalg.norm(a2)
                 kw["axes"] = [a1, a2]
             else:
                 kw["axes"] = [f.direction for f in fs]
@@ -493,39 +519,39 @@ def defect_analysis(
     precision: float = 5e-4,
     angle_precision_deg: float = 0.05,
     sigma_along_path: bool = True,
-    progress=None,
+    progress: Progress | None = None,
 ) -> DefectResult:
     """Defect judgement of a 1-DOF linkage for its task positions (default: the model's own).
 
     A printed position belongs to a circuit when the circuit passes within ``pose_tol`` (length;
     default 2 % of the characteristic length) and ``angle_tol_deg`` of it (combined as
     ``hypot(dp / pose_tol, dtheta / angle_tol) <= 1``); among the traced circuits the fewest
-    that hold every position are kept.  ``progress(message)`` is called with short status
-    strings while it works.
+    that hold every position are kept.  ``progress(done, None, message)`` is called with the
+    number of the step and a short message while it works.
     """
-    say = progress or (lambda msg: None)
+    say = Steps(progress)
     if pose_tol is None:
         pose_tol = 0.02 * mech.characteristic_length
     for name, v in (("pose_tol", pose_tol), ("angle_tol_deg", angle_tol_deg)):
         if not (np.isfinite(v) and v > 0):
-            raise ValueError(f"{name}: expected a positive finite number, got {v}")
+            raise InputError(f"{name}: expected a positive finite number, got {v}")
     if not (np.isfinite(precision) and precision >= 0):
-        raise ValueError(f"precision: expected a finite number >= 0, got {precision}")
+        raise InputError(f"precision: expected a finite number >= 0, got {precision}")
     if int(monte_carlo) != monte_carlo or monte_carlo < 0:
-        raise ValueError(f"monte_carlo: expected a number of samples >= 0, got {monte_carlo}")
+        raise InputError(f"monte_carlo: expected a number of samples >= 0, got {monte_carlo}")
     positions = tuple(positions if positions is not None else mech.positions)
     if len(positions) < 2:
-        raise ValueError("positions: a defect analysis needs at least two task positions")
+        raise InputError("positions: a defect analysis needs at least two task positions")
     from .mobility import mobility
 
     if mech.is_metamorphic and len(mech.all_modes()) > 1:
-        raise ValueError(f"mechanism: {mech.name} is metamorphic; analyse one mode (mech.in_mode(name))")
+        raise InputError(f"mechanism: {mech.name} is metamorphic; analyse one mode (mech.in_mode(name))")
     dof = mobility(mech).dof_instantaneous
     if dof != 1:
-        raise ValueError(f"mechanism: the defect analysis is for one-degree-of-freedom linkages; {mech.name} has {dof}")
+        raise InputError(f"mechanism: the defect analysis is for one-degree-of-freedom linkages; {mech.name} has {dof}")
     drivers = list(drivers) if drivers is not None else candidate_drivers(mech)
     if not drivers:
-        raise ValueError("drivers: no candidate drivers")
+        raise InputError("drivers: no candidate drivers")
     for d in drivers:
         mech.freedom(d)  # raises on unknown names
     say("fitting the task positions onto the closure; DJ at every position")
@@ -536,9 +562,10 @@ def defect_analysis(
 
     # circuits: trace until every fitted position lies on a traced curve
     n = len(positions)
-    traces, problems = [], []
+    traces: list[TrackResult] = []
+    problems: list[MotionProblem] = []
     for j in range(n):
-        if any(_project(pr, tr, fits[j].config, on_curve_tol) is not None for pr, tr in zip(problems, traces)):
+        if any(_project(pr, tr, fits[j].config, on_curve_tol) is not None for pr, tr in zip(problems, traces, strict=True)):
             continue
         say(f"tracing the circuit through position {j + 1}")
         prob, tr = _trace(mech, fits[j].config, drivers, djf, max_arc, h0, None)
@@ -547,8 +574,8 @@ def defect_analysis(
     # membership by pose tolerance (printed data are rounded), fewest circuits
     say("assigning the positions to circuits")
     Dm = np.empty((len(traces), n))
-    meas = {}
-    for c, (pr, tr) in enumerate(zip(problems, traces)):
+    meas: dict[tuple[int, int], tuple[float, float, float, float]] = {}
+    for c, (pr, tr) in enumerate(zip(problems, traces, strict=True)):
         for j, P in enumerate(positions):
             # exactly on the curve (the fitted configuration itself): unambiguous, even where the
             # platform takes the same pose twice on a circuit; else the nearest pose on the curve
@@ -566,7 +593,8 @@ def defect_analysis(
     remap = {c: k for k, c in enumerate(order_c)}
     circuit_of = [remap[c] for c in circuit_of]
     circuits = [tuple(j + 1 for j in range(n) if circuit_of[j] == k) for k in range(len(order_c))]
-    arcs_on = [meas[order_c[0], j][1] if circuit_of[j] == 0 else None for j in range(n)]
+    # arc length of each position on the first circuit (nan elsewhere: only those on it are read)
+    arcs_on = [meas[order_c[0], j][1] if circuit_of[j] == 0 else np.nan for j in range(n)]
     membership = [{"position": j + 1, "circuit": circuit_of[j] + 1,
                    "distance": {"position": meas[order_c[circuit_of[j]], j][2],
                                 "angle_deg": float(np.degrees(meas[order_c[circuit_of[j]], j][3]))},
@@ -596,7 +624,7 @@ def defect_analysis(
     else:
         direction, order, path_arcs = 1, order_f, sorted(fwd)
     order_defect = order != expected
-    pos_arcs = [None] * n
+    pos_arcs: list[float | None] = [None] * n
     for i in on0:
         a = arcs_on[i]
         pos_arcs[i] = (a % S if S else a) if direction == 1 else (((S - a) % S) if S else -a)
@@ -623,16 +651,16 @@ def defect_analysis(
                 if e.kind == "pole":  # DJ through infinity: the driver's limb is serially
                     poles += 1        # singular (the output turns back); the driver moves on
                     continue
-                c = e.x
-                p = c.D[:3, :3] @ mech.platform_point + c.D[:3, 3]
-                val = float(freedom_values(mech, c.q)[idx])
+                cfg = cast(Configuration, e.x)  # a mechanism's motion problem: points are configurations
+                p = cfg.D[:3, :3] @ mech.platform_point + cfg.D[:3, 3]
+                val = float(freedom_values(mech, cfg.q)[idx])
                 if k == 0:
                     pa = to_path(e.s)
-                    bp = BranchPoint(d, k + 1, float(pa), _between(pa, path_arcs), tuple(map(float, p)), val)
+                    bp = BranchPoint(d, k + 1, float(pa), _between(pa, path_arcs), (float(p[0]), float(p[1]), float(p[2])), val)
                     if 0.0 < pa < path_end and not circuit_defect:
                         path_bp.append(bp)
                 else:
-                    bp = BranchPoint(d, k + 1, float(e.s), None, tuple(map(float, p)), val)
+                    bp = BranchPoint(d, k + 1, float(e.s), None, (float(p[0]), float(p[1]), float(p[2])), val)
                 all_bp.append(bp)
         all_bp.sort(key=lambda b: (b.circuit, b.arc))
         path_bp.sort(key=lambda b: b.arc)
@@ -641,9 +669,9 @@ def defect_analysis(
         keeps = len(set(signs)) == 1 and 0 not in signs
         # with one circuit, the path decides (a sign change through a pole is no branch point)
         branch_defect = (not keeps) if circuit_defect else bool(path_bp)
-        usable = not circuit_defect and not order_defect and not branch_defect
+        is_usable = not circuit_defect and not order_defect and not branch_defect
         verdicts.append(DriverVerdict(d, tuple(map(float, dj_pos[:, di])), signs, keeps, tuple(path_bp), tuple(all_bp),
-                                      branch_defect, usable, inverse_singular_points=poles))
+                                      branch_defect, is_usable, inverse_singular_points=poles))
     usable = tuple(v.driver for v in verdicts if v.usable)
 
     plan = None
@@ -657,7 +685,7 @@ def defect_analysis(
     min_sig, min_between = None, None
     if sigma_along_path and not circuit_defect:
         say("measuring the distance to singularities along the path")
-        path_pts = [(to_path(s), x) for s, x in zip(tr0.s, tr0.points) if 0.0 <= to_path(s) <= path_end]
+        path_pts = [(to_path(s), x) for s, x in zip(tr0.s, tr0.points, strict=True) if 0.0 <= to_path(s) <= path_end]
         prob0 = problems[0]
         sig = []
         for a, x in path_pts:
@@ -668,11 +696,11 @@ def defect_analysis(
             min_sig, min_between = mval, _between(marc, path_arcs)
         watch = set(usable) | ({s.driver for s in plan} if plan else set())
         new = []
-        for v in verdicts:
-            if v.driver in watch:
-                vals = [complete_jacobian(mech, x, [v.driver]).sigma_min for _, x in path_pts]
-                v = replace(v, min_sigma_on_path=float(min(vals)) if vals else None)
-            new.append(v)
+        for vd in verdicts:
+            if vd.driver in watch:
+                vals = [complete_jacobian(mech, x, [vd.driver]).sigma_min for _, x in path_pts]
+                vd = replace(vd, min_sigma_on_path=float(min(vals)) if vals else None)
+            new.append(vd)
         verdicts = new
 
     rot = {d: mech.freedom(d).freedom.kind != "P" for d in drivers}

@@ -21,15 +21,26 @@ configuration (not typed in):
 two links merged.  The numerical check is independent: the nullity of the loop-closure
 Jacobian at a *generic* configuration reached by moving along the closure manifold, minus the
 passive freedoms, is the instantaneous mobility ``dof_instantaneous``.
+
+Tolerance.  Every rank above is numerical: a singular value of a nondimensional matrix counts
+when it exceeds the rank tolerance (:mod:`~spatialmech.geometry.tolerances`, default 1e-9).  A
+model typed with rounded numbers (4-6 significant digits) can lose a special geometry (the
+Bennett conditions) to rounding: at the default tolerance it is then rigid, at 1e-4 mobile.  So
+the result also scans the tolerance: the count at every tolerance between 0 and 0.1
+(:attr:`MobilityResult.dof_by_tolerance`, the singular values where it changes and which matrix
+they belong to), and says so when the count changes between 1e-12 and 1e-2.
 """
 
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field
+from itertools import pairwise
 
 import numpy as np
 
+from ..errors import ConvergenceError, InputError
 from ..geometry import screws as sc
+from ..geometry.tolerances import Tolerances, current, resolve, use
 from ..kinematics.closure import (
     Configuration,
     active_mask,
@@ -40,7 +51,15 @@ from ..kinematics.closure import (
 )
 from ..model.mechanism import Mechanism, Mode
 
-__all__ = ["MobilityResult", "mobility", "mobility_modes", "motion_type", "ELEMENTARY_MOTIONS"]
+__all__ = ["ELEMENTARY_MOTIONS", "SCAN_RANGE", "MobilityResult", "ToleranceStep", "mobility", "mobility_modes", "motion_type"]
+
+#: Tolerances scanned for the count's dependence on the rank tolerance: every singular value in
+#: this range is a candidate change point; ``dof_at_tolerance`` lists the decades 1e-12 .. 1e-2.
+SCAN_RANGE = (1e-14, 1e-1)
+#: Where a change of the count is worth a note: a tolerance that rounded input data could need.
+NOTE_RANGE = (1e-12, 1e-2)
+#: Singular values at or below this (relative) are round-off zeros.
+_ROUNDOFF = 1e-15
 
 #: The elementary platform motions used to name a motion type, at the platform point.
 ELEMENTARY_MOTIONS = {
@@ -53,7 +72,7 @@ ELEMENTARY_MOTIONS = {
 }
 
 
-def motion_type(twists, point, *, length_scale: float = 1.0) -> tuple[str, str]:
+def motion_type(twists, point, *, length_scale: float = 1.0, rtol: float | None = None) -> tuple[str, str]:
     """Name a platform twist system at ``point``: ``("RxRyRzTz", "3R1T")``.
 
     The first name lists the elementary motions (rotations about axes through ``point``
@@ -66,19 +85,35 @@ def motion_type(twists, point, *, length_scale: float = 1.0) -> tuple[str, str]:
         return "rigid", "0"
     at_p = T.copy()
     at_p[:, 3:] = T[:, 3:] + np.cross(T[:, :3], p)
-    dim = sc.rank(at_p, length_scale=length_scale)
+    rtol = current().rank if rtol is None else rtol
+    dim = sc.rank(at_p, length_scale=length_scale, rtol=rtol)
     if dim == 0:
         return "rigid", "0"
-    B = sc.basis(at_p, length_scale=length_scale)  # orthonormal basis of the system
+    B = sc.basis(at_p, length_scale=length_scale, rtol=rtol)  # orthonormal basis of the system
     w = B[:, :3]
     sv = np.linalg.svd(w, compute_uv=False)
-    r = int(np.sum(sv > 1e-9))
+    r = int(np.sum(sv > rtol))
     tdim = dim - r
     cls = (f"{r}R" if r else "") + (f"{tdim}T" if tdim else "")
-    members = [k for k, e in ELEMENTARY_MOTIONS.items() if sc.contains(at_p, e, length_scale=length_scale)]
+    ctol = max(current().contains, rtol)  # a looser rank tolerance loosens membership too
+    members = [k for k, e in ELEMENTARY_MOTIONS.items() if sc.contains(at_p, e, length_scale=length_scale, rtol=ctol)]
     if len(members) == dim:
         return "".join(members), cls
     return cls, cls
+
+
+@dataclass(frozen=True)
+class ToleranceStep:
+    """The count for rank tolerances in ``[lower, upper)``: it changes at ``lower``, a singular
+    value of ``source`` (0 and "" for the first step)."""
+
+    lower: float
+    upper: float
+    dof: int
+    source: str = ""
+
+    def to_dict(self) -> dict:
+        return {"from": self.lower, "to": self.upper, "dof": self.dof, "source": self.source}
 
 
 @dataclass(frozen=True)
@@ -107,6 +142,27 @@ class MobilityResult:
     agrees: bool
     explanation: str
     passive: tuple[int, ...] = field(default=())
+    #: The rank tolerance used (relative singular-value threshold, nondimensional).
+    tolerance: float = 1e-9
+    #: The count ``dof`` as a function of the rank tolerance over ``[0, SCAN_RANGE[1])``.
+    dof_by_tolerance: tuple[ToleranceStep, ...] = field(default=())
+    #: One line about that dependence (empty when there is nothing to say).
+    tolerance_note: str = ""
+
+    def dof_at(self, tolerance: float) -> int | None:
+        """The count at another rank tolerance (within the scanned range; else ``None``)."""
+        for s in self.dof_by_tolerance:
+            if s.lower <= tolerance < s.upper:
+                return s.dof
+        return None
+
+    @property
+    def tolerance_margin(self) -> tuple[float, float]:
+        """The range of rank tolerances around :attr:`tolerance` that give the same count."""
+        for s in self.dof_by_tolerance:
+            if s.lower <= self.tolerance < s.upper:
+                return (s.lower, s.upper)
+        return (0.0, float("nan"))
 
     def to_dict(self) -> dict:
         d = asdict(self)
@@ -115,6 +171,8 @@ class MobilityResult:
         d["limb_constraints"] = list(self.limb_constraints)
         d["passive"] = list(self.passive)
         d["constraint_wrenches"] = [list(w) for w in self.constraint_wrenches]
+        d["dof_by_tolerance"] = [s.to_dict() for s in self.dof_by_tolerance]
+        d["dof_at_tolerance"] = [{"tolerance": t, "dof": self.dof_at(t)} for t in _DECADES]
         return d
 
     def formula(self) -> str:
@@ -125,8 +183,9 @@ class MobilityResult:
 
 
 def _canonical(W: np.ndarray, L: float) -> np.ndarray:
-    """A readable basis of a screw system: reduced row echelon form, then each screw scaled to
-    a unit direction (or a unit moment for a pure couple/translation)."""
+    """A readable basis of a screw system: reduced row echelon form (pivot tolerance in force:
+    rounding noise is never a pivot), then each screw scaled to a unit direction (or a unit
+    moment for a pure couple/translation)."""
     if W.shape[0] == 0:
         return W
     A = sc.rref(sc.nondimensional(W, L))
@@ -134,7 +193,7 @@ def _canonical(W: np.ndarray, L: float) -> np.ndarray:
     out = []
     for w in A:
         n = np.linalg.norm(w[:3])
-        w = w / (n if n > 1e-12 else np.linalg.norm(w[3:]))
+        w = w / (n if n > current().pivot * np.linalg.norm(w[3:] / L) else np.linalg.norm(w[3:]))
         w = np.where(np.abs(w) < 1e-12, 0.0, w)
         out.append(np.round(w, 12) + 0.0)
     return np.array(out)
@@ -153,16 +212,27 @@ def _count_structure(mech: Mechanism) -> tuple[int, int, int, list[int]]:
     return n, g, sum(f_limbs), f_limbs
 
 
-def _nullity(A: np.ndarray, rtol: float = 1e-9) -> int:
+def _relative_sv(A: np.ndarray) -> np.ndarray:
+    """Singular values of ``A`` with every nonzero column normalised, divided by ``max(1, largest)``
+    (the numbers compared with the rank tolerance), padded with zeros to one per column."""
     if A.shape[1] == 0:
-        return 0
-    sv = np.linalg.svd(A, compute_uv=False)
-    r = int(np.sum(sv > rtol * max(1.0, sv[0]))) if sv.size else 0
-    return A.shape[1] - r
+        return np.zeros(0)
+    if not np.all(np.isfinite(A)):
+        raise ConvergenceError("mobility: the loop-closure Jacobian overflowed (NaN or infinity); check the model's scale")
+    n = np.linalg.norm(A, axis=0)
+    An = A / np.where(n > 0, n, 1.0)
+    sv = np.linalg.svd(An, compute_uv=False) if A.shape[0] else np.zeros(0)
+    sv = np.r_[sv, np.zeros(A.shape[1] - sv.size)]
+    return sv / max(1.0, sv[0]) if sv.size and sv[0] > 0 else sv
 
 
-def _instantaneous(mech: Mechanism, config: Configuration) -> tuple[int, int, np.ndarray]:
-    """(platform dof, passive freedoms, platform twist basis) at ``config``, nondimensionally."""
+def _nullity(A: np.ndarray, rtol: float) -> int:
+    return int(np.sum(_relative_sv(A) <= rtol))
+
+
+def _scaled_closure(mech: Mechanism, config: Configuration) -> tuple[np.ndarray, np.ndarray, list[list[int]]]:
+    """The nondimensional closure Jacobian (moments / L, slides x L), the column scales, and
+    per limb its columns."""
     active = active_mask(mech)
     L = mech.characteristic_length
     A, _ = closure_jacobian(mech, config, active=active)
@@ -171,34 +241,166 @@ def _instantaneous(mech: Mechanism, config: Configuration) -> tuple[int, int, np
     lin = np.array([r.freedom.is_linear for r in mech.freedom_refs])[active]
     col = np.r_[np.where(lin, L, 1.0), np.ones(3), np.full(3, L)]
     As = row[:, None] * A * col[None, :]
-    N = _nullity(As)
-    # passive freedoms: limb Jacobians' null spaces (platform at rest)
-    xi = 0
-    na = 0
     idx = np.flatnonzero(active)
-    for sl in limb_slices(mech):
-        cols = [i for i, gi in enumerate(idx) if sl.start <= gi < sl.stop]
-        xi += _nullity(As[:, cols]) if cols else 0
-        na += len(cols)
-    # platform twists = projection of the null space onto V
-    _, sv, vt = np.linalg.svd(As)
-    r = int(np.sum(sv > 1e-9 * max(1.0, sv[0])))
-    null = vt[r:]
+    cols = [[i for i, gi in enumerate(idx) if sl.start <= gi < sl.stop] for sl in limb_slices(mech)]
+    return As, col, cols
+
+
+def _instantaneous(mech: Mechanism, config: Configuration, rtol: float) -> tuple[int, int, np.ndarray]:
+    """(platform dof, passive freedoms, platform twist basis) at ``config``, nondimensionally."""
+    L = mech.characteristic_length
+    As, col, limb_cols = _scaled_closure(mech, config)
+    N = _nullity(As, rtol)
+    # passive freedoms: limb Jacobians' null spaces (platform at rest)
+    xi = sum(_nullity(As[:, c], rtol) for c in limb_cols if c)
+    # platform twists = projection of the null space onto V (columns normalised for the SVD)
+    n = np.linalg.norm(As, axis=0)
+    n = np.where(n > 0, n, 1.0)
+    _, sv, vt = np.linalg.svd(As / n)
+    r = int(np.sum(sv > rtol * max(1.0, sv[0])))
+    null = vt[r:] / n  # back to the scaled variables
     V = null[:, -6:] / col[-6:]  # back to SI twists
-    Vb = sc.basis(V, length_scale=L) if V.shape[0] else np.zeros((0, 6))
+    Vb = sc.basis(V, length_scale=L, rtol=rtol) if V.shape[0] else np.zeros((0, 6))
     return N - xi, xi, Vb
 
 
-def mobility(mech: Mechanism, mode: Mode | str | None = None, *, seed: int = 0) -> MobilityResult:
+@dataclass(frozen=True)
+class _Counts:
+    lam: int
+    d: int
+    t: int
+    k: int
+    v: int
+    xi: int
+    M: int
+    W: list
+    Wall: np.ndarray
+    passive: tuple[int, ...]
+
+
+def _formula(limbs_T: list[np.ndarray], L: float, n: int, g: int, sum_f: int, f_limbs: list[int], rtol: float) -> _Counts:
+    """The modified Kutzbach-Grübler count from the limbs' joint twists at rank tolerance ``rtol``."""
+    all_T = np.vstack([T for T in limbs_T if T.size] or [np.zeros((0, 6))])
+    lam = 6 - sc.rank(all_T, length_scale=L, rtol=rtol) if all_T.size else 6
+    d = 6 - lam
+    W = [sc.reciprocal_basis(T, length_scale=L, rtol=rtol) if T.size else np.eye(6) for T in limbs_T]
+    ranks = [sc.rank(T, length_scale=L, rtol=rtol) if T.size else 0 for T in limbs_T]
+    t = sum(w.shape[0] - lam for w in W)
+    Wall = np.vstack(W)
+    k = (sc.rank(Wall, length_scale=L, rtol=rtol) if Wall.size else 0) - lam
+    v = t - k
+    passive = tuple(f - r for f, r in zip(f_limbs, ranks, strict=True))
+    xi = sum(passive)
+    return _Counts(lam, d, t, k, v, xi, d * (n - g - 1) + sum_f + v - xi, W, Wall, passive)
+
+
+#: The tolerances of ``dof_at_tolerance`` in the JSON (decades).
+_DECADES = tuple(10.0**e for e in range(-12, -1))
+
+
+def _candidates(limbs_T: list[np.ndarray], limb_names: list[str], L: float, As: np.ndarray, limb_cols,
+                Wall: np.ndarray) -> list[tuple[float, str]]:
+    """Every singular value (relative) at which a count of the formula or of the instantaneous
+    mobility at the reference can change, with the matrix it belongs to."""
+    out: list[tuple[float, str]] = []
+    all_T = np.vstack([T for T in limbs_T if T.size] or [np.zeros((0, 6))])
+    if all_T.size:
+        out += [(float(s), "joint twists of all limbs") for s in sc.relative_singular_values(all_T, length_scale=L)]
+    for T, name in zip(limbs_T, limb_names, strict=True):
+        if T.size:
+            out += [(float(s), f"joint twists of limb {name}") for s in sc.relative_singular_values(T, length_scale=L)]
+    if Wall.size:
+        out += [(float(s), "constraint wrenches of all limbs") for s in sc.relative_singular_values(Wall, length_scale=L)]
+    out += [(float(s), "loop-closure Jacobian at the reference") for s in _relative_sv(As)]
+    for c, name in zip(limb_cols, limb_names, strict=True):
+        if c:
+            out += [(float(s), f"Jacobian of limb {name}") for s in _relative_sv(As[:, c])]
+    return out
+
+
+def _scan(count, candidates: list[tuple[float, str]]) -> tuple[ToleranceStep, ...]:
+    """``count(tol)`` as a step function over ``[0, SCAN_RANGE[1])``: evaluated between
+    consecutive candidate singular values (the only places where it can change)."""
+    lo, hi = SCAN_RANGE
+    vals = sorted({v for v, _ in candidates if lo < v < hi})
+    edges = [0.0, *vals, hi]
+    steps: list[ToleranceStep] = []
+    for a, b in pairwise(edges):
+        mid = np.sqrt(max(a, _ROUNDOFF) * b) if a > 0 else min(b / 10.0, lo)
+        m = count(mid)
+        if steps and steps[-1].dof == m:
+            steps[-1] = ToleranceStep(steps[-1].lower, b, m, steps[-1].source)
+        else:
+            src = sorted({name for v, name in candidates if v == a}) if a > 0 else []
+            steps.append(ToleranceStep(a, b, m, ", ".join(src)))
+    return tuple(steps)
+
+
+def _say(m: int) -> str:
+    return "rigid (M = 0)" if m == 0 else (f"mobile (M = {m})" if m > 0 else f"M = {m}")
+
+
+def _round_tolerance(lower: float, upper: float) -> float:
+    """A readable tolerance within ``[lower, upper)``: the smallest decade above ``lower``, or
+    their geometric mean."""
+    dec = 10.0 ** np.ceil(np.log10(lower)) if lower > 0 else 1e-12
+    if dec == lower:
+        dec *= 10
+    return float(dec) if dec < upper else float(np.sqrt(lower * upper))
+
+
+def _tolerance_note(steps: tuple[ToleranceStep, ...], tol: float, dof: int) -> str:
+    """One line: at which tolerances the count differs from ``dof`` in the plausible range."""
+    here = next((s for s in steps if s.lower <= tol < s.upper), None)
+    if here is None:
+        return ""
+    a, b = NOTE_RANGE
+    parts = []
+    above = [s for s in steps if s.lower > tol and s.lower < b]
+    below = [s for s in steps if s.upper <= tol and s.upper > a]
+    if above:
+        s = above[0]
+        parts.append(f"{_say(dof)} at tolerance {tol:.0e}, {_say(s.dof)} at {_round_tolerance(s.lower, s.upper):.0e}: "
+                     f"the smallest singular value counted at {tol:.0e} is {s.lower:.2g} ({s.source}), "
+                     f"and the count stays {s.dof} up to {s.upper:.2g}")
+    if below:
+        s = below[-1]
+        src = here.source or "round-off"
+        parts.append(f"{_say(dof)} at tolerance {tol:.0e}, {_say(s.dof)} below {here.lower:.2g}: the largest singular "
+                     f"value treated as zero at {tol:.0e} is {here.lower:.2g} ({src})")
+    if not parts:
+        lower = f"{here.lower:.2g}" if here.lower > _ROUNDOFF else "round-off"
+        upper = f"to {here.upper:.2g}" if here.upper < SCAN_RANGE[1] else f"to at least {here.upper:.2g}"
+        return (f"Tolerance: the count is {dof} for every rank tolerance from {lower} {upper} "
+                f"(the one used, {tol:.0e}, included).")
+    hint = ("; data typed with 4-6 significant digits loses special geometry to rounding: if the model is meant "
+            "to have the other count, analyse it at that tolerance (--tol)")
+    return "Tolerance: " + "; ".join(parts) + hint + "."
+
+
+def mobility(mech: Mechanism, mode: Mode | str | None = None, *, seed: int = 0,
+             tol: Tolerances | float | None = None) -> MobilityResult:
     """Mobility of ``mech`` (in ``mode`` for a metamorphic mechanism).
+
+    ``tol``: the rank tolerance (a number) or a :class:`~spatialmech.geometry.tolerances.Tolerances`;
+    default: the tolerances in force.  Every rank decision (the formula, the generic
+    configuration, the instantaneous mobility, the motion type) uses it; the result also says
+    how the count depends on it (:attr:`MobilityResult.dof_by_tolerance`).
 
     Raises ``ValueError`` when a metamorphic mechanism is given without a mode while its
     declared modes are several (use :func:`mobility_modes`).
     """
+    t = resolve(tol, "rank")
+    with use(t):
+        return _mobility(mech, mode, seed, t)
+
+
+def _mobility(mech: Mechanism, mode, seed: int, tols: Tolerances) -> MobilityResult:
+    rtol = tols.rank
     if mode is None:
         modes = mech.all_modes()
         if len(modes) != 1:
-            raise ValueError(
+            raise InputError(
                 f"mode: {mech.name} is metamorphic with modes {', '.join(m.name for m in modes)}; name one"
             )
         mode = modes[0]
@@ -210,42 +412,42 @@ def mobility(mech: Mechanism, mode: Mode | str | None = None, *, seed: int = 0) 
     ref = Configuration.reference(m)
     active = active_mask(m)
     tw = joint_twists(m, ref)
+    if not all(np.all(np.isfinite(J)) for J in tw):
+        raise ConvergenceError("mobility: the joint twists at the reference overflowed (NaN or infinity); "
+                               "check the model's scale")
     limbs_T = []
-    for sl, J in zip(limb_slices(m), tw):
+    for sl, J in zip(limb_slices(m), tw, strict=True):
         a = active[sl]
         limbs_T.append(J[:, a].T)
-    all_T = np.vstack([T for T in limbs_T if T.size] or [np.zeros((0, 6))])
-    lam = 6 - sc.rank(all_T, length_scale=L) if all_T.size else 6
-    d = 6 - lam
-    W = [sc.reciprocal_basis(T, length_scale=L) if T.size else np.eye(6) for T in limbs_T]
-    ranks = [sc.rank(T, length_scale=L) if T.size else 0 for T in limbs_T]
-    t = sum(w.shape[0] - lam for w in W)
-    Wall = np.vstack(W)
-    k = sc.rank(Wall, length_scale=L) - lam
-    v = t - k
     n, g, sum_f, f_limbs = _count_structure(m)
-    passive = tuple(f - r for f, r in zip(f_limbs, ranks))
-    xi = sum(passive)
-    M = d * (n - g - 1) + sum_f + v - xi
+    c = _formula(limbs_T, L, n, g, sum_f, f_limbs, rtol)
+    lam, d, t, k, v, xi, M, W, Wall, passive = c.lam, c.d, c.t, c.k, c.v, c.xi, c.M, c.W, c.Wall, c.passive
     gk = 6 * (n - g - 1) + sum_f
 
+    # how the count depends on the rank tolerance
+    As_ref, _, limb_cols = _scaled_closure(m, ref)
+    names = [limb.name for limb in m.limbs]
+    cands = _candidates(limbs_T, names, L, As_ref, limb_cols, Wall)
+    steps = _scan(lambda tt: _formula(limbs_T, L, n, g, sum_f, f_limbs, tt).M, cands)
+    note = _tolerance_note(steps, rtol, M)
+
     # the free platform twist system at the reference: reciprocal to all limb constraints
-    Vref = sc.reciprocal_basis(Wall, length_scale=L)
+    Vref = sc.reciprocal_basis(Wall, length_scale=L, rtol=rtol)
     try:
         gen = generic_configuration(m, seed=seed)
-        dof_inst, xi_num, Vgen = _instantaneous(m, gen)
+        dof_inst, _, Vgen = _instantaneous(m, gen, rtol)
         generic_note = ""
-    except RuntimeError as e:  # pragma: no cover - reported, not hidden
+    except RuntimeError as e:  # reported, not hidden
         gen = ref
-        dof_inst, xi_num, Vgen = _instantaneous(m, ref)
+        dof_inst, _, Vgen = _instantaneous(m, ref, rtol)
         generic_note = f" (no generic configuration could be reached: {e}; the reference was used)"
 
     if Vref.shape[0] == dof_inst:
-        motion, mclass = motion_type(Vref, m.platform_point, length_scale=L)
+        motion, mclass = motion_type(Vref, m.platform_point, length_scale=L, rtol=rtol)
         where = "at the reference configuration"
     else:
         p_now = gen.D[:3, :3] @ m.platform_point + gen.D[:3, 3]
-        motion, mclass = motion_type(Vgen, p_now, length_scale=L)
+        motion, mclass = motion_type(Vgen, p_now, length_scale=L, rtol=rtol)
         where = "at a generic configuration"
 
     notes = []
@@ -257,7 +459,7 @@ def mobility(mech: Mechanism, mode: Mode | str | None = None, *, seed: int = 0) 
             f"The classic Grübler-Kutzbach count (d = 6, no corrections) gives {gk}; it ignores the "
             + ", ".join(p for p in parts if p) + " found from the screw systems."
         )
-    if M != dof_inst:
+    if dof_inst != M:
         notes.append(
             f"The screw systems at the reference configuration give M = {M}, but the loop-closure "
             f"Jacobian at a generic configuration has instantaneous mobility {dof_inst}: the "
@@ -266,7 +468,7 @@ def mobility(mech: Mechanism, mode: Mode | str | None = None, *, seed: int = 0) 
         )
     if not notes:
         notes.append(f"The modified formula and the numerical rank agree: {M}.")
-    wr = _canonical(sc.basis(Wall, length_scale=L), L) if Wall.size else np.zeros((0, 6))
+    wr = _canonical(sc.basis(Wall, length_scale=L, rtol=rtol), L) if Wall.size else np.zeros((0, 6))
     return MobilityResult(
         mechanism=mech.name,
         mode=mode_obj.name,
@@ -287,12 +489,15 @@ def mobility(mech: Mechanism, mode: Mode | str | None = None, *, seed: int = 0) 
         xi=int(xi),
         limb_constraints=tuple(int(w.shape[0]) for w in W),
         constraint_wrenches=tuple(tuple(float(x) for x in w) for w in wr),
-        agrees=bool(M == dof_inst),
+        agrees=bool(dof_inst == M),
         explanation=" ".join(notes) + f" Motion named {where}." + generic_note,
         passive=passive,
+        tolerance=float(rtol),
+        dof_by_tolerance=steps,
+        tolerance_note=note,
     )
 
 
-def mobility_modes(mech: Mechanism, *, seed: int = 0) -> list[MobilityResult]:
+def mobility_modes(mech: Mechanism, *, seed: int = 0, tol: Tolerances | float | None = None) -> list[MobilityResult]:
     """Mobility of every mode (one element for a mechanism that is not metamorphic)."""
-    return [mobility(mech, m, seed=seed) for m in mech.all_modes()]
+    return [mobility(mech, m, seed=seed, tol=tol) for m in mech.all_modes()]

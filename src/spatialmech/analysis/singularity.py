@@ -26,27 +26,30 @@ parametrisation: the singularity loci are its zero contours.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
-from typing import Callable
 
 import numpy as np
 
+from ..errors import InputError
 from ..geometry import screws as sc
-from ..geometry.line_geometry import classify_lines
+from ..geometry.line_geometry import classify_lines, json_dict
 from ..kinematics.closure import Configuration
 from ..kinematics.jacobian import CompleteJacobian, complete_jacobian
 from ..kinematics.position import configuration_at_pose
 from ..kinematics.tracking import MotionProblem, track
+from ..geometry.tolerances import current as current_tolerances
 from ..model.mechanism import Limb, Mechanism, Pose
+from ..results import Progress, SingularityKind
 
-__all__ = ["SingularityResult", "singularity", "singularity_at_pose", "SliceResult", "singularity_slice", "locked_actuators"]
+__all__ = ["SingularityResult", "SliceResult", "locked_actuators", "singularity", "singularity_at_pose", "singularity_slice"]
 
 
 @dataclass(frozen=True, eq=False)
 class SingularityResult:
     rank: int
     expected_rank: int
-    kind: str  # "none", "inverse", "constraint", "direct", or a combination "direct+inverse"
+    kind: SingularityKind  # none, inverse, constraint, direct, or inverse+constraint
     sigma_min: float
     condition: float
     transmission: tuple[float, ...]
@@ -60,6 +63,13 @@ class SingularityResult:
     explanation: str
 
     def to_dict(self) -> dict:
+        """JSON (docs/json.md): the uncontrolled ``twist`` screws ``(omega ; v)`` (``v`` in the
+        model's length unit per unit of ``omega``), the line geometry and the self-motion with
+        lengths in the model's unit (``*_len``) and angles in degrees."""
+        sm = self.self_motion
+        if sm is not None:
+            names = {"platform_point_moved": "platform_point_moved_len", "end_platform_point": "end_platform_point_len"}
+            sm = {names.get(k, k): v for k, v in sm.items()}
         return {
             "rank": self.rank,
             "expected_rank": self.expected_rank,
@@ -67,14 +77,14 @@ class SingularityResult:
             "singular": self.kind != "none",
             "sigma_min": self.sigma_min,
             "condition": self.condition,
-            "transmission": dict(zip(self.jacobian.actuators, self.transmission)),
+            "transmission": dict(zip(self.jacobian.actuators, self.transmission, strict=True)),
             "twist": [list(t) for t in self.twist],
-            "twist_convention": "(omega ; v), v = velocity of the point at the origin (SI)",
+            "twist_convention": "(omega ; v): v = velocity of the point at the origin, in the length unit per unit of omega",
             "inverse_actuators": list(self.inverse_actuators),
             "constraint_rank": self.constraint_rank,
             "constraint_rank_generic": self.constraint_rank_generic,
-            "line_geometry": self.line_geometry,
-            "self_motion": self.self_motion,
+            "line_geometry": None if self.line_geometry is None else json_dict(self.line_geometry),
+            "self_motion": sm,
             "wrenches": self.jacobian.wrenches.tolist(),
             "actuators": list(self.jacobian.actuators),
             "explanation": self.explanation,
@@ -99,7 +109,7 @@ def locked_actuators(mech: Mechanism, actuators=None) -> Mechanism:
 def _is_line(w: np.ndarray, L: float, tol: float = 1e-7) -> bool:
     f, m = w[:3], w[3:]
     nf = np.linalg.norm(f)
-    return nf > 1e-12 and abs(f @ m) <= tol * nf * max(np.linalg.norm(m), L * nf)
+    return bool(nf > 1e-12 and abs(f @ m) <= tol * nf * max(np.linalg.norm(m), L * nf))
 
 
 def _as_unit_line(w: np.ndarray) -> np.ndarray:
@@ -126,8 +136,8 @@ def _self_motion(mech: Mechanism, config: Configuration, actuators, arc: float) 
         tr = track(prob, config, max_arc=arc, h0=min(0.01, arc / 10), detect_closure=True, max_steps=400)
     except RuntimeError as e:
         return {"finite": False, "reason": str(e)}
-    if not tr.points or tr.s[-1] < 0.5 * arc and not tr.closed:
-        return {"finite": False, "reason": tr.status, "arc": float(tr.s[-1]) if len(tr.s) else 0.0}
+    if not tr.points or (tr.s[-1] < 0.5 * arc and not tr.closed):
+        return {"finite": False, "reason": tr.message, "arc": float(tr.s[-1]) if len(tr.s) else 0.0}
     p0 = config.D[:3, :3] @ mech.platform_point + config.D[:3, 3]
     end = tr.points[-1]
     p1 = end.D[:3, :3] @ mech.platform_point + end.D[:3, 3]
@@ -150,10 +160,14 @@ def singularity(
     config: Configuration,
     actuators=None,
     *,
-    rtol: float = 1e-7,
+    rtol: float | None = None,
     self_motion_arc: float = 0.3,
 ) -> SingularityResult:
-    """Singularity analysis of ``mech`` at a (closed) configuration with the given actuators."""
+    """Singularity analysis of ``mech`` at a (closed) configuration with the given actuators.
+
+    ``rtol``: the relative singular-value threshold of the wrench system's rank (default: the
+    ``singular`` tolerance in force, :mod:`~spatialmech.geometry.tolerances`)."""
+    rtol = current_tolerances().singular if rtol is None else rtol
     J = complete_jacobian(mech, config, actuators)
     L = mech.characteristic_length
     W = J.wrenches
@@ -175,11 +189,11 @@ def singularity(
         kinds.append("direct")
     elif rank < expected and "constraint" in kinds:
         pass
-    kind = "+".join(kinds) if kinds else "none"
+    kind = SingularityKind("+".join(kinds) if kinds else "none")
     # uncontrolled twists: matrix @ V = 0 (in nondimensional twist coordinates)
     M = sc.nondimensional(J.wrenches, L)
     M = sc.swap(M)  # rows act on (omega ; v / L)
-    twist = ()
+    twist: tuple[tuple[float, ...], ...] = ()
     if rank < 6:
         _, s2, vt = np.linalg.svd(M if M.size else np.zeros((1, 6)))
         r2 = int(np.sum(s2 > rtol * max(1.0, s2[0]))) if s2.size else 0
@@ -195,7 +209,7 @@ def singularity(
     lg = None
     if W.shape[0] and all(_is_line(w, L) for w in W):
         lines = np.array([_as_unit_line(w) for w in W])
-        lg = classify_lines(lines, length_scale=L).to_dict()
+        lg = classify_lines(lines, length_scale=L).as_dict()
     # finite or instantaneous?
     sm = None
     if kind != "none" and "inverse" not in kinds:
@@ -210,22 +224,22 @@ def singularity(
         if "constraint" in kinds:
             parts.append(f"Constraint singularity: the limbs' constraint wrenches have rank {c_rank} instead of {generic}.")
         if "direct" in kinds:
-            parts.append(f"Direct (parallel) singularity: with the actuators locked the wrench system has rank {rank} < {expected}; "
-                         "the platform has an uncontrolled twist.")
+            parts.append("Direct (parallel) singularity: with the actuators locked the wrench system has "
+                         f"rank {rank} < {expected}; the platform has an uncontrolled twist.")
         if sm is not None:
             parts.append("The uncontrolled motion is finite (a self-motion with the actuators locked)." if sm.get("finite")
                          else "The uncontrolled motion is only instantaneous.")
     if lg is not None:
         parts.append(f"Line geometry: rank {lg['rank']}, {lg['case']}.")
-    return SingularityResult(rank, expected, kind, float(J.sigma_min), float(J.condition), tuple(J.transmission), twist, tuple(J.inverse_singular),
-                             c_rank, generic, lg, sm, J, " ".join(parts))
+    return SingularityResult(rank, expected, kind, float(J.sigma_min), float(J.condition), tuple(J.transmission), twist,
+                             tuple(J.inverse_singular), c_rank, generic, lg, sm, J, " ".join(parts))
 
 
 def singularity_at_pose(mech: Mechanism, pose: Pose, actuators=None, **kw) -> SingularityResult:
     """Singularity analysis at a platform pose (fitted onto the closure first)."""
     fit = configuration_at_pose(mech, pose)
     if not fit.converged or not fit.exact:
-        raise ValueError(f"pose: not reachable exactly (nearest closed pose is {fit.position_error:.3g} away); "
+        raise InputError(f"pose: not reachable exactly (nearest closed pose is {fit.position_error:.3g} away); "
                          "singularities are analysed at closed configurations")
     return singularity(mech, fit.config, actuators, **kw)
 
@@ -241,10 +255,19 @@ class SliceResult:
     units: tuple[str, str] = ("", "")
 
     def to_dict(self) -> dict:
-        clean = lambda a: [[None if not np.isfinite(x) else float(x) for x in row] for row in a]
-        return {"axes": list(self.names), "units": list(self.units), "u": self.u.tolist(), "v": self.v.tolist(),
-                "det": clean(self.det), "sign": clean(np.sign(self.det)), "sigma_min": clean(self.sigma_min),
-                "fixed": self.fixed, "sign_changes_along_u": int(np.sum(np.abs(np.diff(np.sign(np.nan_to_num(self.det)), axis=1)) > 0))}
+        """JSON (docs/json.md): the two ``axes`` with their values (``values_deg`` for an
+        angle, ``values_len`` for a length, by ``units``), ``det`` / ``sign`` / ``sigma_min``
+        over the grid (rows along v, columns along u; ``None`` where no pose closes)."""
+        def clean(a):
+            return [[None if not np.isfinite(x) else float(x) for x in row] for row in a]
+
+        axes = []
+        for name, unit, vals in zip(self.names, self.units, (self.u, self.v), strict=True):
+            key = "values_deg" if unit == "deg" else "values_len"
+            axes.append({"name": name, key: [float(x) for x in vals]})
+        return {"axes": axes, "det": clean(self.det), "sign": clean(np.sign(self.det)), "sigma_min": clean(self.sigma_min),
+                "fixed": self.fixed,
+                "sign_changes_along_u": int(np.sum(np.abs(np.diff(np.sign(np.nan_to_num(self.det)), axis=1)) > 0))}
 
 
 def singularity_slice(
@@ -257,12 +280,13 @@ def singularity_slice(
     units=("", ""),
     actuators=None,
     fixed: dict | None = None,
-    progress=None,
+    progress: Progress | None = None,
 ) -> SliceResult:
     """``det J`` and the scale-free ``sigma_min`` over a grid ``pose_of(u_i, v_j)``.
 
     Each grid row is solved by continuation from its neighbour (so the assembly stays the same);
     unreachable poses are ``nan``.  The singularity loci are the zero contours of ``det``.
+    ``progress(j, len(v), "slice")`` after each grid row.
     """
     u = np.asarray(u, float)
     v = np.asarray(v, float)
@@ -282,7 +306,7 @@ def singularity_slice(
             if i == 0:
                 prev_row = fit.config
         if progress:
-            progress(j + 1, len(v))
+            progress(j + 1, len(v), "slice")
     return SliceResult(tuple(names), u, v, det, sig, dict(fixed or {}), tuple(units))
 
 

@@ -12,6 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import InputError
+
 __all__ = ["workspace_figure", "write_workspace_plot"]
 
 _ANGLES = ("alpha", "beta", "gamma")
@@ -45,7 +47,7 @@ def workspace_figure(result):
         c = free[0]
         for lo, hi in result.alone_intervals[c]:
             ax.plot(_conv(c, [lo, hi]), [0, 0], lw=8, color="tab:blue")
-        for x, n in zip(result.boundary_points[:, 0], result.boundary_limits):
+        for x, n in zip(result.boundary_points[:, 0], result.boundary_limits, strict=True):
             ax.plot(_conv(c, x), 0, "o", color=colour[n], label=n)
         ax.set_xlabel(_label(c))
         ax.set_yticks([])
@@ -97,8 +99,8 @@ def workspace_figure(result):
 
 def _legend(ax):
     h, lab = ax.get_legend_handles_labels()
-    seen = {}
-    for hh, ll in zip(h, lab):
+    seen: dict = {}
+    for hh, ll in zip(h, lab, strict=True):
         seen.setdefault(ll, hh)
     if seen:
         ax.legend(seen.values(), seen.keys(), fontsize=6, loc="best")
@@ -108,7 +110,7 @@ def write_workspace_plot(result, path) -> Path:
     """Write :func:`workspace_figure` to ``path`` (format from the suffix: .png, .svg, .pdf)."""
     path = Path(path)
     if path.suffix.lower() not in (".png", ".svg", ".pdf"):
-        raise ValueError(f"plot: expected a .png, .svg or .pdf file name, got {str(path)!r}")
+        raise InputError(f"plot: expected a .png, .svg or .pdf file name, got {str(path)!r}")
     fig = workspace_figure(result)
     fig.savefig(path, dpi=120)
     return path

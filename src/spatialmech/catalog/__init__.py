@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
-from typing import Callable
+from collections.abc import Callable
 
+from ..errors import UnknownNameError
 from ..model.mechanism import Mechanism
 from . import classic, papers
 
-__all__ = ["names", "describe", "build", "resolve", "REGISTRY"]
+__all__ = ["REGISTRY", "build", "describe", "names", "resolve"]
 
 #: name -> (builder, one-line description)
 REGISTRY: dict[str, tuple[Callable[[], Mechanism], str]] = {
@@ -40,7 +41,7 @@ def build(name: str) -> Mechanism:
     try:
         builder = REGISTRY[name][0]
     except KeyError:
-        raise KeyError(f"unknown ready-made model {name!r}; known: {', '.join(REGISTRY)}") from None
+        raise UnknownNameError(f"unknown ready-made model {name!r}; known: {', '.join(REGISTRY)}") from None
     return builder()
 
 

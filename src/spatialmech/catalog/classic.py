@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import least_squares
 
+from ..errors import InputError
 from ..geometry.rotations import euler_matrix, transform
 from ..model.joints import P, R, S, U
 from ..model.mechanism import Limb, Mechanism
@@ -29,7 +30,10 @@ def stewart_6sps(rb: float = 1.0, rp: float = 0.6, h: float = 1.0) -> Mechanism:
         d = A[i] - B[i]
         L = float(np.linalg.norm(d))
         limbs.append(
-            Limb(f"leg{i + 1}", (S(f"B{i + 1}", B[i]), P(f"L{i + 1}", B[i], d / L, actuated=True, offset=L), S(f"A{i + 1}", A[i])))
+            Limb(
+                f"leg{i + 1}",
+                (S(f"B{i + 1}", B[i]), P(f"L{i + 1}", B[i], d / L, actuated=True, offset=L), S(f"A{i + 1}", A[i])),
+            )
         )
     return Mechanism(
         "stewart-6sps", tuple(limbs), platform_point=[0, 0, h],
@@ -48,7 +52,10 @@ def three_rps(rb: float = 0.3, rp: float = 0.15, h: float = 0.3) -> Mechanism:
         d = A[i] - B[i]
         L = float(np.linalg.norm(d))
         limbs.append(
-            Limb(f"leg{i + 1}", (R(f"R{i + 1}", B[i], t), P(f"L{i + 1}", B[i], d / L, actuated=True, offset=L), S(f"S{i + 1}", A[i])))
+            Limb(
+                f"leg{i + 1}",
+                (R(f"R{i + 1}", B[i], t), P(f"L{i + 1}", B[i], d / L, actuated=True, offset=L), S(f"S{i + 1}", A[i])),
+            )
         )
     return Mechanism(
         "three-rps", tuple(limbs), platform_point=[0, 0, h],
@@ -71,7 +78,11 @@ def three_upu(rb: float = 0.3, rp: float = 0.1, h: float = 0.3) -> Mechanism:
         limbs.append(
             Limb(
                 f"leg{i + 1}",
-                (U(f"UB{i + 1}", B[i], [a, b]), P(f"L{i + 1}", B[i], d / L, actuated=True, offset=L), U(f"UA{i + 1}", A[i], [b, a])),
+                (
+                    U(f"UB{i + 1}", B[i], [a, b]),
+                    P(f"L{i + 1}", B[i], d / L, actuated=True, offset=L),
+                    U(f"UA{i + 1}", A[i], [b, a]),
+                ),
             )
         )
     return Mechanism(
@@ -105,7 +116,9 @@ def delta(rb: float = 0.2, arm: float = 0.2, rp: float = 0.05, h: float = -0.35)
     )
 
 
-def planar_4r(ground: float = 4.0, crank: float = 1.0, coupler: float = 3.5, rocker: float = 3.0, angle_deg: float = 60.0) -> Mechanism:
+def planar_4r(
+    ground: float = 4.0, crank: float = 1.0, coupler: float = 3.5, rocker: float = 3.0, angle_deg: float = 60.0
+) -> Mechanism:
     """Planar four-bar (Grashof crank-rocker by default); the coupler is the platform."""
     z = np.array([0.0, 0.0, 1.0])
     A0 = np.zeros(3)
@@ -115,7 +128,7 @@ def planar_4r(ground: float = 4.0, crank: float = 1.0, coupler: float = 3.5, roc
     # B1: intersection of circles |B1 - A1| = coupler, |B1 - B0| = rocker (upper solution)
     d = np.linalg.norm(B0 - A1)
     if not abs(coupler - rocker) <= d <= coupler + rocker:
-        raise ValueError("planar_4r: the loop cannot be assembled at this crank angle")
+        raise InputError("planar_4r: the loop cannot be assembled at this crank angle")
     x = (coupler**2 - rocker**2 + d**2) / (2 * d)
     y = np.sqrt(coupler**2 - x**2)
     e = (B0 - A1) / d
@@ -150,7 +163,7 @@ def bennett(a: float = 1.0, alpha_deg: float = 30.0, b: float = 1.5, theta1_deg:
     al = np.deg2rad(alpha_deg)
     s = b * np.sin(al) / a
     if not 0 < s < 1:
-        raise ValueError("bennett: sin(beta) = b sin(alpha)/a must lie in (0, 1)")
+        raise InputError("bennett: sin(beta) = b sin(alpha)/a must lie in (0, 1)")
     be = np.arcsin(s)
     params = [(a, al), (b, be), (a, al), (b, be)]
     th1 = np.deg2rad(theta1_deg)
@@ -158,7 +171,7 @@ def bennett(a: float = 1.0, alpha_deg: float = 30.0, b: float = 1.5, theta1_deg:
     def chain(th):
         T = np.eye(4)
         frames = [T]
-        for t, (ai, ali) in zip(th, params):
+        for t, (ai, ali) in zip(th, params, strict=True):
             T = T @ _T(_rz(t), [0, 0, 0]) @ _T(np.eye(3), [ai, 0, 0]) @ _T(_rx(ali), [0, 0, 0])
             frames.append(T)
         return frames
@@ -178,7 +191,7 @@ def bennett(a: float = 1.0, alpha_deg: float = 30.0, b: float = 1.5, theta1_deg:
                 best = frames
                 break
     if best is None:  # pragma: no cover - the default parameters assemble
-        raise ValueError("bennett: could not assemble the loop at this input angle")
+        raise InputError("bennett: could not assemble the loop at this input angle")
     o = [f[:3, 3] for f in best[:4]]
     zax = [_unit(f[:3, 2]) for f in best[:4]]
     limbs = (

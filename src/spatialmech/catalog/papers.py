@@ -8,18 +8,19 @@ from importlib import resources
 
 import numpy as np
 
+from ..kinematics.closed_forms.four_sps_cu import PAPER_B_DIMENSIONS, attachment_points
 from ..model.joints import C, P, R, S, Sm, U
 from ..model.mechanism import Limb, Mechanism, Mode, Pose
 
 # ---------------------------------------------------------------- paper B: 4-SPS/CU
-#: Section 6 dimensions of paper B (m).
-FOUR_SPS_CU = {"a": 0.1, "b": 0.2, "z0": 0.2, "leg_limits": (0.1, 0.4), "cu_limits": (0.08, 0.3)}
+#: Section 6 dimensions of paper B (m), defined with the closed form (the catalogue builds its
+#: model from the closed form's data, never the reverse).
+FOUR_SPS_CU = PAPER_B_DIMENSIONS
 
 
 def four_sps_cu_points(a: float, b: float) -> tuple[np.ndarray, np.ndarray]:
     """Platform points ``A_i`` (platform frame) and base points ``B_i`` (conventions.md)."""
-    signs = np.array([[1, -1, 0], [1, 1, 0], [-1, 1, 0], [-1, -1, 0]], dtype=float)
-    return a * signs, b * signs
+    return attachment_points(a, b)
 
 
 def four_sps_cu(a: float | None = None, b: float | None = None, z0: float | None = None) -> Mechanism:

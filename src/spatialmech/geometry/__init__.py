@@ -11,16 +11,16 @@ from .screws import (
 )
 
 __all__ = [
-    "rotations",
-    "screws",
     "DELTA",
     "axis_screw",
-    "translation_screw",
-    "reciprocal_product",
-    "reciprocal_basis",
     "euler_matrix",
-    "matrix_euler",
     "exp_twist",
     "log_transform",
+    "matrix_euler",
+    "reciprocal_basis",
+    "reciprocal_product",
+    "rotations",
+    "screws",
     "transform",
+    "translation_screw",
 ]

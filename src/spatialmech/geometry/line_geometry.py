@@ -56,12 +56,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from itertools import combinations
+from typing import Any
 
 import numpy as np
 
+from ..errors import InputError
 from . import screws as sc
 
-__all__ = ["LineSetGeometry", "classify_lines", "pair_relation"]
+__all__ = ["LineSetGeometry", "classify_lines", "json_dict", "pair_relation"]
 
 #: Default nondimensional tolerance (distances / length_scale, sines of angles, singular values).
 DEFAULT_TOL = 1e-9
@@ -83,8 +85,33 @@ def _jsonable(x):
     if isinstance(x, (list, tuple)):
         return [_jsonable(v) for v in x]
     if isinstance(x, LineSetGeometry):
-        return x.to_dict()
+        return x.as_dict()
     return x
+
+
+#: Keys of :meth:`LineSetGeometry.as_dict` that hold lengths (``*_len`` in JSON).
+_LENGTH_KEYS = frozenset({"point", "offset", "distance", "pitch", "length_scale"})
+
+
+def json_dict(d):
+    """:meth:`LineSetGeometry.as_dict` (SI, radians) in the JSON rule of docs/json.md: lengths
+    ``point_len``, ``offset_len``, ``distance_len``, ``pitch_len``, ``length_scale_len`` (the
+    model's length unit), ``angle_deg`` in degrees; lines stay Plücker 6-vectors."""
+    if isinstance(d, dict):
+        out = {}
+        for k, v in d.items():
+            if k == "units":
+                continue
+            if k == "angle":
+                out["angle_deg"] = None if v is None else float(np.degrees(v))
+            elif k in _LENGTH_KEYS:
+                out[f"{k}_len"] = json_dict(v)
+            else:
+                out[k] = json_dict(v)
+        return out
+    if isinstance(d, (list, tuple)):
+        return [json_dict(v) for v in d]
+    return d
 
 
 @dataclass(frozen=True, eq=False)
@@ -110,7 +137,7 @@ class LineSetGeometry:
     indices: tuple[int, ...] = ()
     pairs: tuple[dict, ...] = ()
     groups: dict = field(default_factory=dict)
-    circuits: tuple["LineSetGeometry", ...] = ()
+    circuits: tuple[LineSetGeometry, ...] = ()
     length_scale: float = 1.0
     tol: float = DEFAULT_TOL
 
@@ -123,11 +150,13 @@ class LineSetGeometry:
         """Whether the lines are linearly dependent (rank below ``min(6, n)``)."""
         return self.rank < min(6, self.n_lines)
 
-    def find_circuit(self, case: str) -> "LineSetGeometry | None":
+    def find_circuit(self, case: str) -> LineSetGeometry | None:
         """The first circuit of the given case, if any."""
         return next((c for c in self.circuits if c.case == case), None)
 
-    def to_dict(self) -> dict:
+    def as_dict(self) -> dict:
+        """Plain Python values, SI and radians (``point``, ``offset``, ``angle`` ...), as the
+        witnesses are stored; :meth:`to_dict` is the JSON form."""
         return {
             "rank": self.rank,
             "case": self.case,
@@ -137,11 +166,15 @@ class LineSetGeometry:
             "witnesses": _jsonable(self.witnesses),
             "pairs": _jsonable(list(self.pairs)),
             "groups": _jsonable(self.groups),
-            "circuits": [c.to_dict() for c in self.circuits],
+            "circuits": [c.as_dict() for c in self.circuits],
             "length_scale": self.length_scale,
             "tol": self.tol,
             "units": "m (points, offsets, moments), unit vectors for directions",
         }
+
+    def to_dict(self) -> dict:
+        """JSON (docs/json.md): :meth:`as_dict` with units in the key names (:func:`json_dict`)."""
+        return json_dict(self.as_dict())
 
     def summary(self) -> str:
         """Several lines of text: the classification, its witnesses and the circuits."""
@@ -177,7 +210,7 @@ def _common_point(L: np.ndarray) -> tuple[np.ndarray, float]:
     s, p = L[:, :3], sc.line_point(L)
     A = np.zeros((3, 3))
     rhs = np.zeros(3)
-    for si, pi in zip(s, p):
+    for si, pi in zip(s, p, strict=True):
         P = np.eye(3) - np.outer(si, si)
         A += P
         rhs += P @ pi
@@ -191,7 +224,7 @@ def _common_plane(L: np.ndarray, scale: float) -> tuple[dict | None, float]:
     ``(p/L, -1)`` acting on ``(n, c/L)``; returns the plane and the residual."""
     s, p = L[:, :3], sc.line_point(L) / scale
     M = np.vstack([np.c_[s, np.zeros(len(s))], np.c_[p, -np.ones(len(p))]])
-    _, sv, vt = np.linalg.svd(M)
+    _, _sv, vt = np.linalg.svd(M)
     v = vt[-1]
     nn = np.linalg.norm(v[:3])
     if nn < 1e-12:
@@ -258,7 +291,7 @@ def pair_relation(l1, l2, *, length_scale: float = 1.0, tol: float = DEFAULT_TOL
     s1, s2 = l1[:3], l2[:3]
     p1, p2 = sc.line_point(l1), sc.line_point(l2)
     c = np.cross(s1, s2)
-    sn = np.linalg.norm(c)
+    sn = float(np.linalg.norm(c))
     if sn < tol:
         dist = float(np.linalg.norm(np.cross(p2 - p1, s1)))
         if dist < tol * length_scale:
@@ -344,7 +377,7 @@ def _rank3(L, idx, scale, tol):
         x = V[:, small][:, 0] @ B
         x = np.r_[x[:3], x[3:] * scale]
         common = _as_line(x, scale, tol)
-        wit = {"common_line": common.get("line"), "pencils": []}
+        wit: dict[str, Any] = {"common_line": common.get("line"), "pencils": []}
         if common["at_infinity"]:
             # two pencils of parallel lines in parallel planes (normal n): they share the line
             # at infinity of those planes; the pencils are the classes of parallel lines
@@ -498,7 +531,7 @@ def _pairs(L, idx, scale, tol):
 
 def _maximal(sets):
     sets = sorted({frozenset(s) for s in sets}, key=lambda s: (-len(s), sorted(s)))
-    keep = []
+    keep: list[frozenset[int]] = []
     for s in sets:
         if not any(s < k for k in keep):
             keep.append(s)
@@ -535,7 +568,7 @@ def _groups(L, idx, pairs, scale, tol):
         for g in _maximal(sets):
             ks = sorted(g)
             sub = L[ks]
-            entry = {"lines": [int(idx[k]) for k in ks]}
+            entry: dict[str, Any] = {"lines": [int(idx[k]) for k in ks]}
             if name == "concurrent":
                 entry["point"] = _common_point(sub)[0]
             elif name == "coplanar":
@@ -592,15 +625,15 @@ def classify_lines(
     """
     arr = np.asarray(lines, dtype=float) if not isinstance(lines, np.ndarray) else lines.astype(float)
     if arr.ndim != 2 or arr.shape[1] != 6:
-        raise ValueError(f"lines: expected shape (n, 6), got {arr.shape}")
+        raise InputError(f"lines: expected shape (n, 6), got {arr.shape}")
     if arr.shape[0] == 0:
-        raise ValueError("lines: at least one line is needed")
+        raise InputError("lines: at least one line is needed")
     for k, l in enumerate(arr):
         sc.validate_line(l, name=f"lines[{k}]")
     if not (np.isfinite(length_scale) and length_scale > 0):
-        raise ValueError(f"length_scale: must be a positive finite length, got {length_scale!r}")
+        raise InputError(f"length_scale: must be a positive finite length, got {length_scale!r}")
     if not (np.isfinite(tol) and 0 < tol < 1e-2):
-        raise ValueError(f"tol: must be in (0, 0.01), got {tol!r}")
+        raise InputError(f"tol: must be in (0, 0.01), got {tol!r}")
     idx = list(range(len(arr)))
     r, case, wit, text = _classify(arr, idx, float(length_scale), float(tol))
     pairs, groups, circuits = (), {}, ()

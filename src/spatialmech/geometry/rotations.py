@@ -20,20 +20,21 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from ..errors import InputError
 from .validate import as_finite_array
 
 __all__ = [
-    "euler_matrix",
-    "matrix_euler",
     "check_sequence",
-    "skew",
-    "transform",
-    "inverse_transform",
+    "euler_matrix",
     "exp_twist",
+    "inverse_transform",
     "log_transform",
+    "matrix_euler",
+    "matrix_rotvec",
     "rotation_angle",
     "rotvec_matrix",
-    "matrix_rotvec",
+    "skew",
+    "transform",
 ]
 
 _AXES = set("xyzXYZ")
@@ -42,13 +43,13 @@ _AXES = set("xyzXYZ")
 def check_sequence(seq: str) -> str:
     """Validate an Euler sequence name such as ``"ZXY"`` (intrinsic) or ``"zxy"`` (extrinsic)."""
     if not isinstance(seq, str) or len(seq) != 3 or not set(seq) <= _AXES:
-        raise ValueError(
+        raise InputError(
             f"seq: expected three axis letters such as 'ZXY' (intrinsic) or 'zxy' (extrinsic), got {seq!r}"
         )
     if not (seq.isupper() or seq.islower()):
-        raise ValueError(f"seq: mixes intrinsic and extrinsic letters: {seq!r}")
+        raise InputError(f"seq: mixes intrinsic and extrinsic letters: {seq!r}")
     if seq[0].lower() == seq[1].lower() or seq[1].lower() == seq[2].lower():
-        raise ValueError(f"seq: consecutive axes must differ, got {seq!r}")
+        raise InputError(f"seq: consecutive axes must differ, got {seq!r}")
     return seq
 
 
@@ -57,10 +58,10 @@ def euler_matrix(seq: str, angles, *, degrees: bool = False) -> np.ndarray:
     check_sequence(seq)
     a = as_finite_array(angles, "angles")
     if a.shape[-1:] != (3,):
-        raise ValueError(f"angles: expected shape (..., 3), got {a.shape}")
+        raise InputError(f"angles: expected shape (..., 3), got {a.shape}")
     flat = a.reshape(-1, 3)
     R = Rotation.from_euler(seq, flat, degrees=degrees).as_matrix()
-    return R.reshape(a.shape[:-1] + (3, 3))
+    return R.reshape((*a.shape[:-1], 3, 3))
 
 
 def matrix_euler(seq: str, R, *, degrees: bool = False) -> np.ndarray:
@@ -69,7 +70,7 @@ def matrix_euler(seq: str, R, *, degrees: bool = False) -> np.ndarray:
     R = as_finite_array(R, "R")
     flat = R.reshape(-1, 3, 3)
     a = Rotation.from_matrix(flat).as_euler(seq, degrees=degrees)
-    return a.reshape(R.shape[:-2] + (3,))
+    return a.reshape((*R.shape[:-2], 3))
 
 
 def skew(v) -> np.ndarray:
@@ -94,7 +95,7 @@ def transform(R, p) -> np.ndarray:
     R = np.asarray(R, dtype=float)
     p = np.asarray(p, dtype=float)
     shape = np.broadcast_shapes(R.shape[:-2], p.shape[:-1])
-    T = np.zeros(shape + (4, 4))
+    T = np.zeros((*shape, 4, 4))
     T[..., :3, :3] = R
     T[..., :3, 3] = p
     T[..., 3, 3] = 1.0
@@ -118,7 +119,7 @@ def exp_twist(screw, theta) -> np.ndarray:
     S = np.asarray(screw, dtype=float)
     th = np.asarray(theta, dtype=float)
     shape = np.broadcast_shapes(S.shape[:-1], th.shape)
-    S = np.broadcast_to(S, shape + (6,))
+    S = np.broadcast_to(S, (*shape, 6))
     th = np.broadcast_to(th, shape)
     w = S[..., :3]
     v = S[..., 3:]
@@ -156,7 +157,7 @@ def log_transform(T) -> np.ndarray:
         t = th[i]
         Ginv = np.eye(3) / t - 0.5 * W + (1.0 / t - 0.5 / np.tan(t / 2.0)) * (W @ W)
         out[i] = np.concatenate([w, Ginv @ p]) * t
-    return out.reshape(T.shape[:-2] + (6,))
+    return out.reshape((*T.shape[:-2], 6))
 
 
 def rotvec_matrix(phi) -> np.ndarray:

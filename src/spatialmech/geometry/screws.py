@@ -25,36 +25,41 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import InputError
 from .rotations import skew
+from .tolerances import DEFAULT, current
 from .validate import as_finite_array, as_unit_vector
 
 __all__ = [
     "DELTA",
-    "axis_screw",
-    "translation_screw",
-    "reciprocal_product",
-    "swap",
     "adjoint",
-    "transform_screws",
-    "plucker_line",
-    "validate_line",
-    "line_point",
-    "pitch",
-    "nondimensional",
-    "rank",
+    "axis_screw",
     "basis",
-    "reciprocal_basis",
     "cofactor_reciprocal",
-    "intersection",
     "contains",
+    "intersection",
+    "line_point",
+    "nondimensional",
+    "pitch",
+    "plucker_line",
+    "rank",
+    "reciprocal_basis",
+    "reciprocal_product",
+    "relative_singular_values",
     "rref",
+    "swap",
+    "transform_screws",
+    "translation_screw",
+    "validate_line",
 ]
 
 #: The reciprocal-product matrix ``[[0, I3], [I3, 0]]``.
 DELTA = np.block([[np.zeros((3, 3)), np.eye(3)], [np.eye(3), np.zeros((3, 3))]])
 
-#: Default relative tolerance for rank decisions on nondimensional, row-normalised screws.
-RANK_RTOL = 1e-9
+#: Default relative tolerance for rank decisions on nondimensional, row-normalised screws (the
+#: default of :attr:`~spatialmech.geometry.tolerances.Tolerances.rank`; functions given no
+#: ``rtol`` use the one in force, :func:`~spatialmech.geometry.tolerances.current`).
+RANK_RTOL = DEFAULT.rank
 
 
 def axis_screw(direction, point, *, pitch: float = 0.0, name: str = "direction") -> np.ndarray:
@@ -95,7 +100,7 @@ def adjoint(T) -> np.ndarray:
     T = np.asarray(T, dtype=float)
     R = T[..., :3, :3]
     p = T[..., :3, 3]
-    Ad = np.zeros(T.shape[:-2] + (6, 6))
+    Ad = np.zeros((*T.shape[:-2], 6, 6))
     Ad[..., :3, :3] = R
     Ad[..., 3:, 3:] = R
     Ad[..., 3:, :3] = skew(p) @ R
@@ -126,10 +131,10 @@ def validate_line(line, *, name: str = "line", atol: float = 1e-9) -> np.ndarray
     L = as_finite_array(line, name, shape=(6,))
     n = np.linalg.norm(L[:3])
     if abs(n - 1.0) > atol:
-        raise ValueError(f"{name}: direction part is not a unit vector (|s| = {n:.6g})")
-    scale = max(1.0, np.linalg.norm(L[3:]))
+        raise InputError(f"{name}: direction part is not a unit vector (|s| = {n:.6g})")
+    scale = max(1.0, float(np.linalg.norm(L[3:])))
     if abs(L[:3] @ L[3:]) > atol * scale:
-        raise ValueError(
+        raise InputError(
             f"{name}: not a line: direction is not orthogonal to moment (s.s0 = {L[:3] @ L[3:]:.3g})"
         )
     return L
@@ -163,6 +168,8 @@ def nondimensional(screws, length_scale: float) -> np.ndarray:
 
 
 def _row_normalised(S: np.ndarray) -> np.ndarray:
+    m = np.max(np.abs(S), axis=-1, keepdims=True)  # scale first: no overflow in the squares
+    S = S / np.where(m > 0, m, 1.0)
     n = np.linalg.norm(S, axis=-1, keepdims=True)
     return S / np.where(n > 0, n, 1.0)
 
@@ -170,9 +177,9 @@ def _row_normalised(S: np.ndarray) -> np.ndarray:
 def _svd(screws, length_scale: float):
     S = np.atleast_2d(np.asarray(screws, dtype=float))
     if S.shape[-1] != 6:
-        raise ValueError(f"screws: expected shape (m, 6), got {S.shape}")
+        raise InputError(f"screws: expected shape (m, 6), got {S.shape}")
     if not np.all(np.isfinite(S)):
-        raise ValueError("screws: contain NaN or infinity")
+        raise InputError("screws: contain NaN or infinity")
     Sn = _row_normalised(nondimensional(S, length_scale))
     if Sn.shape[0] == 0:
         return Sn, np.zeros(0), np.eye(6)
@@ -180,23 +187,35 @@ def _svd(screws, length_scale: float):
     return Sn, sv, vt
 
 
-def _rank_from_sv(sv: np.ndarray, rtol: float) -> int:
+def _rank_from_sv(sv: np.ndarray, rtol: float | None) -> int:
     if sv.size == 0 or sv[0] == 0:
         return 0
+    rtol = current().rank if rtol is None else rtol
     return int(np.sum(sv > rtol * max(1.0, sv[0])))
 
 
-def rank(screws, *, length_scale: float = 1.0, rtol: float = RANK_RTOL) -> int:
+def relative_singular_values(screws, *, length_scale: float = 1.0) -> np.ndarray:
+    """The singular values that rank decisions compare with ``rtol``: those of the
+    nondimensional, row-normalised screws divided by ``max(1, largest)`` (``min(m, 6)`` values,
+    descending).  ``rank(S, rtol=t)`` is the number above ``t``."""
+    _, sv, _ = _svd(screws, length_scale)
+    if sv.size == 0 or sv[0] == 0:
+        return np.zeros(sv.size)
+    return sv / max(1.0, sv[0])
+
+
+def rank(screws, *, length_scale: float = 1.0, rtol: float | None = None) -> int:
     """Dimension of the screw system spanned by ``screws`` (m x 6).
 
     Scale-aware: moments are divided by ``length_scale`` and every screw normalised before
-    the singular values are compared with ``rtol``.
+    the singular values are compared with ``rtol`` (default: the rank tolerance in force,
+    :mod:`~spatialmech.geometry.tolerances`).
     """
     _, sv, _ = _svd(screws, length_scale)
     return _rank_from_sv(sv, rtol)
 
 
-def basis(screws, *, length_scale: float = 1.0, rtol: float = RANK_RTOL) -> np.ndarray:
+def basis(screws, *, length_scale: float = 1.0, rtol: float | None = None) -> np.ndarray:
     """An orthonormal (in nondimensional terms) basis of the span, returned in SI units."""
     _, sv, vt = _svd(screws, length_scale)
     r = _rank_from_sv(sv, rtol)
@@ -205,7 +224,7 @@ def basis(screws, *, length_scale: float = 1.0, rtol: float = RANK_RTOL) -> np.n
     return B
 
 
-def reciprocal_basis(screws, *, length_scale: float = 1.0, rtol: float = RANK_RTOL) -> np.ndarray:
+def reciprocal_basis(screws, *, length_scale: float = 1.0, rtol: float | None = None) -> np.ndarray:
     """Basis (6 - rank, 6) of the screws reciprocal to every screw in ``screws``.
 
     Solved in nondimensional form (moments divided by ``length_scale``) and converted back,
@@ -233,7 +252,7 @@ def cofactor_reciprocal(screws) -> np.ndarray:
     """
     S = np.asarray(screws, dtype=float)
     if S.shape[-2:] != (5, 6):
-        raise ValueError(f"screws: expected shape (..., 5, 6), got {S.shape}")
+        raise InputError(f"screws: expected shape (..., 5, 6), got {S.shape}")
     cols = []
     for j in range(6):
         minor = np.delete(S, j, axis=-1)
@@ -242,30 +261,52 @@ def cofactor_reciprocal(screws) -> np.ndarray:
     return swap(y)
 
 
-def rref(A, *, tol: float = 1e-9) -> np.ndarray:
-    """Reduced row-echelon form of the rows of ``A`` (zero rows dropped): a deterministic,
+def rref(A, *, tol: float | None = None) -> np.ndarray:
+    """Reduced row-echelon form of the rows of ``A`` (dependent rows dropped): a deterministic,
     readable basis of their span (e.g. a constraint system given as forces along x and y
     rather than an arbitrary SVD basis).  Pass nondimensional screws (see
-    :func:`nondimensional`) so that the pivot tolerance is scale-free."""
+    :func:`nondimensional`) so that the tolerances are scale-free.
+
+    Columns are taken in order; a column gives the next pivot only when its largest remaining
+    entry is at least ``tol`` (default: the ``pivot`` tolerance in force,
+    :mod:`~spatialmech.geometry.tolerances`) times the largest entry left in the whole
+    remaining block, so that the rounding noise of typed data never becomes a pivot (dividing
+    by it would blow the row up to 1e15).  The number of rows returned is the rank at the
+    ``rank`` tolerance in force: rows stop only when everything left is below it (relative to
+    the largest entry of ``A``).
+    """
+    t = current()
+    ptol = t.pivot if tol is None else float(tol)
     A = np.array(A, dtype=float, copy=True)
+    if A.ndim != 2:
+        raise InputError(f"A: expected a matrix (rows of screws), got shape {A.shape}")
     rows, cols = A.shape
+    if A.size == 0:
+        return A[:0]
+    floor = t.rank * float(np.max(np.abs(A)))
     r = 0
     for c in range(cols):
         if r == rows:
             break
-        piv = r + int(np.argmax(np.abs(A[r:, c])))
-        if abs(A[piv, c]) < tol:
+        block = np.abs(A[r:, c:])
+        big = float(np.max(block))
+        if big <= floor:
+            break  # the remaining rows are zero up to round-off
+        piv = r + int(np.argmax(block[:, 0]))
+        if abs(A[piv, c]) < ptol * big:
             continue
         A[[r, piv]] = A[[piv, r]]
         A[r] /= A[r, c]
         for i in range(rows):
             if i != r:
                 A[i] -= A[i, c] * A[r]
+        A[r, c] = 1.0
+        A[np.arange(rows) != r, c] = 0.0
         r += 1
     return A[:r]
 
 
-def intersection(A, B, *, length_scale: float = 1.0, rtol: float = RANK_RTOL) -> np.ndarray:
+def intersection(A, B, *, length_scale: float = 1.0, rtol: float | None = None) -> np.ndarray:
     """Basis of the intersection of the spans of ``A`` and ``B`` (as screw systems)."""
     # span(A) ∩ span(B) = reciprocal( reciprocal(A) ∪ reciprocal(B) )
     RA = reciprocal_basis(A, length_scale=length_scale, rtol=rtol)
@@ -274,8 +315,10 @@ def intersection(A, B, *, length_scale: float = 1.0, rtol: float = RANK_RTOL) ->
     return reciprocal_basis(both, length_scale=length_scale, rtol=rtol)
 
 
-def contains(system, screw, *, length_scale: float = 1.0, rtol: float = 1e-7) -> bool:
-    """Whether ``screw`` lies in the span of ``system`` (scale-aware)."""
+def contains(system, screw, *, length_scale: float = 1.0, rtol: float | None = None) -> bool:
+    """Whether ``screw`` lies in the span of ``system`` (scale-aware; ``rtol`` default: the
+    ``contains`` tolerance in force)."""
+    rtol = current().contains if rtol is None else rtol
     S = np.atleast_2d(np.asarray(system, dtype=float))
     r0 = rank(S, length_scale=length_scale, rtol=rtol) if S.size else 0
     r1 = rank(np.vstack([S, np.atleast_2d(screw)]) if S.size else np.atleast_2d(screw),

@@ -1,20 +1,25 @@
 """The ``spatialmech`` command line (click).  Thin: parse, call an analysis, print text or JSON.
 
 User errors (bad files, unknown names, impossible requests) print one line to stderr and exit
-with code 2; nothing here computes.
+with code 2 (1 when a computation did not converge); any other exception is a bug: exit code 3,
+with its traceback under ``--debug`` or ``SPATIALMECH_DEBUG=1`` (:class:`_Group`).  Nothing here
+computes.
 """
 
 from __future__ import annotations
 
+import os
 import sys
+import traceback
 from pathlib import Path
 
 import click
 
 from .. import __version__, catalog
 from ..analysis.mobility import mobility, mobility_modes
-from ..model.schema import ModelFileError, dump
-from .common import UserError, emit_json, json_option  # noqa: F401  (re-exported)
+from ..errors import ConvergenceError, SpatialmechError
+from ..model.schema import dump
+from .common import UserError, check_output_dir, check_output_file, emit_json, json_option, tol_option
 
 
 def _one_line_usage(e: click.UsageError) -> UserError:
@@ -23,9 +28,40 @@ def _one_line_usage(e: click.UsageError) -> UserError:
     return UserError(f"{e.format_message()} (see '{where} --help')")
 
 
+#: Environment variable that turns on the tracebacks of internal errors (like ``--debug``).
+DEBUG_ENV = "SPATIALMECH_DEBUG"
+
+
+def _one_line(e: BaseException) -> str:
+    return "; ".join(part.strip() for part in str(e).splitlines() if part.strip())
+
+
+def _user_error(e: BaseException) -> UserError | None:
+    """The one-line error of a user error (exit 2; 1 for a computation that did not converge),
+    or ``None`` when ``e`` is a programming error."""
+    if isinstance(e, ConvergenceError):
+        err = UserError(f"the computation failed: {_one_line(e)}")
+        err.exit_code = 1
+        return err
+    if isinstance(e, SpatialmechError):
+        return UserError(_one_line(e))
+    if isinstance(e, OSError):  # a path the user gave: cannot read, cannot write, no such directory
+        name = e.filename if e.filename is not None else ""
+        return UserError(f"{name}: {e.strerror or e}" if name else str(e.strerror or e))
+    return None
+
+
 class _Group(click.Group):
-    """Turns the library's input errors into one-line messages: exit code 2 for bad input (also
-    click's usage errors and files that cannot be read or written), 1 for a failed computation."""
+    """The command line's error policy (docs/index.md, "Errors"):
+
+    - user errors -- the library's own exceptions (:class:`~spatialmech.errors.SpatialmechError`:
+      bad input, malformed files, unknown names, searches too large), click's usage errors, and
+      ``OSError`` on the paths the user gave -- print one line ``error: ...`` and exit with code 2
+      (1 for a :class:`~spatialmech.errors.ConvergenceError`);
+    - anything else (a plain ``ValueError``, ``KeyError``, ``IndexError``, ``TypeError`` ...) is a
+      bug: one line ``error: internal error ...`` and exit code 3; with ``--debug`` or
+      ``SPATIALMECH_DEBUG=1`` the full traceback is printed first.
+    """
 
     def make_context(self, info_name, args, parent=None, **extra):
         try:
@@ -42,18 +78,38 @@ class _Group(click.Group):
             raise  # --help, --version, Ctrl-C: click's own (Exit and Abort are RuntimeErrors)
         except click.UsageError as e:
             raise _one_line_usage(e) from None
-        except (ModelFileError, ValueError, KeyError) as e:
-            msg = e.args[0] if isinstance(e, KeyError) and e.args else str(e)
-            raise UserError(str(msg)) from None
+        except click.ClickException:
+            raise  # already one line (UserError)
         except BrokenPipeError:
             raise  # stdout closed early (``| head``): click exits quietly
-        except OSError as e:
-            name = e.filename if e.filename is not None else ""
-            raise UserError(f"{name}: {e.strerror or e}" if name else str(e.strerror or e)) from None
-        except RuntimeError as e:
-            err = UserError(f"the computation failed: {e}")
-            err.exit_code = 1
-            raise err from None
+        except Exception as e:
+            err = _user_error(e)
+            if err is not None:
+                raise err from None
+            raise InternalError(e, traceback.format_exc() if _debug(ctx) else None) from None
+
+
+def _debug(ctx: click.Context) -> bool:
+    return bool(ctx.params.get("debug")) or os.environ.get(DEBUG_ENV, "").strip().lower() in ("1", "true", "yes", "on")
+
+
+class InternalError(click.ClickException):
+    """A programming error: one line (exit code 3) that says how to get the traceback, or the
+    traceback and that line under ``--debug`` / ``SPATIALMECH_DEBUG=1``."""
+
+    exit_code = 3
+
+    def __init__(self, error: BaseException, trace: str | None):
+        first = (str(error).splitlines() or [""])[0]
+        super().__init__(f"internal error ({type(error).__name__}: {first[:200]}); this is a bug in spatialmech, "
+                         "please report it with the command line"
+                         + ("" if trace else f"; run with --debug or {DEBUG_ENV}=1 for the traceback"))
+        self.error, self.trace = error, trace
+
+    def show(self, file=None):
+        if self.trace:
+            click.echo(self.trace.rstrip("\n"), err=True, file=file)
+        click.echo(f"error: {self.format_message()}", err=True, file=file)
 
 
 def _model(spec: str):
@@ -64,10 +120,14 @@ def _model(spec: str):
 
 @click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(__version__, prog_name="spatialmech")
-def cli():
+@click.option("--debug", is_flag=True,
+              help=f"On a bug (exit code 3) print its traceback, as {DEBUG_ENV}=1 does.")
+def cli(debug):
     """Kinematic analysis and synthesis of spatial linkages and parallel mechanisms.
 
-    MODEL arguments take a ready-made name (see `spatialmech models`) or a TOML file.
+    MODEL arguments take a ready-made name (see `spatialmech models`) or a TOML file.  Exit
+    codes: 0 done, 2 bad input, 1 a computation that did not converge, 3 a bug (--debug shows
+    its traceback); the reason is one line on stderr.
 
     \b
     Example:
@@ -86,7 +146,7 @@ def models(as_json):
     """
     rows = [{"name": n, "description": catalog.describe(n)} for n in catalog.names()]
     if as_json:
-        emit_json(rows)
+        emit_json("models", None, {"models": rows})
         return
     w = max(len(r["name"]) for r in rows)
     for r in rows:
@@ -108,31 +168,30 @@ def _mobility_text(r) -> str:
         for w in r.constraint_wrenches:
             lines.append("    (" + " ".join(f"{x:+.4g}" for x in w[:3]) + " ; " + " ".join(f"{x:+.4g}" for x in w[3:]) + ")")
     lines.append(f"  {r.explanation}")
+    if r.tolerance_note:
+        lines.append(f"  {r.tolerance_note}")
     return "\n".join(lines)
 
 
 @cli.command(name="mobility")
 @click.argument("model")
 @click.option("--mode", default=None, help="Motion mode of a metamorphic mechanism (default: all modes).")
+@tol_option("rank")
 @json_option
 def mobility_cmd(model, mode, as_json):
-    """Mobility by the modified Kutzbach-Grübler formula, checked numerically.
+    """Mobility by the modified Kutzbach-Grübler formula, checked numerically, and how the
+    count depends on the rank tolerance (for models typed with rounded numbers).
 
     \b
     Examples:
       spatialmech mobility four-sps-cu
       spatialmech mobility three-rrr-sm --mode R1+R4 --json
-      spatialmech mobility my-mechanism.toml
+      spatialmech mobility my-mechanism.toml --tol 1e-4
     """
     mech = _model(model)
-    if mode is not None:
-        results = [mobility(mech, mode)]
-        single = True
-    else:
-        results = mobility_modes(mech)
-        single = not mech.is_metamorphic
-    if as_json:
-        emit_json(results[0].to_dict() if single else [r.to_dict() for r in results])
+    results = [mobility(mech, mode)] if mode is not None else mobility_modes(mech)
+    if as_json:  # one shape for every model: the list of modes (one for an ordinary mechanism)
+        emit_json("mobility", mech, {"metamorphic": mech.is_metamorphic, "modes": [r.to_dict() for r in results]})
         return
     click.echo("\n\n".join(_mobility_text(r) for r in results))
 
@@ -148,10 +207,11 @@ def export(model, file, as_json):
     Example:
       spatialmech export rssr my-rssr.toml
     """
+    check_output_file(file, "FILE")
     mech = _model(model)
     dump(mech, file)
     if as_json:
-        emit_json({"model": mech.name, "out": str(file), "bytes": file.stat().st_size})
+        emit_json("export", mech, {"out": str(file), "bytes": file.stat().st_size})
     else:
         click.echo(f"wrote {file}")
 
@@ -171,10 +231,11 @@ def demo(out, as_json):
     """
     from ..present.report import build_demo
 
-    out.mkdir(parents=True, exist_ok=True)  # fail now on an unwritable --out, not after the work
+    check_output_dir(out, "--out")  # fail now on an unwritable --out, not after the work
+    out.mkdir(parents=True, exist_ok=True)
     results = build_demo(out, progress=not as_json)
     if as_json:
-        emit_json(results)
+        emit_json("demo", None, {k: v for k, v in results.items() if k != "model"})
     else:
         s = results["summary"]
         click.echo(f"report written to {out / 'index.html'} and {out / 'results.json'}: {s['claims']} claims, "
@@ -200,22 +261,24 @@ def report(model, out, no_trace, as_json):
     """
     from ..present.report import build_model_report
 
+    check_output_dir(out, "--out")  # fail now on an unwritable --out, not after the work
     mech = _model(model)
     out = out if out is not None else Path(f"report-{mech.name}")
-    out.mkdir(parents=True, exist_ok=True)  # fail now on an unwritable --out, not after the work
+    check_output_dir(out, "--out")
+    out.mkdir(parents=True, exist_ok=True)
     results = build_model_report(mech, out, progress=not as_json, trace=not no_trace)
     if as_json:
-        emit_json(results)
+        emit_json("report", mech, {k: v for k, v in results.items() if k != "model"})
     else:
         click.echo(f"report written to {out / 'index.html'} and {out / 'results.json'}")
 
 
+from .cmd_defects import defects  # noqa: E402
 from .cmd_kinematics import fk, ik, jacobian  # noqa: E402  (commands defined in their own modules)
+from .cmd_singularity import singularity_cmd  # noqa: E402
 from .cmd_synth import synth  # noqa: E402
 from .cmd_view import view  # noqa: E402
-from .cmd_defects import defects  # noqa: E402
 from .cmd_workspace import workspace  # noqa: E402
-from .cmd_singularity import singularity_cmd  # noqa: E402
 
 for _cmd in (ik, fk, jacobian, synth, view, defects, workspace, singularity_cmd):
     cli.add_command(_cmd)

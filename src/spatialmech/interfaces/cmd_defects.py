@@ -10,7 +10,11 @@ import numpy as np
 from .. import catalog
 from ..analysis.defects import defect_analysis
 from ..model.schema import load_positions
-from .common import emit_json, json_option
+from ..errors import InputError
+from .common import check_output_dir, emit_json, json_option
+
+#: Largest --monte-carlo: each sample is a whole defect analysis (seconds to tens of seconds).
+MAX_MONTE_CARLO = 1000
 
 
 @click.command()
@@ -18,12 +22,14 @@ from .common import emit_json, json_option
 @click.option("--positions", "positions_file", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="TOML file of task positions ([[positions]] with point and euler/matrix); default: the model's own.")
 @click.option("--driver", "drivers", multiple=True, help="Candidate driver (repeatable; default: every base-joint freedom).")
-@click.option("--pose-tol", type=float, default=None, help="Position tolerance for circuit membership (length; default 2% of the size).")
+@click.option("--pose-tol", type=float, default=None,
+              help="Position tolerance for circuit membership (length; default 2% of the size).")
 @click.option("--angle-tol-deg", type=float, default=1.0, show_default=True, help="Angle tolerance for circuit membership (deg).")
 @click.option("--monte-carlo", type=int, default=0, show_default=True, help="Samples of a perturbation check of the verdicts.")
 @click.option("--precision", type=float, default=5e-4, show_default=True, help="Printed precision of lengths for --monte-carlo.")
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the Monte-Carlo check.")
-@click.option("--plot", "plot_dir", type=click.Path(file_okay=False, path_type=Path), default=None, help="Write the figures into this directory.")
+@click.option("--plot", "plot_dir", type=click.Path(file_okay=False, path_type=Path), default=None,
+              help="Write the figures into this directory.")
 @json_option
 def defects(model, positions_file, drivers, pose_tol, angle_tol_deg, monte_carlo, precision, seed, plot_dir, as_json):
     """Circuit, branch and order defects of a 1-DOF linkage for its task positions; drivers
@@ -35,9 +41,13 @@ def defects(model, positions_file, drivers, pose_tol, angle_tol_deg, monte_carlo
       spatialmech defects five-cs-3 --json --plot figs
       spatialmech defects my-linkage.toml --positions my-positions.toml --driver A0
     """
+    if monte_carlo > MAX_MONTE_CARLO:
+        raise InputError(f"--monte-carlo: at most {MAX_MONTE_CARLO} samples (each is a whole defect analysis), "
+                         f"got {monte_carlo}")
+    check_output_dir(plot_dir, "--plot")
     mech = catalog.resolve(model)
     positions = load_positions(positions_file) if positions_file else None
-    say = (lambda msg: None) if as_json else (lambda msg: click.echo(f"  ... {msg}", err=True))
+    say = None if as_json else (lambda done, total, msg: click.echo(f"  ... {msg}", err=True))
     res = defect_analysis(mech, positions, drivers=list(drivers) or None, pose_tol=pose_tol, angle_tol_deg=angle_tol_deg,
                           monte_carlo=monte_carlo, seed=seed, precision=precision, progress=say)
     paths = []
@@ -46,16 +56,14 @@ def defects(model, positions_file, drivers, pose_tol, angle_tol_deg, monte_carlo
 
         paths = write_defect_figures(mech, res, plot_dir)
     if as_json:
-        d = res.to_dict()
-        if paths:
-            d["figures"] = [str(p) for p in paths]
-        emit_json(d)
+        emit_json("defects", mech, {**res.to_dict(), "figures": [str(p) for p in paths]})
         return
-    d = res.to_dict()
-    click.echo(f"{mech.name}: {len(res.circuits)} circuit(s): " + "; ".join("{" + ", ".join(f"P{j}" for j in c) + "}" for c in res.circuits))
+    circuits = "; ".join("{" + ", ".join(f"P{j}" for j in c) + "}" for c in res.circuits)
+    click.echo(f"{mech.name}: {len(res.circuits)} circuit(s): {circuits}")
     click.echo(f"  circuit defect: {'YES' if res.circuit_defect else 'no'}   order defect: {'YES' if res.order_defect else 'no'}"
                + ("" if res.circuit_defect else f"   (positions met in order {', '.join(f'P{j}' for j in res.order)})"))
-    click.echo(f"  DJ: {res.dj_method}; membership tolerance {res.tolerances['pose']:.3g} {mech.length_unit}, {res.tolerances['angle_deg']:g} deg")
+    click.echo(f"  DJ: {res.dj_method}; membership tolerance {res.tolerances['pose']:.3g} {mech.length_unit}, "
+               f"{res.tolerances['angle_deg']:g} deg")
     names = [p.name for p in (positions if positions is not None else mech.positions)]
     for j, f in enumerate(res.fits):
         if np.hypot(f.position_error / res.tolerances["pose"], np.degrees(f.angle_error) / res.tolerances["angle_deg"]) > 1:
@@ -67,7 +75,8 @@ def defects(model, positions_file, drivers, pose_tol, angle_tol_deg, monte_carlo
         spans = [f"P{b.between[0]}-P{b.between[1]}" if b.between else "?" for b in v.branch_points]
         where = ", ".join(x + (f" x{spans.count(x)}" if spans.count(x) > 1 else "")
                           for x in dict.fromkeys(spans))  # "P6-P7 x2": two zeros between P6 and P7
-        verdict = "usable" if v.usable else ("branch defect" + (f" ({where})" if where else "") if v.branch_defect else "not usable")
+        verdict = ("usable" if v.usable
+                   else ("branch defect" + (f" ({where})" if where else "") if v.branch_defect else "not usable"))
         extra = f"  min sigma on path {v.min_sigma_on_path:.2e}" if v.min_sigma_on_path is not None else ""
         click.echo(f"  {v.driver:>8s}  {signs}   {verdict}{extra}")
     if res.usable_drivers:

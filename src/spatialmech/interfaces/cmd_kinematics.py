@@ -12,12 +12,18 @@ import click
 import numpy as np
 
 from .. import catalog
-from ..geometry.rotations import euler_matrix, matrix_euler
 from ..analysis.defects import dj_table as compute_dj_table
+from ..errors import InputError
+from ..geometry.rotations import euler_matrix, matrix_euler
+from ..geometry.tolerances import current as current_tolerances
 from ..kinematics.jacobian import complete_jacobian
 from ..kinematics.position import configuration_at_pose, forward_position, inverse_position
 from ..model.mechanism import Mechanism, Pose
-from .common import emit_json, json_option
+from ..serialize import pose_dict
+from .common import emit_json, json_option, parse_numbers, tol_option
+
+#: Largest number of starts of ``fk --all`` (each start is one Newton solve).
+MAX_SEEDS = 20_000
 
 pose_options = [
     click.option("--pose", "pose_text", default=None,
@@ -38,7 +44,7 @@ def with_pose(f):
     def wrapper(*args, pose_text=None, xyz=None, euler=None, **kw):
         if pose_text is not None:
             if xyz is not None or euler is not None:
-                raise ValueError("--pose: give either --pose or --xyz/--euler, not both")
+                raise InputError("--pose: give either --pose or --xyz/--euler, not both")
             xyz, euler = parse_pose(pose_text)
         return f(*args, xyz=xyz, euler=euler, **kw)
 
@@ -51,37 +57,50 @@ def parse_pose(text: str):
     """``"X,Y,Z,SEQ,A1,A2,A3"`` -> ((x, y, z), (seq, a1, a2, a3)), angles in degrees."""
     parts = [p.strip() for p in text.split(",")]
     if len(parts) != 7:
-        raise ValueError(f"--pose: expected X,Y,Z,SEQ,A1,A2,A3 (7 comma-separated values), got {len(parts)}")
+        raise InputError(f"--pose: expected X,Y,Z,SEQ,A1,A2,A3 (7 comma-separated values), got {len(parts)}")
     try:
         xyz = tuple(float(v) for v in parts[:3])
         ang = tuple(float(v) for v in parts[4:])
     except ValueError:
-        raise ValueError(f"--pose: expected numbers for X,Y,Z and A1,A2,A3, got {text!r}") from None
+        raise InputError(f"--pose: expected numbers for X,Y,Z and A1,A2,A3, got {text!r}") from None
     return xyz, (parts[3], *ang)
+
+
+#: Largest distance of a requested platform point from the reference one, in characteristic
+#: lengths of the model (farther is out of the numerical range: squares overflow).
+MAX_POSE_DISTANCE = 1e6
 
 
 def resolve_pose(mech: Mechanism, xyz, euler, position) -> Pose:
     if position is not None:
         if xyz is not None or euler is not None:
-            raise ValueError("--position: give either --position or --xyz/--euler, not both")
+            raise InputError("--position: give either --position or --xyz/--euler, not both")
         if not mech.positions:
-            raise ValueError(f"--position: {mech.name} has no built-in task positions")
+            raise InputError(f"--position: {mech.name} has no built-in task positions")
         if not 1 <= position <= len(mech.positions):
-            raise ValueError(f"--position: expected 1..{len(mech.positions)}, got {position}")
+            raise InputError(f"--position: expected 1..{len(mech.positions)}, got {position}")
         return mech.positions[position - 1]
     if xyz is None and euler is None:
-        raise ValueError("--xyz/--euler: give a pose (or --position N)")
+        raise InputError("--xyz/--euler: give a pose (or --position N)")
     p = np.asarray(xyz if xyz is not None else mech.platform_point, dtype=float)
+    if not np.all(np.isfinite(p)):
+        raise InputError(f"--xyz: expected finite numbers, got {', '.join(f'{v:g}' for v in p)}")
+    with np.errstate(over="ignore"):
+        dist = float(np.max(np.abs(p - mech.platform_point)))
+    if dist > MAX_POSE_DISTANCE * mech.characteristic_length:  # squares of such numbers overflow
+        raise InputError(f"--xyz: the point is {dist:.3g} {mech.length_unit} from the reference platform point of "
+                         f"{mech.name}, more than {MAX_POSE_DISTANCE:g} times its size "
+                         f"({mech.characteristic_length:.3g} {mech.length_unit}): out of range")
     if euler is None:
         R = np.eye(3)
     else:
         seq, *ang = euler
+        if not np.all(np.isfinite(ang)):
+            raise InputError(f"--euler: expected finite angles (degrees), got {', '.join(f'{v:g}' for v in ang)}")
         R = euler_matrix(seq, ang, degrees=True)
     return Pose(R, p, "requested")
 
 
-#: Scale-free smallest singular value below which a configuration is reported as singular.
-SINGULAR_SIGMA = 1e-9
 
 
 def _deg(a: float, ndigits: int = 4) -> float:
@@ -104,6 +123,7 @@ def _fmt_value(mech: Mechanism, fid: str, v: float) -> str:
 @click.argument("model")
 @with_pose
 @click.option("--all", "all_solutions", is_flag=True, help="Search every real solution of every limb.")
+@tol_option("reachability")
 @json_option
 def ik(model, xyz, euler, position, all_solutions, as_json):
     """Inverse position: joint values of every limb for a platform pose.
@@ -117,40 +137,52 @@ def ik(model, xyz, euler, position, all_solutions, as_json):
     """
     mech = catalog.resolve(model)
     pose = resolve_pose(mech, xyz, euler, position)
-    res = inverse_position(mech, pose, all_solutions=all_solutions)
-    # A model's task positions are printed (rounded) data: say how far the nearest closed
-    # configuration is instead of leaving a bare "not reachable".
-    fit = configuration_at_pose(mech, pose) if (position is not None and not res.reachable) else None
+    res = inverse_position(mech, pose, all_solutions=all_solutions, fit=True)
+    # A pose that does not close exactly (printed, rounded data: a task position, a pose printed
+    # by fk) is fitted onto the closure: reachable when the nearest closed configuration is
+    # within the reachability tolerance, and either way the distance is said, never hidden.
+    fit = res.pose_fit
+    reach_tol = current_tolerances().reachability
+    d = res.to_dict(mech)
     if as_json:
-        d = res.to_dict(mech)
-        if fit is not None:
-            d["pose_fit"] = {**fit.to_dict(), "note": f"P{position} is printed (rounded) data; pose_fit is the "
-                             "nearest closed configuration (configuration_at_pose), position_error in the model's length unit"}
-        emit_json(d)
+        d["pose_fit"] = None if fit is None else {
+            **fit.to_dict(), "tolerance": reach_tol,
+            "note": "the pose does not close exactly (printed, rounded data?); pose_fit is the nearest closed "
+                    "configuration (configuration_at_pose); within the tolerance (pose_error: the larger of the "
+                    "angle error in rad and the position error over the characteristic length) the pose is "
+                    "reachable and the solutions are those of the fitted pose"}
+        emit_json("ik", mech, d)
         return
-    click.echo(f"{mech.name}: pose {'reachable' if res.reachable else 'NOT reachable'}")
-    for limb in res.to_dict(mech)["limbs"]:
+    order = {r.id: i for i, r in enumerate(mech.freedom_refs)}
+    fitted = (f" (fitted onto the closure: off by {fit.position_error:.3g} {mech.length_unit} and "
+              f"{np.degrees(fit.angle_error):.3g} deg, within the tolerance {reach_tol:g})") if res.fitted else ""
+    click.echo(f"{mech.name}: pose {'reachable' if res.reachable else 'NOT reachable'}{fitted}")
+    for limb in d["limbs"]:
         extra = f", solution set of dimension {limb['passive_dim']} (passive freedoms)" if limb["passive_dim"] else ""
-        click.echo(f"  {limb['limb']}: {len(limb['solutions'])} solution(s){extra}" + ("" if limb["reachable"] else " [least-squares, not closed]"))
+        click.echo(f"  {limb['limb']}: {len(limb['solutions'])} solution(s){extra}"
+                   + ("" if limb["reachable"] else " [least-squares, not closed]"))
         for k, sol in enumerate(limb["solutions"]):
-            vals = ", ".join(f"{fid}={v:.6g}" for fid, v in sol["values"].items())
+            values = sorted({**sol["joints_deg"], **sol["joints_len"]}.items(), key=lambda kv: order[kv[0]])
+            vals = ", ".join(f"{fid}={v:.6g}" for fid, v in values)
             lim = f"  outside limits: {', '.join(sol['outside_limits'])}" if sol["outside_limits"] else ""
             click.echo(f"    [{k + 1}] {vals}  (residual {sol['residual']:.1e}){lim}")
     if res.config is not None:
         click.echo("  actuators: " + ", ".join(f"{k} = {_fmt_value(mech, k, v)}" for k, v in res.actuator_values(mech).items()))
     click.echo("  (rotations in degrees, slides in " + mech.length_unit + ")")
-    if fit is not None and fit.converged:
-        click.echo(f"  note: task position {position} is printed (rounded) data; the nearest closed configuration is "
-                   f"{fit.position_error:.3g} {mech.length_unit} and {np.degrees(fit.angle_error):.3g} deg from it "
-                   "(`spatialmech jacobian --position N` uses that configuration)")
+    if fit is not None and fit.converged and not res.reachable:
+        what = f"task position {position} is printed (rounded) data; " if position is not None else ""
+        click.echo(f"  note: {what}the nearest closed configuration is {fit.position_error:.3g} {mech.length_unit} and "
+                   f"{np.degrees(fit.angle_error):.3g} deg from it (pose error {fit.error:.2g}, beyond the reachability "
+                   f"tolerance {reach_tol:g}; `--tol` sets it; `spatialmech jacobian` uses that configuration)")
 
 
 @click.command()
 @click.argument("model")
 @click.option("--actuators", "values", required=True, help="Comma-separated actuator values in mechanism order (degrees / length).")
 @click.option("--all", "all_solutions", is_flag=True, help="Search all real assembly modes (multi-start).")
-@click.option("--seeds", type=click.IntRange(min=1), default=None,
-              help="Number of starts for --all (default: 200; 512 on the 4-SPS/CU closed form).")
+@click.option("--seeds", type=click.IntRange(min=1, max=MAX_SEEDS), default=None,
+              help=f"Number of starts for --all (default: 200; 512 on the 4-SPS/CU closed form; at most {MAX_SEEDS}).")
+@tol_option("newton")
 @json_option
 def fk(model, values, all_solutions, seeds, as_json):
     """Forward position: platform pose(s) for actuator values.
@@ -161,58 +193,97 @@ def fk(model, values, all_solutions, seeds, as_json):
       spatialmech fk four-sps-cu --actuators 0.21,0.25,0.22,0.19 --all --json
     """
     mech = catalog.resolve(model)
-    try:
-        raw = [float(x) for x in values.split(",") if x.strip()]
-    except ValueError:
-        raise ValueError(f"--actuators: expected comma-separated numbers, got {values!r}") from None
+    raw = parse_numbers(values, "--actuators")
     acts = mech.actuators
     if len(raw) != len(acts):
-        raise ValueError(f"--actuators: {mech.name} has {len(acts)} actuators ({', '.join(acts)}), got {len(raw)} values")
-    vals = [v if mech.freedom(a).freedom.kind == "P" else np.radians(v) for a, v in zip(acts, raw)]
+        raise InputError(f"--actuators: {mech.name} has {len(acts)} actuators ({', '.join(acts)}), got {len(raw)} values")
+    vals = [v if mech.freedom(a).freedom.kind == "P" else np.radians(v) for a, v in zip(acts, raw, strict=True)]
     from ..kinematics.closed_forms import four_sps_cu as k4
 
     geom = k4.geometry_of(mech) if all_solutions else None
     if geom is not None:  # the closed form of this limb layout: faster and more thorough
         fa = k4.forward_all(np.asarray(vals), geometry=geom, **({} if seeds is None else {"n_seeds": seeds}))
-        d = fa.to_dict()
-        d["method"] = "closed form of the 4-SPS/CU (kinematics/closed_forms/four_sps_cu.py)"
         if as_json:
-            emit_json(d)
+            emit_json("fk", mech, fa.to_dict(actuators=acts))
             return
-        click.echo(f"{mech.name}: {len(fa.solutions)} assembly mode(s) found ({fa.n_within_limits} within the leg and CU "
-                   f"limits; closed-form multi-start, {fa.search.n_seeds} seeds)")
+        if not fa.solutions:
+            raise InputError(f"actuators: no assembly found among {fa.search.n_seeds} starts of the closed form "
+                             f"({fa.search.n_converged} converged); not a proof that none exists: check the values "
+                             "against the leg limits, or try more --seeds")
+        click.echo(_fk_header(mech, [s_.kind for s_ in fa.solutions], "closed-form multi-start", fa.search.n_seeds,
+                              fa.search.n_converged) + f"; {fa.n_within_limits} within the leg and CU limits")
         for n, s_ in enumerate(fa.solutions):
             z, al, be, ga = s_.phi
-            sing = f"  singular (sigma_min {s_.sigma_min:.1e})" if s_.sigma_min < SINGULAR_SIGMA else ""
             click.echo(f"  [{n + 1}] z = {round(float(z), 6) + 0.0:.6f} m, alpha = {_deg(al):.4f}, beta = {_deg(be):.4f}, "
-                       f"gamma = {_deg(ga):.4f} deg ('ZYX')  {'within limits' if s_.within_limits else 'outside limits'}{sing}")
-        n_sing = sum(s_.sigma_min < SINGULAR_SIGMA for s_ in fa.solutions)
-        if n_sing:
-            click.echo(f"  warning: {n_sing} of these poses are singular (scale-free sigma_min < {SINGULAR_SIGMA:g}): "
-                       "the locked mechanism has a self-motion there, and singular poses found by different starts "
-                       "are samples of a continuum, not distinct assembly modes")
+                       f"gamma = {_deg(ga):.4f} deg ('ZYX')  {'within limits' if s_.within_limits else 'outside limits'}")
+            _fk_conditioning_lines(s_.kind, s_.sigma_min, s_.condition, s_.singular_below, s_.members, s_.self_motion,
+                                   mech.length_unit, None)
         return
     seeds = 200 if seeds is None else seeds
     if all_solutions and not as_json:
         import sys
 
         with click.progressbar(length=seeds, label="assembly modes", file=sys.stderr) as bar:
-            res = forward_position(mech, vals, all_solutions=True, n_seeds=seeds, progress=lambda k, n: bar.update(1))
+            res = forward_position(mech, vals, all_solutions=True, n_seeds=seeds, progress=lambda k, n, msg: bar.update(1))
     else:
         res = forward_position(mech, vals, all_solutions=all_solutions, n_seeds=seeds)
     if as_json:
-        emit_json(res.to_dict(mech))
+        emit_json("fk", mech, res.to_dict(mech))
         return
-    if not res.solutions or not any(s.converged for s in res.solutions):
-        raise ValueError(f"actuators: no assembly found (Newton did not converge; residual {res.solutions[0].residual:.2e}); try --all")
-    click.echo(f"{mech.name}: {res.search['distinct']} assembly mode(s) found ({res.search['method']}, {res.search['seeds']} start(s))")
-    for k, s in enumerate(res.solutions):
-        if not s.converged:
-            continue
+    converged = [s for s in res.solutions if s.converged]
+    if not converged:
+        if all_solutions:
+            raise InputError(f"actuators: no assembly found among {res.search['seeds']} starts "
+                             f"({res.search['converged_runs']} converged); not a proof that none exists: check the values "
+                             "against the limits and the mechanism's size, or try more --seeds")
+        r0 = res.solutions[0].residual if res.solutions else float("nan")
+        raise InputError(f"actuators: no assembly found (Newton did not converge; residual {r0:.2e}); try --all")
+    click.echo(_fk_header(mech, [s.kind for s in converged], res.search["method"], res.search["seeds"],
+                          res.search["converged_runs"]))
+    for k, s in enumerate(converged):
         e = matrix_euler("ZYX", s.pose.R, degrees=True)
         lim = "within limits" if not s.outside_limits else "outside limits: " + ", ".join(s.outside_limits)
         click.echo(f"  [{k + 1}] platform point ({_num(s.pose.p, '.6g')}) {mech.length_unit}, "
                    f"ZYX angles ({_num(e, '.4f')}) deg  {lim}")
+        c = s.conditioning
+        _fk_conditioning_lines(s.kind, c.sigma_min, c.condition, c.threshold, s.members, s.self_motion, mech.length_unit,
+                               c.free_dim)
+
+
+def _fk_header(mech: Mechanism, kinds, method: str, seeds: int, converged: int) -> str:
+    """``NAME: 2 assembly modes, 1 self-motion set (method, N starts, M converged)``."""
+    n_reg = sum(k == "regular" for k in kinds)
+    n_sing = sum(k == "singular" for k in kinds)
+    n_sm = sum(k == "self-motion" for k in kinds)
+    parts = [f"{n_reg} assembly mode{'s' if n_reg != 1 else ''}"]
+    if n_sing:
+        parts.append(f"{n_sing} singular root{'s' if n_sing != 1 else ''}")
+    if n_sm:
+        parts.append(f"{n_sm} self-motion set{'s' if n_sm != 1 else ''} (a continuum of poses with the actuators held)")
+    return f"{mech.name}: {', '.join(parts)} found ({method}, {seeds} start(s), {converged} converged)"
+
+
+def _fk_conditioning_lines(kind, sigma_min, condition, threshold, members, self_motion, length_unit, free_dim) -> None:
+    """The conditioning of one forward-position result, and what a singular one means."""
+    cond = f"sigma_min {sigma_min:.2e}, condition {condition:.2e} (scale-free)"
+    if kind == "regular":
+        click.echo(f"      {cond}: regular (above {threshold:.0e})" + (f"; reached by {members} starts" if members > 1 else ""))
+    elif kind == "singular" and free_dim is not None and free_dim >= 2:
+        click.echo(f"      SINGULAR: {cond}, below {threshold:.0e}; the platform has {free_dim} free directions with the "
+                   "actuators held (the actuators do not fix the pose here; a set of higher dimension, not traced); "
+                   f"{members} start(s) reached this pose")
+    elif kind == "singular":
+        click.echo(f"      SINGULAR: {cond}, below {threshold:.0e}; an isolated root where assembly modes meet (no finite "
+                   f"motion with the actuators held); {members} start(s) reached it")
+    else:
+        sm = self_motion
+        trace = ""
+        if sm is not None:
+            trace = (f" (traced: platform point moves up to {sm.position_spread:.3g} {length_unit}, turns up to "
+                     f"{np.degrees(sm.rotation_spread):.3g} deg{', a closed loop' if sm.closed else ''})")
+        click.echo(f"      SINGULAR, SELF-MOTION: {cond}, below {threshold:.0e}; the platform moves with the actuators "
+                   f"held: this pose is one point of a continuum{trace}, not an assembly mode; {members} start(s) "
+                   "landed on it")
 
 
 @click.command()
@@ -220,6 +291,7 @@ def fk(model, values, all_solutions, seeds, as_json):
 @with_pose
 @click.option("--driver", "drivers", multiple=True, help="Actuated freedom(s) (repeatable; default: the model's actuators).")
 @click.option("--dj-table", is_flag=True, help="DJ at every built-in task position for every base-joint driver.")
+@tol_option("singular")
 @json_option
 def jacobian(model, xyz, euler, position, drivers, dj_table, as_json):
     """Complete Jacobian (constraint + actuation wrenches), its determinant and conditioning.
@@ -233,20 +305,15 @@ def jacobian(model, xyz, euler, position, drivers, dj_table, as_json):
     mech = catalog.resolve(model)
     if dj_table:
         if not mech.positions:
-            raise ValueError(f"--dj-table: {mech.name} has no built-in task positions")
+            raise InputError(f"--dj-table: {mech.name} has no built-in task positions")
         t = compute_dj_table(mech, list(drivers) or None)
         fits = t.fits
-        rows = [{"driver": d, "dj": [float(x) for x in t.dj[i]], "signs": [int(x) for x in t.signs[i]],
-                 "keeps_sign": t.keeps_sign(d), "sigma_min": [float(x) for x in t.sigma_min[i]]}
-                for i, d in enumerate(t.drivers)]
-        data = {"model": mech.name, "positions": [p.name for p in mech.positions],
-                "pose_fit": [f.to_dict() for f in fits], "drivers": rows,
-                "note": "DJ magnitudes are not comparable between drivers; only signs along one driver are."}
+        data = t.to_dict()
         if as_json:
-            emit_json(data)
+            emit_json("jacobian", mech, {"result": "dj_table", **data})
             return
         click.echo(f"{mech.name}: sign of DJ at {', '.join(data['positions'])}")
-        for r in rows:
+        for r in data["drivers"]:
             click.echo(f"  {r['driver']:>8s}  " + " ".join("+" if s > 0 else ("-" if s < 0 else "0") for s in r["signs"])
                        + ("   keeps its sign" if r["keeps_sign"] else "   changes sign"))
         worst = max(fits, key=lambda f: f.position_error)
@@ -256,10 +323,11 @@ def jacobian(model, xyz, euler, position, drivers, dj_table, as_json):
     pose = resolve_pose(mech, xyz, euler, position)
     fit = configuration_at_pose(mech, pose)
     if not fit.converged:
-        raise ValueError(f"pose: no closed configuration near it (residual {fit.ik_residual:.2e})")
+        raise InputError(f"pose: no closed configuration near it (residual {fit.ik_residual:.2e})")
     J = complete_jacobian(mech, fit.config, list(drivers) or None)
     if as_json:
-        emit_json({**J.to_dict(), "pose_fit": fit.to_dict()})
+        emit_json("jacobian", mech, {"result": "complete_jacobian", "pose": pose_dict(pose.R, pose.p), **J.to_dict(),
+                                     "pose_fit": fit.to_dict()})
         return
     click.echo(f"{mech.name}: complete Jacobian (rows: {J.constraint_rows} constraint, {len(J.actuators)} actuation"
                f" [{', '.join(J.actuators)}]); J $p = (0, qdot)")
@@ -268,8 +336,8 @@ def jacobian(model, xyz, euler, position, drivers, dj_table, as_json):
     if J.det is not None:
         click.echo(f"  det J = {J.det:+.6e}")
     click.echo(f"  scale-free sigma_min = {J.sigma_min:.4g}, 1/condition = {J.condition:.4g}")
-    if J.sigma_min < SINGULAR_SIGMA:
-        click.echo(f"  SINGULAR configuration (sigma_min < {SINGULAR_SIGMA:g}): det J is round-off; "
+    if J.sigma_min < current_tolerances().singular:
+        click.echo(f"  SINGULAR configuration (sigma_min < {current_tolerances().singular:g}): det J is round-off; "
                    "`spatialmech singularity` gives its kind and the uncontrolled twist")
     if J.inverse_singular:
         click.echo(f"  inverse (serial) singular for: {', '.join(J.inverse_singular)}")

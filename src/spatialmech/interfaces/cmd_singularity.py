@@ -10,12 +10,14 @@ import numpy as np
 
 from .. import catalog
 from ..analysis.singularity import singularity, singularity_slice, slice_figure
+from ..errors import InputError
 from ..geometry.rotations import euler_matrix
+from ..geometry.tolerances import current as current_tolerances
 from ..kinematics.closure import Configuration
 from ..kinematics.position import configuration_at_pose
 from ..model.mechanism import Pose
 from .cmd_kinematics import resolve_pose, with_pose
-from .common import emit_json, json_option
+from .common import check_output_file, emit_json, json_option, tol_option
 
 _SLICE_NAMES = ("x", "y", "z", "a1", "a2", "a3")
 
@@ -25,18 +27,19 @@ def _parse_slice(text: str):
     for part in text.split(","):
         bits = part.strip().split(":")
         if len(bits) != 4 or bits[0] not in _SLICE_NAMES:
-            raise ValueError(f"--slice: expected NAME:MIN:MAX:N,NAME:MIN:MAX:N with NAME in {', '.join(_SLICE_NAMES)}, got {part!r}")
+            raise InputError(f"--slice: expected NAME:MIN:MAX:N,NAME:MIN:MAX:N with NAME in {', '.join(_SLICE_NAMES)}, "
+                             f"got {part!r}")
         try:
             lo, hi, n = float(bits[1]), float(bits[2]), int(bits[3])
         except ValueError:
-            raise ValueError(f"--slice: bad numbers in {part!r}") from None
+            raise InputError(f"--slice: bad numbers in {part!r}") from None
         if n < 2 or n > 400:
-            raise ValueError(f"--slice: N must be 2..400, got {n}")
+            raise InputError(f"--slice: N must be 2..400, got {n}")
         if not (np.isfinite(lo) and np.isfinite(hi)):
-            raise ValueError(f"--slice: MIN and MAX must be finite, got {part!r}")
+            raise InputError(f"--slice: MIN and MAX must be finite, got {part!r}")
         axes.append((bits[0], np.linspace(lo, hi, n)))
     if len(axes) != 2 or axes[0][0] == axes[1][0]:
-        raise ValueError("--slice: give exactly two different axes")
+        raise InputError("--slice: give exactly two different axes")
     return axes
 
 
@@ -49,6 +52,7 @@ def _parse_slice(text: str):
               help="Loci on a 2-D slice around the pose: NAME:MIN:MAX:N,NAME:MIN:MAX:N with NAME in x,y,z (length) "
                    "or a1,a2,a3 (the --euler angles, degrees).")
 @click.option("--plot", "plot", type=click.Path(dir_okay=False, path_type=Path), default=None, help="PNG of the slice.")
+@tol_option("singular")
 @json_option
 def singularity_cmd(model, xyz, euler, position, reference, drivers, slice_spec, plot, as_json):
     """Singularity analysis at a pose: rank of the wrench system, kind (inverse, direct,
@@ -61,11 +65,18 @@ def singularity_cmd(model, xyz, euler, position, reference, drivers, slice_spec,
       spatialmech singularity four-sps-cu --xyz 0 0 0.12 --euler ZYX 20 0 0 \\
           --slice a2:-30:30:25,a3:-30:30:25 --plot loci.png
     """
+    if reference:
+        given = [name for name, v in (("a pose (--xyz/--euler/--pose)", xyz if xyz is not None else euler),
+                                      ("--position", position), ("--slice", slice_spec)) if v is not None]
+        if given:
+            raise InputError(f"--reference: analyses the model's reference configuration and takes no pose; "
+                             f"it cannot be combined with {', '.join(given)} (drop --reference to analyse the pose)")
+    check_output_file(plot, "--plot")
     mech = catalog.resolve(model)
     acts = list(drivers) or None
     if slice_spec is not None:
         if euler is None or xyz is None:
-            raise ValueError("--slice: give the base pose with --xyz and --euler")
+            raise InputError("--slice: give the base pose with --xyz and --euler")
         (n1, g1), (n2, g2) = _parse_slice(slice_spec)
         seq, *ang = euler
 
@@ -76,20 +87,21 @@ def singularity_cmd(model, xyz, euler, position, reference, drivers, slice_spec,
             return Pose(R, [vals["x"], vals["y"], vals["z"]])
 
         bar = None if as_json else click.progressbar(length=len(g2), label="slice", file=sys.stderr)
-        prog = (lambda j, n: bar.update(1)) if bar else None
+        prog = (lambda j, n, msg: bar.update(1)) if bar else None
         units = tuple("deg" if n.startswith("a") else mech.length_unit for n in (n1, n2))
         res = singularity_slice(mech, pose_of, g1, g2, names=(n1, n2), units=units, actuators=acts,
-                                fixed={"xyz": list(xyz), "euler": [seq, *ang]}, progress=prog)
+                                fixed={"position_len": list(xyz), "euler_sequence": seq, "euler_deg": list(ang)},
+                                progress=prog)
         if bar:
             bar.render_finish()
         if not np.isfinite(res.det).any():
-            raise ValueError(f"--slice: no pose of the {n1} x {n2} slice closes (the mechanism cannot assemble "
+            raise InputError(f"--slice: no pose of the {n1} x {n2} slice closes (the mechanism cannot assemble "
                              "at any of them); move or narrow the slice")
         if plot is not None:
             slice_figure(res, f"{mech.name}: singularity loci ({seq}, angles in degrees)").savefig(plot)
         d = res.to_dict()
         if as_json:
-            emit_json(d)
+            emit_json("singularity", mech, {"result": "singularity_slice", **d})
             return
         det = res.det
         finite = np.isfinite(det)
@@ -105,20 +117,22 @@ def singularity_cmd(model, xyz, euler, position, reference, drivers, slice_spec,
         pose = resolve_pose(mech, xyz, euler, position)
         fit = configuration_at_pose(mech, pose)
         if not fit.converged:
-            raise ValueError(f"pose: no closed configuration near it (residual {fit.ik_residual:.2e})")
+            raise InputError(f"pose: no closed configuration near it (residual {fit.ik_residual:.2e})")
         config = fit.config
-    r = singularity(mech, config, acts)
+    r = singularity(mech, config, acts, rtol=current_tolerances().singular)
     if as_json:
-        emit_json(r.to_dict())
+        emit_json("singularity", mech, {"result": "singularity", **r.to_dict()})
         return
-    click.echo(f"{mech.name}: {r.kind if r.kind != 'none' else 'not singular'}; wrench-system rank {r.rank} of {r.expected_rank}; "
+    click.echo(f"{mech.name}: {r.kind if r.kind != 'none' else 'not singular'}; "
+               f"wrench-system rank {r.rank} of {r.expected_rank}; "
                f"scale-free sigma_min {r.sigma_min:.3g}")
     for t in r.twist:
         click.echo("  uncontrolled twist (omega ; v): (" + " ".join(f"{x:+.4g}" for x in t[:3]) + " ; "
                    + " ".join(f"{x:+.4g}" for x in t[3:]) + ")")
     if r.line_geometry:
         lg = r.line_geometry
-        click.echo(f"  line geometry of the {len(r.jacobian.wrenches)} wrenches: rank {lg['rank']}, {lg['case']}: {lg['description']}")
+        click.echo(f"  line geometry of the {len(r.jacobian.wrenches)} wrenches: rank {lg['rank']}, "
+                   f"{lg['case']}: {lg['description']}")
         for c in lg.get("circuits", [])[:4]:
             click.echo(f"    dependent subset {c.get('indices')}: {c.get('case')}: {c.get('description')}")
     if r.self_motion:

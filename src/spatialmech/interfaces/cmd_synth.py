@@ -6,13 +6,13 @@ User errors raise ``ValueError`` / ``KeyError``; the main CLI group turns them i
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import click
 import numpy as np
 
-from ..serialize import json_default
+from ..errors import InputError
+from .common import check_output_dir, check_output_file, emit_json
 
 __all__ = ["synth"]
 
@@ -38,7 +38,7 @@ def synth():
 @click.option("--pick", type=click.Choice(["best-rc", "interior"]), default="best-rc", show_default=True,
               help="best-rc: smallest max input slide over curve and line; interior: the most "
                    "interior defect-free crank-rocker of region 1.")
-@click.option("--samples", type=click.IntRange(min=8), default=360, show_default=True,
+@click.option("--samples", type=click.IntRange(min=8, max=5000), default=360, show_default=True,
               help="Samples per Burmester-curve branch.")
 def rccc(task, as_json, plot_dir, save_file, pick, samples):
     """Four-position RCCC synthesis by solution regions (paper D).
@@ -55,6 +55,8 @@ def rccc(task, as_json, plot_dir, save_file, pick, samples):
     from ..synthesis.rccc import synthesize_rccc
     from ..synthesis.tasks import resolve_task
 
+    check_output_file(save_file, "--save")
+    check_output_dir(plot_dir, "--plot")
     t = resolve_task(task)
     res = synthesize_rccc(t, pick=pick, samples=samples)
     if save_file is not None:
@@ -63,9 +65,8 @@ def rccc(task, as_json, plot_dir, save_file, pick, samples):
         from ..synthesis.figures import write_all
 
         write_all(res, plot_dir)
-    d = res.to_dict()
     if as_json:
-        click.echo(json.dumps(d, indent=2, default=json_default, allow_nan=False))
+        emit_json("synth rccc", None, res.to_dict(), length_unit=t.length_unit)
         return
     u = t.length_unit
     lines = [
@@ -95,33 +96,40 @@ def rccc(task, as_json, plot_dir, save_file, pick, samples):
 @click.option("--positions", "positions_file", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="TOML file with exactly seven [[positions]] (default: paper A table 9).")
 @click.option("--json", "as_json", is_flag=True, help="Print machine-readable JSON.")
-@click.option("--samples", type=click.IntRange(min=2), default=40, show_default=True,
+@click.option("--samples", type=click.IntRange(min=2, max=10000), default=40, show_default=True,
               help="Family points listed in the JSON, spread over the branches by arc length.")
-@click.option("--pick", type=click.IntRange(min=0), default=5, show_default=True,
+@click.option("--pick", type=click.IntRange(min=0, max=100), default=5, show_default=True,
               help="Number of small-slide dyads to pick (5: also assemble and check the 5-CS).")
 @click.option("--save", "save_file", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="Write the 5-CS of the five picked dyads as a model file (TOML); needs --pick 5.")
-@click.option("--starts", type=click.IntRange(min=1), default=60, show_default=True,
+@click.option("--starts", type=click.IntRange(min=1, max=5000), default=60, show_default=True,
               help="Random starts of the multi-start search for branches of the family.")
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the random starts.")
-def cs(positions_file, as_json, samples, pick, save_file, starts, seed):
+@click.option("--skip-defects", is_flag=True,
+              help="Do not run the defect analysis of the 5-CS (faster; the result is then not a verified success).")
+def cs(positions_file, as_json, samples, pick, save_file, starts, seed, skip_defects):
     """Seven-position synthesis of CS dyads and a 5-CS linkage (paper A, section 3).
 
     The CS dyads of seven positions form a one-parameter family (15 unknowns, 14 equations,
     eqs 22-26): traced by continuation, then the dyads with the smallest largest C slide are
     picked; five of them make a 5-CS linkage, checked at the seven positions (pose errors,
-    mobility).  Lengths in the positions' unit, angles in degrees.
+    mobility) and by the defect analysis (circuit, order and branch defects for every candidate
+    driver, as `spatialmech defects`; about a minute).  The synthesis is reported a success only
+    when the linkage is defect-free for at least one driver; otherwise the output says what is
+    wrong.  Lengths in the positions' unit, angles in degrees.
 
     \b
     Examples:
       spatialmech synth cs
       spatialmech synth cs --positions my-7-positions.toml --json --save five-cs.toml
+      spatialmech synth cs --skip-defects
     """
     from ..model.schema import dump, load_positions
     from ..synthesis.cs_dyads import assemble_5cs, check_5cs, synthesize_cs
 
     if save_file is not None and pick != 5:
-        raise ValueError(f"save: a 5-CS linkage needs --pick 5 (got --pick {pick})")
+        raise InputError(f"save: a 5-CS linkage needs --pick 5 (got --pick {pick})")
+    check_output_file(save_file, "--save")
     if positions_file is not None:
         poses = load_positions(positions_file)
         source = str(positions_file)
@@ -131,19 +139,21 @@ def cs(positions_file, as_json, samples, pick, save_file, starts, seed):
         poses = five_cs_positions()
         source = "paper A table 9"
     fam = synthesize_cs(poses, n_starts=starts, seed=seed, pick=pick)
-    d = fam.to_dict(samples=samples)
-    d["positions_source"] = source
+    d = {**fam.to_dict(samples=samples), "positions_source": source, "five_cs": None, "success": None, "verdict": None}
     check = mech = None
     if pick == 5:
         if len(fam.picks) < 5:
-            raise ValueError(f"pick: only {len(fam.picks)} well separated dyads found; try more --starts")
+            raise InputError(f"pick: only {len(fam.picks)} well separated dyads found; try more --starts")
         mech = assemble_5cs(fam.task, fam.picks)
-        check = check_5cs(mech, fam.picks)
+        say = None if as_json else (lambda done, total, msg: click.echo(f"  ... defects: {msg}", err=True))
+        check = check_5cs(mech, fam.picks, defects=not skip_defects, progress=say)
         d["five_cs"] = check.to_dict()
+        d["success"] = check.success
+        d["verdict"] = check.verdict()
         if save_file is not None:
             dump(mech, save_file)
-    if as_json:
-        click.echo(json.dumps(d, indent=2, default=json_default, allow_nan=False))
+    if as_json:  # lengths in the positions' own unit (a positions file names none)
+        emit_json("synth cs", None, d, length_unit="unit")
         return
     lines = [
         f"CS dyads for the 7 positions of {source} (paper A eqs 22-26: 15 unknowns, 14 equations)",
@@ -161,7 +171,17 @@ def cs(positions_file, as_json, samples, pick, save_file, starts, seed):
     if check is not None:
         lines.append(f"  5-CS: dof {check.dof}; at the 7 positions: max pose error {check.max_pose_error:.3g}"
                      f" (position/angle rad), max IK residual {np.max(check.ik_residuals):.3g},"
-                     f" all exact: {bool(np.all(check.exact))}")
+                     f" closes exactly at all 7: {bool(np.all(check.exact))}")
+        dr = check.defects
+        if dr is not None:
+            circ = "; ".join("{" + ", ".join(f"P{i}" for i in c) + "}" for c in dr.circuits)
+            lines.append(f"  defects: {len(dr.circuits)} circuit(s) {circ}; circuit defect: "
+                         f"{'YES' if dr.circuit_defect else 'no'}, order defect: {'YES' if dr.order_defect else 'no'}")
+            lines.append("  drivers: " + ", ".join(
+                f"{v.driver} {'usable' if v.usable else ('branch defect' if v.branch_defect else 'not usable')}"
+                for v in dr.drivers))
+        lines.append(f"  result: {check.verdict()}")
     if save_file is not None:
-        lines.append(f"  wrote {save_file}")
+        lines.append(f"  wrote {save_file}" + ("" if check is None or check.success else " (the linkage as synthesised; "
+                                                "it is NOT usable as it stands: see the result above)"))
     click.echo("\n".join(lines))

@@ -6,15 +6,18 @@ Register it in the main group with ``cli.add_command(view)``.
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import click
 
 from .. import catalog
-from ..model.schema import ModelFileError
+from ..errors import ConvergenceError, InputError
+from .common import check_output_file, emit_json
 
-__all__ = ["view", "MOTIONS"]
+#: Largest number of frames (each is a configuration drawn into the page).
+MAX_FRAMES = 2000
+
+__all__ = ["MOTIONS", "view"]
 
 #: Motions the command can compute.  "trace": the whole circuit of a one-degree-of-freedom
 #: mechanism through its reference configuration, followed by the continuation tracker, with the
@@ -42,9 +45,10 @@ class _Error(click.ClickException):
                    "demo (a short loop along the closure manifold, any mobility), auto (trace if 1 DOF).")
 @click.option("--out", "out", required=True, type=click.Path(dir_okay=False, path_type=Path),
               help="The HTML file to write (self-contained: plotly.js is inlined, it opens offline).")
-@click.option("--frames", type=click.IntRange(min=2), default=60, show_default=True,
-              help="Number of configurations (animation frames).")
-@click.option("--json", "as_json", is_flag=True, help='Print {"out", "frames", "bytes"} as JSON.')
+@click.option("--frames", type=click.IntRange(min=2, max=MAX_FRAMES), default=60, show_default=True,
+              help=f"Number of configurations (animation frames, at most {MAX_FRAMES}).")
+@click.option("--json", "as_json", is_flag=True,
+              help="Print what was written (out, frames, bytes, motion) as JSON (docs/json.md).")
 def view(model, motion, out, frames, as_json):
     """Write an interactive 3-D viewer of MODEL (base, platform, limbs, joint axes, task
     positions) animated along a motion, with a slider and play / pause buttons.
@@ -60,6 +64,7 @@ def view(model, motion, out, frames, as_json):
 
     singular = ()
     try:
+        check_output_file(out, "--out")
         mech = catalog.resolve(model)
         if motion == "auto":
             from ..analysis.mobility import mobility
@@ -67,19 +72,20 @@ def view(model, motion, out, frames, as_json):
             motion = "trace" if (not mech.is_metamorphic and mobility(mech).dof_instantaneous == 1) else "demo"
         if motion == "trace":
             configs, singular = traced_motion(mech, frames=frames)
-            title = f"{mech.name}: the traced circuit ({len(configs)} frames); x: DJ zeros of {', '.join(mech.actuators[:1]) or '-'}"
+            zeros_of = ", ".join(mech.actuators[:1]) or "-"
+            title = f"{mech.name}: the traced circuit ({len(configs)} frames); +: DJ zeros of {zeros_of}"
         else:
             configs = sample_motion(mech, n=frames)
             title = f"{mech.name}: a demonstration loop, {len(configs)} configurations (not the tracker)"
-    except (ModelFileError, ValueError, KeyError) as e:
-        raise _Error(str(e.args[0] if isinstance(e, KeyError) else e)) from None
-    except RuntimeError as e:
+    except InputError as e:  # anything else is a bug: the main group shows it as one (exit 3)
+        raise _Error(str(e)) from None
+    except ConvergenceError as e:
         raise _Error(str(e), code=1) from None
     try:
         written = write_viewer(out, mech, configs, title=title, task_positions=mech.positions, singular_points=singular)
     except OSError as e:
         raise _Error(f"--out: cannot write {out}: {e.strerror or e}") from None
     if as_json:
-        click.echo(json.dumps(written.to_dict(), indent=2))
+        emit_json("view", mech, {**written.to_dict(), "motion": motion})
     else:
         click.echo(f"wrote {written.out} ({written.frames} frames, {written.bytes} bytes)")

@@ -1,12 +1,17 @@
-"""Helpers shared by the command modules: one-line user errors, JSON output, the --json flag."""
+"""Helpers shared by the command modules: one-line user errors, JSON output, the --json flag,
+checks of output paths (before the work starts) and parsing of comma-separated numbers."""
 
 from __future__ import annotations
 
 import json
+import math
+import os
+from pathlib import Path
 
 import click
 
-from ..serialize import json_default
+from ..errors import InputError
+from ..serialize import envelope, json_default
 
 
 class UserError(click.ClickException):
@@ -18,8 +23,140 @@ class UserError(click.ClickException):
         click.echo(f"error: {self.format_message()}", err=True, file=file)
 
 
-def emit_json(data) -> None:
-    click.echo(json.dumps(data, indent=2, default=json_default, allow_nan=False))
+def emit_json(command: str, model, payload, *, length_unit: str | None = None) -> None:
+    """Print one command's JSON document: the envelope (``schema_version``, ``command``,
+    ``model``, ``length_unit``; :func:`..serialize.envelope`) around ``payload``.
+
+    ``model`` is a mechanism (its name and length unit are used), a model name, or ``None``
+    where no model applies; ``length_unit`` overrides the mechanism's (e.g. a task's unit).
+    The rule of the fields (units in the key names) is docs/json.md.
+    """
+    name = getattr(model, "name", model)
+    unit = length_unit if length_unit is not None else getattr(model, "length_unit", None)
+    doc = envelope(command, name, payload, length_unit=unit)
+    click.echo(json.dumps(doc, indent=2, default=json_default, allow_nan=False))
 
 
-json_option = click.option("--json", "as_json", is_flag=True, help="Print machine-readable JSON.")
+json_option = click.option("--json", "as_json", is_flag=True, help="Print machine-readable JSON (docs/json.md).")
+
+
+def schema_file_name(command: str) -> str:
+    """``"synth rccc"`` -> ``"synth-rccc.schema.json"``: the JSON Schema of a command's ``--json``
+    output, shipped in ``spatialmech/interfaces/schemas/`` (``common.schema.json`` holds the
+    shared definitions that the others ``$ref``)."""
+    return f"{command.replace(' ', '-')}.schema.json"
+
+
+def load_schema(command: str) -> dict:
+    """The JSON Schema (a dict) of ``command``'s ``--json`` output, or of ``"common"``."""
+    from importlib.resources import files
+
+    path = files("spatialmech.interfaces").joinpath("schemas", schema_file_name(command))
+    if not path.is_file():
+        raise InputError(f"command: no JSON schema for {command!r}")
+    return json.loads(path.read_text(encoding="utf-8"))
+
+
+# ------------------------------------------------------------------ output paths
+def _writable(d: Path) -> bool:
+    return os.access(d, os.W_OK | os.X_OK)
+
+
+def check_output_file(path, option: str, *, suffixes: tuple[str, ...] | None = None) -> Path | None:
+    """Check a file the command will write (``--plot``, ``--out``, ``--save``) before any work:
+    not a directory, its directory exists and is writable, an existing file is writable, and
+    (``suffixes``) a known extension.  ``None`` passes through.  Raises :class:`InputError`
+    naming the option."""
+    if path is None:
+        return None
+    p = Path(path)
+    if p.is_dir():
+        raise InputError(f"{option}: {p} is a directory; give a file name")
+    if suffixes is not None and p.suffix.lower() not in suffixes:
+        raise InputError(f"{option}: {p}: expected a file name ending in {', '.join(suffixes)}")
+    parent = p.parent
+    if not parent.exists():
+        raise InputError(f"{option}: cannot write {p}: {parent}: No such file or directory (create the directory first)")
+    if not parent.is_dir():
+        raise InputError(f"{option}: cannot write {p}: {parent} is not a directory")
+    if p.exists() and not os.access(p, os.W_OK):
+        raise InputError(f"{option}: cannot write {p}: the file is not writable")
+    if not p.exists() and not _writable(parent):
+        raise InputError(f"{option}: cannot write {p}: the directory {parent} is not writable")
+    return p
+
+
+def check_output_dir(path, option: str) -> Path | None:
+    """Check a directory the command will write into (created if missing) before any work: not
+    an existing file, and it or its nearest existing ancestor is a writable directory.  ``None``
+    passes through.  Raises :class:`InputError` naming the option."""
+    if path is None:
+        return None
+    p = Path(path)
+    if p.exists() and not p.is_dir():
+        raise InputError(f"{option}: {p} is a file, not a directory")
+    base = p
+    while not base.exists() and base != base.parent:
+        base = base.parent
+    if not base.is_dir():
+        raise InputError(f"{option}: cannot create the directory {p}: {base} is not a directory")
+    if not _writable(base):
+        raise InputError(f"{option}: cannot write into {p}: {base} is not writable")
+    return p
+
+
+# ------------------------------------------------------------------ numbers at the command line
+def parse_numbers(text: str, option: str, *, count: int | None = None, what: str = "values") -> list[float]:
+    """``"0.2,0.25,0.2"`` -> ``[0.2, 0.25, 0.2]``: every item a finite number (an empty item,
+    as in ``0.2,,0.2``, is an error naming the option and the position, not skipped);
+    ``count`` checks the number of items."""
+    parts = [x.strip() for x in str(text).split(",")]
+    out = []
+    for k, part in enumerate(parts, start=1):
+        if not part:
+            raise InputError(f"{option}: item {k} of {len(parts)} is empty in {text!r}")
+        try:
+            v = float(part)
+        except ValueError:
+            raise InputError(f"{option}: item {k} ({part!r}) is not a number") from None
+        if not math.isfinite(v):
+            raise InputError(f"{option}: item {k} must be a finite number, got {part!r}")
+        out.append(v)
+    if count is not None and len(out) != count:
+        raise InputError(f"{option}: expected {count} {what}, got {len(out)}")
+    return out
+
+
+# ------------------------------------------------------------------ tolerances
+_TOL_MEANING = {
+    "rank": "relative singular-value threshold of the rank decisions",
+    "reachability": "largest pose error (rad, and length / characteristic length) that is fitted instead of refused",
+    "newton": "residual at which Newton stops and an assembly counts as converged",
+    "singular": "scale-free sigma_min below which a configuration is singular",
+}
+
+
+def tol_option(primary: str):
+    """``--tol``: run the command with other tolerances (geometry/tolerances.py).  A number sets
+    ``primary`` (the tolerance the command decides on); ``NAME=VALUE[,NAME=VALUE]`` sets named
+    ones (rank, singular, newton, closure, reachability, dedup, pivot, contains, unit).  The
+    command body runs inside :func:`~spatialmech.geometry.tolerances.use`."""
+    import functools
+
+    from ..geometry.tolerances import DEFAULT, Tolerances, use
+
+    def deco(f):
+        @functools.wraps(f)
+        def wrapper(*args, tol_text=None, **kw):
+            if tol_text is None:
+                return f(*args, **kw)
+            with use(Tolerances.parse(tol_text, primary=primary)):
+                return f(*args, **kw)
+
+        return click.option(
+            "--tol", "tol_text", default=None, metavar="TOL",
+            help=f"Tolerance: a number sets '{primary}' ({_TOL_MEANING.get(primary, primary)}; default "
+                 f"{getattr(DEFAULT, primary):g}); or NAME=VALUE,... for others (docs/conventions.md, Tolerances).",
+        )(wrapper)
+
+    return deco

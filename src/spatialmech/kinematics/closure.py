@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-
+from ..errors import ConvergenceError, InputError
 from ..geometry.rotations import (
     exp_twist,
     inverse_transform,
@@ -33,28 +33,30 @@ from ..geometry.rotations import (
     transform,
 )
 from ..geometry.screws import adjoint
+from ..geometry.tolerances import current as current_tolerances
 from ..model.mechanism import Mechanism
 
 __all__ = [
-    "Configuration",
-    "limb_slices",
-    "reference_screws",
-    "limb_forward",
     "Chain",
-    "limb_chains",
-    "chain_forward",
-    "recentre_balls",
-    "joint_twists",
-    "closure_residual",
-    "closure_jacobian",
-    "active_mask",
-    "correct",
+    "Configuration",
     "CorrectionResult",
+    "active_mask",
+    "ball_groups",
+    "chain_forward",
+    "check_configuration",
+    "closure_jacobian",
+    "closure_residual",
+    "closure_scales",
+    "correct",
     "generic_configuration",
     "joint_points",
-    "check_configuration",
+    "joint_twists",
+    "limb_chains",
+    "limb_forward",
+    "limb_slices",
+    "recentre_balls",
+    "reference_screws",
     "retract",
-    "closure_scales",
 ]
 
 
@@ -66,7 +68,7 @@ class Configuration:
     D: np.ndarray
 
     @classmethod
-    def reference(cls, mech: Mechanism) -> "Configuration":
+    def reference(cls, mech: Mechanism) -> Configuration:
         return cls(np.zeros(len(mech.freedom_refs)), np.eye(4))
 
 
@@ -74,11 +76,11 @@ def check_configuration(mech: Mechanism, config: Configuration) -> None:
     """``ValueError`` naming the problem when ``config`` does not belong to ``mech``."""
     q = np.asarray(config.q)
     if q.shape != (len(mech.freedom_refs),):
-        raise ValueError(f"config.q: {mech.name} has {len(mech.freedom_refs)} joint variables, got shape {q.shape}")
+        raise InputError(f"config.q: {mech.name} has {len(mech.freedom_refs)} joint variables, got shape {q.shape}")
     if np.asarray(config.D).shape != (4, 4):
-        raise ValueError(f"config.D: expected a 4x4 displacement, got shape {np.asarray(config.D).shape}")
+        raise InputError(f"config.D: expected a 4x4 displacement, got shape {np.asarray(config.D).shape}")
     if not (np.all(np.isfinite(q)) and np.all(np.isfinite(config.D))):
-        raise ValueError("config: contains NaN or infinity")
+        raise InputError("config: contains NaN or infinity")
 
 
 def limb_slices(mech: Mechanism) -> list[slice]:
@@ -130,7 +132,7 @@ class Chain:
     balls: tuple[tuple[int, np.ndarray, np.ndarray], ...]  # (first index, centre, axes as columns)
 
 
-_CHAINS: "weakref.WeakKeyDictionary[Mechanism, list[Chain]]" = weakref.WeakKeyDictionary()
+_CHAINS: weakref.WeakKeyDictionary[Mechanism, list[Chain]] = weakref.WeakKeyDictionary()
 
 
 def limb_chains(mech: Mechanism) -> list[Chain]:
@@ -172,7 +174,7 @@ def _rodrigues(W: np.ndarray, W2: np.ndarray, t: float) -> np.ndarray:
 class _Fast:
     """Per-chain precomputed data for scalar forward kinematics (no stacking overhead)."""
 
-    def __init__(self, chain: "Chain"):
+    def __init__(self, chain: Chain):
         S = chain.screws
         self.m = len(S)
         self.w = [S[i, :3].copy() for i in range(self.m)]
@@ -183,7 +185,7 @@ class _Fast:
         self.ball = {b[0]: (b[1], b[2]) for b in chain.balls}
 
 
-_FAST: "weakref.WeakKeyDictionary[Chain, _Fast]" = weakref.WeakKeyDictionary()
+_FAST: weakref.WeakKeyDictionary[Chain, _Fast] = weakref.WeakKeyDictionary()
 
 
 def chain_forward(chain: Chain, q: np.ndarray, *, prefixes: bool = False, local: bool = False):
@@ -220,7 +222,7 @@ def chain_forward(chain: Chain, q: np.ndarray, *, prefixes: bool = False, local:
                 d = R @ Wc[:, j]
                 J[:3, i + j] = d
                 J[3:, i + j] = R @ _cross(c, Wc[:, j]) + _cross(p, d)
-                if prefixes:
+                if pre is not None:
                     pre[i + j] = transform(R, p)
             # T <- T [Rb, c - Rb c]
             p = R @ (c - Rb @ c) + p
@@ -230,7 +232,7 @@ def chain_forward(chain: Chain, q: np.ndarray, *, prefixes: bool = False, local:
         d = R @ f.w[i]
         J[:3, i] = d
         J[3:, i] = R @ f.v[i] + _cross(p, d)
-        if prefixes:
+        if pre is not None:
             pre[i] = transform(R, p)
         t = float(q[i])
         if f.rot[i]:
@@ -285,7 +287,7 @@ def recentre_balls(mech: Mechanism, q: np.ndarray) -> np.ndarray:
 def joint_twists(mech: Mechanism, config: Configuration) -> list[np.ndarray]:
     """Per limb, the (6, m_k) twists of all its freedoms at ``config``."""
     check_configuration(mech, config)
-    return [chain_forward(ch, config.q[sl], local=True)[1] for ch, sl in zip(limb_chains(mech), limb_slices(mech))]
+    return [chain_forward(ch, config.q[sl], local=True)[1] for ch, sl in zip(limb_chains(mech), limb_slices(mech), strict=True)]
 
 
 def closure_residual(mech: Mechanism, config: Configuration) -> np.ndarray:
@@ -293,7 +295,7 @@ def closure_residual(mech: Mechanism, config: Configuration) -> np.ndarray:
     check_configuration(mech, config)
     Dinv = inverse_transform(config.D)
     res = []
-    for ch, sl in zip(limb_chains(mech), limb_slices(mech)):
+    for ch, sl in zip(limb_chains(mech), limb_slices(mech), strict=True):
         T, _ = chain_forward(ch, config.q[sl])
         res.append(_log_single(T @ Dinv))
     return np.concatenate(res)
@@ -310,7 +312,7 @@ def closure_jacobian(mech: Mechanism, config: Configuration, *, active: np.ndarr
     A = np.zeros((6 * K, n + 6))
     Dinv = inverse_transform(config.D)
     res = []
-    for k, (ch, sl) in enumerate(zip(limb_chains(mech), sls)):
+    for k, (ch, sl) in enumerate(zip(limb_chains(mech), sls, strict=True)):
         T, J = chain_forward(ch, config.q[sl], local=True)
         A[6 * k : 6 * k + 6, sl] = J
         A[6 * k : 6 * k + 6, n:] = -np.eye(6)
@@ -339,10 +341,10 @@ class CorrectionResult:
     stationary: bool = False  # steps vanished without closure: a least-squares minimum
 
 
-_BALLS: "weakref.WeakKeyDictionary[Mechanism, list]" = weakref.WeakKeyDictionary()
+_BALLS: weakref.WeakKeyDictionary[Mechanism, list] = weakref.WeakKeyDictionary()
 
 
-def _ball_groups(mech: Mechanism) -> list[tuple[int, np.ndarray]]:
+def ball_groups(mech: Mechanism) -> list[tuple[int, np.ndarray]]:
     """(first global index, axes as columns) of every S joint (cached per mechanism)."""
     if mech in _BALLS:
         return _BALLS[mech]
@@ -361,7 +363,7 @@ def retract(mech, config, active, step, fix_platform=False):
     na = int(active.sum())
     dq[active] = step[:na]
     q = config.q + dq
-    for i, A in _ball_groups(mech):
+    for i, A in ball_groups(mech):
         sl = slice(i, i + 3)
         R_new = rotvec_matrix(A @ dq[sl]) @ rotvec_matrix(A @ config.q[sl])
         q[sl] = A.T @ matrix_rotvec(R_new)
@@ -380,7 +382,7 @@ def correct(
     *,
     active: np.ndarray | None = None,
     fix_platform: bool = False,
-    tol: float = 1e-12,
+    tol: float | None = None,
     max_iter: int = 50,
 ) -> CorrectionResult:
     """Gauss-Newton (minimum-norm) correction of ``config`` onto the closure manifold.
@@ -393,6 +395,8 @@ def correct(
     """
     if active is None:
         active = active_mask(mech)
+    if tol is None:  # the newton tolerance in force (geometry/tolerances.py)
+        tol = current_tolerances().newton
     row, col = closure_scales(mech, active)
     ncols = int(active.sum()) + (0 if fix_platform else 6)
     for it in range(max_iter + 1):
@@ -419,7 +423,7 @@ def joint_points(mech: Mechanism, config: Configuration) -> list[np.ndarray]:
     drawing of the mechanism needs.
     """
     out = []
-    for li, (ch, sl) in enumerate(zip(limb_chains(mech), limb_slices(mech))):
+    for li, (ch, sl) in enumerate(zip(limb_chains(mech), limb_slices(mech), strict=True)):
         _, _, pre = chain_forward(ch, config.q[sl], prefixes=True)
         refs = [r for r in mech.freedom_refs if r.limb == li]
         pts = []
@@ -458,17 +462,17 @@ def generic_configuration(
         A, _ = closure_jacobian(mech, config, active=active)
         As = row[:, None] * A * col[None, :]
         _, sv, vt = np.linalg.svd(As)
-        r = int(np.sum(sv > 1e-9 * max(1.0, sv[0])))
+        r = int(np.sum(sv > current_tolerances().rank * max(1.0, sv[0])))
         N = vt[r:]
         if N.shape[0] == 0:
             break
         c = rng.standard_normal(N.shape[0])
         t = N.T @ c
-        t *= step / max(np.linalg.norm(t), 1e-300)
+        t *= step / max(float(np.linalg.norm(t)), 1e-300)
         trial = retract(mech, config, active, col * t)
         res = correct(mech, trial, active=active)
         if not res.converged:
-            raise RuntimeError(
+            raise ConvergenceError(
                 f"generic configuration: Newton correction did not converge (residual {res.residual:.2e})"
             )
         config = res.config

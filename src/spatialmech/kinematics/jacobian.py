@@ -28,11 +28,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import InputError
 from ..geometry import screws as sc
+from ..geometry.tolerances import DEFAULT, current
 from ..model.mechanism import Mechanism
 from .closure import Configuration, joint_twists, limb_slices
 
-__all__ = ["CompleteJacobian", "complete_jacobian", "limb_constraint_wrenches", "actuation_wrench"]
+__all__ = ["SINGULAR_SIGMA", "CompleteJacobian", "actuation_wrench", "complete_jacobian", "limb_constraint_wrenches"]
+
+#: Scale-free smallest singular value (:attr:`CompleteJacobian.sigma_min`) below which a
+#: configuration is reported as singular (``"singular": true`` in JSON, a flag in text): the
+#: default of :attr:`~spatialmech.geometry.tolerances.Tolerances.singular` (the one in force,
+#: ``current().singular``, is used by :attr:`CompleteJacobian.singular`).
+SINGULAR_SIGMA = DEFAULT.singular
 
 
 @dataclass(frozen=True, eq=False)
@@ -83,23 +91,36 @@ class CompleteJacobian:
         return float(sv[-1]) if self.matrix.shape[0] >= 6 else 0.0
 
     @property
+    def singular(self) -> bool:
+        """``sigma_min`` below the ``singular`` tolerance in force (:mod:`~spatialmech.geometry.tolerances`)."""
+        return bool(self.sigma_min < current().singular)
+
+    @property
     def condition(self) -> float:
         """Inverse condition number (sigma_min / sigma_max) of the scale-free Jacobian, in [0, 1]."""
         sv = self.singular_values()
         return float(sv[-1] / sv[0]) if sv.size and sv[0] > 0 and self.matrix.shape[0] >= 6 else 0.0
 
     def to_dict(self) -> dict:
+        """JSON (docs/json.md): ``matrix`` rows ``(moment ; direction)`` and ``wrenches``
+        ``(direction ; moment)``, moments in the model's length unit; ``det`` (``None`` unless
+        square; only its sign is comparable), the scale-free ``sigma_min``, ``condition`` (1 /
+        condition number) and ``singular`` (``sigma_min`` below the ``singular`` tolerance in force);
+        ``transmission`` by actuator."""
+        sigma = self.sigma_min
         return {
             "matrix": self.matrix.tolist(),
             "wrenches": self.wrenches.tolist(),
-            "constraint_rows": self.constraint_rows,
-            "constraint_limbs": list(self.constraint_limbs),
+            "constraint_rows": int(self.constraint_rows),
+            "constraint_limbs": [int(k) for k in self.constraint_limbs],
             "actuators": list(self.actuators),
             "inverse_singular": list(self.inverse_singular),
             "det": self.det,
-            "sigma_min": self.sigma_min,
+            "sigma_min": sigma,
             "condition": self.condition,
-            "transmission": list(self.transmission),
+            "singular": bool(sigma < current().singular),  # = self.singular
+            "singular_below": current().singular,
+            "transmission": {a: float(t) for a, t in zip(self.actuators, self.transmission, strict=True)},
         }
 
 
@@ -123,9 +144,13 @@ def limb_constraint_wrenches(twists: np.ndarray, *, length_scale: float = 1.0, r
     """
     T = np.atleast_2d(np.asarray(twists, dtype=float))
     L = float(length_scale)
+    rtol = current().rank
     if T.shape[0] == 5:
-        w = sc.cofactor_reciprocal(sc.nondimensional(T, L))  # in nd wrench coordinates
-        if np.linalg.norm(w) > 1e-12:
+        Tn = sc.nondimensional(T, L)
+        w = sc.cofactor_reciprocal(Tn)  # in nd wrench coordinates
+        # the five twists are independent (at the rank tolerance) when the cofactors, relative to
+        # the product of the twists' norms, are not negligible
+        if np.linalg.norm(w) > rtol * float(np.prod(np.linalg.norm(Tn, axis=1))):
             return _from_nd(w[None, :] / np.linalg.norm(w), L)
     W = sc.reciprocal_basis(T, length_scale=L)
     if W.shape[0] == 0:
@@ -134,7 +159,8 @@ def limb_constraint_wrenches(twists: np.ndarray, *, length_scale: float = 1.0, r
     Q, _ = np.linalg.qr(Wn.T)  # orthonormal basis of the system (columns), nd
     if reference is not None and reference.shape == W.shape:
         P = _nd(reference, L) @ Q @ Q.T
-        if np.linalg.matrix_rank(P, tol=1e-9) == W.shape[0]:
+        sv = np.linalg.svd(P, compute_uv=False)  # not row-normalised: a lost row must show
+        if int(np.sum(sv > rtol * max(1.0, sv[0]))) == W.shape[0]:
             return _from_nd(P, L)
     # deterministic: reduced row echelon form of the nd basis
     A = sc.rref(Q.T)
@@ -161,14 +187,15 @@ def actuation_wrench(twists: np.ndarray, index: int, constraints: np.ndarray, *,
         Rn = Rn - (Rn @ Qc) @ Qc.T
     if Rn.shape[0] == 0:
         return (None, 0.0) if with_transmission else None
-    u, s, vt = np.linalg.svd(Rn)
-    if s[0] < 1e-9:
+    _u, s, vt = np.linalg.svd(Rn)
+    rtol = current().rank
+    if s[0] < rtol:
         return (None, 0.0) if with_transmission else None
     w = _from_nd(vt[0], L)
     prod = sc.reciprocal_product(w, T[index])
-    scale = np.linalg.norm(_nd(w, L)) * np.linalg.norm(sc.nondimensional(T[index], L))
+    scale = float(np.linalg.norm(_nd(w, L)) * np.linalg.norm(sc.nondimensional(T[index], L)))
     tau = abs(prod) / (L * max(scale, 1e-300))  # product of nd screws = product / L
-    if abs(prod) < 1e-9 * max(scale, 1e-300):
+    if abs(prod) < rtol * max(scale, 1e-300):
         return (None, 0.0) if with_transmission else None
     return (w / prod, float(tau)) if with_transmission else w / prod
 
@@ -193,7 +220,7 @@ def complete_jacobian(
             actuators = [actuators]
         act_ids = [mech.freedom(a).id for a in actuators]
     if len(set(act_ids)) != len(act_ids):
-        raise ValueError(f"actuators: repeated freedom in {list(actuators)}")
+        raise InputError(f"actuators: repeated freedom in {list(actuators)}")
     L = mech.characteristic_length
     twists = joint_twists(mech, config)
     refs = mech.freedom_refs
@@ -221,7 +248,7 @@ def complete_jacobian(
     for a in act_ids:
         r = by_id[a]
         if r.freedom.locked:
-            raise ValueError(f"actuators: {a} is locked in this mode")
+            raise InputError(f"actuators: {a} is locked in this mode")
         T, W = per_limb_constraints[r.limb]
         col = active_idx[r.limb].index(refs.index(r))
         w, tau = actuation_wrench(T, col, W, length_scale=L, with_transmission=True)
@@ -243,7 +270,9 @@ def driver_determinants(mech: Mechanism, config: Configuration, drivers) -> np.n
     twists = joint_twists(mech, config)
     refs = mech.freedom_refs
     sls = limb_slices(mech)
-    cons, per_limb, active_idx = [], [], []
+    cons: list[np.ndarray] = []
+    per_limb: list[tuple[np.ndarray, np.ndarray]] = []
+    active_idx: list[list[int]] = []
     for k, sl in enumerate(sls):
         idx = [i for i in range(sl.start, sl.stop) if not refs[i].freedom.locked]
         active_idx.append(idx)

@@ -14,37 +14,56 @@ Actuator values are physical values (``offset + q``: a leg length, an angle in r
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from ..errors import InputError
 from ..geometry.rotations import inverse_transform, log_transform, rotation_angle
-from ..model.mechanism import Mechanism, Pose
+from ..geometry.tolerances import Tolerances
+from ..geometry.tolerances import resolve as resolve_tolerances
+from ..geometry import screws as sc
+from ..model.mechanism import Limb, Mechanism, Pose
+from ..results import Progress
+from ..serialize import freedom_values_dict, pose_dict
 from .closure import (
     Configuration,
     active_mask,
     chain_forward,
     correct,
     generic_configuration,
-    joint_points,
+    joint_twists,
     limb_chains,
     limb_slices,
     recentre_balls,
 )
+from .assembly import (
+    AssemblyKind,
+    Conditioning,
+    SelfMotion,
+    dedup_tolerances,
+    group_roots,
+    pose_keys,
+    singular_threshold,
+    trace_set,
+)
+from .tracking import MotionProblem
 
 __all__ = [
+    "FK_CONDITIONING_MEASURE",
+    "ForwardResult",
+    "ForwardSolution",
+    "InverseResult",
+    "LimbSolutions",
     "PoseFit",
     "configuration_at_pose",
-    "LimbSolutions",
-    "InverseResult",
-    "inverse_position",
-    "ForwardSolution",
-    "ForwardResult",
+    "forward_conditioning",
     "forward_position",
     "freedom_values",
-    "within_limits",
+    "inverse_position",
     "platform_pose",
+    "within_limits",
     "wrap_rotations",
 ]
 
@@ -93,14 +112,23 @@ class PoseFit:
     position_error: float  # platform point distance, length unit
     angle_error: float  # rad
     ik_residual: float  # nondimensional closure residual with the platform held at the request
+    length_scale: float = 1.0  # the mechanism's characteristic length
+
+    @property
+    def error(self) -> float:
+        """The pose error, nondimensional: the larger of ``position_error / length_scale`` and
+        ``angle_error`` (rad); compared with the ``reachability`` tolerance."""
+        return float(max(self.position_error / self.length_scale, self.angle_error))
 
     def to_dict(self) -> dict:
+        """JSON (docs/json.md): ``position_error_len`` in the model's length unit, degrees."""
         return {
-            "converged": self.converged,
-            "exact": self.exact,
-            "position_error": self.position_error,
+            "converged": bool(self.converged),
+            "exact": bool(self.exact),
+            "position_error_len": float(self.position_error),
             "angle_error_deg": float(np.degrees(self.angle_error)),
-            "ik_residual": self.ik_residual,
+            "ik_residual": float(self.ik_residual),
+            "pose_error": self.error,
         }
 
 
@@ -109,7 +137,7 @@ def configuration_at_pose(
     pose: Pose,
     *,
     start: Configuration | None = None,
-    tol: float = 1e-10,
+    tol: float | None = None,
     restart_tol: float = 1e-3,
     n_restarts: int = 12,
     seed: int = 0,
@@ -122,13 +150,15 @@ def configuration_at_pose(
     again from ``n_restarts`` seeded random starts and the best kept (a start far from the pose
     can stop in a wrong local minimum).  Then the platform is released and the configuration
     corrected onto the closure manifold by minimum-norm steps.  The pose error between the
-    request and the result is returned, never hidden.
+    request and the result is returned, never hidden.  ``tol``: the nondimensional residual at
+    which a limb counts as closed (default: the ``closure`` tolerance in force).
     """
+    tol = resolve_tolerances(None).closure if tol is None else float(tol)
     D = pose.displacement(mech.platform_point)
     L = mech.characteristic_length
     q = (start.q if start is not None else np.zeros(len(mech.freedom_refs))).astype(float).copy()
     rng = np.random.default_rng(seed)
-    for ch, sl in zip(limb_chains(mech), limb_slices(mech)):
+    for ch, sl in zip(limb_chains(mech), limb_slices(mech), strict=True):
         refs = mech.freedom_refs[sl]
         lin = np.array([r.freedom.kind == "P" for r in refs])
         hold = np.array([r.freedom.locked for r in refs])
@@ -147,7 +177,7 @@ def configuration_at_pose(
     p_got = Dn[:3, :3] @ mech.platform_point + Dn[:3, 3]
     ang = float(rotation_angle(Dn[:3, :3] @ pose.R.T))
     return PoseFit(res.config, res.converged, ik.converged and ik.residual < tol,
-                   float(np.linalg.norm(p_got - pose.p)), ang, ik.residual)
+                   float(np.linalg.norm(p_got - pose.p)), ang, ik.residual, L)
 
 
 # ------------------------------------------------------------------------------ inverse
@@ -161,17 +191,16 @@ class LimbSolutions:
     violations: tuple[tuple[str, ...], ...]  # per solution, freedoms outside their limits
 
     def to_dict(self, mech: Mechanism, first: int) -> dict:
+        """JSON (docs/json.md): per solution the joint values by freedom id, rotations in
+        ``joints_deg`` and slides in ``joints_len``; ``first`` is the limb's first freedom index."""
         refs = mech.freedom_refs
         sols = []
-        for q, res, bad in zip(self.solutions, self.residuals, self.violations):
-            vals = {}
-            for j, qj in enumerate(q):
-                r = refs[first + j]
-                v = r.freedom.offset + qj
-                vals[r.id] = float(np.degrees(v)) if r.freedom.kind != "P" else float(v)
-            sols.append({"values": vals, "residual": res, "outside_limits": list(bad)})
-        return {"limb": self.limb, "reachable": self.reachable, "passive_dim": self.passive_dim,
-                "solutions": sols, "units": "rotations in degrees, slides in length units"}
+        for q, res, bad in zip(self.solutions, self.residuals, self.violations, strict=True):
+            vals = {refs[first + j].id: refs[first + j].freedom.offset + qj for j, qj in enumerate(q)}
+            sols.append({**freedom_values_dict(mech, vals, "joints"), "residual": float(res),
+                         "within_limits": not bad, "outside_limits": list(bad)})
+        return {"limb": self.limb, "reachable": bool(self.reachable), "passive_dim": int(self.passive_dim),
+                "solutions": sols}
 
 
 @dataclass(frozen=True, eq=False)
@@ -180,32 +209,46 @@ class InverseResult:
     limbs: tuple[LimbSolutions, ...]
     config: Configuration | None  # the first solution of every limb, when all are reachable
     search: dict = field(default_factory=dict)
+    #: With ``fit=True``, for a pose that does not close exactly: the nearest closed configuration
+    #: and how far it is (the solutions are then those of the fitted pose when it is within the
+    #: ``reachability`` tolerance, :attr:`fitted`).
+    pose_fit: PoseFit | None = None
 
     @property
     def reachable(self) -> bool:
         return all(l.reachable for l in self.limbs)
 
+    @property
+    def fitted(self) -> bool:
+        """The pose was off the closure by less than the reachability tolerance: the solutions
+        are those of the nearest closed pose (:attr:`pose_fit` says how far it is)."""
+        return self.pose_fit is not None and self.reachable
+
     def actuator_values(self, mech: Mechanism) -> dict[str, float]:
         if self.config is None:
-            raise ValueError("pose: not reachable; no actuator values")
+            raise InputError("pose: not reachable; no actuator values")
         vals = freedom_values(mech, self.config.q)
         return {r.id: float(vals[i]) for i, r in enumerate(mech.freedom_refs) if r.id in mech.actuators}
 
     def to_dict(self, mech: Mechanism) -> dict:
+        """JSON (docs/json.md): the requested ``pose``, every limb's solutions, the actuator
+        values of the first solution (``actuators_deg`` / ``actuators_len``, ``None`` when the
+        pose is not reachable), how the search was made, and ``fitted`` / ``pose_fit``."""
         firsts = [sl.start for sl in limb_slices(mech)]
-        d = {"reachable": self.reachable, "limbs": [l.to_dict(mech, f) for l, f in zip(self.limbs, firsts)],
-             "search": self.search}
-        if self.config is not None:
-            d["actuators"] = {k: (float(np.degrees(v)) if mech.freedom(k).freedom.kind != "P" else v)
-                              for k, v in self.actuator_values(mech).items()}
-        return d
+        acts = (freedom_values_dict(mech, self.actuator_values(mech), "actuators") if self.config is not None
+                else {"actuators_deg": None, "actuators_len": None})
+        # the same fields for every pose: pose_fit is None unless fit=True and the pose does not close exactly
+        return {"reachable": bool(self.reachable), "pose": pose_dict(self.pose.R, self.pose.p),
+                "limbs": [l.to_dict(mech, f) for l, f in zip(self.limbs, firsts, strict=True)], **acts,
+                "search": dict(self.search), "fitted": bool(self.fitted),
+                "pose_fit": None if self.pose_fit is None else self.pose_fit.to_dict()}
 
 
 def _violation(mech: Mechanism, sl: slice, q_limb) -> float:
     """How far a limb's values lie outside their limits (nondimensional: slides / L, angles in rad)."""
     L = mech.characteristic_length
     total = 0.0
-    for r, q in zip(mech.freedom_refs[sl], q_limb):
+    for r, q in zip(mech.freedom_refs[sl], q_limb, strict=True):
         f = r.freedom
         if f.limits is None:
             continue
@@ -292,7 +335,8 @@ def inverse_position(
     n_seeds: int = 48,
     seed: int = 0,
     start: Configuration | None = None,
-    tol: float = 1e-10,
+    tol: Tolerances | float | None = None,
+    fit: bool = False,
 ) -> InverseResult:
     """Joint values of every limb for a platform pose.
 
@@ -300,7 +344,33 @@ def inverse_position(
     also ``n_seeds`` random starts per limb; solutions are distinct when the limb's joint
     twists differ (so passive spins, which leave the geometry unchanged up to that freedom,
     are not counted twice); ``passive_dim > 0`` says the solution set is a continuum.
+
+    ``tol``: a :class:`~spatialmech.geometry.tolerances.Tolerances` or a number (the ``closure``
+    residual at which a limb counts as solved); default: the tolerances in force.
+
+    ``fit``: when the pose does not close exactly (a printed, rounded pose of a constrained
+    mechanism), find the nearest closed configuration (:func:`configuration_at_pose`); if it
+    is within the ``reachability`` tolerance (nondimensional: rad, and length / L) the pose is
+    reachable and the solutions are those of the fitted pose; either way :attr:`InverseResult.pose_fit`
+    says how far it is.
     """
+    t = resolve_tolerances(tol, "closure")
+    res = _inverse(mech, pose, all_solutions, n_seeds, seed, start, t)
+    if not fit or res.reachable:
+        return res
+    pf = configuration_at_pose(mech, pose, start=start, tol=t.closure)
+    if pf.converged and pf.error <= t.reachability:
+        fitted_pose = platform_pose(mech, pf.config, name=pose.name)
+        res2 = _inverse(mech, fitted_pose, all_solutions, n_seeds, seed, pf.config, t)
+        if res2.reachable:
+            return replace(res2, pose=pose, pose_fit=pf,
+                           search={**res2.search, "fitted": "the solutions are those of the nearest closed pose"})
+    return replace(res, pose_fit=pf)
+
+
+def _inverse(mech: Mechanism, pose: Pose, all_solutions: bool, n_seeds: int, seed: int,
+             start: Configuration | None, t: Tolerances) -> InverseResult:
+    tol = t.closure
     D = pose.displacement(mech.platform_point)
     L = mech.characteristic_length
     rng = np.random.default_rng(seed)
@@ -308,7 +378,7 @@ def inverse_position(
     out = []
     q_all = np.zeros(len(mech.freedom_refs))
     all_ok = True
-    for li, (ch, sl) in enumerate(zip(limb_chains(mech), limb_slices(mech))):
+    for li, (ch, sl) in enumerate(zip(limb_chains(mech), limb_slices(mech), strict=True)):
         refs = mech.freedom_refs[sl]
         lin = np.array([r.freedom.kind == "P" for r in refs])
         locked = np.array([r.freedom.locked for r in refs])
@@ -317,7 +387,9 @@ def inverse_position(
             for _ in range(n_seeds):
                 qs = np.where(lin, rng.uniform(-1, 1, len(refs)) * L, rng.uniform(-np.pi, np.pi, len(refs)))
                 starts.append(np.where(locked, q_start[sl], qs))
-        sols, res, sigs = [], [], []
+        sols: list[np.ndarray] = []
+        res: list[float] = []
+        sigs: list[np.ndarray] = []
         best = (None, np.inf)
         for q0 in starts:
             q, rn, ok = _limb_gn(ch, D, q0.astype(float), lin, L, tol=tol)
@@ -327,14 +399,14 @@ def inverse_position(
                 continue
             q = wrap_rotations(mech, q, range(sl.start, sl.stop))
             sig_n = _signature(ch, q, L)
-            if any(np.linalg.norm(sig_n - s2) < 1e-6 for s2 in sigs):
+            if any(np.linalg.norm(sig_n - s2) < t.dedup for s2 in sigs):
                 continue
             sigs.append(sig_n)
             sols.append(q)
             res.append(rn)
         idx_l = set(range(sl.start, sl.stop))
 
-        def _outside(qs):
+        def _outside(qs, sl=sl, idx_l=idx_l):
             return within_limits(mech, np.r_[q_all[: sl.start], qs, q_all[sl.stop :]], indices=idx_l)
 
         if not all_solutions and sols and _outside(sols[0]):
@@ -359,14 +431,16 @@ def inverse_position(
         passive = 0
         if sols:
             _, J = chain_forward(ch, sols[0])
-            passive = int(J.shape[1] - np.linalg.matrix_rank(J * np.r_[np.ones(3), np.full(3, 1 / L)][:, None], tol=1e-9))
+            Jn = J * np.r_[np.ones(3), np.full(3, 1 / L)][:, None]
+            sv = np.linalg.svd(Jn, compute_uv=False)
+            passive = int(J.shape[1] - np.sum(sv > t.rank * max(1.0, sv[0] if sv.size else 0.0)))
             q_all[sl] = sols[0]
         idx = range(sl.start, sl.stop)
         viol = tuple(tuple(within_limits(mech, np.r_[q_all[: sl.start], s, q_all[sl.stop :]], indices=set(idx))) for s in sols)
         out.append(LimbSolutions(mech.limbs[li].name, tuple(sols), tuple(float(r) for r in res), reachable, passive, viol))
     config = Configuration(recentre_balls(mech, q_all), D) if all_ok else None
     search = {"method": "Gauss-Newton per limb", "starts_per_limb": 1 + (n_seeds if all_solutions else 0), "seed": seed,
-              "tolerance": tol, "distinct_by": "joint twists (axis placement) of the limb"}
+              "tolerance": tol, "dedup_tol": t.dedup, "distinct_by": "joint twists (axis placement) of the limb"}
     return InverseResult(pose, tuple(out), config, search)
 
 
@@ -379,19 +453,39 @@ class ForwardSolution:
     residual: float
     iterations: int
     outside_limits: tuple[str, ...]
+    conditioning: Conditioning | None = None  # of a converged root (None for a failed attempt)
+    kind: AssemblyKind | None = None  # regular, singular or self-motion (None for a failed attempt)
+    members: int = 1  # converged runs that this result stands for
+    self_motion: SelfMotion | None = None  # the continuum traced through a self-motion result
+
+    @property
+    def singular(self) -> bool:
+        return self.conditioning is not None and self.conditioning.singular
 
     def to_dict(self, mech: Mechanism) -> dict:
-        from ..geometry.rotations import matrix_euler
-
+        """JSON (docs/json.md), the same fields as the closed forms' forward solutions: status,
+        nondimensional closure ``residual``, the platform ``pose`` (position, named Euler angles
+        in degrees, rotation matrix), limits, and the conditioning (:func:`forward_conditioning`:
+        scale-free ``sigma_min``, ``condition`` = sigma_min / sigma_max, ``singular`` below
+        ``singular_below``); ``kind`` (regular, singular, self-motion), ``members`` (converged
+        runs standing for this result) and, for a self-motion, what its trace found."""
+        c = self.conditioning
         return {
-            "converged": self.converged,
-            "residual": self.residual,
-            "iterations": self.iterations,
-            "position": self.pose.p.tolist(),
-            "rotation_matrix": self.pose.R.tolist(),
-            "euler_ZYX_deg": matrix_euler("ZYX", self.pose.R, degrees=True).tolist(),
-            "outside_limits": list(self.outside_limits),
+            "status": "converged" if self.converged else "not_converged",
+            "converged": bool(self.converged),
+            "iterations": int(self.iterations),
+            "residual": float(self.residual),
+            "pose": pose_dict(self.pose.R, self.pose.p),
             "within_limits": not self.outside_limits,
+            "outside_limits": list(self.outside_limits),
+            "sigma_min": c.sigma_min if c is not None else None,
+            "singular": c.singular if c is not None else None,
+            "condition": c.condition if c is not None else None,
+            "singular_below": c.threshold if c is not None else None,
+            "conditioning_measure": c.measure if c is not None else None,
+            "kind": str(self.kind) if self.kind is not None else None,
+            "members": self.members,
+            "self_motion": self.self_motion.to_dict() if self.self_motion is not None else None,
         }
 
 
@@ -405,7 +499,24 @@ class ForwardResult:
         return bool(self.solutions) and self.solutions[0].converged
 
     def to_dict(self, mech: Mechanism) -> dict:
-        return {"solutions": [s.to_dict(mech) for s in self.solutions], "search": self.search}
+        """JSON (docs/json.md), the same fields as the closed forms' (e.g.
+        :meth:`..closed_forms.four_sps_cu.ForwardAllResult.to_dict`): the actuator values held,
+        the converged solutions (or the failed attempt), and the search."""
+        acts = {}
+        if self.solutions:  # the actuators are held at their values in every solution
+            vals = freedom_values(mech, self.solutions[0].config.q)
+            acts = {r.id: float(vals[i]) for i, r in enumerate(mech.freedom_refs) if r.id in mech.actuators}
+        sols = [s for s in self.solutions if s.converged] or list(self.solutions[:1])
+        names = {"seeds": "n_seeds", "converged_runs": "n_converged", "distinct": "n_distinct", "regular": "n_regular",
+                 "singular": "n_singular", "self_motion_sets": "n_self_motion_sets"}  # as the closed forms
+        return {
+            "method": self.search.get("method", ""),
+            **freedom_values_dict(mech, acts, "actuators"),
+            "n_solutions": sum(s.converged for s in self.solutions),
+            "n_within_limits": sum(s.converged and not s.outside_limits for s in self.solutions),
+            "solutions": [s.to_dict(mech) for s in sols],
+            "search": {names.get(k, k): v for k, v in self.search.items()},
+        }
 
 
 def _actuator_q(mech: Mechanism, values) -> dict[int, float]:
@@ -414,19 +525,19 @@ def _actuator_q(mech: Mechanism, values) -> dict[int, float]:
         items = {mech.freedom(k).id: float(v) for k, v in values.items()}
         missing = set(acts) - set(items)
         if missing:
-            raise ValueError(f"actuators: missing values for {sorted(missing)}")
+            raise InputError(f"actuators: missing values for {sorted(missing)}")
         extra = set(items) - set(acts)
         if extra:
-            raise ValueError(f"actuators: {sorted(extra)} are not actuated in this mechanism (actuators: {acts})")
+            raise InputError(f"actuators: {sorted(extra)} are not actuated in this mechanism (actuators: {acts})")
     else:
         vals = np.asarray(values, dtype=float).ravel()
         if vals.size != len(acts):
-            raise ValueError(f"actuators: expected {len(acts)} values ({', '.join(acts)}), got {vals.size}")
-        items = dict(zip(acts, vals))
+            raise InputError(f"actuators: expected {len(acts)} values ({', '.join(acts)}), got {vals.size}")
+        items = dict(zip(acts, vals, strict=True))
     out = {}
     for k, v in items.items():
         if not np.isfinite(v):
-            raise ValueError(f"actuators: value of {k} is not finite")
+            raise InputError(f"actuators: value of {k} is not finite")
         r = mech.freedom(k)
         out[mech.freedom_refs.index(r)] = v - r.freedom.offset
     return out
@@ -437,8 +548,9 @@ def _pose_seed(mech: Mechanism, rng: np.random.Generator, targets: dict[int, flo
     within a few characteristic lengths, mirrored through the base half of the time) with every
     limb solved for it in the least-squares sense from random joint values, its actuators held
     at their target values."""
-    from ..geometry.rotations import transform
     from scipy.spatial.transform import Rotation as _R
+
+    from ..geometry.rotations import transform
 
     L = mech.characteristic_length
     p0 = mech.platform_point
@@ -449,7 +561,7 @@ def _pose_seed(mech: Mechanism, rng: np.random.Generator, targets: dict[int, flo
     p = p0 * (1 if rng.random() < 0.5 else -1) + rng.normal(scale=L, size=3)
     D = transform(R, p - R @ p0)
     q = np.zeros(len(mech.freedom_refs))
-    for ch, sl in zip(limb_chains(mech), limb_slices(mech)):
+    for ch, sl in zip(limb_chains(mech), limb_slices(mech), strict=True):
         refs = mech.freedom_refs[sl]
         lin = np.array([r.freedom.kind == "P" for r in refs])
         q0 = np.where(lin, rng.uniform(-1, 1, len(refs)) * L, rng.uniform(-np.pi, np.pi, len(refs)))
@@ -460,6 +572,66 @@ def _pose_seed(mech: Mechanism, rng: np.random.Generator, targets: dict[int, flo
                 hold[i - sl.start] = True
         q[sl] = _limb_gn(ch, D, q0, lin, L, max_iter=30, hold=hold)[0]
     return Configuration(q, D)
+
+
+#: What :func:`forward_conditioning` measures (stated in every forward-position result).
+FK_CONDITIONING_MEASURE = (
+    "singular values of the stacked orthonormal bases of the limbs' wrench systems with the actuators locked "
+    "(moments / L): zero when the platform can move with the actuators held"
+)
+
+
+def forward_conditioning(mech: Mechanism, config: Configuration) -> Conditioning:
+    """Whether the actuators hold the platform at ``config``: for every limb, an orthonormal
+    basis of the screws reciprocal to its joint twists with the actuators locked (in
+    nondimensional coordinates, moments / L), stacked; its smallest singular value is 0 exactly
+    when a platform twist is compatible with every limb (a direct singularity; passive spins
+    inside a limb do not count), and ``sigma_min / sigma_max`` is the inverse condition number.
+    Where no actuator is serially singular this equals the scale-free ``sigma_min`` of the complete
+    Jacobian (``kinematics.jacobian``)."""
+    from ..geometry.tolerances import current
+
+    rank_tol = current().rank
+    L = mech.characteristic_length
+    acts = set(mech.actuators)
+    refs = mech.freedom_refs
+    rows = []
+    for T, sl in zip(joint_twists(mech, config), limb_slices(mech), strict=True):
+        keep = [i - sl.start for i in range(sl.start, sl.stop) if not refs[i].freedom.locked and refs[i].id not in acts]
+        if keep:
+            _, sv, vt = np.linalg.svd(sc.nondimensional(T[:, keep].T, L), full_matrices=True)
+            r = int(np.sum(sv > rank_tol * max(1.0, sv[0])))
+            rows.append(vt[r:])
+        else:
+            rows.append(np.eye(6))
+    C = np.vstack(rows)
+    sv = np.linalg.svd(C, compute_uv=False) if C.shape[0] else np.zeros(0)
+    return Conditioning.from_singular_values(sv, FK_CONDITIONING_MEASURE, n_required=6, threshold=singular_threshold())
+
+
+def _actuators_locked(mech: Mechanism) -> Mechanism:
+    """``mech`` with its actuated freedoms locked (the structure that holds the platform)."""
+    ids = set(mech.actuators)
+    limbs = []
+    for limb in mech.limbs:
+        joints = []
+        for j in limb.joints:
+            for f in j.freedoms:
+                if f"{j.name}.{f.name}" in ids:
+                    j = j.with_freedom(f.name, locked=True, actuated=False)
+            joints.append(j)
+        limbs.append(Limb(limb.name, tuple(joints)))
+    return replace(mech, limbs=tuple(limbs), modes=())
+
+
+def _pose_key(mech: Mechanism, config: Configuration) -> np.ndarray:
+    pose = platform_pose(mech, config)
+    return pose_keys(pose.R, pose.p, mech.characteristic_length)
+
+
+def _trace_self_motion(mech: Mechanism, locked: Mechanism, config: Configuration):
+    """The solution set through a singular root, followed with the actuators held."""
+    return trace_set(MotionProblem(locked), config, lambda c: _pose_key(mech, c), h0=0.05, h_max=0.3, max_steps=600)
 
 
 def _fk_from(mech, config, targets, mask, max_iter, patience=None):
@@ -484,20 +656,24 @@ def forward_position(
     n_seeds: int = 200,
     seed: int = 0,
     max_iter: int = 60,
-    progress=None,
+    progress: Progress | None = None,
 ) -> ForwardResult:
     """Platform pose(s) for given actuator values (physical units, in ``mech.actuators`` order
     or a dict by name).
 
     From ``start`` (default: the reference) by Gauss-Newton with the actuators held; with
     ``all_solutions``, also from ``n_seeds`` configurations reached by random walks along the
-    closure manifold (actuators free), deduplicated by the joint points of every limb.
+    closure manifold (actuators free).  Every converged root states its conditioning
+    (:func:`forward_conditioning`) and its ``kind``: roots are distinct when their platform poses
+    differ (scale-free pose distance, :mod:`spatialmech.kinematics.assembly`); a singular root
+    is followed along its self-motion with the actuators held, and all roots on one such
+    continuum are one result of kind ``self-motion`` (not many assembly modes).
     Non-converged runs are reported (``converged = False``), never returned as solutions of
-    the all-solutions search.
+    the all-solutions search.  ``progress(k, n_seeds, "assembly modes")`` after each start.
     """
     targets = _actuator_q(mech, actuator_values)
     if all_solutions and (int(n_seeds) != n_seeds or n_seeds < 1):
-        raise ValueError(f"n_seeds: expected a positive number of starts, got {n_seeds}")
+        raise InputError(f"n_seeds: expected a positive number of starts, got {n_seeds}")
     mask = active_mask(mech)
     for i in targets:
         mask[i] = False
@@ -516,21 +692,49 @@ def forward_position(
                     continue
             runs.append(_fk_from(mech, c, targets, mask, max_iter, patience=12))
             if progress is not None:
-                progress(s + 1, n_seeds)
-    sols, sigs = [], []
-    for k, r in enumerate(runs):
-        if not r.converged and not (k == 0 and not all_solutions):
-            continue
-        sig = np.concatenate([p.ravel() for p in joint_points(mech, r.config)] + [r.config.D[:3, :3].ravel() * L, r.config.D[:3, 3]])
-        if r.converged and any(np.linalg.norm(sig - s2) < 1e-6 * L for s2 in sigs):
-            continue
-        sigs.append(sig)
-        sols.append(ForwardSolution(r.config, platform_pose(mech, r.config), r.converged, r.residual, r.iterations,
-                                    tuple(within_limits(mech, r.config.q))))
+                progress(s + 1, n_seeds, "assembly modes")
+    thr = singular_threshold()
+    dedup, sdedup = dedup_tolerances()
+    locked = _actuators_locked(mech)
+    if not all_solutions:
+        r = first
+        if not r.converged:  # the failed attempt, with the conditioning where it stopped
+            sols = [ForwardSolution(r.config, platform_pose(mech, r.config), False, r.residual, r.iterations,
+                                    tuple(within_limits(mech, r.config.q)), forward_conditioning(mech, r.config))]
+        else:
+            cond = forward_conditioning(mech, r.config)
+            groups = group_roots(_pose_key(mech, r.config)[None, :], [cond.singular], [r.residual],
+                                 lambda i: _trace_self_motion(mech, locked, r.config), dedup_tol=dedup,
+                                 singular_dedup_tol=sdedup, free_dims=[cond.free_dim])
+            g = groups[0]
+            sols = [ForwardSolution(r.config, platform_pose(mech, r.config), True, r.residual, r.iterations,
+                                    tuple(within_limits(mech, r.config.q)), cond, g.kind, 1,
+                                    g.self_motion(np.atleast_2d(_pose_key(mech, r.config)), L))]
+    else:
+        conv = [r for r in runs if r.converged]
+        keys = np.array([_pose_key(mech, r.config) for r in conv]).reshape(-1, 12)
+        conds = [forward_conditioning(mech, r.config) for r in conv]
+        groups = group_roots(keys, [c.singular for c in conds], [r.residual for r in conv],
+                             lambda i: _trace_self_motion(mech, locked, conv[i].config), dedup_tol=dedup,
+                             singular_dedup_tol=sdedup, prefer=[not within_limits(mech, r.config.q) for r in conv],
+                             free_dims=[c.free_dim for c in conds])
+        groups.sort(key=lambda g: min(g.members))  # in the order found (the start's own root first)
+        sols = []
+        for g in groups:
+            r = conv[g.rep]
+            sols.append(ForwardSolution(r.config, platform_pose(mech, r.config), True, r.residual, r.iterations,
+                                        tuple(within_limits(mech, r.config.q)), conds[g.rep], g.kind, len(g.members),
+                                        g.self_motion(keys, L)))
+    kinds = [s.kind for s in sols if s.converged]
     search = {"method": "Gauss-Newton with the actuators held" + (", multi-start" if all_solutions else ""),
               "seeds": 1 + (n_seeds if all_solutions else 0), "seed": seed if all_solutions else None,
-              "converged_runs": sum(r.converged for r in runs), "distinct": sum(s.converged for s in sols),
+              "converged_runs": sum(r.converged for r in runs), "distinct": len(kinds),
+              "n_regular": kinds.count(AssemblyKind.REGULAR), "n_singular": kinds.count(AssemblyKind.SINGULAR),
+              "n_self_motion_sets": kinds.count(AssemblyKind.SELF_MOTION),
               "seeding": ("random platform poses with least-squares limb solutions, and random walks along the closure "
                           "manifold with the actuators free, alternately") if all_solutions else "start configuration",
-              "distinct_by": "joint points of every limb and the platform pose (tolerance 1e-6 L)"}
+              "distinct_by": (f"platform pose distance sqrt(|dp / L|^2 + (2 sin(theta / 2))^2): regular roots within "
+                              f"{dedup:g} are one, isolated singular roots within {sdedup:g}; singular roots on one "
+                              "self-motion traced with the actuators held are one result"),
+              "singular_below": thr}
     return ForwardResult(tuple(sols), search)

@@ -21,27 +21,30 @@ actuator values (forward position by continuation).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable, Protocol
+from typing import Protocol
 
 import numpy as np
-
-from ..geometry.rotations import inverse_transform, log_transform
-from ..model.mechanism import Mechanism
 from scipy.spatial.transform import Rotation
 
-from .closure import Configuration, retract, _ball_groups, closure_scales, active_mask, closure_jacobian
+from ..errors import ConvergenceError, InputError
+from ..geometry.rotations import inverse_transform, log_transform
+from ..geometry.tolerances import current as current_tolerances
+from ..model.mechanism import Mechanism
+from ..results import EventKind, Progress, TrackStatus
+from .closure import Configuration, active_mask, ball_groups, closure_jacobian, closure_scales, retract
 
 __all__ = [
+    "ActuatorPathProblem",
     "CurveProblem",
     "EuclideanProblem",
-    "MotionProblem",
-    "ActuatorPathProblem",
     "Event",
+    "MotionProblem",
     "TrackResult",
-    "track",
-    "trace_motion",
     "correct_on_hyperplane",
+    "trace_motion",
+    "track",
 ]
 
 
@@ -71,10 +74,10 @@ def _observable_tangent(A: np.ndarray, n_obs: int) -> np.ndarray:
     that leave the last ``n_obs`` coordinates, e.g. the platform twist, at rest): the null
     vector with the largest observable part, which has no passive component."""
     _, sv, vt = np.linalg.svd(A, full_matrices=True)
-    r = int(np.sum(sv > 1e-9 * max(1.0, sv[0]))) if sv.size else 0
+    r = int(np.sum(sv > current_tolerances().rank * max(1.0, sv[0]))) if sv.size else 0
     N = vt[r:]
     if N.shape[0] == 0:
-        raise RuntimeError("no tangent: the mechanism cannot move at this configuration (rigid)")
+        raise ConvergenceError("no tangent: the mechanism cannot move at this configuration (rigid)")
     if N.shape[0] == 1:
         return N[0]
     u, _, _ = np.linalg.svd(N[:, -n_obs:])
@@ -123,11 +126,11 @@ class Event:
     bracket: tuple[float, float] = (0.0, 0.0)  # monitor values at the ends of the final bracket
 
     @property
-    def kind(self) -> str:
+    def kind(self) -> EventKind:
         """``"zero"``, or ``"pole"`` when the sign changed through infinity: both values of the
         final (tiny) bracket are larger than both ends of the step."""
         lo = min(abs(self.bracket[0]), abs(self.bracket[1]))
-        return "pole" if lo > max(abs(self.value_before), abs(self.value_after)) else "zero"
+        return EventKind.POLE if lo > max(abs(self.value_before), abs(self.value_after)) else EventKind.ZERO
 
 
 @dataclass
@@ -138,26 +141,32 @@ class TrackResult:
     monitors: dict[str, np.ndarray]
     events: list[Event]
     closed: bool
-    status: str  # "closed", "max_arc", "stopped", "h_min: ..." (failure, with the reason)
+    status: TrackStatus  # closed, max_arc, stopped, or h_min (failure: ``reason`` says why)
     rejected: int = 0
     corrector_iterations: int = 0
     min_monitor: dict[str, float] = field(default_factory=dict)
+    reason: str = ""  # why the tracker failed (empty unless ``status`` is h_min)
 
     @property
     def ok(self) -> bool:
-        return self.status in ("closed", "max_arc", "stopped")
+        return self.status.ok
+
+    @property
+    def message(self) -> str:
+        """The status with its reason, e.g. ``"h_min: no acceptable step above 1e-07 at ..."``."""
+        return f"{self.status}: {self.reason}" if self.reason else str(self.status)
 
 
 def _frame(A: np.ndarray, t: np.ndarray):
     """Row-space projection ``P`` and passive null directions ``G`` of ``A`` at a point, such that
     ``[P A; G; t]`` is square.  Kept fixed while a step is checked."""
     U, sv, vt = np.linalg.svd(A, full_matrices=True)
-    r = int(np.sum(sv > 1e-9 * max(1.0, sv[0]))) if sv.size else 0
+    r = int(np.sum(sv > current_tolerances().rank * max(1.0, sv[0]))) if sv.size else 0
     P = U[:, :r].T
     N = vt[r:]
     Nt = N - np.outer(N @ t, t)  # null directions other than the tangent
     if Nt.shape[0] > 1:
-        _, s2, w = np.linalg.svd(Nt)
+        _, _s2, w = np.linalg.svd(Nt)
         G = w[: Nt.shape[0] - 1]
     else:
         G = np.zeros((0, A.shape[1]))
@@ -216,7 +225,7 @@ def track(
     event_tol: float = 1e-10,
     detect_closure: bool = True,
     stop: Callable | None = None,
-    progress: Callable[[float], None] | None = None,
+    progress: Progress | None = None,
 ) -> TrackResult:
     """Follow the solution curve of ``problem`` from ``x0`` (which must lie on it).
 
@@ -224,12 +233,13 @@ def track(
     to have a positive component on it).  ``monitors``: name -> function(x) whose sign changes
     are located as :class:`Event` s; ``vector_monitor = (names, f)`` evaluates several at once
     (``f(x)`` returns one value per name).  ``stop(x, s)``: return True to stop after a point.
+    ``progress(s, max_arc, "tracing")`` is called after every accepted step.
     Arc length is measured in the problem's (nondimensional) local coordinates.
     """
     monitors = dict(monitors or {})
     if vector_monitor is not None:
         vnames, vfun = vector_monitor
-        cache = {}
+        cache: dict[int, tuple[object, np.ndarray]] = {}
 
         def _vec(x, _f=vfun):
             key = id(x)
@@ -238,8 +248,8 @@ def track(
                 cache[key] = (x, np.asarray(_f(x), dtype=float))
             return cache[key][1]
 
-        for k, nm in enumerate(vnames):
-            monitors[nm] = (lambda x, _k=k: float(_vec(x)[_k]))
+        for j, nm in enumerate(vnames):
+            monitors[nm] = (lambda x, _k=j: float(_vec(x)[_k]))
     t = problem.tangent(x0)
     t = t / np.linalg.norm(t)
     if direction is not None and float(t @ direction) < 0:
@@ -256,7 +266,8 @@ def track(
     rejected = 0
     total_iters = 0
     cos_max = np.cos(np.radians(max_turn_deg))
-    status = "max_arc"
+    status = TrackStatus.MAX_ARC
+    reason = ""
     closed = False
     steps = 0
     while s < max_arc and steps < max_steps:
@@ -264,7 +275,8 @@ def track(
         xp = problem.retract(x, h * t)
         xn, ok, iters, moved = correct_on_hyperplane(problem, xp, t, tol, 12)
         total_iters += iters
-        tn = None
+        tn: np.ndarray | None = None
+        A_n: np.ndarray | None = None
         if ok and moved < 0.5 * h:
             tn = problem.tangent(xn)
             tn = tn / np.linalg.norm(tn)
@@ -273,10 +285,9 @@ def track(
             A_n = problem.jacobian(xn)
             if float(tn @ t) < cos_max:
                 ok = False
-            elif orient != 0.0:
-                if _orientation(A_n, tn, frame) != orient:
-                    ok = False  # the step crossed to another branch
-                    flips += 1
+            elif orient != 0.0 and _orientation(A_n, tn, frame) != orient:
+                ok = False  # the step crossed to another branch
+                flips += 1
         else:
             ok = False
         if not ok:
@@ -284,9 +295,11 @@ def track(
             h *= 0.5
             if h < h_min:
                 why = "an orientation flip (a bifurcation point or a crossing branch)" if flips else "a singular point"
-                status = f"h_min: no acceptable step above {h_min:g} at arc length {s:.6g}: {why}"
+                status = TrackStatus.H_MIN
+                reason = f"no acceptable step above {h_min:g} at arc length {s:.6g}: {why}"
                 break
             continue
+        assert tn is not None and A_n is not None  # both set whenever the step is accepted
         # accept
         s_new = s + h
         vals = {k: float(f(xn)) for k, f in monitors.items()}
@@ -300,18 +313,23 @@ def track(
             g0, g1 = float(t0 @ d_prev), float(t0 @ d_new)
             if g0 < 0 <= g1 and np.linalg.norm(d_new) < 3 * h + 1e-9 and float(tn @ t0) > 0:
                 # land exactly on the start point's plane: the last point is the start again
-                gfun = lambda y: float(t0 @ problem.difference(x0, y))
+                def gfun(y):
+                    return float(t0 @ problem.difference(x0, y))
                 ev = _locate(problem, x, t, h, gfun, "closure", g0, g1, s, len(xs) - 1, tol, event_tol)
                 closed = True
-                xs.append(ev.x); ss.append(ev.s); ts.append(tn)
+                xs.append(ev.x)
+                ss.append(ev.s)
+                ts.append(tn)
                 for k, f in monitors.items():
                     mon[k].append(float(f(ev.x)))
                 # an event at the closing point is the start point met again: not a new one
                 events = [e for e in events if e.s < ev.s - max(event_tol, 1e-9)]
-                status = "closed"
+                status = TrackStatus.CLOSED
                 s = ev.s
                 break
-        xs.append(xn); ss.append(s_new); ts.append(tn)
+        xs.append(xn)
+        ss.append(s_new)
+        ts.append(tn)
         for k in monitors:
             mon[k].append(vals[k])
         x, t, s = xn, tn, s_new
@@ -319,17 +337,17 @@ def track(
         orient = _orientation(A_n, tn, frame)
         steps += 1
         if progress is not None:
-            progress(s)
+            progress(s, max_arc, "tracing")
         if iters <= 2:
             h *= 1.5
         elif iters >= 5:
             h *= 0.7
         if stop is not None and stop(x, s):
-            status = "stopped"
+            status = TrackStatus.STOPPED
             break
     mons = {k: np.array(v) for k, v in mon.items()}
     return TrackResult(xs, np.array(ss), ts, mons, events, closed, status, rejected, total_iters,
-                       {k: float(np.min(np.abs(v))) for k, v in mons.items()})
+                       {k: float(np.min(np.abs(v))) for k, v in mons.items()}, reason)
 
 
 def _locate(problem, x, t, h, f, name, fa, fb, s, step, tol, event_tol):
@@ -363,6 +381,7 @@ def _locate(problem, x, t, h, f, name, fa, fb, s, step, tol, event_tol):
             side = 1
         if hi - lo < event_tol:
             break
+    assert best is not None  # the loop runs at least once
     mid, xm = best
     return Event(name, s + mid, xm, step, fa, fb, float(f(xm)), (float(true_lo), float(true_hi)))
 
@@ -387,7 +406,7 @@ class _MechanismBase:
 
     def _config_diff(self, a: Configuration, b: Configuration) -> np.ndarray:
         dq_all = b.q - a.q
-        for i, A in _ball_groups(self.mech):  # relative rotation of each S joint
+        for i, A in ball_groups(self.mech):  # relative rotation of each S joint
             sl = slice(i, i + 3)
             rel = Rotation.from_rotvec(A @ b.q[sl]) * Rotation.from_rotvec(A @ a.q[sl]).inv()
             dq_all[sl] = A.T @ rel.as_rotvec()
@@ -427,7 +446,12 @@ class ActuatorPathProblem(_MechanismBase):
     of configurations in (free joint variables, platform twist, lam).  Turning points in ``lam``
     are singular (direct-kinematics) configurations; the tracker passes them and reports them."""
 
-    def __init__(self, mech: Mechanism, path: Callable[[float], np.ndarray], path_derivative: Callable[[float], np.ndarray] | None = None):
+    def __init__(
+        self,
+        mech: Mechanism,
+        path: Callable[[float], np.ndarray],
+        path_derivative: Callable[[float], np.ndarray] | None = None,
+    ):
         mask = active_mask(mech)
         self.act_idx = [mech.freedom_refs.index(mech.freedom(a)) for a in mech.actuators]
         self.offsets = np.array([mech.freedom_refs[i].freedom.offset for i in self.act_idx])
@@ -447,7 +471,7 @@ class ActuatorPathProblem(_MechanismBase):
         return self._closure(self._q_with(x))[1]
 
     def jacobian(self, x):
-        config, lam = x
+        _config, lam = x
         c = self._q_with(x)
         A, _ = self._closure(c)
         # derivative with respect to lam through the actuated joint twists
@@ -488,19 +512,19 @@ def trace_motion(
     prob = MotionProblem(mech)
     A = prob.jacobian(start)
     sv = np.linalg.svd(A, compute_uv=False)
-    r = int(np.sum(sv > 1e-9 * max(1.0, sv[0])))
+    r = int(np.sum(sv > current_tolerances().rank * max(1.0, sv[0])))
     N = np.linalg.svd(A, full_matrices=True)[2][r:]
     if N.shape[0] > 1:  # more than one direction moves the platform: not a 1-DOF motion
-        u, s2, _ = np.linalg.svd(N[:, -6:])
+        _u, s2, _ = np.linalg.svd(N[:, -6:])
         dof = int(np.sum(s2 > 1e-7))
         if dof > 1:
-            raise ValueError(f"mechanism: trace_motion follows one-degree-of-freedom motions; {mech.name} has {dof} "
+            raise InputError(f"mechanism: trace_motion follows one-degree-of-freedom motions; {mech.name} has {dof} "
                              "here (lock or drive the others: an ActuatorPathProblem follows a path of actuator values)")
     direction = None
     if increasing is not None:
-        r = mech.freedom(increasing)
-        i = mech.freedom_refs.index(r)
-        idx = list(np.flatnonzero(prob.active))
+        ref = mech.freedom(increasing)
+        i = mech.freedom_refs.index(ref)
+        idx = np.flatnonzero(prob.active).tolist()
         direction = np.zeros(prob.na + 6)
         direction[idx.index(i)] = 1.0 if sense >= 0 else -1.0
     return track(prob, start, direction=direction, monitors=monitors, **kw)

@@ -19,20 +19,22 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import InputError
 from ..geometry.rotations import check_sequence
+from ..geometry.tolerances import current as current_tolerances
 from ..model.mechanism import Mechanism
 from .closure import Configuration, chain_forward, limb_chains, limb_slices
 
 __all__ = [
     "ad",
-    "limb_jacobians",
-    "inverse_velocity",
+    "euler_rate_matrix",
+    "forward_acceleration",
     "forward_velocity",
     "inverse_acceleration",
-    "forward_acceleration",
-    "point_velocity",
+    "inverse_velocity",
+    "limb_jacobians",
     "point_acceleration",
-    "euler_rate_matrix",
+    "point_velocity",
 ]
 
 
@@ -50,7 +52,7 @@ def ad(V) -> np.ndarray:
 
 def limb_jacobians(mech: Mechanism, config: Configuration) -> list[np.ndarray]:
     """Per limb, its spatial Jacobian (6, m_k) in local coordinates (all freedoms)."""
-    return [chain_forward(ch, config.q[sl], local=True)[1] for ch, sl in zip(limb_chains(mech), limb_slices(mech))]
+    return [chain_forward(ch, config.q[sl], local=True)[1] for ch, sl in zip(limb_chains(mech), limb_slices(mech), strict=True)]
 
 
 def _bias(J: np.ndarray, qd: np.ndarray) -> np.ndarray:
@@ -77,7 +79,7 @@ def _limb_solve(mech, J, rhs, locked, name):
     x[cols] = sol
     res = float(np.linalg.norm(row * (J @ x - rhs)))
     if res > 1e-9 * max(1.0, float(np.linalg.norm(row * rhs))):
-        raise ValueError(f"twist: limb {name} cannot produce it (residual {res:.2e}): the constraints forbid it")
+        raise InputError(f"twist: limb {name} cannot produce it (residual {res:.2e}): the constraints forbid it")
     return x
 
 
@@ -89,9 +91,9 @@ def inverse_velocity(mech: Mechanism, config: Configuration, twist) -> np.ndarra
     """
     V = np.asarray(twist, float)
     if V.shape != (6,) or not np.all(np.isfinite(V)):
-        raise ValueError(f"twist: expected 6 finite numbers (omega ; v), got shape {V.shape}")
+        raise InputError(f"twist: expected 6 finite numbers (omega ; v), got shape {V.shape}")
     qd = np.zeros(len(config.q))
-    for limb, J, sl in zip(mech.limbs, limb_jacobians(mech, config), limb_slices(mech)):
+    for limb, J, sl in zip(mech.limbs, limb_jacobians(mech, config), limb_slices(mech), strict=True):
         locked = np.array([r.freedom.locked for r in mech.freedom_refs[sl]])
         qd[sl] = _limb_solve(mech, J, V, locked, limb.name)
     return qd
@@ -101,10 +103,10 @@ def inverse_acceleration(mech: Mechanism, config: Configuration, twist, twist_do
     """Joint rates and joint accelerations for a platform twist and its time derivative."""
     A = np.asarray(twist_dot, float)
     if A.shape != (6,) or not np.all(np.isfinite(A)):
-        raise ValueError(f"twist_dot: expected 6 finite numbers, got shape {A.shape}")
+        raise InputError(f"twist_dot: expected 6 finite numbers, got shape {A.shape}")
     qd = inverse_velocity(mech, config, twist)
     qdd = np.zeros_like(qd)
-    for limb, J, sl in zip(mech.limbs, limb_jacobians(mech, config), limb_slices(mech)):
+    for limb, J, sl in zip(mech.limbs, limb_jacobians(mech, config), limb_slices(mech), strict=True):
         locked = np.array([r.freedom.locked for r in mech.freedom_refs[sl]])
         qdd[sl] = _limb_solve(mech, J, A - _bias(J, qd[sl]), locked, limb.name)
     return qd, qdd
@@ -122,7 +124,7 @@ def _system(mech, config, idx):
     n = len(config.q)
     K = len(Js)
     A = np.zeros((6 * K, n + 6))
-    for k, (J, sl) in enumerate(zip(Js, limb_slices(mech))):
+    for k, (J, sl) in enumerate(zip(Js, limb_slices(mech), strict=True)):
         A[6 * k : 6 * k + 6, sl] = J
         A[6 * k : 6 * k + 6, n:] = -np.eye(6)
     row = np.tile(_scale(mech), K)
@@ -140,19 +142,19 @@ def forward_velocity(mech: Mechanism, config: Configuration, actuator_rates, act
     idx = _actuator_indices(mech, actuators)
     r = np.asarray(actuator_rates, float).ravel()
     if r.size != len(idx) or not np.all(np.isfinite(r)):
-        raise ValueError(f"actuator_rates: expected {len(idx)} finite values, got {r.size}")
+        raise InputError(f"actuator_rates: expected {len(idx)} finite values, got {r.size}")
     _, A, free = _system(mech, config, idx)
     rhs = -A[:, idx] @ r
     M = A[:, free]
     x, *_ = np.linalg.lstsq(M, rhs, rcond=None)
-    if np.linalg.norm(M @ x - rhs) > 1e-9 * max(1.0, np.linalg.norm(rhs)):
-        raise ValueError("actuator_rates: incompatible with the constraints here (an inverse singularity)")
+    if np.linalg.norm(M @ x - rhs) > 1e-9 * max(1.0, float(np.linalg.norm(rhs))):
+        raise InputError("actuator_rates: incompatible with the constraints here (an inverse singularity)")
     # the platform part must be unique: no null motion of the free system moves the platform
     _, s, vt = np.linalg.svd(M)
-    rank = int(np.sum(s > 1e-9 * max(1.0, s[0])))
+    rank = int(np.sum(s > current_tolerances().rank * max(1.0, s[0])))
     null = vt[rank:]
     if null.size and np.max(np.abs(null[:, -6:])) > 1e-7:
-        raise ValueError("actuator_rates: a direct singularity: the actuators do not determine the platform twist here")
+        raise InputError("actuator_rates: a direct singularity: the actuators do not determine the platform twist here")
     qd = np.zeros(len(config.q))
     qd[idx] = r
     for k, i in enumerate(free[:-6]):
@@ -167,10 +169,10 @@ def forward_acceleration(mech: Mechanism, config: Configuration, actuator_rates,
     idx = _actuator_indices(mech, actuators)
     a = np.asarray(actuator_accelerations, float).ravel()
     if a.size != len(idx) or not np.all(np.isfinite(a)):
-        raise ValueError(f"actuator_accelerations: expected {len(idx)} finite values, got {a.size}")
+        raise InputError(f"actuator_accelerations: expected {len(idx)} finite values, got {a.size}")
     Js, A, free = _system(mech, config, idx)
     K = len(Js)
-    bias = np.concatenate([_bias(J, qd[sl]) for J, sl in zip(Js, limb_slices(mech))])
+    bias = np.concatenate([_bias(J, qd[sl]) for J, sl in zip(Js, limb_slices(mech), strict=True)])
     row = np.tile(_scale(mech), K)
     rhs = -row * bias - A[:, idx] @ a
     x, *_ = np.linalg.lstsq(A[:, free], rhs, rcond=None)

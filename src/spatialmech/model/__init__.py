@@ -5,6 +5,24 @@ from .mechanism import Limb, Mechanism, Mode, Pose
 from .schema import ModelFileError, dump, dumps, load, loads
 
 __all__ = [
-    "JOINT_TYPES", "Freedom", "Joint", "make_joint", "R", "P", "H", "C", "U", "S", "Sm",
-    "Limb", "Mechanism", "Mode", "Pose", "ModelFileError", "load", "loads", "dump", "dumps",
+    "JOINT_TYPES",
+    "C",
+    "Freedom",
+    "H",
+    "Joint",
+    "Limb",
+    "Mechanism",
+    "Mode",
+    "ModelFileError",
+    "P",
+    "Pose",
+    "R",
+    "S",
+    "Sm",
+    "U",
+    "dump",
+    "dumps",
+    "load",
+    "loads",
+    "make_joint",
 ]

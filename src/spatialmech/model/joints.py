@@ -30,16 +30,19 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from ..errors import InputError, UnknownNameError
 from ..geometry.screws import axis_screw, translation_screw
-from ..geometry.validate import as_finite_array, as_unit_vector
+from ..geometry.tolerances import DEFAULT, current
+from ..geometry.validate import as_finite_array, as_model_number, as_unit_vector
 
-__all__ = ["Freedom", "Joint", "JOINT_TYPES", "R", "P", "H", "C", "U", "S", "Sm", "make_joint"]
+__all__ = ["JOINT_TYPES", "C", "Freedom", "H", "Joint", "P", "R", "S", "Sm", "U", "make_joint"]
 
 #: Joint types and their number of freedoms.
 JOINT_TYPES = {"R": 1, "P": 1, "H": 1, "C": 2, "U": 2, "S": 3, "Sm": 3}
 
-#: Tolerance for perpendicular / orthonormal joint axes.
-AXIS_ORTHO_ATOL = 1e-6
+#: Tolerance for perpendicular / orthonormal joint axes (the default of
+#: :attr:`~spatialmech.geometry.tolerances.Tolerances.unit`; the one in force is used).
+AXIS_ORTHO_ATOL = DEFAULT.unit
 
 
 @dataclass(frozen=True, eq=False)
@@ -91,9 +94,9 @@ class Joint:
         for f in self.freedoms:
             if f.name == name:
                 return f
-        raise KeyError(f"joint {self.name!r} has no freedom {name!r} (has {[f.name for f in self.freedoms]})")
+        raise UnknownNameError(f"joint {self.name!r} has no freedom {name!r} (has {[f.name for f in self.freedoms]})")
 
-    def with_freedom(self, name: str, **changes) -> "Joint":
+    def with_freedom(self, name: str, **changes) -> Joint:
         fs = tuple(replace(f, **changes) if f.name == name else f for f in self.freedoms)
         return replace(self, freedoms=fs)
 
@@ -106,10 +109,12 @@ def _flags(value, names: tuple[str, ...], field_name: str) -> set[str]:
         return set()
     if isinstance(value, str):
         value = [value]
+    if not isinstance(value, (list, tuple, set, frozenset)):
+        raise InputError(f"{field_name}: expected true, false or a list of freedom names {list(names)}, got {value!r}")
     out = set()
     for v in value:
         if v not in names:
-            raise ValueError(f"{field_name}: unknown freedom {v!r}; this joint has {list(names)}")
+            raise InputError(f"{field_name}: unknown freedom {v!r}; this joint has {list(names)}")
         out.add(v)
     return out
 
@@ -120,19 +125,19 @@ def _per_freedom(value, names: tuple[str, ...], field_name: str) -> dict:
     if isinstance(value, dict):
         for k in value:
             if k not in names:
-                raise ValueError(f"{field_name}: unknown freedom {k!r}; this joint has {list(names)}")
+                raise InputError(f"{field_name}: unknown freedom {k!r}; this joint has {list(names)}")
         return dict(value)
     if len(names) != 1:
-        raise ValueError(f"{field_name}: this joint has several freedoms {list(names)}; give a table by name")
+        raise InputError(f"{field_name}: this joint has several freedoms {list(names)}; give a table by name")
     return {names[0]: value}
 
 
 def _check_limits(lim, field_name: str):
     if lim is None:
         return None
-    a = as_finite_array(lim, field_name, shape=(2,))
+    a = as_model_number(lim, field_name, shape=(2,))
     if a[0] > a[1]:
-        raise ValueError(f"{field_name}: lower limit {a[0]:g} is above upper limit {a[1]:g}")
+        raise InputError(f"{field_name}: lower limit {a[0]:g} is above upper limit {a[1]:g}")
     return (float(a[0]), float(a[1]))
 
 
@@ -156,38 +161,38 @@ def make_joint(
     """Build and validate a joint of any type.  ``field`` prefixes error messages."""
     where = field or f"joint {name!r}"
     if type not in JOINT_TYPES:
-        raise ValueError(f"{where}.type: unknown joint type {type!r}; expected one of {sorted(JOINT_TYPES)}")
-    p = as_finite_array(point, f"{where}.point", shape=(3,))
+        raise InputError(f"{where}.type: unknown joint type {type!r}; expected one of {sorted(JOINT_TYPES)}")
+    p = as_model_number(point, f"{where}.point", shape=(3,))
     if type in ("R", "P", "H", "C"):
         if axis is None:
-            raise ValueError(f"{where}.axis: required for a {type} joint")
+            raise InputError(f"{where}.axis: required for a {type} joint")
         if axes is not None:
-            raise ValueError(f"{where}.axes: a {type} joint takes 'axis', not 'axes'")
+            raise InputError(f"{where}.axes: a {type} joint takes 'axis', not 'axes'")
         dirs = [as_unit_vector(axis, f"{where}.axis", normalize=normalize)]
     elif type == "U":
         if axes is None:
-            raise ValueError(f"{where}.axes: a U joint needs two axes")
+            raise InputError(f"{where}.axes: a U joint needs two axes")
         axs = as_finite_array(axes, f"{where}.axes", shape=(2, 3))
         dirs = [as_unit_vector(axs[i], f"{where}.axes[{i}]", normalize=normalize) for i in range(2)]
-        if abs(dirs[0] @ dirs[1]) > AXIS_ORTHO_ATOL:
-            raise ValueError(f"{where}.axes: the two axes of a U joint must be perpendicular (cos = {dirs[0] @ dirs[1]:.3g})")
+        if abs(dirs[0] @ dirs[1]) > current().unit:
+            raise InputError(f"{where}.axes: the two axes of a U joint must be perpendicular (cos = {dirs[0] @ dirs[1]:.3g})")
     else:  # S, Sm
         if axis is not None:
-            raise ValueError(f"{where}.axis: a {type} joint takes 'axes' (three) or nothing")
+            raise InputError(f"{where}.axis: a {type} joint takes 'axes' (three) or nothing")
         axs = np.eye(3) if axes is None else as_finite_array(axes, f"{where}.axes", shape=(3, 3))
         dirs = [as_unit_vector(axs[i], f"{where}.axes[{i}]", normalize=normalize) for i in range(3)]
         G = np.array(dirs) @ np.array(dirs).T
-        if np.max(np.abs(G - np.eye(3))) > AXIS_ORTHO_ATOL:
-            raise ValueError(f"{where}.axes: the three axes of a {type} joint must be mutually perpendicular")
+        if np.max(np.abs(G - np.eye(3))) > current().unit:
+            raise InputError(f"{where}.axes: the three axes of a {type} joint must be mutually perpendicular")
 
+    names: tuple[str, ...]
     if type == "R":
         kinds, names = ["R"], ("rot",)
     elif type == "P":
         kinds, names = ["P"], ("slide",)
     elif type == "H":
         kinds, names = ["H"], ("screw",)
-        if not np.isfinite(pitch):
-            raise ValueError(f"{where}.pitch: must be finite")
+        pitch = as_model_number(pitch, f"{where}.pitch")
     elif type == "C":
         kinds, names = ["R", "P"], ("rot", "slide")
         dirs = [dirs[0], dirs[0]]
@@ -198,7 +203,7 @@ def make_joint(
     if freedom_names is not None:
         freedom_names = tuple(freedom_names)
         if len(freedom_names) != len(names) or len(set(freedom_names)) != len(names):
-            raise ValueError(f"{where}.freedom_names: expected {len(names)} distinct names, got {list(freedom_names)}")
+            raise InputError(f"{where}.freedom_names: expected {len(names)} distinct names, got {list(freedom_names)}")
         names = freedom_names
     act = _flags(actuated, names, f"{where}.actuated")
     lk = _flags(lockable, names, f"{where}.lockable")
@@ -208,7 +213,7 @@ def make_joint(
     lims = _per_freedom(limits, names, f"{where}.limits")
     offs = _per_freedom(offset, names, f"{where}.offset")
     freedoms = []
-    for k, (kind, nm, d) in enumerate(zip(kinds, names, dirs)):
+    for kind, nm, d in zip(kinds, names, dirs, strict=True):
         freedoms.append(
             Freedom(
                 name=nm,
@@ -220,7 +225,7 @@ def make_joint(
                 lockable=nm in lk,
                 locked=nm in lkd,
                 limits=_check_limits(lims.get(nm), f"{where}.limits.{nm}"),
-                offset=float(as_finite_array(offs.get(nm, 0.0), f"{where}.offset.{nm}", shape=())),
+                offset=as_model_number(offs.get(nm, 0.0), f"{where}.offset.{nm}"),
             )
         )
     return Joint(name=name, type=type, point=p, freedoms=tuple(freedoms))

@@ -14,18 +14,25 @@ and the platform frame is at ``platform_point`` with world-aligned axes.  A plat
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 from itertools import combinations
-from typing import Mapping
 
 import numpy as np
 
+from ..errors import InputError, SearchTooLargeError, UnknownNameError, describe
 from ..geometry.rotations import euler_matrix, transform
+from ..geometry.tolerances import characteristic_length
+from ..geometry.tolerances import current as current_tolerances
 from ..geometry.validate import as_finite_array
 from .joints import Freedom, Joint
 
-__all__ = ["Pose", "Mode", "Limb", "Mechanism", "FreedomRef"]
+__all__ = ["MAX_IMPLICIT_MODES", "FreedomRef", "Limb", "Mechanism", "Mode", "Pose"]
+
+#: Largest number of implicit modes (subsets of the lockable freedoms) of a mechanism without
+#: declared modes: 2^10, i.e. at most 10 lockable freedoms.
+MAX_IMPLICIT_MODES = 2**10
 
 
 @dataclass(frozen=True, eq=False)
@@ -39,12 +46,12 @@ class Pose:
     def __post_init__(self):
         R = as_finite_array(self.R, f"pose {self.name!r}.R", shape=(3, 3))
         if np.max(np.abs(R @ R.T - np.eye(3))) > 1e-6 or np.linalg.det(R) < 0:
-            raise ValueError(f"pose {self.name!r}.R: not a rotation matrix (orthonormal, det +1)")
+            raise InputError(f"pose {self.name!r}.R: not a rotation matrix (orthonormal, det +1)")
         object.__setattr__(self, "R", R)
         object.__setattr__(self, "p", as_finite_array(self.p, f"pose {self.name!r}.p", shape=(3,)))
 
     @classmethod
-    def from_euler(cls, seq: str, angles, p, *, degrees: bool = False, name: str = "") -> "Pose":
+    def from_euler(cls, seq: str, angles, p, *, degrees: bool = False, name: str = "") -> Pose:
         """Pose from Euler angles in an explicitly named sequence (see :mod:`..geometry.rotations`)."""
         return cls(euler_matrix(seq, angles, degrees=degrees), p, name)
 
@@ -54,7 +61,7 @@ class Pose:
         return transform(self.R, self.p - self.R @ p0)
 
     @classmethod
-    def from_displacement(cls, D, reference_point, *, name: str = "") -> "Pose":
+    def from_displacement(cls, D, reference_point, *, name: str = "") -> Pose:
         D = np.asarray(D, dtype=float)
         return cls(D[:3, :3], D[:3, :3] @ np.asarray(reference_point, float) + D[:3, 3], name)
 
@@ -80,13 +87,30 @@ class Limb:
     joints: tuple[Joint, ...]
 
     def __post_init__(self):
-        object.__setattr__(self, "joints", tuple(self.joints))
+        if not isinstance(self.name, str):
+            raise TypeError(f"limb name: expected a str, got {describe(self.name)}")
+        object.__setattr__(self, "joints", _items(self.joints, Joint, _JOINT, f"limb {self.name!r}.joints"))
         if not self.joints:
-            raise ValueError(f"limb {self.name!r}: has no joints")
+            raise InputError(f"limb {self.name!r}: has no joints")
 
     @property
     def dof(self) -> int:
         return sum(j.dof for j in self.joints)
+
+
+_JOINT = "a Joint (R, P, C, U, S, Sm, H)"
+
+
+def _items(values, cls, what: str, name: str) -> tuple:
+    """``values`` as a tuple whose items are all ``cls``; ``TypeError`` naming the item otherwise,
+    e.g. ``limbs[0].joints[1]: expected a Joint (R, P, C, U, S, Sm, H), got str 'S'``."""
+    if isinstance(values, (str, bytes, cls)) or not hasattr(values, "__iter__"):
+        raise TypeError(f"{name}: expected a sequence (list or tuple) of items, each {what}; got {describe(values)}")
+    out = tuple(values)
+    for k, v in enumerate(out):
+        if not isinstance(v, cls):
+            raise TypeError(f"{name}[{k}]: expected {what}, got {describe(v)}")
+    return out
 
 
 @dataclass(frozen=True)
@@ -116,36 +140,47 @@ class Mechanism:
     notes: str = ""
 
     def __post_init__(self):
-        object.__setattr__(self, "limbs", tuple(self.limbs))
-        object.__setattr__(self, "modes", tuple(self.modes))
-        object.__setattr__(self, "positions", tuple(self.positions))
+        if not isinstance(self.name, str):
+            raise TypeError(f"name: expected a str, got {describe(self.name)}")
+        object.__setattr__(self, "limbs", _items(self.limbs, Limb, "a Limb", "limbs"))
+        for i, limb in enumerate(self.limbs):
+            _items(limb.joints, Joint, _JOINT, f"limbs[{i}].joints")
+        object.__setattr__(self, "modes", _items(self.modes, Mode, "a Mode", "modes"))
+        object.__setattr__(self, "positions", _items(self.positions, Pose, "a Pose", "positions"))
         object.__setattr__(self, "aliases", dict(self.aliases))
         object.__setattr__(
             self, "platform_point", as_finite_array(self.platform_point, "platform_point", shape=(3,))
         )
         if not self.limbs:
-            raise ValueError("limbs: a mechanism needs at least one limb")
+            raise InputError("limbs: a mechanism needs at least one limb")
         seen_l, seen_j = set(), set()
         for i, limb in enumerate(self.limbs):
             if limb.name in seen_l:
-                raise ValueError(f"limbs[{i}].name: duplicate limb name {limb.name!r}")
+                raise InputError(f"limbs[{i}].name: duplicate limb name {limb.name!r}")
             seen_l.add(limb.name)
             for j, joint in enumerate(limb.joints):
                 if joint.name in seen_j:
-                    raise ValueError(f"limbs[{i}].joints[{j}].name: duplicate joint name {joint.name!r}")
+                    raise InputError(f"limbs[{i}].joints[{j}].name: duplicate joint name {joint.name!r}")
                 seen_j.add(joint.name)
-        for a, target in self.aliases.items():
+        for target in self.aliases.values():
             self.freedom(target)  # raises on unknown
         lockable = {r.id for r in self.freedom_refs if r.freedom.lockable}
         seen_m = set()
         for k, mode in enumerate(self.modes):
             if mode.name in seen_m:
-                raise ValueError(f"modes[{k}].name: duplicate mode name {mode.name!r}")
+                raise InputError(f"modes[{k}].name: duplicate mode name {mode.name!r}")
             seen_m.add(mode.name)
             for d in mode.driven:
                 fid = self.freedom(d).id
                 if fid not in lockable:
-                    raise ValueError(f"modes[{k}].driven: {d!r} is not a lockable freedom")
+                    raise InputError(f"modes[{k}].driven: {d!r} is not a lockable freedom")
+        # scale (geometry/tolerances.py): a length the nondimensional tolerances can handle
+        L = self.characteristic_length  # InputError naming the joint points when out of range
+        for r in self.freedom_refs:
+            if r.freedom.kind == "H" and abs(r.freedom.pitch) > current_tolerances().max_ratio * L:
+                raise InputError(f"limbs[{r.limb}].joints[{r.joint}].pitch: {r.freedom.pitch:.3g} per rad is more than "
+                                 f"{current_tolerances().max_ratio:g} characteristic lengths ({L:.3g}): to the rank "
+                                 "tolerance it is a prismatic joint; use a P joint")
 
     # ------------------------------------------------------------------ freedoms
     @cached_property
@@ -170,8 +205,8 @@ class Mechanism:
             return matches[0]
         known = sorted(set(self.aliases) | {r.id for r in self.freedom_refs})
         if len(matches) > 1:
-            raise KeyError(f"{name!r} names a joint with several freedoms: {[m.id for m in matches]}")
-        raise KeyError(f"unknown freedom {name!r}; known: {', '.join(known)}")
+            raise UnknownNameError(f"{name!r} names a joint with several freedoms: {[m.id for m in matches]}")
+        raise UnknownNameError(f"unknown freedom {name!r}; known: {', '.join(known)}")
 
     @property
     def actuators(self) -> tuple[str, ...]:
@@ -187,25 +222,34 @@ class Mechanism:
 
     @cached_property
     def characteristic_length(self) -> float:
-        """RMS distance of the joint points from their centroid (1 if they all coincide).
+        """RMS distance of the joint points from their centroid (see
+        :func:`~spatialmech.geometry.tolerances.characteristic_length`: their distance from the
+        origin if they coincide, 1 if that is zero too).
 
         Used to make screw-rank decisions and convergence tests independent of the length unit.
         """
         pts = np.array([j.point for limb in self.limbs for j in limb.joints] + [self.platform_point])
-        L = float(np.sqrt(np.mean(np.sum((pts - pts.mean(axis=0)) ** 2, axis=1))))
-        return L if L > 1e-12 else 1.0
+        return characteristic_length(pts, field="limbs[].joints[].point, platform_point")
 
     # ------------------------------------------------------------------ modes
     def all_modes(self) -> tuple[Mode, ...]:
         """The declared modes, or every subset of the lockable freedoms when none are declared.
 
-        A mechanism without lockable freedoms has one mode, ``"default"``.
+        A mechanism without lockable freedoms has one mode, ``"default"``.  Without declared
+        modes, at most :data:`MAX_IMPLICIT_MODES` subsets are enumerated (10 lockable freedoms);
+        more raise :class:`~spatialmech.errors.SearchTooLargeError`: declare the modes.
         """
         if self.modes:
             return self.modes
         lk = self.lockable
         if not lk:
             return (Mode("default", ()),)
+        if 2 ** len(lk) > MAX_IMPLICIT_MODES:
+            raise SearchTooLargeError(
+                f"modes: {self.name} has {len(lk)} lockable freedoms and no declared modes, i.e. 2^{len(lk)} = "
+                f"{2 ** len(lk)} implicit modes (one per subset), more than {MAX_IMPLICIT_MODES}; declare the modes "
+                "you mean ([[modes]] tables with name and driven freedoms in a file, Mechanism(modes=...) in Python)"
+                " or mark fewer freedoms lockable")
         out = []
         for k in range(len(lk) + 1):
             for sub in combinations(lk, k):
@@ -213,12 +257,21 @@ class Mechanism:
         return tuple(out)
 
     def mode(self, name: str) -> Mode:
+        lk = self.lockable
+        if not self.modes and 2 ** len(lk) > MAX_IMPLICIT_MODES:  # too many implicit modes to list: parse the name
+            if name == "all-locked":
+                return Mode(name, ())
+            sub = name.split("+")
+            if all(x in lk for x in sub) and sub == sorted(set(sub), key=lk.index):
+                return Mode(name, tuple(sub))
+            raise UnknownNameError(f"unknown mode {name!r}; the implicit modes of {self.name} are 'all-locked' and "
+                                   f"lockable freedoms joined by '+' in this order: {', '.join(lk)}")
         for m in self.all_modes():
             if m.name == name:
                 return m
-        raise KeyError(f"unknown mode {name!r}; modes: {', '.join(m.name for m in self.all_modes())}")
+        raise UnknownNameError(f"unknown mode {name!r}; modes: {', '.join(m.name for m in self.all_modes())}")
 
-    def in_mode(self, mode: Mode | str) -> "Mechanism":
+    def in_mode(self, mode: Mode | str) -> Mechanism:
         """This mechanism with the lockable freedoms not driven in ``mode`` locked and the
         driven ones actuated."""
         if isinstance(mode, str):
@@ -237,7 +290,7 @@ class Mechanism:
             limbs.append(Limb(limb.name, tuple(joints)))
         return replace(self, limbs=tuple(limbs), modes=(mode,))
 
-    def with_actuators(self, names) -> "Mechanism":
+    def with_actuators(self, names) -> Mechanism:
         """This mechanism with exactly the named freedoms actuated (e.g. a driver choice)."""
         ids = {self.freedom(n).id for n in names}
         limbs = []

@@ -13,32 +13,103 @@ import math
 import re
 import tomllib
 from pathlib import Path
-from typing import Annotated, Any, Literal, Union
+from typing import Annotated, Any, Literal
 
 import numpy as np
 import tomli_w
 from annotated_types import Len
-from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from pydantic import BaseModel, ConfigDict, Field, PlainValidator, ValidationError
 
+from ..errors import InputError
 from ..geometry.rotations import check_sequence
 from .joints import Joint, make_joint
 from .mechanism import Limb, Mechanism, Mode, Pose
 
-__all__ = ["ModelFileError", "load", "loads", "dump", "dumps", "to_dict", "from_dict", "load_positions", "FORMAT_VERSION"]
+__all__ = ["FORMAT_VERSION", "ModelFileError", "dump", "dumps", "from_dict", "load", "load_positions", "loads", "to_dict"]
 
 FORMAT_VERSION = 1
 
-Vec3 = Annotated[list[float], Len(3, 3)]
-Flags = Union[bool, list[str], str]
-Range = Annotated[list[float], Len(2, 2)]
+#: Largest mechanism or positions file read (bytes): a bigger file is refused, not read into memory.
+MAX_FILE_BYTES = 10_000_000
 
 
-class ModelFileError(ValueError):
+class ModelFileError(InputError):
     """A malformed mechanism file or description; the message is one line naming the field."""
 
 
+def _show(v, width: int = 40) -> str:
+    """A value as the user typed it (TOML spelling of booleans), shortened to ``width``."""
+    if isinstance(v, bool):
+        text = "true" if v else "false"
+    elif isinstance(v, int) and v.bit_length() > 200:  # repr() of a 4300-digit int raises
+        text = f"an integer of {len(str(abs(v))) if v.bit_length() < 14000 else 'more than 4000'} digits"
+    else:
+        text = repr(v)
+    return text if len(text) <= width else text[: width - 3] + "..."
+
+
+def _at(where: str, text: str) -> str:
+    """``".rot[1]: text"``: a message below the field being validated (``where`` may be empty)."""
+    return f"{where}: {text}" if where else text
+
+
+def _number(v, where: str = "") -> float:
+    """A finite number; booleans and strings are not numbers (``point = [true, 0, 0]``)."""
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        raise ValueError(_at(where, f"expected a number, got {_show(v)}"))
+    try:
+        x = float(v)
+    except OverflowError:
+        raise ValueError(_at(where, f"number too large for a float: {_show(v)}")) from None
+    if not math.isfinite(x):
+        raise ValueError(_at(where, f"must be a finite number, got {_show(v)}"))
+    return x
+
+
+def _range(v, where: str = "") -> list[float]:
+    if not isinstance(v, list) or len(v) != 2:
+        raise ValueError(_at(where, f"expected [lower, upper] (two numbers), got {_show(v)}"))
+    return [_number(x, f"{where}[{k}]") for k, x in enumerate(v)]
+
+
+def _flags(v):
+    """``true``/``false``, a freedom name, or a list of freedom names."""
+    if isinstance(v, (bool, str)) or (isinstance(v, list) and all(isinstance(x, str) for x in v)):
+        return v
+    raise ValueError(f"expected true, false, a freedom name or a list of freedom names, got {_show(v)}")
+
+
+def _range_or_table(v):
+    """``[lower, upper]`` or a table of them by freedom name."""
+    if isinstance(v, dict):
+        return {k: _range(x, f".{k}") for k, x in v.items()}
+    if isinstance(v, list):
+        return _range(v)
+    raise ValueError(f"expected [lower, upper] or a table of them by freedom name, got {_show(v)}")
+
+
+def _number_or_table(v):
+    """A number or a table of numbers by freedom name."""
+    if isinstance(v, dict):
+        return {k: _number(x, f".{k}") for k, x in v.items()}
+    return _number(v)
+
+
+def _format_version(v):
+    if isinstance(v, bool) or v != FORMAT_VERSION or not isinstance(v, int):
+        raise ValueError(f"unsupported format {_show(v)}; this version reads format {FORMAT_VERSION}")
+    return v
+
+
+Vec3 = Annotated[list[float], Len(3, 3)]
+Flags = Annotated[bool | list[str] | str, PlainValidator(_flags)]
+RangeOrTable = Annotated[list[float] | dict[str, list[float]] | None, PlainValidator(_range_or_table)]
+NumberOrTable = Annotated[float | dict[str, float] | None, PlainValidator(_number_or_table)]
+
+
 class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, strict=False)
+    # strict: no coercion (true is not 1, "1" is not a number, 1 is not true); ints are numbers
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, strict=True)
 
 
 class JointSpec(_Strict):
@@ -51,10 +122,10 @@ class JointSpec(_Strict):
     actuated: Flags = False
     lockable: Flags = False
     locked: Flags = False
-    limits: Range | dict[str, Range] | None = None
-    limits_deg: Range | dict[str, Range] | None = None
-    offset: float | dict[str, float] | None = None
-    offset_deg: float | dict[str, float] | None = None
+    limits: RangeOrTable = None
+    limits_deg: RangeOrTable = None
+    offset: NumberOrTable = None
+    offset_deg: NumberOrTable = None
     freedom_names: list[str] | None = None
 
 
@@ -82,7 +153,7 @@ class ModeSpec(_Strict):
 
 
 class MechanismSpec(_Strict):
-    format: Literal[1] = 1
+    format: Annotated[Literal[1], PlainValidator(_format_version)] = 1
     name: str
     description: str = ""
     length_unit: str = "m"
@@ -104,6 +175,23 @@ def _loc(loc) -> str:
         else:
             out += ("." if out else "") + str(part)
     return out
+
+
+def _validation_message(e: ValidationError) -> str:
+    """The first error of a pydantic validation as one line that starts with the field."""
+    err = e.errors()[0]
+    loc = _loc(err["loc"])
+    if err["type"] == "extra_forbidden":
+        msg = "unknown field"
+    elif err["type"] == "missing":
+        msg = "required field is missing"
+    elif err["type"] == "value_error":
+        msg = str(err["ctx"]["error"])  # our own validators' messages, without "Value error, "
+    else:
+        msg = f"{err['msg']}, got {_show(err.get('input'))}"
+    if not loc:
+        return msg
+    return f"{loc}{msg}" if msg.startswith((".", "[")) else f"{loc}: {msg}"
 
 
 def _merge_units(js: JointSpec, kinds: dict[str, str], where: str, key: str, deg_key: str) -> dict | None:
@@ -153,8 +241,8 @@ def _joint(js: JointSpec, where: str, normalize: bool) -> Joint:
         )
     except ModelFileError:
         raise
-    except (ValueError, KeyError) as e:
-        raise ModelFileError(str(e).strip("'\"")) from None
+    except InputError as e:
+        raise ModelFileError(str(e)) from None
 
 
 def _pose(ps: PoseSpec, where: str) -> Pose:
@@ -164,24 +252,19 @@ def _pose(ps: PoseSpec, where: str) -> Pose:
         if ps.euler is not None:
             check_sequence(ps.euler.seq)
             return Pose.from_euler(ps.euler.seq, ps.euler.angles_deg, ps.point, degrees=True, name=ps.name)
-        return Pose(np.array(ps.matrix), ps.point, ps.name)
-    except ValueError as e:
+        return Pose(np.array(ps.matrix), np.asarray(ps.point, dtype=float), ps.name)
+    except InputError as e:
         raise ModelFileError(f"{where}: {e}") from None
 
 
 def from_dict(data: dict[str, Any], *, source: str = "<dict>") -> Mechanism:
     """Validate a parsed file (a dict) and build the mechanism."""
+    if not isinstance(data, dict):
+        raise ModelFileError(f"expected a table of fields (a dict), got {type(data).__name__}")
     try:
         spec = MechanismSpec.model_validate(data)
     except ValidationError as e:
-        err = e.errors()[0]
-        loc = _loc(err["loc"])
-        msg = err["msg"]
-        if err["type"] == "extra_forbidden":
-            msg = "unknown field"
-        elif err["type"] == "missing":
-            msg = "required field is missing"
-        raise ModelFileError(f"{loc}: {msg}") from None
+        raise ModelFileError(_validation_message(e)) from None
     limbs = []
     for i, ls in enumerate(spec.limbs):
         joints = tuple(_joint(js, f"limbs[{i}].joints[{j}]", spec.normalize_axes) for j, js in enumerate(ls.joints))
@@ -190,30 +273,57 @@ def from_dict(data: dict[str, Any], *, source: str = "<dict>") -> Mechanism:
     modes = tuple(Mode(m.name, tuple(m.driven), m.description) for m in spec.modes)
     try:
         return Mechanism(
-            name=spec.name, limbs=tuple(limbs), platform_point=spec.platform_point,
+            name=spec.name, limbs=tuple(limbs), platform_point=np.asarray(spec.platform_point, dtype=float),
             description=spec.description, modes=modes, positions=positions, aliases=spec.aliases,
             length_unit=spec.length_unit, source=spec.source or source, notes=spec.notes,
         )
-    except (ValueError, KeyError) as e:
-        raise ModelFileError(str(e).strip("'\"")) from None
+    except InputError as e:
+        raise ModelFileError(str(e)) from None
+
+
+def _parse_toml(text: str) -> dict[str, Any]:
+    if not isinstance(text, str):
+        raise TypeError(f"text: expected TOML text (str), got {type(text).__name__}")
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        raise ModelFileError(f"not valid TOML: {e}") from None
+    except ValueError:  # Python's limit on the digits of an int (sys.get_int_max_str_digits)
+        raise ModelFileError("not valid TOML: an integer of more than 4300 digits") from None
+    except RecursionError:
+        raise ModelFileError("not a usable TOML file: arrays or tables nested too deeply") from None
 
 
 def loads(text: str, *, source: str = "<string>") -> Mechanism:
     """Parse TOML text into a mechanism."""
+    data = _parse_toml(text)
     try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as e:
-        raise ModelFileError(f"not valid TOML: {e}") from None
-    return from_dict(data, source=source)
+        return from_dict(data, source=source)
+    except RecursionError:  # a value nested hundreds of levels deep
+        raise ModelFileError("values nested too deeply") from None
+
+
+def _read_text(path: Path) -> str:
+    """The UTF-8 text of a file of at most :data:`MAX_FILE_BYTES`; errors name the file."""
+    try:
+        with path.open("rb") as f:
+            raw = f.read(MAX_FILE_BYTES + 1)
+    except OSError as e:
+        raise ModelFileError(f"{path}: cannot read: {e.strerror or e}") from None
+    if len(raw) > MAX_FILE_BYTES:
+        raise ModelFileError(f"{path}: larger than {MAX_FILE_BYTES // 1_000_000} MB; not a mechanism file")
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError as e:
+        line = raw[: e.start].count(b"\n") + 1
+        raise ModelFileError(f"{path}: not UTF-8 text (byte 0x{raw[e.start]:02x} on line {line}); "
+                             "save the file as UTF-8") from None
 
 
 def load(path: str | Path) -> Mechanism:
     """Read a mechanism file.  Errors are :class:`ModelFileError` prefixed with the file name."""
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as e:
-        raise ModelFileError(f"{path}: cannot read: {e.strerror}") from None
+    text = _read_text(path)
     try:
         return loads(text, source=str(path))
     except ModelFileError as e:
@@ -309,7 +419,8 @@ def _collapse_arrays(text: str, width: int = 100) -> str:
 
 def dumps(mech: Mechanism) -> str:
     """TOML text of a mechanism; ``loads(dumps(m))`` rebuilds the same mechanism."""
-    head = f"# spatialmech mechanism file (format {FORMAT_VERSION}); angles in degrees, lengths in {mech.length_unit}\n"
+    unit = "".join(c if c.isprintable() else "?" for c in mech.length_unit)  # a comment ends at a newline
+    head = f"# spatialmech mechanism file (format {FORMAT_VERSION}); angles in degrees, lengths in {unit}\n"
     return head + _collapse_arrays(tomli_w.dumps(to_dict(mech)))
 
 
@@ -326,17 +437,16 @@ def load_positions(path: str | Path) -> tuple[Pose, ...]:
     """Task positions from a TOML file with ``[[positions]]`` tables (``point`` and either
     ``euler = {seq, angles_deg}`` or ``matrix``), as in a mechanism file."""
     path = Path(path)
+    text = _read_text(path)
     try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except OSError as e:
-        raise ModelFileError(f"{path}: cannot read: {e.strerror}") from None
-    except tomllib.TOMLDecodeError as e:
-        raise ModelFileError(f"{path}: not valid TOML: {e}") from None
-    try:
+        data = _parse_toml(text)
         spec = _PositionsFile.model_validate(data)
+    except ModelFileError as e:
+        raise ModelFileError(f"{path}: {e}") from None
     except ValidationError as e:
-        err = e.errors()[0]
-        raise ModelFileError(f"{path}: {_loc(err['loc'])}: {err['msg']}") from None
+        raise ModelFileError(f"{path}: {_validation_message(e)}") from None
+    except RecursionError:
+        raise ModelFileError(f"{path}: values nested too deeply") from None
     try:
         return tuple(_pose(p, f"positions[{i}]") if p.name else replace_name(_pose(p, f"positions[{i}]"), f"P{i + 1}")
                      for i, p in enumerate(spec.positions))

@@ -11,23 +11,25 @@ from __future__ import annotations
 
 import base64
 import io
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Sequence
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.colors import ListedColormap
 from matplotlib.figure import Figure
 
+from ..errors import InputError
+
 __all__ = [
     "ReportFigure",
-    "new_figure",
-    "to_png",
-    "figure_from_file",
-    "sign_matrix",
     "curves",
+    "figure_from_file",
+    "new_figure",
     "scalar_field",
+    "sign_matrix",
+    "to_png",
 ]
 
 #: Resolution of the report PNGs (dots per inch).
@@ -63,7 +65,7 @@ def new_figure(figsize=(7.0, 4.2)) -> Figure:
 def to_png(fig: Figure, name: str, title: str, caption: str) -> ReportFigure:
     """Render ``fig`` to PNG bytes (``DPI``) as a :class:`ReportFigure`."""
     if not name.endswith(".png"):
-        raise ValueError(f"name: expected a file name ending in .png, got {name!r}")
+        raise InputError(f"name: expected a file name ending in .png, got {name!r}")
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=DPI)
     return ReportFigure(name, title, caption, buf.getvalue())

@@ -21,10 +21,11 @@ from ..kinematics.jacobian import complete_jacobian
 from ..kinematics.position import configuration_at_pose, freedom_values
 from ..kinematics.tracking import trace_motion
 from ..model.mechanism import Mechanism
+from ..results import Progress, Steps
 from . import figures as F
 from .report import Section, Table, Viewer
 
-__all__ = ["section", "model_section", "STEPS", "MODEL_STEPS"]
+__all__ = ["MODEL_STEPS", "STEPS", "model_section", "section"]
 
 #: Progress steps of :func:`section` and :func:`model_section`.
 STEPS = 1
@@ -41,8 +42,9 @@ def _mob_row(name, r):
     return (name, r.mode, r.dof, r.dof_instantaneous, r.gk_classic, r.motion, r.lam, r.d, r.n, r.g, r.sum_f, r.v, r.xi)
 
 
-def section(progress=lambda step: None) -> Section:
+def section(progress: Progress | None = None) -> Section:
     """The mobility of every ready-made model (modified Kutzbach-Grübler, checked numerically)."""
+    progress = Steps(progress, STEPS)
     progress("mobility of every ready-made model")
     rows, data = [], {}
     for name in catalog.names():
@@ -63,10 +65,11 @@ def _jacobian_row(label, J):
             ", ".join(J.inverse_singular) or "-")
 
 
-def model_section(mech: Mechanism, progress=lambda step: None, *, trace: bool = True) -> Section:
+def model_section(mech: Mechanism, progress: Progress | None = None, *, trace: bool = True) -> Section:
     """Every analysis that applies to ``mech`` (see the module docstring)."""
-    from .motion import sample_motion
+    progress = Steps(progress, MODEL_STEPS)
     from ..analysis.defects import dj_table
+    from .motion import sample_motion
 
     tables, figs, viewers, data, notes = [], [], [], {}, []
     unit = mech.length_unit
@@ -117,7 +120,7 @@ def model_section(mech: Mechanism, progress=lambda step: None, *, trace: bool = 
         tables.append(Table("Task positions fitted onto the closure", ("position", "converged", "exact",
                             f"platform-point error [{unit}]", "orientation error [deg]"),
                             tuple((P.name, f.converged, f.exact, f.position_error, float(np.degrees(f.angle_error)))
-                                  for P, f in zip(mech.positions, fits))))
+                                  for P, f in zip(mech.positions, fits, strict=True))))
     if jrows:
         tables.insert(1, Table("Complete Jacobian (constraint + actuation wrenches; det only when square)",
                                ("configuration", "actuators", "det J", "sigma_min (scale-free)", "1/condition",
@@ -153,7 +156,7 @@ def model_section(mech: Mechanism, progress=lambda step: None, *, trace: bool = 
         ys = {ids[i] + (" [deg]" if mech.freedom_refs[i].freedom.kind != "P" else f" [{unit}]"):
               (np.degrees(q[:, i]) if mech.freedom_refs[i].freedom.kind != "P" else q[:, i]) for i in show}
         F.curves(ax, tr.s, ys, xlabel="arc length (nondimensional)", ylabel=next(iter(ys)) if len(ys) == 1 else "joint value",
-                 title=f"traced motion ({tr.status})")
+                 title=f"traced motion ({tr.message})")
         ax2 = fig.add_subplot(1, 2, 2)
         if mech.actuators:
             sig = np.array([complete_jacobian(mech, c).sigma_min for c in tr.points])
@@ -166,16 +169,16 @@ def model_section(mech: Mechanism, progress=lambda step: None, *, trace: bool = 
         nz = sum(k["kind"] == "zero" for k in kinds)
         figs.append(F.to_png(fig, "motion.png", f"{mech.name}: the one-degree-of-freedom motion traced by continuation",
                              f"Pseudo-arclength continuation from the reference configuration until the motion closes "
-                             f"({tr.status}); dashed lines: sign changes of DJ of {', '.join(mech.actuators) or '-'}, "
+                             f"({tr.message}); dashed lines: sign changes of DJ of {', '.join(mech.actuators) or '-'}, "
                              f"red: {nz} zeros (singular configurations), grey: {len(kinds) - nz} poles (DJ through "
                              "infinity: the platform at rest while the driver moves)."))
-        data["trace"] = {"status": tr.status, "closed": tr.closed, "points": len(tr.points), "arc_length": float(tr.s[-1]),
+        data["trace"] = {"status": tr.status, "closed": tr.closed, "n_points": len(tr.points), "arc_length": float(tr.s[-1]),
                          "events": kinds, "ok": tr.ok}
         idx = np.unique(np.linspace(0, len(tr.points) - 1, min(VIEWER_FRAMES, len(tr.points))).round().astype(int))
         configs = tuple(tr.points[i] for i in idx)
-        sing = tuple(e.x for e, k in zip(tr.events, kinds) if k["kind"] == "zero")
+        sing = tuple(e.x for e, k in zip(tr.events, kinds, strict=True) if k["kind"] == "zero")
         title = f"{mech.name}: the traced motion ({len(idx)} of {len(tr.points)} configurations)"
-        vnote = f"Continuation trace, status {tr.status}; red x: the zeros of DJ (singular configurations)."
+        vnote = f"Continuation trace, status {tr.message}; red x: the zeros of DJ (singular configurations)."
     if configs is None:
         try:
             configs = tuple(sample_motion(mech, n=48))
@@ -189,4 +192,4 @@ def model_section(mech: Mechanism, progress=lambda step: None, *, trace: bool = 
     intro = (f"{mech.description or mech.name}. Lengths in {unit}; angles in degrees in tables and plots."
              + ("\n\n" + "\n\n".join(notes) if notes else ""))
     return Section(f"model-{mech.name}", f"Model {mech.name}", intro, (), tuple(tables), tuple(figs), tuple(viewers),
-                   data=data)
+                   data=data, length_unit=mech.length_unit)

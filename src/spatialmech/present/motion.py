@@ -31,15 +31,16 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import ConvergenceError, InputError
+from ..geometry.validate import as_finite_array
 from ..kinematics.closure import (
     Configuration,
-    retract,
-    closure_scales,
     active_mask,
     closure_jacobian,
+    closure_scales,
     correct,
+    retract,
 )
-from ..geometry.validate import as_finite_array
 from ..model.mechanism import Mechanism
 
 __all__ = ["sample_motion", "tangent_space"]
@@ -77,7 +78,7 @@ def _initial_direction(N: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     U, sv, _ = np.linalg.svd(Np, full_matrices=False)
     moving = int(np.sum(sv > 1e-8))
     if moving == 0:
-        raise ValueError(
+        raise InputError(
             "mech: no motion of the closure manifold moves the platform (a structure, or only idle "
             "spins at this configuration); nothing to animate"
         )
@@ -98,7 +99,7 @@ def _walk(mech, start, t0, targets, active, col):
                 tt = N.T @ (N @ t)  # keep the direction: project the previous one
                 pn = float(np.linalg.norm(tt[-6:]))
                 if pn < 1e-6:
-                    raise RuntimeError(
+                    raise ConvergenceError(
                         f"sample_motion: the walk direction stopped moving the platform at s = {s:.4g} "
                         "(a singularity); use a smaller amplitude"
                     )
@@ -108,7 +109,7 @@ def _walk(mech, start, t0, targets, active, col):
                     break
                 ds /= 2.0
                 if abs(ds) < MIN_STEP:
-                    raise RuntimeError(
+                    raise ConvergenceError(
                         f"sample_motion: Newton correction did not converge at s = {s:.4g} "
                         f"(residual {res.residual:.2e}); use a smaller amplitude"
                     )
@@ -143,18 +144,18 @@ def sample_motion(
     first the reference and ``configs[1] is configs[3]`` (the loop runs out and back).
     """
     if not isinstance(mech, Mechanism):
-        raise ValueError(f"mech: expected a Mechanism, got {type(mech).__name__}")
+        raise InputError(f"mech: expected a Mechanism, got {type(mech).__name__}")
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 2:
-        raise ValueError(f"n: expected an integer number of frames >= 2, got {n!r}")
+        raise InputError(f"n: expected an integer number of frames >= 2, got {n!r}")
     amplitude = float(amplitude)
     if not np.isfinite(amplitude) or amplitude <= 0:
-        raise ValueError(f"amplitude: expected a positive finite number, got {amplitude!r}")
+        raise InputError(f"amplitude: expected a positive finite number, got {amplitude!r}")
     active = active_mask(mech)
     _, col = closure_scales(mech, active)
     if start is None:
         x0 = Configuration.reference(mech)
     elif not isinstance(start, Configuration):
-        raise ValueError(f"start: expected a Configuration, got {type(start).__name__}")
+        raise InputError(f"start: expected a Configuration, got {type(start).__name__}")
     else:
         x0 = Configuration(
             as_finite_array(start.q, "start.q", shape=(len(mech.freedom_refs),)),
@@ -162,7 +163,7 @@ def sample_motion(
         )
     res0 = correct(mech, x0, active=active)
     if not res0.converged:
-        raise ValueError(f"start: not on (or near) the closure manifold (residual {res0.residual:.2e})")
+        raise InputError(f"start: not on (or near) the closure manifold (residual {res0.residual:.2e})")
     x0 = res0.config
     t0 = _initial_direction(tangent_space(mech, x0, active=active), np.random.default_rng(seed))
 
@@ -172,8 +173,8 @@ def sample_motion(
     pos = np.unique(keys[keys > 0])  # increasing
     neg = np.unique(keys[keys < 0])[::-1]  # decreasing
     at = {0.0: x0}
-    at.update(zip(pos.tolist(), _walk(mech, x0, t0, amplitude * pos, active, col)))
-    at.update(zip(neg.tolist(), _walk(mech, x0, t0, amplitude * neg, active, col)))
+    at.update(zip(pos.tolist(), _walk(mech, x0, t0, amplitude * pos, active, col), strict=True))
+    at.update(zip(neg.tolist(), _walk(mech, x0, t0, amplitude * neg, active, col), strict=True))
     return [at[float(k)] for k in keys]
 
 
@@ -194,7 +195,7 @@ def traced_motion(mech: Mechanism, *, frames: int = 60, start: Configuration | N
         mon = (acts, f)
     tr = trace_motion(mech, start, increasing=acts[0] if acts else None, vector_monitor=mon, max_arc=400)
     if not tr.ok:
-        raise RuntimeError(f"the tracker stopped: {tr.status}")
+        raise ConvergenceError(f"the tracker stopped: {tr.message}")
     idx = np.unique(np.linspace(0, len(tr.points) - 1, min(frames, len(tr.points))).round().astype(int))
     configs = [tr.points[i] for i in idx]
     sing = tuple(e.x for e in tr.events if e.kind == "zero")

@@ -18,23 +18,24 @@ order, branch points along the path, the dual-drive plan, closeness to singulari
 
 from __future__ import annotations
 
+import tempfile
 
 import numpy as np
 
 from .. import catalog
-from ..analysis.mobility import mobility
 from ..analysis.defects import DJTable, defect_analysis
-from .defect_figures import write_defect_figures
+from ..analysis.mobility import mobility
+from ..results import Progress, Steps
 from . import figures as F
+from .defect_figures import write_defect_figures
 from .report import Claim, Section, Table, Viewer
 
-__all__ = ["section", "STEPS", "DRIVERS"]
+__all__ = ["DRIVERS", "STEPS", "section"]
 
 #: The ten drivers of paper A (aliases of the 5-CS models): rotation and slide of each C joint.
 DRIVERS = tuple(f"rot{i}" for i in range(1, 6)) + tuple(f"slide{i}" for i in range(1, 6))
 #: Progress steps announced by :func:`section`.
 STEPS = 12
-_TMP = __import__("tempfile").mkdtemp(prefix="spatialmech-paper-a-")
 #: Largest number of viewer frames taken from a traced circuit (evenly subsampled).
 VIEWER_FRAMES = 90
 
@@ -43,8 +44,9 @@ def _sign_text(t: DJTable, d: str) -> str:
     return "".join("+" if s > 0 else ("-" if s < 0 else "0") for s in t.signs[t.drivers.index(d)])
 
 
-def section(progress=lambda step: None) -> Section:
+def section(progress: Progress | None = None) -> Section:
     """Paper A's section of the demo report (see the module docstring)."""
+    progress = Steps(progress, STEPS)
     claims, tables, figs, viewers, data = [], [], [], [], {}
     tabs, res = {}, {}
     for k in (1, 2, 3):
@@ -82,7 +84,7 @@ def section(progress=lambda step: None) -> Section:
         f"{', '.join(f'P{i + 1}-P{i + 2}' for i in c5)}",
         "reproduced" if (c1, c5) == ([5], [2]) else "not reproduced",
         "located by the sign change between consecutive positions; the dual-drive plan itself is the defect analysis",
-        {"rot1_sign_changes_after": c1, "rot5_sign_changes_after": c5},
+        {"sign_changes_after": {"rot1": c1, "rot5": c5}},
         "tests/test_jacobian.py::test_paper_A_linkage1_every_driver_changes_sign_figs_6_7"))
     keep2 = [d for d in DRIVERS if t2.keeps_sign(d)]
     claims.append(Claim(
@@ -103,7 +105,7 @@ def section(progress=lambda step: None) -> Section:
     progress("paper A: DJ sign tables and pose fits")
     rows = []
     for k, t in tabs.items():
-        for P, f in zip(t.positions, t.fits):
+        for P, f in zip(t.positions, t.fits, strict=True):
             rows.append((f"five-cs-{k}", P, f.position_error, float(np.degrees(f.angle_error)), f.exact))
     tables.append(Table(
         "Printed task positions (table 9) fitted onto each linkage's closure", ("linkage", "position",
@@ -143,9 +145,11 @@ def section(progress=lambda step: None) -> Section:
     mech_by = {k: catalog.build(f"five-cs-{k}") for k in res}
     for k, r in res.items():
         progress(f"paper A: figures of five-cs-{k}")
-        for path in write_defect_figures(mech_by[k], r, _TMP):
-            cap = _caption(path.name, k, r)
-            figs.append(F.figure_from_file(path, f"paper_a_{path.name}", cap.split(":")[0] + ": " + cap.split(":")[1].split("(")[0].strip(), cap))
+        with tempfile.TemporaryDirectory(prefix="spatialmech-paper-a-") as tmp:  # read back at once, then removed
+            for path in write_defect_figures(mech_by[k], r, tmp):
+                cap = _caption(path.name, k, r)
+                figs.append(F.figure_from_file(path, f"paper_a_{path.name}",
+                                               cap.split(":")[0] + ": " + cap.split(":")[1].split("(")[0].strip(), cap))
     progress("paper A: 3-D viewer of linkage 1 along its circuit")
     tr = res[1].traces[0]
     idx = np.unique(np.linspace(0, len(tr.points) - 1, min(VIEWER_FRAMES, len(tr.points))).round().astype(int))
@@ -153,7 +157,7 @@ def section(progress=lambda step: None) -> Section:
     viewers.append(Viewer(
         "Paper A, linkage 1 along the traced circuit through P1", mech_by[1], tuple(tr.points[i] for i in idx),
         task_positions=mech_by[1].positions, singular_points=tuple(bps),
-        note=f"{len(idx)} of {len(tr.points)} traced configurations; red x: the DJ zeros (branch points) of rot1 and "
+        note=f"{len(idx)} of {len(tr.points)} traced configurations; red +: the DJ zeros (branch points) of rot1 and "
              "rot5 on the whole circuit; black diamonds: the printed task positions."))
 
     return Section(
@@ -166,7 +170,7 @@ def section(progress=lambda step: None) -> Section:
         "lengths in the paper's unit.",
         tuple(claims), tuple(tables), tuple(figs), tuple(viewers),
         pending=(),
-        data=data)
+        data=data, length_unit="unit")
 
 
 def _caption(fname: str, k: int, r) -> str:
@@ -199,14 +203,17 @@ def _defect_claims(res) -> list:
         "K2 in P6-P7, K1 in P3-P4",
         f"rot1 zeros between {k2}, rot5 zeros between {k1} (tracked, located to 1e-9 in arc)",
         "reproduced" if k2 == [(6, 7)] and k1 == [(3, 4)] else "not reproduced", "",
-        {"K2_arc": [b.arc for b in d1["rot1"].branch_points], "K1_arc": [b.arc for b in d1["rot5"].branch_points]},
+        {"branch_point_arcs": {"K2": [b.arc for b in d1["rot1"].branch_points],
+                               "K1": [b.arc for b in d1["rot5"].branch_points]}},
         "tests/test_defects.py::test_paper_A_linkage1_K2_of_rot1_between_P6_P7_and_K1_of_rot5_between_P3_P4"))
     plan = r1.plan or ()
     ok = [p.driver for p in plan] == ["rot1", "rot5"]
     out.append(Claim(
         "A", "Linkage 1: switching from rot1 to rot5 between K1 and K2 passes all positions (section 6, fig 14)",
         "rot1, then rot5, switching between K1 and K2",
-        "; ".join(f"{p.driver} arc {p.start_arc:.3f}..{p.end_arc:.3f}" + (f" (switch window {p.switch_window[0]:.3f}..{p.switch_window[1]:.3f})" if p.switch_window else "") for p in plan) or "no plan",
+        "; ".join(f"{p.driver} arc {p.start_arc:.3f}..{p.end_arc:.3f}"
+                  + (f" (switch window {p.switch_window[0]:.3f}..{p.switch_window[1]:.3f})" if p.switch_window else "")
+                  for p in plan) or "no plan",
         "reproduced" if ok else "not reproduced", "the plan is searched over all ten drivers; the switch window is (K1, K2)",
         {"plan": [p.to_dict() for p in plan]},
         "tests/test_defects.py::test_paper_A_linkage1_dual_drive_rot1_then_rot5_switching_between_K1_and_K2_fig_14"))
@@ -216,7 +223,7 @@ def _defect_claims(res) -> list:
         "reproduced" if r2.circuit_defect and r2.circuits == ((1,), (2, 3), (4, 5, 6, 7)) else "not reproduced",
         "conventions.md: {P1}, {P2, P3}, {P4..P7}; P5 is within 0.006 of P4's circuit and also near a fourth circuit "
         "(rounded data near a near-bifurcation): the fewest circuits holding every position are kept",
-        {"membership": list(r2.membership)},
+        {"membership": r2.to_dict()["membership"]},
         "tests/test_defects.py::test_paper_A_linkage2_circuit_defect_three_circuits_fig_10"))
     d3 = {v.driver: v for v in r3.drivers}
     out.append(Claim(
@@ -234,18 +241,20 @@ def _defect_claims(res) -> list:
         + (f" between P{b[0]} and P{b[1]}" if b else "") + f"; rot1's own {d3['rot1'].min_sigma_on_path:.2e}",
         "reproduced" if b == (3, 4) else "not reproduced",
         "reported as a robustness measure; the verdict is sensitive to the rounding of the data there",
-        {"min_closure_sigma": r3.min_closure_sigma}, "tests/test_defects.py::test_paper_A_linkage3_passes_close_to_a_singularity_between_P3_and_P4"))
+        {"min_closure_sigma_on_path": r3.min_closure_sigma},
+        "tests/test_defects.py::test_paper_A_linkage3_passes_close_to_a_singularity_between_P3_and_P4"))
     return out
 
 
 def _cs_dyad_claims():
     """Section 3 (eqs 22-26): the printed limbs are CS dyads of the seven positions, lie on the
     synthesised one-parameter family, and any five dyads make a 5-CS through the positions."""
+    from ..catalog.papers import five_cs_data, five_cs_positions
     from ..synthesis.cs_dyads import paper_a_check
 
-    c = paper_a_check()
+    c = paper_a_check(five_cs_positions(), five_cs_data()["linkages"])
     d = c.to_dict()
-    res = max(max(v) for v in d["printed_residuals"].values())
+    res = max(max(v) for v in d["printed_residuals_len"].values())
     proj = [p for ps in c.projections.values() for p in ps]
     dist = max(p.distance for p in proj)
     slide = max(p.slide_change for p in proj)
@@ -254,25 +263,26 @@ def _cs_dyad_claims():
     printed_max = [float(p.printed.max_abs_slide) for p in proj]
     out = [
         Claim("A", "The limbs of linkages 1-3 are CS dyads for the 7 positions (section 3, eqs 22-26)",
-              "each limb satisfies the dyad equations", f"largest residual of the 14 equations over the 15 printed limbs {res:.4f}",
+              "each limb satisfies the dyad equations",
+              f"largest residual of the 14 equations over the 15 printed limbs {res:.4f}",
               "reproduced" if res < 0.02 else "not reproduced",
               "the tables are printed to 3 decimals (conventions.md: link lengths vary by up to 0.01)",
-              {"printed_residuals": d["printed_residuals"]}, "tests/test_cs_dyads.py"),
+              {"printed_residuals_len": d["printed_residuals_len"]}, "tests/test_cs_dyads.py"),
         Claim("A", "The CS dyads for 7 positions form a one-parameter family (15 unknowns, 14 equations; section 3)",
               "a one-parameter infinity of dyads",
               f"a curve of dyads traced by continuation ({len(c.family.branches)} pieces); every printed limb lies "
               f"within {dist:.4f} of it and its slides are reproduced to {slide:.4f}",
               "reproduced" if dist < 0.01 else "not reproduced", "the Jacobian of the 14 equations has rank 14 along the family",
-              {"max_distance": dist, "max_slide_change": slide}, "tests/test_cs_dyads.py"),
+              {"max_distance_len": dist, "max_slide_change_len": slide}, "tests/test_cs_dyads.py"),
         Claim("A", "Any five dyads of the family form a 5-CS linkage guiding the body through the 7 positions (section 3)",
               "a 1-DOF 5-CS through P1..P7",
               f"five small-slide dyads assembled: pose errors <= {syn.max_pose_error:.1e}, mobility {syn.dof}",
               "reproduced" if syn.ok else "not reproduced", "checked by solving the assembled linkage's closure at the 7 poses",
-              {"position_errors": list(map(float, syn.position_errors)), "dof": syn.dof}, "tests/test_cs_dyads.py"),
+              {"position_errors_len": list(map(float, syn.position_errors)), "dof": syn.dof}, "tests/test_cs_dyads.py"),
         Claim("A", "Dyads with small slides can be chosen from the family (section 3)", "choose small slides",
               f"the five picks have max |slide| {', '.join(f'{x:.2f}' for x in picks)}; the printed limbs "
               f"{min(printed_max):.2f}..{max(printed_max):.2f}",
               "reproduced", "smallest max |slide| over the traced family, picks kept apart along it",
-              {"picks_max_abs_slide": picks}, "tests/test_cs_dyads.py"),
+              {"picks_max_abs_slide_len": picks}, "tests/test_cs_dyads.py"),
     ]
     return out, d

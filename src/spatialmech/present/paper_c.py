@@ -16,10 +16,11 @@ import numpy as np
 from .. import catalog
 from ..analysis.mobility import mobility_modes
 from ..catalog.papers import THREE_RRR_TABLE2, THREE_SPS_SMPU_MODES
+from ..results import Progress, Steps
 from . import figures as F
 from .report import Claim, Section, Table, Viewer
 
-__all__ = ["same_motion", "section", "STEPS"]
+__all__ = ["STEPS", "same_motion", "section"]
 
 #: Progress steps announced by :func:`section`.
 STEPS = 3
@@ -37,8 +38,9 @@ def _mobility_table(title: str, results) -> Table:
                        for r in results))
 
 
-def section(progress=lambda step: None) -> Section:
+def section(progress: Progress | None = None) -> Section:
     """Paper C's section of the demo report (see the module docstring)."""
+    progress = Steps(progress, STEPS)
     progress("paper C: mobility of the 3-RRR metamorphic joint (table 2)")
     rrr = catalog.build("three-rrr-sm")
     res = mobility_modes(rrr)
@@ -89,7 +91,7 @@ def section(progress=lambda step: None) -> Section:
         tuple(claims),
         (_mobility_table("3-RRR metamorphic joint: every mode", res),
          _mobility_table("3-SPS/SmPU: every mode", res2)),
-        (fig42,), viewers, data={"section_4_2": data42},
+        (fig42,), viewers, data={"section_4_2": data42}, length_unit="m",
     )
 
 
@@ -98,9 +100,9 @@ def _closed_form_claims():
     motion's actuator extremes."""
     from scipy.optimize import minimize_scalar
 
+    from ..geometry.rotations import transform
     from ..kinematics.closed_forms import spherical_rrr as srrr
     from ..kinematics.closure import Configuration, correct
-    from ..geometry.rotations import transform
 
     mech = catalog.build("three-rrr-sm").in_mode("R1+R4+R7")
     t = np.arange(0.0, 361.0, 5.0)
@@ -118,11 +120,13 @@ def _closed_form_claims():
                  f"equals the general inverse continued along the section 4.2 path to {err21:.1e} rad (73 poses)",
                  "reproduced after correction", "R = Ry(beta) Rx(alpha) Rz(gamma) ('YXZ'); atan2 with the branch "
                  "continuous from home (the printed arctan jumps to the theta + pi assembly when cos(alpha) cos(gamma) < 0)",
-                 {"max_error_rad": err21}, "tests/test_spherical_rrr.py::test_eq21_matches_general_inverse_along_the_section_42_path")]
+                 {"max_error_deg": float(np.degrees(err21))},
+                 "tests/test_spherical_rrr.py::test_eq21_matches_general_inverse_along_the_section_42_path")]
     a0 = np.array([0.3, -0.2, 0.4])
     J = srrr.euler_rate_jacobian(*a0)
     h = 1e-6
-    fd = np.stack([(srrr.actuator_angles(*(a0 + h * e)) - srrr.actuator_angles(*(a0 - h * e))) / (2 * h) for e in np.eye(3)], axis=-1)
+    fd = np.stack([(srrr.actuator_angles(*(a0 + h * e)) - srrr.actuator_angles(*(a0 - h * e))) / (2 * h) for e in np.eye(3)],
+                  axis=-1)
     err22 = float(np.max(np.abs(J - fd)))
     out.append(Claim("C", "Eq 22: the Jacobian of the inverse kinematics", "theta' = J Q'",
                      f"matches finite differences to {err22:.1e}", "reproduced",
@@ -141,7 +145,8 @@ def _closed_form_claims():
         vals = np.array([th(tt, k) for tt in grid])
         ext = []
         for sign, t0 in ((-1, grid[np.argmax(vals)]), (1, grid[np.argmin(vals)])):
-            r = minimize_scalar(lambda tt: sign * th(tt, k), bounds=(t0 - 2, t0 + 2), method="bounded", options={"xatol": 1e-8})
+            r = minimize_scalar(lambda tt, sign=sign, k=k: sign * th(tt, k), bounds=(t0 - 2, t0 + 2), method="bounded",
+                                options={"xatol": 1e-8})
             ext.append(th(r.x, k))
         found[k] = ext
     ok = all(abs(found[k][0] - expected[k][0]) < 0.01 and abs(found[k][1] - expected[k][1]) < 0.01 for k in expected)
@@ -160,4 +165,4 @@ def _closed_form_claims():
     png = F.to_png(fig, "paper_c_section_4_2.png", "Actuator angles along the section 4.2 motion",
                    "alpha = beta = gamma = (pi/6) sin(pi t / 180), R = Ry(beta) Rx(alpha) Rz(gamma); eq 21 with atan2, "
                    "branch continuous from home.")
-    return out, png, {"extremes_deg": found, "eq21_max_error_rad": err21, "eq22_max_fd_error": err22}
+    return out, png, {"extremes_deg": found, "eq21_max_error_deg": float(np.degrees(err21)), "eq22_max_fd_error": err22}

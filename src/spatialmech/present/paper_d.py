@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..results import Progress, Steps
 from ..synthesis.burmester import burmester_det, poles
 from ..synthesis.dyads import direction_residuals, rc_dyad_three_positions
 from ..synthesis.figures import write_all
@@ -27,7 +28,7 @@ from ..synthesis.tasks import get_task
 from . import figures as F
 from .report import Claim, Section, Table, Viewer
 
-__all__ = ["PAPER_M1", "PAPER_M2", "section", "STEPS"]
+__all__ = ["PAPER_M1", "PAPER_M2", "STEPS", "section"]
 
 #: Progress steps announced by :func:`section`.
 STEPS = 3
@@ -56,8 +57,9 @@ _FIGURES = {  # write_all's file -> (report file, title, caption)
 }
 
 
-def section(progress=lambda step: None) -> Section:
+def section(progress: Progress | None = None) -> Section:
     """Paper D's section of the demo report (see the module docstring)."""
+    progress = Steps(progress, STEPS)
     progress("paper D: Burmester curves, regions, RCCC synthesis")
     task = get_task("rccc-four-positions")
     res = synthesize_rccc(task)
@@ -71,10 +73,11 @@ def section(progress=lambda step: None) -> Section:
     claims = [Claim(
         "D", "The circle-point and center-point curves are cubic cones cut by the unit sphere (eqs 8-14); the "
         "poles lie on them", "cubic cones (figure)",
-        f"branches: {', '.join(f'{k} ({l:.3f} rad)' for k, l in zip(cur.kinds, cur.lengths))}; "
+        f"branches: {', '.join(f'{k} ({l:.3f} rad)' for k, l in zip(cur.kinds, cur.lengths, strict=True))}; "
         f"|det| on the samples <= {max(det_u, det_v):.1e}; the 6 poles and 6 image poles: |det| <= {pole_res:.1e}",
         "reproduced", "det B(u0) = 0 (circle points), det A(v) = 0 (center points), each sample Newton-projected",
-        {"kinds": list(cur.kinds), "lengths_rad": list(cur.lengths), "max_det_samples": max(det_u, det_v),
+        {"kinds": list(cur.kinds), "lengths_deg": [float(np.degrees(x)) for x in cur.lengths],
+         "max_det_samples": max(det_u, det_v),
          "max_det_poles": pole_res}, "tests/test_synthesis_burmester.py")]
 
     for label, ex, eq in (("m1", PAPER_M1, "28"), ("m2", PAPER_M2, "30")):
@@ -94,7 +97,7 @@ def section(progress=lambda step: None) -> Section:
             "not reproduced",
             f"residuals up to {worst:.2f}, far above the ~1e-3 that 3-decimal rounding explains; no convention tried "
             "(4,608) does better than 0.07. The method is reproduced on its own points instead",
-            {"residuals": resid, "degrees_off_circle_curve": off},
+            {"residuals": resid, "off_circle_curve_deg": off},
             "tests/test_synthesis_burmester.py::test_paper_example_directions_do_not_satisfy_the_direction_equations"))
 
     ch = res.check
@@ -105,7 +108,7 @@ def section(progress=lambda step: None) -> Section:
         f"Burmester curve and line (defect-free crank-rocker) {res.max_abs_slide:.3f} {unit} "
         f"(slides {', '.join(f'{s:+.3f}' for s in res.slides)} {unit})", "reproduced",
         "slides are affine along a solution line: 3 conditions, 1 parameter",
-        {"max_abs_slide": res.max_abs_slide, "slides": res.slides.tolist()},
+        {"max_abs_slide_len": res.max_abs_slide, "slides_len": res.slides.tolist()},
         "tests/test_synthesis_rccc.py"))
     t3 = task.subset([0, 1, 3])
     u = cur.u[len(cur.u) // 3]
@@ -115,7 +118,7 @@ def section(progress=lambda step: None) -> Section:
     claims.append(Claim(
         "D", "... and exact for three positions", "exact for three positions",
         f"positions 1, 2, 4 with a sampled u0: fixed slides {slide3:.1e} {unit}, direction residuals {dres3:.1e}",
-        "reproduced", "six linear equations for a chosen u0", {"max_slide": slide3, "max_direction_residual": dres3},
+        "reproduced", "six linear equations for a chosen u0", {"max_slide_len": slide3, "max_direction_residual": dres3},
         "tests/test_synthesis_dyads.py::test_rc_dyad_is_exact_for_three_positions"))
     claims.append(Claim(
         "D", "The synthesised RCCC guides the coupler through the four positions (approximately: RCCC)",
@@ -125,7 +128,7 @@ def section(progress=lambda step: None) -> Section:
         f"<= {np.degrees(ch.orientation_errors).max():.1e} deg",
         "reproduced" if bool(np.all(ch.converged)) else "not reproduced",
         "orientation exact by construction; the position errors are the price of the R joint",
-        {"position_errors": ch.position_errors.tolist(), "orientation_errors_deg": np.degrees(ch.orientation_errors).tolist(),
+        {"position_errors_len": ch.position_errors.tolist(), "orientation_errors_deg": np.degrees(ch.orientation_errors).tolist(),
          "type": res.linkage_type, "defects": res.defects}, "tests/test_synthesis_rccc.py"))
 
     progress("paper D: figures (curves, regions 1 and 2, solution lines, linkage)")
@@ -160,4 +163,6 @@ def section(progress=lambda step: None) -> Section:
         "shows the slide of the input C joint; an R joint replaces it where the slide is smallest. Orientations of "
         "table 1 by McCarthy's R = Rz(alpha) Ry(-beta) Rx(delta); lengths in mm (table 1 prints no unit).",
         tuple(claims), tables, tuple(figs), viewers,
-        data={"synthesis": {k: v for k, v in res.to_dict().items() if k != "linkage"}, "poles": pl})
+        data={"synthesis": {k: v for k, v in res.to_dict().items() if k != "linkage"},
+              "poles": {k: {"center_direction": v["center"], "circle_direction": v["circle"]} for k, v in pl.items()}},
+        length_unit=task.length_unit)

@@ -32,32 +32,35 @@ import importlib
 import json
 import sys
 import time
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable, Sequence
 
 import numpy as np
 
+from ..errors import InputError
+from ..results import Progress as ProgressCallback
+from ..results import Verdict, check_progress
 from ..serialize import json_default
-
 from .figures import ReportFigure
 
 __all__ = [
+    "DEMO_SECTIONS",
     "VERDICTS",
     "Claim",
+    "Progress",
+    "Section",
     "Table",
     "Viewer",
-    "Section",
-    "Progress",
-    "DEMO_SECTIONS",
     "build_demo",
     "build_model_report",
-    "write_report",
+    "join_names",
     "render_html",
+    "write_report",
 ]
 
-#: The three verdicts of a claim row.
-VERDICTS = ("reproduced", "reproduced after correction", "not reproduced")
+#: The three verdicts of a claim row (the values of :class:`~spatialmech.results.Verdict`).
+VERDICTS = tuple(v.value for v in Verdict)
 
 #: The sections of the demo report, in order: ``module:function`` in :mod:`spatialmech.present`,
 #: each ``function(progress) -> Section``.
@@ -70,6 +73,17 @@ DEMO_SECTIONS = (
 )
 
 
+def join_names(names, limit: int = 8) -> str:
+    """``"a, b, c"``; past ``limit`` names, ``"a, b, ... and 5 more"``: a list is shortened by whole
+    names, never cut inside one."""
+    names = [str(n) for n in names]
+    if limit < 1:
+        raise InputError(f"limit: expected a positive number of names, got {limit}")
+    if len(names) <= limit:
+        return ", ".join(names)
+    return ", ".join(names[:limit]) + f" and {len(names) - limit} more"
+
+
 @dataclass(frozen=True)
 class Claim:
     """One claim of a paper checked by the project.
@@ -78,20 +92,33 @@ class Claim:
     project's analysis gives (text with numbers and units); ``evidence``: the numbers behind
     ``ours`` (JSON-serialisable); ``note``: why it does (not) reproduce; ``test``: the test
     of the suite that asserts the same thing (``file::function``).
+
+    ``consistent``: the row's own cross-check, when it has one (``None``: none), e.g. measured
+    values against the closed forms quoted in ``note``; ``consistency`` says what was compared.
+    A row whose explanation and measured value disagree has ``consistent = False``: it is shown
+    as INCONSISTENT in the page, counted in the summary, and fails the test suite
+    (tests/test_regressions.py).
     """
 
     paper: str
     claim: str
     paper_value: str
     ours: str
-    verdict: str
+    verdict: Verdict
     note: str = ""
     evidence: dict = field(default_factory=dict)
     test: str = ""
+    consistent: bool | None = None
+    consistency: str = ""
 
     def __post_init__(self):
+        if self.consistent is not None and not isinstance(self.consistent, (bool, np.bool_)):
+            raise InputError(f"consistent: expected True, False or None, got {self.consistent!r}")
+        if self.consistent is not None:
+            object.__setattr__(self, "consistent", bool(self.consistent))
         if self.verdict not in VERDICTS:
-            raise ValueError(f"verdict: expected one of {VERDICTS}, got {self.verdict!r}")
+            raise InputError(f"verdict: expected one of {VERDICTS}, got {self.verdict!r}")
+        object.__setattr__(self, "verdict", Verdict(self.verdict))
 
     @property
     def reproduced(self) -> bool:
@@ -109,6 +136,8 @@ class Claim:
             "note": self.note,
             "evidence": self.evidence,
             "test": self.test,
+            "consistent": self.consistent,
+            "consistency": self.consistency,
         }
 
 
@@ -124,7 +153,7 @@ class Table:
     def __post_init__(self):
         for k, r in enumerate(self.rows):
             if len(r) != len(self.columns):
-                raise ValueError(f"rows[{k}]: expected {len(self.columns)} values ({', '.join(self.columns)}), got {len(r)}")
+                raise InputError(f"rows[{k}]: expected {len(self.columns)} values ({', '.join(self.columns)}), got {len(r)}")
 
     def to_dict(self) -> dict:
         return {"title": self.title, "columns": list(self.columns), "rows": [list(r) for r in self.rows], "note": self.note}
@@ -161,11 +190,15 @@ class Section:
     viewers: tuple[Viewer, ...] = ()
     pending: tuple[str, ...] = ()  # analyses of the paper not (yet) in the report
     data: dict = field(default_factory=dict)  # extra numbers (JSON-serialisable)
+    length_unit: str | None = None  # unit of the section's *_len fields (its model's or paper's; docs/json.md)
 
     def to_dict(self) -> dict:
+        """JSON (docs/json.md): the section's ``length_unit`` declares the unit of the ``*_len``
+        fields of its claims and data (a report spans models in different units)."""
         return {
             "key": self.key,
             "title": self.title,
+            "length_unit": self.length_unit,
             "intro": self.intro,
             "claims": [c.to_dict() for c in self.claims],
             "tables": [t.to_dict() for t in self.tables],
@@ -178,7 +211,9 @@ class Section:
 
 # ------------------------------------------------------------------------------ progress
 class Progress:
-    """Progress of a report on ``file`` (stderr): ``progress("label")`` announces the next step.
+    """Progress of a report on ``file`` (stderr), a :data:`spatialmech.results.Progress`
+    callback: ``progress(done, total, "label")`` announces step ``done`` (counted here when
+    ``done`` is ``None``).
 
     On a terminal: a bar over ``total`` steps with the current label; otherwise one line per
     step with the elapsed time.  ``enabled=False`` prints nothing.
@@ -197,8 +232,10 @@ class Progress:
     def elapsed(self) -> float:
         return time.perf_counter() - self.t0
 
-    def __call__(self, step: str) -> None:
-        self.count += 1
+    def __call__(self, done: float | None, total: float | None, step: str) -> None:
+        self.count = self.count + 1 if done is None else int(done)
+        if total is not None:
+            self.total = max(int(total), 1)
         if not self.enabled:
             return
         n = min(self.count, self.total)
@@ -232,7 +269,7 @@ table{border-collapse:collapse;margin:.6em 0 1.2em;font-size:13px}
 td,th{border:1px solid #ccc;padding:3px 7px;text-align:left;vertical-align:top}
 th{background:#f3f3f3} td.num{text-align:right;font-variant-numeric:tabular-nums}
 .v-reproduced{color:#176f2c;font-weight:bold} .v-corrected{color:#8a5a00;font-weight:bold}
-.v-not{color:#b3261e;font-weight:bold} .small{font-size:12px;color:#555}
+.v-not{color:#b3261e;font-weight:bold} .small{font-size:12px;color:#555} .bad{color:#b3261e;font-weight:bold;font-size:12px}
 code{background:#f5f5f5;padding:0 3px} figure{margin:1em 0} figure img{max-width:100%;border:1px solid #eee}
 figcaption{font-size:13px;color:#444} .pending{background:#fff8e1;padding:.4em .8em;border-left:3px solid #f0c36d}
 .viewer{border:1px solid #ddd;margin:1em 0}
@@ -271,6 +308,11 @@ def _claims_html(claims: Sequence[Claim]) -> str:
     rows = []
     for c in claims:
         test = f"<div class='small'>test: <code>{html.escape(c.test)}</code></div>" if c.test else ""
+        if c.consistent is False:
+            test += ("<div class='bad'>INCONSISTENT: the explanation and the measured values disagree "
+                     f"({html.escape(c.consistency)})</div>")
+        elif c.consistent:
+            test += f"<div class='small'>cross-checked: {html.escape(c.consistency)}</div>"
         rows.append(
             f"<tr><td>{html.escape(c.claim)}</td><td>{html.escape(c.paper_value)}</td><td>{html.escape(c.ours)}</td>"
             f"<td class='{_VERDICT_CLASS[c.verdict]}'>{html.escape(c.verdict)}</td><td>{html.escape(c.note)}{test}</td></tr>"
@@ -292,11 +334,13 @@ def _viewer_html(v: Viewer, div_id: str) -> str:
 
 def summary(sections: Sequence[Section]) -> dict:
     """Counts of the verdicts, overall and per section."""
-    out = {"claims": 0, **{v: 0 for v in VERDICTS}, "by_section": {}}
+    out = {"claims": 0, **dict.fromkeys(VERDICTS, 0), "inconsistent": 0, "by_section": {}}
     for s in sections:
         per = {v: sum(c.verdict == v for c in s.claims) for v in VERDICTS}
-        out["by_section"][s.key] = {"claims": len(s.claims), **per}
+        bad = sum(c.consistent is False for c in s.claims)
+        out["by_section"][s.key] = {"claims": len(s.claims), **per, "inconsistent": bad}
         out["claims"] += len(s.claims)
+        out["inconsistent"] += bad
         for v in VERDICTS:
             out[v] += per[v]
     return out
@@ -357,7 +401,7 @@ def write_report(out, title: str, sections: Sequence[Section], elapsed: float, e
     names = [f.name for sec in sections for f in sec.figures]
     dup = {n for n in names if names.count(n) > 1}
     if dup:
-        raise ValueError(f"figures: duplicate file names {sorted(dup)}")
+        raise InputError(f"figures: duplicate file names {sorted(dup)}")
     for sec in sections:
         for f in sec.figures:
             (out / "figures" / f.name).write_bytes(f.png)
@@ -379,30 +423,57 @@ def write_report(out, title: str, sections: Sequence[Section], elapsed: float, e
 
 
 # ------------------------------------------------------------------------------ entry points
-def build_demo(out, *, progress: bool = True, sections: Sequence[str] = DEMO_SECTIONS) -> dict:
+def _reporter(progress: bool | ProgressCallback | None, total: int, label: str):
+    """``(sink, bar)``: the callback the sections report to and the :class:`Progress` that times
+    the run (printing on stderr when ``progress`` is True; a callable gets every step too)."""
+    if progress is None or isinstance(progress, bool):
+        bar = Progress(total, enabled=bool(progress), label=label)
+        return bar, bar
+    user = check_progress(progress)
+    bar = Progress(total, enabled=False, label=label)
+
+    def sink(done, tot, message):
+        bar(done, tot, message)
+        user(done, tot, message)
+
+    return sink, bar
+
+
+def _offset(sink: ProgressCallback, start: int, total: int) -> ProgressCallback:
+    """A section's callback (steps 1..its STEPS) as steps ``start + 1 ..`` of the whole run."""
+    return lambda done, _total, message: sink(start + (done or 0), total, message)
+
+
+def build_demo(out, *, progress: bool | ProgressCallback = True, sections: Sequence[str] = DEMO_SECTIONS) -> dict:
     """Reproduce every paper's examples and write the report into ``out`` (see module docstring).
 
-    ``sections``: ``module:function`` specs (default :data:`DEMO_SECTIONS`).  Returns the data
-    written to ``results.json``.
+    ``sections``: ``module:function`` specs (default :data:`DEMO_SECTIONS`).  ``progress``: True
+    prints on stderr, False nothing; a :data:`~spatialmech.results.Progress` callback gets
+    ``(step, steps, message)``.  Returns the data written to ``results.json``.
     """
     fns = [_section_function(s) for s in sections]
-    bar = Progress(sum(n for _, n in fns), enabled=progress, label="spatialmech demo")
-    built = [fn(bar) for fn, _ in fns]
+    total = sum(n for _, n in fns)
+    sink, bar = _reporter(progress, total, "spatialmech demo")
+    built, start = [], 0
+    for fn, n in fns:
+        built.append(fn(_offset(sink, start, total)))
+        start += n
     data = write_report(out, "spatialmech reproduction report", built, bar.elapsed)
     bar.close()
     return data
 
 
-def build_model_report(model, out, *, progress: bool = True, trace: bool = True) -> dict:
+def build_model_report(model, out, *, progress: bool | ProgressCallback = True, trace: bool = True) -> dict:
     """Every analysis that applies to one model (ready-made name, TOML file or Mechanism),
     written like the demo into ``out`` (see :func:`.models.model_section`).  ``trace=False``
-    skips the continuation trace of a one-degree-of-freedom motion."""
+    skips the continuation trace of a one-degree-of-freedom motion; ``progress`` as in
+    :func:`build_demo`."""
     from .. import catalog
     from . import models
 
     mech = catalog.resolve(model)
-    bar = Progress(models.MODEL_STEPS, enabled=progress, label=f"spatialmech report {mech.name}")
-    sec = models.model_section(mech, bar, trace=trace)
+    sink, bar = _reporter(progress, models.MODEL_STEPS, f"spatialmech report {mech.name}")
+    sec = models.model_section(mech, sink, trace=trace)
     data = write_report(out, f"spatialmech report: {mech.name}", [sec], bar.elapsed, {"model": mech.name})
     bar.close()
     return data

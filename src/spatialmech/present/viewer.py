@@ -39,19 +39,20 @@ angles.  Example::
 from __future__ import annotations
 
 import html as _html
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Sequence
 
 import numpy as np
 import plotly.graph_objects as go
 from scipy.spatial import ConvexHull
 
+from ..errors import InputError
 from ..geometry.validate import as_finite_array
 from ..kinematics.closure import Configuration, joint_points, joint_twists
 from ..model.mechanism import Mechanism, Pose
 
-__all__ = ["Drawing", "ViewerFile", "drawing", "viewer_figure", "viewer_html", "write_viewer", "DIV_ID"]
+__all__ = ["DIV_ID", "SINGULAR_SYMBOL", "Drawing", "ViewerFile", "drawing", "viewer_figure", "viewer_html", "write_viewer"]
 
 #: ``id`` of the plotly graph ``<div>`` in the page (the browser test reads it).
 DIV_ID = "spatialmech-viewer"
@@ -65,6 +66,10 @@ FRAME_LEN = 0.3
 ARC_RADIUS0, ARC_RADIUS_STEP = 0.35, 0.2
 #: Joint centres closer than this fraction of the scale are "the same point".
 COINCIDENT = 1e-9
+#: Marker of the singular points.  plotly draws 3-D markers as text glyphs: "x" is U+274C, an
+#: emoji that shows as an empty box without an emoji font; "cross" is the ASCII "+", which every
+#: font has (the task positions' "diamond" is U+25C6, in the basic Geometric Shapes block).
+SINGULAR_SYMBOL = "cross"
 _PALETTE = ("#1f77b4", "#2ca02c", "#9467bd", "#8c564b", "#e377c2", "#17becf", "#bcbd22", "#7f7f7f")
 _FRAME_COLOURS = ("#d62728", "#2ca02c", "#1f77b4")  # platform frame x, y, z
 
@@ -96,16 +101,18 @@ class Drawing:
         return np.vstack(parts)
 
     def to_dict(self) -> dict:
+        """JSON (docs/json.md): points in the model's length unit (``*_len``); the platform
+        frame's columns are unit vectors."""
         return {
-            "limbs": [l.tolist() for l in self.limbs],
-            "base": self.base.tolist(),
-            "platform": self.platform.tolist(),
-            "axes": self.axes.tolist(),
-            "joints": self.joints.tolist(),
+            "limbs_len": [l.tolist() for l in self.limbs],
+            "base_len": self.base.tolist(),
+            "platform_len": self.platform.tolist(),
+            "axes_len": self.axes.tolist(),
+            "joints_len": self.joints.tolist(),
             "joint_names": list(self.joint_names),
-            "platform_point": self.platform_point.tolist(),
+            "platform_point_len": self.platform_point.tolist(),
             "platform_frame": self.platform_frame.tolist(),
-            "scale": self.scale,
+            "scale_len": float(self.scale),
         }
 
 
@@ -167,7 +174,7 @@ def _freedom_direction(kind: str, twist: np.ndarray) -> np.ndarray:
 
 def _check_config(mech: Mechanism, config, name: str) -> None:
     if not isinstance(config, Configuration):
-        raise ValueError(f"{name}: expected a Configuration, got {type(config).__name__}")
+        raise InputError(f"{name}: expected a Configuration, got {type(config).__name__}")
     as_finite_array(config.q, f"{name}.q", shape=(len(mech.freedom_refs),))
     as_finite_array(config.D, f"{name}.D", shape=(4, 4))
 
@@ -328,16 +335,16 @@ def viewer_figure(
     empty or mismatched ``configs`` and on NaN anywhere.
     """
     if not isinstance(mech, Mechanism):
-        raise ValueError(f"mech: expected a Mechanism, got {type(mech).__name__}")
+        raise InputError(f"mech: expected a Mechanism, got {type(mech).__name__}")
     configs = list(configs)
     if not configs:
-        raise ValueError("configs: at least one configuration is needed")
+        raise InputError("configs: at least one configuration is needed")
     for k, c in enumerate(configs):
         _check_config(mech, c, f"configs[{k}]")
     poses = list(task_positions)
     for k, pz in enumerate(poses):
         if not isinstance(pz, Pose):
-            raise ValueError(f"task_positions[{k}]: expected a Pose, got {type(pz).__name__}")
+            raise InputError(f"task_positions[{k}]: expected a Pose, got {type(pz).__name__}")
     sing = np.array([_singular_point(mech, x, k) for k, x in enumerate(singular_points)]).reshape(-1, 3)
 
     order = _platform_order(mech)
@@ -370,7 +377,7 @@ def viewer_figure(
             extra.append(segs.reshape(-1, 3))
     if len(sing):
         static.append(go.Scatter3d(**_xyz(sing), mode="markers", name="singular points",
-                                   marker=dict(size=6, color="#d62728", symbol="x")))
+                                   marker=dict(size=9, color="#d62728", symbol=SINGULAR_SYMBOL)))
         extra.append(sing)
 
     first = _animated(d0, fill)
@@ -383,7 +390,7 @@ def viewer_figure(
     centre, half = (lo + hi) / 2, max(float(np.max(hi - lo)) / 2 * 1.08, 1e-9 * s, 1e-12)
     unit = mech.length_unit
     scene = dict(aspectmode="cube")
-    for ax, c in zip("xyz", centre):
+    for ax, c in zip("xyz", centre, strict=True):
         scene[f"{ax}axis"] = dict(range=[c - half, c + half], title=f"{ax} [{unit}]", autorange=False)
 
     anim = dict(mode="immediate", frame=dict(duration=0, redraw=True), transition=dict(duration=0))

@@ -14,18 +14,45 @@ Quick example::
     ('crank-rocker', 0)
 """
 
-from .cs_dyads import CSDyad, CSFamily, assemble_5cs, check_5cs, paper_a_check, synthesize_cs
 from .burmester import BurmesterCurves, burmester_curves, center_point, circle_point, poles
+from .cs_dyads import CSDyad, CSFamily, assemble_5cs, check_5cs, paper_a_check, synthesize_cs
 from .dyads import Dyad, SolutionLine, direction_residuals, rc_dyad_three_positions, solution_line
 from .rccc import RCCCResult, assemble, check_linkage, interior_pick, synthesize_rccc
 from .regions import Region1, Region2, classify_spherical_4r, solution_region_1, solution_region_2
 from .tasks import TaskPositions, get_task, load_task, loads_task, mccarthy_matrix, resolve_task, task_names
 
 __all__ = [
-    "TaskPositions", "get_task", "load_task", "loads_task", "mccarthy_matrix", "resolve_task", "task_names",
-    "BurmesterCurves", "burmester_curves", "center_point", "circle_point", "poles",
-    "Dyad", "SolutionLine", "direction_residuals", "solution_line", "rc_dyad_three_positions",
-    "Region1", "Region2", "classify_spherical_4r", "solution_region_1", "solution_region_2",
-    "RCCCResult", "assemble", "check_linkage", "interior_pick", "synthesize_rccc",
-    "CSDyad", "CSFamily", "synthesize_cs", "assemble_5cs", "check_5cs", "paper_a_check",
+    "BurmesterCurves",
+    "CSDyad",
+    "CSFamily",
+    "Dyad",
+    "RCCCResult",
+    "Region1",
+    "Region2",
+    "SolutionLine",
+    "TaskPositions",
+    "assemble",
+    "assemble_5cs",
+    "burmester_curves",
+    "center_point",
+    "check_5cs",
+    "check_linkage",
+    "circle_point",
+    "classify_spherical_4r",
+    "direction_residuals",
+    "get_task",
+    "interior_pick",
+    "load_task",
+    "loads_task",
+    "mccarthy_matrix",
+    "paper_a_check",
+    "poles",
+    "rc_dyad_three_positions",
+    "resolve_task",
+    "solution_line",
+    "solution_region_1",
+    "solution_region_2",
+    "synthesize_cs",
+    "synthesize_rccc",
+    "task_names",
 ]

@@ -38,20 +38,21 @@ from itertools import combinations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from ..errors import ConvergenceError, InputError
 from .tasks import TaskPositions
 
 __all__ = [
-    "burmester_matrices",
-    "burmester_det",
-    "burmester_gradient",
-    "cubic_coefficients",
-    "project_to_curve",
-    "center_point",
-    "circle_point",
-    "poles",
+    "MONOMIALS",
     "BurmesterCurves",
     "burmester_curves",
-    "MONOMIALS",
+    "burmester_det",
+    "burmester_gradient",
+    "burmester_matrices",
+    "center_point",
+    "circle_point",
+    "cubic_coefficients",
+    "poles",
+    "project_to_curve",
 ]
 
 #: The monomials of the cubic (paper D eq 10's H1..H10 order, with eq 10's "H6 y^2" read as
@@ -69,17 +70,17 @@ def _rotations(task_or_C) -> np.ndarray:
     else:
         C = np.asarray(task_or_C, dtype=float)
     if C.shape != (3, 3, 3):
-        raise ValueError(f"C: expected three relative rotations (3, 3, 3), got {C.shape}")
+        raise InputError(f"C: expected three relative rotations (3, 3, 3), got {C.shape}")
     ang = np.linalg.norm(Rotation.from_matrix(C).as_rotvec(), axis=-1)
     for j in range(3):
         if ang[j] < 1e-9:
-            raise ValueError(
+            raise InputError(
                 f"positions[{j + 1}]: same orientation as position 1: the spherical Burmester"
                 " problem is degenerate (every direction is a solution)"
             )
     for j, k in combinations(range(3), 2):
         if np.linalg.norm(Rotation.from_matrix(C[k] @ C[j].T).as_rotvec()) < 1e-9:
-            raise ValueError(
+            raise InputError(
                 f"positions[{k + 1}]: same orientation as positions[{j + 1}]: the spherical"
                 " Burmester problem is degenerate"
             )
@@ -94,7 +95,7 @@ def burmester_matrices(task_or_C, kind: str = "circle") -> np.ndarray:
         return C - np.eye(3)
     if kind == "center":
         return np.swapaxes(C, -1, -2) - np.eye(3)
-    raise ValueError(f"kind: expected 'circle' or 'center', got {kind!r}")
+    raise InputError(f"kind: expected 'circle' or 'center', got {kind!r}")
 
 
 def _rows(K: np.ndarray, x: np.ndarray) -> np.ndarray:
@@ -170,7 +171,7 @@ def _null_of_rows(b: np.ndarray) -> np.ndarray:
     best = np.take_along_axis(cands, k[..., None, None], axis=-2)[..., 0, :]
     nb = np.take_along_axis(n, k[..., None], axis=-1)
     if np.any(nb < 1e-12):
-        raise ValueError("x: the direction equations have a pencil of solutions here (rank < 2)")
+        raise InputError("x: the direction equations have a pencil of solutions here (rank < 2)")
     return best / nb
 
 
@@ -266,7 +267,7 @@ def _trace(K: np.ndarray, x0: np.ndarray, h: float, max_steps: int = 20000):
             _, gy = _det_grad(K, y)
             ty = np.cross(y, gy)
             ty /= np.linalg.norm(ty)
-            if dist < 1.6 * step and abs(ty @ t) > 0.98 or step < 1e-6:
+            if (dist < 1.6 * step and abs(ty @ t) > 0.98) or step < 1e-6:
                 break
             step *= 0.5
         travelled += dist
@@ -279,7 +280,7 @@ def _trace(K: np.ndarray, x0: np.ndarray, h: float, max_steps: int = 20000):
             if np.linalg.norm(x + x0) < 1.01 * h:
                 return np.array(pts), "pseudo-line"
         pts.append(x)
-    raise RuntimeError("Burmester curve tracing did not close (increase max_steps)")
+    raise ConvergenceError("Burmester curve tracing did not close (increase max_steps)")
 
 
 def _resample(K: np.ndarray, poly: np.ndarray, kind: str, n: int):
@@ -331,7 +332,7 @@ class BurmesterCurves:
         for i, ti in enumerate(flat):
             b = int(np.floor(ti))
             if b < 0 or b >= self.n_branches:
-                raise ValueError(f"t: {ti} outside [0, {self.n_branches})")
+                raise InputError(f"t: {ti} outside [0, {self.n_branches})")
             sel = np.flatnonzero(self.branch == b)
             n = sel.size
             x = (ti - b) * n
@@ -345,7 +346,7 @@ class BurmesterCurves:
             U[i] = project_to_curve(self.K_circle, y / np.linalg.norm(y))
             vi = _null_of_rows(_rows(self.K_circle, U[i]))
             V[i] = vi if vi @ self.v[sel[k]] >= 0 else -vi
-        return U.reshape(t.shape + (3,)), V.reshape(t.shape + (3,))
+        return U.reshape((*t.shape, 3)), V.reshape((*t.shape, 3))
 
     def to_dict(self) -> dict:
         return {
@@ -354,9 +355,9 @@ class BurmesterCurves:
             "center_points": self.v.tolist(),
             "branch": self.branch.tolist(),
             "kinds": list(self.kinds),
-            "lengths_rad": list(self.lengths),
-            "circle_cubic": dict(zip(MONOMIALS, cubic_coefficients(self.K_circle).tolist())),
-            "center_cubic": dict(zip(MONOMIALS, cubic_coefficients(self.K_center).tolist())),
+            "lengths_deg": [float(np.degrees(v)) for v in self.lengths],
+            "circle_cubic": dict(zip(MONOMIALS, cubic_coefficients(self.K_circle).tolist(), strict=True)),
+            "center_cubic": dict(zip(MONOMIALS, cubic_coefficients(self.K_center).tolist(), strict=True)),
         }
 
 
@@ -371,7 +372,7 @@ def burmester_curves(
     satisfies ``|det B(u)| < 1e-12`` and every center point ``|det A(v)| < 1e-12``.
     """
     if samples < 8:
-        raise ValueError(f"samples: need at least 8 points per branch, got {samples}")
+        raise InputError(f"samples: need at least 8 points per branch, got {samples}")
     Kc = burmester_matrices(task_or_C, "circle")
     Kv = burmester_matrices(task_or_C, "center")
     seeds = _seeds(Kc, n_circles)
@@ -384,7 +385,7 @@ def burmester_curves(
         d = np.min(np.linalg.norm(remaining[:, None, :] - both[None, :, :], axis=-1), axis=1)
         remaining = remaining[d > 3 * step]
         if len(branches) > 4:
-            raise RuntimeError("Burmester curve: more than two branches traced (tracing failed)")
+            raise ConvergenceError("Burmester curve: more than two branches traced (tracing failed)")
     # pseudo-line first, then ovals by decreasing length
     branches.sort(key=lambda bk: (bk[1] != "pseudo-line", -len(bk[0])))
     us, ts, bs, kinds, lengths = [], [], [], [], []

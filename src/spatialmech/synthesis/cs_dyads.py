@@ -50,40 +50,46 @@ Example (paper A table 9)::
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Sequence
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy.optimize import least_squares, minimize_scalar
 
+from ..errors import InputError
 from ..geometry.rotations import inverse_transform, rotation_angle, transform
 from ..geometry.validate import as_finite_array, as_unit_vector
 from ..kinematics.tracking import EuclideanProblem, correct_on_hyperplane, track
 from ..model.joints import C as Cjoint
 from ..model.joints import S as Sjoint
 from ..model.mechanism import Limb, Mechanism, Pose
+from ..results import BranchEnd, Progress
+
+if TYPE_CHECKING:
+    from ..analysis.defects import DefectResult
 
 __all__ = [
     "N_POSITIONS",
-    "CSTask",
-    "CSDyad",
     "CSBranch",
+    "CSDyad",
     "CSFamily",
-    "Projection",
+    "CSTask",
     "FiveCSCheck",
     "PaperACheck",
-    "cs_task",
-    "dyad_residual",
-    "dyad_jacobian",
-    "dyad_from_limb",
-    "solve_dyad",
-    "project_dyad",
-    "synthesize_cs",
-    "trace_branch",
-    "pick_small_slides",
+    "Projection",
     "assemble_5cs",
     "check_5cs",
+    "cs_task",
+    "dyad_from_limb",
+    "dyad_jacobian",
+    "dyad_residual",
     "paper_a_check",
+    "pick_small_slides",
+    "project_dyad",
+    "solve_dyad",
+    "synthesize_cs",
+    "trace_branch",
 ]
 
 #: Number of task positions of the method (15 unknowns, 14 equations).
@@ -136,12 +142,12 @@ class CSTask:
     def to_dict(self) -> dict:
         return {
             "positions": [
-                {"name": P.name, "point": P.p.tolist(),
+                {"name": P.name, "point_len": P.p.tolist(),
                  "rotation_vector_deg": np.degrees(_rotvec(P.R)).tolist()}
                 for P in self.poses
             ],
-            "scale": self.scale,
-            "centre": self.centre.tolist(),
+            "scale_len": self.scale,
+            "centre_len": self.centre.tolist(),
         }
 
 
@@ -158,13 +164,13 @@ def cs_task(task_poses: Sequence[Pose] | CSTask) -> CSTask:
         return task_poses
     poses = tuple(task_poses)
     if len(poses) != N_POSITIONS:
-        raise ValueError(
+        raise InputError(
             f"task_poses: seven-position CS synthesis needs exactly {N_POSITIONS} poses, got {len(poses)}"
             " (fewer leave a surface of dyads, more leave finitely many or none)"
         )
     for j, P in enumerate(poses):
         if not isinstance(P, Pose):
-            raise ValueError(f"task_poses[{j}]: expected a Pose, got {type(P).__name__}")
+            raise InputError(f"task_poses[{j}]: expected a Pose, got {type(P).__name__}")
     T = np.array([transform(P.R, P.p) for P in poses])
     T1inv = inverse_transform(T[0])
     D = T @ T1inv
@@ -173,7 +179,7 @@ def cs_task(task_poses: Sequence[Pose] | CSTask) -> CSTask:
     scale = float(np.sqrt(np.mean(np.sum((pts - centre) ** 2, axis=1))))
     rot = max(float(rotation_angle(P.R @ poses[0].R.T)) for P in poses)
     if scale < 1e-12 and rot < 1e-12:
-        raise ValueError("task_poses: all seven poses coincide")
+        raise InputError("task_poses: all seven poses coincide")
     if scale < 1e-12:
         scale = 1.0
     return CSTask(poses, D, centre, scale)
@@ -187,7 +193,7 @@ def _split(x: np.ndarray):
 def _link_vectors(x: np.ndarray, D: np.ndarray):
     """``d_j = M_j - B_j`` for every position: shape (..., 7, 3), and the slides (..., 7)."""
     B1, M1, u, s = _split(x)
-    s_all = np.concatenate([np.zeros(s.shape[:-1] + (1,)), s], axis=-1)
+    s_all = np.concatenate([np.zeros((*s.shape[:-1], 1)), s], axis=-1)
     Mj = np.einsum("jab,...b->...ja", D[:, :3, :3], M1) + D[:, :3, 3]
     d = Mj - B1[..., None, :] - s_all[..., :, None] * u[..., None, :]
     return d, s_all
@@ -220,7 +226,7 @@ def dyad_jacobian(x, D) -> np.ndarray:
     u = x[..., 6:9]
     R = D[:, :3, :3]
     lead = x.shape[:-1]
-    J = np.zeros(lead + (_NF, _NX))
+    J = np.zeros((*lead, _NF, _NX))
     # derivatives of d_j: dM1 -> R_j, dB1 -> -I, du -> -s_j I, ds_j -> -u (j >= 2)
     gM = 2 * np.einsum("...ja,jab->...jb", d, R)  # grad of |d_j|^2 wrt M1
     gB = -2 * d
@@ -265,19 +271,21 @@ class CSDyad:
         """``x = (B1, M1, u, s2..s7)`` in the task's length unit."""
         return np.r_[self.B1, self.M1, self.u, self.slides[1:]]
 
-    def flipped(self) -> "CSDyad":
+    def flipped(self) -> CSDyad:
         """The same dyad with ``u -> -u`` (slides change sign)."""
         return CSDyad(-self.u, self.B1, self.M1, -self.slides, self.link_length, self.residual)
 
     def to_dict(self) -> dict:
+        """JSON (docs/json.md): ``u`` unit direction; ``B1_len``, ``M1_len``, the link length,
+        slides and ``residual_len`` (largest error of eqs 24-25, a length) in the task unit."""
         return {
             "u": self.u.tolist(),
-            "B1": self.B1.tolist(),
-            "M1": self.M1.tolist(),
-            "link_length": self.link_length,
-            "slides": self.slides.tolist(),
-            "max_abs_slide": self.max_abs_slide,
-            "residual": self.residual,
+            "B1_len": self.B1.tolist(),
+            "M1_len": self.M1.tolist(),
+            "link_length_len": float(self.link_length),
+            "slides_len": self.slides.tolist(),
+            "max_abs_slide_len": self.max_abs_slide,
+            "residual_len": float(self.residual),
         }
 
 
@@ -327,7 +335,7 @@ def dyad_from_limb(task_poses, u, B1, M1, slides=None) -> CSDyad:
         if s.shape == (6,):
             s = np.r_[0.0, s]
         if s.shape != (7,):
-            raise ValueError(f"slides: expected 7 values (s1..s7) or 6 (s2..s7), got shape {s.shape}")
+            raise InputError(f"slides: expected 7 values (s1..s7) or 6 (s2..s7), got shape {s.shape}")
     return _dyad(task, np.r_[B1, M1, u, s[1:]])
 
 
@@ -409,13 +417,13 @@ class CSBranch:
 
     ``points``: (K, 15) dyads ``x = (B1, M1, u, s2..s7)`` in the task unit; ``arc``: (K,)
     nondimensional arc length along the curve; ``closed``: the branch is a loop; ``ends``: why
-    tracking stopped at each end ("closed", "left the box", "h_min: ..." = a singular point,
-    "max_arc")."""
+    tracking stopped at each end (:class:`~spatialmech.results.BranchEnd`: "closed", "left the
+    box", "h_min" = a singular point of the family, "max_arc")."""
 
     points: np.ndarray
     arc: np.ndarray
     closed: bool
-    ends: tuple[str, str]
+    ends: tuple[BranchEnd, BranchEnd]
     residual: float  # largest nondimensional residual over the points
 
     @property
@@ -440,15 +448,15 @@ class CSBranch:
         return {
             "closed": self.closed,
             "ends": list(self.ends),
-            "n_points": int(len(self.arc)),
+            "n_points": len(self.arc),
             "arc_length": float(self.arc[-1] - self.arc[0]),
             "residual": self.residual,
-            "min_max_abs_slide": float(np.min(self.max_abs_slide)),
+            "min_max_abs_slide_len": float(np.min(self.max_abs_slide)),
             "points": [
-                {"arc": float(self.arc[i]), "u": p[6:9].tolist(), "B1": p[0:3].tolist(), "M1": p[3:6].tolist(),
-                 "link_length": float(np.linalg.norm(p[3:6] - p[0:3])),
-                 "slides": [0.0] + p[9:15].tolist(), "max_abs_slide": float(np.max(np.abs(p[9:15])))}
-                for i, p in zip(idx, P)
+                {"arc": float(self.arc[i]), "u": p[6:9].tolist(), "B1_len": p[0:3].tolist(), "M1_len": p[3:6].tolist(),
+                 "link_length_len": float(np.linalg.norm(p[3:6] - p[0:3])),
+                 "slides_len": [0.0, *p[9:15].tolist()], "max_abs_slide_len": float(np.max(np.abs(p[9:15])))}
+                for i, p in zip(idx, P, strict=True)
             ],
         }
 
@@ -483,14 +491,14 @@ class CSFamily:
         total = sum(float(b.arc[-1] - b.arc[0]) for b in self.branches) or 1.0
         brs = []
         for b in self.branches:
-            n = None if samples is None else max(2, int(round(samples * float(b.arc[-1] - b.arc[0]) / total)))
+            n = None if samples is None else max(2, round(samples * float(b.arc[-1] - b.arc[0]) / total))
             brs.append(b.to_dict(n))
         return {
             "method": "paper A eqs 22-26: 15 unknowns (B1, M1, u, s2..s7), 14 equations -> a curve of dyads",
             "task": self.task.to_dict(),
-            "length_unit": "task unit",
             "extent": self.extent,
-            "starts": dict(self.starts),
+            "starts": {{"tried": "n_tried", "converged": "n_converged", "new_branches": "n_new_branches"}.get(k, k): v
+                       for k, v in self.starts.items()},
             "n_branches": len(self.branches),
             "branches": brs,
             "picks": [p.to_dict() for p in self.picks],
@@ -506,18 +514,18 @@ def _trace(prob, y0, *, h_max, max_arc, box):
     t0 = prob.tangent(y0)
     fwd = track(prob, y0, direction=t0, **kw)
 
-    def why(r):
+    def why(r) -> BranchEnd:
         if r.status == "stopped":
-            return "left the box"
-        return r.status
+            return BranchEnd.LEFT_BOX
+        return BranchEnd(r.status)
 
     if fwd.closed:
         P = np.array(fwd.points)
-        return P, np.asarray(fwd.s), True, ("closed", "closed")
+        return P, np.asarray(fwd.s), True, (BranchEnd.CLOSED, BranchEnd.CLOSED)
     bwd = track(prob, y0, direction=-t0, **kw)
     if bwd.closed:  # unlikely: closing only in one sense
         P = np.array(bwd.points)
-        return P[::-1], -np.asarray(bwd.s)[::-1], True, ("closed", "closed")
+        return P[::-1], -np.asarray(bwd.s)[::-1], True, (BranchEnd.CLOSED, BranchEnd.CLOSED)
     P = np.concatenate([np.array(bwd.points)[::-1], np.array(fwd.points)[1:]])
     s = np.concatenate([-np.asarray(bwd.s)[::-1], np.asarray(fwd.s)[1:]])
     return P, s, False, (why(bwd), why(fwd))
@@ -531,7 +539,7 @@ def trace_branch(task_poses, dyad: CSDyad, *, extent: float = 8.0, h_max: float 
     task = cs_task(task_poses)
     y, ok, rn = solve_dyad(task, _to_nondim(task, dyad.vector), nondimensional=True)
     if not ok:
-        raise ValueError(f"dyad: least squares from it did not reach the family (residual {rn:.3g})")
+        raise InputError(f"dyad: least squares from it did not reach the family (residual {rn:.3g})")
     P, s, closed, ends = _trace(_problem(task), y, h_max=h_max, max_arc=max_arc, box=extent)
     res = float(np.max(np.linalg.norm(dyad_residual(P, task.nondim_D()), axis=-1)))
     return CSBranch(_to_phys(task, P), s - s[0], closed, ends, res)
@@ -562,12 +570,12 @@ def synthesize_cs(
     """
     task = cs_task(task_poses)
     if not (isinstance(n_starts, (int, np.integer)) and n_starts >= 1):
-        raise ValueError(f"n_starts: expected a positive integer, got {n_starts!r}")
+        raise InputError(f"n_starts: expected a positive integer, got {n_starts!r}")
     if not (isinstance(pick, (int, np.integer)) and pick >= 0):
-        raise ValueError(f"pick: expected a non-negative integer, got {pick!r}")
+        raise InputError(f"pick: expected a non-negative integer, got {pick!r}")
     for nm, v in (("extent", extent), ("h_max", h_max), ("max_arc", max_arc)):
         if not (np.isfinite(v) and v > 0):
-            raise ValueError(f"{nm}: expected a positive finite number, got {v!r}")
+            raise InputError(f"{nm}: expected a positive finite number, got {v!r}")
     rng = np.random.default_rng(seed)
     prob = _problem(task)
     branches_nd: list[tuple] = []
@@ -583,7 +591,7 @@ def synthesize_cs(
         new += 1
         branches_nd.append(_trace(prob, y, h_max=h_max, max_arc=max_arc, box=extent))
     if not branches_nd:
-        raise ValueError(f"task_poses: no CS dyad found from {n_starts} random starts (seed {seed}) within extent {extent}")
+        raise InputError(f"task_poses: no CS dyad found from {n_starts} random starts (seed {seed}) within extent {extent}")
     branches = []
     for P, s, closed, ends in branches_nd:
         res = float(np.max(np.linalg.norm(dyad_residual(P, task.nondim_D()), axis=-1)))
@@ -626,9 +634,9 @@ def pick_small_slides(family: CSFamily, n: int = 5, *, separation: float = 1.0) 
     Each picked ``u`` has its largest component positive (the same dyad as ``-u``, ``-s``).
     """
     if not (isinstance(n, (int, np.integer)) and n >= 0):
-        raise ValueError(f"n: expected a non-negative integer, got {n!r}")
+        raise InputError(f"n: expected a non-negative integer, got {n!r}")
     if not (np.isfinite(separation) and separation >= 0):
-        raise ValueError(f"separation: expected a non-negative number, got {separation!r}")
+        raise InputError(f"separation: expected a non-negative number, got {separation!r}")
     task = family.task
     prob = _problem(task)
     minima, others = [], []
@@ -683,12 +691,12 @@ class Projection:
         return {
             "printed": self.printed.to_dict(),
             "fitted": self.fitted.to_dict(),
-            "distance": self.distance,
-            "B1_change": self.B1_change,
-            "M1_change": self.M1_change,
+            "distance_len": self.distance,
+            "B1_change_len": self.B1_change,
+            "M1_change_len": self.M1_change,
             "axis_change_deg": self.axis_change_deg,
-            "slide_change": self.slide_change,
-            "link_length_change": self.link_length_change,
+            "slide_change_len": self.slide_change,
+            "link_length_change_len": self.link_length_change,
             "converged": self.converged,
         }
 
@@ -730,7 +738,9 @@ def project_dyad(task_poses, dyad: CSDyad, *, max_iter: int = 100) -> Projection
 
 
 # ------------------------------------------------------------------------------ 5-CS linkages
-def assemble_5cs(task_poses, dyads: Sequence[CSDyad], *, name: str = "five-cs-synthesised", length_unit: str = "unit") -> Mechanism:
+def assemble_5cs(
+    task_poses, dyads: Sequence[CSDyad], *, name: str = "five-cs-synthesised", length_unit: str = "unit"
+) -> Mechanism:
     """The 5-CS linkage of five dyads, built exactly like :func:`spatialmech.catalog.papers.five_cs`:
     limbs ``limb1..limb5`` = [C ``C{i}`` (axis ``u``, point ``B1``), S ``S{i}`` at ``M1``], the
     rotation of C1 actuated, aliases ``rot{i}``/``slide{i}``; ``platform_point`` = the task
@@ -739,11 +749,11 @@ def assemble_5cs(task_poses, dyads: Sequence[CSDyad], *, name: str = "five-cs-sy
     task = cs_task(task_poses)
     dyads = tuple(dyads)
     if len(dyads) != 5:
-        raise ValueError(f"dyads: a 5-CS linkage needs exactly 5 dyads, got {len(dyads)}")
+        raise InputError(f"dyads: a 5-CS linkage needs exactly 5 dyads, got {len(dyads)}")
     limbs, aliases = [], {}
     for i, dy in enumerate(dyads):
         if not isinstance(dy, CSDyad):
-            raise ValueError(f"dyads[{i}]: expected a CSDyad, got {type(dy).__name__}")
+            raise InputError(f"dyads[{i}]: expected a CSDyad, got {type(dy).__name__}")
         limbs.append(Limb(f"limb{i + 1}", (
             Cjoint(f"C{i + 1}", dy.B1, dy.u, normalize=True, actuated=["rot"] if i == 0 else False),
             Sjoint(f"S{i + 1}", dy.M1),
@@ -780,6 +790,7 @@ class FiveCSCheck:
     slide_errors: np.ndarray | None
     dof: int
     dof_instantaneous: int
+    defects: DefectResult | None = None  # the defect analysis of the linkage (None: not run)
 
     @property
     def max_pose_error(self) -> float:
@@ -787,20 +798,69 @@ class FiveCSCheck:
 
     @property
     def ok(self) -> bool:
+        """The linkage closes exactly at every position and has one degree of freedom (it need
+        not be able to *move* through them: see :attr:`success`)."""
         return bool(np.all(self.exact) and self.dof == 1 and self.dof_instantaneous == 1)
+
+    @property
+    def usable_drivers(self) -> tuple[str, ...]:
+        """Drivers that move the linkage from the first to the last position in order, without a
+        circuit, order or branch defect (empty when the defects were not analysed)."""
+        return tuple(self.defects.usable_drivers) if self.defects is not None else ()
+
+    @property
+    def success(self) -> bool:
+        """:attr:`ok` and defect-free for at least one driver (the defect analysis must have run)."""
+        return self.ok and bool(self.usable_drivers)
+
+    def verdict(self) -> str:
+        """What the check found, in one plain sentence."""
+        if not np.all(self.exact):
+            bad = [f"P{j + 1}" for j, e in enumerate(self.exact) if not e]
+            return f"not a solution: the linkage does not reach {', '.join(bad)} exactly"
+        if self.dof != 1 or self.dof_instantaneous != 1:
+            return f"not a guidance linkage: mobility {self.dof} (instantaneous {self.dof_instantaneous}) instead of 1"
+        d = self.defects
+        if d is None:
+            return "closes at every position with one degree of freedom; defects NOT analysed, so not known to be usable"
+        if self.usable_drivers:
+            return (f"success: defect-free when driven by {', '.join(self.usable_drivers)} (no circuit, order or "
+                    "branch defect)")
+        problems = []
+        if d.circuit_defect:
+            circ = "; ".join("{" + ", ".join(f"P{i}" for i in c) + "}" for c in d.circuits)
+            problems.append(f"circuit defect: the positions lie on {len(d.circuits)} separate circuits ({circ}), so no "
+                            "driver can move the linkage through all of them")
+        if d.order_defect:
+            problems.append("order defect: along the circuit the positions are met in the order "
+                            + ", ".join(f"P{i}" for i in d.order))
+        if not problems:
+            branch = [v.driver for v in d.drivers if v.branch_defect]
+            problems.append(f"branch defect for every driver ({', '.join(branch) or 'none usable'})"
+                            + (": a plan switching drivers along the path exists" if d.plan else ""))
+        return "FAILED: " + "; ".join(problems)
 
     def to_dict(self) -> dict:
         return {
-            "position_errors": self.position_errors.tolist(),
+            "position_errors_len": self.position_errors.tolist(),
             "angle_errors_deg": np.degrees(self.angle_errors).tolist(),
             "ik_residuals": self.ik_residuals.tolist(),
             "exact": self.exact.tolist(),
             "converged": self.converged.tolist(),
-            "slides": self.slides.tolist(),
-            "max_slide_error": None if self.slide_errors is None else float(np.max(np.abs(self.slide_errors))),
+            "slides_len": self.slides.tolist(),
+            "max_slide_error_len": None if self.slide_errors is None else float(np.max(np.abs(self.slide_errors))),
             "dof": self.dof,
             "dof_instantaneous": self.dof_instantaneous,
             "ok": self.ok,
+            "defects_analysed": self.defects is not None,
+            "circuit_defect": None if self.defects is None else bool(self.defects.circuit_defect),
+            "order_defect": None if self.defects is None else bool(self.defects.order_defect),
+            "branch_defect_drivers": None if self.defects is None else [v.driver for v in self.defects.drivers
+                                                                         if v.branch_defect],
+            "usable_drivers": list(self.usable_drivers),
+            "success": self.success,
+            "verdict": self.verdict(),
+            "defects": None if self.defects is None else self.defects.to_dict(),
         }
 
 
@@ -833,14 +893,19 @@ def _cs_start(mech: Mechanism, pose: Pose):
     return Configuration(np.array(q), D)
 
 
-def check_5cs(mech: Mechanism, dyads: Sequence[CSDyad] | None = None) -> FiveCSCheck:
+def check_5cs(mech: Mechanism, dyads: Sequence[CSDyad] | None = None, *, defects: bool = False,
+              progress: Progress | None = None) -> FiveCSCheck:
     """Solve ``mech`` (from :func:`assemble_5cs` or the catalog) at each of its positions and
-    compute its mobility (see :class:`FiveCSCheck`)."""
+    compute its mobility (see :class:`FiveCSCheck`).  ``defects=True`` also runs the defect
+    analysis (:func:`spatialmech.analysis.defects.defect_analysis`: circuits, order, branch
+    points for every candidate driver; about a minute) when the linkage closes with one degree
+    of freedom: a synthesised linkage is a success only if it is defect-free for at least one
+    driver (:attr:`FiveCSCheck.success`)."""
     from ..analysis.mobility import mobility
     from ..kinematics.position import configuration_at_pose, freedom_values
 
     if not mech.positions:
-        raise ValueError(f"mech: {mech.name} has no task positions to check")
+        raise InputError(f"mech: {mech.name} has no task positions to check")
     ids = [r.id for r in mech.freedom_refs]
     sl_idx = [ids.index(f"{lb.joints[0].name}.slide") for lb in mech.limbs]
     pe, ae, ik, ex, cv, sl = [], [], [], [], [], []
@@ -857,8 +922,13 @@ def check_5cs(mech: Mechanism, dyads: Sequence[CSDyad] | None = None) -> FiveCSC
     if dyads is not None:
         errs = sl - np.array([d.slides for d in dyads]).T
     mob = mobility(mech)
-    return FiveCSCheck(np.array(pe), np.array(ae), np.array(ik), np.array(ex), np.array(cv), sl, errs, int(mob.dof),
-                       int(mob.dof_instantaneous))
+    out = FiveCSCheck(np.array(pe), np.array(ae), np.array(ik), np.array(ex), np.array(cv), sl, errs, int(mob.dof),
+                      int(mob.dof_instantaneous))
+    if defects and out.ok:
+        from ..analysis.defects import defect_analysis
+
+        out = replace(out, defects=defect_analysis(mech, progress=progress))
+    return out
 
 
 # ------------------------------------------------------------------------------ paper A claims
@@ -880,7 +950,7 @@ class PaperACheck:
 
     def to_dict(self) -> dict:
         return {
-            "printed_residuals": {k: [d.residual for d in v] for k, v in self.printed.items()},
+            "printed_residuals_len": {k: [d.residual for d in v] for k, v in self.printed.items()},
             "projections": {k: [p.to_dict() for p in v] for k, v in self.projections.items()},
             "refitted": {k: v.to_dict() for k, v in self.refitted.items()},
             "family": self.family.to_dict(samples=20),
@@ -888,15 +958,17 @@ class PaperACheck:
         }
 
 
-def paper_a_check(*, n_starts: int = 60, seed: int = 0, refit: bool = True,
+def paper_a_check(positions, linkages: dict, *, n_starts: int = 60, seed: int = 0, refit: bool = True,
                   family: CSFamily | None = None) -> PaperACheck:
-    """Everything needed for paper A's section 3 claims (see :class:`PaperACheck`); ``family``:
-    a family of table 9 already synthesised with five picks (else it is synthesised here)."""
-    from ..catalog.papers import five_cs_data, five_cs_positions
-
-    poses = five_cs_positions()
-    task = cs_task(poses)
-    data = five_cs_data()["linkages"]
+    """Everything needed for paper A's section 3 claims (see :class:`PaperACheck`) on the data
+    given: ``positions`` (table 9) and ``linkages`` (tables 1-13 by linkage number: ``u``,
+    ``B1``, ``M_by_position``, ``s`` per limb; the catalogue's ``five_cs_data()["linkages"]``);
+    ``family``: a family of table 9 already synthesised with five picks (else it is synthesised
+    here).  The data are passed in: the numerical core does not read the catalogue."""
+    task = cs_task(positions)
+    data = linkages
+    if not isinstance(data, dict) or not data:
+        raise InputError(f"linkages: expected the paper's linkages by number, got {type(data).__name__}")
     printed, proj, refitted = {}, {}, {}
     for k in sorted(data):
         lk = data[k]
@@ -910,6 +982,6 @@ def paper_a_check(*, n_starts: int = 60, seed: int = 0, refit: bool = True,
             refitted[k] = check_5cs(assemble_5cs(task, fitted, name=f"five-cs-{k}-refitted"), fitted)
     fam = family if family is not None else synthesize_cs(task, n_starts=n_starts, seed=seed, pick=5)
     if len(fam.picks) != 5:
-        raise ValueError(f"family: expected 5 picked dyads, got {len(fam.picks)}")
+        raise InputError(f"family: expected 5 picked dyads, got {len(fam.picks)}")
     synth = check_5cs(assemble_5cs(task, fam.picks), fam.picks)
     return PaperACheck(printed, proj, refitted, fam, synth)

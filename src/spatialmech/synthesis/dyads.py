@@ -38,20 +38,22 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import InputError
 from ..geometry.rotations import skew
 from ..geometry.validate import as_unit_vector
 from .tasks import TaskPositions
 
 __all__ = [
+    "DIRECTION_ATOL",
     "Dyad",
     "SolutionLine",
     "direction_residuals",
+    "dyad_joint_values",
+    "minimax",
     "moment_equations",
+    "rc_dyad_three_positions",
     "slide_equations",
     "solution_line",
-    "rc_dyad_three_positions",
-    "dyad_joint_values",
-    "DIRECTION_ATOL",
 ]
 
 #: Largest direction-equation residual accepted when building a solution line.
@@ -100,7 +102,7 @@ def slide_equations(task: TaskPositions, u, v) -> tuple[np.ndarray, np.ndarray]:
     v = _unit(v, "v")
     b = float(u @ v)
     if 1 - b * b < 1e-14:
-        raise ValueError("u, v: parallel axes have no common normal (use a P/planar model)")
+        raise InputError("u, v: parallel axes have no common normal (use a P/planar model)")
     C, d = task.C, task.d
     uj = np.einsum("jab,b->ja", C, u)
     m = v - b * uj
@@ -152,12 +154,14 @@ class Dyad:
         return G @ np.r_[self.P1, self.P2] + k
 
     def to_dict(self) -> dict:
+        """JSON (docs/json.md): axes as a unit ``direction`` and a ``point_len`` (task length
+        unit), the twist angle in degrees, the common-normal length ``h_len``."""
         return {
             "kind": self.kind,
-            "fixed_axis": {"direction": self.v.tolist(), "point": self.P2.tolist()},
-            "moving_axis": {"direction": self.u.tolist(), "point": self.P1.tolist()},
+            "fixed_axis": {"direction": self.v.tolist(), "point_len": self.P2.tolist()},
+            "moving_axis": {"direction": self.u.tolist(), "point_len": self.P1.tolist()},
             "twist_angle_deg": float(np.degrees(self.twist_angle)),
-            "h": self.h,
+            "h_len": float(self.h),
         }
 
 
@@ -192,18 +196,20 @@ class SolutionLine:
         """``(h*, max_j |s_j(h*)|)`` minimising the largest slide over ``h`` (exact: the
         optimum of a maximum of affine functions is at a crossing of two of ``+-s_j`` or at
         an end of ``h_range``)."""
-        return _minimax(self.slide_alpha[None], self.slide_beta[None], h_range)
+        return minimax(self.slide_alpha[None], self.slide_beta[None], h_range)
 
     def to_dict(self) -> dict:
+        """JSON (docs/json.md): ``u``, ``v`` unit directions; points and slides at ``h = 0`` in
+        the task length unit (``*_len``); their rates per unit of ``h`` (unit-free)."""
         return {
             "u": self.u.tolist(), "v": self.v.tolist(),
-            "P1_at_h0": self.X0[:3].tolist(), "P2_at_h0": self.X0[3:].tolist(),
+            "P1_at_h0_len": self.X0[:3].tolist(), "P2_at_h0_len": self.X0[3:].tolist(),
             "dP1_dh": self.dX[:3].tolist(), "dP2_dh": self.dX[3:].tolist(),
-            "slide_alpha": self.slide_alpha.tolist(), "slide_beta": self.slide_beta.tolist(),
+            "slide_alpha_len": self.slide_alpha.tolist(), "slide_beta": self.slide_beta.tolist(),
         }
 
 
-def _minimax(alpha: np.ndarray, beta: np.ndarray, h_range=None):
+def minimax(alpha: np.ndarray, beta: np.ndarray, h_range=None):
     """Vectorised ``min_h max_j |alpha_j + beta_j h|`` for stacks (m, k): returns (h*, value)
     as arrays (m,) (or floats when m == 1)."""
     alpha = np.asarray(alpha, float)
@@ -245,14 +251,14 @@ def solution_line(task: TaskPositions, u, v, *, atol: float = DIRECTION_ATOL) ->
     v = _unit(v, "v")
     res = direction_residuals(task, u, v)
     if np.max(np.abs(res)) > atol:
-        raise ValueError(
+        raise InputError(
             "u, v: do not satisfy the direction equations u^T (C_j^T - I) v = 0"
             f" (residuals {', '.join(f'{x:.3g}' for x in res)})"
         )
     n = np.cross(v, u)
     nn = np.linalg.norm(n)
     if nn < 1e-9:
-        raise ValueError("u, v: parallel axes have no common normal")
+        raise InputError("u, v: parallel axes have no common normal")
     n /= nn
     M, r = moment_equations(task, u, v)
     A5 = np.vstack([M, _feet_rows(u, v)])
@@ -277,16 +283,16 @@ def rc_dyad_three_positions(task: TaskPositions, u) -> Dyad:
     v = np.cross(b[0], b[1])
     nv = np.linalg.norm(v)
     if nv < 1e-9:
-        raise ValueError("u: this direction gives no unique fixed axis (a pole direction)")
+        raise InputError("u: this direction gives no unique fixed axis (a pole direction)")
     v /= nv
     if abs(u @ v) > 1 - 1e-12:
-        raise ValueError("u: the fixed axis is parallel to the moving axis")
+        raise InputError("u: the fixed axis is parallel to the moving axis")
     M, r = moment_equations(task, u, v)
     G, k = slide_equations(task, u, v)
     A = np.vstack([M, _feet_rows(u, v), G])
     rhs = np.r_[r, 0.0, 0.0, -k]
     if np.linalg.cond(A) > 1e12:
-        raise ValueError("u: the RC dyad equations are singular for this direction")
+        raise InputError("u: the RC dyad equations are singular for this direction")
     X = np.linalg.solve(A, rhs)
     return Dyad(u, v, X[:3], X[3:], "RC")
 

@@ -16,11 +16,11 @@ from matplotlib.patches import Patch
 
 from ..kinematics.closure import Configuration, joint_points
 from .burmester import BurmesterCurves, poles
-from .regions import TYPES, Region1, Region2
 from .rccc import RCCCResult
+from .regions import TYPES, Region1, Region2
 from .tasks import TaskPositions
 
-__all__ = ["plot_curves", "plot_region1", "plot_solution_lines", "plot_region2", "plot_linkage", "write_all"]
+__all__ = ["plot_curves", "plot_linkage", "plot_region1", "plot_region2", "plot_solution_lines", "write_all"]
 
 _TYPE_COLOURS = np.array(
     [[0.20, 0.55, 0.85], [0.95, 0.60, 0.15], [0.30, 0.70, 0.30], [0.80, 0.30, 0.35], [0.0, 0.0, 0.0]]
@@ -135,11 +135,11 @@ def plot_region2(region: Region2, path, mark: tuple[float, float] | None = None)
 def plot_linkage(res: RCCCResult, path) -> Path:
     """The RCCC at the four task positions (3-D): joint axes, links, coupler and task points."""
     mech = res.linkage
-    cfgs = (Configuration.reference(mech),) + res.check.configurations
+    cfgs = (Configuration.reference(mech), *res.check.configurations)
     L = res.task.length_scale * 0.4
     fig = Figure(figsize=(8, 7))
     ax = fig.add_subplot(1, 1, 1, projection="3d")
-    axes_ref = [[f.direction for f in (j.freedoms[0],)][0] for limb in mech.limbs for j in limb.joints]
+    axes_ref = [j.freedoms[0].direction for limb in mech.limbs for j in limb.joints]
     for k, cfg in enumerate(cfgs):
         pts = joint_points(mech, cfg)
         D = cfg.D
@@ -149,7 +149,7 @@ def plot_linkage(res: RCCCResult, path) -> Path:
         dirs = [axes_ref[0], D[:3, :3] @ axes_ref[1], D[:3, :3] @ axes_ref[3], axes_ref[2]]
         col = f"C{k}"
         ax.plot(*np.array(P).T, "-o", color=col, ms=3, label=f"position {res.task.names[k]}")
-        for p, d in zip(P, dirs):
+        for p, d in zip(P, dirs, strict=True):
             ax.plot(*np.array([p - L * d, p + L * d]).T, ":", color=col, lw=0.8)
         tp = D[:3, :3] @ mech.platform_point + D[:3, 3]
         ax.plot(*np.array([P[1], tp, P[2]]).T, "-", color=col, lw=0.6)

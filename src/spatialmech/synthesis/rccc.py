@@ -32,6 +32,7 @@ import numpy as np
 from scipy import ndimage
 from scipy.optimize import minimize_scalar
 
+from ..errors import InputError
 from ..geometry.rotations import rotation_angle
 from ..kinematics.closure import Configuration, correct
 from ..model.joints import C as Cjoint
@@ -39,16 +40,16 @@ from ..model.joints import R as Rjoint
 from ..model.mechanism import Limb, Mechanism, Pose
 from ..model.schema import to_dict as mechanism_to_dict
 from .burmester import BurmesterCurves, burmester_curves
-from .dyads import Dyad, SolutionLine, _minimax, dyad_joint_values, solution_line
+from .dyads import Dyad, SolutionLine, dyad_joint_values, minimax, solution_line
 from .regions import TYPES, Region1, classify_spherical_4r, solution_region_1
 from .tasks import TaskPositions
 
 __all__ = [
-    "assemble",
     "ClosureCheck",
+    "RCCCResult",
+    "assemble",
     "check_linkage",
     "interior_pick",
-    "RCCCResult",
     "synthesize_rccc",
 ]
 
@@ -139,7 +140,7 @@ def interior_pick(region: Region1, type_name: str = "crank-rocker") -> tuple[int
     a robust pick in region 1 (row, column indices)."""
     mask = region.mask(type_name, defect_free=True)
     if not mask.any():
-        raise ValueError(f"type: region 1 has no defect-free {type_name} cell for this task")
+        raise InputError(f"type: region 1 has no defect-free {type_name} cell for this task")
     dist = ndimage.distance_transform_edt(mask)
     i, k = np.unravel_index(int(np.argmax(dist)), mask.shape)
     return int(i), int(k)
@@ -188,14 +189,13 @@ class RCCCResult:
         ch = self.check
         return {
             "task": self.task.name,
-            "length_unit": self.task.length_unit,
             "pick": self.pick,
             "input_dyad": {**self.input_dyad.to_dict(), "curve_parameter": self.t_in},
             "output_dyad": {**self.output_dyad.to_dict(), "curve_parameter": self.t_out},
             "spherical_4r": {"type": self.linkage_type, "defects": self.defects},
-            "max_abs_slide": self.max_abs_slide,
-            "slides": self.slides.tolist(),
-            "position_errors": ch.position_errors.tolist(),
+            "max_abs_slide_len": self.max_abs_slide,
+            "slides_len": self.slides.tolist(),
+            "position_errors_len": ch.position_errors.tolist(),
             "orientation_errors_deg": np.degrees(ch.orientation_errors).tolist(),
             "input_angles_deg": np.degrees(ch.input_angles).tolist(),
             "closure_converged": ch.converged.tolist(),
@@ -205,7 +205,7 @@ class RCCCResult:
 
 def _lines(task, curves) -> tuple[np.ndarray, np.ndarray]:
     al, be = [], []
-    for u, v in zip(curves.u, curves.v):
+    for u, v in zip(curves.u, curves.v, strict=True):
         L = solution_line(task, u, v)
         al.append(L.slide_alpha)
         be.append(L.slide_beta)
@@ -235,19 +235,19 @@ def synthesize_rccc(
     """
     task.require(4, "four-position RCCC synthesis")
     if pick not in ("best-rc", "interior"):
-        raise ValueError(f"pick: expected 'best-rc' or 'interior', got {pick!r}")
+        raise InputError(f"pick: expected 'best-rc' or 'interior', got {pick!r}")
     curves = burmester_curves(task, samples=samples)
     region = solution_region_1(task, curves, stride=stride)
     mask = region.mask("crank-rocker", defect_free=True)
     if not mask.any():
-        raise ValueError("task: region 1 has no defect-free crank-rocker for these positions")
+        raise InputError("task: region 1 has no defect-free crank-rocker for these positions")
     if pick == "interior":
         i, k = interior_pick(region)
         t_in, t_out = float(region.t_in[i]), float(region.t_out[k])
         u_in, v_in = curves.u[region.index_in[i]], curves.v[region.index_in[i]]
     else:
         al, be = _lines(task, curves)
-        hs, ms = _minimax(al, be, h_range)
+        _hs, ms = minimax(al, be, h_range)
         rows = mask.any(axis=1)
         valid = np.zeros(len(curves.t), bool)
         valid[region.index_in[rows]] = True

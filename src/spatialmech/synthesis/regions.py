@@ -36,22 +36,23 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import InputError
 from .burmester import BurmesterCurves
 from .dyads import SolutionLine
 from .tasks import TaskPositions
 
 __all__ = [
-    "TYPES",
-    "DEFECTS",
-    "CIRCUIT",
     "BRANCH",
+    "CIRCUIT",
+    "DEFECTS",
     "ORDER",
-    "classify_spherical_4r",
+    "TYPES",
     "Region1",
-    "solution_region_1",
     "Region2",
-    "solution_region_2",
+    "classify_spherical_4r",
     "sign_pattern",
+    "solution_region_1",
+    "solution_region_2",
 ]
 
 #: Type codes of region 1.
@@ -121,7 +122,7 @@ def classify_spherical_4r(C, u_in, v_in, u_out, v_out, *, tol: float = 1e-9):
     phi_crank = np.mod(theta[..., 1:] - theta[..., :1], _TWO_PI)
     ref = np.where(lo1 < lo2 - tol, theta0, theta0 + np.pi)
     phi_rock = np.mod(theta - ref[..., None], _TWO_PI)
-    phi = np.where(in_crank[..., None], np.concatenate([np.zeros(phi_crank.shape[:-1] + (1,)), phi_crank], -1), phi_rock)
+    phi = np.where(in_crank[..., None], np.concatenate([np.zeros((*phi_crank.shape[:-1], 1)), phi_crank], -1), phi_rock)
     dphi = np.diff(phi, axis=-1)
     inc = np.all(dphi > 0, axis=-1)
     dec = np.all(dphi < 0, axis=-1)
@@ -153,7 +154,7 @@ class Region1:
         m = self.type != TYPES.index("degenerate")
         if type_name is not None:
             if type_name not in TYPES:
-                raise ValueError(f"type: expected one of {TYPES}, got {type_name!r}")
+                raise InputError(f"type: expected one of {TYPES}, got {type_name!r}")
             m &= self.type == TYPES.index(type_name)
         if defect_free:
             m &= self.defects == 0
@@ -170,7 +171,8 @@ class Region1:
     def to_dict(self, grids: bool = False) -> dict:
         d = {"shape": list(self.type.shape), "types": list(TYPES), "defect_bits": dict(DEFECTS), "counts": self.counts()}
         if grids:
-            d |= {"t_in": self.t_in.tolist(), "t_out": self.t_out.tolist(), "type": self.type.tolist(), "defects": self.defects.tolist()}
+            d |= {"t_in": self.t_in.tolist(), "t_out": self.t_out.tolist(),
+                  "type": self.type.tolist(), "defects": self.defects.tolist()}
         return d
 
 
@@ -181,7 +183,7 @@ def solution_region_1(task: TaskPositions, curves: BurmesterCurves, *, stride: i
     """
     task.require(4, "solution region 1")
     if stride < 1:
-        raise ValueError(f"stride: must be >= 1, got {stride}")
+        raise InputError(f"stride: must be >= 1, got {stride}")
     idx = np.arange(0, len(curves.t), stride)
     u, v = curves.u[idx], curves.v[idx]
     T, D = classify_spherical_4r(task.C, u[:, None], v[:, None], u[None, :], v[None, :])
@@ -220,10 +222,10 @@ class Region2:
     def to_dict(self) -> dict:
         uniq, counts = np.unique(self.patterns, return_counts=True)
         return {
-            "h_in": self.h_in.tolist(), "h_out": self.h_out.tolist(),
+            "h_in_len": self.h_in.tolist(), "h_out_len": self.h_out.tolist(),
             "patterns": self.patterns.tolist(),
-            "pattern_counts": {str(k): int(n) for k, n in zip(uniq, counts)},
-            "best_h_in": self.best_h_in, "best_max_abs_slide": self.best_max_abs_slide,
+            "pattern_counts": {str(k): int(n) for k, n in zip(uniq, counts, strict=True)},
+            "best_h_in_len": self.best_h_in, "best_max_abs_slide_len": self.best_max_abs_slide,
         }
 
 
@@ -234,7 +236,7 @@ def solution_region_2(
     h_in = np.asarray(h_in, float)
     h_out = np.asarray(h_out, float)
     if h_in.ndim != 1 or h_out.ndim != 1 or h_in.size < 2 or h_out.size < 2:
-        raise ValueError("h_in, h_out: expected 1-D arrays of at least two values")
+        raise InputError("h_in, h_out: expected 1-D arrays of at least two values")
     s = line_in.slides(h_in)
     inc = np.diff(np.concatenate([np.zeros((len(h_in), 1)), s], axis=1), axis=1)
     scale = max(1.0, float(np.max(np.abs(s))))

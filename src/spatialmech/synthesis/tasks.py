@@ -47,20 +47,21 @@ import numpy as np
 from annotated_types import Len
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
+from ..errors import InputError, UnknownNameError
 from ..geometry.rotations import check_sequence, euler_matrix, rotation_angle, transform
 from ..geometry.validate import as_finite_array
 
 __all__ = [
     "MCCARTHY",
+    "TASKS",
     "TaskPositions",
-    "mccarthy_matrix",
+    "get_task",
     "load_task",
     "loads_task",
-    "task_from_dict",
-    "get_task",
-    "task_names",
+    "mccarthy_matrix",
     "resolve_task",
-    "TASKS",
+    "task_from_dict",
+    "task_names",
 ]
 
 #: The orientation convention of paper D, stated in words (used in reports and files).
@@ -94,9 +95,9 @@ def _check_rotation(R: np.ndarray, name: str) -> np.ndarray:
     R = as_finite_array(R, name, shape=(3, 3))
     err = float(np.max(np.abs(R @ R.T - np.eye(3))))
     if err > ORTHO_ATOL:
-        raise ValueError(f"{name}: not orthonormal (max |R R^T - I| = {err:.3g})")
+        raise InputError(f"{name}: not orthonormal (max |R R^T - I| = {err:.3g})")
     if np.linalg.det(R) < 0:
-        raise ValueError(f"{name}: a reflection (det = -1), not a rotation")
+        raise InputError(f"{name}: a reflection (det = -1), not a rotation")
     return R
 
 
@@ -123,24 +124,24 @@ class TaskPositions:
         R = as_finite_array(self.R, "positions.R")
         p = as_finite_array(self.p, "positions.p")
         if R.ndim != 3 or R.shape[1:] != (3, 3):
-            raise ValueError(f"positions.R: expected shape (n, 3, 3), got {R.shape}")
+            raise InputError(f"positions.R: expected shape (n, 3, 3), got {R.shape}")
         if p.shape != (R.shape[0], 3):
-            raise ValueError(f"positions.p: expected shape ({R.shape[0]}, 3), got {p.shape}")
+            raise InputError(f"positions.p: expected shape ({R.shape[0]}, 3), got {p.shape}")
         n = R.shape[0]
         if n < self.min_positions:
-            raise ValueError(f"positions: need at least {self.min_positions} positions, got {n}")
+            raise InputError(f"positions: need at least {self.min_positions} positions, got {n}")
         for i in range(n):
             _check_rotation(R[i], f"positions[{i}].matrix")
         names = tuple(self.names) or tuple(str(i + 1) for i in range(n))
         if len(names) != n:
-            raise ValueError(f"positions.names: expected {n} names, got {len(names)}")
+            raise InputError(f"positions.names: expected {n} names, got {len(names)}")
         scale = max(1.0, float(np.max(np.linalg.norm(p - p.mean(axis=0), axis=1))))
         for i in range(n):
             for k in range(i):
                 ang = float(rotation_angle(R[i] @ R[k].T))
                 dist = float(np.linalg.norm(p[i] - p[k]))
                 if ang < IDENTICAL_RTOL and dist < IDENTICAL_RTOL * scale:
-                    raise ValueError(
+                    raise InputError(
                         f"positions[{i}]: identical to positions[{k}] (same orientation and point)"
                     )
         object.__setattr__(self, "R", R)
@@ -155,7 +156,7 @@ class TaskPositions:
         lat = as_finite_array(latitude, "latitude")
         az = as_finite_array(azimuth, "azimuth")
         if not (lon.shape == lat.shape == az.shape) or lon.ndim != 1:
-            raise ValueError(
+            raise InputError(
                 f"longitude: longitude, latitude and azimuth must be 1-D of equal length,"
                 f" got {lon.shape}, {lat.shape}, {az.shape}"
             )
@@ -170,7 +171,7 @@ class TaskPositions:
         check_sequence(seq)
         a = as_finite_array(angles, "angles")
         if a.ndim != 2 or a.shape[1] != 3:
-            raise ValueError(f"angles: expected shape (n, 3), got {a.shape}")
+            raise InputError(f"angles: expected shape (n, 3), got {a.shape}")
         R = euler_matrix(seq, a, degrees=degrees)
         deg = a * (1.0 if degrees else 180.0 / np.pi)
         kw.setdefault("convention", f"Euler {seq!r} ({'intrinsic' if seq.isupper() else 'extrinsic'}, scipy)")
@@ -210,7 +211,7 @@ class TaskPositions:
         s = float(np.max(np.linalg.norm(self.p - self.p.mean(axis=0), axis=1)))
         return s if s > 1e-12 else 1.0
 
-    def subset(self, indices) -> "TaskPositions":
+    def subset(self, indices) -> TaskPositions:
         """A task made of some of the positions (e.g. three of four), in the given order."""
         idx = list(indices)
         return TaskPositions(
@@ -220,10 +221,10 @@ class TaskPositions:
             length_unit=self.length_unit, description=self.description, source=self.source,
         )
 
-    def require(self, n: int, what: str) -> "TaskPositions":
+    def require(self, n: int, what: str) -> TaskPositions:
         """Raise ``ValueError`` unless the task has exactly ``n`` positions."""
         if self.n != n:
-            raise ValueError(f"positions: {what} needs exactly {n} positions, got {self.n}")
+            raise InputError(f"positions: {what} needs exactly {n} positions, got {self.n}")
         return self
 
     def to_dict(self) -> dict[str, Any]:
@@ -234,8 +235,8 @@ class TaskPositions:
             "positions": [
                 {
                     "name": self.names[i],
-                    "point": self.p[i].tolist(),
-                    "matrix": self.R[i].tolist(),
+                    "point_len": self.p[i].tolist(),
+                    "rotation_matrix": self.R[i].tolist(),
                     **({"angles_deg": self.angles_deg[i].tolist()} if self.angles_deg is not None else {}),
                 }
                 for i in range(self.n)
@@ -292,13 +293,13 @@ def task_from_dict(data: dict[str, Any], *, source: str = "<dict>", min_position
     except ValidationError as e:
         err = e.errors()[0]
         msg = {"extra_forbidden": "unknown field", "missing": "required field is missing"}.get(err["type"], err["msg"])
-        raise ValueError(f"{_loc(err['loc'])}: {msg}") from None
+        raise InputError(f"{_loc(err['loc'])}: {msg}") from None
     Rs, ps, names, convs, angs = [], [], [], [], []
     for i, ps_ in enumerate(spec.positions):
         where = f"positions[{i}]"
         given = [k for k in ("mccarthy_deg", "euler", "matrix") if getattr(ps_, k) is not None]
         if len(given) != 1:
-            raise ValueError(f"{where}: give exactly one of 'mccarthy_deg', 'euler' or 'matrix' (got {given or 'none'})")
+            raise InputError(f"{where}: give exactly one of 'mccarthy_deg', 'euler' or 'matrix' (got {given or 'none'})")
         if ps_.mccarthy_deg is not None:
             m = ps_.mccarthy_deg
             Rs.append(mccarthy_matrix(m.longitude, m.latitude, m.azimuth, degrees=True))
@@ -308,7 +309,7 @@ def task_from_dict(data: dict[str, Any], *, source: str = "<dict>", min_position
             try:
                 check_sequence(ps_.euler.seq)
             except ValueError as e:
-                raise ValueError(f"{where}.euler.{e}") from None
+                raise InputError(f"{where}.euler.{e}") from None
             Rs.append(euler_matrix(ps_.euler.seq, ps_.euler.angles_deg, degrees=True))
             convs.append(f"Euler {ps_.euler.seq!r} (scipy: upper case intrinsic, lower case extrinsic)")
             angs.append(list(ps_.euler.angles_deg))
@@ -319,7 +320,7 @@ def task_from_dict(data: dict[str, Any], *, source: str = "<dict>", min_position
         ps.append(ps_.point)
         names.append(ps_.name or str(i + 1))
     if len(spec.positions) < min_positions:
-        raise ValueError(f"positions: need at least {min_positions} positions, got {len(spec.positions)}")
+        raise InputError(f"positions: need at least {min_positions} positions, got {len(spec.positions)}")
     same = len(set(convs)) == 1 and bool(angs) and angs[0] is not None
     return TaskPositions(
         np.array(Rs), np.array(ps, dtype=float), name=spec.name, names=tuple(names),
@@ -335,7 +336,7 @@ def loads_task(text: str, *, source: str = "<string>", min_positions: int = 2) -
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
-        raise ValueError(f"not valid TOML: {e}") from None
+        raise InputError(f"not valid TOML: {e}") from None
     return task_from_dict(data, source=source, min_positions=min_positions)
 
 
@@ -345,11 +346,11 @@ def load_task(path: str | Path, *, min_positions: int = 2) -> TaskPositions:
     try:
         text = path.read_text(encoding="utf-8")
     except OSError as e:
-        raise ValueError(f"{path}: cannot read: {e.strerror}") from None
+        raise InputError(f"{path}: cannot read: {e.strerror}") from None
     try:
         return loads_task(text, source=str(path), min_positions=min_positions)
     except ValueError as e:
-        raise ValueError(f"{path}: {e}") from None
+        raise InputError(f"{path}: {e}") from None
 
 
 # ---------------------------------------------------------------------------- ready-made tasks
@@ -382,7 +383,7 @@ def get_task(name: str) -> TaskPositions:
     try:
         return TASKS[name][0]()
     except KeyError:
-        raise KeyError(f"unknown ready-made task {name!r}; known: {', '.join(TASKS)}") from None
+        raise UnknownNameError(f"unknown ready-made task {name!r}; known: {', '.join(TASKS)}") from None
 
 
 def resolve_task(spec, *, min_positions: int = 2) -> TaskPositions:
@@ -395,4 +396,4 @@ def resolve_task(spec, *, min_positions: int = 2) -> TaskPositions:
     p = Path(s)
     if p.exists():
         return load_task(p, min_positions=min_positions)
-    raise KeyError(f"{s}: not a file and not a ready-made task (ready-made: {', '.join(TASKS)})")
+    raise UnknownNameError(f"{s}: not a file and not a ready-made task (ready-made: {', '.join(TASKS)})")

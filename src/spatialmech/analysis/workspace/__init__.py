@@ -57,6 +57,7 @@ stated model (docs/workspace.md).
 
 Example::
 
+    >>> import numpy as np
     >>> from spatialmech import catalog
     >>> ws = orientation_workspace(catalog.build("four-sps-cu"), at={"z": 0.1},
     ...                            limits=paper_b_limits(), step=np.radians(6))
@@ -66,23 +67,33 @@ Example::
 
 from __future__ import annotations
 
-from .limits import ORIENTATION_SEQUENCE, COORDINATES, PAPER_B_LINK_DIAMETERS, ConeLimit, WorkspaceLimits, paper_b_limits, default_limits
 from .checker import PoseChecker, pose_checker, segment_distance
-from .search import Extent, WorkspaceResult, orientation_workspace, position_workspace
+from .limits import (
+    COORDINATES,
+    ORIENTATION_SEQUENCE,
+    PAPER_B_LINK_DIAMETERS,
+    ConeLimit,
+    WorkspaceLimits,
+    default_limits,
+    paper_b_limits,
+)
+from .search import MAX_POSES, MAX_POSES_GENERAL, Extent, WorkspaceResult, orientation_workspace, position_workspace
 
 __all__ = [
-    "ORIENTATION_SEQUENCE",
     "COORDINATES",
+    "MAX_POSES",
+    "MAX_POSES_GENERAL",
+    "ORIENTATION_SEQUENCE",
     "PAPER_B_LINK_DIAMETERS",
     "ConeLimit",
-    "WorkspaceLimits",
-    "paper_b_limits",
-    "default_limits",
-    "PoseChecker",
-    "pose_checker",
-    "segment_distance",
     "Extent",
+    "PoseChecker",
+    "WorkspaceLimits",
     "WorkspaceResult",
+    "default_limits",
     "orientation_workspace",
+    "paper_b_limits",
+    "pose_checker",
     "position_workspace",
+    "segment_distance",
 ]

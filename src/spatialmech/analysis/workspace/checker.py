@@ -2,16 +2,17 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable
 
 import numpy as np
 
+from ...errors import InputError
 from ...model.mechanism import Mechanism, Pose
 from .limits import (
-    WorkspaceLimits,
     _CLOSURE,
     _POSITION,
+    WorkspaceLimits,
     default_limits,
 )
 
@@ -81,7 +82,7 @@ def _link_of_joint(links: list[_Link], limb: int, joint: int) -> int:
     leaving it towards the platform, elsewhere the link arriving at it from the base side."""
     mine = [k for k, lk in enumerate(links) if lk.limb == limb]
     if not mine:
-        raise ValueError(f"cones: the limb of joint #{joint} has no link (all its joints coincide)")
+        raise InputError(f"cones: the limb of joint #{joint} has no link (all its joints coincide)")
     if joint == 0:
         return mine[0]
     for k in mine:
@@ -144,7 +145,7 @@ def _freedom_margins(vals: np.ndarray, los: np.ndarray, his: np.ndarray, rot: np
     mid = 0.5 * (los + his)
     wrapped = vals + 2 * np.pi * np.round((mid - vals) / (2 * np.pi))
     v = np.where(rot, wrapped, vals)
-    out = np.empty(v.shape[:-1] + (2 * v.shape[-1],))
+    out = np.empty((*v.shape[:-1], 2 * v.shape[-1]))
     out[..., 0::2] = v - los
     out[..., 1::2] = his - v
     return out
@@ -158,10 +159,10 @@ def _common(mech: Mechanism, limits: WorkspaceLimits, ref_points: list[np.ndarra
     cones = []
     for c in limits.cones:
         if c.joint not in joint_at:
-            raise ValueError(f"cones: {mech.name} has no joint {c.joint!r}")
+            raise InputError(f"cones: {mech.name} has no joint {c.joint!r}")
         li, ji = joint_at[c.joint]
         if mech.limbs[li].joints[ji].type not in ("S", "U", "Sm"):
-            raise ValueError(f"cones: joint {c.joint!r} is a {mech.limbs[li].joints[ji].type} joint, not S or U")
+            raise InputError(f"cones: joint {c.joint!r} is a {mech.limbs[li].joints[ji].type} joint, not S or U")
         cones.append((c, _link_of_joint(links, li, ji)))
     pairs = []
     for i in range(len(links)):
@@ -206,7 +207,7 @@ def _closed_form_plan(mech: Mechanism):
     index)``; or a string saying why the closed form does not apply."""
     p0 = mech.platform_point
     L = mech.characteristic_length
-    plan = []
+    plan: list[tuple] = []  # ("leg", B, A, length, index) or ("cu", C, k, U, s_ref, index)
     first = 0
     for limb in mech.limbs:
         types = [j.type for j in limb.joints]
@@ -247,17 +248,17 @@ def pose_checker(mech: Mechanism, limits: WorkspaceLimits | None = None, *, meth
     that violates the fewest freedom limits (limbs are independent once the pose is fixed).
     """
     if method not in ("auto", "closed-form", "general"):
-        raise ValueError(f"method: expected 'auto', 'closed-form' or 'general', got {method!r}")
+        raise InputError(f"method: expected 'auto', 'closed-form' or 'general', got {method!r}")
     limits = default_limits(mech) if limits is None else limits
     if not isinstance(limits, WorkspaceLimits):
-        raise ValueError(f"limits: expected a WorkspaceLimits, got {type(limits).__name__}")
+        raise InputError(f"limits: expected a WorkspaceLimits, got {type(limits).__name__}")
     from ...kinematics.closure import Configuration, joint_points
 
     ref_points = joint_points(mech, Configuration.reference(mech))
     links, cones, pairs, fl, names, scale = _common(mech, limits, ref_points)
     plan = _closed_form_plan(mech) if method != "general" else "general kernel requested"
     if isinstance(plan, str) and method == "closed-form":
-        raise ValueError(f"method: no closed form for {mech.name}: {plan}")
+        raise InputError(f"method: no closed form for {mech.name}: {plan}")
     refs = mech.freedom_refs
     los = np.array([refs[k].freedom.limits[0] for k in fl])
     his = np.array([refs[k].freedom.limits[1] for k in fl])
@@ -265,8 +266,8 @@ def pose_checker(mech: Mechanism, limits: WorkspaceLimits | None = None, *, meth
     offs = np.array([r.freedom.offset for r in refs])
     L = mech.characteristic_length
     n_links = len(links)
-    names = names + [_CLOSURE]
-    scale = np.array(scale + [L])
+    names = [*names, _CLOSURE]
+    scale = np.array([*scale, L])
 
     if not isinstance(plan, str):
         slot = {k: i for i, k in enumerate(fl)}
@@ -300,7 +301,7 @@ def pose_checker(mech: Mechanism, limits: WorkspaceLimits | None = None, *, meth
                     seg_b[:, link_of_limb[li]] = b_end
             cols = [_freedom_margins(vals, los, his, rot)] if fl else []
             cols += [c[:, None] for c in _cone_margins(seg_a, seg_b, R, cones)]
-            return np.concatenate(cols + [closure[:, None]], axis=1), seg_a, seg_b
+            return np.concatenate([*cols, closure[:, None]], axis=1), seg_a, seg_b
 
         n_pre = len(names) - 1 - len(pairs)
 
@@ -361,7 +362,7 @@ def pose_checker(mech: Mechanism, limits: WorkspaceLimits | None = None, *, meth
             alt = inverse_position(mech, pose, all_solutions=True, n_seeds=general_seeds)
             if alt.reachable:
                 q = np.zeros(len(refs))
-                for sl, lsol in zip(limb_slices(mech), alt.limbs):
+                for sl, lsol in zip(limb_slices(mech), alt.limbs, strict=True):
                     k = min(range(len(lsol.solutions)), key=lambda j: len(lsol.violations[j]))
                     q[sl] = lsol.solutions[k]
                 row = _general_row(Configuration(q, pose.displacement(mech.platform_point)), R[i : i + 1])

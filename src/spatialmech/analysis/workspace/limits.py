@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Mapping
 
 import numpy as np
 
+from ...errors import InputError
 from ...geometry.validate import as_finite_array, as_unit_vector
 from ...model.mechanism import Mechanism
 
@@ -43,13 +44,13 @@ class ConeLimit:
 
     def __post_init__(self):
         if not isinstance(self.joint, str) or not self.joint:
-            raise ValueError(f"joint: expected a joint name, got {self.joint!r}")
+            raise InputError(f"joint: expected a joint name, got {self.joint!r}")
         object.__setattr__(self, "axis", tuple(float(v) for v in as_unit_vector(self.axis, "axis")))
         if self.frame not in ("base", "platform"):
-            raise ValueError(f"frame: expected 'base' or 'platform', got {self.frame!r}")
+            raise InputError(f"frame: expected 'base' or 'platform', got {self.frame!r}")
         ang = float(as_finite_array(self.max_angle, "max_angle", shape=()))
         if not 0.0 < ang <= np.pi:
-            raise ValueError(f"max_angle: expected 0 < max_angle <= pi rad, got {ang}")
+            raise InputError(f"max_angle: expected 0 < max_angle <= pi rad, got {ang}")
         object.__setattr__(self, "max_angle", ang)
 
     @property
@@ -79,16 +80,16 @@ class WorkspaceLimits:
         object.__setattr__(self, "cones", tuple(self.cones))
         for c in self.cones:
             if not isinstance(c, ConeLimit):
-                raise ValueError(f"cones: expected ConeLimit items, got {type(c).__name__}")
+                raise InputError(f"cones: expected ConeLimit items, got {type(c).__name__}")
         d = self.link_diameter
         if d is not None:
             items = dict(d) if isinstance(d, Mapping) else {"*": d}
             for k, v in items.items():
                 v = float(as_finite_array(v, f"link_diameter[{k}]", shape=()))
                 if v < 0:
-                    raise ValueError(f"link_diameter[{k}]: must be >= 0, got {v}")
+                    raise InputError(f"link_diameter[{k}]: must be >= 0, got {v}")
                 items[k] = v
-            object.__setattr__(self, "link_diameter", items["*"] if "*" in items else items)
+            object.__setattr__(self, "link_diameter", items.get("*", items))
 
     def diameter(self, limb: str) -> float | None:
         d = self.link_diameter
@@ -101,7 +102,7 @@ class WorkspaceLimits:
     def to_dict(self) -> dict:
         d = self.link_diameter
         return {"cones": [c.to_dict() for c in self.cones], "freedom_limits": self.freedom_limits,
-                "link_diameter_m": dict(d) if isinstance(d, Mapping) else d, "source": self.source}
+                "link_diameter_len": dict(d) if isinstance(d, Mapping) else d, "source": self.source}
 
 
 def paper_b_limits(link_diameter: float = PAPER_B_LINK_DIAMETERS[1], max_angle: float = np.pi / 2) -> WorkspaceLimits:

@@ -3,27 +3,36 @@
 from __future__ import annotations
 
 import time
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Callable, Mapping
 
 import numpy as np
 from scipy.optimize import minimize
 
+from ...errors import InputError, SearchTooLargeError
 from ...geometry.rotations import euler_matrix
 from ...geometry.validate import as_finite_array
 from ...model.mechanism import Mechanism
-from .limits import (
-    COORDINATES,
-    ORIENTATION_SEQUENCE,
-    WorkspaceLimits,
-    _BOX,
-    _ORIENTATION,
-    _POSITION,
-)
+from ...results import Progress
 from .checker import (
     PoseChecker,
     pose_checker,
 )
+from .limits import (
+    _BOX,
+    _ORIENTATION,
+    _POSITION,
+    COORDINATES,
+    ORIENTATION_SEQUENCE,
+    WorkspaceLimits,
+)
+
+
+#: Largest grid (poses, including the lines through the centre) sampled unless ``max_poses``
+#: says otherwise: 10^7 on the vectorised closed-form kernel (about a minute), 2 10^4 on the
+#: general kernel (one inverse position per pose).
+MAX_POSES = 10_000_000
+MAX_POSES_GENERAL = 20_000
 
 
 # ------------------------------------------------------------------------------ results
@@ -90,45 +99,71 @@ class WorkspaceResult:
         return int(np.count_nonzero(self.feasible))
 
     def to_dict(self, *, boundary: bool = False) -> dict:
-        """JSON-ready summary; angles in degrees (``*_deg`` keys), positions in metres (``*_m``).
+        """JSON (docs/json.md): coordinates keyed with their unit, ``alpha_deg`` ... (degrees) and
+        ``x_len`` ... (the model's length unit).
 
-        ``<c>_deg`` / ``<c>_m``: ``[min, max]`` of coordinate ``c`` alone (others fixed);
-        ``<c>_deg_set`` / ``<c>_m_set``: over the whole set.
+        ``extents[<c>_<unit>]``: ``alone`` = ``[min, max]`` of coordinate ``c`` alone (the others
+        at their fixed values) with ``alone_active_limits`` and every feasible interval
+        ``alone_intervals``; ``set`` = ``[min, max]`` over the whole set with
+        ``set_active_limits`` and ``set_method``.  ``volume_deg3`` (orientation: Euler-angle
+        coordinates, cubic degrees) or ``volume_len3`` (position), with the power the number of
+        free coordinates (``volume_deg2`` ...).  ``boundary`` adds the refined boundary points.
         """
-        unit = lambda c: "deg" if c in _ORIENTATION else "m"  # noqa: E731
-        conv = lambda c, v: float(np.degrees(v)) if c in _ORIENTATION else float(v)  # noqa: E731
-        d: dict = {"mechanism": self.mechanism, "kind": self.kind, "path": self.path}
-        if self.path_reason:
-            d["path_reason"] = self.path_reason
-        d["orientation_sequence"] = f"{self.sequence}: R = Rz(gamma) Ry(beta) Rx(alpha)"
+        def key(c: str) -> str:
+            return f"{c}_deg" if c in _ORIENTATION else f"{c}_len"
+
+        def conv(c: str, v: float) -> float:
+            return float(np.degrees(v)) if c in _ORIENTATION else float(v)
+
+        def pair(c: str, e) -> list[float] | None:
+            return None if e is None else [conv(c, e.lo), conv(c, e.hi)]
+
+        codes = {"deg" if c in _ORIENTATION else "len" for c in self.free}
+        if len(codes) != 1:
+            raise InputError(f"free: expected angles only or positions only, got {list(self.free)}")
+        code = codes.pop()
+        power = len(self.free)
+        volume = float(self.volume) * (float(np.degrees(1.0)) ** power if code == "deg" else 1.0)
+        extents = {}
         for c in self.free:
-            e = self.alone[c]
-            d[f"{c}_{unit(c)}"] = [conv(c, e.lo), conv(c, e.hi)] if e is not None else None
-        for c in self.free:
-            e = self.extents[c]
-            d[f"{c}_{unit(c)}_set"] = [conv(c, e.lo), conv(c, e.hi)] if e is not None else None
-        d["volume"] = float(self.volume)
-        d["volume_unit"] = self.volume_unit
-        d["active_limits"] = self.active_limits
-        d["extents_active_limits"] = {
-            **{f"{c}_{unit(c)}": [self.alone[c].lo_limit, self.alone[c].hi_limit] for c in self.free if self.alone[c]},
-            **{f"{c}_{unit(c)}_set": [self.extents[c].lo_limit, self.extents[c].hi_limit] for c in self.free if self.extents[c]},
+            a, e = self.alone[c], self.extents[c]
+            extents[key(c)] = {
+                "alone": pair(c, a),
+                "alone_active_limits": None if a is None else [a.lo_limit, a.hi_limit],
+                "alone_intervals": [[conv(c, lo), conv(c, hi)] for lo, hi in self.alone_intervals[c]],
+                "set": pair(c, e),
+                "set_active_limits": None if e is None else [e.lo_limit, e.hi_limit],
+                "set_method": self.extent_method.get(c),
+            }
+        d: dict = {
+            "mechanism": self.mechanism,
+            "kind": self.kind,
+            "path": self.path,
+            "path_reason": self.path_reason or None,
+            "euler_sequence": self.sequence,
+            "orientation_convention": "R = Rz(gamma) Ry(beta) Rx(alpha): alpha about x, beta about y, gamma about z",
+            "free": list(self.free),
+            "fixed": {key(c): conv(c, v) for c, v in self.fixed.items()},
+            "extents": extents,
+            f"volume_{code}{power if power > 1 else ''}": volume,
+            "volume_note": ("Euler-angle coordinates (alpha, beta, gamma), not the Haar measure of SO(3)"
+                            if code == "deg" else "volume of the platform point's positions"),
+            "active_limits": self.active_limits,
+            "bounds": {key(c): [conv(c, v[0]), conv(c, v[1])] for c, v in self.bounds.items()},
+            "step": {key(c): conv(c, v) for c, v in self.step.items()},
+            "boundary_tol": {key(c): conv(c, v) for c, v in self.tol.items()},
+            "n_poses_checked": self.n_poses,
+            "n_grid": int(self.feasible.size),
+            "n_grid_feasible": self.n_feasible,
+            "elapsed_s": self.seconds,
+            "limits": self.limits.to_dict(),
+            "caveat": ("extents are exact to the tolerance along the sampled lines; a feasible island "
+                       "narrower than the grid step can be missed"),
         }
-        d["alone_intervals"] = {f"{c}_{unit(c)}": [[conv(c, a), conv(c, b)] for a, b in self.alone_intervals[c]] for c in self.free}
-        d["set_extent_method"] = dict(self.extent_method)
-        d["fixed"] = {f"{c}_{unit(c)}": conv(c, v) for c, v in self.fixed.items()}
-        d["bounds"] = {f"{c}_{unit(c)}": [conv(c, v[0]), conv(c, v[1])] for c, v in self.bounds.items()}
-        d["step"] = {f"{c}_{unit(c)}": conv(c, v) for c, v in self.step.items()}
-        d["tolerance"] = {f"{c}_{unit(c)}": conv(c, v) for c, v in self.tol.items()}
-        d["n_poses_checked"] = self.n_poses
-        d["n_grid"] = int(self.feasible.size)
-        d["n_grid_feasible"] = self.n_feasible
-        d["seconds"] = self.seconds
-        d["limits"] = self.limits.to_dict()
-        d["caveat"] = ("extents are exact to the tolerance along the sampled lines; a feasible island "
-                       "narrower than the grid step can be missed")
         if boundary:
-            d["boundary_points"] = [[conv(c, v) for c, v in zip(self.free, row)] for row in self.boundary_points]
+            d[f"boundary_points_{code}"] = [[conv(c, v) for c, v in zip(self.free, row, strict=True)]
+                                            for row in self.boundary_points]
+            d["boundary_free"] = list(self.free)
             d["boundary_limits"] = list(self.boundary_limits)
         return d
 
@@ -153,6 +188,7 @@ class _Evaluator:
     def __init__(self, checker: PoseChecker, space: _Space, chunk: int, progress):
         self.checker, self.space, self.chunk, self.progress = checker, space, int(chunk), progress
         self.count = 0
+        self.expected: int | None = None  # estimated poses in all (the progress total), None: unknown
 
     def margins(self, X: np.ndarray) -> np.ndarray:
         out = np.empty((X.shape[0], len(self.checker.names)))
@@ -173,7 +209,8 @@ class _Evaluator:
     def _tick(self, n: int):
         self.count += n
         if self.progress is not None:
-            self.progress(n)
+            total = self.expected if self.expected is not None and self.count <= self.expected else None
+            self.progress(self.count, total, "checking poses")
 
     def active(self, X_out: np.ndarray) -> list[str]:
         if X_out.shape[0] == 0:
@@ -189,8 +226,10 @@ def _bisect(ev: _Evaluator, x_in: np.ndarray, x_out: np.ndarray, tol: np.ndarray
     x_in, x_out = x_in.copy(), x_out.copy()
     if x_in.shape[0] == 0:
         return x_in, x_out
-    width = np.max(np.abs(x_out - x_in) / tol, axis=1).max()
-    n_iter = int(np.ceil(np.log2(max(width, 1.0))))
+    with np.errstate(over="ignore"):
+        width = float(np.max(np.abs(x_out - x_in) / tol, axis=1).max())
+    # at most 200 halvings: beyond ~60 the bracket is at the float resolution of the coordinates
+    n_iter = int(np.ceil(np.log2(width))) if 1.0 < width < 2.0**200 else (200 if width >= 2.0**200 else 0)
     for _ in range(n_iter):
         mid = 0.5 * (x_in + x_out)
         ok = ev.feasible(mid)
@@ -210,7 +249,7 @@ def _axis_values(lo: float, hi: float, c: float, step: float) -> np.ndarray:
 def _line_runs(F: np.ndarray, axis: int):
     """Start and end indices of the runs of True along ``axis``: (line index tuple, i0, i1)."""
     Fm = np.moveaxis(F, axis, -1)
-    pad = np.zeros(Fm.shape[:-1] + (1,), dtype=bool)
+    pad = np.zeros((*Fm.shape[:-1], 1), dtype=bool)
     d = np.diff(np.concatenate([pad, Fm, pad], axis=-1).astype(np.int8), axis=-1)
     starts = np.argwhere(d == 1)  # (..., i): run starts at i
     ends = np.argwhere(d == -1)  # run ends at i - 1
@@ -243,7 +282,7 @@ def _refine_runs(ev, F, grid, axis, tol):
     hi_lim = np.array([_BOX] * len(i1), dtype=object)
     xin_lo = points(lines, i0)
     xin_hi = points(lines, i1)
-    for side, idx, nb, arr, lim, xin in (("lo", i0, i0 - 1, lo, lo_lim, xin_lo), ("hi", i1, i1 + 1, hi, hi_lim, xin_hi)):
+    for _side, idx, nb, arr, lim, xin in (("lo", i0, i0 - 1, lo, lo_lim, xin_lo), ("hi", i1, i1 + 1, hi, hi_lim, xin_hi)):
         sel = np.flatnonzero((nb >= 0) & (nb < n_ax))
         if sel.size == 0:
             continue
@@ -305,31 +344,66 @@ def _polished_extent(ev, checker, x0, k, sign, bounds, tolv, stepv):
     return float(a_in[0, k]), ev.active(a_out)[0]
 
 
+def _axis_count(lo: float, hi: float, c: float, step: float) -> float:
+    """``_axis_values(lo, hi, c, step).size`` without building the array (a float: may be huge)."""
+    with np.errstate(over="ignore"):
+        n = max(float(np.ceil((hi - lo) / step - 1e-9)), 1.0)
+    if np.isfinite(n) and n < 2**52 and abs((c - lo) - (hi - c)) < 1e-12 * max(1.0, hi - lo) and int(n) % 2:
+        n += 1
+    return n + 1
+
+
+def _check_grid_size(free, values, bounds, step, path: str, max_poses) -> None:
+    """Refuse a grid (plus its lines through the centre) larger than ``max_poses`` (default
+    :data:`MAX_POSES` or :data:`MAX_POSES_GENERAL`), before any array is built."""
+    limit = (MAX_POSES_GENERAL if path == "general" else MAX_POSES) if max_poses is None else max_poses
+    counts = [_axis_count(bounds[c][0], bounds[c][1], values[c], step[c]) for c in free]
+    n = float(np.prod(counts)) + sum(counts)
+    if n <= limit:
+        return
+    # sizes by logarithms: a step below the float resolution of the bounds gives inf counts
+    log10_n = sum(np.log10(bounds[c][1] - bounds[c][0]) - np.log10(step[c]) for c in free)
+    e = float((max(log10_n, np.log10(n) if np.isfinite(n) else 0.0) - np.log10(limit)) / len(free))
+    factor = f"{10.0**e:.3g}" if e < 300 else f"1e{e:.0f}"
+    size = f"about {n:.3g}" if np.isfinite(n) else f"about 1e{log10_n:.0f}"
+    raise SearchTooLargeError(
+        f"step: the grid has {size} poses ({' x '.join(f'{c:.3g}' for c in counts)} plus the lines through the "
+        f"centre), more than max_poses = {limit} for the {path} kernel; multiply the step by at least "
+        f"{factor} or narrow the bounds")
+
+
 def _analyse(mech, kind, free, values, bounds, step, tol, limits, method, chunk, progress, max_poses, polish):
+    if isinstance(chunk, bool) or not isinstance(chunk, (int, np.integer)) or chunk < 1:
+        raise InputError(f"chunk: expected a positive number of poses per block, got {chunk!r}")
+    if max_poses is not None and (isinstance(max_poses, bool) or not isinstance(max_poses, (int, np.integer))
+                                  or max_poses < 1):
+        raise InputError(f"max_poses: expected a positive integer, got {max_poses!r}")
     t0 = time.perf_counter()
     checker = pose_checker(mech, limits, method=method)
     space = _Space(free, values)
-    ev = _Evaluator(checker, space, chunk, progress)
+    ev = _Evaluator(checker, space, int(chunk), progress)
     d = len(free)
     stepv = np.array([step[c] for c in free])
     tolv = np.array([tol[c] for c in free])
-    grid = tuple(_axis_values(*bounds[c], values[c], step[c]) for c in free)
+    _check_grid_size(free, values, bounds, step, checker.path, max_poses)
+    grid = tuple(_axis_values(bounds[c][0], bounds[c][1], values[c], step[c]) for c in free)
     shape = tuple(g.size for g in grid)
     n_grid = int(np.prod(shape))
-    n_lines = sum(g.size for g in grid)
-    if max_poses is not None and n_grid + n_lines > max_poses:
-        raise ValueError(f"step: the grid has {n_grid} poses, more than max_poses = {max_poses} for the "
-                         f"{checker.path} kernel; increase the step or narrow the bounds")
     centre = np.array([values[c] for c in free])
+    # the progress total: the lines and the grid, then (below) the bisections of the boundary
+    with np.errstate(over="ignore"):
+        n_halvings = int(min(np.ceil(np.log2(max(float(np.max(stepv / tolv)), 2.0))), 200))  # as in _bisect
+    ev.expected = n_grid + sum(g.size + 2 * n_halvings for g in grid)
 
     # ---- each coordinate alone (others at their fixed value)
-    alone, alone_int = {}, {}
+    alone: dict[str, Extent | None] = {}
+    alone_int: dict[str, list[tuple[float, float]]] = {}
     for k, c in enumerate(free):
         X = np.tile(centre, (grid[k].size, 1))
         X[:, k] = grid[k]
         F1 = ev.feasible(X)
         lo, hi, lo_lim, hi_lim = _refine_line(ev, F1, X, k, tolv)
-        alone_int[c] = [(float(a), float(b)) for a, b in zip(lo, hi)]
+        alone_int[c] = [(float(a), float(b)) for a, b in zip(lo, hi, strict=True)]
         if lo.size:
             i, j = int(np.argmin(lo)), int(np.argmax(hi))
             alone[c] = Extent(float(lo[i]), float(hi[j]), str(lo_lim[i]), str(hi_lim[j]))
@@ -344,10 +418,13 @@ def _analyse(mech, kind, free, values, bounds, step, tol, limits, method, chunk,
         X = np.column_stack([grid[k][idx[k]] for k in range(d)])
         F[s : s + X.shape[0]] = ev.feasible(X)
     F = F.reshape(shape)
+    n_changes = sum(int(np.count_nonzero(np.diff(F, axis=k))) for k in range(d))
+    ev.expected = ev.count + n_changes * (n_halvings + 1)
 
     # ---- boundary refinement along every grid direction
     bpts, blims = [], []
-    extents, method_used = {}, {}
+    extents: dict[str, Extent | None] = {}
+    method_used: dict[str, str] = {}
     volume = 0.0
     for k, c in enumerate(free):
         lines, lo, hi, lo_lim, hi_lim, xin_lo, xin_hi = _refine_runs(ev, F, grid, k, tolv)
@@ -394,7 +471,8 @@ def _analyse(mech, kind, free, values, bounds, step, tol, limits, method, chunk,
         center={c: values[c] for c in free}, bounds={c: tuple(bounds[c]) for c in free},
         grid=grid, feasible=F, alone=alone, alone_intervals=alone_int, extents=extents,
         extent_method=method_used, volume=volume, volume_unit=volume_unit, boundary_points=bp,
-        boundary_limits=tuple(blims), step={c: float(g[1] - g[0]) if g.size > 1 else 0.0 for c, g in zip(free, grid)},
+        boundary_limits=tuple(blims),
+        step={c: float(g[1] - g[0]) if g.size > 1 else 0.0 for c, g in zip(free, grid, strict=True)},
         tol={c: tol[c] for c in free}, n_poses=ev.count, seconds=time.perf_counter() - t0, limits=checker.limits,
     )
 
@@ -420,11 +498,11 @@ def _parse_at(at, allowed: tuple[str, ...], name: str = "at") -> dict[str, float
     if at is None:
         return {}
     if not isinstance(at, Mapping):
-        raise ValueError(f"{name}: expected a mapping of coordinate -> value, got {type(at).__name__}")
+        raise InputError(f"{name}: expected a mapping of coordinate -> value, got {type(at).__name__}")
     out = {}
     for k, v in at.items():
         if k not in allowed:
-            raise ValueError(f"{name}: unknown coordinate {k!r}; expected one of {list(allowed)}")
+            raise InputError(f"{name}: unknown coordinate {k!r}; expected one of {list(allowed)}")
         out[k] = float(as_finite_array(v, f"{name}.{k}", shape=()))
     return out
 
@@ -432,7 +510,7 @@ def _parse_at(at, allowed: tuple[str, ...], name: str = "at") -> dict[str, float
 def _check_positive(value, name: str) -> float:
     v = float(as_finite_array(value, name, shape=()))
     if v <= 0:
-        raise ValueError(f"{name}: must be positive, got {v}")
+        raise InputError(f"{name}: must be positive, got {v}")
     return v
 
 
@@ -440,13 +518,13 @@ def _bounds_of(bounds, free, default) -> dict:
     out = dict(default)
     if bounds is not None:
         if not isinstance(bounds, Mapping):
-            raise ValueError("bounds: expected a mapping of coordinate -> (lower, upper)")
+            raise InputError("bounds: expected a mapping of coordinate -> (lower, upper)")
         for c, v in bounds.items():
             if c not in free:
-                raise ValueError(f"bounds: {c!r} is not a free coordinate ({list(free)})")
+                raise InputError(f"bounds: {c!r} is not a free coordinate ({list(free)})")
             b = as_finite_array(v, f"bounds.{c}", shape=(2,))
             if not b[0] < b[1]:
-                raise ValueError(f"bounds.{c}: expected lower < upper, got {tuple(b)}")
+                raise InputError(f"bounds.{c}: expected lower < upper, got {tuple(b)}")
             out[c] = (float(b[0]), float(b[1]))
     return out
 
@@ -461,7 +539,7 @@ def orientation_workspace(
     bounds: Mapping[str, tuple[float, float]] | None = None,
     method: str = "auto",
     chunk: int = 1 << 15,
-    progress: Callable[[int], None] | None = None,
+    progress: Progress | None = None,
     max_poses: int | None = None,
     polish: bool = True,
 ) -> WorkspaceResult:
@@ -472,21 +550,24 @@ def orientation_workspace(
     (``R = Rz(gamma) Ry(beta) Rx(alpha)``) are sampled over ``bounds`` (default
     ``alpha, gamma in [-pi, pi]``, ``beta in [-pi/2, pi/2]``, which covers SO(3)) with spacing
     ``<= step`` rad and refined to ``tol`` rad.  ``limits`` default to :func:`default_limits`.
-    ``progress(n)`` is called with the number of poses checked by each block (for a progress
-    bar); ``max_poses`` guards the slow general kernel (``ValueError`` when the grid is larger).
+    ``progress(done, None, "checking poses")`` is called after each block with the number of
+    poses checked so far (for a progress bar).  ``max_poses`` bounds the grid (default
+    :data:`MAX_POSES` on the closed-form kernel, :data:`MAX_POSES_GENERAL` on the general one):
+    a larger grid raises :class:`~spatialmech.errors.SearchTooLargeError` (a ``ValueError``)
+    with its size, before any work.
     """
     fixed = _parse_at(at, COORDINATES)
     step = _check_positive(step, "step")
     tol = _check_positive(tol, "tol")
     values = {c: float(mech.platform_point[i]) for i, c in enumerate(_POSITION)}
-    values.update({c: 0.0 for c in _ORIENTATION})
+    values.update(dict.fromkeys(_ORIENTATION, 0.0))
     values.update(fixed)
     free = tuple(c for c in _ORIENTATION if c not in fixed)
     if not free:
-        raise ValueError("at: every angle is fixed; nothing to sample")
+        raise InputError("at: every angle is fixed; nothing to sample")
     default = {"alpha": (-np.pi, np.pi), "beta": (-np.pi / 2, np.pi / 2), "gamma": (-np.pi, np.pi)}
     b = _bounds_of(bounds, free, {c: default[c] for c in free})
-    return _analyse(mech, "orientation", free, values, b, {c: step for c in free}, {c: tol for c in free},
+    return _analyse(mech, "orientation", free, values, b, dict.fromkeys(free, step), dict.fromkeys(free, tol),
                     limits, method, chunk, progress, max_poses, polish)
 
 
@@ -500,7 +581,7 @@ def position_workspace(
     bounds: Mapping[str, tuple[float, float]] | None = None,
     method: str = "auto",
     chunk: int = 1 << 15,
-    progress: Callable[[int], None] | None = None,
+    progress: Progress | None = None,
     max_poses: int | None = None,
     polish: bool = True,
 ) -> WorkspaceResult:
@@ -510,7 +591,7 @@ def position_workspace(
     to hold fixed (a slice).  Coordinates that a limb pins (the CU limb of paper B keeps
     ``x = y = 0``) are fixed automatically on the closed-form path.  Default ``step`` =
     characteristic length / 40, ``tol`` = characteristic length * 1e-6, ``bounds`` = reference
-    point +- 2 characteristic lengths (m).
+    point +- 2 characteristic lengths (m).  ``max_poses`` as in :func:`orientation_workspace`.
     """
     fixed = _parse_at(at, COORDINATES)
     L = mech.characteristic_length
@@ -518,15 +599,15 @@ def position_workspace(
     tol = L * 1e-6 if tol is None else _check_positive(tol, "tol")
     checker_probe = pose_checker(mech, limits, method=method)
     values = {c: float(mech.platform_point[i]) for i, c in enumerate(_POSITION)}
-    values.update({c: 0.0 for c in _ORIENTATION})
+    values.update(dict.fromkeys(_ORIENTATION, 0.0))
     for c, v in checker_probe.pinned.items():
         if c not in fixed:
             fixed[c] = v
     values.update(fixed)
     free = tuple(c for c in _POSITION if c not in fixed)
     if not free:
-        raise ValueError("at: every position coordinate is fixed; nothing to sample")
+        raise InputError("at: every position coordinate is fixed; nothing to sample")
     default = {c: (values[c] - 2 * L, values[c] + 2 * L) for c in free}
     b = _bounds_of(bounds, free, default)
-    return _analyse(mech, "position", free, values, b, {c: step for c in free}, {c: tol for c in free},
+    return _analyse(mech, "position", free, values, b, dict.fromkeys(free, step), dict.fromkeys(free, tol),
                     limits, method, chunk, progress, max_poses, polish)

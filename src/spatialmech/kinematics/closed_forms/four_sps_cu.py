@@ -57,43 +57,51 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.stats import qmc
 
-from ...catalog.papers import FOUR_SPS_CU, four_sps_cu_points
+from ...errors import InputError
 from ...geometry.rotations import euler_matrix, matrix_euler, transform
+from ...geometry.tolerances import current
 from ...geometry.validate import as_finite_array
+from ...results import SolveStatus
+from ...serialize import pose_dict
+from ..assembly import AssemblyKind, SelfMotion, dedup_tolerances, group_roots, pose_keys, singular_threshold, trace_set
 from . import sps
 
 __all__ = [
-    "FourSpsCuGeometry",
-    "PAPER_B",
-    "POSE_ORDER",
+    "CONDITIONING_MEASURE",
+    "DEFAULT_SEED",
     "EULER_SEQUENCE",
-    "rotation",
-    "pose_transform",
-    "leg_vectors",
-    "leg_lengths",
-    "jacobians",
-    "jacobian_x",
-    "jacobian_x_rate",
-    "twist_jacobian",
-    "angular_velocity_matrix",
-    "angular_velocity",
-    "euler_rates",
-    "angular_acceleration",
-    "euler_accelerations",
-    "inverse_velocity",
-    "forward_velocity",
-    "inverse_acceleration",
-    "forward_acceleration",
+    "PAPER_B",
+    "PAPER_B_DIMENSIONS",
+    "POSE_ORDER",
+    "ForwardAllResult",
+    "ForwardBatch",
     "ForwardResult",
     "ForwardSearch",
-    "ForwardAllResult",
+    "FourSpsCuGeometry",
+    "angular_acceleration",
+    "angular_velocity",
+    "angular_velocity_matrix",
+    "attachment_points",
+    "conditioning",
+    "euler_accelerations",
+    "euler_rates",
     "forward",
+    "forward_acceleration",
     "forward_all",
-    "ForwardBatch",
     "forward_batch",
-    "DEFAULT_SEED",
+    "forward_velocity",
+    "geometry_of",
+    "inverse_acceleration",
+    "inverse_velocity",
+    "jacobian_x",
+    "jacobian_x_rate",
+    "jacobians",
+    "leg_lengths",
+    "leg_vectors",
+    "pose_transform",
+    "rotation",
+    "twist_jacobian",
 ]
 
 #: Order of the pose / generalised coordinates: z [m], alpha, beta, gamma [rad].
@@ -110,36 +118,43 @@ _CHUNK = 1 << 14  # poses per block of the vectorised leg-length kernel (fits in
 _TERMS = ("euler", "angular")
 
 
+def attachment_points(a: float, b: float) -> tuple[np.ndarray, np.ndarray]:
+    """Platform points ``A_i = a (s1, s2, 0)`` (platform frame) and base points ``B_i = b (s1, s2, 0)``
+    (4, 3) each, with the sign pattern :data:`SIGNS` (conventions.md)."""
+    signs = np.c_[SIGNS, np.zeros(4)]
+    return float(a) * signs, float(b) * signs
+
+
 @dataclass(frozen=True)
 class FourSpsCuGeometry:
     """Dimensions (m) and limits of the 4-SPS/CU; defaults are paper B, section 6."""
 
-    a: float = FOUR_SPS_CU["a"]
-    b: float = FOUR_SPS_CU["b"]
-    leg_limits: tuple[float, float] = tuple(FOUR_SPS_CU["leg_limits"])
-    z_limits: tuple[float, float] = tuple(FOUR_SPS_CU["cu_limits"])
+    a: float = 0.1
+    b: float = 0.2
+    leg_limits: tuple[float, float] = (0.1, 0.4)
+    z_limits: tuple[float, float] = (0.08, 0.3)
 
     def __post_init__(self):
         for name in ("a", "b"):
             v = as_finite_array(getattr(self, name), name, shape=())
             if v <= 0:
-                raise ValueError(f"{name}: must be positive, got {float(v)}")
+                raise InputError(f"{name}: must be positive, got {float(v)}")
             object.__setattr__(self, name, float(v))
         for name in ("leg_limits", "z_limits"):
             lim = as_finite_array(getattr(self, name), name, shape=(2,))
             if not lim[0] < lim[1]:
-                raise ValueError(f"{name}: expected (lower, upper) with lower < upper, got {tuple(lim)}")
+                raise InputError(f"{name}: expected (lower, upper) with lower < upper, got {tuple(lim)}")
             object.__setattr__(self, name, (float(lim[0]), float(lim[1])))
 
     @property
     def platform_points(self) -> np.ndarray:
         """``A_i`` (4, 3) in the platform frame."""
-        return four_sps_cu_points(self.a, self.b)[0]
+        return attachment_points(self.a, self.b)[0]
 
     @property
     def base_points(self) -> np.ndarray:
         """``B_i`` (4, 3) in the base frame."""
-        return four_sps_cu_points(self.a, self.b)[1]
+        return attachment_points(self.a, self.b)[1]
 
     @property
     def length_scale(self) -> float:
@@ -147,35 +162,41 @@ class FourSpsCuGeometry:
         return self.b
 
     def to_dict(self) -> dict:
-        return {"a_m": self.a, "b_m": self.b, "leg_limits_m": list(self.leg_limits), "z_limits_m": list(self.z_limits)}
+        """JSON (docs/json.md): lengths in the model's unit (``*_len``; paper B: metres)."""
+        return {"a_len": self.a, "b_len": self.b, "leg_limits_len": list(self.leg_limits), "z_limits_len": list(self.z_limits)}
 
 
 #: Paper B, section 6: a = 0.1 m, b = 0.2 m, legs 0.1..0.4 m, CU 0.08..0.3 m.
 PAPER_B = FourSpsCuGeometry()
+#: Paper B, section 6 (m): half-sides ``a`` (platform) and ``b`` (base), the leg-length and CU-length
+#: limits, and ``z0``, the reference height of the ready-made model (``catalog.papers.four_sps_cu``
+#: builds it from these: the catalogue depends on the closed form, not the reverse).
+PAPER_B_DIMENSIONS = {"a": PAPER_B.a, "b": PAPER_B.b, "z0": 0.2, "leg_limits": PAPER_B.leg_limits,
+                      "cu_limits": PAPER_B.z_limits}
 
 
 # ------------------------------------------------------------------ pose and inverse position
 def _phi(phi, name: str = "phi") -> np.ndarray:
     phi = as_finite_array(phi, name)
     if phi.shape[-1:] != (4,):
-        raise ValueError(f"{name}: expected shape (..., 4) ordered (z, alpha, beta, gamma), got {phi.shape}")
+        raise InputError(f"{name}: expected shape (..., 4) ordered (z, alpha, beta, gamma), got {phi.shape}")
     return phi
 
 
 def _vec4(value, name: str, shape: tuple[int, ...]) -> np.ndarray:
     v = as_finite_array(value, name)
     if v.shape[-1:] != (4,):
-        raise ValueError(f"{name}: expected shape (..., 4), got {v.shape}")
+        raise InputError(f"{name}: expected shape (..., 4), got {v.shape}")
     try:
         np.broadcast_shapes(v.shape[:-1], shape)
     except ValueError:
-        raise ValueError(f"{name}: leading shape {v.shape[:-1]} does not broadcast with phi's {shape}") from None
+        raise InputError(f"{name}: leading shape {v.shape[:-1]} does not broadcast with phi's {shape}") from None
     return v
 
 
 def _check_terms(terms: str) -> str:
     if terms not in _TERMS:
-        raise ValueError(f"terms: expected 'euler' (z', Euler-angle rates) or 'angular' (z', omega), got {terms!r}")
+        raise InputError(f"terms: expected 'euler' (z', Euler-angle rates) or 'angular' (z', omega), got {terms!r}")
     return terms
 
 
@@ -188,7 +209,7 @@ def rotation(phi) -> np.ndarray:
 def pose_transform(phi) -> np.ndarray:
     """4x4 pose of the platform frame (eq 7's ``T``), origin at ``(0, 0, z)`` (..., 4, 4)."""
     phi = _phi(phi)
-    p = np.zeros(phi.shape[:-1] + (3,))
+    p = np.zeros((*phi.shape[:-1], 3))
     p[..., 2] = phi[..., 0]
     return transform(rotation(phi), p)
 
@@ -302,7 +323,7 @@ def jacobians(phi, geometry: FourSpsCuGeometry = PAPER_B) -> tuple[np.ndarray, n
     phi = _phi(phi)
     l2, J = _closed_jacobian(phi, geometry.a, geometry.b)
     l = np.sqrt(np.maximum(l2, 0.0))
-    L = np.zeros(phi.shape[:-1] + (4, 4))
+    L = np.zeros((*phi.shape[:-1], 4, 4))
     idx = np.arange(4)
     L[..., idx, idx] = l
     return J, L
@@ -326,7 +347,7 @@ def angular_velocity_matrix(phi) -> np.ndarray:
     phi = _phi(phi)
     _, _, be, ga = np.moveaxis(phi, -1, 0)
     sb, cb, sg, cg = np.sin(be), np.cos(be), np.sin(ga), np.cos(ga)
-    E = np.zeros(phi.shape[:-1] + (3, 3))
+    E = np.zeros((*phi.shape[:-1], 3, 3))
     E[..., 0, 0], E[..., 1, 0], E[..., 2, 0] = cg * cb, sg * cb, -sb
     E[..., 0, 1], E[..., 1, 1] = -sg, cg
     E[..., 2, 2] = 1.0
@@ -339,7 +360,7 @@ def _E_dot(phi: np.ndarray, phidot: np.ndarray) -> np.ndarray:
     _, bd, gd = np.moveaxis(np.asarray(phidot, dtype=float), -1, 0)[1:]
     ez = np.array([0.0, 0.0, 1.0])
     e_a, e_b = E[..., :, 0], E[..., :, 1]
-    Ed = np.zeros(np.broadcast_shapes(E.shape, np.shape(phidot)[:-1] + (3, 3)))
+    Ed = np.zeros(np.broadcast_shapes(E.shape, (*np.shape(phidot)[:-1], 3, 3)))
     Ed[..., :, 0] = np.cross(gd[..., None] * ez + bd[..., None] * e_b, e_a)
     Ed[..., :, 1] = gd[..., None] * np.cross(ez, e_b)
     return Ed
@@ -355,7 +376,7 @@ def angular_velocity(phi, phidot) -> np.ndarray:
 def _E_inverse(phi: np.ndarray) -> np.ndarray:
     cb = np.cos(phi[..., 2])
     if np.any(np.abs(cb) < 1e-12):
-        raise ValueError("phi: cos(beta) = 0 (gimbal lock of the 'ZYX' angles): Euler-angle rates are undefined")
+        raise InputError("phi: cos(beta) = 0 (gimbal lock of the 'ZYX' angles): Euler-angle rates are undefined")
     return np.linalg.inv(angular_velocity_matrix(phi))
 
 
@@ -392,7 +413,7 @@ def _vector_terms(phi: np.ndarray, geometry: FourSpsCuGeometry):
     """``RA_i``, ``c_i = (0,0,z) - B_i``, ``d_i``, ``l_i`` and ``w_i = RA_i x d_i`` (vector form)."""
     R = rotation(phi)
     RA = np.einsum("...ij,nj->...ni", R, geometry.platform_points)
-    c = np.zeros(phi.shape[:-1] + (4, 3)) - geometry.base_points
+    c = np.zeros((*phi.shape[:-1], 4, 3)) - geometry.base_points
     c[..., 2] += phi[..., 0, None]
     d = RA + c
     l = np.linalg.norm(d, axis=-1)
@@ -472,12 +493,12 @@ def _solve(Jm: np.ndarray, rhs: np.ndarray, geometry: FourSpsCuGeometry) -> np.n
     sv = np.linalg.svd(Jm * scale, compute_uv=False)
     if np.any(sv[..., -1] <= 1e-12 * sv[..., 0]):
         worst = float(np.min(sv[..., -1] / sv[..., 0]))
-        raise ValueError(
+        raise InputError(
             f"phi: singular pose (smallest/largest singular value of the Jacobian {worst:.1e}); "
             "the platform rates are not determined by the leg rates"
         )
     shape = np.broadcast_shapes(Jm.shape[:-1], rhs.shape)
-    return np.linalg.solve(np.broadcast_to(Jm, shape + (4,)), np.broadcast_to(rhs, shape)[..., None])[..., 0]
+    return np.linalg.solve(np.broadcast_to(Jm, (*shape, 4)), np.broadcast_to(rhs, shape)[..., None])[..., 0]
 
 
 def forward_velocity(phi, ldot, *, terms: str = "euler", geometry: FourSpsCuGeometry = PAPER_B) -> np.ndarray:
@@ -606,18 +627,44 @@ def _lm_batch(l, seeds, geometry: FourSpsCuGeometry, tol: float, max_iter: int):
     return x, status == 1, iters, residual(), status
 
 
-_STATUS = {0: "max_iter", 1: "converged", 2: "stalled"}
+_STATUS = {0: SolveStatus.MAX_ITER, 1: SolveStatus.CONVERGED, 2: SolveStatus.STALLED}
 
 
 def _canonical(phi: np.ndarray) -> np.ndarray:
     """Same pose with ``beta`` in [-pi/2, pi/2] and ``alpha, gamma`` in (-pi, pi] (from ``R``)."""
-    ang = matrix_euler(EULER_SEQUENCE, rotation(phi))
+    import warnings
+
+    with warnings.catch_warnings():  # at beta = +-pi/2 scipy sets alpha to 0 and says so: intended
+        warnings.filterwarnings("ignore", message="Gimbal lock detected")
+        ang = matrix_euler(EULER_SEQUENCE, rotation(phi))
     return np.concatenate([phi[..., :1], ang[..., ::-1]], axis=-1)
 
 
 def _sigma_min(phi: np.ndarray, geometry: FourSpsCuGeometry) -> np.ndarray:
+    """Smallest singular value of ``Jx`` (Euler-angle rates) with the angle columns divided by b:
+    the conditioning of the solver's equations (it also vanishes at ``beta = +-pi/2``, a gimbal
+    lock of the angles); the mechanism's own is :func:`conditioning`."""
     scale = np.array([1.0, 1.0 / geometry.length_scale, 1.0 / geometry.length_scale, 1.0 / geometry.length_scale])
     return np.linalg.svd(jacobian_x(phi, geometry) * scale, compute_uv=False)[..., -1]
+
+
+#: What :func:`conditioning` measures (stated in every forward-position result).
+CONDITIONING_MEASURE = (
+    "singular values of the leg-rate Jacobian J_omega (l' = J_omega (z', omega)) with the omega columns divided by b: "
+    "zero when the platform can move with the legs held"
+)
+
+
+def conditioning(phi, geometry: FourSpsCuGeometry = PAPER_B) -> tuple[np.ndarray, np.ndarray]:
+    """Conditioning of poses ``phi`` (..., 4) for forward position: ``(sigma_min, condition)``
+    (...,), the smallest singular value and ``sigma_min / sigma_max`` of the nondimensional
+    leg-rate Jacobian (:func:`twist_jacobian`, angular-velocity columns divided by ``b``).
+    Zero exactly where the platform can move with the legs held (every ``alpha = beta = 0``
+    pose); free of the Euler angles' own singularity at ``beta = +-pi/2``."""
+    b = geometry.length_scale
+    J = twist_jacobian(phi, geometry) * np.array([1.0, 1.0 / b, 1.0 / b, 1.0 / b])
+    sv = np.linalg.svd(J, compute_uv=False)
+    return sv[..., -1], np.where(sv[..., 0] > 0, sv[..., -1] / np.where(sv[..., 0] > 0, sv[..., 0], 1.0), 0.0)
 
 
 @dataclass(frozen=True, eq=False)
@@ -625,69 +672,103 @@ class ForwardResult:
     """One forward-position solution (or failed attempt) of the 4-SPS/CU.
 
     ``phi`` = ``(z [m], alpha, beta, gamma [rad])``, ``R = Rz(gamma) Ry(beta) Rx(alpha)``;
-    ``residual`` = ``max_i |l_i(phi) - l_i|`` in metres; ``sigma_min`` = smallest singular value
-    of ``Jx`` with the angle columns divided by ``b`` (0 at a singularity); ``within_limits``
-    checks leg lengths and the CU length ``z`` only (not the joint angles of eqs 18-21).
+    ``residual`` = ``max_i |l_i(phi) - l_i|`` in metres; ``sigma_min`` and ``condition`` (=
+    sigma_min / sigma_max) of :func:`conditioning` (0 at a singularity), ``singular`` below
+    ``singular_below``; ``kind`` (regular, singular, self-motion: see
+    :mod:`spatialmech.kinematics.assembly`), ``members`` (converged seeds standing for this
+    result); ``within_limits`` checks leg lengths and the CU length ``z`` only (not the joint
+    angles of eqs 18-21).
     """
 
     phi: np.ndarray
     leg_lengths: np.ndarray
     converged: bool
-    status: str
+    status: SolveStatus
     iterations: int
     residual: float
     legs_within_limits: bool
     z_within_limits: bool
     sigma_min: float
     seed: np.ndarray
+    length_scale: float = 1.0  # b: the nondimensional residual in JSON is residual / length_scale
+    leg_limits: tuple[float, float] | None = None  # to name the legs outside their limits
+    condition: float = 0.0  # sigma_min / sigma_max
+    singular_below: float = 0.0  # sigma_min threshold of ``singular``
+    kind: AssemblyKind | None = None  # None for a failed attempt
+    members: int = 1
+    self_motion: SelfMotion | None = None
 
     @property
     def within_limits(self) -> bool:
         return self.legs_within_limits and self.z_within_limits
 
     @property
+    def singular(self) -> bool:
+        return bool(self.sigma_min < self.singular_below)
+
+    @property
     def rotation(self) -> np.ndarray:
         return rotation(self.phi)
 
-    def to_dict(self) -> dict:
-        z, al, be, ga = (float(v) for v in self.phi)
+    def to_dict(self, *, actuators=None) -> dict:
+        """JSON (docs/json.md), the same fields as the general engine's forward solutions
+        (:meth:`spatialmech.kinematics.position.ForwardSolution.to_dict`): the pose as the
+        platform point ``(0, 0, z)``, ``euler_deg`` of "ZYX" = ``(gamma, beta, alpha)`` in
+        degrees and the rotation matrix; ``residual`` = largest leg-length error / ``b``;
+        ``outside_limits`` names the legs (``actuators``, default ``l1..l4``) and ``"z"`` (the
+        CU length) outside their limits (joint-angle limits of eqs 18-21 are not checked)."""
+        names = _leg_names(actuators)
+        if self.leg_limits is not None:
+            lo, hi = self.leg_limits
+            outside = [n for n, l in zip(names, self.leg_lengths, strict=True) if not lo <= l <= hi]
+        else:
+            outside = [] if self.legs_within_limits else list(names)
+        if not self.z_within_limits:
+            outside.append("z")
         return {
-            "z_m": z,
-            "alpha_rad": al,
-            "beta_rad": be,
-            "gamma_rad": ga,
-            "euler_sequence": "ZYX: R = Rz(gamma) Ry(beta) Rx(alpha)",
-            "leg_lengths_m": [float(v) for v in self.leg_lengths],
+            "status": str(self.status),
             "converged": bool(self.converged),
-            "status": self.status,
             "iterations": int(self.iterations),
-            "residual_m": float(self.residual),
+            "residual": float(self.residual) / self.length_scale,
+            "pose": pose_dict(self.rotation, [0.0, 0.0, float(self.phi[0])]),
             "within_limits": bool(self.within_limits),
-            "legs_within_limits": bool(self.legs_within_limits),
-            "z_within_limits": bool(self.z_within_limits),
-            "limits_checked": "leg lengths and CU length z (joint-angle limits of eqs 18-21 not checked)",
+            "outside_limits": outside,
             "sigma_min": float(self.sigma_min),
-            "seed": [float(v) for v in self.seed],
+            "singular": self.singular,
+            "condition": float(self.condition),
+            "singular_below": float(self.singular_below),
+            "conditioning_measure": CONDITIONING_MEASURE,
+            "kind": str(self.kind) if self.kind is not None else None,
+            "members": int(self.members),
+            "self_motion": self.self_motion.to_dict() if self.self_motion is not None else None,
         }
+
+
+def _leg_names(actuators) -> list[str]:
+    names = ["l1", "l2", "l3", "l4"] if actuators is None else [str(a) for a in actuators]
+    if len(names) != 4:
+        raise InputError(f"actuators: expected the 4 leg names, got {names}")
+    return names
 
 
 def _check_solver(tol: float, max_iter: int) -> None:
     if not (np.isfinite(tol) and tol > 0):
-        raise ValueError(f"tol: expected a positive tolerance in metres, got {tol}")
+        raise InputError(f"tol: expected a positive tolerance in metres, got {tol}")
     if int(max_iter) != max_iter or max_iter < 1:
-        raise ValueError(f"max_iter: expected a positive integer, got {max_iter}")
+        raise InputError(f"max_iter: expected a positive integer, got {max_iter}")
 
 
 def _leg_input(l, geometry: FourSpsCuGeometry) -> np.ndarray:
     l = as_finite_array(l, "l", shape=(4,))
     if np.any(l <= 0):
-        raise ValueError(f"l: leg lengths must be positive, got {l.tolist()}")
+        raise InputError(f"l: leg lengths must be positive, got {l.tolist()}")
     return l
 
 
-def _results(l, phi, conv, iters, res, status, seeds, geometry) -> list[ForwardResult]:
+def _results(l, phi, conv, iters, res, status, seeds, geometry, tol) -> list[ForwardResult]:
     legs_ok = bool(np.all((l >= geometry.leg_limits[0]) & (l <= geometry.leg_limits[1])))
-    sig = _sigma_min(phi, geometry)
+    sig, cond = conditioning(phi, geometry) if phi.shape[0] else (np.zeros(0), np.zeros(0))
+    thr = singular_threshold(tol / geometry.length_scale)
     out = []
     for i in range(phi.shape[0]):
         z = phi[i, 0]
@@ -703,9 +784,95 @@ def _results(l, phi, conv, iters, res, status, seeds, geometry) -> list[ForwardR
                 z_within_limits=bool(geometry.z_limits[0] <= z <= geometry.z_limits[1]),
                 sigma_min=float(sig[i]),
                 seed=np.asarray(seeds[i], dtype=float).copy(),
+                length_scale=geometry.length_scale,
+                leg_limits=geometry.leg_limits,
+                condition=float(cond[i]),
+                singular_below=thr,
             )
         )
     return out
+
+
+def _key(phi: np.ndarray, geometry: FourSpsCuGeometry) -> np.ndarray:
+    """Scale-free pose coordinates (..., 12) of ``phi``: platform point ``(0, 0, z) / b`` and ``R``."""
+    p = np.zeros((*phi.shape[:-1], 3))
+    p[..., 2] = phi[..., 0]
+    return pose_keys(rotation(phi), p, geometry.length_scale)
+
+
+class _LegProblem:
+    """The poses with the legs held at ``l``, as a tracking problem (see
+    :mod:`spatialmech.kinematics.tracking`): state ``(z, R)``, local coordinates
+    ``(dz / b, omega)`` (rotation vector in the base frame), residual ``(|d_i|^2 - l_i^2) / (2 b^2)``
+    with ``d_i = R A_i + (0, 0, z) - B_i``.  Free of the Euler angles' gimbal lock."""
+
+    def __init__(self, l, geometry: FourSpsCuGeometry):
+        self.l2 = np.asarray(l, dtype=float) ** 2
+        self.g = geometry
+        self.b = geometry.length_scale
+
+    def _d(self, x):
+        z, R = x
+        RA = self.g.platform_points @ R.T
+        d = RA - self.g.base_points
+        d[:, 2] += z
+        return RA, d
+
+    def residual(self, x):
+        _, d = self._d(x)
+        return (np.sum(d * d, axis=1) - self.l2) / (2 * self.b * self.b)
+
+    def jacobian(self, x):
+        RA, d = self._d(x)
+        return np.c_[d[:, 2] * self.b, np.cross(RA, d)] / (self.b * self.b)
+
+    def retract(self, x, dx):
+        from scipy.spatial.transform import Rotation
+
+        z, R = x
+        R2 = Rotation.from_rotvec(np.asarray(dx[1:], dtype=float)).as_matrix() @ R
+        return (z + self.b * float(dx[0]), R2)
+
+    def difference(self, x, y):
+        from scipy.spatial.transform import Rotation
+
+        return np.r_[(y[0] - x[0]) / self.b, Rotation.from_matrix(y[1] @ x[1].T).as_rotvec()]
+
+    def tangent(self, x):
+        return np.linalg.svd(self.jacobian(x))[2][-1]
+
+
+def _trace(l, phi0: np.ndarray, geometry: FourSpsCuGeometry):
+    """Follow the solution set of ``l(phi) = l`` through the singular root ``phi0`` (a self-motion
+    of the platform with the legs held), on ``(z, R)`` (no Euler-angle singularity)."""
+
+    def key(x):
+        return pose_keys(x[1], [0.0, 0.0, x[0]], geometry.length_scale)
+
+    return trace_set(_LegProblem(l, geometry), (float(phi0[0]), rotation(phi0)), key, h0=0.02, h_max=0.1, max_steps=800)
+
+
+def _classify(l, sols: list[ForwardResult], geometry: FourSpsCuGeometry, tol: float,
+              dedup_tol: float | None = None) -> list[ForwardResult]:
+    """The converged roots ``sols`` as results: duplicates merged, roots on one self-motion one
+    result (:func:`spatialmech.kinematics.assembly.group_roots`), each with its kind and members."""
+    from dataclasses import replace
+
+    if not sols:
+        return []
+    phis = np.array([s.phi for s in sols])
+    keys = _key(phis, geometry)
+    dedup, sdedup = dedup_tolerances(tol / geometry.length_scale)
+    if dedup_tol is not None:
+        dedup = float(dedup_tol)
+    b = geometry.length_scale
+    sv = np.linalg.svd(twist_jacobian(phis, geometry) * np.array([1.0, 1.0 / b, 1.0 / b, 1.0 / b]), compute_uv=False)
+    free = [int(np.sum(row < s.singular_below)) for row, s in zip(sv, sols, strict=True)]
+    groups = group_roots(keys, [s.singular for s in sols], [s.residual for s in sols],
+                         lambda i: _trace(l, phis[i], geometry), dedup_tol=dedup, singular_dedup_tol=max(sdedup, dedup),
+                         prefer=[s.within_limits for s in sols], free_dims=free)
+    return [replace(sols[g.rep], kind=g.kind, members=len(g.members), self_motion=g.self_motion(keys, geometry.length_scale))
+            for g in groups]
 
 
 def forward(
@@ -721,7 +888,8 @@ def forward(
 
     Converged means ``max_i |l_i(phi) - l_i| <= tol`` (metres); otherwise ``status`` is
     ``"max_iter"`` or ``"stalled"`` and ``phi`` is the last iterate (never a silent wrong
-    answer).  The angles are returned canonical (``|beta| <= pi/2``).  Do not seed at
+    answer).  The angles are returned canonical (``|beta| <= pi/2``).  The result states its
+    conditioning; a singular root is followed along its self-motion (``kind``).  Do not seed at
     ``alpha = beta = 0`` (singular).  Near a fold of the forward map two assembly modes lie
     close together (e.g. 0.045 rad apart) and the mode reached depends on the seed; it is
     always a genuine mode (:func:`forward_all` lists them all).
@@ -730,7 +898,8 @@ def forward(
     seed = as_finite_array(seed, "seed", shape=(4,))
     _check_solver(tol, max_iter)
     phi, conv, iters, res, status = _lm_batch(l, seed[None], geometry, tol, max_iter)
-    return _results(l, _canonical(phi), conv, iters, res, status, seed[None], geometry)[0]
+    out = _results(l, _canonical(phi), conv, iters, res, status, seed[None], geometry, tol)[0]
+    return _classify(l, [out], geometry, tol)[0] if out.converged else out
 
 
 @dataclass(frozen=True, eq=False)
@@ -739,25 +908,38 @@ class ForwardBatch:
 
     ``phi`` (k, 4) canonical ``(z [m], alpha, beta, gamma [rad])``; ``converged`` (k,);
     ``iterations`` (k,); ``residual`` (k,) = ``max_i |l_i(phi) - l_i|`` in metres; ``status``
-    (k,) of "converged" / "max_iter" / "stalled"; ``within_limits`` (k,) (leg and CU lengths).
+    (k,) of "converged" / "max_iter" / "stalled"; ``within_limits`` (k,) (leg and CU lengths);
+    the conditioning of each row (:func:`conditioning`: ``sigma_min``, ``condition``, and
+    ``singular``; self-motions are not traced here, see :func:`forward_all`).
     """
 
     phi: np.ndarray
     converged: np.ndarray
     iterations: np.ndarray
     residual: np.ndarray
-    status: tuple[str, ...]
+    status: tuple[SolveStatus, ...]
     within_limits: np.ndarray
+    sigma_min: np.ndarray | None = None  # (k,) of :func:`conditioning`
+    condition: np.ndarray | None = None  # (k,) sigma_min / sigma_max
+    singular: np.ndarray | None = None  # (k,) sigma_min below the singular threshold
 
     def to_dict(self) -> dict:
+        """JSON (docs/json.md): one row per pair; ``z_len`` and the angles in degrees,
+        ``R = Rz(gamma) Ry(beta) Rx(alpha)``."""
         return {
-            "phi_order": "z [m], alpha, beta, gamma [rad]; R = Rz(gamma) Ry(beta) Rx(alpha)",
-            "phi": self.phi.tolist(),
+            "euler_sequence": EULER_SEQUENCE,
+            "z_len": self.phi[:, 0].tolist(),
+            "alpha_deg": np.degrees(self.phi[:, 1]).tolist(),
+            "beta_deg": np.degrees(self.phi[:, 2]).tolist(),
+            "gamma_deg": np.degrees(self.phi[:, 3]).tolist(),
             "converged": self.converged.tolist(),
             "iterations": self.iterations.tolist(),
-            "residual_m": self.residual.tolist(),
-            "status": list(self.status),
+            "residual_len": self.residual.tolist(),
+            "status": [str(v) for v in self.status],
             "within_limits": self.within_limits.tolist(),
+            "sigma_min": None if self.sigma_min is None else self.sigma_min.tolist(),
+            "condition": None if self.condition is None else self.condition.tolist(),
+            "singular": None if self.singular is None else self.singular.tolist(),
         }
 
 
@@ -776,19 +958,21 @@ def forward_batch(
     """
     seeds = as_finite_array(seeds, "seeds")
     if seeds.ndim != 2 or seeds.shape[1] != 4:
-        raise ValueError(f"seeds: expected shape (k, 4) ordered (z, alpha, beta, gamma), got {seeds.shape}")
+        raise InputError(f"seeds: expected shape (k, 4) ordered (z, alpha, beta, gamma), got {seeds.shape}")
     l = as_finite_array(l, "l")
     if l.shape not in ((4,), seeds.shape):
-        raise ValueError(f"l: expected shape (4,) or {seeds.shape} like seeds, got {l.shape}")
+        raise InputError(f"l: expected shape (4,) or {seeds.shape} like seeds, got {l.shape}")
     if np.any(l <= 0):
-        raise ValueError("l: leg lengths must be positive")
+        raise InputError("l: leg lengths must be positive")
     _check_solver(tol, max_iter)
     phi, conv, iters, res, status = _lm_batch(l, seeds, geometry, tol, max_iter)
     phi = _canonical(phi)
     lb = np.broadcast_to(l, seeds.shape)
     legs_ok = np.all((lb >= geometry.leg_limits[0]) & (lb <= geometry.leg_limits[1]), axis=-1)
     z_ok = (phi[:, 0] >= geometry.z_limits[0]) & (phi[:, 0] <= geometry.z_limits[1])
-    return ForwardBatch(phi, conv, iters, res, tuple(_STATUS[int(c)] for c in status), legs_ok & z_ok)
+    sig, cond = conditioning(phi, geometry)
+    sing = sig < singular_threshold(tol / geometry.length_scale)
+    return ForwardBatch(phi, conv, iters, res, tuple(_STATUS[int(c)] for c in status), legs_ok & z_ok, sig, cond, sing)
 
 
 @dataclass(frozen=True)
@@ -805,19 +989,32 @@ class ForwardSearch:
     n_converged: int
     n_distinct: int
     hits: tuple[int, ...] = field(default=())  # seeds that converged to each distinct solution
+    n_regular: int = 0
+    n_singular: int = 0  # isolated singular roots (assembly modes meeting)
+    n_self_motion_sets: int = 0  # continua of poses with the legs held
 
     def to_dict(self) -> dict:
+        """JSON (docs/json.md): the search box in the model's length unit and degrees."""
+        box = {}
+        for k, (lo, hi) in self.box.items():
+            name, unit = k.rsplit("_", 1)
+            box[f"{name}_deg" if unit == "rad" else f"{name}_len"] = (
+                [float(np.degrees(lo)), float(np.degrees(hi))] if unit == "rad" else [float(lo), float(hi)])
         return {
             "method": self.method,
             "sequence": self.sequence,
             "n_seeds": self.n_seeds,
-            "box": {k: [float(v[0]), float(v[1])] for k, v in self.box.items()},
-            "tol_m": self.tol_m,
+            "box": box,
+            "tol_len": self.tol_m,
             "max_iter": self.max_iter,
             "dedup_tol": self.dedup_tol,
             "n_converged": self.n_converged,
             "n_distinct": self.n_distinct,
             "hits": list(self.hits),
+            "n_regular": self.n_regular,
+            "n_singular": self.n_singular,
+            "n_self_motion_sets": self.n_self_motion_sets,
+            "limits_checked": "leg lengths and CU length z (joint-angle limits of eqs 18-21 not checked)",
         }
 
 
@@ -837,12 +1034,19 @@ class ForwardAllResult:
     def phis(self) -> np.ndarray:
         return np.array([s.phi for s in self.solutions]).reshape(-1, 4)
 
-    def to_dict(self) -> dict:
+    def to_dict(self, *, actuators=None) -> dict:
+        """JSON (docs/json.md), the same fields as the general engine's
+        (:meth:`spatialmech.kinematics.position.ForwardResult.to_dict`): the leg lengths held as
+        ``actuators_len`` (named by ``actuators``, default ``l1..l4``), the distinct assembly
+        modes and the search."""
+        names = _leg_names(actuators)
         return {
-            "leg_lengths_m": [float(v) for v in self.leg_lengths],
+            "method": "closed form of the 4-SPS/CU (kinematics/closed_forms/four_sps_cu.py)",
+            "actuators_deg": {},
+            "actuators_len": {n: float(v) for n, v in zip(names, self.leg_lengths, strict=True)},
             "n_solutions": len(self.solutions),
             "n_within_limits": self.n_within_limits,
-            "solutions": [s.to_dict() for s in self.solutions],
+            "solutions": [s.to_dict(actuators=names) for s in self.solutions],
             "search": self.search.to_dict(),
         }
 
@@ -855,7 +1059,7 @@ def forward_all(
     qmc_seed: int = 0,
     tol: float = 1e-12,
     max_iter: int = 500,
-    dedup_tol: float = 1e-6,
+    dedup_tol: float | None = None,
 ) -> ForwardAllResult:
     """All real assembly modes it can find for leg lengths ``l`` (4,) [m].
 
@@ -863,11 +1067,13 @@ def forward_all(
     (``scipy.stats.qmc``, seed ``qmc_seed``) over the box ``|z| <= max(l) + sqrt(2) a`` (every
     root lies inside: ``|z| <= l_i + |R A_i|``), ``alpha, gamma`` in ``[-pi, pi]``, ``beta`` in
     ``[-pi/2, pi/2]`` (this covers every orientation), each solved by the vectorised
-    Levenberg-Marquardt iteration of :func:`forward`; converged roots are de-duplicated on
-    ``(z / b, R)`` with the max-norm tolerance ``dedup_tol``.  Mirror roots ``(-z, -alpha,
+    Levenberg-Marquardt iteration of :func:`forward`; converged roots closer than ``dedup_tol``
+    (default: the ``dedup`` tolerance) in scale-free pose distance are one; singular roots
+    are followed along their self-motion with the legs held and all roots on one continuum are
+    one result of kind ``self-motion`` (:mod:`spatialmech.kinematics.assembly`).  Mirror roots ``(-z, -alpha,
     -beta, gamma)`` are real assembly modes too and are reported (outside the CU limits).
     A multi-seed search cannot prove completeness: ``search.hits`` says how many seeds reached
-    each root.  Roots near the singular set ``alpha = beta = 0`` are reached slowly (LM
+    each result.  Roots near the singular set ``alpha = beta = 0`` are reached slowly (LM
     converges linearly in their narrow valleys), hence the larger default ``max_iter``; e.g.
     for the legs of ``(0.256, 0.0085, 0.0077, -0.791)`` 256 seeds find all 8 roots with
     ``max_iter=500`` but only 5 with 200.  Solutions are sorted: within limits first, then by decreasing ``z``.
@@ -875,7 +1081,7 @@ def forward_all(
     l = _leg_input(l, geometry)
     _check_solver(tol, max_iter)
     if int(n_seeds) < 1:
-        raise ValueError(f"n_seeds: expected a positive integer, got {n_seeds}")
+        raise InputError(f"n_seeds: expected a positive integer, got {n_seeds}")
     n_seeds = int(n_seeds)
     zmax = float(np.max(l) + np.sqrt(2.0) * geometry.a)
     box = {
@@ -886,66 +1092,97 @@ def forward_all(
     }
     lo = np.array([v[0] for v in box.values()])
     hi = np.array([v[1] for v in box.values()])
+    from scipy.stats import qmc  # imported here: scipy.stats is slow to import
+
     u = qmc.Halton(d=4, scramble=True, seed=qmc_seed).random(n_seeds)
     seeds = lo + u * (hi - lo)
     phi, conv, iters, res, status = _lm_batch(l, seeds, geometry, tol, max_iter)
     idx = np.flatnonzero(conv)
     canon = _canonical(phi[idx]) if idx.size else np.zeros((0, 4))
-    keys = np.concatenate([canon[:, :1] / geometry.length_scale, rotation(canon).reshape(-1, 9)], axis=1)
-    reps: list[int] = []  # positions in idx of the representatives
-    hits: list[int] = []
-    for j in range(idx.size):
-        for r, rep in enumerate(reps):
-            if np.max(np.abs(keys[j] - keys[rep])) <= dedup_tol:
-                hits[r] += 1
-                if res[idx[j]] < res[idx[rep]]:
-                    reps[r] = j
-                break
-        else:
-            reps.append(j)
-            hits.append(1)
-    chosen = idx[reps] if reps else np.zeros(0, dtype=int)
-    sols = _results(l, canon[reps] if reps else np.zeros((0, 4)), conv[chosen], iters[chosen], res[chosen],
-                    status[chosen], seeds[chosen], geometry)
+    roots = _results(l, canon, conv[idx], iters[idx], res[idx], status[idx], seeds[idx], geometry, tol)
+    dedup = current().dedup if dedup_tol is None else float(dedup_tol)
+    sols = _classify(l, roots, geometry, tol, dedup)
     order = sorted(range(len(sols)), key=lambda i: (not sols[i].within_limits, -sols[i].phi[0]))
+    kinds = [s.kind for s in sols]
     search = ForwardSearch(
-        method="multi-seed Levenberg-Marquardt (batched, Nielsen damping) on (l(phi)^2 - l^2)/2 = 0, "
-        "de-duplicated on (z/b, R)",
+        method="multi-seed Levenberg-Marquardt (batched, Nielsen damping) on (l(phi)^2 - l^2)/2 = 0; roots "
+        "de-duplicated by pose distance sqrt(|dz / b|^2 + (2 sin(theta / 2))^2), singular roots on one traced "
+        "self-motion counted once",
         sequence=f"scrambled Halton (scipy.stats.qmc), seed {qmc_seed}",
         n_seeds=n_seeds,
         box=box,
         tol_m=tol,
         max_iter=max_iter,
-        dedup_tol=dedup_tol,
+        dedup_tol=dedup,
         n_converged=int(idx.size),
         n_distinct=len(sols),
-        hits=tuple(hits[i] for i in order),
+        hits=tuple(sols[i].members for i in order),
+        n_regular=kinds.count(AssemblyKind.REGULAR),
+        n_singular=kinds.count(AssemblyKind.SINGULAR),
+        n_self_motion_sets=kinds.count(AssemblyKind.SELF_MOTION),
     )
     return ForwardAllResult(l.copy(), tuple(sols[i] for i in order), search)
 
 
 def geometry_of(mech) -> FourSpsCuGeometry | None:
-    """The closed-form geometry of a mechanism when it *is* a 4-SPS/CU of paper B's layout (same
-    joint screws as ``catalog.papers.four_sps_cu(a, b, z0)`` with its limits), else ``None``.
+    """The closed-form geometry of a mechanism when it *is* a 4-SPS/CU of paper B's layout, read
+    from the mechanism itself, else ``None``: four S-P-S legs from ``B_i = b (s1, s2, 0)`` to
+    ``A_i + (0, 0, z0)``, ``A_i = a (s1, s2, 0)`` (:func:`attachment_points`), each P freedom
+    along its leg, actuated, its value the leg length (``offset`` = the reference length) and the
+    same limits on all four, the actuators exactly these four in leg order; a C-U limb: C along
+    +Z through the Z axis with the slide's value the height ``z`` (its limits the CU limits), U at
+    ``(0, 0, z0)`` about Y then X; platform point ``(0, 0, z0)``.
 
     Lets general commands use the closed forms on a matching model (e.g. a file exported from
-    the ready-made one) and fall back to the general engine on anything else."""
-    from ...catalog.papers import four_sps_cu as build
-    from ..closure import reference_screws
-
+    the ready-made one) and fall back to the general engine on anything else.  (The catalogue's
+    ``four_sps_cu`` builds its model from :data:`PAPER_B_DIMENSIONS` and :func:`attachment_points`;
+    this module does not depend on the catalogue.)"""
     try:
-        if len(mech.limbs) != 5 or [len(l.joints) for l in mech.limbs] != [3, 3, 3, 3, 2]:
+        limbs = mech.limbs
+        if [tuple(j.type for j in limb.joints) for limb in limbs] != [("S", "P", "S")] * 4 + [("C", "U")]:
             return None
-        A1 = mech.limbs[0].joints[2].point
-        B1 = mech.limbs[0].joints[0].point
+        A1, B1 = np.asarray(limbs[0].joints[2].point, float), np.asarray(limbs[0].joints[0].point, float)
         a, b, z0 = float(A1[0]), float(B1[0]), float(A1[2])
-        ref = build(a=a, b=b, z0=z0)
-        if not np.allclose(reference_screws(ref), reference_screws(mech), atol=1e-12):
+        if not (a > 0 and b > 0):
             return None
-        legs = mech.limbs[0].joints[1].freedoms[0].limits
-        cu = mech.limbs[4].joints[0].freedoms[1].limits
-        if legs is None or cu is None:
+        tol = 1e-9 * max(a, b, abs(z0))
+
+        def near(u, v, t=tol) -> bool:
+            return bool(np.all(np.abs(np.asarray(u, float) - np.asarray(v, float)) <= t))
+
+        A, B = attachment_points(a, b)
+        top = np.array([0.0, 0.0, z0])
+        leg_limits, act_ids = None, []
+        for i in range(4):
+            bj, pj, aj = limbs[i].joints
+            d = A[i] + top - B[i]
+            length = float(np.linalg.norm(d))
+            f = pj.freedoms[0]
+            if not (near(bj.point, B[i]) and near(aj.point, A[i] + top) and near(f.direction, d / length, 1e-9)):
+                return None
+            if not f.actuated or f.locked or f.limits is None or abs(f.offset - length) > tol:
+                return None
+            if leg_limits is None:
+                leg_limits = tuple(f.limits)
+            elif not near(f.limits, leg_limits, 0.0):
+                return None
+            act_ids.append(f"{pj.name}.{f.name}")
+        cj, uj = limbs[4].joints
+        rot, slide = cj.freedoms
+        ez = np.array([0.0, 0.0, 1.0])
+        if not (near(cj.point[:2], [0.0, 0.0]) and near(rot.direction, ez, 1e-9) and near(slide.direction, ez, 1e-9)):
             return None
-        return FourSpsCuGeometry(a=a, b=b, leg_limits=tuple(legs), z_limits=tuple(cu))
-    except (IndexError, ValueError):
+        if slide.limits is None or abs(slide.offset - z0) > tol:
+            return None
+        if any(f.actuated or f.locked for f in (*cj.freedoms, *uj.freedoms)):
+            return None
+        if not (near(uj.point, top) and near(uj.freedoms[0].direction, [0.0, 1.0, 0.0], 1e-9)
+                and near(uj.freedoms[1].direction, [1.0, 0.0, 0.0], 1e-9) and near(mech.platform_point, top)):
+            return None
+        if list(mech.actuators) != act_ids:
+            return None
+        assert leg_limits is not None
+        return FourSpsCuGeometry(a=a, b=b, leg_limits=(float(leg_limits[0]), float(leg_limits[1])),
+                                 z_limits=(float(slide.limits[0]), float(slide.limits[1])))
+    except (AttributeError, IndexError, TypeError, ValueError):
         return None

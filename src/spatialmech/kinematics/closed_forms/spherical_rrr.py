@@ -51,23 +51,24 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from ...errors import InputError
 from ...geometry.rotations import euler_matrix, matrix_euler
 from ...geometry.validate import as_finite_array
 
 __all__ = [
     "EULER_SEQ",
     "LIMB_AXES",
-    "orientation",
-    "euler_angles",
+    "ForwardOrientation",
     "actuator_angles",
     "actuator_angles_from_matrix",
-    "euler_rate_matrix",
     "angular_velocity_jacobian",
+    "euler_angles",
     "euler_rate_jacobian",
-    "limb_conditioning",
-    "platform_angular_velocity",
-    "ForwardOrientation",
+    "euler_rate_matrix",
     "forward_orientation",
+    "limb_conditioning",
+    "orientation",
+    "platform_angular_velocity",
 ]
 
 #: Paper C's Euler sequence (intrinsic Y-X'-Z''): angles passed as ``(beta, alpha, gamma)``.
@@ -89,7 +90,7 @@ def _angles(alpha, beta, gamma):
     try:
         return np.broadcast_arrays(a, b, g)
     except ValueError:
-        raise ValueError(
+        raise InputError(
             f"alpha, beta, gamma: shapes {a.shape}, {b.shape}, {g.shape} do not broadcast"
         ) from None
 
@@ -97,10 +98,10 @@ def _angles(alpha, beta, gamma):
 def _rotations(R, name: str = "R") -> np.ndarray:
     R = as_finite_array(R, name)
     if R.shape[-2:] != (3, 3):
-        raise ValueError(f"{name}: expected shape (..., 3, 3), got {R.shape}")
+        raise InputError(f"{name}: expected shape (..., 3, 3), got {R.shape}")
     err = np.max(np.abs(np.swapaxes(R, -1, -2) @ R - np.eye(3)), initial=0.0)
     if err > 1e-6 or np.any(np.linalg.det(R) < 0):
-        raise ValueError(f"{name}: not a rotation matrix (orthonormal with det +1); error {err:.3g}")
+        raise InputError(f"{name}: not a rotation matrix (orthonormal with det +1); error {err:.3g}")
     return R
 
 
@@ -209,7 +210,7 @@ def euler_rate_matrix(alpha, beta, gamma) -> np.ndarray:
     Columns: ``Ry(beta) x`` (alpha), ``y`` (beta), ``Ry(beta) Rx(alpha) z`` (gamma).  Singular
     when ``cos(alpha) = 0`` (gimbal lock of the Y-X-Z sequence).
     """
-    a, b, g = _angles(alpha, beta, gamma)
+    a, b, _g = _angles(alpha, beta, gamma)
     sa, ca, sb, cb = np.sin(a), np.cos(a), np.sin(b), np.cos(b)
     z, o = np.zeros_like(a), np.ones_like(a)
     col_a = np.stack([cb, z, -sb], axis=-1)
@@ -240,10 +241,10 @@ def platform_angular_velocity(R, theta_dot) -> np.ndarray:
     R = _rotations(R)
     td = as_finite_array(theta_dot, "theta_dot")
     if td.shape[-1:] != (3,):
-        raise ValueError(f"theta_dot: expected shape (..., 3), got {td.shape}")
+        raise InputError(f"theta_dot: expected shape (..., 3), got {td.shape}")
     J = angular_velocity_jacobian(R)
     if not np.all(np.isfinite(J)) or np.any(np.abs(np.linalg.det(J)) < 1e-12):
-        raise ValueError("R: the mechanism is singular at this orientation (J_omega not invertible)")
+        raise InputError("R: the mechanism is singular at this orientation (J_omega not invertible)")
     return np.linalg.solve(J, td[..., None])[..., 0]
 
 
@@ -287,13 +288,13 @@ class ForwardOrientation:
         )
 
     def to_dict(self) -> dict:
+        """JSON (docs/json.md): angles in degrees (``alpha_deg`` ...), the rotation matrix."""
         return {
-            "R": np.asarray(self.R).tolist(),
+            "rotation_matrix": np.asarray(self.R).tolist(),
             "euler_sequence": f"{EULER_SEQ} (R = Ry(beta) Rx(alpha) Rz(gamma))",
-            "units": "rad",
-            "alpha": np.asarray(self.alpha).tolist(),
-            "beta": np.asarray(self.beta).tolist(),
-            "gamma": np.asarray(self.gamma).tolist(),
+            "alpha_deg": np.degrees(np.asarray(self.alpha)).tolist(),
+            "beta_deg": np.degrees(np.asarray(self.beta)).tolist(),
+            "gamma_deg": np.degrees(np.asarray(self.gamma)).tolist(),
             "converged": np.asarray(self.converged).tolist(),
             "residual": np.asarray(self.residual).tolist(),
             "on_home_branch": np.asarray(self.on_home_branch).tolist(),
@@ -325,7 +326,7 @@ def _newton(R, theta, tol, max_iter):
         nrm = np.linalg.norm(dw, axis=-1, keepdims=True)
         dw = dw * np.minimum(1.0, 0.5 / np.maximum(nrm, 1e-300))
         dw = np.where((res < tol)[..., None], 0.0, dw)
-        R = Rotation.from_rotvec(dw.reshape(-1, 3)).as_matrix().reshape(dw.shape + (3,)) @ R
+        R = Rotation.from_rotvec(dw.reshape(-1, 3)).as_matrix().reshape((*dw.shape, 3)) @ R
     return R, res, its
 
 
@@ -348,21 +349,21 @@ def forward_orientation(
     """
     th = as_finite_array(theta, "theta")
     if th.shape[-1:] != (3,):
-        raise ValueError(f"theta: expected shape (..., 3), got {th.shape}")
+        raise InputError(f"theta: expected shape (..., 3), got {th.shape}")
     if along_path and th.ndim != 2:
-        raise ValueError(f"theta: along_path needs shape (n, 3), got {th.shape}")
+        raise InputError(f"theta: along_path needs shape (n, 3), got {th.shape}")
     R0 = np.eye(3) if R0 is None else _rotations(R0, "R0")
     if along_path:
-        Rs, res, total = [], [], 0
+        Rs, rs, total = [], [], 0
         R = R0
         for row in th:
             R, r, its = _newton(R, row, tol, max_iter)
             Rs.append(R)
-            res.append(r)
+            rs.append(r)
             total += its
-        R, res, its = np.array(Rs), np.array(res), total
+        R, res, its = np.array(Rs), np.array(rs), total
     else:
-        R, res, its = _newton(np.broadcast_to(R0, th.shape[:-1] + (3, 3)).copy(), th, tol, max_iter)
+        R, res, its = _newton(np.broadcast_to(R0, (*th.shape[:-1], 3, 3)).copy(), th, tol, max_iter)
     back = actuator_angles_from_matrix(R)
     d = np.angle(np.exp(1j * (back - th)))
     on_branch = np.all(np.abs(d) < 1e-6, axis=-1)

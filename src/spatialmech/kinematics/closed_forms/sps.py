@@ -26,16 +26,17 @@ from __future__ import annotations
 
 import numpy as np
 
+from ...errors import InputError
 from ...geometry.screws import reciprocal_product
 from ...geometry.validate import as_finite_array
 
-__all__ = ["leg_vectors", "leg_lengths", "leg_lines", "leg_rates"]
+__all__ = ["leg_lengths", "leg_lines", "leg_rates", "leg_vectors"]
 
 
 def _points(value, name: str) -> np.ndarray:
     pts = as_finite_array(value, name)
     if pts.ndim != 2 or pts.shape[1] != 3 or pts.shape[0] == 0:
-        raise ValueError(f"{name}: expected shape (n, 3) with n >= 1, got {pts.shape}")
+        raise InputError(f"{name}: expected shape (n, 3) with n >= 1, got {pts.shape}")
     return pts
 
 
@@ -43,13 +44,13 @@ def _pose(R, p) -> tuple[np.ndarray, np.ndarray]:
     R = as_finite_array(R, "R")
     p = as_finite_array(p, "p")
     if R.shape[-2:] != (3, 3):
-        raise ValueError(f"R: expected shape (..., 3, 3), got {R.shape}")
+        raise InputError(f"R: expected shape (..., 3, 3), got {R.shape}")
     if p.shape[-1:] != (3,):
-        raise ValueError(f"p: expected shape (..., 3), got {p.shape}")
+        raise InputError(f"p: expected shape (..., 3), got {p.shape}")
     try:
         np.broadcast_shapes(R.shape[:-2], p.shape[:-1])
     except ValueError:
-        raise ValueError(f"p: leading shape {p.shape[:-1]} does not broadcast with R's {R.shape[:-2]}") from None
+        raise InputError(f"p: leading shape {p.shape[:-1]} does not broadcast with R's {R.shape[:-2]}") from None
     return R, p
 
 
@@ -63,7 +64,7 @@ def leg_vectors(R, p, base_points, platform_points) -> np.ndarray:
     B = _points(base_points, "base_points")
     A = _points(platform_points, "platform_points")
     if A.shape != B.shape:
-        raise ValueError(f"platform_points: expected {B.shape[0]} points like base_points, got {A.shape[0]}")
+        raise InputError(f"platform_points: expected {B.shape[0]} points like base_points, got {A.shape[0]}")
     RA = np.einsum("...ij,nj->...ni", R, A)
     return RA + p[..., None, :] - B
 
@@ -83,7 +84,7 @@ def leg_lines(R, p, base_points, platform_points) -> np.ndarray:
     d = leg_vectors(R, p, base_points, platform_points)
     length = np.linalg.norm(d, axis=-1, keepdims=True)
     if np.any(length <= 1e-15):
-        raise ValueError("R, p: a leg has zero length (base and platform points coincide), its line is undefined")
+        raise InputError("R, p: a leg has zero length (base and platform points coincide), its line is undefined")
     u = d / length
     B = np.broadcast_to(np.asarray(base_points, dtype=float), u.shape)
     return np.concatenate([u, np.cross(B, u)], axis=-1)
@@ -97,6 +98,6 @@ def leg_rates(R, p, base_points, platform_points, twist) -> np.ndarray:
     """
     twist = as_finite_array(twist, "twist")
     if twist.shape[-1:] != (6,):
-        raise ValueError(f"twist: expected shape (..., 6), got {twist.shape}")
+        raise InputError(f"twist: expected shape (..., 6), got {twist.shape}")
     lines = leg_lines(R, p, base_points, platform_points)
     return reciprocal_product(lines, twist[..., None, :])

@@ -1,0 +1,68 @@
+"""The exceptions spatialmech raises on purpose, in one place.
+
+Every error that a user can cause (a bad argument, a malformed file, an unknown name, an
+unreachable pose, a search that would be too large) is an :class:`InputError`; a numerical
+routine that did not reach its goal raises :class:`ConvergenceError`.  Both derive from
+:class:`SpatialmechError` *and* from the built-in type a caller would expect (``ValueError``,
+``KeyError``, ``RuntimeError``), so ``except ValueError`` keeps working.
+
+The command line prints these as one line ``error: ...`` (exit code 2 for input errors, 1 for a
+failed computation); any other exception is a programming error and keeps its traceback.
+
+    >>> import spatialmech as sm
+    >>> try:
+    ...     sm.load_model("no-such-model")
+    ... except sm.InputError as e:
+    ...     print(type(e).__name__, isinstance(e, KeyError))
+    UnknownNameError True
+"""
+
+from __future__ import annotations
+
+__all__ = ["ConvergenceError", "InputError", "SearchTooLargeError", "SpatialmechError", "UnknownNameError", "describe"]
+
+
+class SpatialmechError(Exception):
+    """Base of every exception that spatialmech raises on purpose."""
+
+
+class InputError(SpatialmechError, ValueError):
+    """Bad input: the message is one line that names the argument or field and the problem."""
+
+
+class UnknownNameError(InputError, KeyError):
+    """A name (model, joint, freedom, mode, driver, link) that does not exist; lists the known ones."""
+
+    def __str__(self) -> str:  # KeyError would quote the message
+        return str(self.args[0]) if self.args else ""
+
+
+class SearchTooLargeError(InputError):
+    """A requested search (modes, grid, candidates) exceeds its size limit; the message says the
+    size and how to reduce it."""
+
+
+class ConvergenceError(SpatialmechError, RuntimeError):
+    """A numerical routine did not converge (the message says which and how far it got)."""
+
+
+def describe(value) -> str:
+    """What a value is, for an error message: its type and a short repr, or its shape.
+
+        >>> describe("S"), describe([1, 2]), describe(None)
+        ("str 'S'", 'list of length 2', 'None')
+        >>> import numpy as np
+        >>> describe(np.zeros((3, 4)))
+        'ndarray of shape (3, 4)'
+    """
+    import reprlib
+
+    if value is None:
+        return "None"
+    kind = type(value).__name__
+    shape = getattr(value, "shape", None)
+    if isinstance(shape, tuple) and not isinstance(value, (str, bytes)):
+        return f"{kind} of shape {shape}"
+    if isinstance(value, (list, tuple, dict, set, frozenset)):
+        return f"{kind} of length {len(value)}"
+    return f"{kind} {reprlib.repr(value)}"

@@ -1,0 +1,450 @@
+"""The one intermediate structure of the exports: a body tree with loop closures.
+
+:func:`body_tree` turns a mechanism into a :class:`BodyTree`, which both writers read
+(:mod:`.mjcf` for MuJoCo, :mod:`.urdf`), and :func:`mechanism_from_tree` turns a body tree
+back into a mechanism (the MJCF import builds a body tree from a MuJoCo model first).
+
+From mechanism to body tree
+---------------------------
+The link graph and its spanning tree come from :mod:`spatialmech.model.topology` (cut S
+joints where a loop has one).  Every link but the ground is a :class:`Body`; the tree joint
+that leads to it says how it moves relative to its parent body.  Everything is stated **in
+world coordinates at the reference configuration** (every joint variable zero), where every
+body frame is world-aligned: a body's origin is the point of the joint that leads to it (the
+output link's is the platform point, so that its pose *is* the platform pose).
+
+A spatialmech joint becomes simulator joints (:class:`Axis`), applied in order from parent to
+child: ``R`` a hinge, ``P`` a slide, ``C`` a hinge and a slide on one axis, ``U`` two hinges,
+``S`` one ball (three hinges when a freedom is actuated, lockable or locked; ``Sm`` always
+three hinges), ``H`` a hinge and a slide coupled by the pitch (:class:`Coupling`).  A hinge or
+slide's value is the freedom's *physical* value ``offset + q`` (its ``ref`` is the offset), so
+limits and actuator targets are the model's own numbers.  A tree joint that runs against its
+limb (the child is on the ground side) has its simulator joints in reverse order with negated
+axes; the values are unchanged.
+
+Each cut joint becomes a :class:`Closure`: a cut ``S`` is a ``connect`` (the two links keep one
+point in common); any other cut joint ``a -> b`` is rebuilt as a tree joint from ``a`` to a
+*ghost* copy of ``b`` that a ``weld`` holds to ``b`` (six independent equations, so the
+closure is exact for every joint type).  A locked freedom keeps its joint and gets a
+:class:`Coupling` holding it at its value.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import InputError, UnknownNameError
+from ..model.joints import Joint, make_joint
+from ..model.mechanism import Limb, Mechanism, Mode
+from ..model.topology import GROUND, OUTPUT, GraphJoint, link_graph, spanning_tree
+
+__all__ = [
+    "Axis",
+    "Body",
+    "BodyTree",
+    "Closure",
+    "Coupling",
+    "TreeJoint",
+    "body_tree",
+    "mechanism_from_tree",
+]
+
+
+@dataclass(frozen=True, eq=False)
+class Axis:
+    """One simulator joint: a ``hinge`` or ``slide`` (one freedom) or a ``ball`` (a whole S).
+
+    ``anchor`` and ``axis`` are in world coordinates at the reference configuration (``axis``
+    is zero for a ball); ``ref`` is the joint's value there (the freedom's offset), ``range``
+    its limits (physical values) or ``None``; ``freedoms`` the spatialmech freedom ids it
+    stands for."""
+
+    name: str
+    kind: str  # "hinge" | "slide" | "ball"
+    anchor: np.ndarray
+    axis: np.ndarray
+    ref: float = 0.0
+    range: tuple[float, float] | None = None
+    actuated: bool = False
+    locked: bool = False
+    freedoms: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True, eq=False)
+class TreeJoint:
+    """A spatialmech joint on a tree edge: its simulator joints in the order applied from the
+    parent body to the child body (reversed and negated when ``reversed``)."""
+
+    name: str
+    type: str
+    axes: tuple[Axis, ...]
+    reversed: bool = False
+    pitch: float = 0.0  # H joints
+
+
+@dataclass(frozen=True, eq=False)
+class Body:
+    """A rigid body of the tree: the link ``link`` (a ghost is a copy of a link that closes a
+    cut joint), attached to ``parent`` (``None``: the ground) by ``joint`` (``None``: rigidly).
+    ``origin``: world position of its frame at the reference (frames are world-aligned there).
+    ``segments``: pairs of world points (at the reference) to draw the link between."""
+
+    name: str
+    link: str
+    parent: str | None
+    origin: np.ndarray
+    joint: TreeJoint | None
+    ghost: bool = False
+    segments: tuple[tuple[np.ndarray, np.ndarray], ...] = ()
+
+
+@dataclass(frozen=True, eq=False)
+class Closure:
+    """A loop closure (a cut joint): ``connect`` (a common point, ``anchor``) or ``weld`` (a
+    common frame) between ``body1`` and ``body2`` (``None``: the ground)."""
+
+    name: str
+    kind: str  # "connect" | "weld"
+    body1: str | None
+    body2: str | None
+    anchor: np.ndarray
+    joint_type: str
+
+
+@dataclass(frozen=True, eq=False)
+class Coupling:
+    """A joint equality ``y - y0 = a0 + a1 (x - x0)`` between simulator joints ``joint1`` (y) and
+    ``joint2`` (x; ``None``: ``y`` held at ``y0 + a0``): an H joint's slide and hinge, or a lock."""
+
+    name: str
+    joint1: str
+    joint2: str | None
+    polycoef: tuple[float, float]
+    purpose: str  # "helical" | "lock"
+
+
+@dataclass(frozen=True, eq=False)
+class BodyTree:
+    """A mechanism as bodies (parents before children), loop closures and couplings, in world
+    coordinates at the reference configuration; see the module docstring."""
+
+    name: str
+    bodies: tuple[Body, ...]
+    closures: tuple[Closure, ...]
+    couplings: tuple[Coupling, ...]
+    output: str  # the body whose frame is the platform frame
+    platform_point: np.ndarray
+    characteristic_length: float
+    length_unit: str = "m"
+    description: str = ""
+    limbs: tuple[tuple[str, tuple[str, ...]], ...] = ()  # limb names and their joint names, ground to output
+    joint_types: dict[str, str] = field(default_factory=dict)
+    aliases: dict[str, str] = field(default_factory=dict)
+    modes: tuple[Mode, ...] = ()
+    ground_segments: tuple[tuple[np.ndarray, np.ndarray], ...] = ()  # to draw the ground between
+    lockable: tuple[str, ...] = ()  # lockable freedoms (metamorphic mechanisms), by id
+
+    def body(self, name: str) -> Body:
+        for b in self.bodies:
+            if b.name == name:
+                return b
+        raise UnknownNameError(f"unknown body {name!r}; bodies: {', '.join(b.name for b in self.bodies)}")
+
+    @property
+    def axes(self) -> tuple[Axis, ...]:
+        """Every simulator joint, in body order."""
+        return tuple(a for b in self.bodies if b.joint is not None for a in b.joint.axes)
+
+    @property
+    def actuated(self) -> tuple[Axis, ...]:
+        return tuple(a for a in self.axes if a.actuated and not a.locked)
+
+    def metadata(self) -> dict:
+        """What a simulator file cannot say by itself, for a faithful import: the model's name,
+        unit, output body, limb names and order, joint types, aliases and modes."""
+        return {
+            "format": "spatialmech body tree 1",
+            "name": self.name,
+            "description": self.description,
+            "length_unit": self.length_unit,
+            "output": self.output,
+            "platform_point": [float(x) for x in self.platform_point],
+            "limbs": [[n, list(js)] for n, js in self.limbs],
+            "joint_types": dict(self.joint_types),
+            "aliases": dict(self.aliases),
+            "lockable": list(self.lockable),
+            "modes": [{"name": m.name, "driven": list(m.driven), "description": m.description} for m in self.modes],
+        }
+
+
+# ------------------------------------------------------------------ mechanism -> body tree
+def _axes_of(joint: Joint, reversed_: bool) -> tuple[tuple[Axis, ...], tuple[Coupling, ...]]:
+    plain_ball = joint.type == "S" and not any(f.actuated or f.lockable or f.locked for f in joint.freedoms)
+    if plain_ball:
+        ball = Axis(joint.name, "ball", joint.point.copy(), np.zeros(3),
+                    freedoms=tuple(f"{joint.name}.{f.name}" for f in joint.freedoms))
+        return (ball,), ()
+    axes: list[Axis] = []
+    couplings: list[Coupling] = []
+    for f in joint.freedoms:
+        fid = f"{joint.name}.{f.name}"
+        kind = "slide" if f.kind == "P" else "hinge"
+        axes.append(Axis(fid, kind, f.point.copy(), f.direction.copy(), float(f.offset), f.limits,
+                         f.actuated and not f.locked, f.locked, (fid,)))
+        if f.kind == "H":  # a hinge and a slide on one axis, slide = pitch * hinge
+            slide = f"{fid}:slide"
+            axes.append(Axis(slide, "slide", f.point.copy(), f.direction.copy(), 0.0, None, False, False, ()))
+            couplings.append(Coupling(f"helical:{fid}", slide, fid, (0.0, float(f.pitch)), "helical"))
+        if f.locked:
+            couplings.append(Coupling(f"lock:{fid}", fid, None, (0.0, 0.0), "lock"))
+    if reversed_:
+        axes = [Axis(a.name, a.kind, a.anchor, -a.axis, a.ref, a.range, a.actuated, a.locked, a.freedoms)
+                for a in reversed(axes)]
+    return tuple(axes), tuple(couplings)
+
+
+def _attachments(mech: Mechanism, links: list[str], graph) -> dict[str, list[np.ndarray]]:
+    """Points to draw each link between: its joints' points, and the platform point for the
+    output link; a link whose points all coincide (a spherical linkage) is drawn between points
+    half a characteristic length out along its joints' first axes."""
+    L = mech.characteristic_length
+    out: dict[str, list[np.ndarray]] = {k: [] for k in links}
+    axes: dict[str, list[np.ndarray]] = {k: [] for k in links}
+    for j in graph.joints:
+        for end in (j.a, j.b):
+            out[end].append(j.joint.point)
+            axes[end].append(j.joint.freedoms[0].direction)
+    out[OUTPUT] = [mech.platform_point, *out[OUTPUT]]
+    axes[OUTPUT] = [np.zeros(3), *axes[OUTPUT]]
+    for k, pts in out.items():
+        if len(pts) > 1 and max(float(np.linalg.norm(p - pts[0])) for p in pts) < 1e-9 * L:
+            out[k] = [p + 0.5 * L * a for p, a in zip(pts, axes[k], strict=True) if np.linalg.norm(a) > 0]
+    return out
+
+
+def _segments(points: list[np.ndarray], hub: np.ndarray | None, L: float) -> tuple[tuple[np.ndarray, np.ndarray], ...]:
+    """Capsules from ``hub`` to each point (a star: platform, ground), or along the points in
+    order (a link of a limb); segments shorter than 1e-6 L are left out."""
+    pairs = [(hub, p) for p in points] if hub is not None else list(zip(points[:-1], points[1:], strict=True))
+    return tuple((a.copy(), b.copy()) for a, b in pairs if float(np.linalg.norm(b - a)) > 1e-6 * L)
+
+
+def body_tree(mech: Mechanism) -> BodyTree:
+    """The :class:`BodyTree` of a mechanism (see the module docstring)."""
+    if not isinstance(mech, Mechanism):
+        raise TypeError(f"mech: expected a Mechanism, got {type(mech).__name__}")
+    graph = link_graph(mech)
+    tree = spanning_tree(graph)
+    L = mech.characteristic_length
+    att = _attachments(mech, [k.name for k in graph.links], graph)
+    bodies: list[Body] = []
+    couplings: list[Coupling] = []
+    closures: list[Closure] = []
+
+    def body_of(link: str) -> str | None:
+        return None if link == GROUND else link
+
+    for link in tree.order[1:]:  # the ground is the world, not a body
+        plink, jname = tree.parent[link]
+        gj: GraphJoint = graph.joint(jname)
+        rev = tree.reversed(jname)
+        axes, cps = _axes_of(gj.joint, rev)
+        couplings.extend(cps)
+        origin = mech.platform_point.copy() if link == OUTPUT else gj.joint.point.copy()
+        pts = att[link]
+        segs = _segments(pts[1:], pts[0], L) if link == OUTPUT else _segments(pts, None, L)
+        bodies.append(Body(link, link, body_of(plink), origin,
+                           TreeJoint(gj.name, gj.type, axes, rev, float(gj.joint.freedoms[0].pitch)), segments=segs))
+    for c in (graph.joint(n) for n in tree.cut):
+        if c.type == "S" and not any(f.actuated or f.lockable or f.locked for f in c.joint.freedoms):
+            closures.append(Closure(c.name, "connect", body_of(c.a), body_of(c.b), c.joint.point.copy(), c.type))
+            continue
+        ghost = f"{c.b}~{c.name}"
+        axes, cps = _axes_of(c.joint, False)
+        couplings.extend(cps)
+        bodies.append(Body(ghost, c.b, body_of(c.a), c.joint.point.copy(),
+                           TreeJoint(c.name, c.type, axes, False, float(c.joint.freedoms[0].pitch)), ghost=True))
+        closures.append(Closure(c.name, "weld", ghost, body_of(c.b), c.joint.point.copy(), c.type))
+    pts = att[GROUND]
+    ground = _segments(pts, np.mean(pts, axis=0), L) if len(pts) > 1 else ()
+    return BodyTree(
+        name=mech.name, bodies=tuple(bodies), closures=tuple(closures), couplings=tuple(couplings), output=OUTPUT,
+        platform_point=mech.platform_point.copy(), characteristic_length=L, length_unit=mech.length_unit,
+        description=mech.description, limbs=tuple((limb.name, tuple(j.name for j in limb.joints)) for limb in mech.limbs),
+        joint_types={j.name: j.type for limb in mech.limbs for j in limb.joints}, aliases=dict(mech.aliases),
+        modes=tuple(mech.modes), ground_segments=ground, lockable=mech.lockable)
+
+
+# ------------------------------------------------------------------ body tree -> mechanism
+@dataclass(frozen=True)
+class _Edge:
+    name: str
+    a: str  # link the simulator joints move from
+    b: str
+    axes: tuple[Axis, ...]
+    kind: str  # "tree" | "connect"
+
+
+def _reverse(axes: tuple[Axis, ...]) -> tuple[Axis, ...]:
+    return tuple(Axis(a.name, a.kind, a.anchor, -a.axis, a.ref, a.range, a.actuated, a.locked, a.freedoms)
+                 for a in reversed(axes))
+
+
+def _close(u, v, tol: float) -> bool:
+    return bool(np.linalg.norm(np.asarray(u, float) - np.asarray(v, float)) <= tol)
+
+
+def _fields(name: str, axes: list[Axis], defaults: list[str], lockable: frozenset[str]) -> dict:
+    """Freedom names and per-freedom flags of ``axes`` as :func:`~spatialmech.model.joints.make_joint`
+    keywords.  A simulator joint named ``"JOINT.freedom"`` names its freedom."""
+    names = [a.name.split(".", 1)[1] if a.name.startswith(f"{name}.") else d for a, d in zip(axes, defaults, strict=True)]
+    return {
+        "freedom_names": names,
+        "actuated": [n for n, a in zip(names, axes, strict=True) if a.actuated],
+        "locked": [n for n, a in zip(names, axes, strict=True) if a.locked],
+        "lockable": [n for n, a in zip(names, axes, strict=True) if a.locked or a.name in lockable],
+        "limits": {n: a.range for n, a in zip(names, axes, strict=True) if a.range is not None} or None,
+        "offset": {n: a.ref for n, a in zip(names, axes, strict=True) if a.ref != 0.0} or None,
+    }
+
+
+def _joint_from_axes(name: str, axes: tuple[Axis, ...], L: float, declared: str | None,
+                     helical: dict[str, tuple[str, float]], lockable: frozenset[str], where: str) -> Joint:
+    """A spatialmech joint from simulator joints in limb order: R, P, C, U, S, Sm, or H (a hinge
+    with a slide coupled to it, ``helical``: slide name -> (hinge name, pitch))."""
+    slides = {s for s in helical if any(a.name == s for a in axes)}
+    real = [a for a in axes if a.name not in slides]
+    kinds = [a.kind for a in real]
+    tol = 1e-9 * max(L, 1.0)
+    if kinds == ["ball"]:
+        if declared not in (None, "S"):
+            raise InputError(f"{where}: a ball joint cannot be a {declared} joint")
+        return make_joint("S", name, point=real[0].anchor)
+    if slides:
+        (slide,) = slides
+        hinge, pitch = helical[slide]
+        s = next(a for a in axes if a.name == slide)
+        if kinds != ["hinge"] or real[0].name != hinge or abs(abs(float(s.axis @ real[0].axis)) - 1.0) > 1e-9:
+            raise InputError(f"{where}: a coupled slide that does not make a helical joint with one hinge on its axis")
+        sign = float(np.sign(s.axis @ real[0].axis))
+        return make_joint("H", name, point=real[0].anchor, axis=real[0].axis, pitch=sign * pitch, normalize=True,
+                          **_fields(name, real, ["screw"], lockable))
+    if kinds in (["hinge"], ["slide"]):
+        t = "R" if kinds == ["hinge"] else "P"
+        return make_joint(t, name, point=real[0].anchor, axis=real[0].axis, normalize=True,
+                          **_fields(name, real, ["rot" if t == "R" else "slide"], lockable))
+    if sorted(kinds) == ["hinge", "slide"]:
+        h, s = real[kinds.index("hinge")], real[kinds.index("slide")]
+        if abs(abs(float(h.axis @ s.axis)) - 1.0) > 1e-9 or np.linalg.norm(np.cross(s.anchor - h.anchor, h.axis)) > tol:
+            raise InputError(f"{where}: a hinge and a slide that are not on one axis (not a C joint)")
+        if float(h.axis @ s.axis) < 0:
+            s = Axis(s.name, s.kind, s.anchor, -s.axis, -s.ref, None if s.range is None else (-s.range[1], -s.range[0]),
+                     s.actuated, s.locked, s.freedoms)
+        return make_joint("C", name, point=h.anchor, axis=h.axis, normalize=True, **_fields(name, [h, s], ["rot", "slide"], lockable))
+    if kinds == ["hinge", "hinge"]:
+        if not _close(real[0].anchor, real[1].anchor, tol) or abs(float(real[0].axis @ real[1].axis)) > 1e-9:
+            raise InputError(f"{where}: two hinges that do not meet at right angles (not a U joint)")
+        return make_joint("U", name, point=real[0].anchor, axes=[real[0].axis, real[1].axis], normalize=True,
+                          **_fields(name, real, ["rot1", "rot2"], lockable))
+    if kinds == ["hinge", "hinge", "hinge"]:
+        if not all(_close(a.anchor, real[0].anchor, tol) for a in real):
+            raise InputError(f"{where}: three hinges that do not meet in a point (not a spherical joint)")
+        t = declared if declared in ("S", "Sm") else "S"
+        kw = _fields(name, real, ["rot1", "rot2", "rot3"], lockable)
+        if t == "Sm":
+            kw["lockable"] = kw["freedom_names"]
+        return make_joint(t, name, point=real[0].anchor, axes=[a.axis for a in real], normalize=True, **kw)
+    raise InputError(f"{where}: simulator joints {kinds} do not make a spatialmech joint (R, P, H, C, U, S, Sm)")
+
+
+def mechanism_from_tree(bt: BodyTree) -> Mechanism:
+    """The mechanism a :class:`BodyTree` describes.
+
+    Links are bodies: a ghost, or a body welded to another, is the other body's link; a body
+    without joints is its parent's link.  Joints are the tree joints and the ``connect``
+    closures (S joints); couplings lock a freedom (``joint2`` empty) or make a helical joint.  The
+    limbs are the chains of links from the ground to the output body, in the order and with the
+    names of ``bt.limbs`` where it names them.  Raises :class:`~spatialmech.errors.InputError`
+    when the graph is not limbs to one output link or a joint is not a spatialmech joint."""
+    link_of: dict[str | None, str] = {None: GROUND}
+    for b in bt.bodies:  # parents come first
+        if b.parent not in link_of:
+            raise InputError(f"body {b.name!r}: its parent {b.parent!r} is not listed before it")
+        link_of[b.name] = b.name if b.joint is not None else link_of[b.parent]
+    for c in bt.closures:  # a weld makes one link of two bodies
+        if c.kind == "weld":
+            keep, drop = link_of[c.body2], link_of[c.body1]
+            for k, v in list(link_of.items()):
+                if v == drop:
+                    link_of[k] = keep
+    locked = {c.joint1 for c in bt.couplings if c.joint2 is None}
+    for c in bt.couplings:
+        if c.joint2 is None and c.polycoef[0] != 0.0:
+            raise InputError(f"equality {c.name!r}: holds {c.joint1!r} away from its reference value; spatialmech "
+                             "locks a freedom at its reference value")
+    helical = {c.joint1: (c.joint2, c.polycoef[1]) for c in bt.couplings if c.joint2 is not None}
+
+    def marked(axes: tuple[Axis, ...]) -> tuple[Axis, ...]:
+        return tuple(Axis(a.name, a.kind, a.anchor, a.axis, a.ref, a.range, a.actuated, a.locked or a.name in locked,
+                          a.freedoms) for a in axes)
+
+    edges: list[_Edge] = []
+    for b in bt.bodies:
+        if b.joint is not None:
+            edges.append(_Edge(b.joint.name, link_of[b.parent], link_of[b.name], marked(b.joint.axes), "tree"))
+    for c in bt.closures:
+        if c.kind == "connect":
+            edges.append(_Edge(c.name, link_of[c.body1], link_of[c.body2], (Axis(c.name, "ball", c.anchor, np.zeros(3)),),
+                               "connect"))
+        elif c.kind != "weld":
+            raise InputError(f"closure {c.name!r}: unsupported kind {c.kind!r} (connect or weld)")
+    if bt.output not in link_of:
+        raise UnknownNameError(f"output: no body {bt.output!r}; bodies: {', '.join(b.name for b in bt.bodies)}")
+    ground, output = GROUND, link_of[bt.output]
+    for e in edges:
+        if e.a == e.b:
+            raise InputError(f"joint {e.name!r}: joins link {e.a!r} to itself (a weld or a fixed body in its loop)")
+    inc: dict[str, list[_Edge]] = {}
+    for e in edges:
+        inc.setdefault(e.a, []).append(e)
+        inc.setdefault(e.b, []).append(e)
+    for link, es in inc.items():
+        if link not in (ground, output) and len(es) != 2:
+            raise InputError(f"link {link!r}: has {len(es)} joints; only limbs (chains of links with two joints each) "
+                             "between the ground and one output link can be imported today")
+    chains: list[list[tuple[_Edge, bool]]] = []
+    used: set[str] = set()
+    for e0 in inc.get(ground, []):
+        if e0.name in used:
+            continue
+        chain: list[tuple[_Edge, bool]] = []
+        at, e = ground, e0
+        while True:
+            used.add(e.name)
+            forward = e.a == at
+            chain.append((e, forward))
+            at = e.b if forward else e.a
+            if at in (output, ground):
+                break
+            e = next(x for x in inc[at] if x.name != e.name)
+        if at != output:
+            raise InputError(f"joints {[c[0].name for c in chain]}: a loop from the ground back to the ground, not a "
+                             "limb to the output link")
+        chains.append(chain)
+    missing = sorted({e.name for e in edges} - used)
+    if missing:
+        raise InputError(f"joints {missing}: not on a chain from the ground to the output link")
+    first = {js[0]: (k, n) for k, (n, js) in enumerate(bt.limbs) if js}
+    chains.sort(key=lambda ch: first.get(ch[0][0].name, (len(first), ""))[0])
+    limbs = []
+    for k, chain in enumerate(chains):
+        joints = []
+        for e, forward in chain:
+            axes = e.axes if forward else _reverse(e.axes)
+            joints.append(_joint_from_axes(e.name, axes, bt.characteristic_length, bt.joint_types.get(e.name), helical,
+                                           frozenset(bt.lockable), f"joint {e.name!r}"))
+        limbs.append(Limb(first.get(chain[0][0].name, (0, f"limb{k + 1}"))[1], tuple(joints)))
+    return Mechanism(bt.name, tuple(limbs), bt.platform_point, description=bt.description, modes=bt.modes,
+                     aliases=bt.aliases, length_unit=bt.length_unit)

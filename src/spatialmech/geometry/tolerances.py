@@ -1,0 +1,224 @@
+"""Every numerical tolerance of spatialmech, in one place, and the scale they are measured in.
+
+A decision that depends on a tolerance (is this screw system of rank 4? is this configuration
+closed? is this pose reachable? are these two solutions the same?) reads it from a
+:class:`Tolerances`.  Every tolerance is *nondimensional*: lengths are divided by the
+mechanism's characteristic length ``L`` (:func:`characteristic_length`, the RMS distance of the
+joint points from their centroid), so a model in millimetres and the same model in metres make
+the same decisions.  Angles are in radians (already nondimensional).
+
+The tolerances in force are :data:`DEFAULT` unless a caller passes its own, either explicitly
+(``mobility(mech, tol=1e-4)``) or for a whole block of work with :func:`use` (the command
+line's ``--tol`` does that)::
+
+    >>> from spatialmech.geometry.tolerances import DEFAULT, Tolerances, current, use
+    >>> DEFAULT.rank
+    1e-09
+    >>> with use(rank=1e-4):
+    ...     current().rank
+    0.0001
+    >>> current().rank
+    1e-09
+    >>> Tolerances.parse("1e-4", primary="reachability").reachability
+    0.0001
+    >>> Tolerances.parse("rank=1e-6,closure=1e-8").closure
+    1e-08
+
+Scale.  The characteristic length must lie in ``[min_length, max_length]`` model units and the
+model must not lie more than ``max_ratio`` characteristic lengths from its origin (a helical
+pitch, likewise, at most ``max_ratio`` characteristic lengths per radian): outside these the
+moments of the screws lose the digits that the rank decisions need, so such models are refused
+with an :class:`~spatialmech.errors.InputError` naming the field rather than analysed wrongly.
+Every number typed into a model must be finite and at most ``max_input`` in magnitude.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
+from dataclasses import dataclass, fields, replace
+
+import numpy as np
+
+from ..errors import InputError
+
+__all__ = ["DEFAULT", "Tolerances", "characteristic_length", "current", "use"]
+
+
+@dataclass(frozen=True)
+class Tolerances:
+    """The numerical tolerances (all nondimensional; see the module docstring)."""
+
+    #: Relative singular-value threshold for the rank of a screw system or of a Jacobian made
+    #: nondimensional (moments / L, slides / L) and row- or column-normalised: a singular value
+    #: ``s`` counts when ``s > rank * max(1, s_max)``.  Decides lambda, t, k, xi, the motion type,
+    #: the instantaneous mobility, the tangent space of the closure manifold.
+    rank: float = 1e-9
+    #: Scale-free smallest singular value of a complete Jacobian (or of a wrench system at a pose)
+    #: below which the configuration is reported singular (``singularity``, ``jacobian``, ``fk``).
+    singular: float = 1e-7
+    #: Nondimensional closure residual (rad, and length / L) at which Newton corrections stop and
+    #: count as converged (forward position, generic configurations, path tracking).
+    newton: float = 1e-12
+    #: Nondimensional residual below which a limb solved for a given platform pose counts as
+    #: closed (inverse position, pose fits).
+    closure: float = 1e-10
+    #: Largest nondimensional pose error (rad, and length / L) between a requested platform pose
+    #: and the nearest closed configuration for which ``ik`` fits the pose (and says by how
+    #: much) instead of calling it unreachable: covers poses printed with 6 significant digits.
+    reachability: float = 1e-5
+    #: Nondimensional distance between two solutions' signatures below which they are the same
+    #: solution (inverse position: joint lines and ball centres / L).
+    dedup: float = 1e-6
+    #: Pivot threshold of the readable (row-echelon) basis of a screw system, relative to the
+    #: largest remaining entry: smaller pivots are rounding noise of typed data, not structure.
+    pivot: float = 1e-3
+    #: Relative singular-value threshold for "this screw lies in that system" (motion names).
+    contains: float = 1e-6
+    #: Tolerance on ``| |axis| - 1 |`` and on the perpendicularity of the declared axes of a joint.
+    unit: float = 1e-6
+    #: Smallest and largest accepted characteristic length, in model units.
+    min_length: float = 1e-12
+    max_length: float = 1e12
+    #: Largest accepted distance of the model from its origin, and helical pitch, in
+    #: characteristic lengths.
+    max_ratio: float = 1e6
+    #: Largest magnitude of any number typed into a model (coordinates, pitches, offsets, limits).
+    max_input: float = 1e12
+
+    def __post_init__(self):
+        for f in fields(self):
+            v = getattr(self, f.name)
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v <= 0:
+                raise InputError(f"tolerances.{f.name}: expected a positive finite number, got {v!r}")
+            object.__setattr__(self, f.name, float(v))
+        for name in ("rank", "singular", "newton", "closure", "reachability", "dedup", "pivot", "contains", "unit"):
+            if getattr(self, name) >= 1:
+                raise InputError(f"tolerances.{name}: a relative tolerance must be below 1, got {getattr(self, name):g}")
+        if self.min_length >= self.max_length:
+            raise InputError(f"tolerances.min_length: must be below max_length ({self.min_length:g} >= {self.max_length:g})")
+        if self.max_ratio < 1:
+            raise InputError(f"tolerances.max_ratio: must be at least 1, got {self.max_ratio:g}")
+
+    def replace(self, **changes) -> Tolerances:
+        """A copy with some tolerances changed (names checked)."""
+        known = {f.name for f in fields(self)}
+        bad = sorted(set(changes) - known)
+        if bad:
+            raise InputError(f"tolerances: unknown name(s) {', '.join(bad)}; known: {', '.join(sorted(known))}")
+        return replace(self, **changes)
+
+    def to_dict(self) -> dict:
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+    @classmethod
+    def parse(cls, text: str, *, primary: str = "rank", base: Tolerances | None = None) -> Tolerances:
+        """``"1e-4"`` (sets ``primary``) or ``"rank=1e-4,closure=1e-8"`` (named ones), on top of
+        ``base`` (default: the tolerances in force).  The error names ``--tol``."""
+        base = current() if base is None else base
+        text = str(text).strip()
+        if not text:
+            raise InputError("--tol: expected a number or NAME=VALUE[,NAME=VALUE...], got an empty value")
+        changes: dict[str, float] = {}
+        for part in text.split(","):
+            part = part.strip()
+            name, sep, value = part.partition("=")
+            if not sep:
+                name, value = primary, name
+            name = name.strip()
+            try:
+                x = float(value)
+            except ValueError:
+                raise InputError(f"--tol: expected a number or NAME=VALUE, got {part!r}") from None
+            if name in changes:
+                raise InputError(f"--tol: {name} given twice")
+            changes[name] = x
+        try:
+            return base.replace(**changes)
+        except InputError as e:
+            raise InputError(f"--tol: {e}") from None
+
+
+#: The tolerances used when none are given.
+DEFAULT = Tolerances()
+
+#: Points whose spread is below this, relative to their coordinates, are the same point (round-off).
+_SAME_POINT = 1e-13
+
+_CURRENT: ContextVar[Tolerances] = ContextVar("spatialmech_tolerances", default=DEFAULT)
+
+
+def current() -> Tolerances:
+    """The tolerances in force (:data:`DEFAULT` outside a :func:`use` block)."""
+    return _CURRENT.get()
+
+
+def resolve(tol: Tolerances | float | None, field: str = "rank") -> Tolerances:
+    """``tol`` as a :class:`Tolerances`: ``None`` -> the tolerances in force, a number -> them with
+    ``field`` set to it."""
+    if tol is None:
+        return current()
+    if isinstance(tol, Tolerances):
+        return tol
+    if isinstance(tol, bool) or not isinstance(tol, (int, float, np.floating)):
+        raise InputError(f"tol: expected a number or a Tolerances, got {type(tol).__name__}")
+    return current().replace(**{field: float(tol)})
+
+
+@contextmanager
+def use(tol: Tolerances | None = None, **changes) -> Iterator[Tolerances]:
+    """Run a block with other tolerances: ``use(Tolerances(...))`` or ``use(rank=1e-4)``."""
+    t = current() if tol is None else tol
+    if not isinstance(t, Tolerances):
+        raise InputError(f"tol: expected a Tolerances, got {type(t).__name__}")
+    t = t.replace(**changes) if changes else t
+    token = _CURRENT.set(t)
+    try:
+        yield t
+    finally:
+        _CURRENT.reset(token)
+
+
+def characteristic_length(points, *, tol: Tolerances | None = None, field: str = "points") -> float:
+    """RMS distance of ``points`` (n x 3) from their centroid, computed without overflow or
+    underflow.  When the points coincide (up to round-off relative to their size) the length
+    is their distance from the origin, or 1 when that is zero too (a spherical mechanism
+    centred at the origin).
+
+    Raises :class:`InputError` naming ``field`` when the length is outside
+    ``[min_length, max_length]`` or the points lie more than ``max_ratio`` such lengths from the
+    origin (see the module docstring).
+    """
+    t = current() if tol is None else tol
+    P = np.asarray(points, dtype=float).reshape(-1, 3)
+    if not np.all(np.isfinite(P)):
+        raise InputError(f"{field}: contain NaN or infinity")
+    size = float(np.max(np.abs(P))) if P.size else 0.0
+    if size == 0.0:
+        return 1.0
+    Q = P / size  # O(1): no overflow or underflow in the squares
+    c = Q.mean(axis=0)
+    spread = float(np.sqrt(np.mean(np.sum((Q - c) ** 2, axis=1))))
+    if spread <= _SAME_POINT:  # every point at the same place (up to round-off): a spherical mechanism
+        L = size * float(np.linalg.norm(c))
+        what = "distance of the joint points (which coincide) from the origin"
+    else:
+        L = size * spread
+        what = "characteristic length (RMS distance of the joint points from their centroid)"
+    if not t.min_length <= L <= t.max_length:
+        hint = (" (a spherical mechanism centred at the origin: put its joint points exactly there)"
+                if t.min_length > L else "")
+        raise InputError(
+            f"{field}: the model's {what} is {L:.3g} model units, outside the supported range "
+            f"[{t.min_length:g}, {t.max_length:g}]; express its lengths in another unit{hint}"
+        )
+    far = size / L
+    if far > t.max_ratio:
+        raise InputError(
+            f"{field}: the model lies {far:.3g} characteristic lengths ({L:.3g}) from its origin, more than "
+            f"{t.max_ratio:g}: the screws' moments would lose the digits that rank decisions need; "
+            "move the origin near the mechanism"
+        )
+    return L
