@@ -97,6 +97,7 @@ def test_ik_of_a_task_position_number_reports_the_fit():
     assert sm.ik("stewart-6sps", ([0, 0, 1.05], None)).pose_fit is None
 
 
+@pytest.mark.slow
 def test_fk_degrees_flag_and_the_closed_form_path():
     legs = sm.ik("four-sps-cu", POSE_B, degrees=True).actuators
     r = sm.fk("four-sps-cu", list(legs.values()), all_solutions=True)
@@ -152,6 +153,7 @@ def test_singularity_kind_is_an_enum_and_the_reference_of_paper_b_is_direct():
     assert d["kind"] == "direct" and d["result"] == "singularity"
 
 
+@pytest.mark.slow
 def test_workspace_extent_matches_its_closed_form():
     """Paper B at z = 0.1 m: alpha alone reaches atan(z / b) = 26.565 deg (the A1 cone)."""
     seen = []
@@ -177,12 +179,14 @@ def test_track_closes_and_every_traced_pose_is_reachable(four_bar_motion):
     assert np.ptp(d["joint_values_deg"]["A0.rot"]) == pytest.approx(360.0, abs=1e-6)  # a crank
 
 
+@pytest.mark.slow
 def test_track_events_are_enum_kinds():
     m = sm.track("rssr")  # the rocker's two limit positions are poles of DJ(crank)
     kinds = [e.kind for e in m.result.events]
     assert kinds == [EventKind.POLE, EventKind.POLE]
 
 
+@pytest.mark.slow
 def test_defects_on_positions_from_the_motion(four_bar_motion):
     P = [four_bar_motion.poses[k] for k in (0, 9, 18, 27)]
     msgs = []
@@ -196,6 +200,7 @@ def test_defects_on_positions_from_the_motion(four_bar_motion):
 
 
 # ------------------------------------------------------------------ synthesis
+@pytest.mark.slow
 def test_synth_rccc_gives_a_one_dof_mechanism():
     r = sm.synth_rccc(samples=60)
     assert r.linkage_type == "crank-rocker" and r.defects == 0
@@ -312,6 +317,7 @@ def test_results_are_frozen_dataclasses():
         assert dataclasses.is_dataclass(cls) and cls.__dataclass_params__.frozen, cls
 
 
+@pytest.mark.slow
 def test_one_progress_signature_for_fk_and_track():
     calls = []
     sm.fk("stewart-6sps", [1.2] * 6, all_solutions=True, seeds=5,

@@ -44,6 +44,7 @@ from spatialmech.synthesis.cs_dyads import (
 from .conftest import seeds
 
 
+# the paper-A family costs ~10 s: every test that uses it (or _claims) is marked slow
 @lru_cache(maxsize=1)
 def _family():
     return synthesize_cs(five_cs_positions(), seed=0, pick=5)
@@ -150,6 +151,7 @@ def test_dimension_count_is_one():
     assert worst > 1e-4
 
 
+@pytest.mark.slow
 def test_bad_input_raises_naming_the_argument():
     poses = five_cs_positions()
     with pytest.raises(ValueError, match=r"^task_poses: .*exactly 7"):
@@ -213,6 +215,7 @@ def test_paper_a_printed_limbs_satisfy_eqs_24_25_to_the_printed_precision():
         assert np.max(np.abs(Mp - Mc)) < 0.0025, (k, i)
 
 
+@pytest.mark.slow
 def test_paper_a_printed_limbs_project_onto_the_synthesised_family():
     """Claim (b): the nearest dyad of the family to each printed limb (least squares over the 15
     printed numbers) is within 0.005 of it (measured 0.0042, consistent with 3-decimal rounding
@@ -232,6 +235,7 @@ def test_paper_a_printed_limbs_project_onto_the_synthesised_family():
             assert d < 2e-3, (k, i, d)
 
 
+@pytest.mark.slow
 def test_paper_a_refitted_linkages_pass_exactly_through_the_seven_positions():
     """The three paper linkages rebuilt from their projected limbs close exactly at the 7
     positions (pose error < 1e-9, 1 DOF), whereas the printed (rounded) linkages only come
@@ -245,6 +249,7 @@ def test_paper_a_refitted_linkages_pass_exactly_through_the_seven_positions():
     assert int(np.argmax(printed.position_errors)) == 3
 
 
+@pytest.mark.slow
 def test_paper_a_any_five_dyads_of_the_family_form_a_5cs():
     """Claim (c) with the five small-slide picks: the 5-CS closes exactly at the 7 positions
     (pose error < 1e-9, IK residual < 1e-10), has 1 DOF (formula and numerical rank), and the
@@ -257,6 +262,7 @@ def test_paper_a_any_five_dyads_of_the_family_form_a_5cs():
     assert np.max(np.abs(ch.slide_errors)) < 1e-9
 
 
+@pytest.mark.slow
 @settings(max_examples=4)
 @given(st.integers(0, 10**6))
 def test_any_five_family_points_form_an_exact_5cs(seed):
@@ -276,6 +282,7 @@ def test_any_five_family_points_form_an_exact_5cs(seed):
     assert np.all(ch.exact) and ch.max_pose_error < 1e-9 and ch.dof == 1
 
 
+@pytest.mark.slow
 def test_paper_a_small_slide_picks():
     """'Choose dyads with small slides': the first pick is the smallest max |s_j| of the family
     (measured 5.3028 on table 9; tolerance 5.25-5.35), no tracked point is smaller by more than
@@ -302,6 +309,7 @@ def test_paper_a_small_slide_picks():
     assert len(pick_small_slides(fam, 2)) == 2
 
 
+@pytest.mark.slow
 def test_family_to_dict_is_json_serialisable():
     import json
 
@@ -313,6 +321,7 @@ def test_family_to_dict_is_json_serialisable():
     json.dumps(_claims().to_dict(), allow_nan=False)
 
 
+@pytest.mark.slow
 def test_projection_of_an_exact_dyad_does_not_move_it():
     p = project_dyad(five_cs_positions(), _family().picks[0])
     assert p.converged and p.distance < 1e-10

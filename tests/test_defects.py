@@ -134,6 +134,7 @@ def fourbar():
     return m, poses
 
 
+@pytest.mark.slow
 def test_four_bar_crank_is_usable_rocker_has_branch_defects(fourbar):
     m, poses = fourbar
     res = defect_analysis(m, poses, drivers=["A0", "B0"])
@@ -144,6 +145,7 @@ def test_four_bar_crank_is_usable_rocker_has_branch_defects(fourbar):
     assert d["B0"].branch_defect
 
 
+@pytest.mark.slow
 def test_scrambled_positions_give_an_order_defect(fourbar):
     m, poses = fourbar
     res = defect_analysis(m, [poses[0], poses[3], poses[1], poses[2], poses[4]], drivers=["A0"])

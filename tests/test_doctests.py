@@ -17,7 +17,7 @@ import pytest
 import spatialmech
 
 #: Modules whose examples take more than a few seconds (run by the full suite only).
-SLOW = {"spatialmech.synthesis.cs_dyads", "spatialmech.api", "spatialmech.analysis.workspace"}
+SLOW = {"spatialmech.synthesis.cs_dyads", "spatialmech.api", "spatialmech.analysis.workspace", "spatialmech.synthesis"}
 
 #: Modules that must have examples (the public API page's functions, the errors, the package).
 REQUIRED = {"spatialmech", "spatialmech.api", "spatialmech.errors", "spatialmech.results"}

@@ -227,6 +227,16 @@ def test_poses_out_of_the_numerical_range_are_refused_naming_the_option(args, co
     assert_one_line_error(run(*args), 2, contains)
 
 
+@pytest.mark.parametrize("args, contains", [
+    (["fk", "four-sps-cu", "--actuators", "0.25,0.25,0.25,3.2e153", "--json"], "item 4 (L4.slide = 3.2e+153 m) is out of range"),
+    (["fk", "rssr", "--actuators", "1e300"], "item 1 (A0.rot = 1e+300 deg) is out of range"),
+])
+def test_actuator_values_out_of_the_numerical_range_are_refused(args, contains):
+    """Found by tests/test_fuzz.py: a leg length of 3.2e153 m overflowed to inf in the result and
+    ``fk --json`` died in ``json.dumps`` (an internal error, exit 3)."""
+    assert_one_line_error(run(*args), 2, contains)
+
+
 def test_parse_numbers_checks_the_count():
     assert parse_numbers(" 1, 2.5 ,-3e-2", "--x") == [1.0, 2.5, -0.03]
     with pytest.raises(InputError, match="--x: expected 2 values, got 3"):
@@ -362,6 +372,7 @@ def test_a_workspace_grid_over_the_limit_is_refused_with_its_size():
     assert time.perf_counter() - t0 < 5.0
 
 
+@pytest.mark.slow
 def test_workspace_progress_gives_an_estimate_of_the_total():
     """The progress bar of a workspace search has a total (so click shows an ETA): the grid and
     lines first, then the grid plus the bisections of the boundary changes it found."""

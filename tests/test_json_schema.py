@@ -77,14 +77,14 @@ CASES = [
     (["singularity", "four-sps-cu", *POSE], "singularity", "four-sps-cu"),
     (["singularity", "four-sps-cu", "--xyz", "0", "0", "0.12", "--euler", "ZYX", "20", "0", "0",
       "--slice", "a2:-30:30:3,z:0.1:0.14:3"], "singularity", "four-sps-cu"),
-    (["workspace", "four-sps-cu", "--orientation", "--at", "z=0.1", "--step-deg", "15"], "workspace", "four-sps-cu"),
     (["workspace", "four-sps-cu", "--position", "--at", "alpha=0,beta=0,gamma=0", "--step", "0.05"],
      "workspace", "four-sps-cu"),
     (["workspace", "three-sps-smpu", "--orientation", "--at", "alpha=0,beta=0", "--step-deg", "60", "--tol-deg", "1"],
      "workspace", "three-sps-smpu"),  # general path
-    (["synth", "rccc", "--samples", "60"], "synth rccc", None),
 ]
-SLOW_CASES = [
+SLOW_CASES = [  # more than ~1 s each: deselected by the quick loop (pytest -m "not slow")
+    (["workspace", "four-sps-cu", "--orientation", "--at", "z=0.1", "--step-deg", "15"], "workspace", "four-sps-cu"),
+    (["synth", "rccc", "--samples", "60"], "synth rccc", None),
     (["singularity", "four-sps-cu", "--reference"], "singularity", "four-sps-cu"),  # finite self-motion
     (["defects", "five-cs-1"], "defects", "five-cs-1"),
     (["synth", "cs", "--samples", "6", "--starts", "20"], "synth cs", None),
@@ -102,6 +102,7 @@ def test_json_of_the_slow_commands(args, command, model, registry):
     check(run_json(*args), command, model, registry)
 
 
+@pytest.mark.slow
 def test_export_and_view_json(tmp_path, registry):
     d = check(run_json("export", "rssr", str(tmp_path / "r.toml")), "export", "rssr", registry)
     assert d["bytes"] == (tmp_path / "r.toml").stat().st_size and d["length_unit"] == "m"
@@ -149,6 +150,7 @@ def test_fk_closed_form_and_general_engine_give_the_same_fields():
     assert np.allclose(euler_matrix("ZYX", g["euler_deg"], degrees=True), g["rotation_matrix"], atol=1e-9)
 
 
+@pytest.mark.slow
 def test_ik_jacobian_workspace_give_the_same_fields_for_every_model():
     a = run_json("ik", "four-sps-cu", *POSE)
     b = run_json("ik", "delta", "--xyz", "0.02", "0.01", "-0.33")

@@ -219,6 +219,7 @@ def test_regulus_of_a_hyperboloid(seed):
         assert sc.rank(tr) == 3
 
 
+@pytest.mark.slow
 @settings(max_examples=10, deadline=None)
 @given(seeds)
 def test_congruences(seed):

@@ -50,6 +50,7 @@ def run(*args):
 
 
 # ------------------------------------------------------------------ 1. fk --all without assembly
+@pytest.mark.slow
 @pytest.mark.parametrize("model, values", [("stewart-6sps", "100,0.01,100,0.01,100,0.01"), ("three-rps", "50,50,0.001")])
 def test_fk_all_without_any_assembly_says_so_instead_of_crashing(model, values):
     """Absurd actuator values on general-engine models: a one-line error naming the number of
@@ -69,6 +70,7 @@ def test_fk_single_start_without_assembly_keeps_its_message():
 
 
 # ------------------------------------------------------------------ 2. singular forward position
+@pytest.mark.slow
 def test_fk_at_the_singular_home_pose_flags_a_self_motion_not_an_assembly_mode():
     """four-sps-cu with every leg sqrt(0.06) m: the home pose, on a finite self-motion (the legs
     locked, the platform still moves: z^2 = l^2 - 2a^2 - 2b^2 + 4ab cos(gamma))."""
@@ -84,6 +86,7 @@ def test_fk_at_the_singular_home_pose_flags_a_self_motion_not_an_assembly_mode()
     assert res.search["distinct"] == 1 and res.search["n_regular"] == 0 and res.search["n_self_motion_sets"] == 1
 
 
+@pytest.mark.slow
 def test_fk_text_at_the_singular_home_pose_says_self_motion():
     text = run("fk", "four-sps-cu", "--actuators", HOME_LEGS).output
     assert "0 assembly modes, 1 self-motion set" in text and "SINGULAR, SELF-MOTION" in text
@@ -110,6 +113,7 @@ def test_conditioning_of_the_general_engine_matches_the_closed_form_zero_set():
         assert c.singular == singular and bool(sig < singular_threshold()) == singular
 
 
+@pytest.mark.slow
 def test_closed_form_forward_all_at_singular_legs_is_one_self_motion_set_not_hundreds_of_modes():
     res = k.forward_all([HOME_LEG] * 4, n_seeds=128)
     assert res.search.n_converged > 100

@@ -90,8 +90,8 @@ def test_bad_files_give_one_line_errors_naming_the_field(kind):
     assert "\n" not in str(e.value)
 
 
-@pytest.mark.parametrize("kind", ["unknown joint type", pytest.param("NaN", marks=pytest.mark.slow),
-                                  pytest.param("malformed TOML", marks=pytest.mark.slow)])  # a subprocess each
+@pytest.mark.slow  # a subprocess (interpreter start) each
+@pytest.mark.parametrize("kind", ["unknown joint type", "NaN", "malformed TOML"])
 def test_cli_reports_bad_files_in_one_line_with_exit_code_2(kind, tmp_path):
     text, msg = BAD[kind]
     f = tmp_path / "bad.toml"

@@ -292,6 +292,7 @@ def test_rref_never_pivots_on_noise(seed, r, noise):
 
 
 # ----------------------------------------------------------------- 4. scale
+@pytest.mark.slow
 @settings(max_examples=12)
 @given(st.sampled_from(["stewart-6sps", "bennett", "three-rps", "four-sps-cu"]), st.floats(-11.0, 11.0))
 def test_mobility_does_not_depend_on_the_unit_of_length(name, exponent):

@@ -7,7 +7,8 @@ routine that did not reach its goal raises :class:`ConvergenceError`.  Both deri
 ``KeyError``, ``RuntimeError``), so ``except ValueError`` keeps working.
 
 The command line prints these as one line ``error: ...`` (exit code 2 for input errors, 1 for a
-failed computation); any other exception is a programming error and keeps its traceback.
+failed computation); any other exception is a programming error: exit code 3, and its traceback
+under ``spatialmech --debug`` or ``SPATIALMECH_DEBUG=1`` (docs/index.md, "Errors and exit codes").
 
     >>> import spatialmech as sm
     >>> try:

@@ -32,6 +32,7 @@ closure is exact for every joint type).  A locked freedom keeps its joint and ge
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from itertools import pairwise
 
 import numpy as np
 
@@ -227,7 +228,7 @@ def _attachments(mech: Mechanism, links: list[str], graph) -> dict[str, list[np.
 def _segments(points: list[np.ndarray], hub: np.ndarray | None, L: float) -> tuple[tuple[np.ndarray, np.ndarray], ...]:
     """Capsules from ``hub`` to each point (a star: platform, ground), or along the points in
     order (a link of a limb); segments shorter than 1e-6 L are left out."""
-    pairs = [(hub, p) for p in points] if hub is not None else list(zip(points[:-1], points[1:], strict=True))
+    pairs = [(hub, p) for p in points] if hub is not None else list(pairwise(points))
     return tuple((a.copy(), b.copy()) for a, b in pairs if float(np.linalg.norm(b - a)) > 1e-6 * L)
 
 
@@ -304,7 +305,7 @@ def _fields(name: str, axes: list[Axis], defaults: list[str], lockable: frozense
         "freedom_names": names,
         "actuated": [n for n, a in zip(names, axes, strict=True) if a.actuated],
         "locked": [n for n, a in zip(names, axes, strict=True) if a.locked],
-        "lockable": [n for n, a in zip(names, axes, strict=True) if a.locked or a.name in lockable],
+        "lockable": [n for n, a in zip(names, axes, strict=True) if a.name in lockable],
         "limits": {n: a.range for n, a in zip(names, axes, strict=True) if a.range is not None} or None,
         "offset": {n: a.ref for n, a in zip(names, axes, strict=True) if a.ref != 0.0} or None,
     }
@@ -342,7 +343,8 @@ def _joint_from_axes(name: str, axes: tuple[Axis, ...], L: float, declared: str 
         if float(h.axis @ s.axis) < 0:
             s = Axis(s.name, s.kind, s.anchor, -s.axis, -s.ref, None if s.range is None else (-s.range[1], -s.range[0]),
                      s.actuated, s.locked, s.freedoms)
-        return make_joint("C", name, point=h.anchor, axis=h.axis, normalize=True, **_fields(name, [h, s], ["rot", "slide"], lockable))
+        return make_joint("C", name, point=h.anchor, axis=h.axis, normalize=True,
+                          **_fields(name, [h, s], ["rot", "slide"], lockable))
     if kinds == ["hinge", "hinge"]:
         if not _close(real[0].anchor, real[1].anchor, tol) or abs(float(real[0].axis @ real[1].axis)) > 1e-9:
             raise InputError(f"{where}: two hinges that do not meet at right angles (not a U joint)")
@@ -376,15 +378,17 @@ def mechanism_from_tree(bt: BodyTree) -> Mechanism:
     for c in bt.closures:  # a weld makes one link of two bodies
         if c.kind == "weld":
             keep, drop = link_of[c.body2], link_of[c.body1]
-            for k, v in list(link_of.items()):
-                if v == drop:
-                    link_of[k] = keep
-    locked = {c.joint1 for c in bt.couplings if c.joint2 is None}
-    for c in bt.couplings:
-        if c.joint2 is None and c.polycoef[0] != 0.0:
-            raise InputError(f"equality {c.name!r}: holds {c.joint1!r} away from its reference value; spatialmech "
+            for body, lk in list(link_of.items()):
+                if lk == drop:
+                    link_of[body] = keep
+    locked = {cp.joint1 for cp in bt.couplings if cp.joint2 is None}
+    helical: dict[str, tuple[str, float]] = {}
+    for cp in bt.couplings:
+        if cp.joint2 is None and cp.polycoef[0] != 0.0:
+            raise InputError(f"equality {cp.name!r}: holds {cp.joint1!r} away from its reference value; spatialmech "
                              "locks a freedom at its reference value")
-    helical = {c.joint1: (c.joint2, c.polycoef[1]) for c in bt.couplings if c.joint2 is not None}
+        if cp.joint2 is not None:
+            helical[cp.joint1] = (cp.joint2, cp.polycoef[1])
 
     def marked(axes: tuple[Axis, ...]) -> tuple[Axis, ...]:
         return tuple(Axis(a.name, a.kind, a.anchor, a.axis, a.ref, a.range, a.actuated, a.locked or a.name in locked,

@@ -5,7 +5,8 @@
 
 - ``compiler angle="radian"``; gravity off and contacts off (``option``), the implicitfast
   integrator; every body has the same explicit inertia (mass 1, radius of gyration 0.2 L, L the
-  characteristic length), so the file needs no unit of mass;
+  characteristic length), so the file needs no unit of mass; joint damping of 10 per second
+  (times the body's inertia about, or mass along, the joint) and a little armature;
 - bodies nested as the spanning tree, frames world-aligned at the reference configuration; a
   ``hinge`` / ``slide`` per freedom with ``ref`` = the freedom's offset (its value is the
   physical value ``offset + q``: a leg length, an angle in radians), ``range`` from its limits;
@@ -61,7 +62,7 @@ def _vec(v) -> str:
 
 def _require_mujoco():
     try:
-        import mujoco
+        import mujoco  # type: ignore[import-untyped]
     except ImportError:  # pragma: no cover - mujoco is a dependency; a broken install still gets one line
         raise InputError("the 'mujoco' package is not installed: pip install 'mujoco>=3.2'") from None
     return mujoco
@@ -89,8 +90,10 @@ def _geoms(parent: ET.Element, body: Body, origin: np.ndarray, L: float, colour:
                           rgba=_ACTUATED if ax.actuated else _JOINT)
 
 
-def _joint(parent: ET.Element, ax: Axis, origin: np.ndarray) -> None:
-    attrs = {"name": ax.name, "type": ax.kind, "pos": _vec(ax.anchor - origin)}
+def _joint(parent: ET.Element, ax: Axis, origin: np.ndarray, gyr: float) -> None:
+    inertia = 1.0 if ax.kind == "slide" else gyr  # of a body of mass 1 along / about the joint
+    attrs = {"name": ax.name, "type": ax.kind, "pos": _vec(ax.anchor - origin),
+             "damping": _num(10.0 * inertia), "armature": _num(0.01 * inertia)}
     if ax.kind != "ball":
         attrs["axis"] = _vec(ax.axis)
         if ax.ref != 0.0:
@@ -111,7 +114,6 @@ def mjcf_tree(tree: BodyTree) -> ET.ElementTree:
     ET.SubElement(custom, "text", name=METADATA, data=json.dumps(tree.metadata(), separators=(",", ":")))
     default = ET.SubElement(root, "default")
     ET.SubElement(default, "geom", contype="0", conaffinity="0", group="1")
-    ET.SubElement(default, "joint", damping=_num(0.5 * L * L), armature=_num(0.01 * L * L))
     pts = [p for b in tree.bodies for s in b.segments for p in s] + [p for s in tree.ground_segments for p in s]
     pts += [b.origin for b in tree.bodies]
     lo, hi = np.min(pts, axis=0), np.max(pts, axis=0)
@@ -128,7 +130,7 @@ def mjcf_tree(tree: BodyTree) -> ET.ElementTree:
         ET.SubElement(el, "inertial", pos="0 0 0", mass="1", diaginertia=_vec([gyr, gyr, gyr]))
         if b.joint is not None:
             for ax in b.joint.axes:
-                _joint(el, ax, b.origin)
+                _joint(el, ax, b.origin, gyr)
         colour = _OUTPUT if b.name == tree.output else _LINK
         _geoms(el, b, b.origin, L, colour)
         elements[b.name], origins[b.name] = el, b.origin
@@ -175,7 +177,10 @@ def to_mjcf(model: Mechanism | BodyTree) -> str:
     tree = body_tree(model) if isinstance(model, Mechanism) else model
     if not isinstance(tree, BodyTree):
         raise TypeError(f"model: expected a Mechanism or a BodyTree, got {type(model).__name__}")
-    return ET.tostring(mjcf_tree(tree).getroot(), encoding="unicode") + "\n"
+    root = mjcf_tree(tree).getroot()
+    if root is None:  # pragma: no cover - the writer always builds a root
+        raise RuntimeError("empty MJCF document")
+    return ET.tostring(root, encoding="unicode") + "\n"
 
 
 # ------------------------------------------------------------------ reading
@@ -230,16 +235,16 @@ def read_body_tree(path) -> BodyTree:
         bodies.append(Body(bname, bname, None if parent == 0 else body_names[parent], d.xpos[i].copy(), tj))
     closures, couplings = [], []
     for k in range(m.neq):
-        en = name(mujoco.mjtObj.mjOBJ_EQUALITY, k, "equality")
         t = int(m.eq_type[k])
+        kinds = {int(mujoco.mjtEq.mjEQ_CONNECT): "connect", int(mujoco.mjtEq.mjEQ_WELD): "weld",
+                 int(mujoco.mjtEq.mjEQ_JOINT): "joint"}
+        en = name(mujoco.mjtObj.mjOBJ_EQUALITY, k, kinds.get(t, "equality"))
         if t in (mujoco.mjtEq.mjEQ_CONNECT, mujoco.mjtEq.mjEQ_WELD):
             if int(m.eq_objtype[k]) != int(mujoco.mjtObj.mjOBJ_BODY):
                 raise InputError(f"{p}: equality {en!r} joins sites; give body1/body2 and an anchor")
             b1, b2 = int(m.eq_obj1id[k]), int(m.eq_obj2id[k])
             kind = "connect" if t == mujoco.mjtEq.mjEQ_CONNECT else "weld"
-            anchor = d.xpos[b1] + d.xmat[b1].reshape(3, 3) @ m.eq_data[k, 0:3]
-            if kind == "weld":
-                anchor = d.xpos[b2] + d.xmat[b2].reshape(3, 3) @ m.eq_data[k, 3:6]
+            anchor = d.xpos[b1] + d.xmat[b1].reshape(3, 3) @ m.eq_data[k, 0:3]  # a weld's only names its frame
             jn = en.split(":", 1)[1] if en.startswith(f"{kind}:") else en
             closures.append(Closure(jn, kind, None if b1 == 0 else body_names[b1], None if b2 == 0 else body_names[b2],
                                     anchor.copy(), ""))

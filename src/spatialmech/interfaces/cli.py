@@ -18,7 +18,6 @@ import click
 from .. import __version__, catalog
 from ..analysis.mobility import mobility, mobility_modes
 from ..errors import ConvergenceError, SpatialmechError
-from ..model.schema import dump
 from .common import UserError, check_output_dir, check_output_file, emit_json, json_option, tol_option
 
 
@@ -199,21 +198,34 @@ def mobility_cmd(model, mode, as_json):
 @cli.command()
 @click.argument("model")
 @click.argument("file", type=click.Path(dir_okay=False, writable=True, path_type=Path))
+@click.option("--format", "fmt", type=click.Choice(["toml", "mjcf", "urdf"]), default=None,
+              help="toml (the model file format), mjcf (MuJoCo) or urdf; default: from FILE's extension "
+                   "(.toml, .xml, .urdf).")
+@click.option("--mode", default=None, help="Export a metamorphic mechanism in this motion mode (the other "
+                                           "lockable freedoms locked).")
 @json_option
-def export(model, file, as_json):
-    """Write a model (e.g. a ready-made one) as a TOML file to start your own from.
+def export(model, file, fmt, mode, as_json):
+    """Write a model (e.g. a ready-made one) as a TOML file to start your own from, or as a
+    MuJoCo model (MJCF) or URDF to carry it to a simulator (docs/validation.md).
 
     \b
-    Example:
+    Examples:
       spatialmech export rssr my-rssr.toml
+      spatialmech export four-sps-cu four-sps-cu.xml     # MJCF: python -m mujoco.viewer --mjcf=four-sps-cu.xml
+      spatialmech export stewart-6sps stewart.urdf       # URDF, loop closures in an extension block
     """
+    from ..exchange import export_model, format_of
+
+    fmt = format_of(file, fmt)  # before any work: a file name whose format is unknown
     check_output_file(file, "FILE")
     mech = _model(model)
-    dump(mech, file)
+    if mode is not None:
+        mech = mech.in_mode(mode)
+    fmt = export_model(mech, file, fmt)
     if as_json:
-        emit_json("export", mech, {"out": str(file), "bytes": file.stat().st_size})
+        emit_json("export", mech, {"out": str(file), "format": fmt, "bytes": file.stat().st_size})
     else:
-        click.echo(f"wrote {file}")
+        click.echo(f"wrote {file} ({fmt})")
 
 
 @cli.command()
@@ -278,9 +290,10 @@ from .cmd_kinematics import fk, ik, jacobian  # noqa: E402  (commands defined in
 from .cmd_singularity import singularity_cmd  # noqa: E402
 from .cmd_synth import synth  # noqa: E402
 from .cmd_view import view  # noqa: E402
+from .cmd_validate import validate_cmd  # noqa: E402
 from .cmd_workspace import workspace  # noqa: E402
 
-for _cmd in (ik, fk, jacobian, synth, view, defects, workspace, singularity_cmd):
+for _cmd in (ik, fk, jacobian, synth, view, defects, workspace, singularity_cmd, validate_cmd):
     cli.add_command(_cmd)
 
 

@@ -27,7 +27,8 @@ MAX_SEEDS = 20_000
 
 pose_options = [
     click.option("--pose", "pose_text", default=None,
-                 help="X,Y,Z,SEQ,A1,A2,A3 in one option: platform point (length) and Euler angles (deg), e.g. 0,0,0.12,ZYX,34.38,-5.73,11.46."),
+                 help="X,Y,Z,SEQ,A1,A2,A3 in one option: platform point (length) and Euler angles (deg), "
+                      "e.g. 0,0,0.12,ZYX,34.38,-5.73,11.46."),
     click.option("--xyz", nargs=3, type=float, default=None, help="Platform point position X Y Z (model length unit)."),
     click.option("--euler", "euler", nargs=4, type=(str, float, float, float), default=None,
                  help="Orientation: SEQ A1 A2 A3, angles in degrees (e.g. ZYX 30 -5 10; upper case = intrinsic)."),
@@ -69,6 +70,8 @@ def parse_pose(text: str):
 #: Largest distance of a requested platform point from the reference one, in characteristic
 #: lengths of the model (farther is out of the numerical range: squares overflow).
 MAX_POSE_DISTANCE = 1e6
+#: Largest rotational actuator value (degrees) accepted: beyond it a double has no precision left.
+MAX_ANGLE_DEG = 1e9
 
 
 def resolve_pose(mech: Mechanism, xyz, euler, position) -> Pose:
@@ -178,7 +181,8 @@ def ik(model, xyz, euler, position, all_solutions, as_json):
 
 @click.command()
 @click.argument("model")
-@click.option("--actuators", "values", required=True, help="Comma-separated actuator values in mechanism order (degrees / length).")
+@click.option("--actuators", "values", required=True,
+              help="Comma-separated actuator values in mechanism order (degrees / length).")
 @click.option("--all", "all_solutions", is_flag=True, help="Search all real assembly modes (multi-start).")
 @click.option("--seeds", type=click.IntRange(min=1, max=MAX_SEEDS), default=None,
               help=f"Number of starts for --all (default: 200; 512 on the 4-SPS/CU closed form; at most {MAX_SEEDS}).")
@@ -197,6 +201,13 @@ def fk(model, values, all_solutions, seeds, as_json):
     acts = mech.actuators
     if len(raw) != len(acts):
         raise InputError(f"--actuators: {mech.name} has {len(acts)} actuators ({', '.join(acts)}), got {len(raw)} values")
+    for k, (a, v) in enumerate(zip(acts, raw, strict=True), start=1):  # beyond these, squares overflow
+        slide = mech.freedom(a).freedom.kind == "P"
+        top = MAX_POSE_DISTANCE * mech.characteristic_length if slide else MAX_ANGLE_DEG
+        if abs(v) > top:
+            unit = mech.length_unit if slide else "deg"
+            why = f" (1e6 times the size of {mech.name})" if slide else ""
+            raise InputError(f"--actuators: item {k} ({a} = {v:g} {unit}) is out of range: at most {top:.3g} {unit}{why}")
     vals = [v if mech.freedom(a).freedom.kind == "P" else np.radians(v) for a, v in zip(acts, raw, strict=True)]
     from ..kinematics.closed_forms import four_sps_cu as k4
 
@@ -342,4 +353,5 @@ def jacobian(model, xyz, euler, position, drivers, dj_table, as_json):
     if J.inverse_singular:
         click.echo(f"  inverse (serial) singular for: {', '.join(J.inverse_singular)}")
     if not fit.exact:
-        click.echo(f"  note: the pose was fitted onto the closure (error {fit.position_error:.3g} {mech.length_unit}, {np.degrees(fit.angle_error):.3g} deg)")
+        click.echo(f"  note: the pose was fitted onto the closure (error {fit.position_error:.3g} {mech.length_unit}, "
+                   f"{np.degrees(fit.angle_error):.3g} deg)")

@@ -507,6 +507,19 @@ def _parse_at(at, allowed: tuple[str, ...], name: str = "at") -> dict[str, float
     return out
 
 
+#: Largest distance of a fixed position coordinate from the reference platform point, in
+#: characteristic lengths (farther is out of the numerical range: squares overflow).
+MAX_DISTANCE = 1e6
+
+
+def _check_position_range(mech: Mechanism, fixed: Mapping[str, float]) -> None:
+    L = mech.characteristic_length
+    for i, c in enumerate(_POSITION):
+        if c in fixed and abs(fixed[c] - float(mech.platform_point[i])) > MAX_DISTANCE * L:
+            raise InputError(f"at.{c}: {fixed[c]:g} is more than {MAX_DISTANCE:g} times the size of {mech.name} "
+                             f"({L:.3g} m) from its reference platform point: out of range")
+
+
 def _check_positive(value, name: str) -> float:
     v = float(as_finite_array(value, name, shape=()))
     if v <= 0:
@@ -557,6 +570,7 @@ def orientation_workspace(
     with its size, before any work.
     """
     fixed = _parse_at(at, COORDINATES)
+    _check_position_range(mech, fixed)
     step = _check_positive(step, "step")
     tol = _check_positive(tol, "tol")
     values = {c: float(mech.platform_point[i]) for i, c in enumerate(_POSITION)}
@@ -594,6 +608,7 @@ def position_workspace(
     point +- 2 characteristic lengths (m).  ``max_poses`` as in :func:`orientation_workspace`.
     """
     fixed = _parse_at(at, COORDINATES)
+    _check_position_range(mech, fixed)
     L = mech.characteristic_length
     step = L / 40 if step is None else _check_positive(step, "step")
     tol = L * 1e-6 if tol is None else _check_positive(tol, "tol")

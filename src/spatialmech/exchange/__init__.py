@@ -1,0 +1,73 @@
+"""Models that travel to other tools: MuJoCo (MJCF) and URDF exports, and MJCF import.
+
+One intermediate structure, :class:`~.bodies.BodyTree` (a spanning tree of the link graph as
+bodies, plus the loop closures), serves both writers; see docs/validation.md.
+
+    >>> import spatialmech as sm
+    >>> from spatialmech.exchange import body_tree, to_mjcf, to_urdf
+    >>> tree = body_tree(sm.load_model("rssr"))
+    >>> [c.kind for c in tree.closures], [a.name for a in tree.actuated]
+    (['connect'], ['A0.rot'])
+    >>> to_mjcf(tree).startswith('<mujoco model="rssr">'), "<robot" in to_urdf(tree)
+    (True, True)
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from ..errors import InputError
+from ..model.mechanism import Mechanism
+from .bodies import Axis, Body, BodyTree, Closure, Coupling, TreeJoint, body_tree, mechanism_from_tree
+from .mjcf import from_mjcf, to_mjcf
+from .urdf import to_urdf
+
+__all__ = [
+    "FORMATS",
+    "Axis",
+    "Body",
+    "BodyTree",
+    "Closure",
+    "Coupling",
+    "TreeJoint",
+    "body_tree",
+    "export_model",
+    "format_of",
+    "from_mjcf",
+    "mechanism_from_tree",
+    "to_mjcf",
+    "to_urdf",
+]
+
+#: Export formats and the file extensions that imply them.
+FORMATS = {"toml": (".toml",), "mjcf": (".xml", ".mjcf"), "urdf": (".urdf",)}
+
+
+def format_of(path, fmt: str | None = None) -> str:
+    """The export format: ``fmt`` if given (``toml``, ``mjcf``, ``urdf``), else from the file's
+    extension (``.toml``; ``.xml`` / ``.mjcf``; ``.urdf``)."""
+    if fmt is not None:
+        if fmt not in FORMATS:
+            raise InputError(f"--format: expected one of {', '.join(FORMATS)}, got {fmt!r}")
+        return fmt
+    suffix = Path(os.fspath(path)).suffix.lower()
+    for name, suffixes in FORMATS.items():
+        if suffix in suffixes:
+            return name
+    raise InputError(f"FILE: cannot tell the format from the extension {suffix or '(none)'!r} of {os.fspath(path)}; "
+                     f"use .toml, .xml (MJCF) or .urdf, or give --format {'|'.join(FORMATS)}")
+
+
+def export_model(mech: Mechanism, path, fmt: str | None = None) -> str:
+    """Write ``mech`` to ``path`` as TOML (the model file format), MJCF or URDF; returns the
+    format used (``fmt`` or the one the extension implies)."""
+    fmt = format_of(path, fmt)
+    if fmt == "toml":
+        from ..model.schema import dump
+
+        dump(mech, path)
+    else:
+        text = to_mjcf(mech) if fmt == "mjcf" else to_urdf(mech)
+        Path(os.fspath(path)).write_text(text, encoding="utf-8")
+    return fmt
