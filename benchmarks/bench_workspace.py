@@ -83,8 +83,9 @@ def run(n: int = 1_000_000, loop_n: int = 5000, general_n: int = 20, step_deg: f
         d = ws.to_dict()
         out["workspace"] = {"step_deg": step_deg, "seconds": dt, "poses_checked": ws.n_poses,
                             "pose_checks_per_s": ws.n_poses / dt,
-                            **{k: d[k] for k in ("alpha_deg", "beta_deg", "gamma_deg", "alpha_deg_set", "beta_deg_set",
-                                                 "gamma_deg_set", "volume")}}
+                            **{c: d["extents"][c]["alone"] for c in ("alpha_deg", "beta_deg", "gamma_deg")},
+                            **{f"{c}_set": d["extents"][c]["set"] for c in ("alpha_deg", "beta_deg", "gamma_deg")},
+                            "volume_deg3": d["volume_deg3"]}
     return out
 
 

@@ -301,7 +301,7 @@ def test_cli_orientation_json_keys(tmp_path):
         assert key in d
     assert d["fixed"] == {"x_len": 0.0, "y_len": 0.0, "z_len": 0.1} and d["length_unit"] == "m"
     assert d["extents"]["alpha_deg"]["alone"][1] == pytest.approx(np.degrees(np.arctan(0.5)), abs=TOL_DEG)
-    assert d["gamma_deg"][1] == pytest.approx(np.degrees(gamma_leg_limit(0.1)), abs=TOL_DEG)
+    assert d["extents"]["gamma_deg"]["alone"][1] == pytest.approx(np.degrees(gamma_leg_limit(0.1)), abs=TOL_DEG)
     assert (tmp_path / "w.png").exists()
 
 

@@ -411,7 +411,7 @@ def write_report(out, title: str, sections: Sequence[Section], elapsed: float, e
         "elapsed_s": round(float(elapsed), 2),
         "verdicts": list(VERDICTS),
         "summary": summary(sections),
-        "claims": [c.to_dict() for sec in sections for c in sec.claims],
+        "claims": [{**c.to_dict(), "length_unit": sec.length_unit} for sec in sections for c in sec.claims],  # as its section
         "sections": [sec.to_dict() for sec in sections],
         **(extra or {}),
     }
