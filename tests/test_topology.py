@@ -64,8 +64,9 @@ def test_ready_made_models_have_limbs_minus_one_loops(name):
     g = link_graph(mech)
     n_joints = sum(len(limb.joints) for limb in mech.limbs)
     assert len(g.joints) == n_joints
-    assert len(g.links) == 2 + sum(len(limb.joints) - 1 for limb in mech.limbs)
-    assert g.connected and g.n_loops == len(mech.limbs) - 1
+    assert len(g.links) == 2 + len(mech.bodies) + sum(len(limb.joints) - 1 for limb in mech.limbs)
+    # limbs between hubs: loops = limbs - moving hubs (output link and bodies)
+    assert g.connected and g.n_loops == len(mech.limbs) - 1 - len(mech.bodies)
     t = spanning_tree(g)
     check_tree(g, t)
     check_loops(g, t)

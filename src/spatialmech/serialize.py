@@ -96,6 +96,8 @@ UNIT_FREE_KEYS: dict[str, str] = {
     "max_iter": "iteration limit",
     "members": "converged starts that one result stands for",
     "n": "number of links (mobility formula)",
+    "links": "number of links (mobility; = n)",
+    "loops": "number of independent loops of the link graph (mobility)",
     "n_branches": "number of branches",
     "n_converged": "number of converged starts",
     "n_distinct": "number of distinct solutions",

@@ -41,7 +41,7 @@ from ..kinematics.position import PoseFit, configuration_at_pose, freedom_values
 from ..kinematics.tracking import MotionProblem, TrackResult, correct_on_hyperplane, track
 from ..model.joints import make_joint
 from ..geometry.tolerances import current as current_tolerances
-from ..model.mechanism import Limb, Mechanism, Pose
+from ..model.mechanism import Mechanism, Pose
 from ..results import Progress, Steps, TrackStatus
 
 __all__ = [
@@ -495,7 +495,7 @@ def perturbed(mech: Mechanism, positions, rng: np.random.Generator, length: floa
             else:
                 kw["axes"] = [f.direction for f in fs]
             joints.append(make_joint(j.type, j.name, **kw))
-        limbs.append(Limb(limb.name, tuple(joints)))
+        limbs.append(limb.with_joints(joints))
     new_pos = []
     for P in positions:
         dR = Rotation.from_rotvec(np.radians(rng.uniform(-angle_deg, angle_deg, 3))).as_matrix()

@@ -45,7 +45,9 @@ from ..kinematics.closure import (
     Configuration,
     active_mask,
     closure_jacobian,
+    closure_scales,
     generic_configuration,
+    hub_count,
     joint_twists,
     limb_slices,
 )
@@ -142,6 +144,12 @@ class MobilityResult:
     agrees: bool
     explanation: str
     passive: tuple[int, ...] = field(default=())
+    #: Independent loops of the link graph, ``g - n + 1``.
+    loops: int = 0
+    #: How ``t`` and ``k`` were counted: ``"limbs"`` (constraint wrenches of limbs between the
+    #: ground and the output link) or ``"loops"`` (closure equations of the independent loops of
+    #: a link-and-joint graph; see :func:`mobility`).
+    counted_by: str = "limbs"
     #: The rank tolerance used (relative singular-value threshold, nondimensional).
     tolerance: float = 1e-9
     #: The count ``dof`` as a function of the rank tolerance over ``[0, SCAN_RANGE[1])``.
@@ -167,6 +175,7 @@ class MobilityResult:
     def to_dict(self) -> dict:
         d = asdict(self)
         d["lambda"] = d.pop("lam")
+        d["links"] = self.n
         d["actuators"] = list(self.actuators)
         d["limb_constraints"] = list(self.limb_constraints)
         d["passive"] = list(self.passive)
@@ -200,9 +209,10 @@ def _canonical(W: np.ndarray, L: float) -> np.ndarray:
 
 
 def _count_structure(mech: Mechanism) -> tuple[int, int, int, list[int]]:
-    """Links n (incl. base and platform), joints g, sum of freedoms, per-limb freedoms."""
+    """Links n (incl. the ground, the output link and the internal bodies), joints g, sum of
+    freedoms, per-limb freedoms; a locked joint is removed and its two links merged."""
     g = 0
-    n = 2
+    n = 2 + len(mech.bodies)
     f_limbs = []
     for limb in mech.limbs:
         gk = sum(1 for j in limb.joints if j.dof > 0)
@@ -234,12 +244,8 @@ def _scaled_closure(mech: Mechanism, config: Configuration) -> tuple[np.ndarray,
     """The nondimensional closure Jacobian (moments / L, slides x L), the column scales, and
     per limb its columns."""
     active = active_mask(mech)
-    L = mech.characteristic_length
     A, _ = closure_jacobian(mech, config, active=active)
-    K = len(mech.limbs)
-    row = np.tile(np.r_[np.ones(3), np.full(3, 1.0 / L)], K)
-    lin = np.array([r.freedom.is_linear for r in mech.freedom_refs])[active]
-    col = np.r_[np.where(lin, L, 1.0), np.ones(3), np.full(3, L)]
+    row, col = closure_scales(mech, active)
     As = row[:, None] * A * col[None, :]
     idx = np.flatnonzero(active)
     cols = [[i for i, gi in enumerate(idx) if sl.start <= gi < sl.stop] for sl in limb_slices(mech)]
@@ -259,7 +265,8 @@ def _instantaneous(mech: Mechanism, config: Configuration, rtol: float) -> tuple
     _, sv, vt = np.linalg.svd(As / n)
     r = int(np.sum(sv > rtol * max(1.0, sv[0])))
     null = vt[r:] / n  # back to the scaled variables
-    V = null[:, -6:] / col[-6:]  # back to SI twists
+    na = int(active_mask(mech).sum())
+    V = null[:, na : na + 6] * col[na : na + 6]  # the output link's part, back to SI twists (u = col x)
     Vb = sc.basis(V, length_scale=L, rtol=rtol) if V.shape[0] else np.zeros((0, 6))
     return N - xi, xi, Vb
 
@@ -292,6 +299,25 @@ def _formula(limbs_T: list[np.ndarray], L: float, n: int, g: int, sum_f: int, f_
     passive = tuple(f - r for f, r in zip(f_limbs, ranks, strict=True))
     xi = sum(passive)
     return _Counts(lam, d, t, k, v, xi, d * (n - g - 1) + sum_f + v - xi, W, Wall, passive)
+
+
+def _loop_formula(limbs_T: list[np.ndarray], L: float, As: np.ndarray, limb_cols, hubs: int, n: int, g: int,
+                  sum_f: int, f_limbs: list[int], rtol: float) -> _Counts:
+    """The modified count for a link-and-joint graph, from its loops: ``t = d * loops`` closure
+    equations (``d = 6 - lambda`` per loop), of which ``k`` are independent (the rank of the
+    closure Jacobian at the reference less the ``6 * hubs`` columns of the moving hubs); ``xi``
+    the motions of each limb with both its end links at rest."""
+    all_T = np.vstack([T for T in limbs_T if T.size] or [np.zeros((0, 6))])
+    lam = 6 - sc.rank(all_T, length_scale=L, rtol=rtol) if all_T.size else 6
+    d = 6 - lam
+    loops = g - n + 1
+    t = d * loops
+    k = As.shape[1] - _nullity(As, rtol) - 6 * hubs
+    v = t - k
+    W = [sc.reciprocal_basis(T, length_scale=L, rtol=rtol) if T.size else np.eye(6) for T in limbs_T]
+    passive = tuple(_nullity(As[:, c], rtol) if c else 0 for c in limb_cols)
+    xi = sum(passive)
+    return _Counts(lam, d, t, k, v, xi, d * (n - g - 1) + sum_f + v - xi, W, np.zeros((0, 6)), passive)
 
 
 #: The tolerances of ``dof_at_tolerance`` in the JSON (decades).
@@ -420,19 +446,30 @@ def _mobility(mech: Mechanism, mode, seed: int, tols: Tolerances) -> MobilityRes
         a = active[sl]
         limbs_T.append(J[:, a].T)
     n, g, sum_f, f_limbs = _count_structure(m)
-    c = _formula(limbs_T, L, n, g, sum_f, f_limbs, rtol)
+    As_ref, _, limb_cols = _scaled_closure(m, ref)
+    h = hub_count(m)
+    by_loops = m.is_graph
+
+    def count(tt: float) -> _Counts:
+        if by_loops:
+            return _loop_formula(limbs_T, L, As_ref, limb_cols, h, n, g, sum_f, f_limbs, tt)
+        return _formula(limbs_T, L, n, g, sum_f, f_limbs, tt)
+
+    c = count(rtol)
     lam, d, t, k, v, xi, M, W, Wall, passive = c.lam, c.d, c.t, c.k, c.v, c.xi, c.M, c.W, c.Wall, c.passive
     gk = 6 * (n - g - 1) + sum_f
 
     # how the count depends on the rank tolerance
-    As_ref, _, limb_cols = _scaled_closure(m, ref)
     names = [limb.name for limb in m.limbs]
     cands = _candidates(limbs_T, names, L, As_ref, limb_cols, Wall)
-    steps = _scan(lambda tt: _formula(limbs_T, L, n, g, sum_f, f_limbs, tt).M, cands)
+    steps = _scan(lambda tt: count(tt).M, cands)
     note = _tolerance_note(steps, rtol, M)
 
-    # the free platform twist system at the reference: reciprocal to all limb constraints
-    Vref = sc.reciprocal_basis(Wall, length_scale=L, rtol=rtol)
+    if by_loops:  # the output link's free twists at the reference, and the wrenches reciprocal to them
+        _, _, Vref = _instantaneous(m, ref, rtol)
+        Wall = sc.reciprocal_basis(Vref, length_scale=L, rtol=rtol) if Vref.shape[0] else np.eye(6)
+    else:  # the free platform twist system at the reference: reciprocal to all limb constraints
+        Vref = sc.reciprocal_basis(Wall, length_scale=L, rtol=rtol)
     try:
         gen = generic_configuration(m, seed=seed)
         dof_inst, _, Vgen = _instantaneous(m, gen, rtol)
@@ -492,6 +529,8 @@ def _mobility(mech: Mechanism, mode, seed: int, tols: Tolerances) -> MobilityRes
         agrees=bool(dof_inst == M),
         explanation=" ".join(notes) + f" Motion named {where}." + generic_note,
         passive=passive,
+        loops=int(g - n + 1),
+        counted_by="loops" if by_loops else "limbs",
         tolerance=float(rtol),
         dof_by_tolerance=steps,
         tolerance_note=note,

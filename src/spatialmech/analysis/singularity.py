@@ -39,7 +39,7 @@ from ..kinematics.jacobian import CompleteJacobian, complete_jacobian
 from ..kinematics.position import configuration_at_pose
 from ..kinematics.tracking import MotionProblem, track
 from ..geometry.tolerances import current as current_tolerances
-from ..model.mechanism import Limb, Mechanism, Pose
+from ..model.mechanism import Mechanism, Pose
 from ..results import Progress, SingularityKind
 
 __all__ = ["SingularityResult", "SliceResult", "locked_actuators", "singularity", "singularity_at_pose", "singularity_slice"]
@@ -102,7 +102,7 @@ def locked_actuators(mech: Mechanism, actuators=None) -> Mechanism:
                 if f"{j.name}.{f.name}" in ids:
                     j = j.with_freedom(f.name, locked=True, actuated=False)
             joints.append(j)
-        limbs.append(Limb(limb.name, tuple(joints)))
+        limbs.append(limb.with_joints(joints))
     return replace(mech, limbs=tuple(limbs), modes=())
 
 

@@ -21,10 +21,12 @@ REGISTRY: dict[str, tuple[Callable[[], Mechanism], str]] = {
     "stewart-6sps": (classic.stewart_6sps, "Gough-Stewart platform 6-SPS, 6 DOF"),
     "three-rps": (classic.three_rps, "3-RPS parallel mechanism, 2 rotations + 1 translation"),
     "three-upu": (classic.three_upu, "Translational 3-UPU (Tsai), 3 translations"),
-    "delta": (classic.delta, "Delta robot (parallelograms as U-U pairs), 3 translations"),
+    "delta": (classic.delta, "Clavel Delta robot (3 R + 12 S, 5 loops), 3 translations"),
+    "delta-ruu": (classic.delta_ruu, "Delta robot (parallelograms as U-U pairs), 3 translations"),
     "planar-4r": (classic.planar_4r, "Planar four-bar crank-rocker, 1 DOF"),
     "bennett": (classic.bennett, "Bennett overconstrained spatial 4R, 1 DOF (classic G-K -2)"),
     "rssr": (classic.rssr, "Spatial RSSR four-bar, 1 DOF + 1 passive spin"),
+    "spatial-six-bar": (classic.spatial_six_bar, "Spatial six-bar (two RSSR loops sharing a link), 1 DOF + 2 passive spins"),
 }
 
 

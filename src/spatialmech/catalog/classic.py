@@ -91,7 +91,33 @@ def three_upu(rb: float = 0.3, rp: float = 0.1, h: float = 0.3) -> Mechanism:
     )
 
 
-def delta(rb: float = 0.2, arm: float = 0.2, rp: float = 0.05, h: float = -0.35) -> Mechanism:
+def delta(rb: float = 0.2, arm: float = 0.2, rp: float = 0.05, h: float = -0.35, width: float = 0.06) -> Mechanism:
+    """The Clavel Delta: per limb an actuated R joint on the base, an arm, and a parallelogram of
+    two rods with spherical joints at both ends (``width`` apart) to the platform.  11 links, 3 R
+    + 12 S joints, 5 independent loops; 3 DOF (3 translations) and the 6 rods' spins passive."""
+    angs = [90, 210, 330]
+    B = _ring(rb, angs)
+    W = _ring(rp, angs, h)
+    links = ["ground", "platform"]
+    joints = []
+    for i, ang in enumerate(np.deg2rad(angs)):
+        r = np.array([np.cos(ang), np.sin(ang), 0.0])
+        a = np.array([-np.sin(ang), np.cos(ang), 0.0])
+        E = B[i] + arm * r
+        k = i + 1
+        links += [f"arm{k}", f"rod{k}a", f"rod{k}b"]
+        joints.append((R(f"R{k}", B[i], a, actuated=True), "ground", f"arm{k}"))
+        for side, sgn in (("a", 1.0), ("b", -1.0)):
+            off = sgn * 0.5 * width * a
+            joints.append((S(f"E{k}{side}", E + off), f"arm{k}", f"rod{k}{side}"))
+            joints.append((S(f"W{k}{side}", W[i] + off), f"rod{k}{side}", "platform"))
+    return Mechanism.from_graph(
+        "delta", links, joints, platform_point=[0, 0, h],
+        description="Clavel Delta robot (3 R + 12 S, parallelograms of two SS rods), 3 translations",
+    )
+
+
+def delta_ruu(rb: float = 0.2, arm: float = 0.2, rp: float = 0.05, h: float = -0.35) -> Mechanism:
     """Delta robot with the forearm parallelogram replaced by its kinematic equivalent, two
     universal joints with parallel inner axes (3-RUU): 3 translations."""
     angs = [90, 210, 330]
@@ -111,7 +137,7 @@ def delta(rb: float = 0.2, arm: float = 0.2, rp: float = 0.05, h: float = -0.35)
             )
         )
     return Mechanism(
-        "delta", tuple(limbs), platform_point=[0, 0, h],
+        "delta-ruu", tuple(limbs), platform_point=[0, 0, h],
         description="Delta robot (parallelograms as equivalent U-U pairs, 3-RUU), 3 translations",
     )
 
@@ -201,6 +227,29 @@ def bennett(a: float = 1.0, alpha_deg: float = 30.0, b: float = 1.5, theta1_deg:
     return Mechanism(
         "bennett", limbs, platform_point=o[2],
         description="Bennett linkage (overconstrained spatial 4R): classic G-K -2, mobility 1",
+    )
+
+
+def spatial_six_bar() -> Mechanism:
+    """A spatial six-bar of two RSSR loops that share a link: the crank (R about z) drives the
+    rocker (R about x) through the rod ``rod1`` (S-S); the rocker drives the follower (R about
+    y) through ``rod2`` (S-S).  6 links, 3 R + 4 S joints, 2 independent loops; mobility 1 with
+    the two rods' spins passive.  The rocker has three joints: an internal body of the graph;
+    the follower is the output link."""
+    X, Y, Z = np.eye(3)
+    links = ["ground", "crank", "rod1", "rocker", "rod2", "follower"]
+    joints = [
+        (R("A0", [0.0, 0.0, 0.0], Z, actuated=True), "ground", "crank"),
+        (S("A1", [0.3, 0.0, 0.0]), "crank", "rod1"),
+        (S("B1", [0.0, 1.0, -0.1]), "rod1", "rocker"),
+        (R("B0", [0.0, 1.0, 0.5], X), "ground", "rocker"),
+        (S("C1", [0.0, 1.3, 0.8]), "rocker", "rod2"),
+        (S("D1", [0.9, 2.0, 0.5]), "rod2", "follower"),
+        (R("D0", [0.6, 2.0, 0.5], Y), "ground", "follower"),
+    ]
+    return Mechanism.from_graph(
+        "spatial-six-bar", links, joints, output="follower", platform_point=[0.6, 2.0, 0.5],
+        description="Spatial six-bar: two RSSR loops sharing the rocker; 1 DOF (+2 passive rod spins)",
     )
 
 

@@ -156,8 +156,10 @@ def _mobility_text(r) -> str:
     lines = [
         f"{r.mechanism}  mode {r.mode}" + (f"  (actuators: {', '.join(r.actuators)})" if r.actuators else ""),
         f"  {r.formula()}",
+        f"  links n = {r.n}, joints g = {r.g}, independent loops = {r.loops}",
         f"  lambda = {r.lam} common constraints, d = {r.d}; t = {r.t}, k = {r.k}, v = t - k = {r.v};"
-        f" xi = {r.xi} passive",
+        f" xi = {r.xi} passive"
+        + ("  (t, k: closure equations of the loops)" if r.counted_by == "loops" else ""),
         f"  classic Grübler-Kutzbach (d = 6): {r.gk_classic}",
         f"  instantaneous mobility (closure-Jacobian rank, generic configuration): {r.dof_instantaneous}",
         f"  motion: {r.motion}  ({r.motion_class})",

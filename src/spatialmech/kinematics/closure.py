@@ -1,14 +1,18 @@
 """One closure formulation for every mechanism.
 
 A configuration is the vector ``q`` of all joint variables (every freedom of every limb, in
-:attr:`Mechanism.freedom_refs` order; zero at the reference) and the platform displacement
-``D`` (4x4).  Limb ``k`` closes when its product of exponentials equals the platform
-displacement: ``FK_k(q_k) = D``.  The residual of limb ``k`` is the twist
-``log(FK_k D^-1)`` (6,), zero at closure.
+:attr:`Mechanism.freedom_refs` order; zero at the reference), the platform (output link)
+displacement ``D`` (4x4) and, for a mechanism with internal bodies (hub links of a
+link-and-joint graph, :attr:`Mechanism.bodies`), their displacements ``B`` (k, 4, 4).
+Limb ``k`` runs from hub ``a`` to hub ``b`` and closes when ``D_a FK_k(q_k) = D_b`` (``D_a`` is
+the identity for the ground): the residual of limb ``k`` is the twist
+``log(D_a FK_k D_b^-1)`` (6,), zero at closure.  For limbs from the ground to the platform
+this is ``log(FK_k D^-1)``.
 
 Linearisation: ``FK_k(q + dq) ~ exp(J_k dq) FK_k`` with ``J_k`` the limb's *spatial* Jacobian
-(the joint twists at the current configuration, columns), and ``D_new = exp(V) D``; hence the
-closure Jacobian ``[blockdiag(J_k) | -1]`` acting on ``(dq_active, V)``.
+(the joint twists at the current configuration, columns), and ``D_new = exp(V) D`` for every
+hub; hence the closure Jacobian with blocks ``Ad(D_a) J_k``, ``+1`` under ``V_a`` and ``-1``
+under ``V_b``, acting on ``(dq_active, V, V_bodies)``.
 
 Only *active* freedoms (not locked) are unknowns; locked freedoms keep their value.
 Nondimensional forms (moments divided by the characteristic length ``L``; prismatic variables
@@ -18,7 +22,7 @@ divided by ``L``) are used for rank decisions and convergence tests.
 from __future__ import annotations
 
 import weakref
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -49,27 +53,47 @@ __all__ = [
     "closure_scales",
     "correct",
     "generic_configuration",
+    "hub_count",
+    "hub_displacements",
     "joint_points",
     "joint_twists",
     "limb_chains",
     "limb_forward",
     "limb_slices",
+    "placed_configuration",
     "recentre_balls",
     "reference_screws",
     "retract",
 ]
 
 
+_NO_BODIES = np.zeros((0, 4, 4))
+_NO_BODIES.setflags(write=False)
+
+
 @dataclass(frozen=True, eq=False)
 class Configuration:
-    """Joint variables ``q`` (all freedoms) and platform displacement ``D`` (4x4)."""
+    """Joint variables ``q`` (all freedoms), platform displacement ``D`` (4x4) and the
+    displacements ``B`` (k, 4, 4) of the mechanism's internal bodies (none by default)."""
 
     q: np.ndarray
     D: np.ndarray
+    B: np.ndarray = field(default_factory=lambda: _NO_BODIES)
 
     @classmethod
     def reference(cls, mech: Mechanism) -> Configuration:
-        return cls(np.zeros(len(mech.freedom_refs)), np.eye(4))
+        k = len(mech.bodies)
+        return cls(np.zeros(len(mech.freedom_refs)), np.eye(4), np.tile(np.eye(4), (k, 1, 1)) if k else _NO_BODIES)
+
+    def hub(self, index: int | None) -> np.ndarray:
+        """The displacement of hub ``index`` (see :meth:`Mechanism.hub_index`)."""
+        if index is None:
+            return np.eye(4)
+        return self.D if index == 0 else self.B[index - 1]
+
+    def with_q(self, q) -> Configuration:
+        """The same hub displacements with other joint variables."""
+        return Configuration(np.asarray(q, dtype=float), self.D, self.B)
 
 
 def check_configuration(mech: Mechanism, config: Configuration) -> None:
@@ -79,7 +103,10 @@ def check_configuration(mech: Mechanism, config: Configuration) -> None:
         raise InputError(f"config.q: {mech.name} has {len(mech.freedom_refs)} joint variables, got shape {q.shape}")
     if np.asarray(config.D).shape != (4, 4):
         raise InputError(f"config.D: expected a 4x4 displacement, got shape {np.asarray(config.D).shape}")
-    if not (np.all(np.isfinite(q)) and np.all(np.isfinite(config.D))):
+    if np.shape(config.B) != (len(mech.bodies), 4, 4):
+        raise InputError(f"config.B: {mech.name} has {len(mech.bodies)} internal bodies, got displacements of shape "
+                         f"{np.shape(config.B)}")
+    if not (np.all(np.isfinite(q)) and np.all(np.isfinite(config.D)) and np.all(np.isfinite(config.B))):
         raise InputError("config: contains NaN or infinity")
 
 
@@ -285,50 +312,119 @@ def recentre_balls(mech: Mechanism, q: np.ndarray) -> np.ndarray:
 
 
 def joint_twists(mech: Mechanism, config: Configuration) -> list[np.ndarray]:
-    """Per limb, the (6, m_k) twists of all its freedoms at ``config``."""
+    """Per limb, the (6, m_k) spatial twists of all its freedoms at ``config``."""
     check_configuration(mech, config)
-    return [chain_forward(ch, config.q[sl], local=True)[1] for ch, sl in zip(limb_chains(mech), limb_slices(mech), strict=True)]
+    out = []
+    for (a, _), ch, sl in zip(mech.limb_ends, limb_chains(mech), limb_slices(mech), strict=True):
+        J = chain_forward(ch, config.q[sl], local=True)[1]
+        out.append(J if a is None else adjoint(config.hub(a)) @ J)
+    return out
+
+
+def hub_count(mech: Mechanism) -> int:
+    """Moving hub links whose twists are unknowns of the closure: the output link and the
+    internal bodies (``1 + len(mech.bodies)``)."""
+    return 1 + len(mech.bodies)
+
+
+def _place_hubs(mech: Mechanism, q: np.ndarray, known: dict) -> dict:
+    """Place hubs through limbs from the ``known`` ones (hub index -> displacement), in place."""
+    chains, sls = limb_chains(mech), limb_slices(mech)
+    grew = True
+    while grew and len(known) < len(mech.bodies) + 2:
+        grew = False
+        for (a, b), ch, sl in zip(mech.limb_ends, chains, sls, strict=True):
+            if (a in known) == (b in known):
+                continue
+            T, _ = chain_forward(ch, q[sl])
+            if a in known:
+                known[b] = known[a] @ T
+            else:
+                known[a] = known[b] @ inverse_transform(T)
+            grew = True
+    return known
+
+
+def hub_displacements(mech: Mechanism, q: np.ndarray, D: np.ndarray, B: np.ndarray | None = None) -> np.ndarray:
+    """Displacements (k, 4, 4) of the internal bodies implied by the joint variables ``q``: each
+    body placed through a limb from a hub already placed (the ground, the output link at ``D``,
+    or a body placed before), as a start for Newton.  ``B``: bodies to keep where they are
+    (rows with NaN are placed); by default every body is placed.  A body no limb reaches keeps
+    the identity."""
+    k = len(mech.bodies)
+    out = np.tile(np.eye(4), (k, 1, 1)) if B is None else np.array(B, dtype=float)
+    known = {None: np.eye(4), 0: np.asarray(D, dtype=float)}
+    if B is not None:
+        for i in range(k):
+            if np.all(np.isfinite(out[i])):
+                known[1 + i] = out[i]
+    _place_hubs(mech, q, known)
+    for i in range(k):
+        out[i] = known.get(1 + i, np.eye(4))
+    return out
+
+
+def placed_configuration(mech: Mechanism, q) -> Configuration:
+    """A configuration with joint variables ``q`` and every moving hub (the output link and the
+    bodies) placed through the limbs from the ground: closed when ``q`` is, and otherwise a
+    start for Newton that respects as many limbs as a tree of them can."""
+    q = np.asarray(q, dtype=float)
+    known = _place_hubs(mech, q, {None: np.eye(4)})
+    B = np.array([known.get(1 + i, np.eye(4)) for i in range(len(mech.bodies))]).reshape(-1, 4, 4)
+    return Configuration(q, known.get(0, np.eye(4)), B)
 
 
 def closure_residual(mech: Mechanism, config: Configuration) -> np.ndarray:
-    """Stacked limb residuals ``log(FK_k D^-1)`` (6 K,), SI units."""
+    """Stacked limb residuals ``log(D_a FK_k D_b^-1)`` (6 K,), SI units."""
     check_configuration(mech, config)
-    Dinv = inverse_transform(config.D)
     res = []
-    for ch, sl in zip(limb_chains(mech), limb_slices(mech), strict=True):
+    for (a, b), ch, sl in zip(mech.limb_ends, limb_chains(mech), limb_slices(mech), strict=True):
         T, _ = chain_forward(ch, config.q[sl])
-        res.append(_log_single(T @ Dinv))
+        if a is not None:
+            T = config.hub(a) @ T
+        res.append(_log_single(T @ inverse_transform(config.hub(b))))
     return np.concatenate(res)
 
 
 def closure_jacobian(mech: Mechanism, config: Configuration, *, active: np.ndarray | None = None):
-    """The closure Jacobian (6K, n_active + 6) in SI units and the residual (6K,)."""
+    """The closure Jacobian (6K, n_active + 6 h) in SI units and the residual (6K,).
+
+    Columns: the active joint variables, then the spatial twist of the output link (6), then
+    those of the internal bodies (6 each; ``h`` = :func:`hub_count`)."""
     check_configuration(mech, config)
     if active is None:
         active = active_mask(mech)
     sls = limb_slices(mech)
     K = len(sls)
     n = len(config.q)
-    A = np.zeros((6 * K, n + 6))
-    Dinv = inverse_transform(config.D)
+    h = hub_count(mech)
+    A = np.zeros((6 * K, n + 6 * h))
     res = []
-    for k, (ch, sl) in enumerate(zip(limb_chains(mech), sls, strict=True)):
+    for k, ((a, b), ch, sl) in enumerate(zip(mech.limb_ends, limb_chains(mech), sls, strict=True)):
         T, J = chain_forward(ch, config.q[sl], local=True)
-        A[6 * k : 6 * k + 6, sl] = J
-        A[6 * k : 6 * k + 6, n:] = -np.eye(6)
-        res.append(_log_single(T @ Dinv))
-    cols = np.concatenate([active, np.ones(6, bool)])
+        rows = slice(6 * k, 6 * k + 6)
+        if a is None:
+            A[rows, sl] = J
+        else:
+            Da = config.hub(a)
+            A[rows, sl] = adjoint(Da) @ J
+            T = Da @ T
+            A[rows, n + 6 * a : n + 6 * a + 6] += np.eye(6)
+        if b is not None:  # a limb may also end at the ground
+            A[rows, n + 6 * b : n + 6 * b + 6] -= np.eye(6)
+        res.append(_log_single(T @ inverse_transform(config.hub(b))))
+    cols = np.concatenate([active, np.ones(6 * h, bool)])
     return A[:, cols], np.concatenate(res)
 
 
 def closure_scales(mech: Mechanism, active: np.ndarray):
     """Row and column scalings that make the closure system nondimensional: moment rows divided
-    by the characteristic length ``L``, prismatic and platform-translation columns times ``L``."""
+    by the characteristic length ``L``, prismatic and hub-translation columns times ``L``."""
     L = mech.characteristic_length
     K = len(mech.limbs)
     row = np.tile(np.r_[np.ones(3), np.full(3, 1.0 / L)], K)
     lin = np.array([r.freedom.is_linear for r in mech.freedom_refs])[active]
-    col = np.r_[np.where(lin, L, 1.0), np.ones(3), np.full(3, L)]
+    col = np.r_[np.where(lin, L, 1.0), np.tile(np.r_[np.ones(3), np.full(3, L)], hub_count(mech))]
     return row, col
 
 
@@ -357,8 +453,18 @@ def ball_groups(mech: Mechanism) -> list[tuple[int, np.ndarray]]:
     return out
 
 
+def _orthonormal(D: np.ndarray) -> np.ndarray:
+    U, _, Vt = np.linalg.svd(D[:3, :3])  # keep the rotation orthonormal (no drift)
+    D[:3, :3] = U @ Vt
+    return D
+
+
 def retract(mech, config, active, step, fix_platform=False):
-    """Retraction: add a local-coordinate step (see ``chain_forward(local=True)``)."""
+    """Retraction: add a local-coordinate step (see ``chain_forward(local=True)``).
+
+    ``step``: the active joint steps, then a twist (6) per moving hub (:func:`hub_count`: the
+    output link, then the internal bodies); a shorter step leaves the remaining hubs where they
+    are.  ``fix_platform`` holds the output link (its twist in ``step`` is ignored)."""
     dq = np.zeros_like(config.q)
     na = int(active.sum())
     dq[active] = step[:na]
@@ -367,13 +473,16 @@ def retract(mech, config, active, step, fix_platform=False):
         sl = slice(i, i + 3)
         R_new = rotvec_matrix(A @ dq[sl]) @ rotvec_matrix(A @ config.q[sl])
         q[sl] = A.T @ matrix_rotvec(R_new)
-    if fix_platform:
-        D = config.D
-    else:
-        D = exp_twist(step[na:], 1.0) @ config.D
-        U, _, Vt = np.linalg.svd(D[:3, :3])  # keep the rotation orthonormal (no drift)
-        D[:3, :3] = U @ Vt
-    return Configuration(q, D)
+    V = np.asarray(step[na:], dtype=float)
+    D = config.D if fix_platform or len(V) < 6 else _orthonormal(exp_twist(V[:6], 1.0) @ config.D)
+    B = config.B
+    if len(B):
+        B = B.copy()
+        for i in range(len(B)):
+            Vi = V[6 + 6 * i : 12 + 6 * i]
+            if len(Vi) == 6:
+                B[i] = _orthonormal(exp_twist(Vi, 1.0) @ B[i])
+    return Configuration(q, D, B)
 
 
 def correct(
@@ -389,7 +498,7 @@ def correct(
 
     ``active`` selects the joint variables that may move (default: every unlocked freedom;
     pass a mask without the actuators for forward position).  ``fix_platform`` holds the
-    platform displacement (inverse position).  Returns the corrected configuration with
+    platform displacement (inverse position); internal bodies always move.  Returns the corrected configuration with
     ``converged`` and the final nondimensional residual norm; never raises on
     non-convergence (the caller decides).
     """
@@ -398,7 +507,11 @@ def correct(
     if tol is None:  # the newton tolerance in force (geometry/tolerances.py)
         tol = current_tolerances().newton
     row, col = closure_scales(mech, active)
-    ncols = int(active.sum()) + (0 if fix_platform else 6)
+    na = int(active.sum())
+    # unknowns: the active joints, the output twist unless held, the bodies' twists
+    keep = np.ones(len(col), bool)
+    if fix_platform:
+        keep[na : na + 6] = False
     for it in range(max_iter + 1):
         A, r = closure_jacobian(mech, config, active=active)
         rn = float(np.linalg.norm(row * r))
@@ -406,12 +519,13 @@ def correct(
             return CorrectionResult(config, True, it, rn)
         if it == max_iter or not np.isfinite(rn):
             break
-        As = (row[:, None] * A * col[None, :])[:, :ncols]
+        As = (row[:, None] * A * col[None, :])[:, keep]
         x, *_ = np.linalg.lstsq(As, -(row * r), rcond=None)
         if np.linalg.norm(x) < 1e-13 * max(1.0, rn):
             return CorrectionResult(config, False, it, rn, stationary=True)
-        step = col[:ncols] * x
-        config = retract(mech, config, active, np.r_[step, np.zeros(6)] if fix_platform else step, fix_platform)
+        step = np.zeros(len(col))
+        step[keep] = col[keep] * x
+        config = retract(mech, config, active, step, fix_platform)
     return CorrectionResult(config, False, it, rn)
 
 
@@ -425,6 +539,9 @@ def joint_points(mech: Mechanism, config: Configuration) -> list[np.ndarray]:
     out = []
     for li, (ch, sl) in enumerate(zip(limb_chains(mech), limb_slices(mech), strict=True)):
         _, _, pre = chain_forward(ch, config.q[sl], prefixes=True)
+        a = mech.limb_ends[li][0]
+        if a is not None:
+            pre = config.hub(a) @ pre
         refs = [r for r in mech.freedom_refs if r.limb == li]
         pts = []
         seen = set()

@@ -32,9 +32,10 @@ from ..errors import InputError
 from ..geometry import screws as sc
 from ..geometry.tolerances import DEFAULT, current
 from ..model.mechanism import Mechanism
-from .closure import Configuration, joint_twists, limb_slices
+from .closure import Configuration, active_mask, closure_jacobian, closure_scales, joint_twists, limb_slices
 
-__all__ = ["SINGULAR_SIGMA", "CompleteJacobian", "actuation_wrench", "complete_jacobian", "limb_constraint_wrenches"]
+__all__ = ["SINGULAR_SIGMA", "CompleteJacobian", "actuation_wrench", "closure_determinant", "complete_jacobian",
+           "limb_constraint_wrenches"]
 
 #: Scale-free smallest singular value (:attr:`CompleteJacobian.sigma_min`) below which a
 #: configuration is reported as singular (``"singular": true`` in JSON, a flag in text): the
@@ -221,6 +222,8 @@ def complete_jacobian(
         act_ids = [mech.freedom(a).id for a in actuators]
     if len(set(act_ids)) != len(act_ids):
         raise InputError(f"actuators: repeated freedom in {list(actuators)}")
+    if mech.bodies:
+        return _graph_jacobian(mech, config, act_ids)
     L = mech.characteristic_length
     twists = joint_twists(mech, config)
     refs = mech.freedom_refs
@@ -261,11 +264,96 @@ def complete_jacobian(
     return CompleteJacobian(M, n_c, tuple(limbs_of_rows), tuple(act_ids), tuple(singular), L, tuple(trans))
 
 
+def _graph_jacobian(mech: Mechanism, config: Configuration, act_ids: list[str]) -> CompleteJacobian:
+    """The complete Jacobian of a mechanism with internal bodies, by elimination from the
+    nondimensional closure system ``A_p x_p + A_a qdot_a + A_V V = 0``: projected onto the left
+    null space of the passive columns ``A_p`` (passive joints and bodies) it reads
+    ``H V + G qdot_a = 0``; the constraint rows span ``N^T H`` with ``N`` the left null space of
+    ``G``, the actuation rows are ``-G^+ H`` (so that ``J V = (0, qdot_a)`` as for limbs).  The
+    rows are orthonormal bases: ``det`` is not sign-continuous along a path (use
+    :func:`driver_determinants`, which is)."""
+    refs = mech.freedom_refs
+    by_id = {r.id: i for i, r in enumerate(refs)}
+    active = active_mask(mech)
+    for a in act_ids:
+        if refs[by_id[a]].freedom.locked:
+            raise InputError(f"actuators: {a} is locked in this mode")
+    A, _ = closure_jacobian(mech, config, active=active)
+    row, col = closure_scales(mech, active)
+    As = row[:, None] * A * col[None, :]
+    na = int(active.sum())
+    pos = np.cumsum(active) - 1
+    acols = [int(pos[by_id[a]]) for a in act_ids]
+    vcols = list(range(na, na + 6))
+    pcols = [c for c in range(As.shape[1]) if c not in set(acols) | set(vcols)]
+    rtol = current().rank
+    P = As[:, pcols]
+    U, sv, _ = np.linalg.svd(P, full_matrices=True)
+    r = int(np.sum(sv > rtol * max(1.0, sv[0] if sv.size else 0.0)))
+    Qn = U[:, r:]  # left null space of the passive columns
+    H = Qn.T @ As[:, vcols]
+    G = Qn.T @ As[:, acols]
+    colV = col[vcols]
+    Ug, sg, _ = np.linalg.svd(G, full_matrices=True) if G.size else (np.eye(G.shape[0]), np.zeros(0), None)
+    rg = int(np.sum(sg > rtol * max(1.0, sg[0] if sg.size else 0.0)))
+    C = Ug[:, rg:].T @ H  # constraint part
+    if C.shape[0]:
+        _, sc_, Vc = np.linalg.svd(C, full_matrices=False)
+        C = Vc[: int(np.sum(sc_ > rtol * max(1.0, sc_[0] if sc_.size else 0.0)))]
+    rows_out = [c / colV for c in C]
+    singular, trans = [], []
+    for k, a in enumerate(act_ids):
+        g = G[:, k]
+        others = np.delete(G, k, axis=1)
+        if others.shape[1]:
+            Qo, _ = np.linalg.qr(others)
+            g_perp = g - Qo @ (Qo.T @ g)
+        else:
+            g_perp = g
+        ng = float(np.linalg.norm(g))
+        tau = float(np.linalg.norm(g_perp)) / ng if ng > 0 else 0.0
+        trans.append(tau)
+        if tau < rtol:
+            singular.append(a)
+            rows_out.append(np.zeros(6))
+            continue
+        # qdot_a = -(g_perp . H V) / (g_perp . g): the component of the closure along g_perp
+        w = -(g_perp @ H) / float(g_perp @ g)
+        rows_out.append(col[acols[k]] * w / colV)
+    M = np.array(rows_out).reshape(-1, 6)
+    return CompleteJacobian(M, int(C.shape[0]), tuple([-1] * int(C.shape[0])), tuple(act_ids), tuple(singular),
+                            mech.characteristic_length, tuple(trans))
+
+
+def closure_determinant(mech: Mechanism, config: Configuration, driver: str) -> float:
+    """The determinant of the nondimensional closure Jacobian with ``driver``'s column removed
+    (every other unlocked freedom and every moving hub free), for a mechanism whose closure
+    system is square once the driver is held: zero exactly where the driver does not determine
+    the motion (a branch point), and a polynomial in the joint twists, so its sign is
+    continuous along a path.  ``nan`` when the system is not square."""
+    active = active_mask(mech)
+    A, _ = closure_jacobian(mech, config, active=active)
+    row, col = closure_scales(mech, active)
+    As = row[:, None] * A * col[None, :]
+    pos = np.cumsum(active) - 1
+    i = mech.freedom_refs.index(mech.freedom(driver))
+    if not active[i]:
+        raise InputError(f"drivers: {driver} is locked")
+    M = np.delete(As, int(pos[i]), axis=1)
+    return float(np.linalg.det(M)) if M.shape[0] == M.shape[1] else float("nan")
+
+
 def driver_determinants(mech: Mechanism, config: Configuration, drivers) -> np.ndarray:
     """``det J`` for each single driver in ``drivers`` at one configuration, sharing the
     constraint rows (one twist evaluation for all drivers).  Equal to
     ``complete_jacobian(mech, config, [d]).det`` for each ``d``; ``nan`` where J is not square
-    (a mechanism with redundant constraints) — use the driver rate along the motion instead."""
+    (a mechanism with redundant constraints) — use the driver rate along the motion instead.
+
+    A mechanism with internal bodies (a link-and-joint graph) gets :func:`closure_determinant`
+    per driver instead: the same zeros where a driver loses control of the motion, a different
+    magnitude and no poles."""
+    if mech.bodies:
+        return np.array([closure_determinant(mech, config, d) for d in drivers])
     L = mech.characteristic_length
     twists = joint_twists(mech, config)
     refs = mech.freedom_refs

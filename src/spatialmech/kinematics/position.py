@@ -24,19 +24,24 @@ from ..geometry.rotations import inverse_transform, log_transform, rotation_angl
 from ..geometry.tolerances import Tolerances
 from ..geometry.tolerances import resolve as resolve_tolerances
 from ..geometry import screws as sc
-from ..model.mechanism import Limb, Mechanism, Pose
+from ..model.mechanism import Mechanism, Pose
 from ..results import Progress
 from ..serialize import freedom_values_dict, pose_dict
 from .closure import (
     Configuration,
     active_mask,
     chain_forward,
+    closure_jacobian,
+    closure_scales,
     correct,
     generic_configuration,
+    hub_displacements,
     joint_twists,
     limb_chains,
     limb_slices,
+    placed_configuration,
     recentre_balls,
+    retract,
 )
 from .assembly import (
     AssemblyKind,
@@ -62,6 +67,7 @@ __all__ = [
     "forward_position",
     "freedom_values",
     "inverse_position",
+    "limb_clusters",
     "platform_pose",
     "within_limits",
     "wrap_rotations",
@@ -158,6 +164,13 @@ def configuration_at_pose(
     L = mech.characteristic_length
     q = (start.q if start is not None else np.zeros(len(mech.freedom_refs))).astype(float).copy()
     rng = np.random.default_rng(seed)
+    if mech.bodies:  # limbs that share bodies are solved together (see _inverse)
+        inv = _inverse(mech, pose, False, n_restarts, seed, start, resolve_tolerances(tol, "closure"))
+        for ls, sl in zip(inv.limbs, limb_slices(mech), strict=True):
+            if ls.solutions:
+                q[sl] = ls.solutions[0]
+        c0 = inv.config if inv.config is not None else Configuration(q, D, hub_displacements(mech, q, D))
+        return _fit_from(mech, pose, c0, tol, L)
     for ch, sl in zip(limb_chains(mech), limb_slices(mech), strict=True):
         refs = mech.freedom_refs[sl]
         lin = np.array([r.freedom.kind == "P" for r in refs])
@@ -171,7 +184,12 @@ def configuration_at_pose(
                 if rt < rn:
                     qk, rn = qt, rt
         q[sl] = qk
-    ik = correct(mech, Configuration(q, D), fix_platform=True, max_iter=100)
+    return _fit_from(mech, pose, Configuration(q, D), tol, L)
+
+
+def _fit_from(mech: Mechanism, pose: Pose, c0: Configuration, tol: float, L: float) -> PoseFit:
+    """Close ``c0`` with the platform held at ``pose`` (else released), and the pose error."""
+    ik = correct(mech, c0, fix_platform=True, max_iter=100)
     res = ik if ik.converged else correct(mech, ik.config, max_iter=100)
     Dn = res.config.D
     p_got = Dn[:3, :3] @ mech.platform_point + Dn[:3, 3]
@@ -368,80 +386,243 @@ def inverse_position(
     return replace(res, pose_fit=pf)
 
 
+def limb_clusters(mech: Mechanism) -> list[list[int]]:
+    """The limbs grouped by the internal bodies they share (:attr:`Mechanism.bodies`): with the
+    output link held, each group closes on its own (a Delta arm with its R joint and its two
+    rods).  A limb from the ground to the output link is a group of its own.  In limb order."""
+    parent = list(range(len(mech.limbs)))
+
+    def find(i: int) -> int:
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    owner: dict[int, int] = {}
+    for li, ends in enumerate(mech.limb_ends):
+        for h in ends:
+            if h is not None and h >= 1:
+                if h in owner:
+                    parent[find(li)] = find(owner[h])
+                else:
+                    owner[h] = li
+    groups: dict[int, list[int]] = {}
+    for li in range(len(mech.limbs)):
+        groups.setdefault(find(li), []).append(li)
+    return sorted(groups.values())
+
+
 def _inverse(mech: Mechanism, pose: Pose, all_solutions: bool, n_seeds: int, seed: int,
              start: Configuration | None, t: Tolerances) -> InverseResult:
-    tol = t.closure
     D = pose.displacement(mech.platform_point)
-    L = mech.characteristic_length
     rng = np.random.default_rng(seed)
     q_start = start.q if start is not None else np.zeros(len(mech.freedom_refs))
-    out = []
+    out: list[LimbSolutions | None] = [None] * len(mech.limbs)
     q_all = np.zeros(len(mech.freedom_refs))
+    B_all = hub_displacements(mech, q_start, D) if start is None else start.B.copy()
     all_ok = True
-    for li, (ch, sl) in enumerate(zip(limb_chains(mech), limb_slices(mech), strict=True)):
-        refs = mech.freedom_refs[sl]
-        lin = np.array([r.freedom.kind == "P" for r in refs])
-        locked = np.array([r.freedom.locked for r in refs])
-        starts = [q_start[sl].copy()]
-        if all_solutions:
-            for _ in range(n_seeds):
-                qs = np.where(lin, rng.uniform(-1, 1, len(refs)) * L, rng.uniform(-np.pi, np.pi, len(refs)))
-                starts.append(np.where(locked, q_start[sl], qs))
-        sols: list[np.ndarray] = []
-        res: list[float] = []
-        sigs: list[np.ndarray] = []
-        best = (None, np.inf)
-        for q0 in starts:
-            q, rn, ok = _limb_gn(ch, D, q0.astype(float), lin, L, tol=tol)
-            if not ok:
-                if rn < best[1]:
-                    best = (q, rn)
-                continue
-            q = wrap_rotations(mech, q, range(sl.start, sl.stop))
-            sig_n = _signature(ch, q, L)
-            if any(np.linalg.norm(sig_n - s2) < t.dedup for s2 in sigs):
-                continue
-            sigs.append(sig_n)
-            sols.append(q)
-            res.append(rn)
-        idx_l = set(range(sl.start, sl.stop))
-
-        def _outside(qs, sl=sl, idx_l=idx_l):
-            return within_limits(mech, np.r_[q_all[: sl.start], qs, q_all[sl.stop :]], indices=idx_l)
-
-        if not all_solutions and sols and _outside(sols[0]):
-            # the solution nearest the start violates a limit (e.g. a leg flipped through its base
-            # joint far from the reference): prefer one within the limits, else the least violation
-            best_v = _violation(mech, sl, sols[0])
-            for _ in range(n_seeds):
-                qs0 = np.where(lin, rng.uniform(-1, 1, len(refs)) * L, rng.uniform(-np.pi, np.pi, len(refs)))
-                qs, rn, ok = _limb_gn(ch, D, np.where(locked, q_start[sl], qs0), lin, L, tol=tol)
-                if ok:
-                    qs = wrap_rotations(mech, qs, range(sl.start, sl.stop))
-                    v = _violation(mech, sl, qs)
-                    if v < best_v - 1e-12:
-                        sols, res, best_v = [qs], [rn], v
-                    if v == 0.0:
-                        break
-        reachable = bool(sols)
-        if not reachable:
-            all_ok = False
-            sols = [best[0]] if best[0] is not None else []
-            res = [best[1]]
-        passive = 0
-        if sols:
-            _, J = chain_forward(ch, sols[0])
-            Jn = J * np.r_[np.ones(3), np.full(3, 1 / L)][:, None]
-            sv = np.linalg.svd(Jn, compute_uv=False)
-            passive = int(J.shape[1] - np.sum(sv > t.rank * max(1.0, sv[0] if sv.size else 0.0)))
-            q_all[sl] = sols[0]
-        idx = range(sl.start, sl.stop)
-        viol = tuple(tuple(within_limits(mech, np.r_[q_all[: sl.start], s, q_all[sl.stop :]], indices=set(idx))) for s in sols)
-        out.append(LimbSolutions(mech.limbs[li].name, tuple(sols), tuple(float(r) for r in res), reachable, passive, viol))
-    config = Configuration(recentre_balls(mech, q_all), D) if all_ok else None
+    clusters = []
+    for cl in limb_clusters(mech):
+        if len(cl) == 1 and mech.limb_ends[cl[0]] == (None, 0):
+            res_l = _inverse_limb(mech, cl[0], D, q_start, q_all, all_solutions, n_seeds, rng, t)
+            out[cl[0]] = res_l
+            all_ok &= res_l.reachable
+        else:
+            sols, B_all = _inverse_cluster(mech, cl, D, q_start, q_all, B_all, all_solutions, n_seeds, rng, t)
+            clusters.append({"limbs": [mech.limbs[i].name for i in cl],
+                             "bodies": sorted({mech.hubs[h + 1] for i in cl for h in mech.limb_ends[i]
+                                               if h is not None and h >= 1}),
+                             "n_solutions": len(sols[0].solutions) if sols[0].reachable else 0})
+            for i, ls in zip(cl, sols, strict=True):
+                out[i] = ls
+                all_ok &= ls.reachable
+    config = Configuration(recentre_balls(mech, q_all), D, B_all) if all_ok else None
     search = {"method": "Gauss-Newton per limb", "starts_per_limb": 1 + (n_seeds if all_solutions else 0), "seed": seed,
-              "tolerance": tol, "dedup_tol": t.dedup, "distinct_by": "joint twists (axis placement) of the limb"}
-    return InverseResult(pose, tuple(out), config, search)
+              "tolerance": t.closure, "dedup_tol": t.dedup, "distinct_by": "joint twists (axis placement) of the limb"}
+    if clusters:
+        search["clusters"] = clusters
+        search["coupled"] = ("limbs that share an internal body are solved together with the body (Gauss-Newton on their "
+                             "closure equations); their solutions correspond index by index")
+    return InverseResult(pose, tuple(x for x in out if x is not None), config, search)
+
+
+def _random_q(mech: Mechanism, rng: np.random.Generator, sl: slice, keep: np.ndarray, held) -> np.ndarray:
+    """Random joint values for the freedoms of ``sl`` (slides within +-L, angles within +-pi);
+    freedoms in the ``held`` mask keep ``keep``."""
+    refs = mech.freedom_refs[sl]
+    lin = np.array([r.freedom.kind == "P" for r in refs])
+    L = mech.characteristic_length
+    qs = np.where(lin, rng.uniform(-1, 1, len(refs)) * L, rng.uniform(-np.pi, np.pi, len(refs)))
+    return np.where(held, keep, qs)
+
+
+def _limb_passive(chain, q, L: float, rank: float) -> int:
+    _, J = chain_forward(chain, q)
+    Jn = J * np.r_[np.ones(3), np.full(3, 1 / L)][:, None]
+    sv = np.linalg.svd(Jn, compute_uv=False)
+    return int(J.shape[1] - np.sum(sv > rank * max(1.0, sv[0] if sv.size else 0.0)))
+
+
+def _inverse_limb(mech: Mechanism, li: int, D: np.ndarray, q_start: np.ndarray, q_all: np.ndarray,
+                  all_solutions: bool, n_seeds: int, rng: np.random.Generator, t: Tolerances) -> LimbSolutions:
+    """Every solution (or the one nearest the start) of a limb from the ground to the output
+    link held at ``D``; fills ``q_all`` with the first."""
+    tol = t.closure
+    L = mech.characteristic_length
+    ch, sl = limb_chains(mech)[li], limb_slices(mech)[li]
+    refs = mech.freedom_refs[sl]
+    lin = np.array([r.freedom.kind == "P" for r in refs])
+    locked = np.array([r.freedom.locked for r in refs])
+    starts = [q_start[sl].copy()]
+    if all_solutions:
+        starts += [_random_q(mech, rng, sl, q_start[sl], locked) for _ in range(n_seeds)]
+    sols: list[np.ndarray] = []
+    res: list[float] = []
+    sigs: list[np.ndarray] = []
+    best = (None, np.inf)
+    for q0 in starts:
+        q, rn, ok = _limb_gn(ch, D, q0.astype(float), lin, L, tol=tol)
+        if not ok:
+            if rn < best[1]:
+                best = (q, rn)
+            continue
+        q = wrap_rotations(mech, q, range(sl.start, sl.stop))
+        sig_n = _signature(ch, q, L)
+        if any(np.linalg.norm(sig_n - s2) < t.dedup for s2 in sigs):
+            continue
+        sigs.append(sig_n)
+        sols.append(q)
+        res.append(rn)
+    idx_l = set(range(sl.start, sl.stop))
+
+    def _outside(qs):
+        return within_limits(mech, np.r_[q_all[: sl.start], qs, q_all[sl.stop :]], indices=idx_l)
+
+    if not all_solutions and sols and _outside(sols[0]):
+        # the solution nearest the start violates a limit (e.g. a leg flipped through its base
+        # joint far from the reference): prefer one within the limits, else the least violation
+        best_v = _violation(mech, sl, sols[0])
+        for _ in range(n_seeds):
+            qs, rn, ok = _limb_gn(ch, D, _random_q(mech, rng, sl, q_start[sl], locked), lin, L, tol=tol)
+            if ok:
+                qs = wrap_rotations(mech, qs, range(sl.start, sl.stop))
+                v = _violation(mech, sl, qs)
+                if v < best_v - 1e-12:
+                    sols, res, best_v = [qs], [rn], v
+                if v == 0.0:
+                    break
+    reachable = bool(sols)
+    if not reachable:
+        sols = [best[0]] if best[0] is not None else []
+        res = [best[1]]
+    passive = 0
+    if sols:
+        passive = _limb_passive(ch, sols[0], L, t.rank)
+        q_all[sl] = sols[0]
+    viol = tuple(tuple(_outside(s)) for s in sols)
+    return LimbSolutions(mech.limbs[li].name, tuple(sols), tuple(float(r) for r in res), reachable, passive, viol)
+
+
+def _cluster_newton(mech: Mechanism, config: Configuration, rows: np.ndarray, cols: np.ndarray, tol: float,
+                    max_iter: int = 60) -> tuple[Configuration, float, bool]:
+    """Gauss-Newton on the closure equations ``rows`` in the unknowns ``cols`` (of the
+    nondimensional closure system with every unlocked freedom active), output link held."""
+    active = active_mask(mech)
+    row, col = closure_scales(mech, active)
+    rn = np.inf
+    for _ in range(max_iter):
+        A, r = closure_jacobian(mech, config, active=active)
+        rr = (row * r)[rows]
+        rn = float(np.linalg.norm(rr))
+        if rn < tol:
+            return config, rn, True
+        if not np.isfinite(rn):
+            break
+        As = (row[:, None] * A * col[None, :])[np.ix_(rows, cols)]
+        x, *_ = np.linalg.lstsq(As, -rr, rcond=None)
+        if np.linalg.norm(x) < 1e-14:
+            break
+        step = np.zeros(len(col))
+        step[cols] = col[cols] * x
+        config = retract(mech, config, active, step, fix_platform=True)
+    return config, rn, rn < tol
+
+
+def _cluster_system(mech: Mechanism, cl: list[int], held=()) -> tuple[np.ndarray, list[int], np.ndarray, np.ndarray]:
+    """For a group of limbs: their freedoms' indices, the hub indices of their bodies, and the
+    rows and columns of the closure system (every unlocked freedom active) that are theirs; the
+    freedoms in ``held`` are not unknowns."""
+    sls = limb_slices(mech)
+    active = active_mask(mech)
+    na = int(active.sum())
+    pos = np.cumsum(active) - 1  # index of each active freedom among the active columns
+    idx = np.concatenate([np.arange(sls[i].start, sls[i].stop) for i in cl])
+    held = set(held)
+    qcols = [int(pos[i]) for i in idx if active[i] and i not in held]
+    bodies = sorted({h for i in cl for h in mech.limb_ends[i] if h is not None and h >= 1})
+    bcols = [na + 6 * h + k for h in bodies for k in range(6)]
+    rows = np.concatenate([np.arange(6 * i, 6 * i + 6) for i in cl])
+    return idx, bodies, rows, np.array(qcols + bcols, dtype=int)
+
+
+def _inverse_cluster(mech: Mechanism, cl: list[int], D: np.ndarray, q_start: np.ndarray, q_all: np.ndarray,
+                     B_all: np.ndarray, all_solutions: bool, n_seeds: int, rng: np.random.Generator,
+                     t: Tolerances) -> tuple[list[LimbSolutions], np.ndarray]:
+    """Solutions of a group of limbs that share internal bodies (:func:`limb_clusters`), the
+    output link held at ``D``: Newton on their closure equations in their joint variables and
+    the bodies' twists, from the start and (``all_solutions``, or when the start fails) from
+    random joint values with the bodies placed through the limbs.  Fills ``q_all`` (and returns
+    the bodies' displacements) with the first solution."""
+    L = mech.characteristic_length
+    sls = limb_slices(mech)
+    locked = ~active_mask(mech)
+    idx, bodies, rows, cols = _cluster_system(mech, cl)
+    found: list[tuple[np.ndarray, np.ndarray, float]] = []  # (q, B, residual)
+    keys: list[np.ndarray] = []
+    best: tuple[np.ndarray | None, np.ndarray | None, float] = (None, None, np.inf)
+    n_starts = 1 + n_seeds
+    for s in range(n_starts):
+        q0 = q_all.copy()
+        q0[idx] = q_start[idx]
+        if s > 0:
+            for i in cl:
+                q0[sls[i]] = _random_q(mech, rng, sls[i], q_start[sls[i]], locked[sls[i]])
+        B0 = B_all.copy()
+        for h in bodies:
+            B0[h - 1] = np.nan
+        c0 = Configuration(q0, D, hub_displacements(mech, q0, D, B0))
+        c, rn, ok = _cluster_newton(mech, c0, rows, cols, t.closure)
+        if not ok:
+            if rn < best[2]:
+                best = (c.q, c.B, rn)
+        else:
+            q = c.q.copy()
+            q[idx] = wrap_rotations(mech, q[idx], idx)
+            key = np.concatenate([np.r_[c.B[h - 1][:3, :3].ravel(), c.B[h - 1][:3, 3] / L] for h in bodies]
+                                 + [_signature(limb_chains(mech)[i], q[sls[i]], L) for i in cl])
+            if not any(np.linalg.norm(key - k2) < t.dedup for k2 in keys):
+                keys.append(key)
+                found.append((q, c.B, rn))
+        if found and not all_solutions:
+            break
+    reachable = bool(found)
+    if not reachable:
+        found = [(best[0], best[1], best[2])] if best[0] is not None and best[1] is not None else []
+    if found:
+        q_first, B_first, _ = found[0]
+        q_all[idx] = q_first[idx]
+        B_all = B_all.copy()
+        for h in bodies:
+            B_all[h - 1] = B_first[h - 1]
+    out = []
+    for i in cl:
+        sl = sls[i]
+        sols = tuple(q[sl] for q, _, _ in found)
+        viol = tuple(tuple(within_limits(mech, np.r_[q_all[: sl.start], qs, q_all[sl.stop :]],
+                                         indices=set(range(sl.start, sl.stop)))) for qs in sols)
+        passive = _limb_passive(limb_chains(mech)[i], sols[0], L, t.rank) if sols else 0
+        out.append(LimbSolutions(mech.limbs[i].name, sols, tuple(float(r) for _, _, r in found), reachable, passive, viol))
+    return out, B_all
 
 
 # ------------------------------------------------------------------------------ forward
@@ -561,6 +742,18 @@ def _pose_seed(mech: Mechanism, rng: np.random.Generator, targets: dict[int, flo
     p = p0 * (1 if rng.random() < 0.5 else -1) + rng.normal(scale=L, size=3)
     D = transform(R, p - R @ p0)
     q = np.zeros(len(mech.freedom_refs))
+    if mech.bodies:  # a link-and-joint graph: random joint values, the bodies placed through the limbs
+        for sl in limb_slices(mech):
+            q[sl] = _random_q(mech, rng, sl, q[sl], np.zeros(sl.stop - sl.start, bool))
+        for i, v in targets.items():
+            q[i] = v
+        if rng.random() < 0.25:  # the output placed through the limbs too
+            return placed_configuration(mech, q)
+        c = Configuration(q, D, hub_displacements(mech, q, D))
+        for cl in limb_clusters(mech):  # each group of limbs fitted to the pose (least squares)
+            _, _, rows, cols = _cluster_system(mech, cl, held=targets)
+            c = _cluster_newton(mech, c, rows, cols, 1e-12, max_iter=30)[0]
+        return c
     for ch, sl in zip(limb_chains(mech), limb_slices(mech), strict=True):
         refs = mech.freedom_refs[sl]
         lin = np.array([r.freedom.kind == "P" for r in refs])
@@ -592,6 +785,8 @@ def forward_conditioning(mech: Mechanism, config: Configuration) -> Conditioning
     from ..geometry.tolerances import current
 
     rank_tol = current().rank
+    if mech.bodies:
+        return _graph_forward_conditioning(mech, config, rank_tol)
     L = mech.characteristic_length
     acts = set(mech.actuators)
     refs = mech.freedom_refs
@@ -609,6 +804,30 @@ def forward_conditioning(mech: Mechanism, config: Configuration) -> Conditioning
     return Conditioning.from_singular_values(sv, FK_CONDITIONING_MEASURE, n_required=6, threshold=singular_threshold())
 
 
+def _graph_forward_conditioning(mech: Mechanism, config: Configuration, rank_tol: float) -> Conditioning:
+    """:func:`forward_conditioning` of a mechanism with internal bodies: with the actuators
+    locked, the part of the output link's columns of the nondimensional closure Jacobian that
+    the other unknowns (passive joints, bodies) cannot absorb; its singular values equal those
+    of the stacked limb wrench bases when every limb runs from the ground to the output."""
+    mask = active_mask(mech)
+    acts = set(mech.actuators)
+    for i, r in enumerate(mech.freedom_refs):
+        if r.id in acts:
+            mask[i] = False
+    A, _ = closure_jacobian(mech, config, active=mask)
+    row, col = closure_scales(mech, mask)
+    As = row[:, None] * A * col[None, :]
+    na = int(mask.sum())
+    out = As[:, na : na + 6]
+    other = np.delete(As, np.s_[na : na + 6], axis=1)
+    if other.shape[1]:
+        U, sv, _ = np.linalg.svd(other, full_matrices=False)
+        Q = U[:, : int(np.sum(sv > rank_tol * max(1.0, sv[0] if sv.size else 0.0)))]
+        out = out - Q @ (Q.T @ out)
+    sv = np.linalg.svd(out, compute_uv=False)
+    return Conditioning.from_singular_values(sv, FK_CONDITIONING_MEASURE, n_required=6, threshold=singular_threshold())
+
+
 def _actuators_locked(mech: Mechanism) -> Mechanism:
     """``mech`` with its actuated freedoms locked (the structure that holds the platform)."""
     ids = set(mech.actuators)
@@ -620,7 +839,7 @@ def _actuators_locked(mech: Mechanism) -> Mechanism:
                 if f"{j.name}.{f.name}" in ids:
                     j = j.with_freedom(f.name, locked=True, actuated=False)
             joints.append(j)
-        limbs.append(Limb(limb.name, tuple(joints)))
+        limbs.append(limb.with_joints(joints))
     return replace(mech, limbs=tuple(limbs), modes=())
 
 
@@ -638,7 +857,7 @@ def _fk_from(mech, config, targets, mask, max_iter, patience=None):
     q = config.q.copy()
     for i, v in targets.items():
         q[i] = v
-    c = Configuration(q, config.D)
+    c = config.with_q(q)
     if patience is not None:  # abandon starts that are not converging after a few steps
         res = correct(mech, c, active=mask, max_iter=patience)
         if res.converged or res.residual > 1e-1:

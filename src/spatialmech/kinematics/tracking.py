@@ -33,7 +33,7 @@ from ..geometry.rotations import inverse_transform, log_transform
 from ..geometry.tolerances import current as current_tolerances
 from ..model.mechanism import Mechanism
 from ..results import EventKind, Progress, TrackStatus
-from .closure import Configuration, active_mask, ball_groups, closure_jacobian, closure_scales, retract
+from .closure import Configuration, active_mask, ball_groups, closure_jacobian, closure_scales, hub_count, retract
 
 __all__ = [
     "ActuatorPathProblem",
@@ -393,6 +393,7 @@ class _MechanismBase:
         self.active = active
         self.row, self.col = closure_scales(mech, active)
         self.na = int(active.sum())
+        self.nh = 6 * hub_count(mech)  # twists of the output link and the internal bodies
         self.L = mech.characteristic_length
         refs = mech.freedom_refs
         self.kinds = np.array([r.freedom.kind for r in refs])[active]
@@ -413,8 +414,9 @@ class _MechanismBase:
         dq = dq_all[self.active]
         rot = self.kinds != "P"
         dq = np.where(rot, (dq + np.pi) % (2 * np.pi) - np.pi, dq)
-        V = log_transform(b.D @ inverse_transform(a.D))
-        return np.r_[dq, V] / self.col
+        V = [log_transform(b.D @ inverse_transform(a.D))]
+        V += [log_transform(Bb @ inverse_transform(Ba)) for Ba, Bb in zip(a.B, b.B, strict=True)]
+        return np.concatenate([dq, *V]) / self.col
 
 
 class MotionProblem(_MechanismBase):
@@ -438,7 +440,7 @@ class MotionProblem(_MechanismBase):
         return self._config_diff(x, y)
 
     def tangent(self, x):
-        return _observable_tangent(self.jacobian(x), 6)
+        return _observable_tangent(self.jacobian(x), self.nh)
 
 
 class ActuatorPathProblem(_MechanismBase):
@@ -465,7 +467,7 @@ class ActuatorPathProblem(_MechanismBase):
         config, lam = x
         q = config.q.copy()
         q[self.act_idx] = np.asarray(self.path(lam), dtype=float) - self.offsets
-        return Configuration(q, config.D)
+        return config.with_q(q)
 
     def residual(self, x):
         return self._closure(self._q_with(x))[1]
@@ -492,7 +494,7 @@ class ActuatorPathProblem(_MechanismBase):
         return np.r_[self._config_diff(x[0], y[0]), y[1] - x[1]]
 
     def tangent(self, x):
-        return _observable_tangent(self.jacobian(x), 7)
+        return _observable_tangent(self.jacobian(x), self.nh + 1)
 
 
 def trace_motion(
@@ -515,7 +517,7 @@ def trace_motion(
     r = int(np.sum(sv > current_tolerances().rank * max(1.0, sv[0])))
     N = np.linalg.svd(A, full_matrices=True)[2][r:]
     if N.shape[0] > 1:  # more than one direction moves the platform: not a 1-DOF motion
-        _u, s2, _ = np.linalg.svd(N[:, -6:])
+        _u, s2, _ = np.linalg.svd(N[:, prob.na : prob.na + 6])
         dof = int(np.sum(s2 > 1e-7))
         if dof > 1:
             raise InputError(f"mechanism: trace_motion follows one-degree-of-freedom motions; {mech.name} has {dof} "
@@ -525,6 +527,6 @@ def trace_motion(
         ref = mech.freedom(increasing)
         i = mech.freedom_refs.index(ref)
         idx = np.flatnonzero(prob.active).tolist()
-        direction = np.zeros(prob.na + 6)
+        direction = np.zeros(prob.na + prob.nh)
         direction[idx.index(i)] = 1.0 if sense >= 0 else -1.0
     return track(prob, start, direction=direction, monitors=monitors, **kw)

@@ -23,7 +23,15 @@ from ..errors import InputError
 from ..geometry.rotations import check_sequence
 from ..geometry.tolerances import current as current_tolerances
 from ..model.mechanism import Mechanism
-from .closure import Configuration, chain_forward, limb_chains, limb_slices
+from .closure import (
+    Configuration,
+    active_mask,
+    chain_forward,
+    closure_jacobian,
+    closure_scales,
+    limb_chains,
+    limb_slices,
+)
 
 __all__ = [
     "ad",
@@ -83,6 +91,12 @@ def _limb_solve(mech, J, rhs, locked, name):
     return x
 
 
+def _no_graph_acceleration(mech: Mechanism) -> None:
+    if mech.bodies:
+        raise InputError(f"mechanism: accelerations of a mechanism with internal bodies ({mech.name}: "
+                         f"{', '.join(mech.bodies)}) are not implemented yet; velocities are")
+
+
 def inverse_velocity(mech: Mechanism, config: Configuration, twist) -> np.ndarray:
     """Joint rates of every freedom (local coordinates) for a platform twist ``(omega ; v)``.
 
@@ -92,6 +106,8 @@ def inverse_velocity(mech: Mechanism, config: Configuration, twist) -> np.ndarra
     V = np.asarray(twist, float)
     if V.shape != (6,) or not np.all(np.isfinite(V)):
         raise InputError(f"twist: expected 6 finite numbers (omega ; v), got shape {V.shape}")
+    if mech.bodies:
+        return _graph_velocity(mech, config, {}, V)[1]
     qd = np.zeros(len(config.q))
     for limb, J, sl in zip(mech.limbs, limb_jacobians(mech, config), limb_slices(mech), strict=True):
         locked = np.array([r.freedom.locked for r in mech.freedom_refs[sl]])
@@ -104,12 +120,57 @@ def inverse_acceleration(mech: Mechanism, config: Configuration, twist, twist_do
     A = np.asarray(twist_dot, float)
     if A.shape != (6,) or not np.all(np.isfinite(A)):
         raise InputError(f"twist_dot: expected 6 finite numbers, got shape {A.shape}")
+    _no_graph_acceleration(mech)
     qd = inverse_velocity(mech, config, twist)
     qdd = np.zeros_like(qd)
     for limb, J, sl in zip(mech.limbs, limb_jacobians(mech, config), limb_slices(mech), strict=True):
         locked = np.array([r.freedom.locked for r in mech.freedom_refs[sl]])
         qdd[sl] = _limb_solve(mech, J, A - _bias(J, qd[sl]), locked, limb.name)
     return qd, qdd
+
+
+def _graph_velocity(mech: Mechanism, config: Configuration, rates: dict[int, float],
+                    twist: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    """Velocities of a mechanism with internal bodies from its closure system: the freedoms in
+    ``rates`` (index -> rate) held, the output twist held when ``twist`` is given, every other
+    unlocked freedom and every body free.  Returns ``(output twist, joint rates)``; raises
+    :class:`~spatialmech.errors.InputError` when the held rates are incompatible with the
+    constraints or do not determine the output twist."""
+    active = active_mask(mech)
+    A, _ = closure_jacobian(mech, config, active=active)
+    row, col = closure_scales(mech, active)
+    As = row[:, None] * A * col[None, :]
+    na = int(active.sum())
+    pos = np.cumsum(active) - 1
+    x_held = np.zeros(As.shape[1])
+    held = np.zeros(As.shape[1], bool)
+    for i, v in rates.items():
+        if not active[i]:
+            raise InputError(f"actuator_rates: {mech.freedom_refs[i].id} is locked")
+        x_held[pos[i]] = v / col[pos[i]]
+        held[pos[i]] = True
+    if twist is not None:
+        x_held[na : na + 6] = twist / col[na : na + 6]
+        held[na : na + 6] = True
+    rhs = -As[:, held] @ x_held[held]
+    M = As[:, ~held]
+    x, *_ = np.linalg.lstsq(M, rhs, rcond=None)
+    if np.linalg.norm(M @ x - rhs) > 1e-9 * max(1.0, float(np.linalg.norm(rhs))):
+        what = "twist" if twist is not None else "actuator_rates"
+        raise InputError(f"{what}: incompatible with the constraints here (the closure cannot be kept)")
+    full = x_held.copy()
+    full[~held] = x
+    if twist is None:  # the output part must be unique
+        _, sv, vt = np.linalg.svd(M)
+        r = int(np.sum(sv > current_tolerances().rank * max(1.0, sv[0])))
+        null = np.zeros((vt.shape[0] - r, As.shape[1]))
+        null[:, ~held] = vt[r:]
+        if null.size and np.max(np.abs(null[:, na : na + 6])) > 1e-7:
+            raise InputError("actuator_rates: a direct singularity: the actuators do not determine the platform twist here")
+    u = full * col
+    qd = np.zeros(len(config.q))
+    qd[active] = u[:na]
+    return u[na : na + 6], qd
 
 
 def _actuator_indices(mech: Mechanism, actuators) -> list[int]:
@@ -143,6 +204,8 @@ def forward_velocity(mech: Mechanism, config: Configuration, actuator_rates, act
     r = np.asarray(actuator_rates, float).ravel()
     if r.size != len(idx) or not np.all(np.isfinite(r)):
         raise InputError(f"actuator_rates: expected {len(idx)} finite values, got {r.size}")
+    if mech.bodies:
+        return _graph_velocity(mech, config, dict(zip(idx, r, strict=True)), None)
     _, A, free = _system(mech, config, idx)
     rhs = -A[:, idx] @ r
     M = A[:, free]
@@ -165,6 +228,7 @@ def forward_velocity(mech: Mechanism, config: Configuration, actuator_rates, act
 def forward_acceleration(mech: Mechanism, config: Configuration, actuator_rates, actuator_accelerations,
                          actuators=None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """``(V, Vdot, qdot, qddot)`` for actuator rates and accelerations."""
+    _no_graph_acceleration(mech)
     V, qd = forward_velocity(mech, config, actuator_rates, actuators)
     idx = _actuator_indices(mech, actuators)
     a = np.asarray(actuator_accelerations, float).ravel()

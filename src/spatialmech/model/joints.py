@@ -80,6 +80,22 @@ class Joint:
     type: str
     point: np.ndarray
     freedoms: tuple[Freedom, ...]
+    #: True when this joint is traversed against the direction it was described in (its
+    #: freedoms then move its first link relative to its second; see :meth:`flipped`).
+    reversed: bool = False
+
+    def flipped(self) -> Joint:
+        """The same joint traversed the other way: the motion of its first link relative to its
+        second.  The inverse of ``exp(S1 q1) ... exp(Sn qn)`` is ``exp(-Sn qn) ... exp(-S1 q1)``:
+        the freedoms in reverse order with negated directions (every screw negated), so every
+        joint variable keeps its value and meaning.  ``flipped().flipped()`` is the original."""
+        fs = tuple(replace(f, direction=-f.direction) for f in self.freedoms[::-1])
+        return replace(self, freedoms=fs, reversed=not self.reversed)
+
+    @property
+    def described(self) -> Joint:
+        """This joint as it was described (un-flipped)."""
+        return self.flipped() if self.reversed else self
 
     @property
     def dof(self) -> int:

@@ -28,7 +28,12 @@ from ..geometry.tolerances import current as current_tolerances
 from ..geometry.validate import as_finite_array
 from .joints import Freedom, Joint
 
-__all__ = ["MAX_IMPLICIT_MODES", "FreedomRef", "Limb", "Mechanism", "Mode", "Pose"]
+__all__ = ["GROUND", "MAX_IMPLICIT_MODES", "OUTPUT", "FreedomRef", "Limb", "Mechanism", "Mode", "Pose"]
+
+#: Default name of the fixed link.
+GROUND = "ground"
+#: Default name of the output link (the platform).
+OUTPUT = "platform"
 
 #: Largest number of implicit modes (subsets of the lockable freedoms) of a mechanism without
 #: declared modes: 2^10, i.e. at most 10 lockable freedoms.
@@ -81,10 +86,20 @@ class Mode:
 
 @dataclass(frozen=True, eq=False)
 class Limb:
-    """A serial chain of joints from the base (first) to the platform (last)."""
+    """A serial chain of joints from link ``base`` (first joint) to link ``tip`` (last joint).
+
+    By default a limb runs from the ground to the output link (the platform).  In a mechanism
+    described as a link-and-joint graph (:meth:`Mechanism.from_graph`) a limb is a chain
+    between two *hub* links: the ground, the output link or a named internal body (a link with
+    three or more joints, such as a Delta arm).  ``links`` names the limb's intermediate links
+    (one fewer than its joints; generated as ``"<limb>.link<k>"`` when empty).
+    """
 
     name: str
     joints: tuple[Joint, ...]
+    base: str = GROUND
+    tip: str | None = None  # None: the mechanism's output link
+    links: tuple[str, ...] = ()
 
     def __post_init__(self):
         if not isinstance(self.name, str):
@@ -92,10 +107,32 @@ class Limb:
         object.__setattr__(self, "joints", _items(self.joints, Joint, _JOINT, f"limb {self.name!r}.joints"))
         if not self.joints:
             raise InputError(f"limb {self.name!r}: has no joints")
+        for what in ("base", "tip"):
+            v = getattr(self, what)
+            if not (isinstance(v, str) and v) and not (what == "tip" and v is None):
+                raise TypeError(f"limb {self.name!r}.{what}: expected a link name (str), got {describe(v)}")
+        links = tuple(self.links)
+        if links:
+            if len(links) != len(self.joints) - 1:
+                raise InputError(f"limb {self.name!r}.links: {len(self.joints)} joints have {len(self.joints) - 1} "
+                                 f"intermediate links, got {len(links)} names")
+            for k, v in enumerate(links):
+                if not (isinstance(v, str) and v):
+                    raise TypeError(f"limb {self.name!r}.links[{k}]: expected a link name (str), got {describe(v)}")
+        object.__setattr__(self, "links", links)
 
     @property
     def dof(self) -> int:
         return sum(j.dof for j in self.joints)
+
+    @property
+    def link_names(self) -> tuple[str, ...]:
+        """The names of the intermediate links, from the base side."""
+        return self.links or tuple(f"{self.name}.link{k}" for k in range(1, len(self.joints)))
+
+    def with_joints(self, joints) -> Limb:
+        """This limb with other joints (same ends and link names)."""
+        return replace(self, joints=tuple(joints))
 
 
 _JOINT = "a Joint (R, P, C, U, S, Sm, H)"
@@ -138,6 +175,8 @@ class Mechanism:
     length_unit: str = "m"
     source: str = ""
     notes: str = ""
+    output: str = OUTPUT
+    bodies: tuple[str, ...] = ()
 
     def __post_init__(self):
         if not isinstance(self.name, str):
@@ -162,6 +201,7 @@ class Mechanism:
                 if joint.name in seen_j:
                     raise InputError(f"limbs[{i}].joints[{j}].name: duplicate joint name {joint.name!r}")
                 seen_j.add(joint.name)
+        self._check_links()
         for target in self.aliases.values():
             self.freedom(target)  # raises on unknown
         lockable = {r.id for r in self.freedom_refs if r.freedom.lockable}
@@ -181,6 +221,93 @@ class Mechanism:
                 raise InputError(f"limbs[{r.limb}].joints[{r.joint}].pitch: {r.freedom.pitch:.3g} per rad is more than "
                                  f"{current_tolerances().max_ratio:g} characteristic lengths ({L:.3g}): to the rank "
                                  "tolerance it is a prismatic joint; use a P joint")
+
+    def _check_links(self) -> None:
+        """Limb ends name known hub links; link names are unique; every body is attached by at
+        least two limb ends and reached from the ground."""
+        for what in ("output",):
+            if not (isinstance(self.output, str) and self.output):
+                raise TypeError(f"{what}: expected a link name (str), got {describe(self.output)}")
+        object.__setattr__(self, "bodies", tuple(self.bodies))
+        for k, b in enumerate(self.bodies):
+            if not (isinstance(b, str) and b):
+                raise TypeError(f"bodies[{k}]: expected a link name (str), got {describe(b)}")
+        hubs = self.hubs
+        if len(set(hubs)) != len(hubs):
+            raise InputError(f"bodies: link names must be unique and differ from the ground and output link, got {list(hubs)}")
+        names = set(hubs)
+        for i, limb in enumerate(self.limbs):
+            for what, end in (("base", limb.base), ("tip", self.limb_tip(limb))):
+                if end not in names:
+                    raise UnknownNameError(f"limbs[{i}].{what}: unknown link {end!r}; the limb ends are the hub links "
+                                           f"{', '.join(hubs)}")
+            for k, ln in enumerate(limb.link_names):
+                if ln in names:
+                    raise InputError(f"limbs[{i}].links[{k}]: duplicate link name {ln!r}")
+                names.add(ln)
+        ends = dict.fromkeys(hubs, 0)
+        for limb in self.limbs:
+            ends[limb.base] += 1
+            ends[self.limb_tip(limb)] += 1
+        for b in (self.output, *self.bodies):
+            if ends[b] == 0:
+                raise InputError(f"{'output' if b == self.output else 'bodies'}: link {b!r} is not attached to any limb")
+        for b in self.bodies:
+            if ends[b] < 2:
+                raise InputError(f"bodies: link {b!r} is attached by one limb end only; it would move freely")
+        reached, grew = {GROUND}, True
+        while grew:
+            grew = False
+            for limb in self.limbs:
+                a, b = limb.base, self.limb_tip(limb)
+                if (a in reached) != (b in reached):
+                    reached |= {a, b}
+                    grew = True
+        lost = [h for h in hubs if h not in reached]
+        if lost:
+            raise InputError(f"limbs: links not connected to the ground: {', '.join(lost)}")
+
+    # ------------------------------------------------------------------ links
+    @property
+    def hubs(self) -> tuple[str, ...]:
+        """The links that limbs start and end at: the ground, the output link, the bodies."""
+        return (GROUND, self.output, *self.bodies)
+
+    def limb_tip(self, limb: Limb) -> str:
+        """The link a limb ends at (its ``tip``, the output link by default)."""
+        return self.output if limb.tip is None else limb.tip
+
+    def hub_index(self, link: str) -> int | None:
+        """Where a hub link's displacement sits: ``None`` for the ground (fixed), 0 for the
+        output link (``Configuration.D``), ``1 + i`` for body ``i`` (``Configuration.B[i]``)."""
+        if link == GROUND:
+            return None
+        if link == self.output:
+            return 0
+        try:
+            return 1 + self.bodies.index(link)
+        except ValueError:
+            raise UnknownNameError(f"unknown hub link {link!r}; hubs: {', '.join(self.hubs)}") from None
+
+    @cached_property
+    def limb_ends(self) -> tuple[tuple[int | None, int | None], ...]:
+        """Per limb, the :meth:`hub_index` of its base and of its tip."""
+        return tuple((self.hub_index(limb.base), self.hub_index(self.limb_tip(limb))) for limb in self.limbs)
+
+    @property
+    def is_graph(self) -> bool:
+        """True unless every limb runs from the ground to the output link with its joints as
+        described (a mechanism that needs the link-and-joint graph form to be written)."""
+        return bool(self.bodies) or any(
+            limb.base != GROUND or limb.tip not in (None, self.output) or limb.links
+            or any(j.reversed for j in limb.joints) for limb in self.limbs)
+
+    @classmethod
+    def from_graph(cls, name: str, links, joints, *, output: str | None = None, **kwargs) -> Mechanism:
+        """A mechanism from its link-and-joint graph; see :func:`spatialmech.model.topology.mechanism_from_graph`."""
+        from .topology import mechanism_from_graph  # topology builds on this module
+
+        return mechanism_from_graph(name, links, joints, output=output, **kwargs)
 
     # ------------------------------------------------------------------ freedoms
     @cached_property
@@ -287,7 +414,7 @@ class Mechanism:
                         on = fid in driven
                         joint = joint.with_freedom(f.name, locked=not on, actuated=on)
                 joints.append(joint)
-            limbs.append(Limb(limb.name, tuple(joints)))
+            limbs.append(limb.with_joints(joints))
         return replace(self, limbs=tuple(limbs), modes=(mode,))
 
     def with_actuators(self, names) -> Mechanism:
@@ -300,5 +427,5 @@ class Mechanism:
                 for f in joint.freedoms:
                     joint = joint.with_freedom(f.name, actuated=f"{joint.name}.{f.name}" in ids)
                 joints.append(joint)
-            limbs.append(Limb(limb.name, tuple(joints)))
+            limbs.append(limb.with_joints(joints))
         return replace(self, limbs=tuple(limbs))

@@ -134,6 +134,12 @@ class LimbSpec(_Strict):
     joints: Annotated[list[JointSpec], Len(1)]
 
 
+class GraphJointSpec(JointSpec):
+    """A joint of the link-and-joint graph form: its freedoms move ``links[1]`` relative to ``links[0]``."""
+
+    links: Annotated[list[str], Len(2, 2)]
+
+
 class EulerSpec(_Strict):
     seq: str
     angles_deg: Vec3
@@ -159,7 +165,10 @@ class MechanismSpec(_Strict):
     length_unit: str = "m"
     normalize_axes: bool = False
     platform_point: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
-    limbs: Annotated[list[LimbSpec], Len(1)]
+    limbs: Annotated[list[LimbSpec], Len(1)] | None = None
+    links: Annotated[list[str], Len(2)] | None = None
+    joints: Annotated[list[GraphJointSpec], Len(1)] | None = None
+    output: str | None = None
     modes: list[ModeSpec] = Field(default_factory=list)
     positions: list[PoseSpec] = Field(default_factory=list)
     aliases: dict[str, str] = Field(default_factory=dict)
@@ -265,18 +274,35 @@ def from_dict(data: dict[str, Any], *, source: str = "<dict>") -> Mechanism:
         spec = MechanismSpec.model_validate(data)
     except ValidationError as e:
         raise ModelFileError(_validation_message(e)) from None
-    limbs = []
-    for i, ls in enumerate(spec.limbs):
-        joints = tuple(_joint(js, f"limbs[{i}].joints[{j}]", spec.normalize_axes) for j, js in enumerate(ls.joints))
-        limbs.append(Limb(ls.name, joints))
+    graph = spec.links is not None or spec.joints is not None
+    if graph and spec.limbs is not None:
+        raise ModelFileError("limbs: give either 'limbs' or the graph form 'links' + 'joints', not both")
+    if not graph and spec.limbs is None:
+        raise ModelFileError("limbs: required field is missing (or give the graph form: 'links' and 'joints')")
+    if graph and (spec.links is None or spec.joints is None):
+        raise ModelFileError(f"{'joints' if spec.joints is None else 'links'}: the graph form needs both 'links' and 'joints'")
+    if not graph and spec.output is not None:
+        raise ModelFileError("output: only the graph form ('links' + 'joints') names an output link; "
+                             "with 'limbs' the output link is the platform")
     positions = tuple(_pose(p, f"positions[{i}]") for i, p in enumerate(spec.positions))
     modes = tuple(Mode(m.name, tuple(m.driven), m.description) for m in spec.modes)
+    common: dict[str, Any] = dict(
+        platform_point=np.asarray(spec.platform_point, dtype=float),
+        description=spec.description, modes=modes, positions=positions, aliases=spec.aliases,
+        length_unit=spec.length_unit, source=spec.source or source, notes=spec.notes,
+    )
     try:
-        return Mechanism(
-            name=spec.name, limbs=tuple(limbs), platform_point=np.asarray(spec.platform_point, dtype=float),
-            description=spec.description, modes=modes, positions=positions, aliases=spec.aliases,
-            length_unit=spec.length_unit, source=spec.source or source, notes=spec.notes,
-        )
+        if graph:
+            edges = [(_joint(js, f"joints[{j}]", spec.normalize_axes), js.links[0], js.links[1])
+                     for j, js in enumerate(spec.joints or [])]
+            return Mechanism.from_graph(spec.name, spec.links, edges, output=spec.output, **common)
+        limbs = []
+        for i, ls in enumerate(spec.limbs or []):
+            joints = tuple(_joint(js, f"limbs[{i}].joints[{j}]", spec.normalize_axes) for j, js in enumerate(ls.joints))
+            limbs.append(Limb(ls.name, joints))
+        return Mechanism(name=spec.name, limbs=tuple(limbs), **common)
+    except ModelFileError:
+        raise
     except InputError as e:
         raise ModelFileError(str(e)) from None
 
@@ -390,7 +416,16 @@ def to_dict(mech: Mechanism) -> dict[str, Any]:
         d["notes"] = mech.notes
     if mech.aliases:
         d["aliases"] = dict(mech.aliases)
-    d["limbs"] = [{"name": l.name, "joints": [_joint_dict(j) for j in l.joints]} for l in mech.limbs]
+    if mech.is_graph:
+        from .topology import link_graph
+
+        g = link_graph(mech)
+        d["output"] = mech.output
+        hubs = list(mech.hubs)
+        d["links"] = hubs + [k.name for k in g.links if k.name not in hubs]
+        d["joints"] = [{**_joint_dict(j.joint), "links": [j.a, j.b]} for j in g.joints]
+    else:
+        d["limbs"] = [{"name": l.name, "joints": [_joint_dict(j) for j in l.joints]} for l in mech.limbs]
     if mech.modes:
         d["modes"] = [{"name": m.name, "driven": list(m.driven), "description": m.description} for m in mech.modes]
     if mech.positions:

@@ -38,7 +38,7 @@ from typing import Any
 
 from ..errors import InputError, UnknownNameError
 from .joints import Joint
-from .mechanism import Mechanism
+from .mechanism import GROUND, OUTPUT, Limb, Mechanism
 
 __all__ = [
     "GROUND",
@@ -52,13 +52,10 @@ __all__ = [
     "default_cut_preference",
     "link_graph",
     "loops",
+    "mechanism_from_graph",
     "spanning_tree",
 ]
 
-#: Name of the ground link (the fixed base).
-GROUND = "ground"
-#: Name of the output link of a limbs-to-platform mechanism (the platform).
-OUTPUT = "platform"
 
 
 @dataclass(frozen=True)
@@ -69,7 +66,7 @@ class Link:
     from 1 on the ground side); they are ``None`` for the ground and the output link."""
 
     name: str
-    kind: str  # "ground" | "output" | "link"
+    kind: str  # "ground" | "output" | "body" | "link"
     limb: int | None = None
     index: int | None = None
 
@@ -156,21 +153,154 @@ class LinkGraph:
 
 
 def link_graph(mech: Mechanism) -> LinkGraph:
-    """The link graph of a limbs-to-platform mechanism (see the module docstring)."""
+    """The link graph of a mechanism (see the module docstring).
+
+    Every joint appears as it was described: a joint that a limb traverses backwards
+    (:attr:`~spatialmech.model.joints.Joint.reversed`) is an edge from the link after it in
+    the limb to the link before it."""
     if not isinstance(mech, Mechanism):
         raise TypeError(f"mech: expected a Mechanism, got {type(mech).__name__}")
     links = [Link(GROUND, "ground")]
     joints = []
     for li, limb in enumerate(mech.limbs):
-        n = len(limb.joints)
-        for k in range(1, n):
-            links.append(Link(f"{limb.name}.link{k}", "link", li, k))
+        inner = limb.link_names
+        for k, ln in enumerate(inner, start=1):
+            links.append(Link(ln, "link", li, k))
+        chain = (limb.base, *inner, mech.limb_tip(limb))
         for k, joint in enumerate(limb.joints):
-            a = GROUND if k == 0 else f"{limb.name}.link{k}"
-            b = OUTPUT if k == n - 1 else f"{limb.name}.link{k + 1}"
-            joints.append(GraphJoint(joint.name, joint, a, b, li, k))
-    links.append(Link(OUTPUT, "output"))
-    return LinkGraph(mech.name, tuple(links), tuple(joints))
+            a, b = chain[k], chain[k + 1]
+            if joint.reversed:
+                a, b = b, a
+            joints.append(GraphJoint(joint.name, joint.described, a, b, li, k))
+    links.append(Link(mech.output, "output"))
+    links.extend(Link(b, "body") for b in mech.bodies)
+    return LinkGraph(mech.name, tuple(links), tuple(joints), output=mech.output)
+
+
+def mechanism_from_graph(name: str, links, joints, *, output: str | None = None, **kwargs) -> Mechanism:
+    """A :class:`Mechanism` from its link-and-joint graph.
+
+    ``links``: the link names, one of them ``"ground"`` (the fixed link).  ``joints``: a
+    sequence of ``(joint, a, b)``, the joint's freedoms moving link ``b`` relative to link ``a``.
+    ``output``: the link whose pose is the task (default: the link named ``"platform"``).
+    ``kwargs`` go to :class:`Mechanism` (``platform_point`` is the output link's reference point).
+
+    The graph is cut into *limbs*, serial chains between **hub** links: the ground, the output
+    link and every link with three or more joints (an internal *body*, such as a Delta arm);
+    links with two joints are the chains' intermediate links.  A chain is traversed in the
+    direction most of its joints were described in (a joint traversed backwards is
+    :meth:`~spatialmech.model.joints.Joint.flipped`, so its variables keep their meaning).
+    Errors name the field: unknown or duplicate links, a joint from a link to itself, links
+    not connected to the ground, a link held by one joint only (it would move freely).
+    """
+    from .joints import Joint as _JointType
+
+    if isinstance(links, (str, bytes)) or not hasattr(links, "__iter__"):
+        raise TypeError(f"links: expected a sequence of link names, got {type(links).__name__}")
+    names = list(links)
+    for k, ln in enumerate(names):
+        if not (isinstance(ln, str) and ln):
+            raise TypeError(f"links[{k}]: expected a link name (str), got {ln!r}")
+    if len(set(names)) != len(names):
+        dup = sorted({x for x in names if names.count(x) > 1})
+        raise InputError(f"links: duplicate link names {dup}")
+    if GROUND not in names:
+        raise InputError(f"links: one link must be named {GROUND!r} (the fixed link); got {names}")
+    if output is None:
+        if OUTPUT not in names:
+            raise InputError(f"output: name the output link (the link whose pose is the task); links: {', '.join(names)}")
+        output = OUTPUT
+    if output not in names:
+        raise UnknownNameError(f"output: unknown link {output!r}; links: {', '.join(names)}")
+    if output == GROUND:
+        raise InputError("output: the output link cannot be the ground")
+    edges: list[tuple[Joint, str, str]] = []
+    seen: set[str] = set()
+    for k, item in enumerate(joints):
+        if not (isinstance(item, (tuple, list)) and len(item) == 3):
+            raise TypeError(f"joints[{k}]: expected (joint, link a, link b), got {item!r}")
+        j, a, b = item
+        if not isinstance(j, _JointType):
+            raise TypeError(f"joints[{k}]: expected a Joint (R, P, C, U, S, Sm, H), got {type(j).__name__}")
+        for end in (a, b):
+            if end not in names:
+                raise UnknownNameError(f"joints[{k}].links: unknown link {end!r} in joint {j.name!r}; links: {', '.join(names)}")
+        if a == b:
+            raise InputError(f"joints[{k}].links: joint {j.name!r} connects link {a!r} to itself")
+        if j.name in seen:
+            raise InputError(f"joints[{k}].name: duplicate joint name {j.name!r}")
+        seen.add(j.name)
+        edges.append((j, a, b))
+    if not edges:
+        raise InputError("joints: a mechanism needs at least one joint")
+    degree = dict.fromkeys(names, 0)
+    for _, a, b in edges:
+        degree[a] += 1
+        degree[b] += 1
+    reached = {GROUND}
+    grew = True
+    while grew:
+        grew = False
+        for _, a, b in edges:
+            if (a in reached) != (b in reached):
+                reached |= {a, b}
+                grew = True
+    lost = [ln for ln in names if ln not in reached]
+    if lost:
+        raise InputError(f"links: not connected to the ground: {', '.join(lost)}")
+    for ln in names:
+        if ln not in (GROUND, output) and degree[ln] == 1:
+            raise InputError(f"links: link {ln!r} is held by one joint only; it would move freely "
+                             "(connect it or remove it)")
+    hubs = [GROUND, output] + [ln for ln in names if ln not in (GROUND, output) and degree[ln] >= 3]
+    # hub depth from the ground, to orient chains with no preferred direction
+    depth = {GROUND: 0}
+    frontier = [GROUND]
+    while frontier:
+        nxt = []
+        for x in frontier:
+            for _, a, b in edges:
+                for u, v in ((a, b), (b, a)):
+                    if u == x and v not in depth:
+                        depth[v] = depth[x] + 1
+                        nxt.append(v)
+        frontier = nxt
+    used: set[int] = set()
+    chains: list[tuple[str, list[tuple[int, bool]], list[str], str]] = []  # base, (edge, forward), inner, tip
+    hub_set = set(hubs)
+    for h in hubs:
+        for e0, (_, a0, b0) in enumerate(edges):
+            if e0 in used or h not in (a0, b0):
+                continue
+            steps, inner, at, e = [], [], h, e0
+            while True:
+                used.add(e)
+                _, a, b = edges[e]
+                forward = at == a
+                steps.append((e, forward))
+                at = b if forward else a
+                if at in hub_set:
+                    break
+                inner.append(at)
+                e = next(i for i, (_, x, y) in enumerate(edges) if i not in used and at in (x, y))
+            chains.append((h, steps, inner, at))
+    limbs = []
+    taken: set[str] = set()
+    for base, steps, inner, tip in chains:
+        n_back = sum(not f for _, f in steps)
+        flip = 2 * n_back > len(steps) or (2 * n_back == len(steps) and depth[tip] < depth[base])
+        if flip:
+            base, tip = tip, base
+            steps = [(e, not f) for e, f in steps[::-1]]
+            inner = inner[::-1]
+        js = [edges[e][0] if f else edges[e][0].flipped() for e, f in steps]
+        lname = js[0].name if len(js) == 1 else f"{js[0].name}-{js[-1].name}"
+        while lname in taken:
+            lname += "'"
+        taken.add(lname)
+        limbs.append(Limb(lname, tuple(js), base=base, tip=None if tip == output else tip, links=tuple(inner)))
+    bodies = tuple(ln for ln in hubs[2:])
+    return Mechanism(name=name, limbs=tuple(limbs), output=output, bodies=bodies, **kwargs)
 
 
 def _reach(g: LinkGraph, start: str) -> set[str]:

@@ -40,7 +40,7 @@ from __future__ import annotations
 
 import html as _html
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -50,7 +50,7 @@ from scipy.spatial import ConvexHull
 from ..errors import InputError
 from ..geometry.validate import as_finite_array
 from ..kinematics.closure import Configuration, joint_points, joint_twists
-from ..model.mechanism import Mechanism, Pose
+from ..model.mechanism import GROUND, Mechanism, Pose
 
 __all__ = ["DIV_ID", "SINGULAR_SYMBOL", "Drawing", "ViewerFile", "drawing", "viewer_figure", "viewer_html", "write_viewer"]
 
@@ -93,10 +93,13 @@ class Drawing:
     platform_point: np.ndarray
     platform_frame: np.ndarray
     scale: float
+    #: (m, 2, 3) segments of the internal bodies of a link-and-joint graph (each body's joints
+    #: joined to their centroid); empty for limbs from the ground to the platform.
+    bodies: np.ndarray = field(default_factory=lambda: np.zeros((0, 2, 3)))
 
     def points(self) -> np.ndarray:
         """Every drawn point (for bounding boxes and finiteness checks)."""
-        parts = [*self.limbs, self.base, self.platform, self.axes.reshape(-1, 3), self.joints,
+        parts = [*self.limbs, self.base, self.platform, self.axes.reshape(-1, 3), self.bodies.reshape(-1, 3), self.joints,
                  self.platform_point[None, :], self.platform_point + FRAME_LEN * self.scale * self.platform_frame.T]
         return np.vstack(parts)
 
@@ -113,6 +116,7 @@ class Drawing:
             "platform_point_len": self.platform_point.tolist(),
             "platform_frame": self.platform_frame.tolist(),
             "scale_len": float(self.scale),
+            "bodies_len": self.bodies.tolist(),
         }
 
 
@@ -177,11 +181,20 @@ def _check_config(mech: Mechanism, config, name: str) -> None:
         raise InputError(f"{name}: expected a Configuration, got {type(config).__name__}")
     as_finite_array(config.q, f"{name}.q", shape=(len(mech.freedom_refs),))
     as_finite_array(config.D, f"{name}.D", shape=(4, 4))
+    as_finite_array(config.B, f"{name}.B", shape=(len(mech.bodies), 4, 4))
+
+
+def _attachments(mech: Mechanism, pts: list[np.ndarray], link: str) -> np.ndarray:
+    """The joint points by which limbs are attached to hub ``link`` (first joints of limbs that
+    start there, last joints of limbs that end there)."""
+    out = [P[0] for limb, P in zip(mech.limbs, pts, strict=True) if limb.base == link]
+    out += [P[-1] for limb, P in zip(mech.limbs, pts, strict=True) if mech.limb_tip(limb) == link]
+    return np.array(out).reshape(-1, 3)
 
 
 def _platform_order(mech: Mechanism) -> np.ndarray:
     ref = Configuration.reference(mech)
-    last = np.array([p[-1] for p in joint_points(mech, ref)])
+    last = _attachments(mech, joint_points(mech, ref), mech.output)
     return _outline_order(last, mech.characteristic_length)
 
 
@@ -232,9 +245,14 @@ def drawing(mech: Mechanism, config: Configuration) -> Drawing:
             path.extend(piece[1:])
         limbs.append(np.array(path))
 
-    first = np.array([P[0] for P in pts])
-    last = np.array([P[-1] for P in pts])
+    first = _attachments(mech, pts, GROUND)
+    last = _attachments(mech, pts, mech.output)
     order = _platform_order(mech)  # from the reference: the same corners at every configuration
+    segs = []
+    for b in mech.bodies:
+        at = _attachments(mech, pts, b)
+        c = at.mean(axis=0)
+        segs += [[c, a] for a in at]
     return Drawing(
         limbs=tuple(limbs),
         base=_closed(first, _outline_order(first, s)),
@@ -245,6 +263,7 @@ def drawing(mech: Mechanism, config: Configuration) -> Drawing:
         platform_point=pp,
         platform_frame=R.copy(),
         scale=s,
+        bodies=np.array(segs).reshape(-1, 2, 3),
     )
 
 
@@ -278,6 +297,9 @@ def _animated(d: Drawing, fill: bool) -> list:
     out += [go.Scatter3d(**_xyz(l)) for l in d.limbs]
     x, y, z = _segments(d.axes)
     out.append(go.Scatter3d(x=x, y=y, z=z))
+    if len(d.bodies):
+        x, y, z = _segments(d.bodies)
+        out.append(go.Scatter3d(x=x, y=y, z=z))
     out.append(go.Scatter3d(**_xyz(d.joints)))
     for k in range(3):
         x, y, z = _segments(_frame_segments(d.platform_point, d.platform_frame, FRAME_LEN * d.scale, k))
@@ -302,6 +324,10 @@ def _style_animated(traces: list, d: Drawing, mech: Mechanism, fill: bool) -> No
         i += 1
     traces[i].update(mode="lines", name="joint axes (R, P, H, C, U)", line=dict(color="#333333", width=4))
     i += 1
+    if len(d.bodies):
+        traces[i].update(mode="lines", name=f"internal bodies ({', '.join(mech.bodies)})",
+                         line=dict(color="#7f7f7f", width=9))
+        i += 1
     traces[i].update(mode="markers", name="joints", marker=dict(size=4, color="#333333"), text=list(d.joint_names),
                      hovertemplate="%{text}<br>(%{x:.4g}, %{y:.4g}, %{z:.4g})<extra></extra>")
     i += 1
