@@ -2,9 +2,12 @@
 
 The exported geometry is checked with MuJoCo itself: at the reference (qpos0) and at generic
 configurations of the library, mapped to MuJoCo's joints, every loop closure holds to
-round-off and the output body is where the library puts the platform."""
+round-off and the output body is where the library puts the platform.  Limbs to a platform and
+link-and-joint graphs with internal loops (the Clavel Delta, the spatial six-bar, a graph whose
+joints are described against the way its limbs run) go through the same path."""
 
 import json
+import re
 import xml.etree.ElementTree as ET
 
 import mujoco
@@ -12,6 +15,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
+import spatialmech as sm
 from spatialmech import catalog
 from spatialmech.analysis.validation import MujocoSimulator
 from spatialmech.errors import InputError
@@ -21,7 +25,7 @@ from spatialmech.geometry.rotations import rotation_angle
 from spatialmech.interfaces.cli import cli
 from spatialmech.kinematics.closure import closure_residual, generic_configuration
 from spatialmech.kinematics.position import platform_pose
-from spatialmech.model import H, Limb, Mechanism, P, R, S, U
+from spatialmech.model import C, H, Limb, Mechanism, P, R, S, U
 from spatialmech.model.topology import link_graph, spanning_tree
 
 MODELS = catalog.names()
@@ -42,6 +46,34 @@ def custom() -> Mechanism:
     b = Limb("b", (H("B0", [2, 0, 0], z, pitch=0.1), U("B1", [2, 0, 1], [x, y], locked=["rot2"]),
                    R("B2", [1.5, 1, 1], [0, 0.6, 0.8])))
     return Mechanism("custom", (a, b), platform_point=[1.2, 1, 1])
+
+
+def flipped_graph() -> Mechanism:
+    """A spatial six-bar as a link-and-joint graph whose joints are described against the way
+    its limbs and its spanning tree run (flipped S, R and U joints), with an output link named
+    "follower", its point off the follower's C joint, and a second loop without an S joint
+    (R-U-U-C: cut at a U joint, closed by a weld of a ghost body)."""
+    x, y, z = np.eye(3)
+    links = ["ground", "crank", "rod1", "rocker", "rod2", "follower"]
+    joints = [
+        (R("A0", [0.0, 0.0, 0.0], z, actuated=True), "crank", "ground"),
+        (S("A1", [0.3, 0.0, 0.0]), "rod1", "crank"),
+        (S("B1", [0.0, 1.0, -0.1]), "rod1", "rocker"),
+        (R("B0", [0.0, 1.0, 0.5], x), "rocker", "ground"),
+        (U("C1", [0.0, 1.3, 0.8], [x, [0, 0.6, 0.8]]), "rod2", "rocker"),
+        (U("D1", [0.9, 2.0, 0.5], [[0.6, 0, 0.8], y]), "follower", "rod2"),
+        (C("D0", [0.6, 2.0, 0.5], y), "follower", "ground"),
+    ]
+    return Mechanism.from_graph("flipped", links, joints, output="follower", platform_point=[0.7, 2.1, 0.4])
+
+
+def without_metadata(mech: Mechanism, keep: dict | None = None) -> str:
+    """The MJCF of ``mech`` with its spatialmech metadata replaced by ``keep`` (as a hand-written
+    file would have it: nothing, or only the output body's name)."""
+    data = json.dumps(keep or {}).replace('"', "&quot;")
+    text, n = re.subn(r'<text name="spatialmech" data="[^"]*"', f'<text name="spatialmech" data="{data}"', to_mjcf(mech))
+    assert n == 1
+    return text
 
 
 def closure_at(sim: MujocoSimulator, config) -> tuple[float, float]:
@@ -99,6 +131,43 @@ def test_metamorphic_modes_lock_freedoms_with_joint_equalities(tmp_path):
     assert back.actuators == ("R1.rot",) and {r.id for r in back.freedom_refs if r.freedom.locked} == {"R4.rot", "R7.rot"}
 
 
+def test_a_graph_with_joints_described_backwards_exports_exactly():
+    """Flipped joints (a limb or the tree traversing a joint against its description): a ball's
+    rotation is inverted once for each, so MuJoCo's closures hold at the library's
+    configurations; the loop without an S joint is closed by a weld."""
+    mech = flipped_graph()
+    assert sm.mobility(mech).dof == 1
+    assert [j.name for limb in mech.limbs for j in limb.joints if j.reversed] == ["B1"]
+    tree = body_tree(mech)
+    assert tree.output == "follower" and tree.hubs == ("rocker",)
+    assert tree.joint_links["A0"] == ("crank", "ground") and tree.joint_links["C1"] == ("rod2", "rocker")
+    assert {b.joint.name for b in tree.bodies if b.joint is not None and b.joint.reversed} == {"A0", "B0", "B1", "D0"}
+    assert [(c.name, c.kind) for c in tree.closures] == [("A1", "connect"), ("C1", "weld")]
+    sim = MujocoSimulator(mech)
+    for seed in (1, 2, 3):
+        c = generic_configuration(mech, seed=seed, step=0.4)
+        res, pose_err = closure_at(sim, c)
+        assert res < 1e-11 and pose_err < 1e-11, (seed, res, pose_err)
+
+
+def test_graph_models_become_body_trees_with_internal_bodies():
+    """The Delta: 10 bodies (3 arms, 6 rods, the platform), a connect per cut S joint (5 loops),
+    the arms drawn as stars from their R joint; the metadata names limbs, ends and bodies."""
+    mech = catalog.build("delta")
+    tree = body_tree(mech)
+    assert len(tree.bodies) == 10 and [c.kind for c in tree.closures] == ["connect"] * 5
+    assert tree.hubs == ("arm1", "arm2", "arm3") and tree.output == "platform"
+    arm = tree.body("arm1")
+    assert arm.parent is None and arm.joint.name == "R1" and len(arm.segments) == 2
+    assert all(np.allclose(a, arm.origin) for a, _ in arm.segments)
+    meta = tree.metadata()
+    assert meta["bodies"] == ["arm1", "arm2", "arm3"] and ["arm1", "platform"] in meta["limb_ends"]
+    assert meta["joint_links"]["E1a"] == ["arm1", "rod1a"]
+    six = body_tree(catalog.build("spatial-six-bar"))
+    follower = six.body("follower")  # the output link: its frame at the platform point
+    assert six.output == "follower" and np.allclose(follower.origin, [0.6, 2.0, 0.5])
+
+
 def test_reversed_helical_and_locked_joints_export_exactly():
     mech = custom()
     tree = body_tree(mech)
@@ -116,6 +185,10 @@ def test_reversed_helical_and_locked_joints_export_exactly():
 def same_mechanism(a: Mechanism, b: Mechanism) -> None:
     assert a.name == b.name and a.length_unit == b.length_unit
     assert [limb.name for limb in a.limbs] == [limb.name for limb in b.limbs]
+    assert (a.output, a.bodies, a.is_graph) == (b.output, b.bodies, b.is_graph)
+    assert [(la.base, a.limb_tip(la), la.link_names) for la in a.limbs] == [
+        (lb.base, b.limb_tip(lb), lb.link_names) for lb in b.limbs]
+    assert [[j.reversed for j in limb.joints] for limb in a.limbs] == [[j.reversed for j in limb.joints] for limb in b.limbs]
     assert np.allclose(a.platform_point, b.platform_point, atol=1e-15)
     assert a.actuators == b.actuators and a.lockable == b.lockable and a.aliases == b.aliases
     assert [m.name for m in a.modes] == [m.name for m in b.modes]
@@ -140,13 +213,56 @@ def test_mjcf_round_trip(name, tmp_path):
     mech = catalog.build(name)
     f = tmp_path / "m.xml"
     export_model(mech, f)
-    same_mechanism(mech, from_mjcf(f))
+    back = from_mjcf(f)
+    same_mechanism(mech, back)
+    if mech.is_graph:  # the graph form comes back, with its loops and mobility
+        m0, m1 = sm.mobility(mech), sm.mobility(back)
+        assert (m1.dof, m1.loops, m1.motion) == (m0.dof, m0.loops, m0.motion)
 
 
 def test_round_trip_of_reversed_helical_and_locked_joints(tmp_path):
     f = tmp_path / "c.xml"
     f.write_text(to_mjcf(custom()))
     same_mechanism(custom(), from_mjcf(f))
+
+
+def test_round_trip_of_a_graph_with_joints_described_backwards(tmp_path):
+    f = tmp_path / "g.xml"
+    f.write_text(to_mjcf(flipped_graph()))
+    back = from_mjcf(f)
+    same_mechanism(flipped_graph(), back)
+    g0, g1 = link_graph(flipped_graph()), link_graph(back)
+    assert {(j.name, j.a, j.b) for j in g0.joints} == {(j.name, j.a, j.b) for j in g1.joints}
+
+
+@pytest.mark.parametrize("name, dof, loops", [("delta", 3, 5), ("spatial-six-bar", 1, 2)])
+def test_an_mjcf_with_internal_loops_and_no_metadata_imports_as_a_graph(name, dof, loops, tmp_path):
+    """A hand-written MJCF (here an export without its metadata, but for the output body's
+    name): the link graph is cut into limbs between hub links, giving the graph form with the
+    same links, joints, loops and mobility."""
+    mech = catalog.build(name)
+    f = tmp_path / "g.xml"
+    f.write_text(without_metadata(mech, {"output": mech.output}))
+    back = from_mjcf(f)
+    assert back.is_graph and back.output == mech.output and set(back.bodies) == set(mech.bodies)
+    g0, g1 = link_graph(mech), link_graph(back)
+    assert {k.name for k in g0.links} == {k.name for k in g1.links}
+    assert {(j.name, j.type, frozenset((j.a, j.b))) for j in g0.joints} == {
+        (j.name, j.type, frozenset((j.a, j.b))) for j in g1.joints}
+    assert g1.n_loops == loops
+    m0, m1 = sm.mobility(mech), sm.mobility(back)
+    assert m1.dof == m0.dof == dof and m1.loops == loops and m1.motion == m0.motion
+    if name == "spatial-six-bar":  # without its name in the metadata, the output body is not known
+        f.write_text(without_metadata(mech))
+        with pytest.raises(InputError, match="no output link"):
+            from_mjcf(f)
+
+
+def test_damaged_metadata_is_an_input_error(tmp_path):
+    f = tmp_path / "g.xml"
+    f.write_text(without_metadata(catalog.build("delta"), {"limbs": 3}))
+    with pytest.raises(InputError, match="is not spatialmech metadata"):
+        from_mjcf(f)
 
 
 GENERIC = """<mujoco model="hand-written">
@@ -216,6 +332,8 @@ def test_urdf_is_a_tree_and_lists_the_closures(name, tmp_path):
     children = [j.find("child").get("link") for j in root.findall("joint")]
     assert sorted(children) == sorted(links - {"ground"})  # every link but the root has one parent: a tree
     assert all(j.find("parent").get("link") in links for j in root.findall("joint"))
+    assert mech.output in links
+    assert root.find(f"{{{SPATIALMECH_NS}}}loop_closures").get("output") == mech.output
     closures = root.findall(f"{{{SPATIALMECH_NS}}}loop_closures/{{{SPATIALMECH_NS}}}closure")
     cut = spanning_tree(link_graph(mech)).cut
     assert [c.get("name") for c in closures] == list(cut)

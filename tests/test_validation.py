@@ -21,9 +21,11 @@ from spatialmech.interfaces.cli import cli
 from spatialmech.interfaces.common import load_schema
 from spatialmech.kinematics.closed_forms import four_sps_cu as k4
 from spatialmech.kinematics.closed_forms.four_sps_cu_paper import cone_trajectory
+from spatialmech.kinematics.closure import generic_configuration
 from spatialmech.kinematics.position import configuration_at_pose
 from spatialmech.model.mechanism import Pose
 from spatialmech.serialize import unit_rule_violations
+from tests.test_exchange import flipped_graph
 
 
 def run(*args):
@@ -118,6 +120,55 @@ def test_stewart_platform():
     assert r.motion == "loop" and r.max_position_error < 1e-12
 
 
+# ------------------------------------------------------------------ link-and-joint graphs (issue 11)
+def test_clavel_delta():
+    """The Delta with its parallelograms (3 R + 12 S, 5 loops): its three arms driven round a
+    loop from a generic configuration; the platform translates without turning, in MuJoCo as in
+    the library, and the arms (internal bodies) are where the library puts them."""
+    mech = catalog.build("delta")
+    start = generic_configuration(mech, seed=3, step=0.3)
+    r = V.validate(mech, start=start, frames=6, amplitude=0.05)
+    within(r)
+    assert r.motion == "loop" and len(r.poses) == 6 and r.max_position_error < 1e-12
+    assert max(rotation_angle(p.library.R) for p in r.poses) < 1e-9  # 3T: the platform never turns
+    assert max(rotation_angle(p.simulated.R) for p in r.poses) < 1e-9
+    moved = max(np.linalg.norm(p.library.p - r.poses[0].library.p) for p in r.poses)
+    assert moved > 0.01 * mech.characteristic_length
+    assert max(p.joint_deviation for p in r.poses) < 1e-9
+    assert not any("turns back" in n for n in r.notes)  # round a loop the actuators turn back by design
+
+
+def test_spatial_six_bar_and_its_internal_body():
+    """Two RSSR loops sharing the rocker (an internal body), the follower as output link: traced
+    by the crank.  The simulator's rocker is compared with the library's too."""
+    mech = catalog.build("spatial-six-bar")
+    r = V.validate(mech, frames=6)
+    within(r)
+    assert r.motion == "trace" and r.mechanism.output == "follower"
+    turned = max(np.degrees(rotation_angle(p.library.R)) for p in r.poses)
+    assert turned > 1.0  # the follower did turn
+    sim = V.MujocoSimulator(mech)
+    a, b = (generic_configuration(mech, seed=s, step=0.3) for s in (1, 2))
+    sim.set_configuration(a)
+    assert sim.body_deviation(a) < 1e-12 < 1e-3 < sim.body_deviation(b)
+
+
+def test_graph_with_joints_described_backwards():
+    """Flipped S, R and U joints, a loop closed by a weld, an output point off the pivot."""
+    r = V.validate(flipped_graph(), frames=5, arc=1.0)
+    within(r)
+    assert max(np.degrees(rotation_angle(p.library.R)) for p in r.poses) > 5.0  # the follower turned
+    assert max(np.linalg.norm(p.library.p - r.poses[0].library.p) for p in r.poses) > 0.01  # and its point moved
+
+
+def test_cli_validates_the_delta():
+    r = run("validate", "delta", "--poses", "4", "--json")
+    assert r.exit_code == 0, r.output
+    doc = json.loads(r.output)
+    assert doc["passed"] and doc["model"] == "delta" and doc["motion"] == "loop" and doc["n_poses_checked"] == 4
+    assert doc["max_position_error_len"] < 1e-8 * doc["characteristic_length_len"]
+
+
 # ------------------------------------------------------------------ the check can fail
 def test_a_wrong_export_is_caught(monkeypatch):
     """A base ball joint placed 1e-6 L off in the exported file: the validation reports errors of that
@@ -136,6 +187,27 @@ def test_a_wrong_export_is_caught(monkeypatch):
     monkeypatch.setattr(mjcf, "to_mjcf", shifted)
     r = V.validate(mech, frames=4)
     assert not r.passed and 1e-8 * L < r.max_position_error < 1e-4 * L
+
+
+def test_a_wrong_graph_export_is_caught(monkeypatch):
+    """A Delta whose platform-side ball W2a is 1e-5 L off in the exported file (a cut joint: a
+    connect equality's anchor): one rod of a parallelogram longer than the other, so that the
+    platform turns a little (measured: 5e-7 rad); caught."""
+    mech = catalog.build("delta")
+    L = mech.characteristic_length
+    good = mjcf.to_mjcf
+
+    def shifted(model):
+        text = good(model)
+        key = 'name="connect:W2a" body1="rod2a" body2="platform" anchor="'
+        head, tail = text.split(key, 1)
+        x, rest = tail.split(" ", 1)
+        return head + key + repr(float(x) + 1e-5 * L) + " " + rest
+
+    monkeypatch.setattr(mjcf, "to_mjcf", shifted)
+    r = V.validate(mech, frames=4)
+    assert not r.passed and all(p.settled for p in r.poses)
+    assert 1e-8 < r.max_orientation_error < 1e-4 and r.max_position_error < 1e-4 * L
 
 
 def test_a_branch_switch_is_flagged(monkeypatch):

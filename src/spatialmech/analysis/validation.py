@@ -26,9 +26,13 @@ one of two methods:
 
 At each pose the report states the position error (model length unit), the orientation error
 (the angle of ``R_sim R_lib^T``), whether the simulator settled, and whether it switched branch:
-its pose, or one of its hinge or slide values, is more than ``branch_tol`` (nondimensional:
-rad, length / L) from the library's -- near a singularity, where a simulator driven by its
+its pose, one of its hinge or slide values, or the pose of an internal body (a hub link of a
+link-and-joint graph, such as a Delta arm) is more than ``branch_tol`` (nondimensional: rad,
+length / L) from the library's -- near a singularity, where a simulator driven by its
 actuators may leave the library's assembly mode, as ADAMS would.
+
+Mechanisms described as limbs and as link-and-joint graphs with internal loops (the Clavel
+Delta, a spatial six-bar) are exported, driven and compared alike.
 
 MuJoCo is imported here, lazily: a missing package is an :class:`~spatialmech.errors.InputError`.
 """
@@ -391,7 +395,8 @@ class MujocoSimulator:
     def qpos_of(self, config: Configuration) -> np.ndarray:
         """MuJoCo's ``qpos`` of a library configuration (hinge and slide values are the freedoms'
         physical values; a ball's quaternion is the S joint's rotation, inverted when the tree
-        runs against the limb)."""
+        runs against the limb: the tree joint against the joint's described direction, or the
+        limb against it, but not both)."""
         mj, m = self.mj, self.model
         vals = freedom_values(self.mech, config.q)
         q = np.array(m.qpos0, dtype=float)
@@ -400,10 +405,12 @@ class MujocoSimulator:
             adr = int(m.jnt_qposadr[j])
             if ax.kind == "ball":
                 idx = [self._index[f] for f in ax.freedoms]
-                A = np.array([self.mech.freedom_refs[i].freedom.direction for i in idx]).T
-                R = rotvec_matrix(A @ config.q[idx])
+                refs = [self.mech.freedom_refs[i] for i in idx]
+                A = np.array([r.freedom.direction for r in refs]).T
+                R = rotvec_matrix(A @ config.q[idx])  # the motion in the limb's direction
+                flipped = self.mech.limbs[refs[0].limb].joints[refs[0].joint].reversed
                 quat = np.zeros(4)
-                mj.mju_mat2Quat(quat, (R.T if rev else R).ravel())
+                mj.mju_mat2Quat(quat, (R.T if rev != flipped else R).ravel())
                 q[adr:adr + 4] = quat
             elif ax.freedoms:
                 q[adr] = by_name[ax.name] = float(vals[self._index[ax.freedoms[0]]])
@@ -444,6 +451,20 @@ class MujocoSimulator:
             else:
                 diff /= self.L
             worst = max(worst, abs(diff))
+        return worst
+
+    def body_deviation(self, config: Configuration) -> float:
+        """Largest distance (position / L + angle in rad) between the simulator's pose of an
+        internal body of a link-and-joint graph (a Delta arm, the shared rocker of a six-bar)
+        and the library's (``config.B``); 0 for a mechanism without internal bodies."""
+        worst = 0.0
+        for k, name in enumerate(self.mech.bodies):
+            bid = self.mj.mj_name2id(self.model, self.mj.mjtObj.mjOBJ_BODY, name)
+            B = np.asarray(config.B[k])
+            p = B[:3, :3] @ self.tree.body(name).origin + B[:3, 3]
+            R = self.data.xmat[bid].reshape(3, 3)
+            worst = max(worst, float(np.linalg.norm(self.data.xpos[bid] - p)) / self.L
+                        + float(rotation_angle(R @ B[:3, :3].T)))
         return worst
 
     # ---------------------------------------------------------------- driving
@@ -519,7 +540,7 @@ class PoseCheck:
     residual: float  # the simulator's constraint residual / L
     iterations: int  # Newton iterations (project) or time steps (settle)
     branch_switched: bool
-    joint_deviation: float  # rad, length / L
+    joint_deviation: float  # rad, length / L: hinge and slide values, and internal bodies' poses
 
 
 @dataclass(frozen=True, eq=False)
@@ -670,12 +691,13 @@ def validate(mech: Mechanism, motion: str | None = None, *, method: str = "proje
         got = sim.output_pose()
         perr = float(np.linalg.norm(got.p - lib.p))
         oerr = float(rotation_angle(got.R @ lib.R.T))
-        dev = sim.joint_deviation(config)
+        dev = max(sim.joint_deviation(config), sim.body_deviation(config))
         switched = max(perr / L, oerr) > branch_tol or dev > branch_tol
         acts = dict(zip(mech.actuators, (float(x) for x in lp.actuators), strict=True))
         checks.append(PoseCheck(lp.label, acts, lib, got, perr, oerr, settled, residual, iters, switched, dev))
     mj = _mujoco()
     notes = ["the simulator starts in the library's first configuration (its assembly mode)"]
-    notes += _turning_points(mech, poses)
+    if motion == "trace":  # round a loop or along a path of their own the actuators turn back by design
+        notes += _turning_points(mech, poses)
     return ValidationResult(mech, motion, method, f"MuJoCo {mj.__version__}", tuple(checks), float(tol),
                             time.perf_counter() - t0, mode, tuple(notes))

@@ -7,11 +7,13 @@ back into a mechanism (the MJCF import builds a body tree from a MuJoCo model fi
 From mechanism to body tree
 ---------------------------
 The link graph and its spanning tree come from :mod:`spatialmech.model.topology` (cut S
-joints where a loop has one).  Every link but the ground is a :class:`Body`; the tree joint
-that leads to it says how it moves relative to its parent body.  Everything is stated **in
-world coordinates at the reference configuration** (every joint variable zero), where every
-body frame is world-aligned: a body's origin is the point of the joint that leads to it (the
-output link's is the platform point, so that its pose *is* the platform pose).
+joints where a loop has one), so a mechanism described as limbs from the ground to a platform
+and one described as a link-and-joint graph with internal loops (the Clavel Delta, a spatial
+six-bar) go through the same path.  Every link but the ground is a :class:`Body`; the tree
+joint that leads to it says how it moves relative to its parent body.  Everything is stated
+**in world coordinates at the reference configuration** (every joint variable zero), where
+every body frame is world-aligned: a body's origin is the point of the joint that leads to it
+(the output link's is the platform point, so that its pose *is* the platform pose).
 
 A spatialmech joint becomes simulator joints (:class:`Axis`), applied in order from parent to
 child: ``R`` a hinge, ``P`` a slide, ``C`` a hinge and a slide on one axis, ``U`` two hinges,
@@ -27,19 +29,33 @@ point in common); any other cut joint ``a -> b`` is rebuilt as a tree joint from
 *ghost* copy of ``b`` that a ``weld`` holds to ``b`` (six independent equations, so the
 closure is exact for every joint type).  A locked freedom keeps its joint and gets a
 :class:`Coupling` holding it at its value.
+
+Each joint keeps the direction it was *described* in (its freedoms move link ``b`` relative to
+link ``a``, :attr:`BodyTree.joint_links`), whichever way a limb or the tree traverses it; the
+limbs (names, joints, end links) and the internal bodies travel as metadata, so an import gives
+back the same limbs.
+
+From body tree to mechanism
+---------------------------
+:func:`mechanism_from_tree` makes links of the bodies (a ghost, or a body welded to another, is
+the other body's link; a body without joints is its parent's), joints of the tree joints and
+the ``connect`` closures, and rebuilds the limbs the metadata names.  Without metadata (a
+hand-written MJCF) the link graph is cut into limbs between hub links
+(:func:`~spatialmech.model.topology.mechanism_from_graph`): limbs from the ground to the output
+link, or the graph form when the model has internal loops.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from itertools import pairwise
 
 import numpy as np
 
 from ..errors import InputError, UnknownNameError
 from ..model.joints import Joint, make_joint
-from ..model.mechanism import Limb, Mechanism, Mode
-from ..model.topology import GROUND, OUTPUT, GraphJoint, link_graph, spanning_tree
+from ..model.mechanism import GROUND, Limb, Mechanism, Mode
+from ..model.topology import GraphJoint, link_graph, mechanism_from_graph, spanning_tree
 
 __all__ = [
     "Axis",
@@ -135,13 +151,19 @@ class BodyTree:
     bodies: tuple[Body, ...]
     closures: tuple[Closure, ...]
     couplings: tuple[Coupling, ...]
-    output: str  # the body whose frame is the platform frame
+    output: str  # the body whose frame is the platform frame (the output link)
     platform_point: np.ndarray
     characteristic_length: float
     length_unit: str = "m"
     description: str = ""
-    limbs: tuple[tuple[str, tuple[str, ...]], ...] = ()  # limb names and their joint names, ground to output
+    limbs: tuple[tuple[str, tuple[str, ...]], ...] = ()  # limb names and their joint names, base to tip
     joint_types: dict[str, str] = field(default_factory=dict)
+    #: Per limb (as ``limbs``), the links it runs between: (base, tip).  Empty: ground to output.
+    limb_ends: tuple[tuple[str, str], ...] = ()
+    #: The mechanism's internal bodies (hub links other than the ground and the output link).
+    hubs: tuple[str, ...] = ()
+    #: Per joint, the links it was described between, (a, b): its freedoms move b relative to a.
+    joint_links: dict[str, tuple[str, str]] = field(default_factory=dict)
     aliases: dict[str, str] = field(default_factory=dict)
     modes: tuple[Mode, ...] = ()
     ground_segments: tuple[tuple[np.ndarray, np.ndarray], ...] = ()  # to draw the ground between
@@ -164,16 +186,20 @@ class BodyTree:
 
     def metadata(self) -> dict:
         """What a simulator file cannot say by itself, for a faithful import: the model's name,
-        unit, output body, limb names and order, joint types, aliases and modes."""
+        unit, output body, limb names, order and end links, internal bodies, joint types and
+        described directions, aliases and modes."""
         return {
-            "format": "spatialmech body tree 1",
+            "format": "spatialmech body tree 2",
             "name": self.name,
             "description": self.description,
             "length_unit": self.length_unit,
             "output": self.output,
             "platform_point": [float(x) for x in self.platform_point],
             "limbs": [[n, list(js)] for n, js in self.limbs],
+            "limb_ends": [list(e) for e in self.limb_ends],
+            "bodies": list(self.hubs),
             "joint_types": dict(self.joint_types),
+            "joint_links": {k: list(v) for k, v in self.joint_links.items()},
             "aliases": dict(self.aliases),
             "lockable": list(self.lockable),
             "modes": [{"name": m.name, "driven": list(m.driven), "description": m.description} for m in self.modes],
@@ -181,9 +207,13 @@ class BodyTree:
 
 
 # ------------------------------------------------------------------ mechanism -> body tree
+def _plain_ball(joint: Joint) -> bool:
+    """An S joint with no actuated, lockable or locked freedom: one MuJoCo ball."""
+    return joint.type == "S" and not any(f.actuated or f.lockable or f.locked for f in joint.freedoms)
+
+
 def _axes_of(joint: Joint, reversed_: bool) -> tuple[tuple[Axis, ...], tuple[Coupling, ...]]:
-    plain_ball = joint.type == "S" and not any(f.actuated or f.lockable or f.locked for f in joint.freedoms)
-    if plain_ball:
+    if _plain_ball(joint):
         ball = Axis(joint.name, "ball", joint.point.copy(), np.zeros(3),
                     freedoms=tuple(f"{joint.name}.{f.name}" for f in joint.freedoms))
         return (ball,), ()
@@ -206,19 +236,19 @@ def _axes_of(joint: Joint, reversed_: bool) -> tuple[tuple[Axis, ...], tuple[Cou
     return tuple(axes), tuple(couplings)
 
 
-def _attachments(mech: Mechanism, links: list[str], graph) -> dict[str, list[np.ndarray]]:
+def _attachments(mech: Mechanism, graph) -> dict[str, list[np.ndarray]]:
     """Points to draw each link between: its joints' points, and the platform point for the
     output link; a link whose points all coincide (a spherical linkage) is drawn between points
     half a characteristic length out along its joints' first axes."""
     L = mech.characteristic_length
-    out: dict[str, list[np.ndarray]] = {k: [] for k in links}
-    axes: dict[str, list[np.ndarray]] = {k: [] for k in links}
+    out: dict[str, list[np.ndarray]] = {k.name: [] for k in graph.links}
+    axes: dict[str, list[np.ndarray]] = {k.name: [] for k in graph.links}
     for j in graph.joints:
         for end in (j.a, j.b):
             out[end].append(j.joint.point)
             axes[end].append(j.joint.freedoms[0].direction)
-    out[OUTPUT] = [mech.platform_point, *out[OUTPUT]]
-    axes[OUTPUT] = [np.zeros(3), *axes[OUTPUT]]
+    out[mech.output] = [mech.platform_point, *out[mech.output]]
+    axes[mech.output] = [np.zeros(3), *axes[mech.output]]
     for k, pts in out.items():
         if len(pts) > 1 and max(float(np.linalg.norm(p - pts[0])) for p in pts) < 1e-9 * L:
             out[k] = [p + 0.5 * L * a for p, a in zip(pts, axes[k], strict=True) if np.linalg.norm(a) > 0]
@@ -226,20 +256,22 @@ def _attachments(mech: Mechanism, links: list[str], graph) -> dict[str, list[np.
 
 
 def _segments(points: list[np.ndarray], hub: np.ndarray | None, L: float) -> tuple[tuple[np.ndarray, np.ndarray], ...]:
-    """Capsules from ``hub`` to each point (a star: platform, ground), or along the points in
-    order (a link of a limb); segments shorter than 1e-6 L are left out."""
+    """Capsules from ``hub`` to each point (a star: platform, ground, internal bodies), or along
+    the points in order (a link of a limb); segments shorter than 1e-6 L are left out."""
     pairs = [(hub, p) for p in points] if hub is not None else list(pairwise(points))
     return tuple((a.copy(), b.copy()) for a, b in pairs if float(np.linalg.norm(b - a)) > 1e-6 * L)
 
 
 def body_tree(mech: Mechanism) -> BodyTree:
-    """The :class:`BodyTree` of a mechanism (see the module docstring)."""
+    """The :class:`BodyTree` of a mechanism (see the module docstring): limbs from the ground to
+    the output link and link-and-joint graphs with internal bodies alike."""
     if not isinstance(mech, Mechanism):
         raise TypeError(f"mech: expected a Mechanism, got {type(mech).__name__}")
     graph = link_graph(mech)
     tree = spanning_tree(graph)
     L = mech.characteristic_length
-    att = _attachments(mech, [k.name for k in graph.links], graph)
+    att = _attachments(mech, graph)
+    kinds = {k.name: k.kind for k in graph.links}
     bodies: list[Body] = []
     couplings: list[Coupling] = []
     closures: list[Closure] = []
@@ -253,13 +285,18 @@ def body_tree(mech: Mechanism) -> BodyTree:
         rev = tree.reversed(jname)
         axes, cps = _axes_of(gj.joint, rev)
         couplings.extend(cps)
-        origin = mech.platform_point.copy() if link == OUTPUT else gj.joint.point.copy()
+        origin = mech.platform_point.copy() if link == mech.output else gj.joint.point.copy()
         pts = att[link]
-        segs = _segments(pts[1:], pts[0], L) if link == OUTPUT else _segments(pts, None, L)
+        if link == mech.output:
+            segs = _segments(pts[1:], pts[0], L)
+        elif kinds[link] == "body":  # an internal body (a Delta arm): a star from its tree joint
+            segs = _segments([p for p in pts if float(np.linalg.norm(p - origin)) > 1e-9 * L], origin, L)
+        else:
+            segs = _segments(pts, None, L)
         bodies.append(Body(link, link, body_of(plink), origin,
                            TreeJoint(gj.name, gj.type, axes, rev, float(gj.joint.freedoms[0].pitch)), segments=segs))
     for c in (graph.joint(n) for n in tree.cut):
-        if c.type == "S" and not any(f.actuated or f.lockable or f.locked for f in c.joint.freedoms):
+        if _plain_ball(c.joint):
             closures.append(Closure(c.name, "connect", body_of(c.a), body_of(c.b), c.joint.point.copy(), c.type))
             continue
         ghost = f"{c.b}~{c.name}"
@@ -271,11 +308,13 @@ def body_tree(mech: Mechanism) -> BodyTree:
     pts = att[GROUND]
     ground = _segments(pts, np.mean(pts, axis=0), L) if len(pts) > 1 else ()
     return BodyTree(
-        name=mech.name, bodies=tuple(bodies), closures=tuple(closures), couplings=tuple(couplings), output=OUTPUT,
+        name=mech.name, bodies=tuple(bodies), closures=tuple(closures), couplings=tuple(couplings), output=mech.output,
         platform_point=mech.platform_point.copy(), characteristic_length=L, length_unit=mech.length_unit,
         description=mech.description, limbs=tuple((limb.name, tuple(j.name for j in limb.joints)) for limb in mech.limbs),
-        joint_types={j.name: j.type for limb in mech.limbs for j in limb.joints}, aliases=dict(mech.aliases),
-        modes=tuple(mech.modes), ground_segments=ground, lockable=mech.lockable)
+        joint_types={j.name: j.type for j in graph.joints}, aliases=dict(mech.aliases),
+        modes=tuple(mech.modes), ground_segments=ground, lockable=mech.lockable,
+        limb_ends=tuple((limb.base, mech.limb_tip(limb)) for limb in mech.limbs), hubs=tuple(mech.bodies),
+        joint_links={j.name: (j.a, j.b) for j in graph.joints})
 
 
 # ------------------------------------------------------------------ body tree -> mechanism
@@ -361,15 +400,51 @@ def _joint_from_axes(name: str, axes: tuple[Axis, ...], L: float, declared: str 
     raise InputError(f"{where}: simulator joints {kinds} do not make a spatialmech joint (R, P, H, C, U, S, Sm)")
 
 
-def mechanism_from_tree(bt: BodyTree) -> Mechanism:
-    """The mechanism a :class:`BodyTree` describes.
+@dataclass(frozen=True)
+class _LimbWalk:
+    """A limb of the metadata laid on the imported link graph: its joints, each with the links it
+    goes from and to in the limb's direction, and its intermediate links."""
 
-    Links are bodies: a ghost, or a body welded to another, is the other body's link; a body
-    without joints is its parent's link.  Joints are the tree joints and the ``connect``
-    closures (S joints); couplings lock a freedom (``joint2`` empty) or make a helical joint.  The
-    limbs are the chains of links from the ground to the output body, in the order and with the
-    names of ``bt.limbs`` where it names them.  Raises :class:`~spatialmech.errors.InputError`
-    when the graph is not limbs to one output link or a joint is not a spatialmech joint."""
+    name: str
+    base: str
+    tip: str
+    steps: tuple[tuple[str, str, str], ...]  # (joint, from link, to link)
+    inner: tuple[str, ...]
+
+
+def _walk_limbs(bt: BodyTree, ends: dict[str, tuple[str, str]], output: str) -> list[_LimbWalk] | None:
+    """The metadata's limbs (``bt.limbs``, ``bt.limb_ends``) walked along the joints' links
+    ``ends``; ``None`` when there is no metadata or it does not fit the graph (a joint unknown or
+    used twice, a joint not at the link the walk has reached, a limb not ending at its tip, a
+    joint on no limb): the graph is then cut into limbs afresh."""
+    if not bt.limbs:
+        return None
+    limb_ends = bt.limb_ends or tuple((GROUND, output) for _ in bt.limbs)
+    if len(limb_ends) != len(bt.limbs):
+        return None
+    used: set[str] = set()
+    out = []
+    for (name, jnames), (base, tip) in zip(bt.limbs, limb_ends, strict=True):
+        at, steps, inner = base, [], []
+        for jn in jnames:
+            if jn not in ends or jn in used or at not in ends[jn]:
+                return None
+            a, b = ends[jn]
+            nxt = b if at == a else a
+            used.add(jn)
+            steps.append((jn, at, nxt))
+            inner.append(nxt)
+            at = nxt
+        if not steps or at != tip:
+            return None
+        out.append(_LimbWalk(name, base, tip, tuple(steps), tuple(inner[:-1])))
+    return out if used == set(ends) else None
+
+
+def _links_and_joints(bt: BodyTree) -> tuple[list[str], list[_Edge], str]:
+    """The links (the ground first, then in body order), the joints as edges (tree joints and
+    ``connect`` closures; simulator joints in the edge's ``a -> b`` order, locks marked) and the
+    output link of a body tree."""
     link_of: dict[str | None, str] = {None: GROUND}
     for b in bt.bodies:  # parents come first
         if b.parent not in link_of:
@@ -382,13 +457,6 @@ def mechanism_from_tree(bt: BodyTree) -> Mechanism:
                 if lk == drop:
                     link_of[body] = keep
     locked = {cp.joint1 for cp in bt.couplings if cp.joint2 is None}
-    helical: dict[str, tuple[str, float]] = {}
-    for cp in bt.couplings:
-        if cp.joint2 is None and cp.polycoef[0] != 0.0:
-            raise InputError(f"equality {cp.name!r}: holds {cp.joint1!r} away from its reference value; spatialmech "
-                             "locks a freedom at its reference value")
-        if cp.joint2 is not None:
-            helical[cp.joint1] = (cp.joint2, cp.polycoef[1])
 
     def marked(axes: tuple[Axis, ...]) -> tuple[Axis, ...]:
         return tuple(Axis(a.name, a.kind, a.anchor, a.axis, a.ref, a.range, a.actuated, a.locked or a.name in locked,
@@ -406,49 +474,68 @@ def mechanism_from_tree(bt: BodyTree) -> Mechanism:
             raise InputError(f"closure {c.name!r}: unsupported kind {c.kind!r} (connect or weld)")
     if bt.output not in link_of:
         raise UnknownNameError(f"output: no body {bt.output!r}; bodies: {', '.join(b.name for b in bt.bodies)}")
-    ground, output = GROUND, link_of[bt.output]
+    seen: set[str] = set()
     for e in edges:
         if e.a == e.b:
             raise InputError(f"joint {e.name!r}: joins link {e.a!r} to itself (a weld or a fixed body in its loop)")
-    inc: dict[str, list[_Edge]] = {}
+        if e.name in seen:
+            raise InputError(f"joint {e.name!r}: two joints of this name (name the simulator joints 'JOINT.freedom' "
+                             "and the equalities uniquely)")
+        seen.add(e.name)
+    links = list(dict.fromkeys([GROUND, *(link_of[b.name] for b in bt.bodies)]))
+    return links, edges, link_of[bt.output]
+
+
+def mechanism_from_tree(bt: BodyTree) -> Mechanism:
+    """The mechanism a :class:`BodyTree` describes (the module docstring).
+
+    Joints are the tree joints and the ``connect`` closures (S joints); couplings lock a freedom
+    (``joint2`` empty) or make a helical joint.  Each joint is rebuilt in the direction it was
+    described in (``bt.joint_links``; otherwise the direction of the limb it is on, or of the
+    tree).  The limbs are the metadata's (names, order, end links, internal bodies) when they fit
+    the graph; otherwise the graph is cut into limbs between hub links
+    (:func:`~spatialmech.model.topology.mechanism_from_graph`), which gives the graph form when
+    the model has internal loops.  Raises :class:`~spatialmech.errors.InputError` when a joint
+    is not a spatialmech joint or the graph is not a mechanism (a link held by one joint, links
+    not connected to the ground)."""
+    links, edges, output = _links_and_joints(bt)
+    helical: dict[str, tuple[str, float]] = {}
+    for cp in bt.couplings:
+        if cp.joint2 is None and cp.polycoef[0] != 0.0:
+            raise InputError(f"equality {cp.name!r}: holds {cp.joint1!r} away from its reference value; spatialmech "
+                             "locks a freedom at its reference value")
+        if cp.joint2 is not None:
+            helical[cp.joint1] = (cp.joint2, cp.polycoef[1])
+    walks = _walk_limbs(bt, {e.name: (e.a, e.b) for e in edges}, output)
+    along = {jn: (u, v) for w in walks or () for jn, u, v in w.steps}
+    joints: dict[str, tuple[Joint, str, str]] = {}
     for e in edges:
-        inc.setdefault(e.a, []).append(e)
-        inc.setdefault(e.b, []).append(e)
-    for link, es in inc.items():
-        if link not in (ground, output) and len(es) != 2:
-            raise InputError(f"link {link!r}: has {len(es)} joints; only limbs (chains of links with two joints each) "
-                             "between the ground and one output link can be imported today")
-    chains: list[list[tuple[_Edge, bool]]] = []
-    used: set[str] = set()
-    for e0 in inc.get(ground, []):
-        if e0.name in used:
-            continue
-        chain: list[tuple[_Edge, bool]] = []
-        at, e = ground, e0
-        while True:
-            used.add(e.name)
-            forward = e.a == at
-            chain.append((e, forward))
-            at = e.b if forward else e.a
-            if at in (output, ground):
-                break
-            e = next(x for x in inc[at] if x.name != e.name)
-        if at != output:
-            raise InputError(f"joints {[c[0].name for c in chain]}: a loop from the ground back to the ground, not a "
-                             "limb to the output link")
-        chains.append(chain)
-    missing = sorted({e.name for e in edges} - used)
-    if missing:
-        raise InputError(f"joints {missing}: not on a chain from the ground to the output link")
-    first = {js[0]: (k, n) for k, (n, js) in enumerate(bt.limbs) if js}
-    chains.sort(key=lambda ch: first.get(ch[0][0].name, (len(first), ""))[0])
-    limbs = []
-    for k, chain in enumerate(chains):
-        joints = []
-        for e, forward in chain:
-            axes = e.axes if forward else _reverse(e.axes)
-            joints.append(_joint_from_axes(e.name, axes, bt.characteristic_length, bt.joint_types.get(e.name), helical,
-                                           frozenset(bt.lockable), f"joint {e.name!r}"))
-        limbs.append(Limb(first.get(chain[0][0].name, (0, f"limb{k + 1}"))[1], tuple(joints)))
-    return Mechanism(bt.name, tuple(limbs), bt.platform_point, description=bt.description, modes=bt.modes,
-                     aliases=bt.aliases, length_unit=bt.length_unit)
+        d = tuple(bt.joint_links.get(e.name, ()))
+        a, b = d if d in ((e.a, e.b), (e.b, e.a)) else along.get(e.name, (e.a, e.b))
+        axes = e.axes if (a, b) == (e.a, e.b) else _reverse(e.axes)
+        joints[e.name] = (_joint_from_axes(e.name, axes, bt.characteristic_length, bt.joint_types.get(e.name), helical,
+                                           frozenset(bt.lockable), f"joint {e.name!r}"), a, b)
+    kw = {"platform_point": bt.platform_point, "description": bt.description, "modes": bt.modes,
+          "aliases": bt.aliases, "length_unit": bt.length_unit}
+    if walks is not None:
+        limbs = []
+        for w in walks:
+            js = []
+            for jn, u, v in w.steps:
+                joint, a, b = joints[jn]
+                js.append(joint if (u, v) == (a, b) else joint.flipped())
+            generated = tuple(f"{w.name}.link{k}" for k in range(1, len(js)))
+            limbs.append(Limb(w.name, tuple(js), base=w.base, tip=None if w.tip == output else w.tip,
+                              links=() if w.inner == generated else w.inner))
+        try:
+            return Mechanism(bt.name, tuple(limbs), output=output, bodies=bt.hubs, **kw)
+        except InputError:  # metadata that does not fit (internal bodies not named): cut the graph afresh
+            pass
+    mech = mechanism_from_graph(bt.name, links, [joints[e.name] for e in edges], output=output, **kw)
+    # a ball has no direction of its own: one the cut traverses backwards is the same S joint forwards
+    fixed = []
+    for limb in mech.limbs:
+        fixed.append(limb.with_joints(
+            make_joint("S", j.name, point=j.point) if j.reversed and _plain_ball(j) and j.name not in bt.joint_links
+            else j for j in limb.joints))
+    return replace(mech, limbs=tuple(fixed))

@@ -18,13 +18,16 @@
 - geometry to look at in the viewer: capsules for links, cylinders along hinge and slide axes
   (actuated ones red), spheres for spherical joints; they never collide;
 - ``custom/text name="spatialmech"``: JSON with what MJCF cannot say (model name, unit, output
-  body, limb names, joint types), read back by :func:`from_mjcf`.
+  body, limb names and end links, internal bodies, joint types and described directions),
+  read back by :func:`from_mjcf`.
 
 :func:`from_mjcf` reads an MJCF file with the ``mujoco`` package (so every form MuJoCo accepts
 is read: defaults, orientations, includes), builds a body tree in world coordinates at
 ``qpos0`` and turns it into a mechanism (:func:`~.bodies.mechanism_from_tree`): hinges,
 slides and balls, ``connect`` (S) and ``weld`` closures, joint-equality locks and helical
-couplings.  The output link is the metadata's, or a body named ``platform``.
+couplings.  The output link is the metadata's, or a body named ``platform``.  Without the
+metadata (a hand-written file) the link graph is cut into limbs between hub links: a model with
+internal loops (a Delta's parallelograms) comes back in graph form, with the same mobility.
 """
 
 from __future__ import annotations
@@ -258,22 +261,36 @@ def read_body_tree(path) -> BodyTree:
             couplings.append(Coupling(en, j1, j2, (float(c[0]), float(c[1])), "lock" if j2 is None else "helical"))
         else:
             raise InputError(f"{p}: equality {en!r}: only connect, weld and joint equalities are supported")
-    bodies = _name_tree_joints(bodies, meta)
-    output = str(meta.get("output", OUTPUT))
-    if output not in {b.name for b in bodies}:
-        raise InputError(f"{p}: no output link: name the body whose pose is the output '{OUTPUT}' (or say so in the "
-                         f"custom text {METADATA!r})")
-    out_body = next(b for b in bodies if b.name == output)
-    L = _characteristic_length([a.anchor for b in bodies if b.joint for a in b.joint.axes]
-                               + [c.anchor for c in closures] + [out_body.origin])
-    modes = tuple(Mode(x["name"], tuple(x["driven"]), x.get("description", "")) for x in meta.get("modes", []))
-    return BodyTree(
-        name=str(meta.get("name") or bytes(m.names).split(b"\0", 1)[0].decode("utf-8") or "mjcf"),
-        bodies=tuple(bodies), closures=tuple(closures), couplings=tuple(couplings), output=output,
-        platform_point=np.asarray(meta.get("platform_point", out_body.origin), dtype=float), characteristic_length=L,
-        length_unit=str(meta.get("length_unit", "m")), description=str(meta.get("description", "")),
-        limbs=tuple((n, tuple(js)) for n, js in meta.get("limbs", [])), joint_types=dict(meta.get("joint_types", {})),
-        aliases=dict(meta.get("aliases", {})), modes=modes, lockable=tuple(meta.get("lockable", ())))
+    if not isinstance(meta, dict):
+        raise InputError(f"{p}: custom text {METADATA!r}: expected a JSON object, got {type(meta).__name__}")
+    try:
+        bodies = _name_tree_joints(bodies, meta)
+        output = str(meta.get("output", OUTPUT))
+        if output not in {b.name for b in bodies}:
+            raise InputError(f"{p}: no output link: name the body whose pose is the output '{OUTPUT}' (or say so in "
+                             f"the custom text {METADATA!r}: {{\"output\": \"BODY\"}})")
+        out_body = next(b for b in bodies if b.name == output)
+        L = _characteristic_length([a.anchor for b in bodies if b.joint for a in b.joint.axes]
+                                   + [c.anchor for c in closures] + [out_body.origin])
+        modes = tuple(Mode(x["name"], tuple(x["driven"]), x.get("description", "")) for x in meta.get("modes", []))
+        return BodyTree(
+            name=str(meta.get("name") or bytes(m.names).split(b"\0", 1)[0].decode("utf-8") or "mjcf"),
+            bodies=tuple(bodies), closures=tuple(closures), couplings=tuple(couplings), output=output,
+            platform_point=np.asarray(meta.get("platform_point", out_body.origin), dtype=float),
+            characteristic_length=L, length_unit=str(meta.get("length_unit", "m")),
+            description=str(meta.get("description", "")),
+            limbs=tuple((str(n), tuple(str(j) for j in js)) for n, js in meta.get("limbs", [])),
+            joint_types={str(k): str(v) for k, v in meta.get("joint_types", {}).items()},
+            aliases={str(k): str(v) for k, v in meta.get("aliases", {}).items()}, modes=modes,
+            lockable=tuple(str(x) for x in meta.get("lockable", ())),
+            limb_ends=tuple((str(a), str(b)) for a, b in meta.get("limb_ends", [])),
+            hubs=tuple(str(x) for x in meta.get("bodies", [])),
+            joint_links={str(k): (str(a), str(b)) for k, (a, b) in meta.get("joint_links", {}).items()})
+    except InputError:
+        raise
+    except (TypeError, ValueError, KeyError, AttributeError) as e:  # a custom text written by hand, or damaged
+        raise InputError(f"{p}: custom text {METADATA!r} is not spatialmech metadata ({type(e).__name__}: {e}); "
+                         "remove it or fix it (docs/validation.md)") from None
 
 
 def _characteristic_length(points) -> float:
