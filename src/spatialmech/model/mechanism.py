@@ -27,6 +27,7 @@ from ..geometry.tolerances import characteristic_length
 from ..geometry.tolerances import current as current_tolerances
 from ..geometry.validate import as_finite_array
 from .joints import Freedom, Joint
+from .task import TaskCoordinates
 
 __all__ = ["GROUND", "MAX_IMPLICIT_MODES", "OUTPUT", "FreedomRef", "Limb", "Mechanism", "Mode", "Pose"]
 
@@ -177,6 +178,9 @@ class Mechanism:
     notes: str = ""
     output: str = OUTPUT
     bodies: tuple[str, ...] = ()
+    #: The task coordinates a user gives to pose the output link (None: chosen from the
+    #: mobility analysis, :func:`spatialmech.kinematics.task.default_task`).
+    task: TaskCoordinates | None = None
 
     def __post_init__(self):
         if not isinstance(self.name, str):
@@ -202,6 +206,8 @@ class Mechanism:
                     raise InputError(f"limbs[{i}].joints[{j}].name: duplicate joint name {joint.name!r}")
                 seen_j.add(joint.name)
         self._check_links()
+        if self.task is not None and not isinstance(self.task, TaskCoordinates):
+            raise TypeError(f"task: expected a TaskCoordinates, got {describe(self.task)}")
         for target in self.aliases.values():
             self.freedom(target)  # raises on unknown
         lockable = {r.id for r in self.freedom_refs if r.freedom.lockable}

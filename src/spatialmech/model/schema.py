@@ -24,6 +24,7 @@ from ..errors import InputError
 from ..geometry.rotations import check_sequence
 from .joints import Joint, make_joint
 from .mechanism import Limb, Mechanism, Mode, Pose
+from .task import TaskCoordinates
 
 __all__ = ["FORMAT_VERSION", "ModelFileError", "dump", "dumps", "from_dict", "load", "load_positions", "loads", "to_dict"]
 
@@ -169,6 +170,8 @@ class MechanismSpec(_Strict):
     links: Annotated[list[str], Len(2)] | None = None
     joints: Annotated[list[GraphJointSpec], Len(1)] | None = None
     output: str | None = None
+    task: list[str] | None = None
+    task_euler: str = "ZYX"
     modes: list[ModeSpec] = Field(default_factory=list)
     positions: list[PoseSpec] = Field(default_factory=list)
     aliases: dict[str, str] = Field(default_factory=dict)
@@ -286,7 +289,15 @@ def from_dict(data: dict[str, Any], *, source: str = "<dict>") -> Mechanism:
                              "with 'limbs' the output link is the platform")
     positions = tuple(_pose(p, f"positions[{i}]") for i, p in enumerate(spec.positions))
     modes = tuple(Mode(m.name, tuple(m.driven), m.description) for m in spec.modes)
-    common: dict[str, Any] = dict(
+    task = None
+    if spec.task is not None:
+        try:
+            task = TaskCoordinates(tuple(spec.task), spec.task_euler)
+        except InputError as e:
+            raise ModelFileError(str(e)) from None
+    elif spec.task_euler != "ZYX":
+        raise ModelFileError("task_euler: given without 'task' (the task coordinates it names the angles of)")
+    common: dict[str, Any] = dict(task=task,
         platform_point=np.asarray(spec.platform_point, dtype=float),
         description=spec.description, modes=modes, positions=positions, aliases=spec.aliases,
         length_unit=spec.length_unit, source=spec.source or source, notes=spec.notes,
@@ -416,6 +427,9 @@ def to_dict(mech: Mechanism) -> dict[str, Any]:
         d["notes"] = mech.notes
     if mech.aliases:
         d["aliases"] = dict(mech.aliases)
+    if mech.task is not None:
+        d["task"] = list(mech.task.given)
+        d["task_euler"] = mech.task.euler
     if mech.is_graph:
         from .topology import link_graph
 

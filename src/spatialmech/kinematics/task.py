@@ -1,0 +1,199 @@
+"""Posing a lower-mobility mechanism by its task coordinates; the parasitic ones are solved.
+
+Task coordinates (:mod:`spatialmech.model.task`): ``x, y, z`` the output link's reference point
+(the model's length unit) and ``a1, a2, a3`` its Euler angles in a named sequence (rad).  For a
+displacement ``D`` of the output link, the point is ``P = R p0 + t`` and the spatial twist of
+the output is ``V = (omega ; dP/dt - omega x P)`` with ``omega = E(a) da/dt`` (:func:`euler_rate_matrix`),
+so ``V = C(values) d(values)/dt`` with the 6x6 map :func:`coordinate_map`.
+
+:func:`solve_task` holds the given coordinates exactly and solves the closure equations by
+Gauss-Newton (minimum norm) in the unknowns: every unlocked joint variable (actuators included),
+the solved coordinates and the internal bodies' twists.  :func:`default_task` picks the given
+coordinates from the output link's twist space at the reference configuration.
+
+    >>> from spatialmech.catalog import build
+    >>> import numpy as np
+    >>> m = build("three-rps")
+    >>> default_task(m).given
+    ('z', 'a2', 'a3')
+    >>> r = solve_task(m, {"z": 0.33, "a2": np.radians(5), "a3": np.radians(5)})
+    >>> r.converged, r.solved
+    (True, ('x', 'y', 'a1'))
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from itertools import combinations
+
+import numpy as np
+
+from ..errors import InputError
+from ..geometry.rotations import euler_matrix, matrix_euler, skew, transform
+from ..geometry.tolerances import current as current_tolerances
+from ..model.mechanism import Mechanism
+from ..model.task import TASK_NAMES, TaskCoordinates
+from ..results import SolveStatus
+from .closure import Configuration, active_mask, closure_jacobian, closure_scales, retract
+from .velocity import euler_rate_matrix
+
+__all__ = ["TaskSolution", "coordinate_map", "default_task", "pose_from_task", "solve_task", "task_values"]
+
+
+def task_values(mech: Mechanism, D, euler: str = "ZYX") -> np.ndarray:
+    """The six task coordinates ``(x, y, z, a1, a2, a3)`` (length unit, rad) of the output
+    displacement ``D`` (4x4)."""
+    D = np.asarray(D, dtype=float)
+    P = D[:3, :3] @ mech.platform_point + D[:3, 3]
+    return np.r_[P, matrix_euler(euler, D[:3, :3])]
+
+
+def pose_from_task(mech: Mechanism, values, euler: str = "ZYX") -> np.ndarray:
+    """The output displacement (4x4) with task coordinates ``values`` (6,)."""
+    v = np.asarray(values, dtype=float)
+    R = euler_matrix(euler, v[3:])
+    return transform(R, v[:3] - R @ mech.platform_point)
+
+
+def coordinate_map(values, euler: str = "ZYX") -> np.ndarray:
+    """``C`` (6x6) with ``V = C d(values)/dt``: the spatial twist of the output link for rates of
+    its task coordinates at ``values``."""
+    v = np.asarray(values, dtype=float)
+    E = euler_rate_matrix(euler, v[3:])
+    C = np.zeros((6, 6))
+    C[:3, 3:] = E
+    C[3:, :3] = np.eye(3)
+    C[3:, 3:] = skew(v[:3]) @ E  # -omega x P = P x omega
+    return C
+
+
+def default_task(mech: Mechanism, euler: str = "ZYX") -> TaskCoordinates:
+    """The given coordinates of ``mech`` by default: the mechanism's own ``task`` if declared;
+    otherwise the ``M`` coordinates (``M`` = the output link's freedoms at the reference, the
+    nullity of the closure Jacobian projected on the output twist) whose rates parametrise the
+    output twist space there: for every ``M``-subset, the smallest singular value of its rows of
+    an orthonormal basis of ``C^-1 V`` (positions divided by the characteristic length); among
+    the subsets within a factor 2 of the best, the one with the most angles (a rotary output is
+    posed by its angle), then the best conditioned, then the earliest in ``x, y, z, a1, a2, a3``."""
+    own = getattr(mech, "task", None)
+    if own is not None:
+        return own
+    c = Configuration.reference(mech)
+    active = active_mask(mech)
+    A, _ = closure_jacobian(mech, c, active=active)
+    row, col = closure_scales(mech, active)
+    As = row[:, None] * A * col[None, :]
+    _, sv, vt = np.linalg.svd(As)
+    r = int(np.sum(sv > current_tolerances().rank * max(1.0, sv[0] if sv.size else 0.0)))
+    na = int(active.sum())
+    V = (vt[r:] * col[None, :])[:, na : na + 6]  # output twists of the null motions (SI)
+    L = mech.characteristic_length
+    rates = np.linalg.solve(coordinate_map(task_values(mech, c.D, euler), euler), V.T)  # (6, k)
+    rates[:3] /= L
+    U, s, _ = np.linalg.svd(rates, full_matrices=False)
+    M = int(np.sum(s > 1e-7 * max(1.0, s[0] if s.size else 0.0)))
+    if M == 0:
+        raise InputError(f"task: {mech.name}'s output link cannot move at the reference configuration")
+    if M == 6:
+        return TaskCoordinates(TASK_NAMES, euler)
+    B = U[:, :M]  # orthonormal basis of the coordinate-rate space
+    subs = list(combinations(range(6), M))
+    smin = [float(np.linalg.svd(B[list(sub)], compute_uv=False)[-1]) for sub in subs]
+    top = max(smin)
+    # among the well-conditioned subsets (at least half the best), the one with the most angles
+    # (a rotary output is posed by its angle, which does not fold back as a point's coordinate does)
+    ok = [k for k in range(len(subs)) if smin[k] >= 0.5 * top]
+    best = max(ok, key=lambda k: (sum(i >= 3 for i in subs[k]), round(smin[k], 9), -k))
+    return TaskCoordinates(tuple(TASK_NAMES[i] for i in subs[best]), euler)
+
+
+@dataclass(frozen=True, eq=False)
+class TaskSolution:
+    """A configuration with the given task coordinates held and the others solved."""
+
+    config: Configuration
+    values: Mapping[str, float]  # all six coordinates (length unit, rad)
+    task: TaskCoordinates
+    converged: bool
+    residual: float  # nondimensional closure residual
+    iterations: int
+    status: SolveStatus
+
+    @property
+    def given(self) -> tuple[str, ...]:
+        return self.task.given
+
+    @property
+    def solved(self) -> tuple[str, ...]:
+        return self.task.solved
+
+    @property
+    def D(self) -> np.ndarray:
+        return self.config.D
+
+
+def _check_given(task: TaskCoordinates, given: Mapping[str, float]) -> dict[str, float]:
+    if not isinstance(given, Mapping):
+        raise InputError(f"given: expected a mapping of task coordinate -> value, got {type(given).__name__}")
+    out = {}
+    for k, v in given.items():
+        if k not in TASK_NAMES:
+            raise InputError(f"given.{k}: unknown task coordinate; expected one of {', '.join(TASK_NAMES)}")
+        if k not in task.given:
+            raise InputError(f"given.{k}: {k} is solved (parasitic) under this task ({', '.join(task.given)} given); "
+                             "name it among the given coordinates (task / --free) to hold it")
+        x = float(v)
+        if not np.isfinite(x):
+            raise InputError(f"given.{k}: must be finite, got {v!r}")
+        out[k] = x
+    return out
+
+
+def solve_task(mech: Mechanism, given: Mapping[str, float], *, task: TaskCoordinates | None = None,
+               seed: Configuration | None = None, tol: float | None = None, max_iter: int = 60) -> TaskSolution:
+    """Hold the ``given`` task coordinates (a subset of ``task.given``; the rest of the given
+    ones keep the seed's values) and solve the closure for the joint variables, the solved
+    coordinates and the internal bodies, by Gauss-Newton from ``seed`` (default: the
+    reference).  Never raises on non-convergence: ``converged``/``status`` say."""
+    task = default_task(mech) if task is None else task
+    if not isinstance(task, TaskCoordinates):
+        raise TypeError(f"task: expected a TaskCoordinates, got {type(task).__name__}")
+    g = _check_given(task, given)
+    tol = current_tolerances().newton if tol is None else float(tol)
+    config = Configuration.reference(mech) if seed is None else seed
+    values = task_values(mech, config.D, task.euler)
+    for k, v in g.items():
+        values[TASK_NAMES.index(k)] = v
+    free = [i for i, n in enumerate(TASK_NAMES) if n in task.solved]
+    config = Configuration(config.q, pose_from_task(mech, values, task.euler), config.B)
+    active = active_mask(mech)
+    na = int(active.sum())
+    row, col = closure_scales(mech, active)
+    L = mech.characteristic_length
+    cscale = np.array([L, L, L, 1.0, 1.0, 1.0])[free]
+    scales = np.r_[col[:na], cscale, col[na + 6 :]]
+    rn = np.inf
+    it = 0
+    status = SolveStatus.MAX_ITER
+    for it in range(max_iter + 1):
+        A, r = closure_jacobian(mech, config, active=active)
+        rn = float(np.linalg.norm(row * r))
+        if rn < tol:
+            return TaskSolution(config, dict(zip(TASK_NAMES, map(float, values), strict=True)), task, True, rn, it,
+                                SolveStatus.CONVERGED)
+        if it == max_iter or not np.isfinite(rn):
+            break
+        Cf = coordinate_map(values, task.euler)[:, free]
+        G = np.hstack([A[:, :na], A[:, na : na + 6] @ Cf, A[:, na + 6 :]])
+        x, *_ = np.linalg.lstsq(row[:, None] * G * scales[None, :], -(row * r), rcond=None)
+        if np.linalg.norm(x) < 1e-13 * max(1.0, rn):
+            status = SolveStatus.STALLED
+            break
+        u = scales * x
+        nf = len(free)
+        step = np.r_[u[:na], np.zeros(6), u[na + nf :]]
+        values[free] += u[na : na + nf]
+        config = retract(mech, config, active, step, fix_platform=True)
+        config = Configuration(config.q, pose_from_task(mech, values, task.euler), config.B)
+    return TaskSolution(config, dict(zip(TASK_NAMES, map(float, values), strict=True)), task, False, rn, it, status)
