@@ -81,6 +81,11 @@ CASES = [
      "workspace", "four-sps-cu"),
     (["workspace", "three-sps-smpu", "--orientation", "--at", "alpha=0,beta=0", "--step-deg", "60", "--tol-deg", "1"],
      "workspace", "three-sps-smpu"),  # general path
+    (["workspace", "three-rps", "--task", "--over", "a2:-30:30:3,a3:-30:30:3", "--at", "z=0.33",
+      "--cone", "S1=40,S2=40,S3=40", "--tol-deg", "1"], "workspace", "three-rps"),  # over task coordinates
+    (["workspace", "three-upu", "--task", "--over", "x:-0.1:0.1:3", "--at", "z=0.3", "--limit", "actuators=0.3:0.4",
+      "--tol", "1e-3"], "workspace", "three-upu"),
+    (["singularity", "three-rps", "--slice", "a2:-30:30:3,a3:-30:30:3", "--at", "z=0.33"], "singularity", "three-rps"),
 ]
 SLOW_CASES = [  # more than ~1 s each: deselected by the quick loop (pytest -m "not slow")
     (["workspace", "four-sps-cu", "--orientation", "--at", "z=0.1", "--step-deg", "15"], "workspace", "four-sps-cu"),

@@ -637,46 +637,93 @@ def singularity(model: ModelLike, pose=None, *, config: Configuration | None = N
 
 
 def workspace(model: ModelLike, *, kind: str = "orientation", at: Mapping[str, float] | None = None,
-              step: float | None = None, tol: float | None = None, bounds=None, method: str = "auto",
+              step: float | None = None, tol=None, bounds=None, method: str = "auto",
               link_diameter: float | None = None, interference: bool = True, max_poses: int | None = None,
-              progress: Progress | None = None):
+              progress: Progress | None = None, over: Mapping | None = None, free=None, limits=None):
     """Workspace under joint limits (strokes, joint cones, link interference), sampled and
     refined at the boundary: ``kind="orientation"`` at a fixed position (free angles alpha,
     beta, gamma of ``R = Rz(gamma) Ry(beta) Rx(alpha)``), or ``"position"`` at a fixed
     orientation.  SI and radians: ``at`` fixes coordinates (``x, y, z`` length,
     ``alpha, beta, gamma`` rad); ``step``/``tol`` are radians (orientation; default 2 deg and
     0.001 deg) or lengths (position).  ``link_diameter`` overrides the interference check's
-    capsules, ``interference=False`` skips it.  Returns a
-    :class:`~spatialmech.analysis.workspace.WorkspaceResult`.
+    capsules, ``interference=False`` skips it; ``limits`` (a
+    :class:`~spatialmech.analysis.workspace.WorkspaceLimits`) replaces the default limits.
+    Returns a :class:`~spatialmech.analysis.workspace.WorkspaceResult`.
+
+    ``kind="task"``: over the task coordinates of a lower-mobility mechanism (docs/workspace.md):
+    ``over`` maps 1 to 3 given task coordinates (``x, y, z`` length, ``a1, a2, a3`` rad) to
+    ``(lo, hi, n)`` or grid values, ``at`` holds other given ones, ``free`` names the coordinates
+    to solve (default: the model's task); ``tol`` is the boundary tolerance (a number, or by
+    coordinate; default 1e-3 of the grid step), ``max_poses`` the largest grid.  The parasitic
+    coordinates are solved at every cell.  Returns a
+    :class:`~spatialmech.analysis.workspace.TaskWorkspaceResult`.
 
     >>> import numpy as np, spatialmech as sm
     >>> ws = sm.workspace("four-sps-cu", at={"z": 0.1}, step=np.radians(10))
     >>> round(float(np.degrees(ws.alone["alpha"].hi)), 1), ws.alone["alpha"].hi_limit
     (26.6, 'A1 cone')
+    >>> t = sm.workspace("three-rps", kind="task", over={"a2": (-0.2, 0.2, 3), "a3": (-0.2, 0.2, 3)}, at={"z": 0.33})
+    >>> t.solved, t.reachable_fraction
+    (('x', 'y', 'a1'), 1.0)
     """
     from .analysis.workspace import WorkspaceLimits, default_limits, orientation_workspace, position_workspace
 
     mech = _mechanism(model)
-    kind = _check_choice(kind, "kind", ("orientation", "position"))
+    kind = _check_choice(kind, "kind", ("orientation", "position", "task"))
     method = _check_choice(method, "method", ("auto", "closed-form", "general"))
     interference = _check_bool(interference, "interference")
     if at is not None and not isinstance(at, Mapping):
         raise TypeError(f"at: expected a mapping of coordinate -> value (SI, rad), got {describe(at)}")
     step = _check_number(step, "step", positive=True, optional=True)
-    tol = _check_number(tol, "tol", positive=True, optional=True)
+    if kind != "task" or not isinstance(tol, Mapping):
+        tol = _check_number(tol, "tol", positive=True, optional=True)
     link_diameter = _check_number(link_diameter, "link_diameter", optional=True)
     if link_diameter is not None and link_diameter < 0:
         raise InputError(f"link_diameter: expected a non-negative length, got {link_diameter}")
     if max_poses is not None:
         max_poses = _check_int(max_poses, "max_poses", minimum=1)
-    limits = default_limits(mech)
+    if limits is not None and not isinstance(limits, WorkspaceLimits):
+        raise TypeError(f"limits: expected a WorkspaceLimits, got {describe(limits)}")
+    limits = default_limits(mech) if limits is None else limits
     if link_diameter is not None or not interference:
         limits = WorkspaceLimits(limits.cones, link_diameter if interference else None, limits.freedom_limits, limits.source)
+    if kind == "task":
+        return _task_workspace(mech, over, at, free, limits, tol, step, bounds, max_poses, progress)
+    for name, value in (("over", over), ("free", free)):
+        if value is not None:
+            raise InputError(f"{name}: only with kind='task' (the workspace over task coordinates)")
     kw = dict(at=at, limits=limits, bounds=bounds, method=method, max_poses=max_poses, progress=_progress(progress))
     if kind == "orientation":
         return orientation_workspace(mech, step=np.radians(2.0) if step is None else step,
                                      tol=np.radians(1e-3) if tol is None else tol, **kw)
     return position_workspace(mech, step=step, tol=tol, **kw)
+
+
+def _task_workspace(mech: Mechanism, over, at, free, limits, tol, step, bounds, max_poses, progress):
+    """``workspace(kind="task")``: the checks of its own arguments, then the analysis."""
+    from .analysis.workspace import task_workspace
+    from .model.task import TASK_NAMES, TaskCoordinates
+
+    if over is None:
+        raise InputError("over: kind='task' needs the grid: {coordinate: (lo, hi, n)} over task coordinates "
+                         "(x, y, z length; a1, a2, a3 rad)")
+    if not isinstance(over, Mapping):
+        raise TypeError(f"over: expected a mapping of task coordinate -> (lo, hi, n) or values, got {describe(over)}")
+    for name, value in (("step", step), ("bounds", bounds)):
+        if value is not None:
+            raise InputError(f"{name}: not with kind='task' (the grid is given by over)")
+    task = None
+    if free is not None:
+        names = [free] if isinstance(free, str) else free
+        if not isinstance(names, Sequence) or not all(isinstance(n, str) for n in names):
+            raise TypeError(f"free: expected task coordinate names, got {describe(free)}")
+        own = mech.task.euler if mech.task is not None else "ZYX"
+        for n in names:
+            if n not in TASK_NAMES:
+                raise InputError(f"free: unknown task coordinate {n!r}; expected some of {', '.join(TASK_NAMES)}")
+        task = TaskCoordinates(tuple(n for n in TASK_NAMES if n not in names), own)
+    return task_workspace(mech, over, at=at, task=task, limits=limits, tol=tol, max_cells=max_poses,
+                          progress=_progress(progress))
 
 
 # ============================================================================ tracking

@@ -18,6 +18,7 @@ from ..kinematics.position import configuration_at_pose
 from ..model.mechanism import Pose
 from .cmd_kinematics import resolve_pose, with_pose
 from .common import check_output_file, emit_json, json_option, tol_option
+from .task_args import parse_axes, parse_task_at, task_from_free
 
 _SLICE_NAMES = ("x", "y", "z", "a1", "a2", "a3")
 
@@ -43,6 +44,47 @@ def _parse_slice(text: str):
     return axes
 
 
+def _task_slice(mech, slice_spec: str, at, free, acts, plot, as_json) -> None:
+    """``singularity --slice ... [--at ...]`` without a pose: a slice over task coordinates."""
+    from ..analysis.task_slice import task_singularity_slice
+    from ..analysis.workspace.task import euler_convention
+
+    axes = parse_axes(slice_spec, "--slice", min_axes=2, max_axes=2)
+    held = parse_task_at(at, "--at")
+    task = task_from_free(free, mech)
+    bar = None if as_json else click.progressbar(length=1, label="slice (solving task coordinates)", file=sys.stderr)
+
+    def prog(done, total, msg):
+        if bar is not None:
+            bar.length = max(bar.length, int(total or done))
+            bar.update(int(done) - bar.pos)
+
+    res = task_singularity_slice(mech, axes, at=held, task=task, actuators=acts, progress=prog if bar else None)
+    if bar:
+        bar.render_finish()
+    (n1, n2) = res.names
+    if not np.isfinite(res.sigma_min).any():
+        raise InputError(f"--slice: the task coordinates do not close at any point of the {n1} x {n2} slice; "
+                         "move or narrow the slice")
+    if plot is not None:
+        shown = res.for_display()
+        slice_figure(shown, f"{mech.name}: singularity loci over task coordinates ({res.euler}, angles in degrees; "
+                            f"solved {', '.join(res.solved)})").savefig(plot)
+    if as_json:
+        emit_json("singularity", mech, {"result": "singularity_task_slice", **res.to_dict()})
+        return
+    det, finite = res.det, np.isfinite(res.sigma_min)
+    held_text = ", ".join(f"{c} = {np.degrees(v):.4g} deg" if c.startswith("a") else f"{c} = {v:.6g} {mech.length_unit}"
+                          for c, v in res.held.items())
+    click.echo(f"{mech.name}: det J over task coordinates {n1} x {n2} ({len(res.u)} x {len(res.v)} points"
+               + (f", {held_text} held" if held_text else "") + f"; solved {', '.join(res.solved) or 'none'}; "
+               f"{int(finite.sum())} close): {int(np.sum(det[finite] > 0))} positive, {int(np.sum(det[finite] < 0))} "
+               f"negative, smallest sigma_min {np.nanmin(res.sigma_min):.3g}")
+    click.echo(f"  orientation: {euler_convention(res.euler)}; {res.n_solves} solves in {res.seconds:.2f} s")
+    if plot is not None:
+        click.echo(f"  wrote {plot}")
+
+
 @click.command(name="singularity")
 @click.argument("model")
 @with_pose
@@ -50,11 +92,16 @@ def _parse_slice(text: str):
 @click.option("--driver", "drivers", multiple=True, help="Actuated freedom(s) (default: the model's actuators).")
 @click.option("--slice", "slice_spec", default=None,
               help="Loci on a 2-D slice around the pose: NAME:MIN:MAX:N,NAME:MIN:MAX:N with NAME in x,y,z (length) "
-                   "or a1,a2,a3 (the --euler angles, degrees).")
+                   "or a1,a2,a3 (the --euler angles, degrees); without a pose, over task coordinates (see --at).")
+@click.option("--at", "at", default=None, metavar="NAME=VALUE,...",
+              help="A slice over task coordinates (lower-mobility mechanisms; no pose given): the given coordinates "
+                   "held, x, y, z (length) or a1, a2, a3 (deg); the parasitic ones are solved at every grid point.")
+@click.option("--free", "free", default=None, metavar="NAME,...",
+              help="With a task slice: the coordinates to solve (default: the model's task, or the slice and --at names).")
 @click.option("--plot", "plot", type=click.Path(dir_okay=False, path_type=Path), default=None, help="PNG of the slice.")
 @tol_option("singular")
 @json_option
-def singularity_cmd(model, xyz, euler, position, reference, drivers, slice_spec, plot, as_json):
+def singularity_cmd(model, xyz, euler, position, reference, drivers, slice_spec, at, free, plot, as_json):
     """Singularity analysis at a pose: rank of the wrench system, kind (inverse, direct,
     constraint), uncontrolled twist, line geometry of the wrenches, finite self-motion.
 
@@ -64,16 +111,26 @@ def singularity_cmd(model, xyz, euler, position, reference, drivers, slice_spec,
       spatialmech singularity four-sps-cu --xyz 0 0 0.12 --euler ZYX 34.38 -5.73 11.46 --json
       spatialmech singularity four-sps-cu --xyz 0 0 0.12 --euler ZYX 20 0 0 \\
           --slice a2:-30:30:25,a3:-30:30:25 --plot loci.png
+      spatialmech singularity three-rps --slice a2:-30:30:31,a3:-30:30:31 --at z=0.33
     """
     if reference:
         given = [name for name, v in (("a pose (--xyz/--euler/--pose)", xyz if xyz is not None else euler),
-                                      ("--position", position), ("--slice", slice_spec)) if v is not None]
+                                      ("--position", position), ("--slice", slice_spec), ("--at", at),
+                                      ("--free", free)) if v is not None]
         if given:
             raise InputError(f"--reference: analyses the model's reference configuration and takes no pose; "
                              f"it cannot be combined with {', '.join(given)} (drop --reference to analyse the pose)")
+    posed = xyz is not None or euler is not None or position is not None
+    for name, v in (("--at", at), ("--free", free)):
+        if v is not None and (slice_spec is None or posed):
+            raise InputError(f"{name}: only with --slice and no pose (a slice over task coordinates, the parasitic "
+                             "ones solved); with a pose, --slice varies the pose itself")
     check_output_file(plot, "--plot")
     mech = catalog.resolve(model)
     acts = list(drivers) or None
+    if slice_spec is not None and not posed:
+        _task_slice(mech, slice_spec, at, free, acts, plot, as_json)
+        return
     if slice_spec is not None:
         if euler is None or xyz is None:
             raise InputError("--slice: give the base pose with --xyz and --euler")

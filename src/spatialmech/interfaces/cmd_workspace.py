@@ -1,8 +1,10 @@
-"""CLI command ``workspace``: orientation / position workspace under joint limits.
+"""CLI command ``workspace``: orientation / position workspace under joint limits, and (``--task``)
+the workspace over the task coordinates of a lower-mobility mechanism.
 
 Angles at the command line are in degrees, lengths in the model's length unit (m).  ``--at``
 takes ``name=value`` pairs separated by commas: ``x, y, z`` (m) and ``alpha, beta, gamma``
-(deg), with ``R = Rz(gamma) Ry(beta) Rx(alpha)`` (intrinsic "ZYX", paper B eq 7).
+(deg), with ``R = Rz(gamma) Ry(beta) Rx(alpha)`` (intrinsic "ZYX", paper B eq 7); with
+``--task``, task coordinates ``x, y, z`` and ``a1, a2, a3`` (deg, the task's Euler sequence).
 """
 
 from __future__ import annotations
@@ -21,9 +23,11 @@ from ..analysis.workspace import (
     orientation_workspace,
     pose_checker,
     position_workspace,
+    with_freedom_limits,
 )
 from ..errors import InputError
 from .common import UserError, check_output_file, emit_json, json_option
+from .task_args import cone_limits, freedom_limits, parse_axes, parse_task_at, task_from_free
 
 _ANGLES = ("alpha", "beta", "gamma")
 #: Largest grid (poses) the slow general kernel accepts from the CLI unless --max-poses says more.
@@ -85,6 +89,102 @@ def _text(res, length_unit: str = "m") -> str:
     return "\n".join(lines)
 
 
+def _with_diameter(limits: WorkspaceLimits, link_diameter, no_interference: bool) -> WorkspaceLimits:
+    if link_diameter is not None and not (np.isfinite(link_diameter) and link_diameter >= 0):
+        raise InputError(f"--link-diameter: expected a non-negative number of metres, got {link_diameter}")
+    return WorkspaceLimits(limits.cones, None if no_interference else link_diameter, limits.freedom_limits, limits.source)
+
+
+def _progress_bar():
+    """A progress callback drawing a bar on stderr (opened at the first report) and its closer."""
+    bars: list = []
+
+    def progress(done, total, message):
+        if not bars:
+            bars.append(click.progressbar(length=1, label=message or "checking poses", file=sys.stderr, show_pos=True))
+            bars[0].__enter__()
+        bar = bars[0]
+        bar.label = message or bar.label
+        bar.length = max(bar.length, int(done), int(total or 0))  # total: the search's estimate
+        bar.update(int(done) - bar.pos)
+
+    def close():
+        if bars:
+            bars[0].__exit__(None, None, None)
+
+    return progress, close
+
+
+def _task_text(res, length_unit: str) -> str:
+    """The text report of a workspace over task coordinates."""
+    from ..analysis.workspace.task import euler_convention
+
+    def show(c: str, v: float) -> str:
+        return f"{np.degrees(v):.4f} deg" if c.startswith("a") else f"{v:.6g} {length_unit}"
+
+    held = ", ".join(f"{c} = {show(c, v)}" for c, v in res.fixed.items())
+    lines = [f"{res.mechanism}: workspace over task coordinates {', '.join(res.over)}"
+             + (f" ({held} held)" if held else "") + f"; solved: {', '.join(res.solved) or 'none'}",
+             f"orientation: {euler_convention(res.euler)}"]
+    for c in res.over:
+        e = res.extents[c]
+        lines.append(f"  {c:3s}: empty" if e is None else
+                     f"  {c:3s}: [{show(c, e.lo)}, {show(c, e.hi)}]   limits: {e.lo_limit} / {e.hi_limit}")
+    solved = [f"{c} [{show(c, res.ranges[c][0])}, {show(c, res.ranges[c][1])}]" for c in res.solved
+              if res.ranges.get(c) is not None]
+    if solved:
+        lines.append("  solved over the reachable set: " + ", ".join(solved))
+    n = int(res.feasible.size)
+    lines.append(f"reachable: {res.n_feasible} of {n} grid cells ({100 * res.reachable_fraction:.1f} %); "
+                 f"{int(res.converged.sum())} close" + ("" if res.volume is None else
+                                                       f"; measure {_measure(res, length_unit)}"))
+    if res.active_limits:
+        lines.append("active limits (boundary points): " + ", ".join(f"{k} {v}" for k, v in res.active_limits.items()))
+    elif not res.limit_names:
+        lines.append("no limits: the model has none and none were given (--limit, --cone); "
+                     "only closure bounds the set")
+    lines.append(f"{res.n_solves} solves in {res.seconds:.2f} s ({res.n_solves / max(res.seconds, 1e-9):.0f} per s); "
+                 "boundary tolerance " + ", ".join(f"{c} {show(c, t)}" for c, t in res.tol.items()))
+    return "\n".join(lines)
+
+
+def _measure(res, length_unit: str) -> str:
+    d = len(res.over)
+    if res.over[0].startswith("a"):
+        return f"{res.volume * np.degrees(1.0) ** d:.6g} deg" + (f"^{d}" if d > 1 else "")
+    return f"{res.volume:.6g} {length_unit}" + (f"^{d}" if d > 1 else "")
+
+
+def _task_workspace(mech, over, at, free, limits, tol_deg, tol_m, max_cells, plot, as_json) -> None:
+    """``workspace --task``: the grid, the held coordinates, the solve, the output."""
+    from ..analysis.workspace.task import task_workspace
+
+    axes = parse_axes(over, "--over")
+    held = parse_task_at(at, "--at")
+    task = task_from_free(free, mech)
+    for name, v in (("--tol-deg", tol_deg), ("--tol", tol_m)):
+        if v is not None and not (np.isfinite(v) and v > 0):
+            raise InputError(f"{name}: must be a positive number, got {v}")
+    L = mech.characteristic_length
+    tol = {c: (np.radians(tol_deg) if c.startswith("a") else (tol_m if tol_m is not None else 1e-6 * L)) for c in axes}
+    progress, close = (None, lambda: None) if as_json else _progress_bar()
+    try:
+        res = task_workspace(mech, axes, at=held, task=task, limits=limits, tol=tol, max_cells=max_cells,
+                             progress=progress)
+    finally:
+        close()
+    if plot:
+        from ..present.task_workspace import write_task_workspace_plot
+
+        write_task_workspace_plot(res, plot)
+    if as_json:
+        emit_json("workspace", mech, {**res.to_dict(), "plot": str(plot) if plot else None})
+        return
+    click.echo(_task_text(res, mech.length_unit))
+    if plot:
+        click.echo(f"plot written to {plot}")
+
+
 @click.command()
 @click.argument("model")
 @click.option("--orientation", "orientation_flag", is_flag=True,
@@ -105,10 +205,23 @@ def _text(res, length_unit: str = "m") -> str:
 @click.option("--max-poses", type=click.IntRange(min=1), default=None,
               help=f"Largest grid accepted (default: {MAX_POSES:.0e} on the closed-form path, {GENERAL_MAX_POSES} "
                    "on the general path); a larger grid is refused with its size before any work.")
+@click.option("--task", "task_flag", is_flag=True,
+              help="Workspace over the task coordinates of a lower-mobility mechanism: sample --over, hold --at, "
+                   "solve the parasitic coordinates at every cell (docs/workspace.md).")
+@click.option("--over", "over", default=None, metavar="NAME:MIN:MAX:N,...",
+              help="With --task: 1 to 3 grid axes over task coordinates x, y, z (length) or a1, a2, a3 (deg).")
+@click.option("--free", "free", default=None, metavar="NAME,...",
+              help="With --task: the coordinates to solve (default: the model's task, or the grid and --at names).")
+@click.option("--cone", "cones", multiple=True, metavar="JOINT=DEG",
+              help="Cone limit of an S or U joint (deg): the link's angle to the platform z axis (to the base z axis "
+                   "at a limb's first joint); repeatable or comma-separated.")
+@click.option("--limit", "freedom_limits_text", multiple=True, metavar="FREEDOM=LO:HI",
+              help="Limits of a freedom's value (length, or deg for a rotation); 'actuators=LO:HI' sets every "
+                   "actuator; repeatable or comma-separated.")
 @click.option("--plot", "plot", type=click.Path(dir_okay=False), default=None, help="Write a figure (.png/.svg/.pdf).")
 @json_option
 def workspace(model, orientation_flag, position_flag, at, step_deg, tol_deg, step_m, tol_m, method, link_diameter,
-              no_interference, max_poses, plot, as_json):
+              no_interference, max_poses, task_flag, over, free, cones, freedom_limits_text, plot, as_json):
     """Workspace under joint limits (strokes, joint cones, link interference), sampled and refined
     at the boundary by bisection.
 
@@ -116,25 +229,46 @@ def workspace(model, orientation_flag, position_flag, at, step_deg, tol_deg, ste
     JSON (docs/json.md): extents.alpha_deg.alone ([min, max] of one angle alone, others fixed),
     extents.alpha_deg.set (over the whole set), volume_deg3 (orientation) or volume_len3
     (position), active_limits (boundary points per limit), path (closed-form or general).
+    --task (lower-mobility mechanisms): the given task coordinates on the --over grid, the
+    parasitic ones solved at every cell; extents.a2_deg.range, solved_ranges, reachable_fraction,
+    samples (docs/workspace.md).
     \b
     Examples:
       spatialmech workspace four-sps-cu --orientation --at z=0.1
       spatialmech workspace four-sps-cu --position --at alpha=0,beta=0,gamma=0 --json
       spatialmech workspace four-sps-cu --at z=0.1 --step-deg 3 --plot ws.png
+      spatialmech workspace three-rps --task --over a2:-40:40:41,a3:-40:40:41 --at z=0.33 --cone S1=45,S2=45,S3=45
     """
-    kind = "position" if position_flag else "orientation"
+    kind = "task" if task_flag else "position" if position_flag else "orientation"
     try:
-        if orientation_flag and position_flag:
-            raise InputError("--orientation, --position: give one of them, not both")
+        given = [name for name, v in (("--orientation", orientation_flag), ("--position", position_flag),
+                                      ("--task", task_flag)) if v]
+        if len(given) > 1:
+            raise InputError(f"{', '.join(given)}: give one of them, not {'both' if len(given) == 2 else 'all three'}")
+        if not task_flag:
+            for name, v in (("--over", over), ("--free", free)):
+                if v is not None:
+                    raise InputError(f"{name}: only with --task (the workspace over task coordinates)")
+        elif over is None:
+            raise InputError("--task: give the grid with --over NAME:MIN:MAX:N[,...], e.g. --over a2:-20:20:41,a3:-20:20:41")
         check_output_file(plot, "--plot", suffixes=(".png", ".svg", ".pdf"))
         mech = catalog.resolve(model)
-        fixed = parse_at(at)
+        new_limits = freedom_limits(freedom_limits_text, mech)
+        if new_limits:
+            mech = with_freedom_limits(mech, new_limits)
         limits = default_limits(mech)
+        extra_cones = cone_limits(cones, mech)
+        if extra_cones:
+            limits = WorkspaceLimits(limits.cones + extra_cones, limits.link_diameter, limits.freedom_limits,
+                                     (limits.source + " + " if limits.source else "") + "--cone")
+        if task_flag:
+            if link_diameter is not None or no_interference:
+                limits = _with_diameter(limits, link_diameter, no_interference)
+            _task_workspace(mech, over, at, free, limits, tol_deg, tol_m, max_poses, plot, as_json)
+            return
+        fixed = parse_at(at)
         if link_diameter is not None or no_interference:
-            if link_diameter is not None and not (np.isfinite(link_diameter) and link_diameter >= 0):
-                raise InputError(f"--link-diameter: expected a non-negative number of metres, got {link_diameter}")
-            limits = WorkspaceLimits(limits.cones, None if no_interference else link_diameter,
-                                     limits.freedom_limits, limits.source)
+            limits = _with_diameter(limits, link_diameter, no_interference)
         for name, v in (("--step-deg", step_deg), ("--tol-deg", tol_deg)):
             if not (np.isfinite(v) and v > 0):
                 raise InputError(f"{name}: must be a positive number of degrees, got {v}")
@@ -150,21 +284,11 @@ def workspace(model, orientation_flag, position_flag, at, step_deg, tol_deg, ste
         if as_json:
             res = run(None)
         else:
-            bars = []  # opened at the first progress report: no progress line before an input error
-
-            def progress(done, total, message):
-                if not bars:
-                    bars.append(click.progressbar(length=1, label=message or "checking poses", file=sys.stderr, show_pos=True))
-                    bars[0].__enter__()
-                bar = bars[0]
-                n = int(done) - bar.pos
-                bar.length = max(bar.length, int(done), int(total or 0))  # total: the search's estimate
-                bar.update(n)
+            progress, close = _progress_bar()  # opened at the first report: none before an input error
             try:
                 res = run(progress)
             finally:
-                if bars:
-                    bars[0].__exit__(None, None, None)
+                close()
         if plot:
             from ..analysis.workspace_plot import write_workspace_plot
 
@@ -172,7 +296,7 @@ def workspace(model, orientation_flag, position_flag, at, step_deg, tol_deg, ste
     except InputError as e:  # not ConvergenceError (exit 1) nor a bug (exit 3): see cli._Group
         msg = str(e)
         # the library names its arguments; say which command-line option to change
-        msg = msg.replace("max_poses =", "--max-poses =")
+        msg = msg.replace("max_poses =", "--max-poses =").replace("max_cells =", "--max-poses =")
         for arg, opt in (("step", "--step-deg" if kind == "orientation" else "--step"),
                          ("tol", "--tol-deg" if kind == "orientation" else "--tol")):
             if msg.startswith(arg + ":"):
@@ -182,5 +306,35 @@ def workspace(model, orientation_flag, position_flag, at, step_deg, tol_deg, ste
         emit_json("workspace", mech, {**res.to_dict(), "plot": str(plot) if plot else None})
         return
     click.echo(_text(res, mech.length_unit))
+    hint = _lower_mobility_hint(mech) if res.n_feasible == 0 or "closure" in res.active_limits else ""
+    if hint:
+        click.echo(hint)
     if plot:
         click.echo(f"plot written to {plot}")
+
+
+def _lower_mobility_hint(mech) -> str:
+    """For a pose workspace bounded by closure (or empty) of a mechanism with fewer than six output
+    freedoms: why, and the command that samples its task coordinates instead."""
+    from ..kinematics.task import default_task
+
+    try:
+        task = default_task(mech)
+    except InputError:
+        return ""
+    if len(task.given) == 6:
+        return ""
+    from ..kinematics.task import task_values
+    from ..model.task import TASK_NAMES
+
+    given = task.given
+    ref = dict(zip(TASK_NAMES, task_values(mech, np.eye(4), task.euler), strict=True))
+    L = mech.characteristic_length
+    order = sorted(given, key=lambda c: not c.startswith("a"))  # angles first
+    over = ",".join(f"{c}:-20:20:41" if c.startswith("a") else f"{c}:{ref[c] - L / 2:.4g}:{ref[c] + L / 2:.4g}:41"
+                    for c in order[:2])
+    at = ",".join(f"{c}={np.degrees(ref[c]):.4g}" if c.startswith("a") else f"{c}={ref[c]:.4g}" for c in order[2:])
+    return (f"note: {mech.name}'s output has {len(given)} freedoms ({', '.join(given)} given; "
+            f"{', '.join(task.solved)} parasitic): a grid of six-coordinate poses almost never lies on its "
+            f"closure set.  Sample its task coordinates instead: spatialmech workspace {mech.name} --task "
+            f"--over {over}" + (f" --at {at}" if at else ""))

@@ -67,7 +67,7 @@ Example::
 
 from __future__ import annotations
 
-from .checker import PoseChecker, pose_checker, segment_distance
+from .checker import ConfigurationChecker, PoseChecker, configuration_checker, pose_checker, segment_distance
 from .limits import (
     COORDINATES,
     ORIENTATION_SEQUENCE,
@@ -76,8 +76,10 @@ from .limits import (
     WorkspaceLimits,
     default_limits,
     paper_b_limits,
+    with_freedom_limits,
 )
 from .search import MAX_POSES, MAX_POSES_GENERAL, Extent, WorkspaceResult, orientation_workspace, position_workspace
+from .task import TASK_PATH, TaskWorkspaceResult, task_workspace
 
 __all__ = [
     "COORDINATES",
@@ -85,15 +87,21 @@ __all__ = [
     "MAX_POSES_GENERAL",
     "ORIENTATION_SEQUENCE",
     "PAPER_B_LINK_DIAMETERS",
+    "TASK_PATH",
     "ConeLimit",
+    "ConfigurationChecker",
     "Extent",
     "PoseChecker",
+    "TaskWorkspaceResult",
     "WorkspaceLimits",
     "WorkspaceResult",
+    "configuration_checker",
     "default_limits",
     "orientation_workspace",
     "paper_b_limits",
     "pose_checker",
     "position_workspace",
     "segment_distance",
+    "task_workspace",
+    "with_freedom_limits",
 ]

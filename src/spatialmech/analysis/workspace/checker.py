@@ -331,8 +331,8 @@ def pose_checker(mech: Mechanism, limits: WorkspaceLimits | None = None, *, meth
                     pinned.update({_POSITION[i]: float(item[1][i]) for i in range(3) if i != axis_k[0]})
         return PoseChecker(mech, limits, "closed-form", tuple(names), scale, fn, "", pinned, fn_feasible)
 
-    from ...kinematics.closure import limb_slices
-    from ...kinematics.position import inverse_position
+    from ...kinematics.closure import hub_displacements, limb_slices
+    from ...kinematics.position import inverse_position, limb_clusters
 
     def _general_row(config, R1):
         vals = offs + config.q
@@ -362,10 +362,16 @@ def pose_checker(mech: Mechanism, limits: WorkspaceLimits | None = None, *, meth
             alt = inverse_position(mech, pose, all_solutions=True, n_seeds=general_seeds)
             if alt.reachable:
                 q = np.zeros(len(refs))
-                for sl, lsol in zip(limb_slices(mech), alt.limbs, strict=True):
-                    k = min(range(len(lsol.solutions)), key=lambda j: len(lsol.violations[j]))
-                    q[sl] = lsol.solutions[k]
-                row = _general_row(Configuration(q, pose.displacement(mech.platform_point)), R[i : i + 1])
+                sls = limb_slices(mech)
+                # limbs that share a body have corresponding solutions: one choice per group
+                for group in limb_clusters(mech):
+                    viol = [sum(len(alt.limbs[g].violations[j]) for g in group)
+                            for j in range(len(alt.limbs[group[0]].solutions))]
+                    k = int(np.argmin(viol))
+                    for g in group:
+                        q[sls[g]] = alt.limbs[g].solutions[k]
+                D = pose.displacement(mech.platform_point)
+                row = _general_row(Configuration(q, D, hub_displacements(mech, q, D)), R[i : i + 1])
                 if best is None or np.min(row / scale) > np.min(best / scale):
                     best = row
             if best is None:
@@ -375,3 +381,64 @@ def pose_checker(mech: Mechanism, limits: WorkspaceLimits | None = None, *, meth
         return out
 
     return PoseChecker(mech, limits, "general", tuple(names), scale, fn_general, plan, {})
+
+
+# ------------------------------------------------------------------------------ configuration checker
+@dataclass(frozen=True, eq=False)
+class ConfigurationChecker:
+    """Named margins (>= 0 inside every limit) of one *closed configuration*: freedom limits on
+    ``offset + q``, cone limits, link interference; the same names, scales and margins as
+    :func:`pose_checker` without its ``closure`` margin (a configuration is closed by
+    construction: the caller solved it).  Used where the pose is not known beforehand, e.g. the
+    workspace over the task coordinates of a lower-mobility mechanism, whose parasitic
+    coordinates are solved first.
+    """
+
+    mechanism: Mechanism
+    limits: WorkspaceLimits
+    names: tuple[str, ...]
+    scales: np.ndarray
+    _fn: Callable = field(repr=False)
+
+    def margins(self, config) -> np.ndarray:
+        """The (m,) margins at ``config`` (a closed :class:`~spatialmech.kinematics.closure.Configuration`)."""
+        return self._fn(config)
+
+    def violated(self, config) -> str:
+        """The most violated limit (scaled margins) at ``config``, ``""`` when within every limit."""
+        if not self.names:
+            return ""
+        m = self.margins(config) / self.scales
+        k = int(np.argmin(m))
+        return self.names[k] if m[k] < 0 else ""
+
+
+def configuration_checker(mech: Mechanism, limits: WorkspaceLimits | None = None) -> ConfigurationChecker:
+    """The limit margins of closed configurations of ``mech`` (``limits`` default to
+    :func:`default_limits`); see :class:`ConfigurationChecker`."""
+    limits = default_limits(mech) if limits is None else limits
+    if not isinstance(limits, WorkspaceLimits):
+        raise InputError(f"limits: expected a WorkspaceLimits, got {type(limits).__name__}")
+    from ...kinematics.closure import Configuration, joint_points
+
+    ref_points = joint_points(mech, Configuration.reference(mech))
+    links, cones, pairs, fl, names, scale = _common(mech, limits, ref_points)
+    refs = mech.freedom_refs
+    los = np.array([refs[k].freedom.limits[0] for k in fl])
+    his = np.array([refs[k].freedom.limits[1] for k in fl])
+    rot = np.array([refs[k].freedom.kind != "P" for k in fl], dtype=bool)
+    offs = np.array([r.freedom.offset for r in refs])
+    n_links = len(links)
+
+    def fn(config) -> np.ndarray:
+        cols = [_freedom_margins((offs + config.q)[fl][None], los, his, rot)] if fl else []
+        if cones or pairs:
+            pts = joint_points(mech, config)
+            seg_a = np.array([pts[lk.limb][lk.ends[0]] for lk in links]).reshape(1, n_links, 3)
+            seg_b = np.array([pts[lk.limb][lk.ends[1]] for lk in links]).reshape(1, n_links, 3)
+            R1 = np.asarray(config.D, dtype=float)[None, :3, :3]
+            cols += [c[:, None] for c in _cone_margins(seg_a, seg_b, R1, cones)]
+            cols += [c[:, None] for c in _pair_margins(seg_a, seg_b, pairs)]
+        return np.concatenate(cols, axis=1)[0] if cols else np.zeros(0)
+
+    return ConfigurationChecker(mech, limits, tuple(names), np.asarray(scale, dtype=float), fn)

@@ -129,3 +129,29 @@ def default_limits(mech: Mechanism) -> WorkspaceLimits:
     if mech.name == "four-sps-cu":
         return paper_b_limits()
     return WorkspaceLimits(source="the model's freedom limits")
+
+
+def with_freedom_limits(mech: Mechanism, limits: Mapping[str, tuple[float, float]]) -> Mechanism:
+    """``mech`` with other limits on some freedoms' physical values ``offset + q`` (SI, rad):
+    ``{"L1.slide": (0.25, 0.45)}``; names are freedom ids or aliases."""
+    from dataclasses import replace
+
+    if not isinstance(limits, Mapping):
+        raise InputError(f"limits: expected a mapping of freedom -> (lower, upper), got {type(limits).__name__}")
+    new: dict[str, tuple[float, float]] = {}
+    for name, rng in limits.items():
+        ref = mech.freedom(name)
+        lo, hi = (float(v) for v in as_finite_array(rng, f"limits[{name}]", shape=(2,)))
+        if not lo < hi:
+            raise InputError(f"limits[{name}]: expected lower < upper, got ({lo}, {hi})")
+        new[ref.id] = (lo, hi)
+    limbs = []
+    for limb in mech.limbs:
+        joints = []
+        for j in limb.joints:
+            for f in j.freedoms:
+                if f"{j.name}.{f.name}" in new:
+                    j = j.with_freedom(f.name, limits=new[f"{j.name}.{f.name}"])
+            joints.append(j)
+        limbs.append(limb.with_joints(joints))
+    return replace(mech, limbs=tuple(limbs))
