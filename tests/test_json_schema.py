@@ -68,6 +68,7 @@ CASES = [
     (["ik", "four-sps-cu", *POSE], "ik", "four-sps-cu"),
     (["ik", "delta", "--xyz", "0.02", "0.01", "-0.33"], "ik", "delta"),
     (["ik", "five-cs-1", "--position", "3"], "ik", "five-cs-1"),  # not reachable: rounded data, pose_fit
+    (["ik", "three-rps", "--pose", "0,0,0.33,ZYX,0,5,5", "--free", "x,y,a1"], "ik", "three-rps"),
     (["fk", "four-sps-cu", "--actuators", FK_ACTUATORS, "--all", "--seeds", "16"], "fk", "four-sps-cu"),  # closed form
     (["fk", "four-sps-cu", "--actuators", FK_ACTUATORS], "fk", "four-sps-cu"),  # general engine
     (["fk", "stewart-6sps", "--actuators", "1.2,1.2,1.2,1.2,1.2,1.2"], "fk", "stewart-6sps"),

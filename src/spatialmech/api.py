@@ -42,6 +42,7 @@ from .geometry.tolerances import resolve as resolve_tolerances
 from .geometry.rotations import euler_matrix
 from .kinematics.closure import Configuration, check_configuration
 from .kinematics.jacobian import CompleteJacobian, complete_jacobian
+from .kinematics.task import TaskSolution, solve_pose, task_solution_dict
 from .kinematics.position import (
     ForwardResult,
     InverseResult,
@@ -335,6 +336,8 @@ class IKResult:
     result: InverseResult
     position: int | None = None
     reachability: float = 0.0  # the reachability tolerance used (nondimensional)
+    #: With ``free``: the task solve (the coordinates held and the parasitic ones solved).
+    task: TaskSolution | None = None
 
     @property
     def reachable(self) -> bool:
@@ -358,15 +361,23 @@ class IKResult:
         d = self.result.to_dict(self.mechanism)
         fit = self.pose_fit
         d["pose_fit"] = None if fit is None else {**fit.to_dict(), "tolerance": self.reachability, "note": _IK_FIT_NOTE}
+        d["task"] = None if self.task is None else task_solution_dict(self.task)
         return d
 
 
 def ik(model: ModelLike, pose, *, all_solutions: bool = False, n_seeds: int = 48, seed: int = 0,
-       degrees: bool = False, tol=None) -> IKResult:
+       degrees: bool = False, tol=None, free=None) -> IKResult:
     """Inverse position: the joint values of every limb for a platform pose.
 
     ``all_solutions``: also ``n_seeds`` random starts per limb (every real solution it finds).
     ``tol``: a :class:`~spatialmech.geometry.tolerances.Tolerances` or the closure tolerance.
+    ``free``: task coordinates to solve (names from ``x, y, z, a1, a2, a3``; angles in the pose's
+    Euler sequence, ``"ZYX"`` when it gives none): for a lower-mobility mechanism, the parasitic
+    ones (:attr:`IKResult.task` has the solved values); the others are held at the pose's values.
+
+    >>> r = sm.ik("three-rps", ([0, 0, 0.33], ("ZYX", 0, 5, 5)), degrees=True, free=["x", "y", "a1"])
+    >>> r.reachable, [round(v, 6) for v in r.actuators.values()]
+    (True, [0.374613, 0.366706, 0.347013])
 
     >>> import spatialmech as sm
     >>> r = sm.ik("four-sps-cu", ([0, 0, 0.12], ("ZYX", 34.38, -5.73, 11.46)), degrees=True)
@@ -377,9 +388,18 @@ def ik(model: ModelLike, pose, *, all_solutions: bool = False, n_seeds: int = 48
     degrees = _check_bool(degrees, "degrees")
     all_solutions = _check_bool(all_solutions, "all_solutions")
     P, position = _pose(mech, pose, degrees)
+    task = None
+    if free is not None:
+        names = _names(free, "free") or []
+        seq = pose[1][0] if (isinstance(pose, (tuple, list)) and len(pose) == 2 and isinstance(pose[1], (tuple, list))
+                             and len(pose[1]) == 4 and isinstance(pose[1][0], str)) else "ZYX"
+        task = solve_pose(mech, P, names, euler=seq)
+        if task.converged:
+            P = Pose(task.D[:3, :3], task.D[:3, :3] @ mech.platform_point + task.D[:3, 3], "requested, solved")
     res = inverse_position(mech, P, all_solutions=all_solutions, n_seeds=_check_int(n_seeds, "n_seeds", minimum=1),
-                           seed=_check_int(seed, "seed"), tol=tol, fit=True)
-    return IKResult(mech, P, res, position, resolve_tolerances(tol, "closure").reachability)
+                           seed=_check_int(seed, "seed"), tol=tol, fit=True,
+                           start=task.config if task is not None and task.converged else None)
+    return IKResult(mech, P, res, position, resolve_tolerances(tol, "closure").reachability, task)
 
 
 @dataclass(frozen=True, eq=False)

@@ -20,6 +20,7 @@ REGISTRY: dict[str, tuple[Callable[[], Mechanism], str]] = {
     "five-cs-3": (lambda: papers.five_cs(3), "Paper A: 5-CS guidance linkage 3 (tables 10-13) + 7 task positions"),
     "stewart-6sps": (classic.stewart_6sps, "Gough-Stewart platform 6-SPS, 6 DOF"),
     "three-rps": (classic.three_rps, "3-RPS parallel mechanism, 2 rotations + 1 translation"),
+    "three-prs": (classic.three_prs, "3-PRS parallel mechanism (vertical rails), 2 rotations + 1 translation"),
     "three-upu": (classic.three_upu, "Translational 3-UPU (Tsai), 3 translations"),
     "delta": (classic.delta, "Clavel Delta robot (3 R + 12 S, 5 loops), 3 translations"),
     "delta-ruu": (classic.delta_ruu, "Delta robot (parallelograms as U-U pairs), 3 translations"),

@@ -63,6 +63,30 @@ def three_rps(rb: float = 0.3, rp: float = 0.15, h: float = 0.3) -> Mechanism:
     )
 
 
+def three_prs(rb: float = 0.3, rp: float = 0.15, h: float = 0.3) -> Mechanism:
+    """3-PRS: actuated sliders on vertical rails at 120 deg (radius ``rb``, slider height 0 at the
+    reference), an R joint on each slider with its axis tangent to the base circle, a leg of fixed
+    length to an S joint on the platform (radius ``rp``, height ``h``): 2 rotations + Tz with the
+    same parasitic motion as the 3-RPS (each S centre stays in its leg's radial plane)."""
+    angs = [90, 210, 330]
+    B = _ring(rb, angs)
+    A = _ring(rp, angs, h)
+    Z = np.array([0.0, 0.0, 1.0])
+    limbs = []
+    for i, ang in enumerate(np.deg2rad(angs)):
+        t = np.array([-np.sin(ang), np.cos(ang), 0.0])
+        limbs.append(
+            Limb(
+                f"leg{i + 1}",
+                (P(f"P{i + 1}", B[i], Z, actuated=True), R(f"R{i + 1}", B[i], t), S(f"S{i + 1}", A[i])),
+            )
+        )
+    return Mechanism(
+        "three-prs", tuple(limbs), platform_point=[0, 0, h],
+        description="3-PRS parallel mechanism (vertical rails), 3 DOF (2 rotations + 1 translation, with parasitic motion)",
+    )
+
+
 def three_upu(rb: float = 0.3, rp: float = 0.1, h: float = 0.3) -> Mechanism:
     """Translational 3-UPU (Tsai): in each leg the first base-U axis is parallel to the last
     platform-U axis and the two middle axes are parallel: pure translation, 3 DOF."""

@@ -18,6 +18,7 @@ from ..geometry.rotations import euler_matrix, matrix_euler
 from ..geometry.tolerances import current as current_tolerances
 from ..kinematics.jacobian import complete_jacobian
 from ..kinematics.position import configuration_at_pose, forward_position, inverse_position
+from ..kinematics.task import default_task, solve_pose, task_solution_dict
 from ..model.mechanism import Mechanism, Pose
 from ..serialize import pose_dict
 from .common import emit_json, json_option, parse_numbers, tol_option
@@ -126,13 +127,18 @@ def _fmt_value(mech: Mechanism, fid: str, v: float) -> str:
 @click.argument("model")
 @with_pose
 @click.option("--all", "all_solutions", is_flag=True, help="Search every real solution of every limb.")
+@click.option("--free", "free", default=None,
+              help="Task coordinates to SOLVE (parasitic), comma-separated from x,y,z,a1,a2,a3 (a1..a3: the --euler "
+                   "sequence's angles, default ZYX); the others are held at the pose's values. For lower-mobility "
+                   "mechanisms, e.g. --free x,y,a1 for a 3-RPS.")
 @tol_option("reachability")
 @json_option
-def ik(model, xyz, euler, position, all_solutions, as_json):
+def ik(model, xyz, euler, position, all_solutions, free, as_json):
     """Inverse position: joint values of every limb for a platform pose.
 
     \b
     Examples:
+      spatialmech ik three-rps --pose 0,0,0.33,ZYX,0,5,5 --free x,y,a1 --json
       spatialmech ik four-sps-cu --xyz 0 0 0.12 --euler ZYX 34.38 -5.73 11.46
       spatialmech ik four-sps-cu --pose 0,0,0.12,ZYX,34.38,-5.73,11.46 --json
       spatialmech ik five-cs-1 --position 3 --json
@@ -140,13 +146,23 @@ def ik(model, xyz, euler, position, all_solutions, as_json):
     """
     mech = catalog.resolve(model)
     pose = resolve_pose(mech, xyz, euler, position)
-    res = inverse_position(mech, pose, all_solutions=all_solutions, fit=True)
+    task = None
+    if free is not None:
+        names = [n.strip() for n in free.split(",")]
+        if any(not n for n in names):
+            raise InputError(f"--free: empty name in {free!r}; expected names from x,y,z,a1,a2,a3 separated by commas")
+        task = solve_pose(mech, pose, names, euler=euler[0] if euler is not None else "ZYX")
+        if task.converged:
+            pose = Pose(task.D[:3, :3], task.D[:3, :3] @ mech.platform_point + task.D[:3, 3], "requested, solved")
+    res = inverse_position(mech, pose, all_solutions=all_solutions, fit=True,
+                           start=task.config if task is not None and task.converged else None)
     # A pose that does not close exactly (printed, rounded data: a task position, a pose printed
     # by fk) is fitted onto the closure: reachable when the nearest closed configuration is
     # within the reachability tolerance, and either way the distance is said, never hidden.
     fit = res.pose_fit
     reach_tol = current_tolerances().reachability
     d = res.to_dict(mech)
+    d["task"] = None if task is None else task_solution_dict(task)
     if as_json:
         d["pose_fit"] = None if fit is None else {
             **fit.to_dict(), "tolerance": reach_tol,
@@ -160,6 +176,13 @@ def ik(model, xyz, euler, position, all_solutions, as_json):
     fitted = (f" (fitted onto the closure: off by {fit.position_error:.3g} {mech.length_unit} and "
               f"{np.degrees(fit.angle_error):.3g} deg, within the tolerance {reach_tol:g})") if res.fitted else ""
     click.echo(f"{mech.name}: pose {'reachable' if res.reachable else 'NOT reachable'}{fitted}")
+    if task is not None:
+        t = d["task"]
+        vals = {**t["values_len"], **t["values_deg"]}
+        unit = {n: (mech.length_unit if n in t["values_len"] else "deg") for n in vals}
+        click.echo(f"  task coordinates ({t['euler']}): given {', '.join(f'{n} = {vals[n]:.6g} {unit[n]}' for n in t['given'])}")
+        click.echo(f"  solved{'' if task.converged else ' (NOT converged: ' + t['status'] + ')'}: "
+                   + ", ".join(f"{n} = {vals[n]:.6g} {unit[n]}" for n in t["solved"]))
     for limb in d["limbs"]:
         extra = f", solution set of dimension {limb['passive_dim']} (passive freedoms)" if limb["passive_dim"] else ""
         click.echo(f"  {limb['limb']}: {len(limb['solutions'])} solution(s){extra}"
@@ -172,6 +195,11 @@ def ik(model, xyz, euler, position, all_solutions, as_json):
     if res.config is not None:
         click.echo("  actuators: " + ", ".join(f"{k} = {_fmt_value(mech, k, v)}" for k, v in res.actuator_values(mech).items()))
     click.echo("  (rotations in degrees, slides in " + mech.length_unit + ")")
+    if task is None and not res.reachable:
+        dt = default_task(mech)
+        if len(dt.given) < 6:
+            click.echo(f"  note: {mech.name}'s output link has {len(dt.given)} freedoms: a full pose is reachable only with its "
+                       f"parasitic coordinates solved; try --free {','.join(dt.solved)} (gives {', '.join(dt.given)})")
     if fit is not None and fit.converged and not res.reachable:
         what = f"task position {position} is printed (rounded) data; " if position is not None else ""
         click.echo(f"  note: {what}the nearest closed configuration is {fit.position_error:.3g} {mech.length_unit} and "

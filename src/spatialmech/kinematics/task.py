@@ -38,7 +38,17 @@ from ..results import SolveStatus
 from .closure import Configuration, active_mask, closure_jacobian, closure_scales, retract
 from .velocity import euler_rate_matrix
 
-__all__ = ["TaskSolution", "coordinate_map", "default_task", "pose_from_task", "solve_task", "task_values"]
+__all__ = [
+    "TaskSolution",
+    "coordinate_map",
+    "default_task",
+    "pose_from_task",
+    "solve_pose",
+    "solve_task",
+    "task_jacobian",
+    "task_solution_dict",
+    "task_values",
+]
 
 
 def task_values(mech: Mechanism, D, euler: str = "ZYX") -> np.ndarray:
@@ -197,3 +207,55 @@ def solve_task(mech: Mechanism, given: Mapping[str, float], *, task: TaskCoordin
         config = retract(mech, config, active, step, fix_platform=True)
         config = Configuration(config.q, pose_from_task(mech, values, task.euler), config.B)
     return TaskSolution(config, dict(zip(TASK_NAMES, map(float, values), strict=True)), task, False, rn, it, status)
+
+
+def solve_pose(mech: Mechanism, pose, free, *, euler: str = "ZYX", seed: Configuration | None = None) -> TaskSolution:
+    """A requested output pose (:class:`~spatialmech.model.mechanism.Pose`) whose coordinates
+    ``free`` (names from ``x, y, z, a1, a2, a3``, angles in sequence ``euler``) are to be solved:
+    the other coordinates are held at the pose's values and :func:`solve_task` finds the rest."""
+    names = [str(n).strip() for n in free]
+    for k, n in enumerate(names):
+        if n not in TASK_NAMES:
+            raise InputError(f"free[{k}]: unknown task coordinate {n!r}; expected one of {', '.join(TASK_NAMES)}")
+    if len(set(names)) != len(names):
+        raise InputError(f"free: {names} repeats a coordinate")
+    if len(names) >= 6:
+        raise InputError("free: at least one coordinate must be given (held)")
+    task = TaskCoordinates(tuple(n for n in TASK_NAMES if n not in names), euler)
+    values = task_values(mech, pose.displacement(mech.platform_point), euler)
+    return solve_task(mech, {n: float(values[TASK_NAMES.index(n)]) for n in task.given}, task=task, seed=seed)
+
+
+def task_solution_dict(sol: TaskSolution) -> dict:
+    """JSON (docs/json.md) of a task solve: which coordinates were given and solved, the six
+    values (``values_len``: x, y, z in the model's length unit; ``values_deg``: a1, a2, a3)."""
+    return {"given": list(sol.given), "solved": list(sol.solved), "euler": sol.task.euler,
+            "converged": bool(sol.converged), "status": str(sol.status), "residual": float(sol.residual),
+            "values_len": {n: float(sol.values[n]) for n in TASK_NAMES[:3]},
+            "values_deg": {n: float(np.degrees(sol.values[n])) for n in TASK_NAMES[3:]}}
+
+
+def task_jacobian(mech: Mechanism, sol: TaskSolution) -> tuple[np.ndarray, tuple[str, ...], tuple[str, ...]]:
+    """The input-output Jacobian over the task coordinates at a task solution: ``J`` (n_act x M)
+    with ``d actuators = J d(given coordinates)``, the parasitic coordinates, the passive joints
+    and the bodies following (minimum-norm solve of the linearised closure).  Returns
+    ``(J, actuator ids, given coordinate names)``; actuator rates in their own units (rad, length)
+    per unit of each given coordinate (length unit or rad)."""
+    active = active_mask(mech)
+    na = int(active.sum())
+    A, _ = closure_jacobian(mech, sol.config, active=active)
+    row, col = closure_scales(mech, active)
+    C = coordinate_map([sol.values[n] for n in TASK_NAMES], sol.task.euler)
+    gi = [TASK_NAMES.index(n) for n in sol.given]
+    fi = [TASK_NAMES.index(n) for n in sol.solved]
+    L = mech.characteristic_length
+    cs = np.array([L, L, L, 1.0, 1.0, 1.0])
+    G = np.hstack([A[:, :na], A[:, na : na + 6] @ C[:, fi], A[:, na + 6 :]])
+    scales = np.r_[col[:na], cs[fi], col[na + 6 :]]
+    rhs = -(A[:, na : na + 6] @ C[:, gi])
+    X, *_ = np.linalg.lstsq(row[:, None] * G * scales[None, :], row[:, None] * rhs, rcond=None)
+    U = scales[:, None] * X  # rates of the unknowns per unit rate of each given coordinate
+    pos = np.cumsum(active) - 1
+    acts = mech.actuators
+    rows = [int(pos[mech.freedom_refs.index(mech.freedom(a))]) for a in acts]
+    return U[rows], tuple(acts), tuple(sol.given)
