@@ -69,6 +69,7 @@ CASES = [
     (["ik", "delta", "--xyz", "0.02", "0.01", "-0.33"], "ik", "delta"),
     (["ik", "five-cs-1", "--position", "3"], "ik", "five-cs-1"),  # not reachable: rounded data, pose_fit
     (["ik", "three-rps", "--pose", "0,0,0.33,ZYX,0,5,5", "--free", "x,y,a1"], "ik", "three-rps"),
+    (["parasitic", "three-rps", "--over", "a2:-10:10:3,a3:-5:5:2", "--at", "z=0.33"], "parasitic", "three-rps"),
     (["fk", "four-sps-cu", "--actuators", FK_ACTUATORS, "--all", "--seeds", "16"], "fk", "four-sps-cu"),  # closed form
     (["fk", "four-sps-cu", "--actuators", FK_ACTUATORS], "fk", "four-sps-cu"),  # general engine
     (["fk", "stewart-6sps", "--actuators", "1.2,1.2,1.2,1.2,1.2,1.2"], "fk", "stewart-6sps"),

@@ -93,3 +93,19 @@ def test_task_jacobian_matches_finite_differences(name, given):
         dn[n] -= h
         cols.append((solve_task(m, up, seed=s.config).config.q[idx] - solve_task(m, dn, seed=s.config).config.q[idx]) / (2 * h))
     assert np.allclose(J, np.array(cols).T, atol=1e-7)
+
+
+def test_parasitic_command_tabulates_and_plots(tmp_path):
+    f = tmp_path / "p.png"
+    out = CliRunner().invoke(cli, ["parasitic", "three-rps", "--over", "a2:-10:10:3,a3:-10:10:3", "--at", "z=0.3",
+                                   "--plot", str(f), "--json"])
+    assert out.exit_code == 0, out.output
+    d = json.loads(out.output)
+    assert d["task"]["solved"] == ["x", "y", "a1"] and d["n_converged"] == d["cells"] == 9
+    a2, a3 = np.meshgrid(np.radians([-10.0, 0.0, 10.0]), np.radians([-10.0, 0.0, 10.0]), indexing="ij")
+    x, y, a1 = parasitic(0.15, a2.ravel(), a3.ravel())
+    assert np.allclose(d["solved_values"]["x_len"], x, atol=1e-10)
+    assert np.allclose(d["solved_values"]["a1_deg"], np.degrees(a1), atol=1e-8)
+    assert f.stat().st_size > 1000
+    bad = CliRunner().invoke(cli, ["parasitic", "three-rps", "--over", "q:0:1:3"])
+    assert bad.exit_code == 2 and "--over" in bad.output

@@ -97,6 +97,8 @@ UNIT_FREE_KEYS: dict[str, str] = {
     "members": "converged starts that one result stands for",
     "n": "number of links (mobility formula)",
     "links": "number of links (mobility; = n)",
+    "grid_points": "points per grid axis (parasitic)",
+    "cells": "number of grid cells (parasitic)",
     "loops": "number of independent loops of the link graph (mobility)",
     "n_branches": "number of branches",
     "n_converged": "number of converged starts",
