@@ -105,6 +105,7 @@ def test_parasitic_command_tabulates_and_plots(tmp_path):
     a2, a3 = np.meshgrid(np.radians([-10.0, 0.0, 10.0]), np.radians([-10.0, 0.0, 10.0]), indexing="ij")
     x, y, a1 = parasitic(0.15, a2.ravel(), a3.ravel())
     assert np.allclose(d["solved_values"]["x_len"], x, atol=1e-10)
+    assert np.allclose(d["solved_values"]["y_len"], y, atol=1e-10)
     assert np.allclose(d["solved_values"]["a1_deg"], np.degrees(a1), atol=1e-8)
     assert f.stat().st_size > 1000
     bad = CliRunner().invoke(cli, ["parasitic", "three-rps", "--over", "q:0:1:3"])
