@@ -76,6 +76,8 @@ CASES = [
     (["jacobian", "four-sps-cu", *POSE], "jacobian", "four-sps-cu"),
     (["jacobian", "five-cs-1", "--position", "3", "--driver", "rot1"], "jacobian", "five-cs-1"),
     (["jacobian", "five-cs-3", "--dj-table"], "jacobian", "five-cs-3"),
+    (["jacobian", "three-rps", "--pose", "0,0,0.33,ZYX,0,5,5", "--free", "x,y,a1"], "jacobian", "three-rps"),
+    (["jacobian", "delta", "--xyz", "0.02", "0.01", "-0.33"], "jacobian", "delta"),  # task_jacobian over x, y, z
     (["singularity", "four-sps-cu", *POSE], "singularity", "four-sps-cu"),
     (["singularity", "four-sps-cu", "--xyz", "0", "0", "0.12", "--euler", "ZYX", "20", "0", "0",
       "--slice", "a2:-30:30:3,z:0.1:0.14:3"], "singularity", "four-sps-cu"),

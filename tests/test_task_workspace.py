@@ -318,6 +318,19 @@ def test_cli_workspace_task_errors_are_one_line(args, message):
     assert r.exit_code == 2 and r.output.count("\n") == 1 and message in r.output, r.output
 
 
+@pytest.mark.parametrize("model, given", [("three-upu", "x, y, z"), ("three-rps", "z, a2, a3")])
+def test_cli_workspace_task_without_over_suggests_a_grid_of_the_models_own_coordinates(model, given):
+    r = run("workspace", model, "--task")
+    assert r.exit_code == 2 and f"over the given coordinates ({given})" in r.output, r.output
+    words = r.output.split("e.g. ")[1].split()
+    over, at = words[words.index("--over") + 1], words[words.index("--at") + 1]
+    assert {a.split(":")[0] for a in over.split(",")} | {a.split("=")[0] for a in at.split(",")} == set(given.split(", "))
+    coarse = ",".join(a.rsplit(":", 1)[0] + ":3" for a in over.split(","))  # the suggestion runs as given
+    ok = run("workspace", model, "--task", "--over", coarse, "--at", at, "--json")
+    assert ok.exit_code == 0, ok.output
+    assert json.loads(ok.output)["given"] == given.split(", ")
+
+
 def test_cli_singularity_task_slice(tmp_path):
     r = run("singularity", "three-rps", "--slice", "a2:-30:30:3,a3:-30:30:3", "--at", "z=0.33",
             "--plot", str(tmp_path / "s.png"))

@@ -7,7 +7,7 @@ plots), always labelled; Euler sequences always named explicitly (``"ZXY"`` intr
 
 Every analysis by a short name (one page: docs/api.md; the functions are in
 :mod:`spatialmech.api`): ``sm.load_model``, ``sm.mobility``, ``sm.ik``, ``sm.fk``,
-``sm.jacobian``, ``sm.velocity``, ``sm.singularity``, ``sm.workspace``, ``sm.track``,
+``sm.jacobian``, ``sm.velocity``, ``sm.singularity``, ``sm.workspace``, ``sm.parasitic``, ``sm.track``,
 ``sm.defects``, ``sm.synth_rccc``, ``sm.synth_cs``, ``sm.report``, ``sm.view``.  Each takes a
 :class:`Mechanism`, a ready-made model name or a TOML file path, checks its arguments
 (``TypeError``, :class:`InputError`) and returns a result whose ``to_dict()`` is its JSON.
@@ -35,6 +35,7 @@ from .api import (
     mobility,
     mobility_modes,
     models,
+    parasitic,
     report,
     singularity,
     synth_cs,
@@ -109,6 +110,7 @@ __all__ = [
     "mobility",
     "mobility_modes",
     "models",
+    "parasitic",
     "report",
     "results",
     "singularity",

@@ -42,7 +42,7 @@ from .geometry.tolerances import resolve as resolve_tolerances
 from .geometry.rotations import euler_matrix
 from .kinematics.closure import Configuration, check_configuration
 from .kinematics.jacobian import CompleteJacobian, complete_jacobian
-from .kinematics.task import TaskSolution, solve_pose, task_solution_dict
+from .kinematics.task import TaskJacobian, TaskSolution, solve_pose, task_jacobian_at, task_solution_dict
 from .kinematics.position import (
     ForwardResult,
     InverseResult,
@@ -77,6 +77,7 @@ __all__ = [
     "mobility",
     "mobility_modes",
     "models",
+    "parasitic",
     "report",
     "singularity",
     "synth_cs",
@@ -375,11 +376,11 @@ def ik(model: ModelLike, pose, *, all_solutions: bool = False, n_seeds: int = 48
     Euler sequence, ``"ZYX"`` when it gives none): for a lower-mobility mechanism, the parasitic
     ones (:attr:`IKResult.task` has the solved values); the others are held at the pose's values.
 
+    >>> import spatialmech as sm
     >>> r = sm.ik("three-rps", ([0, 0, 0.33], ("ZYX", 0, 5, 5)), degrees=True, free=["x", "y", "a1"])
     >>> r.reachable, [round(v, 6) for v in r.actuators.values()]
     (True, [0.374613, 0.366706, 0.347013])
 
-    >>> import spatialmech as sm
     >>> r = sm.ik("four-sps-cu", ([0, 0, 0.12], ("ZYX", 34.38, -5.73, 11.46)), degrees=True)
     >>> [round(v, 4) for v in r.actuators.values()]
     [0.2167, 0.239, 0.2273, 0.2069]
@@ -391,9 +392,7 @@ def ik(model: ModelLike, pose, *, all_solutions: bool = False, n_seeds: int = 48
     task = None
     if free is not None:
         names = _names(free, "free") or []
-        seq = pose[1][0] if (isinstance(pose, (tuple, list)) and len(pose) == 2 and isinstance(pose[1], (tuple, list))
-                             and len(pose[1]) == 4 and isinstance(pose[1][0], str)) else "ZYX"
-        task = solve_pose(mech, P, names, euler=seq)
+        task = solve_pose(mech, P, names, euler=_pose_sequence(pose))
         if task.converged:
             P = Pose(task.D[:3, :3], task.D[:3, :3] @ mech.platform_point + task.D[:3, 3], "requested, solved")
     res = inverse_position(mech, P, all_solutions=all_solutions, n_seeds=_check_int(n_seeds, "n_seeds", minimum=1),
@@ -507,6 +506,9 @@ class JacobianResult:
     jacobian: CompleteJacobian
     pose_fit: PoseFit | None = None
     pose: Pose | None = None  # the requested pose (default: the configuration's)
+    #: Lower-mobility models: the input-output Jacobian over the given task coordinates
+    #: (``None`` when the output link has six freedoms).
+    task: TaskJacobian | None = None
 
     @property
     def det(self) -> float | None:
@@ -519,27 +521,61 @@ class JacobianResult:
     def to_dict(self) -> dict:
         P = self.pose if self.pose is not None else platform_pose(self.mechanism, self.config)
         return {"result": "complete_jacobian", "pose": pose_dict(P.R, P.p), **self.jacobian.to_dict(),
-                "pose_fit": None if self.pose_fit is None else self.pose_fit.to_dict()}
+                "pose_fit": None if self.pose_fit is None else self.pose_fit.to_dict(),
+                "task_jacobian": None if self.task is None else self.task.to_dict(self.mechanism)}
 
 
 def jacobian(model: ModelLike, pose=None, *, config: Configuration | None = None, drivers=None,
-             degrees: bool = False) -> JacobianResult:
+             degrees: bool = False, free=None) -> JacobianResult:
     """The complete Jacobian (constraint + actuation wrenches), ``det J`` and its conditioning at
-    a pose (fitted onto the closure), a configuration, or the reference configuration.
+    a pose (fitted onto the closure), a configuration, or the reference configuration; for a
+    lower-mobility model also :attr:`JacobianResult.task`, the input-output Jacobian over the
+    given task coordinates (the parasitic ones solved).
 
-    ``drivers``: the actuated freedom(s) (default: the model's actuators).
+    ``drivers``: the actuated freedom(s) (default: the model's actuators).  ``free``: as in
+    :func:`ik`, task coordinates to solve, the others held at the pose's values (and the
+    coordinates of the input-output Jacobian; default: the model's task).
 
     >>> import spatialmech as sm
     >>> J = sm.jacobian("five-cs-1", 3, drivers="rot1")
     >>> J.det > 0, J.jacobian.matrix.shape, J.pose_fit.exact
     (True, (6, 6), False)
+    >>> J = sm.jacobian("three-rps", ([0, 0, 0.33], ("ZYX", 0, 5, 5)), degrees=True, free=["x", "y", "a1"])
+    >>> J.task.given, J.task.matrix.shape
+    (('z', 'a2', 'a3'), (3, 3))
     """
     mech = _mechanism(model)
     degrees = _check_bool(degrees, "degrees")
     drivers = _names(drivers, "drivers")
-    c, fit = _configuration(mech, pose, config, degrees)
-    requested = _pose(mech, pose, degrees)[0] if pose is not None else None
-    return JacobianResult(mech, c, complete_jacobian(mech, c, drivers), fit, requested)
+    task = None
+    if free is not None:
+        if pose is None or config is not None:
+            raise InputError("free: needs a pose (and no config): the coordinates not named are held at its values")
+        names = _names(free, "free") or []
+        P, _ = _pose(mech, pose, degrees)
+        sol = solve_pose(mech, P, names, euler=_pose_sequence(pose))
+        if not sol.converged:
+            raise InputError(f"free: the held coordinates do not close with {', '.join(names)} solved ({sol.status}, "
+                             f"residual {sol.residual:.2e}); the pose is out of reach")
+        task = sol.task
+        solved = Pose(sol.D[:3, :3], sol.D[:3, :3] @ mech.platform_point + sol.D[:3, 3], "requested, solved")
+        fit = configuration_at_pose(mech, solved, start=sol.config)
+        if not fit.converged:
+            raise InputError(f"pose: no closed configuration near it (residual {fit.ik_residual:.2e})")
+        c, requested = fit.config, solved
+    else:
+        c, fit = _configuration(mech, pose, config, degrees)
+        requested = _pose(mech, pose, degrees)[0] if pose is not None else None
+    return JacobianResult(mech, c, complete_jacobian(mech, c, drivers), fit, requested,
+                          task_jacobian_at(mech, c, drivers, task=task))
+
+
+def _pose_sequence(pose) -> str:
+    """The Euler sequence a pose tuple names (``"ZYX"`` when it names none)."""
+    if (isinstance(pose, (tuple, list)) and len(pose) == 2 and isinstance(pose[1], (tuple, list))
+            and len(pose[1]) == 4 and isinstance(pose[1][0], str)):
+        return pose[1][0]
+    return "ZYX"
 
 
 @dataclass(frozen=True, eq=False)
@@ -744,6 +780,58 @@ def _task_workspace(mech: Mechanism, over, at, free, limits, tol, step, bounds, 
         task = TaskCoordinates(tuple(n for n in TASK_NAMES if n not in names), own)
     return task_workspace(mech, over, at=at, task=task, limits=limits, tol=tol, max_cells=max_poses,
                           progress=_progress(progress))
+
+
+def parasitic(model: ModelLike, over: Mapping, *, at: Mapping[str, float] | None = None, free=None,
+              euler: str | None = None, plot=None, progress: Progress | None = None):
+    """The parasitic motion of a lower-mobility mechanism: its solved task coordinates over a grid
+    of one or two given ones (``spatialmech parasitic``, docs/lower-mobility.md).
+
+    SI and radians: ``over`` maps the grid's given coordinates (``x, y, z`` length, ``a1, a2, a3``
+    rad) to ``(lo, hi, n)`` or increasing values; ``at`` holds other given ones (default: their
+    reference values); ``free`` names the coordinates to solve (default: those the model's task
+    does not give) and ``euler`` the sequence of ``a1, a2, a3`` (default: the model's task's, else
+    ``"ZYX"``).  ``plot``: a figure file (.png, .pdf, .svg), one panel per solved coordinate.
+    Returns a :class:`~spatialmech.analysis.parasitic.ParasiticTable` (``values(name)``,
+    ``ranges``, ``to_dict()``).
+
+    >>> import spatialmech as sm
+    >>> t = sm.parasitic("three-rps", {"a2": (-0.1, 0.1, 3), "a3": (-0.1, 0.1, 3)}, at={"z": 0.33})
+    >>> t.solved, {n: round(hi, 6) for n, (lo, hi) in t.ranges.items()}
+    (('x', 'y', 'a1'), {'x': 0.000747, 'y': 0.000375, 'a1': 0.005008})
+    """
+    from .analysis.parasitic import parasitic_table
+    from .kinematics.task import default_task
+    from .model.task import TASK_NAMES, TaskCoordinates
+
+    mech = _mechanism(model)
+    if not isinstance(over, Mapping):
+        raise TypeError(f"over: expected a mapping of task coordinate -> (lo, hi, n) or values, got {describe(over)}")
+    if at is not None and not isinstance(at, Mapping):
+        raise TypeError(f"at: expected a mapping of task coordinate -> value (SI, rad), got {describe(at)}")
+    if euler is not None and not isinstance(euler, str):
+        raise TypeError(f"euler: expected a named Euler sequence such as 'ZYX', got {describe(euler)}")
+    task = None
+    if free is not None or euler is not None:
+        seq = euler if euler is not None else (mech.task.euler if mech.task is not None else "ZYX")
+        if free is None:
+            given = default_task(mech, seq).given  # the model's own task, else the default
+        else:
+            names = _names(free, "free") or []
+            for n in names:
+                if n not in TASK_NAMES:
+                    raise InputError(f"free: unknown task coordinate {n!r}; expected some of {', '.join(TASK_NAMES)}")
+            given = tuple(n for n in TASK_NAMES if n not in names)
+        task = TaskCoordinates(given, seq)
+    path = None if plot is None else _path(plot, "plot")
+    if path is not None and path.suffix.lower() not in (".png", ".pdf", ".svg"):
+        raise InputError(f"plot: expected a .png, .pdf or .svg file, got {str(path)!r}")
+    table = parasitic_table(mech, over, at=at, task=task, progress=_progress(progress))
+    if path is not None:
+        from .present.parasitic import parasitic_figure
+
+        parasitic_figure(table.grid, path)
+    return table
 
 
 # ============================================================================ tracking

@@ -188,6 +188,8 @@ UNIT_FREE_KEYS: dict[str, str] = {
     "from": "arc (nondimensional) where a plan step starts; lower end of a tolerance range",
     "ik_residual": "nondimensional closure residual of a pose fit",
     "ik_residuals": "nondimensional closure residuals of pose fits",
+    "io_matrix": ("input-output Jacobian over the given task coordinates (rows: actuators, columns: given "
+                  "coordinates), nondimensional: lengths / characteristic length, angles in rad"),
     "min_closure_sigma_on_path": "scale-free closeness of the path to a singularity of the linkage",
     "min_sigma_on_path": "scale-free closeness of the path to a singularity of a driver",
     "normal": "unit normal of a plane",

@@ -18,7 +18,7 @@ from ..geometry.rotations import euler_matrix, matrix_euler
 from ..geometry.tolerances import current as current_tolerances
 from ..kinematics.jacobian import complete_jacobian
 from ..kinematics.position import configuration_at_pose, forward_position, inverse_position
-from ..kinematics.task import default_task, solve_pose, task_solution_dict
+from ..kinematics.task import TaskJacobian, default_task, solve_pose, task_jacobian_at, task_solution_dict
 from ..model.mechanism import Mechanism, Pose
 from ..serialize import pose_dict
 from .common import emit_json, json_option, parse_numbers, tol_option
@@ -66,6 +66,14 @@ def parse_pose(text: str):
     except ValueError:
         raise InputError(f"--pose: expected numbers for X,Y,Z and A1,A2,A3, got {text!r}") from None
     return xyz, (parts[3], *ang)
+
+
+def free_names(text: str) -> list[str]:
+    """``--free x,y,a1`` -> ``["x", "y", "a1"]`` (the names are checked by ``solve_pose``)."""
+    names = [n.strip() for n in text.split(",")]
+    if any(not n for n in names):
+        raise InputError(f"--free: empty name in {text!r}; expected names from x,y,z,a1,a2,a3 separated by commas")
+    return names
 
 
 #: Largest distance of a requested platform point from the reference one, in characteristic
@@ -148,10 +156,7 @@ def ik(model, xyz, euler, position, all_solutions, free, as_json):
     pose = resolve_pose(mech, xyz, euler, position)
     task = None
     if free is not None:
-        names = [n.strip() for n in free.split(",")]
-        if any(not n for n in names):
-            raise InputError(f"--free: empty name in {free!r}; expected names from x,y,z,a1,a2,a3 separated by commas")
-        task = solve_pose(mech, pose, names, euler=euler[0] if euler is not None else "ZYX")
+        task = solve_pose(mech, pose, free_names(free), euler=euler[0] if euler is not None else "ZYX")
         if task.converged:
             pose = Pose(task.D[:3, :3], task.D[:3, :3] @ mech.platform_point + task.D[:3, 3], "requested, solved")
     res = inverse_position(mech, pose, all_solutions=all_solutions, fit=True,
@@ -330,18 +335,26 @@ def _fk_conditioning_lines(kind, sigma_min, condition, threshold, members, self_
 @with_pose
 @click.option("--driver", "drivers", multiple=True, help="Actuated freedom(s) (repeatable; default: the model's actuators).")
 @click.option("--dj-table", is_flag=True, help="DJ at every built-in task position for every base-joint driver.")
+@click.option("--free", "free", default=None,
+              help="Task coordinates to SOLVE (parasitic), as for ik: the others are held at the pose's values and "
+                   "both Jacobians are taken there; also the coordinates of the input-output Jacobian.")
 @tol_option("singular")
 @json_option
-def jacobian(model, xyz, euler, position, drivers, dj_table, as_json):
-    """Complete Jacobian (constraint + actuation wrenches), its determinant and conditioning.
+def jacobian(model, xyz, euler, position, drivers, dj_table, free, as_json):
+    """Complete Jacobian (constraint + actuation wrenches), its determinant and conditioning; for a
+    lower-mobility model also the input-output Jacobian over its given task coordinates (d actuators
+    / d given coordinates, the parasitic ones solved).
 
     \b
     Examples:
       spatialmech jacobian five-cs-1 --position 3 --driver rot1
       spatialmech jacobian five-cs-3 --dj-table --json
       spatialmech jacobian four-sps-cu --xyz 0 0 0.12 --euler ZYX 34.38 -5.73 11.46
+      spatialmech jacobian three-rps --pose 0,0,0.33,ZYX,0,5,5 --free x,y,a1
     """
     mech = catalog.resolve(model)
+    if dj_table and free is not None:
+        raise InputError("--free: not with --dj-table (the DJ table is at the built-in task positions)")
     if dj_table:
         if not mech.positions:
             raise InputError(f"--dj-table: {mech.name} has no built-in task positions")
@@ -360,13 +373,22 @@ def jacobian(model, xyz, euler, position, drivers, dj_table, as_json):
                    f" {np.degrees(max(f.angle_error for f in fits)):.3g} deg")
         return
     pose = resolve_pose(mech, xyz, euler, position)
-    fit = configuration_at_pose(mech, pose)
+    sol = None
+    if free is not None:
+        sol = solve_pose(mech, pose, free_names(free), euler=euler[0] if euler is not None else "ZYX")
+        if not sol.converged:
+            raise InputError(f"--free: the held coordinates do not close with {free} solved ({sol.status}, residual "
+                             f"{sol.residual:.2e}); the pose is out of reach")
+        pose = Pose(sol.D[:3, :3], sol.D[:3, :3] @ mech.platform_point + sol.D[:3, 3], "requested, solved")
+    fit = configuration_at_pose(mech, pose, start=None if sol is None else sol.config)
     if not fit.converged:
         raise InputError(f"pose: no closed configuration near it (residual {fit.ik_residual:.2e})")
     J = complete_jacobian(mech, fit.config, list(drivers) or None)
+    tj = task_jacobian_at(mech, fit.config, list(drivers) or None, task=None if sol is None else sol.task)
     if as_json:
         emit_json("jacobian", mech, {"result": "complete_jacobian", "pose": pose_dict(pose.R, pose.p), **J.to_dict(),
-                                     "pose_fit": fit.to_dict()})
+                                     "pose_fit": fit.to_dict(),
+                                     "task_jacobian": None if tj is None else tj.to_dict(mech)})
         return
     click.echo(f"{mech.name}: complete Jacobian (rows: {J.constraint_rows} constraint, {len(J.actuators)} actuation"
                f" [{', '.join(J.actuators)}]); J $p = (0, qdot)")
@@ -383,3 +405,23 @@ def jacobian(model, xyz, euler, position, drivers, dj_table, as_json):
     if not fit.exact:
         click.echo(f"  note: the pose was fitted onto the closure (error {fit.position_error:.3g} {mech.length_unit}, "
                    f"{np.degrees(fit.angle_error):.3g} deg)")
+    if tj is not None:
+        _echo_task_jacobian(mech, tj)
+
+
+def _echo_task_jacobian(mech: Mechanism, tj: TaskJacobian) -> None:
+    """The input-output Jacobian over the given task coordinates, as text (angles in degrees)."""
+    sol = tj.solution
+    u = mech.length_unit
+    vals = ", ".join(f"{n} = {sol.values[n]:.6g} {u}" if n in ("x", "y", "z") else f"{n} = {np.degrees(sol.values[n]):.6g} deg"
+                     for n in tj.solved)
+    click.echo(f"  input-output Jacobian over the task ({sol.task.euler}: given {', '.join(tj.given)}; solved "
+               f"{', '.join(tj.solved)}, here {vals}):")
+    click.echo("  d actuator / d given coordinate (actuator in [unit], per unit of the coordinate):")
+    cols = [f"{n} (per {u})" if n in ("x", "y", "z") else f"{n} (per deg)" for n in tj.given]
+    click.echo(" " * 20 + "".join(f"{c:>16s}" for c in cols))
+    for a, row in zip(tj.actuators, tj.matrix, strict=True):
+        slide = mech.freedom(a).freedom.kind == "P"
+        cells = [(x if slide else np.degrees(x)) * (1.0 if n in ("x", "y", "z") else np.pi / 180.0)
+                 for x, n in zip(row, tj.given, strict=True)]
+        click.echo(f"  {a + (f' [{u}]' if slide else ' [deg]'):>18s}" + "".join(f"{c:+16.6e}" for c in cells))

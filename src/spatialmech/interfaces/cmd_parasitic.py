@@ -6,18 +6,13 @@ import click
 import numpy as np
 
 from .. import catalog
-from ..kinematics.task_grid import solve_task_grid
-from ..model.task import TASK_NAMES
+from ..analysis.parasitic import parasitic_table
 from .common import check_output_file, emit_json, json_option
 from .task_args import parse_axes, parse_task_at, task_from_free
 
 
-def _unit_key(name: str) -> str:
-    return f"{name}_deg" if name.startswith("a") else f"{name}_len"
-
-
-def _shown(name: str, v):
-    return np.degrees(v) if name.startswith("a") else np.asarray(v)
+def _held(name: str, v: float, unit: str) -> str:
+    return f"{name} = {np.degrees(v):.6g} deg" if name.startswith("a") else f"{name} = {v:.6g} {unit}"
 
 
 @click.command(name="parasitic")
@@ -44,42 +39,27 @@ def parasitic_cmd(model, over_text, at_text, free_text, euler, plot, as_json):
     over = parse_axes(over_text, "--over", min_axes=1, max_axes=2)
     at = parse_task_at(at_text)
     task = task_from_free(free_text, mech, euler)
-    grid = solve_task_grid(mech, over, at=at, task=task)
+    table = parasitic_table(mech, over, at=at, task=task)
+    grid = table.grid
     solved = grid.solved
     n_ok = int(grid.converged.sum())
-    table = {}
-    for name in solved:
-        k = TASK_NAMES.index(name)
-        v = _shown(name, grid.values[..., k])
-        table[_unit_key(name)] = [None if not np.isfinite(x) else float(x) for x in v.ravel()]
-        ok = v[np.isfinite(v)]
-        table[name] = {"min": float(ok.min()) if ok.size else None, "max": float(ok.max()) if ok.size else None}
     if plot_path is not None:
         from ..present.parasitic import parasitic_figure
 
         parasitic_figure(grid, plot_path)
     if as_json:
-        emit_json("parasitic", mech, {
-            "task": {"given": list(grid.given), "solved": list(solved), "euler": grid.task.euler},
-            "over": list(grid.over),
-            "axes": {_unit_key(n): [float(x) for x in _shown(n, a)] for n, a in zip(grid.over, grid.axes, strict=True)},
-            "held": {_unit_key(n): float(_shown(n, v)) for n, v in grid.fixed.items()},
-            "grid_points": list(grid.shape), "cells": int(grid.converged.size), "n_converged": n_ok,
-            "converged": [bool(c) for c in grid.converged.ravel()],
-            "solved_values": {_unit_key(n): table[_unit_key(n)] for n in solved},
-            "elapsed_s": float(grid.seconds), "plot": None if plot_path is None else str(plot_path)})
+        emit_json("parasitic", mech, table.to_dict(plot_path))
         return
     unit = mech.length_unit
     dims = " x ".join(f"{n} ({a.size})" for n, a in zip(grid.over, grid.axes, strict=True))
     click.echo(f"{mech.name}: parasitic motion over {dims}"
-               f"; held {', '.join(f'{n} = {float(_shown(n, v)):.6g}' for n, v in grid.fixed.items()) or 'nothing'}"
+               f"; held {', '.join(_held(n, v, unit) for n, v in grid.fixed.items()) or 'nothing'}"
                f"  (task {grid.task.euler}: given {', '.join(grid.given)}; solved {', '.join(solved)})")
     click.echo(f"  {n_ok} of {grid.converged.size} cells solved in {grid.seconds:.2f} s"
                + ("" if n_ok == grid.converged.size else "; unsolved cells are left empty (not reachable from a neighbour)"))
-    for name in solved:
-        r = table[name]
-        u = "deg" if name.startswith("a") else unit
-        if r["min"] is not None:
-            click.echo(f"  {name}: {r['min']:.6g} .. {r['max']:.6g} {u}")
+    for name, r in table.ranges.items():
+        if r is not None:
+            lo, hi = (float(np.degrees(x)) if name.startswith("a") else x for x in r)
+            click.echo(f"  {name}: {lo:.6g} .. {hi:.6g} {'deg' if name.startswith('a') else unit}")
     if plot_path is not None:
         click.echo(f"  figure: {plot_path}")

@@ -159,9 +159,16 @@ def _task_workspace(mech, over, at, free, limits, tol_deg, tol_m, max_cells, plo
     """``workspace --task``: the grid, the held coordinates, the solve, the output."""
     from ..analysis.workspace.task import task_workspace
 
+    task = task_from_free(free, mech)
+    if over is None:
+        from ..kinematics.task import default_task
+
+        shown = task if task is not None else default_task(mech)
+        over_s, at_s = _task_grid_suggestion(mech, shown)
+        raise InputError(f"--task: give the grid with --over NAME:MIN:MAX:N[,...] over the given coordinates "
+                         f"({', '.join(shown.given)}), e.g. --over {over_s}" + (f" --at {at_s}" if at_s else ""))
     axes = parse_axes(over, "--over")
     held = parse_task_at(at, "--at")
-    task = task_from_free(free, mech)
     for name, v in (("--tol-deg", tol_deg), ("--tol", tol_m)):
         if v is not None and not (np.isfinite(v) and v > 0):
             raise InputError(f"{name}: must be a positive number, got {v}")
@@ -249,8 +256,6 @@ def workspace(model, orientation_flag, position_flag, at, step_deg, tol_deg, ste
             for name, v in (("--over", over), ("--free", free)):
                 if v is not None:
                     raise InputError(f"{name}: only with --task (the workspace over task coordinates)")
-        elif over is None:
-            raise InputError("--task: give the grid with --over NAME:MIN:MAX:N[,...], e.g. --over a2:-20:20:41,a3:-20:20:41")
         check_output_file(plot, "--plot", suffixes=(".png", ".svg", ".pdf"))
         mech = catalog.resolve(model)
         new_limits = freedom_limits(freedom_limits_text, mech)
@@ -313,6 +318,21 @@ def workspace(model, orientation_flag, position_flag, at, step_deg, tol_deg, ste
         click.echo(f"plot written to {plot}")
 
 
+def _task_grid_suggestion(mech, task) -> tuple[str, str]:
+    """A first --over / --at for ``workspace --task``: the first two given coordinates (angles first;
+    +-20 deg, or +-L/2 about the reference), the others held at their reference values."""
+    from ..kinematics.task import task_values
+    from ..model.task import TASK_NAMES
+
+    ref = dict(zip(TASK_NAMES, task_values(mech, np.eye(4), task.euler), strict=True))
+    L = mech.characteristic_length
+    order = sorted(task.given, key=lambda c: not c.startswith("a"))  # angles first
+    over = ",".join(f"{c}:-20:20:41" if c.startswith("a") else f"{c}:{ref[c] - L / 2:.4g}:{ref[c] + L / 2:.4g}:41"
+                    for c in order[:2])
+    at = ",".join(f"{c}={np.degrees(ref[c]):.4g}" if c.startswith("a") else f"{c}={ref[c]:.4g}" for c in order[2:])
+    return over, at
+
+
 def _lower_mobility_hint(mech) -> str:
     """For a pose workspace bounded by closure (or empty) of a mechanism with fewer than six output
     freedoms: why, and the command that samples its task coordinates instead."""
@@ -324,16 +344,8 @@ def _lower_mobility_hint(mech) -> str:
         return ""
     if len(task.given) == 6:
         return ""
-    from ..kinematics.task import task_values
-    from ..model.task import TASK_NAMES
-
     given = task.given
-    ref = dict(zip(TASK_NAMES, task_values(mech, np.eye(4), task.euler), strict=True))
-    L = mech.characteristic_length
-    order = sorted(given, key=lambda c: not c.startswith("a"))  # angles first
-    over = ",".join(f"{c}:-20:20:41" if c.startswith("a") else f"{c}:{ref[c] - L / 2:.4g}:{ref[c] + L / 2:.4g}:41"
-                    for c in order[:2])
-    at = ",".join(f"{c}={np.degrees(ref[c]):.4g}" if c.startswith("a") else f"{c}={ref[c]:.4g}" for c in order[2:])
+    over, at = _task_grid_suggestion(mech, task)
     return (f"note: {mech.name}'s output has {len(given)} freedoms ({', '.join(given)} given; "
             f"{', '.join(task.solved)} parasitic): a grid of six-coordinate poses almost never lies on its "
             f"closure set.  Sample its task coordinates instead: spatialmech workspace {mech.name} --task "

@@ -39,6 +39,7 @@ from .closure import Configuration, active_mask, closure_jacobian, closure_scale
 from .velocity import euler_rate_matrix
 
 __all__ = [
+    "TaskJacobian",
     "TaskSolution",
     "coordinate_map",
     "default_task",
@@ -46,6 +47,7 @@ __all__ = [
     "solve_pose",
     "solve_task",
     "task_jacobian",
+    "task_jacobian_at",
     "task_solution_dict",
     "task_values",
 ]
@@ -235,12 +237,13 @@ def task_solution_dict(sol: TaskSolution) -> dict:
             "values_deg": {n: float(np.degrees(sol.values[n])) for n in TASK_NAMES[3:]}}
 
 
-def task_jacobian(mech: Mechanism, sol: TaskSolution) -> tuple[np.ndarray, tuple[str, ...], tuple[str, ...]]:
+def task_jacobian(mech: Mechanism, sol: TaskSolution, drivers=None) -> tuple[np.ndarray, tuple[str, ...], tuple[str, ...]]:
     """The input-output Jacobian over the task coordinates at a task solution: ``J`` (n_act x M)
     with ``d actuators = J d(given coordinates)``, the parasitic coordinates, the passive joints
     and the bodies following (minimum-norm solve of the linearised closure).  Returns
     ``(J, actuator ids, given coordinate names)``; actuator rates in their own units (rad, length)
-    per unit of each given coordinate (length unit or rad)."""
+    per unit of each given coordinate (length unit or rad).  ``drivers``: the freedoms whose
+    rates are the rows (default: the model's actuators)."""
     active = active_mask(mech)
     na = int(active.sum())
     A, _ = closure_jacobian(mech, sol.config, active=active)
@@ -256,6 +259,64 @@ def task_jacobian(mech: Mechanism, sol: TaskSolution) -> tuple[np.ndarray, tuple
     X, *_ = np.linalg.lstsq(row[:, None] * G * scales[None, :], row[:, None] * rhs, rcond=None)
     U = scales[:, None] * X  # rates of the unknowns per unit rate of each given coordinate
     pos = np.cumsum(active) - 1
-    acts = mech.actuators
-    rows = [int(pos[mech.freedom_refs.index(mech.freedom(a))]) for a in acts]
-    return U[rows], tuple(acts), tuple(sol.given)
+    acts = tuple(mech.actuators) if drivers is None else tuple(mech.freedom(a).id for a in drivers)
+    refs = [mech.freedom_refs.index(mech.freedom(a)) for a in acts]
+    locked = [a for a, r in zip(acts, refs, strict=True) if not active[r]]
+    if locked:
+        raise InputError(f"drivers: {', '.join(locked)} {'is' if len(locked) == 1 else 'are'} locked in {mech.name}")
+    return U[[int(pos[r]) for r in refs]], acts, tuple(sol.given)
+
+
+@dataclass(frozen=True, eq=False)
+class TaskJacobian:
+    """The input-output Jacobian of a lower-mobility mechanism over its given task coordinates
+    (:func:`task_jacobian_at`): ``matrix`` (n_drivers x M, SI: actuator rate in rad or length
+    per unit rate of each given coordinate, length or rad), with the parasitic coordinates
+    solved; ``solution`` the task solve at the configuration (its six ``values``)."""
+
+    matrix: np.ndarray
+    actuators: tuple[str, ...]
+    solution: TaskSolution
+
+    @property
+    def given(self) -> tuple[str, ...]:
+        return self.solution.given
+
+    @property
+    def solved(self) -> tuple[str, ...]:
+        return self.solution.solved
+
+    def scaled(self, mech: Mechanism) -> np.ndarray:
+        """The matrix nondimensional: lengths (actuator slides and x, y, z) divided by the
+        characteristic length, angles in rad."""
+        L = mech.characteristic_length
+        r = np.array([L if mech.freedom(a).freedom.kind == "P" else 1.0 for a in self.actuators])
+        c = np.array([L if n in TASK_NAMES[:3] else 1.0 for n in self.given])
+        return self.matrix * c[None, :] / r[:, None]
+
+    def to_dict(self, mech: Mechanism) -> dict:
+        """JSON (docs/json.md): ``given``, ``solved``, ``euler``, ``actuators``, ``io_matrix``
+        (:meth:`scaled`: rows by actuator, columns by given coordinate, nondimensional) and
+        ``characteristic_length_len`` to restore the units."""
+        return {"given": list(self.given), "solved": list(self.solved), "euler": self.solution.task.euler,
+                "actuators": list(self.actuators), "io_matrix": self.scaled(mech).tolist(),
+                "characteristic_length_len": float(mech.characteristic_length)}
+
+
+def task_jacobian_at(mech: Mechanism, config: Configuration, drivers=None, *,
+                     task: TaskCoordinates | None = None) -> TaskJacobian | None:
+    """:func:`task_jacobian` at a closed configuration of a lower-mobility mechanism, over its
+    task (``task``, else the model's own, else :func:`default_task`); ``None`` when the output
+    link has six freedoms (then every coordinate is given) or cannot move."""
+    try:
+        task = default_task(mech) if task is None else task
+    except InputError:  # the output link cannot move
+        return None
+    if len(task.given) == 6:
+        return None
+    values = task_values(mech, config.D, task.euler)
+    sol = solve_task(mech, {n: float(values[TASK_NAMES.index(n)]) for n in task.given}, task=task, seed=config)
+    if not sol.converged:
+        return None
+    J, acts, _ = task_jacobian(mech, sol, drivers)
+    return TaskJacobian(J, acts, sol)
