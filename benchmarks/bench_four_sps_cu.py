@@ -36,6 +36,7 @@ import time  # noqa: E402
 import numpy as np  # noqa: E402
 
 from spatialmech.kinematics.closed_forms import four_sps_cu as k  # noqa: E402
+from spatialmech.kinematics.closed_forms import four_sps_cu_forward as kf  # noqa: E402
 
 TARGET_RATIO = 100.0
 TARGET_POSES_PER_S = 5e6
@@ -103,10 +104,10 @@ def run(n: int = 2_000_000, loop_n: int = 20_000, fk_n: int = 200, repeat: int =
     legs = k.leg_lengths(fk_phi, geom)
     seeds = fk_phi + np.array([0.01, 0.05, -0.05, 0.05])
     t0 = time.perf_counter()
-    single = [k.forward(legs[i], seeds[i], geometry=geom) for i in range(fk_n)]
+    single = [kf.forward(legs[i], seeds[i], geometry=geom) for i in range(fk_n)]
     t_single = time.perf_counter() - t0
     t0 = time.perf_counter()
-    batch = k.forward_batch(legs, seeds, geometry=geom)
+    batch = kf.forward_batch(legs, seeds, geometry=geom)
     t_batch = time.perf_counter() - t0
     err = np.abs(batch.phi - fk_phi).max(axis=1)
 

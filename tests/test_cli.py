@@ -87,7 +87,7 @@ def test_view_traces_a_one_dof_mechanism_and_marks_singular_points(tmp_path):
     assert r.exit_code == 0, r.output
     d = json.loads(r.output)
     assert d["frames"] == 12 and d["motion"] == "trace" and out.stat().st_size > 100_000
-    from spatialmech.present.motion import traced_motion
+    from spatialmech.analysis.traced_motion import traced_motion
     from spatialmech import catalog
 
     m = catalog.build("planar-4r")

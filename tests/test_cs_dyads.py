@@ -27,19 +27,17 @@ from spatialmech.model.mechanism import Pose
 from spatialmech.synthesis import cs_dyads as cd
 from spatialmech.synthesis.cs_dyads import (
     CSDyad,
-    assemble_5cs,
-    check_5cs,
     cs_task,
     dyad_from_limb,
     dyad_jacobian,
     dyad_residual,
-    paper_a_check,
     pick_small_slides,
     project_dyad,
     solve_dyad,
     synthesize_cs,
     trace_branch,
 )
+from spatialmech.synthesis.five_cs import assemble_5cs, check_5cs, paper_a_check
 
 from .conftest import seeds
 

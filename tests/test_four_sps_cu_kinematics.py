@@ -18,6 +18,7 @@ from scipy.optimize import brentq
 from spatialmech import catalog
 from spatialmech.geometry.rotations import euler_matrix, skew
 from spatialmech.kinematics.closed_forms import four_sps_cu as k
+from spatialmech.kinematics.closed_forms import four_sps_cu_forward as kf
 from spatialmech.kinematics.closed_forms import sps
 from spatialmech.kinematics.closure import Configuration, correct
 from spatialmech.model.mechanism import Pose
@@ -291,8 +292,8 @@ def test_forward_round_trip(seed):
     largest pose error 6e-10.  Closer to a fold two modes come close together (next test)."""
     rng = np.random.default_rng(seed)
     phi = random_phi(rng, 1, min_tilt=0.1)[0]
-    assume(k._sigma_min(phi, k.PAPER_B) >= 0.01)
-    res = k.forward(k.leg_lengths(phi), phi + rng.uniform(-1, 1, 4) * [0.0004, 0.002, 0.002, 0.002])
+    assume(kf._sigma_min(phi, k.PAPER_B) >= 0.01)
+    res = kf.forward(k.leg_lengths(phi), phi + rng.uniform(-1, 1, 4) * [0.0004, 0.002, 0.002, 0.002])
     assert res.converged and res.status == "converged"
     assert res.residual <= 1e-12
     assert np.allclose(k.leg_lengths(res.phi), k.leg_lengths(phi), atol=1e-12)
@@ -307,16 +308,16 @@ def test_near_a_fold_a_close_seed_can_reach_the_neighbouring_mode():
     phi = np.array([0.14011099, 0.20465682, -0.39739529, -0.5902849])
     seed = np.array([0.13559393, 0.19638262, -0.35724253, -0.62523112])
     l = k.leg_lengths(phi)
-    res = k.forward(l, seed)
+    res = kf.forward(l, seed)
     assert res.converged and np.allclose(k.leg_lengths(res.phi), l, atol=1e-12)
     assert np.allclose(res.phi, [0.13267437, 0.21857122, -0.42104119, -0.63566447], atol=1e-7)
-    modes = k.forward_all(l)
+    modes = kf.forward_all(l)
     assert len(modes.solutions) == 4 and modes.n_within_limits == 2
     assert _same_modes(modes.phis[:2], np.array([phi, res.phi]))
 
 
 def test_forward_from_the_default_seed_finds_a_mode_of_the_example():
-    res = k.forward(k.leg_lengths(EXAMPLE))
+    res = kf.forward(k.leg_lengths(EXAMPLE))
     assert res.converged and res.within_limits
     assert np.allclose(k.leg_lengths(res.phi), k.leg_lengths(EXAMPLE), atol=1e-12)
     json.dumps(res.to_dict())
@@ -325,20 +326,20 @@ def test_forward_from_the_default_seed_finds_a_mode_of_the_example():
 def test_forward_reports_non_convergence_for_impossible_legs():
     """Legs of 0.05 m cannot reach (min |B_i - A_i| = b sqrt2 - a sqrt2 = 0.141 m): the solver
     says so (status and residual), never a silent answer; forward_all returns no solution."""
-    res = k.forward([0.05] * 4)
+    res = kf.forward([0.05] * 4)
     assert not res.converged and res.status in ("max_iter", "stalled")
     assert res.residual > 0.05
-    allres = k.forward_all([0.05] * 4, n_seeds=32, max_iter=50)
+    allres = kf.forward_all([0.05] * 4, n_seeds=32, max_iter=50)
     assert allres.solutions == () and allres.search.n_converged == 0
 
 
 def test_forward_batch_matches_single_solves(rng):
     phi = random_phi(rng, 30, min_tilt=0.1)
     seeds = phi + 0.03
-    batch = k.forward_batch(k.leg_lengths(phi), seeds)
+    batch = kf.forward_batch(k.leg_lengths(phi), seeds)
     assert batch.converged.all() and np.all(batch.residual <= 1e-12)
     assert np.allclose(batch.phi, phi, atol=1e-8)
-    one = k.forward(k.leg_lengths(phi[7]), seeds[7])
+    one = kf.forward(k.leg_lengths(phi[7]), seeds[7])
     assert np.allclose(one.phi, batch.phi[7], atol=1e-12)
     json.dumps(batch.to_dict())
 
@@ -394,7 +395,7 @@ def test_multiple_assembly_modes_claim():
     limits (joint-angle limits of eqs 18-21 not checked).  The independent one-unknown
     reduction finds the same 4 roots, and more seeds find nothing new."""
     l = k.leg_lengths(EXAMPLE)
-    res = k.forward_all(l)
+    res = kf.forward_all(l)
     assert len(res.solutions) == 4 and res.n_within_limits == 2
     assert all(s.converged and s.residual <= 1e-12 for s in res.solutions)
     inside = res.phis[:2]
@@ -404,7 +405,7 @@ def test_multiple_assembly_modes_claim():
     assert np.all(res.phis[2:, 0] < 0)
     assert _same_modes(res.phis[2:], res.phis[:2] * [-1, -1, -1, 1])
     assert _same_modes(res.phis, univariate_roots(l))
-    assert _same_modes(k.forward_all(l, n_seeds=2048, qmc_seed=7).phis, res.phis)
+    assert _same_modes(kf.forward_all(l, n_seeds=2048, qmc_seed=7).phis, res.phis)
     d = res.to_dict()
     json.dumps(d)
     assert d["search"]["n_seeds"] == 512 and sum(d["search"]["hits"]) == d["search"]["n_converged"]
@@ -416,7 +417,7 @@ def test_forward_all_agrees_with_the_univariate_reduction(rng):
     counts = []
     for phi in random_phi(rng, 5, min_tilt=0.1):
         l = k.leg_lengths(phi)
-        found = k.forward_all(l, n_seeds=256).phis
+        found = kf.forward_all(l, n_seeds=256).phis
         assert _same_modes(found, univariate_roots(l))
         counts.append(len(found))
     assert set(counts) <= {4, 8}
@@ -427,7 +428,7 @@ def test_eight_modes_near_the_singular_set():
     including upside-down platforms (alpha ~ pi); roots this close to the singular set converge
     slowly, which is why forward_all's default max_iter is 500."""
     l = k.leg_lengths([0.2559735, 0.00848177, 0.007662, -0.79141761])
-    res = k.forward_all(l, n_seeds=256)
+    res = kf.forward_all(l, n_seeds=256)
     assert len(res.solutions) == 8
     assert _same_modes(res.phis, univariate_roots(l))
     assert np.sum(np.abs(np.abs(res.phis[:, 1]) - np.pi) < 0.1) == 4
@@ -488,12 +489,12 @@ def test_generic_sps_stacks_broadcast(rng):
     [
         (lambda: k.leg_lengths([0.2, np.nan, 0, 0]), "^phi: contains NaN"),
         (lambda: k.leg_lengths([0.2, 0, 0]), "^phi: expected shape"),
-        (lambda: k.forward([0.2, 0.2, -0.1, 0.2]), "^l: leg lengths must be positive"),
-        (lambda: k.forward([0.2] * 3), "^l: expected shape"),
-        (lambda: k.forward([0.2] * 4, [0.2, 0, 0]), "^seed: expected shape"),
-        (lambda: k.forward([0.2] * 4, tol=0), "^tol:"),
-        (lambda: k.forward_all([0.2] * 4, n_seeds=0), "^n_seeds:"),
-        (lambda: k.forward_batch([0.2] * 4, np.zeros((3, 5))), "^seeds: expected shape"),
+        (lambda: kf.forward([0.2, 0.2, -0.1, 0.2]), "^l: leg lengths must be positive"),
+        (lambda: kf.forward([0.2] * 3), "^l: expected shape"),
+        (lambda: kf.forward([0.2] * 4, [0.2, 0, 0]), "^seed: expected shape"),
+        (lambda: kf.forward([0.2] * 4, tol=0), "^tol:"),
+        (lambda: kf.forward_all([0.2] * 4, n_seeds=0), "^n_seeds:"),
+        (lambda: kf.forward_batch([0.2] * 4, np.zeros((3, 5))), "^seeds: expected shape"),
         (lambda: k.inverse_velocity(EXAMPLE, [0, 0, 0, 1], terms="deg"), "^terms:"),
         (lambda: k.inverse_velocity(EXAMPLE, [0, 0, 1]), "^rates: expected shape"),
         (lambda: k.FourSpsCuGeometry(a=-0.1), "^a: must be positive"),
@@ -514,7 +515,7 @@ def test_other_geometry_is_used(rng):
     T = k.pose_transform(phi)
     ref = sps.leg_lengths(T[..., :3, :3], T[..., :3, 3], g.base_points, g.platform_points)
     assert np.allclose(k.leg_lengths(phi, g), ref, atol=1e-15)
-    res = k.forward(k.leg_lengths(phi[0], g), phi[0] + 0.02, geometry=g)
+    res = kf.forward(k.leg_lengths(phi[0], g), phi[0] + 0.02, geometry=g)
     assert res.converged and np.allclose(res.phi, phi[0], atol=1e-8)
     assert g.to_dict()["a_len"] == 0.15
 

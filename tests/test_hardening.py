@@ -207,9 +207,9 @@ def test_a_length_unit_with_a_control_character_writes_a_readable_file():
 @pytest.mark.parametrize("values, contains", [("0.2,,0.2", "--actuators: item 2 of 3 is empty"),
                                               (",0.2", "--actuators: item 1 of 2 is empty"),
                                               ("0.2,", "--actuators: item 2 of 2 is empty"),
-                                              ("0.2,abc", "--actuators: item 2 ('abc') is not a number"),
-                                              ("0.2,nan", "--actuators: item 2 must be a finite number"),
-                                              ("1e999", "--actuators: item 1 must be a finite number")])
+                                              ("0.2,abc", "--actuators: item 2 expects a number, got 'abc'"),
+                                              ("0.2,nan", "--actuators: item 2 must be finite, got 'nan'"),
+                                              ("1e999", "--actuators: item 1 must be finite, got '1e999'")])
 def test_actuator_values_are_parsed_strictly(values, contains):
     """Before: ``--actuators 0.2,,0.2`` silently dropped the empty item."""
     assert_one_line_error(run("fk", "rssr", "--actuators", values), 2, contains)

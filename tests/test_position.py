@@ -43,9 +43,12 @@ def test_delta_inverse_finds_both_elbows_of_every_arm():
     pose = sm.Pose(np.eye(3), [0.02, 0.01, -0.33])
     inv = inverse_position(DELTA, pose, all_solutions=True)
     assert inv.reachable
-    assert [len(l.solutions) for l in inv.limbs] == [2, 2, 2]
+    # Clavel Delta: three R limbs (ground -> arm) and six S-S rods (arm -> platform); each arm's
+    # cluster (its R limb and its two rods) is solved together, so every limb lists both elbows
+    assert [lb.base for lb in DELTA.limbs[:3]] == ["ground"] * 3
+    assert [len(l.solutions) for l in inv.limbs] == [2] * 9
     # the two elbow solutions have different actuator angles
-    for l in inv.limbs:
+    for l in inv.limbs[:3]:
         assert abs(l.solutions[0][0] - l.solutions[1][0]) > 0.5
 
 
@@ -128,12 +131,13 @@ def test_cli_kinematics_errors(args, msg):
 def test_general_forward_all_agrees_with_the_closed_form_of_the_4sps_cu():
     """Every assembly mode the general engine finds is one of the closed form's (cross-check)."""
     from spatialmech.kinematics.closed_forms import four_sps_cu as k4
+    from spatialmech.kinematics.closed_forms import four_sps_cu_forward as k4f
     from spatialmech.geometry.rotations import matrix_euler
 
     m = catalog.build("four-sps-cu")
     assert k4.geometry_of(m) is not None and k4.geometry_of(STEWART) is None
     legs = k4.leg_lengths([0.12, 0.2, -0.1, 0.6])
-    closed = k4.forward_all(legs).phis
+    closed = k4f.forward_all(legs).phis
     gen = forward_position(m, legs, all_solutions=True, n_seeds=60, seed=1)
     found = [s for s in gen.solutions if s.converged]
     assert len(found) >= 2

@@ -36,6 +36,7 @@ from spatialmech.kinematics.assembly import (
     singular_threshold,
 )
 from spatialmech.kinematics.closed_forms import four_sps_cu as k
+from spatialmech.kinematics.closed_forms import four_sps_cu_forward as kf
 from spatialmech.kinematics.closed_forms import four_sps_cu_paper as kp
 from spatialmech.kinematics.position import forward_conditioning, forward_position
 from spatialmech.present.report import Claim, join_names, render_html, summary
@@ -115,7 +116,7 @@ def test_conditioning_of_the_general_engine_matches_the_closed_form_zero_set():
 
 @pytest.mark.slow
 def test_closed_form_forward_all_at_singular_legs_is_one_self_motion_set_not_hundreds_of_modes():
-    res = k.forward_all([HOME_LEG] * 4, n_seeds=128)
+    res = kf.forward_all([HOME_LEG] * 4, n_seeds=128)
     assert res.search.n_converged > 100
     (s,) = res.solutions
     assert s.kind == AssemblyKind.SELF_MOTION and s.singular and s.members == res.search.n_converged
@@ -127,7 +128,7 @@ def test_closed_form_forward_all_at_singular_legs_is_one_self_motion_set_not_hun
 
 
 def test_closed_form_keeps_the_four_regular_modes_of_the_example():
-    res = k.forward_all(k.leg_lengths([0.12, 0.2, -0.1, 0.6]), n_seeds=128)
+    res = kf.forward_all(k.leg_lengths([0.12, 0.2, -0.1, 0.6]), n_seeds=128)
     assert [s.kind for s in res.solutions] == [AssemblyKind.REGULAR] * 4
     assert sum(s.members for s in res.solutions) == res.search.n_converged
 
@@ -139,7 +140,7 @@ def test_a_double_root_at_a_fold_is_one_singular_result_and_its_mirror():
 
     a0 = brentq(lambda a: kp.det_jacobian_nd([0.2, a, 0.3, 0.6]), 0.2, 0.26, xtol=1e-15)
     legs = k.leg_lengths([0.2, a0, 0.3, 0.6])
-    res = k.forward_all(legs, n_seeds=128)
+    res = kf.forward_all(legs, n_seeds=128)
     kinds = sorted(str(s.kind) for s in res.solutions)
     assert kinds.count("singular") == 2 and kinds.count("self-motion") == 0, kinds
     sing = [s for s in res.solutions if s.kind == AssemblyKind.SINGULAR]
@@ -297,7 +298,7 @@ def test_present_paper_b_has_no_numerical_code():
 
 # ------------------------------------------------------------------ 5. synth cs and the catalogue
 def _check(defects, *, exact=True, dof=1):
-    from spatialmech.synthesis.cs_dyads import FiveCSCheck
+    from spatialmech.synthesis.five_cs import FiveCSCheck
 
     z = np.zeros(7)
     return FiveCSCheck(z, z, z, np.full(7, exact), np.ones(7, bool), np.zeros((7, 5)), None, dof, dof, defects)
@@ -327,7 +328,8 @@ def test_synth_cs_of_paper_a_positions_reports_the_circuit_defect():
     """The five small-slide dyads of table 9 close at every position (the old 'all exact: True')
     but the linkage has a circuit defect: the synthesis says FAILED and why."""
     from spatialmech.catalog.papers import five_cs_positions
-    from spatialmech.synthesis.cs_dyads import assemble_5cs, check_5cs, synthesize_cs
+    from spatialmech.synthesis.cs_dyads import synthesize_cs
+    from spatialmech.synthesis.five_cs import assemble_5cs, check_5cs
 
     fam = synthesize_cs(five_cs_positions(), seed=0, pick=5)
     check = check_5cs(assemble_5cs(fam.task, fam.picks), fam.picks, defects=True)

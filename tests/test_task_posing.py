@@ -12,27 +12,32 @@ from click.testing import CliRunner
 
 import spatialmech as sm
 from spatialmech import catalog
+from spatialmech.catalog import classic
 from spatialmech.interfaces.cli import cli
 from spatialmech.kinematics.closed_forms.three_rps import parasitic
 from spatialmech.geometry.rotations import matrix_euler
 from spatialmech.kinematics.task import solve_task, task_jacobian
 
 
-@pytest.mark.parametrize("name", ["three-rps", "three-prs"])
-def test_parasitic_motion_matches_the_closed_form(name):
+@pytest.mark.parametrize("build, rp, zs", [
+    (classic.three_rps, 0.15, (0.26, 0.3, 0.34)),
+    (classic.three_prs, 0.15, (0.26, 0.3, 0.34)),
+    (lambda: classic.three_rps(rb=0.4, rp=0.22, h=0.35), 0.22, (0.3, 0.38)),  # not the defaults
+])
+def test_parasitic_motion_matches_the_closed_form(build, rp, zs):
     """Each S centre stays in its leg's radial plane: x, y and a1 (ZYX) depend on the tilts
     only (not on z), a1 = atan2(sin a2 sin a3, cos a2 + cos a3); engine vs closed form to 1e-10."""
-    m = catalog.build(name)
+    m = build()
     tilts = np.radians(np.linspace(-20.0, 20.0, 7))
     worst = 0.0
-    for z in (0.26, 0.3, 0.34):
+    for z in zs:
         seed = None
         for a2 in tilts:
             for a3 in tilts:
                 r = solve_task(m, {"z": z, "a2": a2, "a3": a3}, seed=seed)
                 assert r.converged
                 seed = r.config
-                x, y, a1 = parasitic(0.15, a2, a3)
+                x, y, a1 = parasitic(rp, a2, a3)
                 worst = max(worst, abs(r.values["x"] - x), abs(r.values["y"] - y), abs(r.values["a1"] - a1))
     assert worst < 1e-10
 

@@ -105,7 +105,10 @@ def check_boundary(mech, ws, max_points=8):
         if lim == "closure":
             assert not res.converged or checker.violated(res.config)
         else:
-            assert res.converged and checker.violated(res.config) == lim
+            # the named limit is broken just outside (on a symmetric mechanism another limit may
+            # be broken there too, and be the first one the checker names)
+            assert res.converged and checker.violated(res.config) is not None
+            assert (checker.margins(res.config) / checker.scales)[names.index(lim)] < 0.0, lim
 
 
 def _task(ws):

@@ -20,7 +20,7 @@ from spatialmech.kinematics.closure import (
 )
 from spatialmech.model.joints import R
 from spatialmech.model.mechanism import Limb, Mechanism
-from spatialmech.present.motion import sample_motion
+from spatialmech.kinematics.motion import sample_motion
 from spatialmech.present.viewer import (
     ARC_RADIUS0,
     ARC_RADIUS_STEP,
@@ -120,7 +120,7 @@ def test_demo_motion_start_off_the_manifold_is_refused():
 def test_demo_motion_reports_failed_corrections(monkeypatch):
     """Non-convergence is never silent: at the start it is a ValueError (the start is not on
     the manifold), during the walk a RuntimeError after step halving down to MIN_STEP."""
-    import spatialmech.present.motion as motion
+    import spatialmech.kinematics.motion as motion
 
     real = motion.correct
     mech = catalog.build("bennett")

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from spatialmech import catalog
-from spatialmech.present.motion import sample_motion
+from spatialmech.kinematics.motion import sample_motion
 from spatialmech.present.viewer import DIV_ID, viewer_figure, write_viewer
 
 #: A browser start and WebGL rendering take tens of seconds: not part of the quick loop.

@@ -281,7 +281,7 @@ def test_to_dict_is_json_and_labelled(ws_z01):
 
 @pytest.mark.slow
 def test_plot_writes_a_png(tmp_path, ws_z01):
-    from spatialmech.analysis.workspace_plot import write_workspace_plot
+    from spatialmech.present.workspace import write_workspace_plot
 
     out = write_workspace_plot(ws_z01, tmp_path / "ws.png")
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

@@ -37,12 +37,20 @@ import numpy as np
 from ..errors import InputError
 from ..kinematics.closure import Configuration, active_mask, closure_jacobian, closure_scales
 from ..kinematics.jacobian import complete_jacobian, driver_determinants
-from ..kinematics.position import PoseFit, configuration_at_pose, freedom_values
-from ..kinematics.tracking import MotionProblem, TrackResult, correct_on_hyperplane, track
-from ..model.joints import make_joint
 from ..geometry.tolerances import current as current_tolerances
+from ..kinematics.position import PoseFit, configuration_at_pose, freedom_values
+from ..kinematics.tracking import MotionProblem, TrackResult
+from ..model.joints import make_joint
 from ..model.mechanism import Mechanism, Pose
 from ..results import Progress, Steps, TrackStatus
+from .defect_circuits import (
+    arc_on_curve,
+    fewest_circuits,
+    pose_distance,
+    positions_between,
+    switching_plan,
+    trace_circuit,
+)
 
 __all__ = [
     "BranchPoint",
@@ -233,6 +241,7 @@ def _renamed(d: dict, names: dict[str, str]) -> dict:
 
 
 def _membership_json(m: dict) -> dict:
+    """One position's circuit membership for JSON: units in the key names."""
     out = _renamed(m, {"position": "position_number"})
     if isinstance(out.get("distance"), dict):
         out["distance"] = _renamed(out["distance"], {"position": "position_len"})
@@ -316,153 +325,6 @@ def dj_table(mech: Mechanism, drivers=None, positions=None) -> DJTable:
 
 
 
-# ----------------------------------------------------------------------------- helpers
-def _project(problem: MotionProblem, tr: TrackResult, config: Configuration, tol: float):
-    """Arc length of ``config`` on the traced curve, or ``None`` when it is not on it."""
-    d = np.array([np.linalg.norm(problem.difference(x, config)) for x in tr.points])
-    k0 = int(np.argmin(d))
-    best = (np.inf, None)
-    for k in {max(0, k0 - 1), k0, min(len(tr.points) - 1, k0 + 1)}:
-        x, t = tr.points[k], tr.tangents[k]
-        a = float(t @ problem.difference(x, config))
-        xs, ok, _, _ = correct_on_hyperplane(problem, problem.retract(x, a * t), t, 1e-11, 30)
-        if not ok:
-            continue
-        dist = float(np.linalg.norm(problem.difference(xs, config)))
-        if dist < best[0]:
-            best = (dist, tr.s[k] + a)
-    return best[1] if best[0] < tol else None
-
-
-def _pose_of(mech: Mechanism, x: Configuration):
-    D = x.D
-    return D[:3, :3], D[:3, :3] @ mech.platform_point + D[:3, 3]
-
-
-def _pose_distance(mech, prob, tr: TrackResult, pose: Pose, pose_tol: float, angle_tol: float):
-    """Distance of a printed pose from a traced curve, normalised by the tolerances
-    (``hypot(|dp| / pose_tol, dtheta / angle_tol)``), refined along the curve between samples.
-    Returns (normalised distance, arc, |dp|, dtheta)."""
-    from ..geometry.rotations import rotation_angle
-
-    def meas(x):
-        R, p = _pose_of(mech, x)
-        dp = float(np.linalg.norm(p - pose.p))
-        th = float(rotation_angle(R @ pose.R.T))
-        return float(np.hypot(dp / pose_tol, th / angle_tol)), dp, th
-
-    vals = [meas(x)[0] for x in tr.points]
-    k0 = int(np.argmin(vals))
-    best = (vals[k0], float(tr.s[k0]), *meas(tr.points[k0])[1:])
-    for k in (k0 - 1, k0):
-        if k < 0 or k + 1 >= len(tr.points):
-            continue
-        x, t, h = tr.points[k], tr.tangents[k], float(tr.s[k + 1] - tr.s[k])
-        g = (np.sqrt(5) - 1) / 2
-        lo, hi = 0.0, h
-        cache: dict[float, tuple[float, float, float]] = {}
-
-        def at(a, x=x, t=t, cache=cache):
-            if a not in cache:
-                xa, ok, _, _ = correct_on_hyperplane(prob, prob.retract(x, a * t), t, 1e-11, 20)
-                cache[a] = meas(xa) if ok else (np.inf, np.inf, np.inf)
-            return cache[a]
-
-        for _ in range(30):
-            a1, a2 = hi - g * (hi - lo), lo + g * (hi - lo)
-            if at(a1)[0] < at(a2)[0]:
-                hi = a2
-            else:
-                lo = a1
-        a = 0.5 * (lo + hi)
-        m = at(a)
-        if m[0] < best[0]:
-            best = (m[0], float(tr.s[k] + a), m[1], m[2])
-    return best
-
-
-def _cover(D: np.ndarray) -> list[int]:
-    """Fewest circuits (rows) covering every position (column) within tolerance (D <= 1); ties
-    broken by the smallest total distance.  Positions no circuit covers keep their own."""
-    from itertools import combinations
-
-    nC, nP = D.shape
-    need = [j for j in range(nP) if np.any(D[:, j] <= 1.0)]
-    for size in range(1, nC + 1):
-        best = None
-        for sub in combinations(range(nC), size):
-            if all(np.any(D[list(sub), j] <= 1.0) for j in need):
-                cost = sum(np.min(D[list(sub), j]) for j in need)
-                if best is None or cost < best[0]:
-                    best = (cost, list(sub))
-        if best is not None:
-            chosen = best[1]
-            for j in range(nP):  # positions out of tolerance everywhere: their own circuit
-                if j not in need:
-                    chosen.append(int(np.argmin(D[:, j])))
-            return sorted(set(chosen))
-    return list(range(nC))
-
-
-def _trace(mech, start, names, djf, max_arc, h0, progress):
-    prob = MotionProblem(mech)
-    tr = track(prob, start, vector_monitor=(names, djf), max_arc=max_arc, h0=h0, event_tol=1e-9,
-               progress=progress)
-    return prob, tr
-
-
-def _between(arc: float, arcs: list[float]) -> tuple[int, int] | None:
-    """Positions (from 1) whose arcs bracket ``arc`` on the path (arcs sorted along the path)."""
-    for j in range(len(arcs) - 1):
-        if arcs[j] <= arc <= arcs[j + 1]:
-            return (j + 1, j + 2)
-    return None
-
-
-def _plan(drivers: list[str], zeros: dict[str, list[float]], a: float, b: float, arcs: list[float]):
-    """Fewest driver switches covering the path [a, b] with no driver passing its own DJ zero.
-
-    Greedy: from the current arc, take the driver that goes furthest before its next zero;
-    it must be switched before that zero, after the last zero of the next driver."""
-    steps = []
-    c = a
-    current = None
-    guard = 0
-    while guard < 20:
-        guard += 1
-        reach = {}
-        for d in drivers:
-            nxt = [z for z in zeros[d] if z > c + 1e-12]
-            reach[d] = min(nxt) if nxt else np.inf
-        if current is None:
-            current = max(drivers, key=lambda d: reach[d])
-        r = reach[current]
-        if r >= b:
-            steps.append([current, c, b, None])
-            return steps
-        # next driver: regular on (w, its next zero) with w < r
-        best, best_reach, best_lo = None, -np.inf, None
-        for d in drivers:
-            if d == current:
-                continue
-            before = [z for z in zeros[d] if z < r]
-            lo = max([c, *before])
-            if lo >= r:
-                continue
-            nxt = [z for z in zeros[d] if z > lo + 1e-12]
-            rd = min(nxt) if nxt else np.inf
-            # furthest reach first; on a tie the widest switching window
-            if rd > best_reach or (rd == best_reach and best_lo is not None and lo < best_lo):
-                best, best_reach, best_lo = d, rd, lo
-        if best is None or best_lo is None or best_reach <= r:  # best_lo is set with best
-            return None
-        c_new = 0.5 * (best_lo + r)  # switch in the middle of the window
-        steps.append([current, c, c_new, (best_lo, r)])
-        c = c_new
-        current = best
-    return None
-
-
 def perturbed(mech: Mechanism, positions, rng: np.random.Generator, length: float, angle_deg: float):
     """A copy of ``mech`` and ``positions`` with every joint point and axis and every position
     perturbed uniformly within the printed precision (``length``; axes by ``length`` per
@@ -528,8 +390,73 @@ def defect_analysis(
     ``hypot(dp / pose_tol, dtheta / angle_tol) <= 1``); among the traced circuits the fewest
     that hold every position are kept.  ``progress(done, None, message)`` is called with the
     number of the step and a short message while it works.
+
+    The steps (module docstring): :func:`_checked_arguments`, :func:`dj_table` (fits and DJ),
+    :func:`_trace_circuits`, :func:`_assign_circuits`, :func:`_path_along_first_circuit`,
+    :func:`_driver_verdict` per driver, :func:`_drive_plan`, :func:`_distance_to_singularities`
+    and, optionally, :func:`_monte_carlo`.
     """
     say = Steps(progress)
+    positions, drivers, pose_tol = _checked_arguments(mech, positions, drivers, pose_tol=pose_tol,
+                                                      angle_tol_deg=angle_tol_deg, precision=precision,
+                                                      monte_carlo=monte_carlo)
+    say("fitting the task positions onto the closure; DJ at every position")
+    table = dj_table(mech, drivers, positions)
+    fits = list(table.fits)
+    djf, dj_method = dj_function(mech, drivers, fits[0].config)
+    dj_pos = table.dj.T  # (positions, drivers)
+
+    problems, traces = _trace_circuits(mech, fits, drivers, djf, on_curve_tol, max_arc, h0, say)
+    say("assigning the positions to circuits")
+    circ = _assign_circuits(mech, positions, fits, problems, traces, pose_tol=pose_tol,
+                            angle_tol=np.radians(angle_tol_deg), on_curve_tol=on_curve_tol)
+    circuit_defect = len(circ.circuits) > 1
+    path = _path_along_first_circuit(circ)
+    order_defect = path.order_defect
+
+    verdicts: list[DriverVerdict] = []
+    zeros_on_path: dict[str, list[float]] = {}
+    for di, d in enumerate(drivers):
+        verdict = _driver_verdict(mech, d, dj_pos[:, di], circ.traces, path, circuit_defect=circuit_defect,
+                                  order_defect=order_defect)
+        verdicts.append(verdict)
+        zeros_on_path[d] = [b.arc for b in verdict.branch_points]
+    usable = tuple(v.driver for v in verdicts if v.usable)
+    plan = None
+    if not usable and not circuit_defect and not order_defect:
+        plan = _drive_plan(drivers, zeros_on_path, path)
+
+    min_sig, min_between = None, None
+    if sigma_along_path and not circuit_defect:
+        say("measuring the distance to singularities along the path")
+        watch = set(usable) | ({s.driver for s in plan} if plan else set())
+        min_sig, min_between, verdicts = _distance_to_singularities(mech, circ.problems[0], circ.traces[0], path,
+                                                                    verdicts, watch)
+
+    rot = {d: mech.freedom(d).freedom.kind != "P" for d in drivers}
+    result = DefectResult(
+        mechanism=mech.name, drivers=tuple(verdicts), circuits=tuple(circ.circuits),
+        circuit_closed=tuple(tr.closed for tr in circ.traces), circuit_status=tuple(tr.status for tr in circ.traces),
+        circuit_defect=circuit_defect, order_defect=order_defect, order=tuple(path.order),
+        direction=path.direction, position_arcs=tuple(path.position_arcs),
+        path_length=float(path.end) if not circuit_defect else None,
+        usable_drivers=usable, plan=plan, fits=tuple(fits), dj_method=dj_method, min_closure_sigma=min_sig,
+        min_closure_sigma_between=min_between, traces=tuple(circ.traces), rotational=rot,
+        membership=tuple(circ.membership),
+        tolerances={"pose": pose_tol, "angle_deg": angle_tol_deg, "on_curve": on_curve_tol}, table=table,
+    )
+    if monte_carlo:
+        result = replace(result, robustness=_monte_carlo(mech, positions, result, monte_carlo, seed, precision,
+                                                         angle_precision_deg, drivers, max_arc, h0, say))
+    return result
+
+
+# ----------------------------------------------------------------------------- its steps
+def _checked_arguments(mech: Mechanism, positions, drivers, *, pose_tol: float | None, angle_tol_deg: float,
+                       precision: float, monte_carlo: int) -> tuple[tuple[Pose, ...], list[str], float]:
+    """Step 0: the arguments of :func:`defect_analysis` checked (an ``InputError`` naming the
+    argument), the defaults filled in.  The mechanism must have one degree of freedom and, when
+    metamorphic, be in one mode.  Returns ``(positions, drivers, pose_tol)``."""
     if pose_tol is None:
         pose_tol = 0.02 * mech.characteristic_length
     for name, v in (("pose_tol", pose_tol), ("angle_tol_deg", angle_tol_deg)):
@@ -542,6 +469,17 @@ def defect_analysis(
     positions = tuple(positions if positions is not None else mech.positions)
     if len(positions) < 2:
         raise InputError("positions: a defect analysis needs at least two task positions")
+    _check_one_dof(mech)
+    drivers = list(drivers) if drivers is not None else candidate_drivers(mech)
+    if not drivers:
+        raise InputError("drivers: no candidate drivers")
+    for d in drivers:
+        mech.freedom(d)  # raises on unknown names
+    return positions, drivers, pose_tol
+
+
+def _check_one_dof(mech: Mechanism) -> None:
+    """An ``InputError`` unless ``mech`` has one (instantaneous) degree of freedom in one mode."""
     from .mobility import mobility
 
     if mech.is_metamorphic and len(mech.all_modes()) > 1:
@@ -549,181 +487,228 @@ def defect_analysis(
     dof = mobility(mech).dof_instantaneous
     if dof != 1:
         raise InputError(f"mechanism: the defect analysis is for one-degree-of-freedom linkages; {mech.name} has {dof}")
-    drivers = list(drivers) if drivers is not None else candidate_drivers(mech)
-    if not drivers:
-        raise InputError("drivers: no candidate drivers")
-    for d in drivers:
-        mech.freedom(d)  # raises on unknown names
-    say("fitting the task positions onto the closure; DJ at every position")
-    table = dj_table(mech, drivers, positions)
-    fits = list(table.fits)
-    djf, dj_method = dj_function(mech, drivers, fits[0].config)
-    dj_pos = table.dj.T  # (positions, drivers)
 
-    # circuits: trace until every fitted position lies on a traced curve
-    n = len(positions)
+
+def _trace_circuits(mech: Mechanism, fits: list[PoseFit], drivers: list[str], djf, on_curve_tol: float,
+                    max_arc: float, h0: float, say: Steps) -> tuple[list[MotionProblem], list[TrackResult]]:
+    """Step 3a: trace circuits until every fitted position lies on a traced curve (to
+    ``on_curve_tol``, nondimensional): the circuit through position 1, then one through each
+    position that no traced circuit passes through, in order."""
     traces: list[TrackResult] = []
     problems: list[MotionProblem] = []
-    for j in range(n):
-        if any(_project(pr, tr, fits[j].config, on_curve_tol) is not None for pr, tr in zip(problems, traces, strict=True)):
+    for j, fit in enumerate(fits):
+        if any(arc_on_curve(pr, tr, fit.config, on_curve_tol) is not None
+               for pr, tr in zip(problems, traces, strict=True)):
             continue
         say(f"tracing the circuit through position {j + 1}")
-        prob, tr = _trace(mech, fits[j].config, drivers, djf, max_arc, h0, None)
+        prob, tr = trace_circuit(mech, fit.config, drivers, djf, max_arc, h0, None)
         traces.append(tr)
         problems.append(prob)
-    # membership by pose tolerance (printed data are rounded), fewest circuits
-    say("assigning the positions to circuits")
+    return problems, traces
+
+
+@dataclass(frozen=True, eq=False)
+class _Circuits:
+    """The circuits kept by :func:`_assign_circuits`, in the order of their first position."""
+
+    problems: list[MotionProblem]
+    traces: list[TrackResult]
+    circuit_of: list[int]  # the circuit (from 0) of each position
+    circuits: list[tuple[int, ...]]  # the positions (from 1) on each circuit
+    arcs_on: list[float]  # traced arc of each position on the first circuit (nan on the others)
+    membership: list[dict]  # per position: its circuit, its distance from it, other circuits near it
+
+
+def _assign_circuits(mech: Mechanism, positions, fits: list[PoseFit], problems: list[MotionProblem],
+                     traces: list[TrackResult], *, pose_tol: float, angle_tol: float, on_curve_tol: float) -> _Circuits:
+    """Step 3b: every position's distance from every traced circuit (0 when its fitted
+    configuration lies on it; else the normalised distance of the printed pose,
+    :func:`pose_distance`, ``angle_tol`` in rad), the fewest circuits that hold every position
+    (:func:`fewest_circuits`), each position on its nearest kept circuit; the kept circuits are
+    renumbered in the order of their first position."""
+    n = len(positions)
     Dm = np.empty((len(traces), n))
     meas: dict[tuple[int, int], tuple[float, float, float, float]] = {}
     for c, (pr, tr) in enumerate(zip(problems, traces, strict=True)):
         for j, P in enumerate(positions):
             # exactly on the curve (the fitted configuration itself): unambiguous, even where the
             # platform takes the same pose twice on a circuit; else the nearest pose on the curve
-            a = 0.0 if tr.points[0] is fits[j].config else _project(pr, tr, fits[j].config, on_curve_tol)
+            a = 0.0 if tr.points[0] is fits[j].config else arc_on_curve(pr, tr, fits[j].config, on_curve_tol)
             if a is not None:
                 meas[c, j] = (0.0, float(a), fits[j].position_error, fits[j].angle_error)
             else:
-                meas[c, j] = _pose_distance(mech, pr, tr, P, pose_tol, np.radians(angle_tol_deg))
+                meas[c, j] = pose_distance(mech, pr, tr, P, pose_tol, angle_tol)
             Dm[c, j] = meas[c, j][0]
-    chosen = _cover(Dm)
-    circuit_of = [min(chosen, key=lambda c: Dm[c, j]) for j in range(n)]
-    order_c = sorted(chosen, key=lambda c: min(j for j in range(n) if circuit_of[j] == c))
-    traces = [traces[c] for c in order_c]
-    problems_o = [problems[c] for c in order_c]
+    chosen = fewest_circuits(Dm)
+    nearest = [min(chosen, key=lambda c: Dm[c, j]) for j in range(n)]
+    order_c = sorted(chosen, key=lambda c: min(j for j in range(n) if nearest[j] == c))
     remap = {c: k for k, c in enumerate(order_c)}
-    circuit_of = [remap[c] for c in circuit_of]
+    circuit_of = [remap[c] for c in nearest]
     circuits = [tuple(j + 1 for j in range(n) if circuit_of[j] == k) for k in range(len(order_c))]
-    # arc length of each position on the first circuit (nan elsewhere: only those on it are read)
     arcs_on = [meas[order_c[0], j][1] if circuit_of[j] == 0 else np.nan for j in range(n)]
     membership = [{"position": j + 1, "circuit": circuit_of[j] + 1,
-                   "distance": {"position": meas[order_c[circuit_of[j]], j][2],
-                                "angle_deg": float(np.degrees(meas[order_c[circuit_of[j]], j][3]))},
+                   "distance": {"position": meas[nearest[j], j][2],
+                                "angle_deg": float(np.degrees(meas[nearest[j], j][3]))},
                    # other traced circuits that also pass within tolerance: kept ones by number, the
                    # ones the fewest-circuits cover dropped as "extra"
                    "also_within_tolerance_of": [remap[c] + 1 if c in remap else "extra" for c in range(len(Dm))
-                                                if c != order_c[circuit_of[j]] and Dm[c, j] <= 1.0]}
+                                                if c != nearest[j] and Dm[c, j] <= 1.0]}
                   for j in range(n)]
-    closed = [tr.closed for tr in traces]
-    statuses = [tr.status for tr in traces]
-    problems = problems_o
-    circuit_defect = len(circuits) > 1
+    return _Circuits([problems[c] for c in order_c], [traces[c] for c in order_c], circuit_of, circuits, arcs_on,
+                     membership)
 
-    # order and direction along the first circuit
-    tr0 = traces[0]
+
+def _along(arc_traced: float, period: float | None, direction: int) -> float:
+    """A traced arc as an arc along the path: modulo the circuit's length when it closed,
+    reversed when the path runs against the traced direction."""
+    if direction == 1:
+        return arc_traced % period if period else arc_traced
+    return ((period - arc_traced) % period) if period else -arc_traced
+
+
+@dataclass(frozen=True)
+class _Path:
+    """The path from position 1 along the first circuit (:func:`_path_along_first_circuit`)."""
+
+    direction: int  # +1 along the traced direction, -1 against it
+    order: list[int]  # positions (from 1) on the first circuit in the order the path meets them
+    expected: list[int]  # the same positions in their given order
+    path_arcs: list[float]  # their arcs along the path, sorted
+    position_arcs: list[float | None]  # arc along the path of every position (None off the first circuit)
+    period: float | None  # length of the first circuit when it closed
+
+    @property
+    def end(self) -> float:
+        """Arc of the last position met along the path (0 without positions)."""
+        return self.path_arcs[-1] if self.path_arcs else 0.0
+
+    @property
+    def order_defect(self) -> bool:
+        return self.order != self.expected
+
+    def to_path(self, arc_traced: float) -> float:
+        return _along(arc_traced, self.period, self.direction)
+
+
+def _path_along_first_circuit(circ: _Circuits) -> _Path:
+    """Step 4a: order and direction along the first circuit.  The positions on it are sorted by
+    their arcs both ways round; the direction in which they come in their given order is the
+    path's (forward when neither does: an order defect)."""
+    tr0 = circ.traces[0]
     S = tr0.s[-1] if tr0.closed else None
-    on0 = [i for i in range(n) if circuit_of[i] == 0]
-    fwd = [arcs_on[i] % S if S else arcs_on[i] for i in on0]
-    order_f = [on0[k] + 1 for k in np.argsort(fwd, kind="stable")]
-    bwd = [((S - a) % S) if S else -a for a in [arcs_on[i] for i in on0]]
-    order_b = [on0[k] + 1 for k in np.argsort(bwd, kind="stable")]
+    on0 = [i for i, c in enumerate(circ.circuit_of) if c == 0]
     expected = [i + 1 for i in on0]
-    if order_f == expected:
-        direction, order, path_arcs = 1, order_f, sorted(fwd)
-    elif order_b == expected:
+    fwd = [_along(circ.arcs_on[i], S, 1) for i in on0]
+    bwd = [_along(circ.arcs_on[i], S, -1) for i in on0]
+    order_f = [on0[k] + 1 for k in np.argsort(fwd, kind="stable")]
+    order_b = [on0[k] + 1 for k in np.argsort(bwd, kind="stable")]
+    if order_f != expected and order_b == expected:
         direction, order, path_arcs = -1, order_b, sorted(bwd)
     else:
         direction, order, path_arcs = 1, order_f, sorted(fwd)
-    order_defect = order != expected
-    pos_arcs: list[float | None] = [None] * n
+    pos_arcs: list[float | None] = [None] * len(circ.circuit_of)
     for i in on0:
-        a = arcs_on[i]
-        pos_arcs[i] = (a % S if S else a) if direction == 1 else (((S - a) % S) if S else -a)
+        pos_arcs[i] = _along(circ.arcs_on[i], S, direction)
+    return _Path(direction, order, expected, path_arcs, pos_arcs, S)
 
-    # branch points
 
-    def to_path(arc_traced: float) -> float:
-        if direction == 1:
-            return arc_traced % S if S else arc_traced
-        return ((S - arc_traced) % S) if S else -arc_traced
+def _branch_points(mech: Mechanism, driver: str, traces: list[TrackResult], path: _Path, *,
+                   circuit_defect: bool) -> tuple[list[BranchPoint], list[BranchPoint], int]:
+    """Step 4b: the zeros of ``driver``'s DJ met by the tracker (events of the traced circuits):
+    all of them, those strictly inside the path (none when there is a circuit defect), and the
+    number of poles (DJ through infinity: the driver's limb is serially singular and the output
+    turns back while the driver moves on; not branch points)."""
+    idx = mech.freedom_refs.index(mech.freedom(driver))
+    all_bp, path_bp = [], []
+    poles = 0
+    for k, tr in enumerate(traces):
+        for e in tr.events:
+            if e.name != driver:
+                continue
+            if e.kind == "pole":
+                poles += 1
+                continue
+            cfg = cast(Configuration, e.x)  # a mechanism's motion problem: points are configurations
+            p = cfg.D[:3, :3] @ mech.platform_point + cfg.D[:3, 3]
+            point = (float(p[0]), float(p[1]), float(p[2]))
+            val = float(freedom_values(mech, cfg.q)[idx])
+            if k == 0:
+                pa = path.to_path(e.s)
+                bp = BranchPoint(driver, k + 1, float(pa), positions_between(pa, path.path_arcs), point, val)
+                if 0.0 < pa < path.end and not circuit_defect:
+                    path_bp.append(bp)
+            else:
+                bp = BranchPoint(driver, k + 1, float(e.s), None, point, val)
+            all_bp.append(bp)
+    all_bp.sort(key=lambda b: (b.circuit, b.arc))
+    path_bp.sort(key=lambda b: b.arc)
+    return all_bp, path_bp, poles
 
-    verdicts = []
-    path_end = path_arcs[-1] if path_arcs else 0.0
-    zeros_on_path = {}
-    for di, d in enumerate(drivers):
-        r = mech.freedom(d)
-        idx = mech.freedom_refs.index(r)
-        all_bp, path_bp = [], []
-        poles = 0
-        for k, tr in enumerate(traces):
-            for e in tr.events:
-                if e.name != d:
-                    continue
-                if e.kind == "pole":  # DJ through infinity: the driver's limb is serially
-                    poles += 1        # singular (the output turns back); the driver moves on
-                    continue
-                cfg = cast(Configuration, e.x)  # a mechanism's motion problem: points are configurations
-                p = cfg.D[:3, :3] @ mech.platform_point + cfg.D[:3, 3]
-                val = float(freedom_values(mech, cfg.q)[idx])
-                if k == 0:
-                    pa = to_path(e.s)
-                    bp = BranchPoint(d, k + 1, float(pa), _between(pa, path_arcs), (float(p[0]), float(p[1]), float(p[2])), val)
-                    if 0.0 < pa < path_end and not circuit_defect:
-                        path_bp.append(bp)
-                else:
-                    bp = BranchPoint(d, k + 1, float(e.s), None, (float(p[0]), float(p[1]), float(p[2])), val)
-                all_bp.append(bp)
-        all_bp.sort(key=lambda b: (b.circuit, b.arc))
-        path_bp.sort(key=lambda b: b.arc)
-        zeros_on_path[d] = [b.arc for b in path_bp]
-        signs = tuple(int(x) for x in np.sign(dj_pos[:, di]))
-        keeps = len(set(signs)) == 1 and 0 not in signs
-        # with one circuit, the path decides (a sign change through a pole is no branch point)
-        branch_defect = (not keeps) if circuit_defect else bool(path_bp)
-        is_usable = not circuit_defect and not order_defect and not branch_defect
-        verdicts.append(DriverVerdict(d, tuple(map(float, dj_pos[:, di])), signs, keeps, tuple(path_bp), tuple(all_bp),
-                                      branch_defect, is_usable, inverse_singular_points=poles))
-    usable = tuple(v.driver for v in verdicts if v.usable)
 
-    plan = None
-    if not usable and not circuit_defect and not order_defect:
-        raw = _plan(drivers, zeros_on_path, 0.0, path_end, path_arcs)
-        if raw is not None:
-            plan = tuple(PlanStep(d, float(a), float(b), (float(w[0]), float(w[1])) if w else None,
-                                  _between(0.5 * (w[0] + w[1]), path_arcs) if w else None) for d, a, b, w in raw)
+def _driver_verdict(mech: Mechanism, driver: str, dj: np.ndarray, traces: list[TrackResult], path: _Path, *,
+                    circuit_defect: bool, order_defect: bool) -> DriverVerdict:
+    """Step 4c: the verdict on one driver from its DJ at the positions (``dj``) and its branch
+    points (:func:`_branch_points`).  With one circuit the path decides the branch defect (a
+    sign change through a pole is no branch point); with several, a change of DJ's sign does.
+    Usable: no circuit, order or branch defect."""
+    all_bp, path_bp, poles = _branch_points(mech, driver, traces, path, circuit_defect=circuit_defect)
+    signs = tuple(int(x) for x in np.sign(dj))
+    keeps = len(set(signs)) == 1 and 0 not in signs
+    branch_defect = (not keeps) if circuit_defect else bool(path_bp)
+    is_usable = not circuit_defect and not order_defect and not branch_defect
+    return DriverVerdict(driver, tuple(map(float, dj)), signs, keeps, tuple(path_bp), tuple(all_bp),
+                         branch_defect, is_usable, inverse_singular_points=poles)
 
-    # closeness to singularities along the path
+
+def _drive_plan(drivers: list[str], zeros_on_path: dict[str, list[float]], path: _Path) -> tuple[PlanStep, ...] | None:
+    """Step 4d: when no single driver is usable (and there is no circuit or order defect), a
+    multi-drive plan that switches drivers inside intervals free of their DJ zeros
+    (:func:`switching_plan`, paper A section 6), or ``None`` when there is none."""
+    raw = switching_plan(drivers, zeros_on_path, 0.0, path.end)
+    if raw is None:
+        return None
+    return tuple(PlanStep(d, float(a), float(b), (float(w[0]), float(w[1])) if w else None,
+                          positions_between(0.5 * (w[0] + w[1]), path.path_arcs) if w else None)
+                 for d, a, b, w in raw)
+
+
+def _distance_to_singularities(mech: Mechanism, problem: MotionProblem, tr0: TrackResult, path: _Path,
+                               verdicts: list[DriverVerdict], watch: set[str]):
+    """Step 5: the scale-free smallest singular value of the closure Jacobian at every traced
+    point on the path (its minimum and the positions bracketing it), and for each driver in
+    ``watch`` (the usable and planned ones) that of its complete Jacobian.  Returns
+    ``(min_sigma, between, verdicts)`` (``None, None`` without points on the path)."""
+    path_pts = [(path.to_path(s), x) for s, x in zip(tr0.s, tr0.points, strict=True)
+                if 0.0 <= path.to_path(s) <= path.end]
     min_sig, min_between = None, None
-    if sigma_along_path and not circuit_defect:
-        say("measuring the distance to singularities along the path")
-        path_pts = [(to_path(s), x) for s, x in zip(tr0.s, tr0.points, strict=True) if 0.0 <= to_path(s) <= path_end]
-        prob0 = problems[0]
-        sig = []
-        for a, x in path_pts:
-            sv = np.linalg.svd(prob0.jacobian(x), compute_uv=False)
-            sig.append((float(sv[-1] / sv[0]), a))
-        if sig:
-            mval, marc = min(sig)
-            min_sig, min_between = mval, _between(marc, path_arcs)
-        watch = set(usable) | ({s.driver for s in plan} if plan else set())
-        new = []
-        for vd in verdicts:
-            if vd.driver in watch:
-                vals = [complete_jacobian(mech, x, [vd.driver]).sigma_min for _, x in path_pts]
-                vd = replace(vd, min_sigma_on_path=float(min(vals)) if vals else None)
-            new.append(vd)
-        verdicts = new
-
-    rot = {d: mech.freedom(d).freedom.kind != "P" for d in drivers}
-    result = DefectResult(
-        mechanism=mech.name, drivers=tuple(verdicts), circuits=tuple(circuits), circuit_closed=tuple(closed),
-        circuit_status=tuple(statuses), circuit_defect=circuit_defect, order_defect=order_defect, order=tuple(order),
-        direction=direction, position_arcs=tuple(pos_arcs), path_length=float(path_end) if not circuit_defect else None,
-        usable_drivers=usable, plan=plan, fits=tuple(fits), dj_method=dj_method, min_closure_sigma=min_sig,
-        min_closure_sigma_between=min_between, traces=tuple(traces), rotational=rot, membership=tuple(membership),
-        tolerances={"pose": pose_tol, "angle_deg": angle_tol_deg, "on_curve": on_curve_tol}, table=table,
-    )
-    if monte_carlo:
-        result = replace(result, robustness=_monte_carlo(mech, positions, result, monte_carlo, seed, precision,
-                                                         angle_precision_deg, drivers, max_arc, h0, say))
-    return result
+    sig = []
+    for a, x in path_pts:
+        sv = np.linalg.svd(problem.jacobian(x), compute_uv=False)
+        sig.append((float(sv[-1] / sv[0]), a))
+    if sig:
+        mval, marc = min(sig)
+        min_sig, min_between = mval, positions_between(marc, path.path_arcs)
+    new = []
+    for vd in verdicts:
+        if vd.driver in watch:
+            vals = [complete_jacobian(mech, x, [vd.driver]).sigma_min for _, x in path_pts]
+            vd = replace(vd, min_sigma_on_path=float(min(vals)) if vals else None)
+        new.append(vd)
+    return min_sig, min_between, new
 
 
 def _verdict_key(r: DefectResult):
+    """What the Monte-Carlo check compares: circuit and order defects, the usable drivers and
+    the drivers whose DJ keeps its sign."""
     return (r.circuit_defect, r.order_defect, tuple(sorted(r.usable_drivers)),
             tuple(sorted(v.driver for v in r.drivers if v.keeps_sign)))
 
 
 def _monte_carlo(mech, positions, base, n, seed, precision, angle_deg, drivers, max_arc, h0, say):
+    """Step 6 (optional): ``n`` seeded samples of the data perturbed within its printed
+    precision (:func:`perturbed`), each analysed again; how many give the same verdict
+    (:func:`_verdict_key`) as ``base``, how many fail (e.g. a perturbed overconstrained linkage
+    is rigid), and the other verdicts met."""
     rng = np.random.default_rng(seed)
     key0 = _verdict_key(base)
     same, failures, keys = 0, 0, []

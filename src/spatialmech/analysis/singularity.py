@@ -21,13 +21,14 @@ of the limbs and the actuation wrenches of the actuators: the rows of the comple
   instantaneous.
 
 :func:`singularity_slice` maps ``sign(det J)`` and ``sigma_min`` over a 2-D slice of a pose
-parametrisation: the singularity loci are its zero contours.
+parametrisation: the singularity loci are its zero contours (drawn by
+:func:`spatialmech.present.singularity.slice_figure`).
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -36,7 +37,7 @@ from ..geometry import screws as sc
 from ..geometry.line_geometry import classify_lines, json_dict
 from ..kinematics.closure import Configuration
 from ..kinematics.jacobian import CompleteJacobian, complete_jacobian
-from ..kinematics.position import configuration_at_pose
+from ..kinematics.position import configuration_at_pose, locked_actuators
 from ..kinematics.tracking import MotionProblem, track
 from ..geometry.tolerances import current as current_tolerances
 from ..model.mechanism import Mechanism, Pose
@@ -89,21 +90,6 @@ class SingularityResult:
             "actuators": list(self.jacobian.actuators),
             "explanation": self.explanation,
         }
-
-
-def locked_actuators(mech: Mechanism, actuators=None) -> Mechanism:
-    """The mechanism with its actuators locked (the structure that must hold the platform)."""
-    ids = {mech.freedom(a).id for a in (actuators if actuators is not None else mech.actuators)}
-    limbs = []
-    for limb in mech.limbs:
-        joints = []
-        for j in limb.joints:
-            for f in j.freedoms:
-                if f"{j.name}.{f.name}" in ids:
-                    j = j.with_freedom(f.name, locked=True, actuated=False)
-            joints.append(j)
-        limbs.append(limb.with_joints(joints))
-    return replace(mech, limbs=tuple(limbs), modes=())
 
 
 def _is_line(w: np.ndarray, L: float, tol: float = 1e-7) -> bool:
@@ -308,26 +294,3 @@ def singularity_slice(
         if progress:
             progress(j + 1, len(v), "slice")
     return SliceResult(tuple(names), u, v, det, sig, dict(fixed or {}), tuple(units))
-
-
-def slice_figure(res: SliceResult, title: str = ""):
-    """Sign of ``det J`` with its zero contours (the singularity loci) and ``sigma_min``."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    f = Figure(figsize=(11, 4.6), dpi=110)
-    FigureCanvasAgg(f)
-    ax1, ax2 = f.subplots(1, 2)
-    U, V = np.meshgrid(res.u, res.v)
-    ax1.pcolormesh(U, V, np.sign(res.det), cmap="coolwarm", vmin=-1.5, vmax=1.5, shading="auto")
-    if np.nanmin(res.det) < 0 < np.nanmax(res.det):
-        ax1.contour(U, V, np.nan_to_num(res.det), levels=[0.0], colors="k", linewidths=1.5)
-    ax1.set_title("sign of det J (red +, blue -); black: det J = 0")
-    c = ax2.pcolormesh(U, V, np.log10(np.maximum(res.sigma_min, 1e-12)), cmap="viridis", shading="auto")
-    f.colorbar(c, ax=ax2, label="log10 sigma_min (scale-free)")
-    ax2.set_title("distance to a singularity")
-    for ax in (ax1, ax2):
-        ax.set_xlabel(f"{res.names[0]} ({res.units[0]})")
-        ax.set_ylabel(f"{res.names[1]} ({res.units[1]})")
-    f.suptitle(title or "singularity loci")
-    return f

@@ -64,6 +64,7 @@ __all__ = [
     "Closure",
     "Coupling",
     "TreeJoint",
+    "as_body_tree",
     "body_tree",
     "mechanism_from_tree",
 ]
@@ -260,6 +261,15 @@ def _segments(points: list[np.ndarray], hub: np.ndarray | None, L: float) -> tup
     the points in order (a link of a limb); segments shorter than 1e-6 L are left out."""
     pairs = [(hub, p) for p in points] if hub is not None else list(pairwise(points))
     return tuple((a.copy(), b.copy()) for a, b in pairs if float(np.linalg.norm(b - a)) > 1e-6 * L)
+
+
+def as_body_tree(model: Mechanism | BodyTree) -> BodyTree:
+    """What the writers (MJCF, URDF) take: a mechanism's :func:`body_tree`, or a body tree as it
+    is; a ``TypeError`` naming ``model`` for anything else."""
+    tree = body_tree(model) if isinstance(model, Mechanism) else model
+    if not isinstance(tree, BodyTree):
+        raise TypeError(f"model: expected a Mechanism or a BodyTree, got {type(model).__name__}")
+    return tree
 
 
 def body_tree(mech: Mechanism) -> BodyTree:

@@ -41,7 +41,7 @@ import numpy as np
 from ..errors import InputError
 from ..model.mechanism import Mechanism, Mode
 from ..model.topology import OUTPUT
-from .bodies import Axis, Body, BodyTree, Closure, Coupling, TreeJoint, body_tree, mechanism_from_tree
+from .bodies import Axis, Body, BodyTree, Closure, Coupling, TreeJoint, as_body_tree, mechanism_from_tree
 
 __all__ = ["METADATA", "from_mjcf", "mjcf_tree", "read_body_tree", "to_mjcf"]
 
@@ -177,10 +177,7 @@ def mjcf_tree(tree: BodyTree) -> ET.ElementTree:
 
 def to_mjcf(model: Mechanism | BodyTree) -> str:
     """The MJCF text of a mechanism (or of a body tree); it loads with ``mujoco.MjModel.from_xml_string``."""
-    tree = body_tree(model) if isinstance(model, Mechanism) else model
-    if not isinstance(tree, BodyTree):
-        raise TypeError(f"model: expected a Mechanism or a BodyTree, got {type(model).__name__}")
-    root = mjcf_tree(tree).getroot()
+    root = mjcf_tree(as_body_tree(model)).getroot()
     if root is None:  # pragma: no cover - the writer always builds a root
         raise RuntimeError("empty MJCF document")
     return ET.tostring(root, encoding="unicode") + "\n"

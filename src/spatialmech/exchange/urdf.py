@@ -32,7 +32,7 @@ import xml.etree.ElementTree as ET
 import numpy as np
 
 from ..model.mechanism import Mechanism
-from .bodies import Axis, BodyTree, body_tree
+from .bodies import Axis, BodyTree, as_body_tree
 
 __all__ = ["DRAKE_NS", "SPATIALMECH_NS", "to_urdf", "urdf_tree"]
 
@@ -168,10 +168,7 @@ def urdf_tree(tree: BodyTree) -> ET.ElementTree:
 
 def to_urdf(model: Mechanism | BodyTree) -> str:
     """The URDF text of a mechanism (or of a body tree)."""
-    tree = body_tree(model) if isinstance(model, Mechanism) else model
-    if not isinstance(tree, BodyTree):
-        raise TypeError(f"model: expected a Mechanism or a BodyTree, got {type(model).__name__}")
-    return '<?xml version="1.0"?>\n' + ET.tostring(_root(urdf_tree(tree)), encoding="unicode") + "\n"
+    return '<?xml version="1.0"?>\n' + ET.tostring(_root(urdf_tree(as_body_tree(model))), encoding="unicode") + "\n"
 
 
 def _root(doc: ET.ElementTree) -> ET.Element:

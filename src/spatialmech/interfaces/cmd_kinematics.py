@@ -243,10 +243,11 @@ def fk(model, values, all_solutions, seeds, as_json):
             raise InputError(f"--actuators: item {k} ({a} = {v:g} {unit}) is out of range: at most {top:.3g} {unit}{why}")
     vals = [v if mech.freedom(a).freedom.kind == "P" else np.radians(v) for a, v in zip(acts, raw, strict=True)]
     from ..kinematics.closed_forms import four_sps_cu as k4
+    from ..kinematics.closed_forms import four_sps_cu_forward as k4f
 
     geom = k4.geometry_of(mech) if all_solutions else None
     if geom is not None:  # the closed form of this limb layout: faster and more thorough
-        fa = k4.forward_all(np.asarray(vals), geometry=geom, **({} if seeds is None else {"n_seeds": seeds}))
+        fa = k4f.forward_all(np.asarray(vals), geometry=geom, **({} if seeds is None else {"n_seeds": seeds}))
         if as_json:
             emit_json("fk", mech, fa.to_dict(actuators=acts))
             return

@@ -9,7 +9,7 @@ import click
 import numpy as np
 
 from .. import catalog
-from ..analysis.singularity import singularity, singularity_slice, slice_figure
+from ..analysis.singularity import singularity, singularity_slice
 from ..errors import InputError
 from ..geometry.rotations import euler_matrix
 from ..geometry.tolerances import current as current_tolerances
@@ -67,6 +67,8 @@ def _task_slice(mech, slice_spec: str, at, free, acts, plot, as_json) -> None:
         raise InputError(f"--slice: the task coordinates do not close at any point of the {n1} x {n2} slice; "
                          "move or narrow the slice")
     if plot is not None:
+        from ..present.singularity import slice_figure  # matplotlib: only when a figure is asked for
+
         shown = res.for_display()
         slice_figure(shown, f"{mech.name}: singularity loci over task coordinates ({res.euler}, angles in degrees; "
                             f"solved {', '.join(res.solved)})").savefig(plot)
@@ -155,6 +157,8 @@ def singularity_cmd(model, xyz, euler, position, reference, drivers, slice_spec,
             raise InputError(f"--slice: no pose of the {n1} x {n2} slice closes (the mechanism cannot assemble "
                              "at any of them); move or narrow the slice")
         if plot is not None:
+            from ..present.singularity import slice_figure
+
             slice_figure(res, f"{mech.name}: singularity loci ({seq}, angles in degrees)").savefig(plot)
         d = res.to_dict()
         if as_json:

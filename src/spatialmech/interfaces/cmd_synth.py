@@ -62,7 +62,7 @@ def rccc(task, as_json, plot_dir, save_file, pick, samples):
     if save_file is not None:
         dump(res.linkage, save_file)
     if plot_dir is not None:
-        from ..synthesis.figures import write_all
+        from ..present.synthesis_figures import write_all
 
         write_all(res, plot_dir)
     if as_json:
@@ -125,7 +125,8 @@ def cs(positions_file, as_json, samples, pick, save_file, starts, seed, skip_def
       spatialmech synth cs --skip-defects
     """
     from ..model.schema import dump, load_positions
-    from ..synthesis.cs_dyads import assemble_5cs, check_5cs, synthesize_cs
+    from ..synthesis.cs_dyads import synthesize_cs
+    from ..synthesis.five_cs import assemble_5cs, check_5cs
 
     if save_file is not None and pick != 5:
         raise InputError(f"save: a 5-CS linkage needs --pick 5 (got --pick {pick})")

@@ -22,7 +22,7 @@ __all__ = ["MOTIONS", "view"]
 #: Motions the command can compute.  "trace": the whole circuit of a one-degree-of-freedom
 #: mechanism through its reference configuration, followed by the continuation tracker, with the
 #: zeros of DJ (branch points of the first actuator) marked as singular points; "demo":
-#: :func:`..present.motion.sample_motion`, a short loop along the closure manifold (any mobility);
+#: :func:`..kinematics.motion.sample_motion`, a short loop along the closure manifold (any mobility);
 #: "auto": trace when the mechanism has one degree of freedom, else demo.
 MOTIONS = ("auto", "trace", "demo")
 
@@ -59,7 +59,8 @@ def view(model, motion, out, frames, as_json):
       spatialmech view five-cs-1 --frames 120 --out five-cs-1.html --json
       spatialmech view bennett --motion trace --out bennett.html
     """
-    from ..present.motion import sample_motion, traced_motion
+    from ..analysis.traced_motion import traced_motion
+    from ..kinematics.motion import sample_motion
     from ..present.viewer import write_viewer
 
     singular = ()

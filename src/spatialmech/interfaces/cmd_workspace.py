@@ -26,7 +26,7 @@ from ..analysis.workspace import (
     with_freedom_limits,
 )
 from ..errors import InputError
-from .common import UserError, check_output_file, emit_json, json_option
+from .common import UserError, check_output_file, emit_json, json_option, parse_number
 from .task_args import cone_limits, freedom_limits, parse_axes, parse_task_at, task_from_free
 
 _ANGLES = ("alpha", "beta", "gamma")
@@ -48,12 +48,7 @@ def parse_at(text: str | None) -> dict[str, float]:
         k, v = (s.strip() for s in part.split("=", 1))
         if k not in COORDINATES:
             raise InputError(f"--at: unknown coordinate {k!r}; expected one of {', '.join(COORDINATES)}")
-        try:
-            val = float(v)
-        except ValueError:
-            raise InputError(f"--at: {k} expects a number, got {v!r}") from None
-        if not np.isfinite(val):
-            raise InputError(f"--at: {k} must be finite, got {v!r}")
+        val = parse_number(v, "--at", k)
         out[k] = float(np.radians(val)) if k in _ANGLES else val
     return out
 
@@ -295,7 +290,7 @@ def workspace(model, orientation_flag, position_flag, at, step_deg, tol_deg, ste
             finally:
                 close()
         if plot:
-            from ..analysis.workspace_plot import write_workspace_plot
+            from ..present.workspace import write_workspace_plot
 
             write_workspace_plot(res, plot)
     except InputError as e:  # not ConvergenceError (exit 1) nor a bug (exit 3): see cli._Group

@@ -106,6 +106,19 @@ def check_output_dir(path, option: str) -> Path | None:
 
 
 # ------------------------------------------------------------------ numbers at the command line
+def parse_number(text: str, option: str, what: str) -> float:
+    """One finite number typed at the command line; ``what`` (e.g. ``"z"``, ``"item 2"``) and
+    ``option`` name it in the error: ``--at: z expects a number, got 'abc'``,
+    ``--actuators: item 2 must be finite, got 'nan'``."""
+    try:
+        v = float(text)
+    except ValueError:
+        raise InputError(f"{option}: {what} expects a number, got {text!r}") from None
+    if not math.isfinite(v):
+        raise InputError(f"{option}: {what} must be finite, got {text!r}")
+    return v
+
+
 def parse_numbers(text: str, option: str, *, count: int | None = None, what: str = "values") -> list[float]:
     """``"0.2,0.25,0.2"`` -> ``[0.2, 0.25, 0.2]``: every item a finite number (an empty item,
     as in ``0.2,,0.2``, is an error naming the option and the position, not skipped);
@@ -115,13 +128,7 @@ def parse_numbers(text: str, option: str, *, count: int | None = None, what: str
     for k, part in enumerate(parts, start=1):
         if not part:
             raise InputError(f"{option}: item {k} of {len(parts)} is empty in {text!r}")
-        try:
-            v = float(part)
-        except ValueError:
-            raise InputError(f"{option}: item {k} ({part!r}) is not a number") from None
-        if not math.isfinite(v):
-            raise InputError(f"{option}: item {k} must be a finite number, got {part!r}")
-        out.append(v)
+        out.append(parse_number(part, option, f"item {k}"))
     if count is not None and len(out) != count:
         raise InputError(f"{option}: expected {count} {what}, got {len(out)}")
     return out

@@ -20,22 +20,13 @@ from ..analysis.workspace import ConeLimit
 from ..errors import InputError
 from ..model.mechanism import Mechanism
 from ..model.task import TASK_NAMES, TaskCoordinates
+from .common import parse_number
 
 __all__ = ["MAX_AXIS_POINTS", "TASK_NAMES", "cone_limits", "freedom_limits", "parse_axes", "parse_task_at",
            "task_from_free"]
 
 #: Largest number of points along one grid axis.
 MAX_AXIS_POINTS = 400
-
-
-def _number(text: str, option: str, what: str) -> float:
-    try:
-        v = float(text)
-    except ValueError:
-        raise InputError(f"{option}: {what} expects a number, got {text!r}") from None
-    if not math.isfinite(v):
-        raise InputError(f"{option}: {what} must be finite, got {text!r}")
-    return v
 
 
 def _si(name: str, value: float) -> float:
@@ -51,7 +42,7 @@ def parse_axes(text: str, option: str = "--over", *, min_axes: int = 1, max_axes
             raise InputError(f"{option}: expected NAME:MIN:MAX:N[,...] with NAME in {', '.join(TASK_NAMES)} (lengths in "
                              f"the model's unit, angles in degrees), got {part.strip()!r}")
         name = bits[0]
-        lo, hi = (_number(b, option, f"{name} {w}") for b, w in zip(bits[1:3], ("MIN", "MAX"), strict=True))
+        lo, hi = (parse_number(b, option, f"{name} {w}") for b, w in zip(bits[1:3], ("MIN", "MAX"), strict=True))
         try:
             n = int(bits[3])
         except ValueError:
@@ -88,7 +79,7 @@ def parse_task_at(text: str | None, option: str = "--at") -> dict[str, float]:
                              "(lengths in the model's unit, angles in degrees)")
         if k in out:
             raise InputError(f"{option}: {k} is given twice")
-        out[k] = _si(k, _number(v, option, k))
+        out[k] = _si(k, parse_number(v, option, k))
     return out
 
 
@@ -126,7 +117,7 @@ def cone_limits(items, mech: Mechanism, option: str = "--cone") -> tuple[ConeLim
             joint, deg = (s.strip() for s in part.split("=", 1))
             if joint not in known:
                 raise InputError(f"{option}: {mech.name} has no joint {joint!r}; its joints: {', '.join(sorted(known))}")
-            angle = _number(deg, option, joint)
+            angle = parse_number(deg, option, joint)
             if not 0 < angle <= 180:
                 raise InputError(f"{option}: {joint} expects 0 < DEG <= 180, got {deg}")
             out.append(ConeLimit(joint, (0.0, 0.0, 1.0), "base" if joint in first else "platform", math.radians(angle)))
@@ -146,7 +137,7 @@ def freedom_limits(items, mech: Mechanism, option: str = "--limit") -> dict[str,
                 raise InputError(f"{option}: expected FREEDOM=LO:HI, got {part!r}")
             name, rng = (s.strip() for s in part.split("=", 1))
             lo_t, hi_t = rng.split(":", 1)
-            lo, hi = _number(lo_t, option, f"{name} LO"), _number(hi_t, option, f"{name} HI")
+            lo, hi = parse_number(lo_t, option, f"{name} LO"), parse_number(hi_t, option, f"{name} HI")
             if not lo < hi:
                 raise InputError(f"{option}: {name} expects LO < HI, got {rng}")
             names = list(mech.actuators) if name == "actuators" else [name]

@@ -374,8 +374,18 @@ def placed_configuration(mech: Mechanism, q) -> Configuration:
     return Configuration(q, known.get(0, np.eye(4)), B)
 
 
+def _compiled():
+    """The compiled kernels (:mod:`.compiled`) when they are in use, else ``None``: the Python
+    code below runs (``SPATIALMECH_PURE=1``, or numba missing) and is the reference."""
+    from . import compiled  # imported here: it builds on this module
+
+    return compiled if compiled.enabled() else None
+
+
 def closure_residual(mech: Mechanism, config: Configuration) -> np.ndarray:
     """Stacked limb residuals ``log(D_a FK_k D_b^-1)`` (6 K,), SI units."""
+    if (fast := _compiled()) is not None:
+        return fast.closure_residual(mech, config)
     check_configuration(mech, config)
     res = []
     for (a, b), ch, sl in zip(mech.limb_ends, limb_chains(mech), limb_slices(mech), strict=True):
@@ -391,6 +401,8 @@ def closure_jacobian(mech: Mechanism, config: Configuration, *, active: np.ndarr
 
     Columns: the active joint variables, then the spatial twist of the output link (6), then
     those of the internal bodies (6 each; ``h`` = :func:`hub_count`)."""
+    if (fast := _compiled()) is not None:
+        return fast.closure_jacobian(mech, config, active=active)
     check_configuration(mech, config)
     if active is None:
         active = active_mask(mech)
@@ -465,6 +477,8 @@ def retract(mech, config, active, step, fix_platform=False):
     ``step``: the active joint steps, then a twist (6) per moving hub (:func:`hub_count`: the
     output link, then the internal bodies); a shorter step leaves the remaining hubs where they
     are.  ``fix_platform`` holds the output link (its twist in ``step`` is ignored)."""
+    if (fast := _compiled()) is not None:
+        return fast.retract(mech, config, active, step, fix_platform)
     dq = np.zeros_like(config.q)
     na = int(active.sum())
     dq[active] = step[:na]
@@ -502,6 +516,8 @@ def correct(
     ``converged`` and the final nondimensional residual norm; never raises on
     non-convergence (the caller decides).
     """
+    if (fast := _compiled()) is not None:
+        return fast.correct(mech, config, active=active, fix_platform=fix_platform, tol=tol, max_iter=max_iter)
     if active is None:
         active = active_mask(mech)
     if tol is None:  # the newton tolerance in force (geometry/tolerances.py)

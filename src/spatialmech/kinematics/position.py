@@ -27,6 +27,7 @@ from ..geometry import screws as sc
 from ..model.mechanism import Mechanism, Pose
 from ..results import Progress
 from ..serialize import freedom_values_dict, pose_dict
+from . import compiled
 from .closure import (
     Configuration,
     active_mask,
@@ -68,6 +69,7 @@ __all__ = [
     "freedom_values",
     "inverse_position",
     "limb_clusters",
+    "locked_actuators",
     "platform_pose",
     "within_limits",
     "wrap_rotations",
@@ -283,6 +285,8 @@ def _violation(mech: Mechanism, sl: slice, q_limb) -> float:
 def _limb_gn(chain, D, q, lin, L, tol=1e-12, max_iter=60, hold=None):
     """Gauss-Newton for one limb with the platform held at ``D``, in local coordinates (S
     joints updated by composing rotations); freedoms in the ``hold`` mask keep their value."""
+    if compiled.enabled():
+        return compiled.limb_gn(chain, D, q, lin, L, tol=tol, max_iter=max_iter, hold=hold)
     Dinv = inverse_transform(D)
     colscale = np.where(lin, L, 1.0)
     if hold is not None:
@@ -828,9 +832,11 @@ def _graph_forward_conditioning(mech: Mechanism, config: Configuration, rank_tol
     return Conditioning.from_singular_values(sv, FK_CONDITIONING_MEASURE, n_required=6, threshold=singular_threshold())
 
 
-def _actuators_locked(mech: Mechanism) -> Mechanism:
-    """``mech`` with its actuated freedoms locked (the structure that holds the platform)."""
-    ids = set(mech.actuators)
+def locked_actuators(mech: Mechanism, actuators=None) -> Mechanism:
+    """``mech`` with its actuators (or the freedoms named in ``actuators``, by id or alias)
+    locked and no longer actuated: the structure that must hold the platform (forward position's
+    self-motions, the singularity analysis)."""
+    ids = {mech.freedom(a).id for a in (actuators if actuators is not None else mech.actuators)}
     limbs = []
     for limb in mech.limbs:
         joints = []
@@ -914,7 +920,7 @@ def forward_position(
                 progress(s + 1, n_seeds, "assembly modes")
     thr = singular_threshold()
     dedup, sdedup = dedup_tolerances()
-    locked = _actuators_locked(mech)
+    locked = locked_actuators(mech)
     if not all_solutions:
         r = first
         if not r.converged:  # the failed attempt, with the conditioning where it stopped

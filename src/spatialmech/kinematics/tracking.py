@@ -33,6 +33,7 @@ from ..geometry.rotations import inverse_transform, log_transform
 from ..geometry.tolerances import current as current_tolerances
 from ..model.mechanism import Mechanism
 from ..results import EventKind, Progress, TrackStatus
+from . import compiled
 from .closure import Configuration, active_mask, ball_groups, closure_jacobian, closure_scales, hub_count, retract
 
 __all__ = [
@@ -406,6 +407,8 @@ class _MechanismBase:
         return retract(self.mech, config, self.active, self.col * dx)
 
     def _config_diff(self, a: Configuration, b: Configuration) -> np.ndarray:
+        if compiled.enabled():
+            return compiled.config_difference(self.mech, a, b, self.active, self.kinds != "P", self.col)
         dq_all = b.q - a.q
         for i, A in ball_groups(self.mech):  # relative rotation of each S joint
             sl = slice(i, i + 3)

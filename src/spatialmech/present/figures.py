@@ -72,7 +72,7 @@ def to_png(fig: Figure, name: str, title: str, caption: str) -> ReportFigure:
 
 
 def figure_from_file(path, name: str, title: str, caption: str) -> ReportFigure:
-    """A PNG written by another module (e.g. :func:`spatialmech.synthesis.figures.write_all`)."""
+    """A PNG written by another module (e.g. :func:`spatialmech.present.synthesis_figures.write_all`)."""
     return ReportFigure(name, title, caption, Path(path).read_bytes())
 
 

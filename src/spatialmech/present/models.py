@@ -69,7 +69,7 @@ def model_section(mech: Mechanism, progress: Progress | None = None, *, trace: b
     """Every analysis that applies to ``mech`` (see the module docstring)."""
     progress = Steps(progress, MODEL_STEPS)
     from ..analysis.defects import dj_table
-    from .motion import sample_motion
+    from ..kinematics.motion import sample_motion
 
     tables, figs, viewers, data, notes = [], [], [], {}, []
     unit = mech.length_unit

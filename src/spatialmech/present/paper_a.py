@@ -277,7 +277,7 @@ def _cs_dyad_claims():
     """Section 3 (eqs 22-26): the printed limbs are CS dyads of the seven positions, lie on the
     synthesised one-parameter family, and any five dyads make a 5-CS through the positions."""
     from ..catalog.papers import five_cs_data, five_cs_positions
-    from ..synthesis.cs_dyads import paper_a_check
+    from ..synthesis.five_cs import paper_a_check
 
     c = paper_a_check(five_cs_positions(), five_cs_data()["linkages"])
     d = c.to_dict()

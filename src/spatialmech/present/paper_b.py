@@ -27,6 +27,7 @@ import numpy as np
 from .. import catalog
 from ..analysis.mobility import mobility
 from ..kinematics.closed_forms import four_sps_cu as k
+from ..kinematics.closed_forms import four_sps_cu_forward as kf
 from ..kinematics.closed_forms import four_sps_cu_paper as kp
 from ..kinematics.closure import Configuration
 from ..kinematics.jacobian import complete_jacobian
@@ -225,7 +226,7 @@ def section(progress: Progress | None = None) -> Section:
 
     progress("paper B: forward position (all assembly modes of an example)")
     lx = k.leg_lengths(EXAMPLE_POSE)
-    res = k.forward_all(lx)
+    res = kf.forward_all(lx)
     ph = res.phis
     found = bool(np.any(np.all(np.abs(ph - np.asarray(EXAMPLE_POSE)) < 1e-9, axis=1)))
     claims.append(Claim("B", "Forward position: the pose from the four leg lengths (section 4)", "solved numerically",
@@ -255,7 +256,7 @@ def section(progress: Progress | None = None) -> Section:
     data["workspace"] = ws.to_dict()
 
     progress("paper B: 3-D viewer")
-    from .motion import sample_motion
+    from ..kinematics.motion import sample_motion
 
     viewers = (Viewer("Paper B, 4-SPS/CU: a demonstration loop from the home pose", mech,
                       tuple(sample_motion(mech, n=48)), note="A short loop along the closure manifold (not a tracked "
@@ -382,7 +383,7 @@ def workspace_claim(step_deg: float = 4.0, *, polish: bool = True):
 
 
 def _workspace_figure(res):
-    from ..analysis.workspace_plot import workspace_figure
+    from .workspace import workspace_figure
 
     return F.to_png(workspace_figure(res), "paper_b_workspace.png", "4-SPS/CU orientation workspace at z = 0.1 m",
                     "Feasible (alpha, beta, gamma) under the limits of eqs 18-22, with the active limit at the boundary.")

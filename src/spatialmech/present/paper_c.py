@@ -73,7 +73,7 @@ def section(progress: Progress | None = None) -> Section:
     progress("paper C: closed-form inverse kinematics and the section 4.2 motion")
     c42, fig42, data42 = _closed_form_claims()
     claims.extend(c42)
-    from .motion import sample_motion
+    from ..kinematics.motion import sample_motion
 
     viewers = (
         Viewer("Paper C, 3-RRR metamorphic spherical joint: a demonstration loop (all three actuators driven)", rrr,

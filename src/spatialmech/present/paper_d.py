@@ -8,7 +8,7 @@ Claims: the Burmester curves (eqs 8-14) with the poles on them, the RC dyad bein
 for four positions and exact for three, the synthesised RCCC's errors at the four positions,
 and the example directions of eqs 28 and 30, which do not satisfy the paper's own direction
 equation (not reproduced; residuals reported).  Figures: the five of
-:func:`spatialmech.synthesis.figures.write_all` (curves, regions 1 and 2, solution lines, the
+:func:`spatialmech.present.synthesis_figures.write_all` (curves, regions 1 and 2, solution lines, the
 linkage).
 """
 
@@ -22,7 +22,7 @@ import numpy as np
 from ..results import Progress, Steps
 from ..synthesis.burmester import burmester_det, poles
 from ..synthesis.dyads import direction_residuals, rc_dyad_three_positions
-from ..synthesis.figures import write_all
+from .synthesis_figures import write_all
 from ..synthesis.rccc import synthesize_rccc
 from ..synthesis.tasks import get_task
 from . import figures as F
@@ -149,7 +149,7 @@ def section(progress: Progress | None = None) -> Section:
     )
 
     progress("paper D: 3-D viewer of the RCCC")
-    from .motion import sample_motion
+    from ..kinematics.motion import sample_motion
 
     mech = res.linkage
     viewers = (Viewer("Paper D: the synthesised RCCC (a demonstration loop from position 1)", mech,

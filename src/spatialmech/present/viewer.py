@@ -30,7 +30,7 @@ Lengths are in the model's ``length_unit`` (labelled on the axes); nothing here 
 angles.  Example::
 
     from spatialmech import catalog
-    from spatialmech.present.motion import sample_motion
+    from spatialmech.kinematics.motion import sample_motion
     from spatialmech.present.viewer import write_viewer
     mech = catalog.build("bennett")
     write_viewer("bennett.html", mech, sample_motion(mech, n=40))   # ViewerFile(frames=40, ...)

@@ -30,8 +30,10 @@ Method (general for any seven positions):
 3. "choose dyads with small slides" (paper A, section 1): the points of the family with the
    smallest ``max_j |s_j|`` (local minima refined along the curve), greedily picked so that
    they are well separated along the family;
-4. any five dyads form a 5-CS linkage (:func:`assemble_5cs`), checked by solving its closure
-   at the seven positions and by its mobility (:func:`check_5cs`).
+4. any five dyads form a 5-CS linkage (:func:`spatialmech.synthesis.five_cs.assemble_5cs`),
+   checked by solving its closure at the seven positions and by its mobility
+   (:func:`spatialmech.synthesis.five_cs.check_5cs`); :mod:`.five_cs` also checks paper A's
+   section 3 claims.
 
 Internally the unknowns are nondimensional (points relative to the centroid of the task
 points, lengths divided by the task scale ``L`` = RMS distance of the task points from their
@@ -41,6 +43,7 @@ centroid); everything returned is in the task's length unit.  Angles in radians 
 Example (paper A table 9)::
 
     >>> from spatialmech.catalog.papers import five_cs_positions
+    >>> from spatialmech.synthesis.five_cs import assemble_5cs, check_5cs
     >>> fam = synthesize_cs(five_cs_positions(), seed=0)
     >>> len(fam.branches), [round(p.max_abs_slide, 2) for p in fam.picks]
     (9, [5.3, 9.76, 10.9, 11.18, 11.81])
@@ -51,8 +54,7 @@ Example (paper A table 9)::
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import least_squares, minimize_scalar
@@ -61,13 +63,8 @@ from ..errors import InputError
 from ..geometry.rotations import inverse_transform, rotation_angle, transform
 from ..geometry.validate import as_finite_array, as_unit_vector
 from ..kinematics.tracking import EuclideanProblem, correct_on_hyperplane, track
-from ..model.joints import C as Cjoint
-from ..model.joints import S as Sjoint
-from ..model.mechanism import Limb, Mechanism, Pose
-from ..results import BranchEnd, Progress
-
-if TYPE_CHECKING:
-    from ..analysis.defects import DefectResult
+from ..model.mechanism import Pose
+from ..results import BranchEnd
 
 __all__ = [
     "N_POSITIONS",
@@ -75,16 +72,11 @@ __all__ = [
     "CSDyad",
     "CSFamily",
     "CSTask",
-    "FiveCSCheck",
-    "PaperACheck",
     "Projection",
-    "assemble_5cs",
-    "check_5cs",
     "cs_task",
     "dyad_from_limb",
     "dyad_jacobian",
     "dyad_residual",
-    "paper_a_check",
     "pick_small_slides",
     "project_dyad",
     "solve_dyad",
@@ -735,253 +727,3 @@ def project_dyad(task_poses, dyad: CSDyad, *, max_iter: int = 100) -> Projection
         link_length_change=abs(fit.link_length - dyad.link_length),
         converged=bool(ok),
     )
-
-
-# ------------------------------------------------------------------------------ 5-CS linkages
-def assemble_5cs(
-    task_poses, dyads: Sequence[CSDyad], *, name: str = "five-cs-synthesised", length_unit: str = "unit"
-) -> Mechanism:
-    """The 5-CS linkage of five dyads, built exactly like :func:`spatialmech.catalog.papers.five_cs`:
-    limbs ``limb1..limb5`` = [C ``C{i}`` (axis ``u``, point ``B1``), S ``S{i}`` at ``M1``], the
-    rotation of C1 actuated, aliases ``rot{i}``/``slide{i}``; ``platform_point`` = the task
-    point of position 1; reference configuration = position 1 (all joint variables 0);
-    ``positions`` = the task poses relative to position 1."""
-    task = cs_task(task_poses)
-    dyads = tuple(dyads)
-    if len(dyads) != 5:
-        raise InputError(f"dyads: a 5-CS linkage needs exactly 5 dyads, got {len(dyads)}")
-    limbs, aliases = [], {}
-    for i, dy in enumerate(dyads):
-        if not isinstance(dy, CSDyad):
-            raise InputError(f"dyads[{i}]: expected a CSDyad, got {type(dy).__name__}")
-        limbs.append(Limb(f"limb{i + 1}", (
-            Cjoint(f"C{i + 1}", dy.B1, dy.u, normalize=True, actuated=["rot"] if i == 0 else False),
-            Sjoint(f"S{i + 1}", dy.M1),
-        )))
-        aliases[f"rot{i + 1}"] = f"C{i + 1}.rot"
-        aliases[f"slide{i + 1}"] = f"C{i + 1}.slide"
-    return Mechanism(
-        name=name,
-        limbs=tuple(limbs),
-        platform_point=task.reference_point,
-        description="5-CS rigid-body guidance linkage synthesised for seven positions (paper A section 3)",
-        positions=task.relative_poses,
-        aliases=aliases,
-        length_unit=length_unit,
-        source="spatialmech.synthesis.cs_dyads (paper A eqs 22-26)",
-        notes="Reference configuration = task position 1 (slides zero). Drivers rot1..rot5 / slide1..slide5.",
-    )
-
-
-@dataclass(frozen=True, eq=False)
-class FiveCSCheck:
-    """A 5-CS linkage checked at its task positions: for each position the closed configuration
-    nearest to the task pose (:func:`~spatialmech.kinematics.position.configuration_at_pose`),
-    its position error (length unit) and angle error (rad), whether the pose itself closes
-    (``exact``), the C slides found (``slides[j, i]``, limb i at position j) and their
-    difference from the dyads' slides when given; the mobility (dof) of the linkage."""
-
-    position_errors: np.ndarray
-    angle_errors: np.ndarray
-    ik_residuals: np.ndarray
-    exact: np.ndarray
-    converged: np.ndarray
-    slides: np.ndarray
-    slide_errors: np.ndarray | None
-    dof: int
-    dof_instantaneous: int
-    defects: DefectResult | None = None  # the defect analysis of the linkage (None: not run)
-
-    @property
-    def max_pose_error(self) -> float:
-        return float(max(np.max(self.position_errors), np.max(self.angle_errors)))
-
-    @property
-    def ok(self) -> bool:
-        """The linkage closes exactly at every position and has one degree of freedom (it need
-        not be able to *move* through them: see :attr:`success`)."""
-        return bool(np.all(self.exact) and self.dof == 1 and self.dof_instantaneous == 1)
-
-    @property
-    def usable_drivers(self) -> tuple[str, ...]:
-        """Drivers that move the linkage from the first to the last position in order, without a
-        circuit, order or branch defect (empty when the defects were not analysed)."""
-        return tuple(self.defects.usable_drivers) if self.defects is not None else ()
-
-    @property
-    def success(self) -> bool:
-        """:attr:`ok` and defect-free for at least one driver (the defect analysis must have run)."""
-        return self.ok and bool(self.usable_drivers)
-
-    def verdict(self) -> str:
-        """What the check found, in one plain sentence."""
-        if not np.all(self.exact):
-            bad = [f"P{j + 1}" for j, e in enumerate(self.exact) if not e]
-            return f"not a solution: the linkage does not reach {', '.join(bad)} exactly"
-        if self.dof != 1 or self.dof_instantaneous != 1:
-            return f"not a guidance linkage: mobility {self.dof} (instantaneous {self.dof_instantaneous}) instead of 1"
-        d = self.defects
-        if d is None:
-            return "closes at every position with one degree of freedom; defects NOT analysed, so not known to be usable"
-        if self.usable_drivers:
-            return (f"success: defect-free when driven by {', '.join(self.usable_drivers)} (no circuit, order or "
-                    "branch defect)")
-        problems = []
-        if d.circuit_defect:
-            circ = "; ".join("{" + ", ".join(f"P{i}" for i in c) + "}" for c in d.circuits)
-            problems.append(f"circuit defect: the positions lie on {len(d.circuits)} separate circuits ({circ}), so no "
-                            "driver can move the linkage through all of them")
-        if d.order_defect:
-            problems.append("order defect: along the circuit the positions are met in the order "
-                            + ", ".join(f"P{i}" for i in d.order))
-        if not problems:
-            branch = [v.driver for v in d.drivers if v.branch_defect]
-            problems.append(f"branch defect for every driver ({', '.join(branch) or 'none usable'})"
-                            + (": a plan switching drivers along the path exists" if d.plan else ""))
-        return "FAILED: " + "; ".join(problems)
-
-    def to_dict(self) -> dict:
-        return {
-            "position_errors_len": self.position_errors.tolist(),
-            "angle_errors_deg": np.degrees(self.angle_errors).tolist(),
-            "ik_residuals": self.ik_residuals.tolist(),
-            "exact": self.exact.tolist(),
-            "converged": self.converged.tolist(),
-            "slides_len": self.slides.tolist(),
-            "max_slide_error_len": None if self.slide_errors is None else float(np.max(np.abs(self.slide_errors))),
-            "dof": self.dof,
-            "dof_instantaneous": self.dof_instantaneous,
-            "ok": self.ok,
-            "defects_analysed": self.defects is not None,
-            "circuit_defect": None if self.defects is None else bool(self.defects.circuit_defect),
-            "order_defect": None if self.defects is None else bool(self.defects.order_defect),
-            "branch_defect_drivers": None if self.defects is None else [v.driver for v in self.defects.drivers
-                                                                         if v.branch_defect],
-            "usable_drivers": list(self.usable_drivers),
-            "success": self.success,
-            "verdict": self.verdict(),
-            "defects": None if self.defects is None else self.defects.to_dict(),
-        }
-
-
-def _cs_start(mech: Mechanism, pose: Pose):
-    """Closed-form joint values of a mechanism of C-S limbs at a pose (the start of the pose
-    fit; Gauss-Newton from all-zero joint values can stop at a wrong local minimum when a C
-    rotation is near 180 degrees).  Per limb: slide ``s = u . (M_j - M1)``, rotation = signed
-    angle about ``u`` from ``M1 - B1`` to ``M_j - B1 - s u`` (perpendicular parts), S rotation
-    vector of ``R_u(theta)^T R``.  ``None`` when a limb is not [C, S]."""
-    from scipy.spatial.transform import Rotation
-
-    from ..kinematics.closure import Configuration
-
-    D = pose.displacement(mech.platform_point)
-    q = []
-    for lb in mech.limbs:
-        if [j.type for j in lb.joints] != ["C", "S"]:
-            return None
-        c, sj = lb.joints
-        u = c.freedoms[0].direction
-        B1, M1 = c.point, sj.point
-        Mj = D[:3, :3] @ M1 + D[:3, 3]
-        s = float(u @ (Mj - M1))
-        a = (M1 - B1) - (u @ (M1 - B1)) * u
-        b = (Mj - B1 - s * u) - (u @ (Mj - B1 - s * u)) * u
-        th = float(np.arctan2(u @ np.cross(a, b), a @ b))
-        Rs = Rotation.from_rotvec(-th * u).as_matrix() @ D[:3, :3]
-        A = np.array([f.direction for f in sj.freedoms]).T
-        q += [th, s, *(A.T @ Rotation.from_matrix(Rs).as_rotvec())]
-    return Configuration(np.array(q), D)
-
-
-def check_5cs(mech: Mechanism, dyads: Sequence[CSDyad] | None = None, *, defects: bool = False,
-              progress: Progress | None = None) -> FiveCSCheck:
-    """Solve ``mech`` (from :func:`assemble_5cs` or the catalog) at each of its positions and
-    compute its mobility (see :class:`FiveCSCheck`).  ``defects=True`` also runs the defect
-    analysis (:func:`spatialmech.analysis.defects.defect_analysis`: circuits, order, branch
-    points for every candidate driver; about a minute) when the linkage closes with one degree
-    of freedom: a synthesised linkage is a success only if it is defect-free for at least one
-    driver (:attr:`FiveCSCheck.success`)."""
-    from ..analysis.mobility import mobility
-    from ..kinematics.position import configuration_at_pose, freedom_values
-
-    if not mech.positions:
-        raise InputError(f"mech: {mech.name} has no task positions to check")
-    ids = [r.id for r in mech.freedom_refs]
-    sl_idx = [ids.index(f"{lb.joints[0].name}.slide") for lb in mech.limbs]
-    pe, ae, ik, ex, cv, sl = [], [], [], [], [], []
-    for P in mech.positions:
-        fit = configuration_at_pose(mech, P, start=_cs_start(mech, P))
-        pe.append(fit.position_error)
-        ae.append(fit.angle_error)
-        ik.append(fit.ik_residual)
-        ex.append(fit.exact)
-        cv.append(fit.converged)
-        sl.append(freedom_values(mech, fit.config.q)[sl_idx])
-    sl = np.array(sl)
-    errs = None
-    if dyads is not None:
-        errs = sl - np.array([d.slides for d in dyads]).T
-    mob = mobility(mech)
-    out = FiveCSCheck(np.array(pe), np.array(ae), np.array(ik), np.array(ex), np.array(cv), sl, errs, int(mob.dof),
-                      int(mob.dof_instantaneous))
-    if defects and out.ok:
-        from ..analysis.defects import defect_analysis
-
-        out = replace(out, defects=defect_analysis(mech, progress=progress))
-    return out
-
-
-# ------------------------------------------------------------------------------ paper A claims
-@dataclass(frozen=True, eq=False)
-class PaperACheck:
-    """Paper A's section 3 claims on the data of table 9 and linkages 1-3 (tables 1-13).
-
-    ``printed``: per linkage, per limb, the printed limb as a dyad (its ``residual`` = largest
-    |eq 24| as a length difference and |eq 25|, from the 3-decimal rounding); ``projections``:
-    each printed limb projected onto the family; ``refitted``: each paper linkage rebuilt from
-    its projected limbs, checked at the seven positions; ``family`` and ``synthesised``: the
-    family of table 9 and the check of the 5-CS from its five picked dyads."""
-
-    printed: dict
-    projections: dict
-    refitted: dict
-    family: CSFamily
-    synthesised: FiveCSCheck
-
-    def to_dict(self) -> dict:
-        return {
-            "printed_residuals_len": {k: [d.residual for d in v] for k, v in self.printed.items()},
-            "projections": {k: [p.to_dict() for p in v] for k, v in self.projections.items()},
-            "refitted": {k: v.to_dict() for k, v in self.refitted.items()},
-            "family": self.family.to_dict(samples=20),
-            "synthesised": self.synthesised.to_dict(),
-        }
-
-
-def paper_a_check(positions, linkages: dict, *, n_starts: int = 60, seed: int = 0, refit: bool = True,
-                  family: CSFamily | None = None) -> PaperACheck:
-    """Everything needed for paper A's section 3 claims (see :class:`PaperACheck`) on the data
-    given: ``positions`` (table 9) and ``linkages`` (tables 1-13 by linkage number: ``u``,
-    ``B1``, ``M_by_position``, ``s`` per limb; the catalogue's ``five_cs_data()["linkages"]``);
-    ``family``: a family of table 9 already synthesised with five picks (else it is synthesised
-    here).  The data are passed in: the numerical core does not read the catalogue."""
-    task = cs_task(positions)
-    data = linkages
-    if not isinstance(data, dict) or not data:
-        raise InputError(f"linkages: expected the paper's linkages by number, got {type(data).__name__}")
-    printed, proj, refitted = {}, {}, {}
-    for k in sorted(data):
-        lk = data[k]
-        dys = tuple(
-            dyad_from_limb(task, lk["u"][i], lk["B1"][i], lk["M_by_position"][0][i], lk["s"][i]) for i in range(5)
-        )
-        printed[k] = dys
-        proj[k] = tuple(project_dyad(task, d) for d in dys)
-        if refit:
-            fitted = tuple(p.fitted for p in proj[k])
-            refitted[k] = check_5cs(assemble_5cs(task, fitted, name=f"five-cs-{k}-refitted"), fitted)
-    fam = family if family is not None else synthesize_cs(task, n_starts=n_starts, seed=seed, pick=5)
-    if len(fam.picks) != 5:
-        raise InputError(f"family: expected 5 picked dyads, got {len(fam.picks)}")
-    synth = check_5cs(assemble_5cs(task, fam.picks), fam.picks)
-    return PaperACheck(printed, proj, refitted, fam, synth)

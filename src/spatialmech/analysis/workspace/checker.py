@@ -10,8 +10,8 @@ import numpy as np
 from ...errors import InputError
 from ...model.mechanism import Mechanism, Pose
 from .limits import (
-    _CLOSURE,
-    _POSITION,
+    CLOSURE,
+    POSITION_COORDINATES,
     WorkspaceLimits,
     default_limits,
 )
@@ -266,7 +266,7 @@ def pose_checker(mech: Mechanism, limits: WorkspaceLimits | None = None, *, meth
     offs = np.array([r.freedom.offset for r in refs])
     L = mech.characteristic_length
     n_links = len(links)
-    names = [*names, _CLOSURE]
+    names = [*names, CLOSURE]
     scale = np.array([*scale, L])
 
     if not isinstance(plan, str):
@@ -328,7 +328,7 @@ def pose_checker(mech: Mechanism, limits: WorkspaceLimits | None = None, *, meth
             if item[0] == "cu" and np.linalg.norm(item[3]) < 1e-12 * L:
                 axis_k = np.flatnonzero(np.abs(np.abs(item[2]) - 1.0) < 1e-12)
                 if axis_k.size == 1:
-                    pinned.update({_POSITION[i]: float(item[1][i]) for i in range(3) if i != axis_k[0]})
+                    pinned.update({POSITION_COORDINATES[i]: float(item[1][i]) for i in range(3) if i != axis_k[0]})
         return PoseChecker(mech, limits, "closed-form", tuple(names), scale, fn, "", pinned, fn_feasible)
 
     from ...kinematics.closure import hub_displacements, limb_slices

@@ -15,13 +15,16 @@ from ...model.mechanism import Mechanism
 ORIENTATION_SEQUENCE = "ZYX"
 #: Pose coordinates: position of the platform point (m) and the three angles (rad).
 COORDINATES = ("x", "y", "z", "alpha", "beta", "gamma")
-_POSITION = COORDINATES[:3]
-_ORIENTATION = COORDINATES[3:]
+#: The position coordinates (m) and the orientation coordinates (rad) among :data:`COORDINATES`.
+POSITION_COORDINATES = COORDINATES[:3]
+ORIENTATION_COORDINATES = COORDINATES[3:]
 #: Paper B eq 22 and section 6: link diameters ``D_min = 0.008 m <= D_i <= D_max = 0.01 m``.
 PAPER_B_LINK_DIAMETERS = (0.008, 0.01)
 
-_BOX = "box"
-_CLOSURE = "closure"
+#: The active limit of a boundary point that is the sampling box's own bound (no limit met
+#: inside it), and the name of the margin that says whether a pose closes.
+BOX = "box"
+CLOSURE = "closure"
 
 
 # ------------------------------------------------------------------------------ limits

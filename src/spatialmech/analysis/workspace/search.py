@@ -19,11 +19,11 @@ from .checker import (
     pose_checker,
 )
 from .limits import (
-    _BOX,
-    _ORIENTATION,
-    _POSITION,
+    BOX,
     COORDINATES,
+    ORIENTATION_COORDINATES,
     ORIENTATION_SEQUENCE,
+    POSITION_COORDINATES,
     WorkspaceLimits,
 )
 
@@ -110,15 +110,15 @@ class WorkspaceResult:
         free coordinates (``volume_deg2`` ...).  ``boundary`` adds the refined boundary points.
         """
         def key(c: str) -> str:
-            return f"{c}_deg" if c in _ORIENTATION else f"{c}_len"
+            return f"{c}_deg" if c in ORIENTATION_COORDINATES else f"{c}_len"
 
         def conv(c: str, v: float) -> float:
-            return float(np.degrees(v)) if c in _ORIENTATION else float(v)
+            return float(np.degrees(v)) if c in ORIENTATION_COORDINATES else float(v)
 
         def pair(c: str, e) -> list[float] | None:
             return None if e is None else [conv(c, e.lo), conv(c, e.hi)]
 
-        codes = {"deg" if c in _ORIENTATION else "len" for c in self.free}
+        codes = {"deg" if c in ORIENTATION_COORDINATES else "len" for c in self.free}
         if len(codes) != 1:
             raise InputError(f"free: expected angles only or positions only, got {list(self.free)}")
         code = codes.pop()
@@ -278,8 +278,8 @@ def _refine_runs(ev, F, grid, axis, tol):
     i1 = ends[:, -1] - 1
     lo = grid[axis][i0].astype(float)
     hi = grid[axis][i1].astype(float)
-    lo_lim = np.array([_BOX] * len(i0), dtype=object)
-    hi_lim = np.array([_BOX] * len(i1), dtype=object)
+    lo_lim = np.array([BOX] * len(i0), dtype=object)
+    hi_lim = np.array([BOX] * len(i1), dtype=object)
     xin_lo = points(lines, i0)
     xin_hi = points(lines, i1)
     for _side, idx, nb, arr, lim, xin in (("lo", i0, i0 - 1, lo, lo_lim, xin_lo), ("hi", i1, i1 + 1, hi, hi_lim, xin_hi)):
@@ -448,7 +448,7 @@ def _analyse(mech, kind, free, values, bounds, step, tol, limits, method, chunk,
         if polish and checker.path == "closed-form":
             bnds = [tuple(bounds[cc]) for cc in free]
             for side, (x0, sign) in enumerate(((xin_lo[i], -1.0), (xin_hi[j], 1.0))):
-                if lims[side] == _BOX:
+                if lims[side] == BOX:
                     continue
                 got = _polished_extent(ev, checker, x0, k, sign, bnds, tolv, stepv)
                 if got is not None and sign * (got[0] - ext[side]) > 0.0:
@@ -457,9 +457,9 @@ def _analyse(mech, kind, free, values, bounds, step, tol, limits, method, chunk,
         extents[c] = Extent(ext[0], ext[1], lims[0], lims[1])
         method_used[c] = how
     if d == 1:
-        volume_unit = "rad" if free[0] in _ORIENTATION else "m"
+        volume_unit = "rad" if free[0] in ORIENTATION_COORDINATES else "m"
     else:
-        us = ["rad" if c in _ORIENTATION else "m" for c in free]
+        us = ["rad" if c in ORIENTATION_COORDINATES else "m" for c in free]
         volume_unit = " ".join(f"{u}^{us.count(u)}" if us.count(u) > 1 else u for u in dict.fromkeys(us))
     if kind == "orientation":
         volume_unit += " (Euler-angle coordinates alpha, beta, gamma; not the Haar measure of SO(3))"
@@ -482,8 +482,8 @@ def _refine_line(ev, F1, X, k, tolv):
     starts, ends = _line_runs(F1, 0)
     i0, i1 = starts[:, -1], ends[:, -1] - 1
     lo, hi = X[i0, k].astype(float), X[i1, k].astype(float)
-    lo_lim = np.array([_BOX] * i0.size, dtype=object)
-    hi_lim = np.array([_BOX] * i1.size, dtype=object)
+    lo_lim = np.array([BOX] * i0.size, dtype=object)
+    hi_lim = np.array([BOX] * i1.size, dtype=object)
     n = X.shape[0]
     for idx, nb, arr, lim in ((i0, i0 - 1, lo, lo_lim), (i1, i1 + 1, hi, hi_lim)):
         sel = np.flatnonzero((nb >= 0) & (nb < n))
@@ -514,7 +514,7 @@ MAX_DISTANCE = 1e6
 
 def _check_position_range(mech: Mechanism, fixed: Mapping[str, float]) -> None:
     L = mech.characteristic_length
-    for i, c in enumerate(_POSITION):
+    for i, c in enumerate(POSITION_COORDINATES):
         if c in fixed and abs(fixed[c] - float(mech.platform_point[i])) > MAX_DISTANCE * L:
             raise InputError(f"at.{c}: {fixed[c]:g} is more than {MAX_DISTANCE:g} times the size of {mech.name} "
                              f"({L:.3g} m) from its reference platform point: out of range")
@@ -573,10 +573,10 @@ def orientation_workspace(
     _check_position_range(mech, fixed)
     step = _check_positive(step, "step")
     tol = _check_positive(tol, "tol")
-    values = {c: float(mech.platform_point[i]) for i, c in enumerate(_POSITION)}
-    values.update(dict.fromkeys(_ORIENTATION, 0.0))
+    values = {c: float(mech.platform_point[i]) for i, c in enumerate(POSITION_COORDINATES)}
+    values.update(dict.fromkeys(ORIENTATION_COORDINATES, 0.0))
     values.update(fixed)
-    free = tuple(c for c in _ORIENTATION if c not in fixed)
+    free = tuple(c for c in ORIENTATION_COORDINATES if c not in fixed)
     if not free:
         raise InputError("at: every angle is fixed; nothing to sample")
     default = {"alpha": (-np.pi, np.pi), "beta": (-np.pi / 2, np.pi / 2), "gamma": (-np.pi, np.pi)}
@@ -613,13 +613,13 @@ def position_workspace(
     step = L / 40 if step is None else _check_positive(step, "step")
     tol = L * 1e-6 if tol is None else _check_positive(tol, "tol")
     checker_probe = pose_checker(mech, limits, method=method)
-    values = {c: float(mech.platform_point[i]) for i, c in enumerate(_POSITION)}
-    values.update(dict.fromkeys(_ORIENTATION, 0.0))
+    values = {c: float(mech.platform_point[i]) for i, c in enumerate(POSITION_COORDINATES)}
+    values.update(dict.fromkeys(ORIENTATION_COORDINATES, 0.0))
     for c, v in checker_probe.pinned.items():
         if c not in fixed:
             fixed[c] = v
     values.update(fixed)
-    free = tuple(c for c in _POSITION if c not in fixed)
+    free = tuple(c for c in POSITION_COORDINATES if c not in fixed)
     if not free:
         raise InputError("at: every position coordinate is fixed; nothing to sample")
     default = {c: (values[c] - 2 * L, values[c] + 2 * L) for c in free}

@@ -53,15 +53,13 @@ from ...model.mechanism import Mechanism
 from ...model.task import TaskCoordinates
 from ...results import Progress, check_progress
 from .checker import ConfigurationChecker, configuration_checker
-from .limits import WorkspaceLimits, default_limits
+from .limits import BOX, CLOSURE, WorkspaceLimits, default_limits
 from .search import Extent
 
 __all__ = ["TASK_PATH", "TaskWorkspaceResult", "euler_convention", "task_workspace"]
 
 #: The ``path`` of a task-coordinate workspace (closed-form and general are the pose paths).
 TASK_PATH = "task-continuation"
-CLOSURE = "closure"
-BOX = "box"
 
 
 def euler_convention(seq: str) -> str:

@@ -1,12 +1,13 @@
-"""A demonstration motion for the 3-D viewer: a short loop along the closure manifold.
+"""The tangent space of the closure manifold, and a demonstration motion along it: a short loop
+of closed configurations (what the 3-D viewer animates for a model of any mobility).
 
-This is **not** the continuation tracker (``kinematics/tracking.py``): it does no
-driver-controlled tracking, no branch or singularity handling and no step-size control beyond
-halving a failed step.  It exists so that the viewer (:mod:`.viewer`) has something honest to
-animate for any model: every configuration it returns satisfies the closure equations of
-:mod:`..kinematics.closure` (checked by :func:`..kinematics.closure.correct`), and the viewer
-accepts any list of :class:`~..kinematics.closure.Configuration` so that tracked paths can be
-shown the same way.
+This is **not** the continuation tracker (:mod:`.tracking`): it does no driver-controlled
+tracking, no branch or singularity handling and no step-size control beyond halving a failed
+step.  It exists so that the viewer (:mod:`spatialmech.present.viewer`, which only draws) has
+something honest to animate for any model: every configuration it returns satisfies the closure
+equations of :mod:`.closure` (checked by :func:`.closure.correct`), and the viewer accepts any
+list of :class:`~.closure.Configuration` so that tracked paths can be shown the same way (the
+circuit of a one-degree-of-freedom linkage: :func:`spatialmech.analysis.traced_motion.traced_motion`).
 
 The walk
 --------
@@ -23,7 +24,7 @@ flips), scaled so that its platform part ``(w ; v / L)`` has unit norm: the walk
 Frame ``i`` of ``n`` sits at ``s_i = amplitude * sin(2 pi i / n)``: from the start out to
 ``+amplitude``, back through the start to ``-amplitude`` and back.  Configurations are computed
 once per distinct ``s`` by predictor (``x + ds t``) and Newton corrector
-(:func:`~..kinematics.closure.correct`), walking outwards from the start on each side, so the
+(:func:`~.closure.correct`), walking outwards from the start on each side, so the
 loop closes exactly (frame ``i`` and frame ``n/2 - i`` are the same configuration).
 """
 
@@ -33,7 +34,7 @@ import numpy as np
 
 from ..errors import ConvergenceError, InputError
 from ..geometry.validate import as_finite_array
-from ..kinematics.closure import (
+from .closure import (
     Configuration,
     active_mask,
     closure_jacobian,
@@ -46,7 +47,7 @@ from ..model.mechanism import Mechanism
 __all__ = ["sample_motion", "tangent_space"]
 
 #: Relative singular-value threshold for the rank of the nondimensional closure Jacobian
-#: (the same as :func:`..kinematics.closure.generic_configuration`).
+#: (the same as :func:`.closure.generic_configuration`).
 RANK_RTOL = 1e-9
 #: Largest predictor step (nondimensional platform motion) before a Newton correction.
 MAX_STEP = 0.05
@@ -60,7 +61,7 @@ def tangent_space(mech: Mechanism, config: Configuration, *, active: np.ndarray 
     Returns ``N`` (k, n_active + 6): rows span the null space of the nondimensional closure
     Jacobian, in nondimensional coordinates (joint rotations in rad, slides / L, platform twist
     ``(w ; v / L)``, the last six columns).  Multiply by the column scaling of
-    :func:`..kinematics.closure.correct` to get SI steps.
+    :func:`.closure.correct` to get SI steps.
     """
     if active is None:
         active = active_mask(mech)
@@ -176,27 +177,3 @@ def sample_motion(
     at.update(zip(pos.tolist(), _walk(mech, x0, t0, amplitude * pos, active, col), strict=True))
     at.update(zip(neg.tolist(), _walk(mech, x0, t0, amplitude * neg, active, col), strict=True))
     return [at[float(k)] for k in keys]
-
-
-def traced_motion(mech: Mechanism, *, frames: int = 60, start: Configuration | None = None):
-    """The circuit of a one-degree-of-freedom mechanism through ``start`` (default: the reference),
-    followed by the continuation tracker and subsampled to ``frames`` configurations, with the
-    platform points where DJ of the first actuator vanishes (its branch points).
-
-    Raises ``RuntimeError`` when the tracker cannot follow the motion."""
-    from ..analysis.defects import dj_function
-    from ..kinematics.tracking import trace_motion
-
-    start = start if start is not None else Configuration.reference(mech)
-    acts = list(mech.actuators[:1])
-    mon = None
-    if acts:
-        f, _ = dj_function(mech, acts, start)
-        mon = (acts, f)
-    tr = trace_motion(mech, start, increasing=acts[0] if acts else None, vector_monitor=mon, max_arc=400)
-    if not tr.ok:
-        raise ConvergenceError(f"the tracker stopped: {tr.message}")
-    idx = np.unique(np.linspace(0, len(tr.points) - 1, min(frames, len(tr.points))).round().astype(int))
-    configs = [tr.points[i] for i in idx]
-    sing = tuple(e.x for e in tr.events if e.kind == "zero")
-    return configs, sing

@@ -1,4 +1,4 @@
-"""Figures of the RCCC synthesis (Matplotlib, Agg canvas, written to files; never shown).
+"""Figures of the RCCC synthesis, paper D (Matplotlib, Agg canvas, written to files; never shown).
 
 Every function takes result objects and a path, writes one PNG (or any format Matplotlib
 infers from the suffix) and returns the path.  Angles on axes are labelled in degrees,
@@ -15,10 +15,10 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Patch
 
 from ..kinematics.closure import Configuration, joint_points
-from .burmester import BurmesterCurves, poles
-from .rccc import RCCCResult
-from .regions import TYPES, Region1, Region2
-from .tasks import TaskPositions
+from ..synthesis.burmester import BurmesterCurves, poles
+from ..synthesis.rccc import RCCCResult
+from ..synthesis.regions import TYPES, Region1, Region2, solution_region_2
+from ..synthesis.tasks import TaskPositions
 
 __all__ = ["plot_curves", "plot_linkage", "plot_region1", "plot_region2", "plot_solution_lines", "write_all"]
 
@@ -165,8 +165,6 @@ def plot_linkage(res: RCCCResult, path) -> Path:
 def write_all(res: RCCCResult, out_dir, *, n: int = 121) -> list[Path]:
     """All figures of a synthesis into ``out_dir``: curves, region 1, solution lines, region 2,
     linkage.  Region 2 spans ``+-2`` task length scales around the chosen dyads."""
-    from .regions import solution_region_2
-
     out = Path(out_dir)
     span = 2.0 * res.task.length_scale
     r2 = solution_region_2(

@@ -1,0 +1,190 @@
+"""Circuit geometry for the defect analysis (:func:`spatialmech.analysis.defects.defect_analysis`):
+tracing a circuit with its DJ monitor, where a configuration or a printed pose lies on a traced
+curve, the fewest circuits that hold every position, which positions bracket an arc along the
+path, and the driver-switching plan of a multi-drive (paper A section 6).
+
+These are steps of the defect analysis, public so that the analysis module can import them; the
+results of the analysis are its own (:class:`~spatialmech.analysis.defects.DefectResult`).
+Arcs are the nondimensional arc length of the tracked curve (joint rad, lengths / L).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from itertools import combinations
+
+import numpy as np
+
+from ..geometry.rotations import rotation_angle
+from ..kinematics.closure import Configuration
+from ..kinematics.tracking import MotionProblem, TrackResult, correct_on_hyperplane, track
+from ..model.mechanism import Mechanism, Pose
+from ..results import Progress
+
+__all__ = [
+    "arc_on_curve",
+    "fewest_circuits",
+    "pose_distance",
+    "positions_between",
+    "switching_plan",
+    "trace_circuit",
+]
+
+
+def trace_circuit(mech: Mechanism, start: Configuration, names: list[str], djf: Callable, max_arc: float,
+                  h0: float, progress: Progress | None = None) -> tuple[MotionProblem, TrackResult]:
+    """The circuit of ``mech`` through ``start``, traced by the continuation tracker with the DJ
+    of every driver in ``names`` (``djf``: configuration -> array, one value per driver) as a
+    vector monitor, so that its zeros (branch points) and poles become events of the track."""
+    prob = MotionProblem(mech)
+    tr = track(prob, start, vector_monitor=(names, djf), max_arc=max_arc, h0=h0, event_tol=1e-9,
+               progress=progress)
+    return prob, tr
+
+
+def arc_on_curve(problem: MotionProblem, tr: TrackResult, config: Configuration, tol: float) -> float | None:
+    """Arc length of ``config`` on the traced curve ``tr``, or ``None`` when it is not on it
+    (its distance from the curve, nondimensional, is ``tol`` or more).
+
+    The nearest sample and its neighbours are each corrected onto the curve along their tangent
+    (the hyperplane through ``config``); the closest corrected point gives the arc."""
+    d = np.array([np.linalg.norm(problem.difference(x, config)) for x in tr.points])
+    k0 = int(np.argmin(d))
+    best: tuple[float, float | None] = (np.inf, None)
+    for k in {max(0, k0 - 1), k0, min(len(tr.points) - 1, k0 + 1)}:
+        x, t = tr.points[k], tr.tangents[k]
+        a = float(t @ problem.difference(x, config))
+        xs, ok, _, _ = correct_on_hyperplane(problem, problem.retract(x, a * t), t, 1e-11, 30)
+        if not ok:
+            continue
+        dist = float(np.linalg.norm(problem.difference(xs, config)))
+        if dist < best[0]:
+            best = (dist, tr.s[k] + a)
+    return best[1] if best[0] < tol else None
+
+
+def _pose_of(mech: Mechanism, x: Configuration):
+    """Orientation and platform point of the output link in configuration ``x``."""
+    D = x.D
+    return D[:3, :3], D[:3, :3] @ mech.platform_point + D[:3, 3]
+
+
+def pose_distance(mech: Mechanism, prob: MotionProblem, tr: TrackResult, pose: Pose, pose_tol: float,
+                  angle_tol: float) -> tuple[float, float, float, float]:
+    """Distance of a printed pose from a traced curve, normalised by the tolerances
+    (``hypot(|dp| / pose_tol, dtheta / angle_tol)``, ``angle_tol`` in rad), refined along the
+    curve between samples by golden-section search.  Returns (normalised distance, arc, |dp|,
+    dtheta)."""
+
+    def meas(x):
+        R, p = _pose_of(mech, x)
+        dp = float(np.linalg.norm(p - pose.p))
+        th = float(rotation_angle(R @ pose.R.T))
+        return float(np.hypot(dp / pose_tol, th / angle_tol)), dp, th
+
+    vals = [meas(x)[0] for x in tr.points]
+    k0 = int(np.argmin(vals))
+    best = (vals[k0], float(tr.s[k0]), *meas(tr.points[k0])[1:])
+    for k in (k0 - 1, k0):
+        if k < 0 or k + 1 >= len(tr.points):
+            continue
+        x, t, h = tr.points[k], tr.tangents[k], float(tr.s[k + 1] - tr.s[k])
+        g = (np.sqrt(5) - 1) / 2
+        lo, hi = 0.0, h
+        cache: dict[float, tuple[float, float, float]] = {}
+
+        def at(a, x=x, t=t, cache=cache):
+            if a not in cache:
+                xa, ok, _, _ = correct_on_hyperplane(prob, prob.retract(x, a * t), t, 1e-11, 20)
+                cache[a] = meas(xa) if ok else (np.inf, np.inf, np.inf)
+            return cache[a]
+
+        for _ in range(30):
+            a1, a2 = hi - g * (hi - lo), lo + g * (hi - lo)
+            if at(a1)[0] < at(a2)[0]:
+                hi = a2
+            else:
+                lo = a1
+        a = 0.5 * (lo + hi)
+        m = at(a)
+        if m[0] < best[0]:
+            best = (m[0], float(tr.s[k] + a), m[1], m[2])
+    return best
+
+
+def fewest_circuits(D: np.ndarray) -> list[int]:
+    """Fewest circuits (rows of ``D``) covering every position (column) within tolerance
+    (``D <= 1``, the normalised distances of :func:`pose_distance`); ties broken by the smallest
+    total distance.  Positions no circuit covers keep their own (the nearest).  Sorted indices."""
+    nC, nP = D.shape
+    need = [j for j in range(nP) if np.any(D[:, j] <= 1.0)]
+    for size in range(1, nC + 1):
+        best = None
+        for sub in combinations(range(nC), size):
+            if all(np.any(D[list(sub), j] <= 1.0) for j in need):
+                cost = sum(np.min(D[list(sub), j]) for j in need)
+                if best is None or cost < best[0]:
+                    best = (cost, list(sub))
+        if best is not None:
+            chosen = best[1]
+            for j in range(nP):  # positions out of tolerance everywhere: their own circuit
+                if j not in need:
+                    chosen.append(int(np.argmin(D[:, j])))
+            return sorted(set(chosen))
+    return list(range(nC))
+
+
+def positions_between(arc: float, arcs: list[float]) -> tuple[int, int] | None:
+    """Positions (from 1) whose arcs bracket ``arc`` on the path (``arcs`` sorted along the
+    path), or ``None`` outside them."""
+    for j in range(len(arcs) - 1):
+        if arcs[j] <= arc <= arcs[j + 1]:
+            return (j + 1, j + 2)
+    return None
+
+
+def switching_plan(drivers: list[str], zeros: dict[str, list[float]], a: float, b: float):
+    """Fewest driver switches covering the path ``[a, b]`` with no driver passing its own DJ
+    zero (``zeros``: the arcs of each driver's zeros on the path).
+
+    Greedy: from the current arc, take the driver that goes furthest before its next zero; it
+    must be switched before that zero, after the last zero of the next driver, in the middle of
+    that window.  Returns ``[driver, from_arc, to_arc, switch_window or None]`` per step, or
+    ``None`` when no plan exists (or it needs more than 20 steps)."""
+    steps: list[list] = []
+    c = a
+    current = None
+    guard = 0
+    while guard < 20:
+        guard += 1
+        reach = {}
+        for d in drivers:
+            nxt = [z for z in zeros[d] if z > c + 1e-12]
+            reach[d] = min(nxt) if nxt else np.inf
+        if current is None:
+            current = max(drivers, key=lambda d: reach[d])
+        r = reach[current]
+        if r >= b:
+            steps.append([current, c, b, None])
+            return steps
+        # next driver: regular on (w, its next zero) with w < r
+        best, best_reach, best_lo = None, -np.inf, None
+        for d in drivers:
+            if d == current:
+                continue
+            before = [z for z in zeros[d] if z < r]
+            lo = max([c, *before])
+            if lo >= r:
+                continue
+            nxt = [z for z in zeros[d] if z > lo + 1e-12]
+            rd = min(nxt) if nxt else np.inf
+            # furthest reach first; on a tie the widest switching window
+            if rd > best_reach or (rd == best_reach and best_lo is not None and lo < best_lo):
+                best, best_reach, best_lo = d, rd, lo
+        if best is None or best_lo is None or best_reach <= r:  # best_lo is set with best
+            return None
+        c_new = 0.5 * (best_lo + r)  # switch in the middle of the window
+        steps.append([current, c, c_new, (best_lo, r)])
+        c = c_new
+        current = best
+    return None

@@ -1,0 +1,553 @@
+"""The public API: position, Jacobian, velocity, singularity, workspace and parasitic motion
+(``sm.ik``, ``sm.fk``, ``sm.jacobian``, ``sm.velocity``, ``sm.singularity``, ``sm.workspace``,
+``sm.parasitic``)."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import InputError, describe
+from ..geometry.tolerances import resolve as resolve_tolerances
+from ..kinematics.closure import Configuration
+from ..kinematics.jacobian import CompleteJacobian, complete_jacobian
+from ..kinematics.position import (
+    ForwardResult,
+    InverseResult,
+    PoseFit,
+    configuration_at_pose,
+    forward_position,
+    inverse_position,
+    platform_pose,
+)
+from ..kinematics.task import TaskJacobian, TaskSolution, solve_pose, task_jacobian_at, task_solution_dict
+from ..model.mechanism import Mechanism, Pose
+from ..results import Progress
+from ..serialize import pose_dict
+from .checks import (
+    ModelLike,
+    as_configuration,
+    as_mechanism,
+    as_pose,
+    check_bool,
+    check_choice,
+    check_int,
+    check_names,
+    check_number,
+    check_numbers,
+    check_path,
+    optional_progress,
+    pose_sequence,
+)
+
+
+#: The note on ``pose_fit`` in the JSON of ``ik`` (as ``spatialmech ik --json``).
+_IK_FIT_NOTE = ("the pose does not close exactly (printed, rounded data?); pose_fit is the nearest closed "
+                "configuration (configuration_at_pose); within the tolerance (pose_error: the larger of the "
+                "angle error in rad and the position error over the characteristic length) the pose is "
+                "reachable and the solutions are those of the fitted pose")
+
+
+@dataclass(frozen=True, eq=False)
+class IKResult:
+    """Inverse position: every limb's joint values for one platform pose (:attr:`result`).
+
+    A pose that does not close exactly (printed, rounded data) is fitted onto the closure:
+    :attr:`pose_fit` says how far the nearest closed configuration is; within the
+    ``reachability`` tolerance the pose counts as reachable (``result.fitted``)."""
+
+    mechanism: Mechanism
+    pose: Pose
+    result: InverseResult
+    position: int | None = None
+    reachability: float = 0.0  # the reachability tolerance used (nondimensional)
+    #: With ``free``: the task solve (the coordinates held and the parasitic ones solved).
+    task: TaskSolution | None = None
+
+    @property
+    def reachable(self) -> bool:
+        return self.result.reachable
+
+    @property
+    def pose_fit(self) -> PoseFit | None:
+        return self.result.pose_fit
+
+    @property
+    def config(self) -> Configuration | None:
+        """The configuration of the first solution of every limb (``None`` if not reachable)."""
+        return self.result.config
+
+    @property
+    def actuators(self) -> dict[str, float]:
+        """Actuator values (SI: rad, length), by freedom id; raises when not reachable."""
+        return self.result.actuator_values(self.mechanism)
+
+    def to_dict(self) -> dict:
+        d = self.result.to_dict(self.mechanism)
+        fit = self.pose_fit
+        d["pose_fit"] = None if fit is None else {**fit.to_dict(), "tolerance": self.reachability, "note": _IK_FIT_NOTE}
+        d["task"] = None if self.task is None else task_solution_dict(self.task)
+        return d
+
+
+def ik(model: ModelLike, pose, *, all_solutions: bool = False, n_seeds: int = 48, seed: int = 0,
+       degrees: bool = False, tol=None, free=None) -> IKResult:
+    """Inverse position: the joint values of every limb for a platform pose.
+
+    ``all_solutions``: also ``n_seeds`` random starts per limb (every real solution it finds).
+    ``tol``: a :class:`~spatialmech.geometry.tolerances.Tolerances` or the closure tolerance.
+    ``free``: task coordinates to solve (names from ``x, y, z, a1, a2, a3``; angles in the pose's
+    Euler sequence, ``"ZYX"`` when it gives none): for a lower-mobility mechanism, the parasitic
+    ones (:attr:`IKResult.task` has the solved values); the others are held at the pose's values.
+
+    >>> import spatialmech as sm
+    >>> r = sm.ik("three-rps", ([0, 0, 0.33], ("ZYX", 0, 5, 5)), degrees=True, free=["x", "y", "a1"])
+    >>> r.reachable, [round(v, 6) for v in r.actuators.values()]
+    (True, [0.374613, 0.366706, 0.347013])
+
+    >>> r = sm.ik("four-sps-cu", ([0, 0, 0.12], ("ZYX", 34.38, -5.73, 11.46)), degrees=True)
+    >>> [round(v, 4) for v in r.actuators.values()]
+    [0.2167, 0.239, 0.2273, 0.2069]
+    """
+    mech = as_mechanism(model)
+    degrees = check_bool(degrees, "degrees")
+    all_solutions = check_bool(all_solutions, "all_solutions")
+    P, position = as_pose(mech, pose, degrees)
+    task = None
+    if free is not None:
+        names = check_names(free, "free") or []
+        task = solve_pose(mech, P, names, euler=pose_sequence(pose))
+        if task.converged:
+            P = Pose(task.D[:3, :3], task.D[:3, :3] @ mech.platform_point + task.D[:3, 3], "requested, solved")
+    res = inverse_position(mech, P, all_solutions=all_solutions, n_seeds=check_int(n_seeds, "n_seeds", minimum=1),
+                           seed=check_int(seed, "seed"), tol=tol, fit=True,
+                           start=task.config if task is not None and task.converged else None)
+    return IKResult(mech, P, res, position, resolve_tolerances(tol, "closure").reachability, task)
+
+
+@dataclass(frozen=True, eq=False)
+class FKResult:
+    """Forward position: the platform pose(s) for actuator values.
+
+    ``result`` is the general engine's :class:`~spatialmech.kinematics.position.ForwardResult`, or,
+    for ``all_solutions`` on a 4-SPS/CU of paper B's layout, the closed form's
+    ``ForwardAllResult`` (``closed_form`` is True)."""
+
+    mechanism: Mechanism
+    actuator_values: np.ndarray  # SI (rad, length), in mechanism.actuators order
+    result: object
+    closed_form: bool = False
+
+    @property
+    def poses(self) -> tuple[Pose, ...]:
+        """The platform pose of every converged solution (assembly mode)."""
+        if self.closed_form:
+            from ..kinematics.closed_forms import four_sps_cu as k4
+
+            return tuple(Pose(k4.rotation(s.phi), k4.pose_transform(s.phi)[:3, 3], f"mode {n + 1}")
+                         for n, s in enumerate(self.result.solutions) if s.converged)
+        return tuple(s.pose for s in self.result.solutions if s.converged)
+
+    @property
+    def converged(self) -> bool:
+        """At least one assembly was found."""
+        return bool(self.poses)
+
+    def to_dict(self) -> dict:
+        if self.closed_form:
+            return self.result.to_dict(actuators=self.mechanism.actuators)
+        return self.result.to_dict(self.mechanism)
+
+
+def fk(model: ModelLike, actuators, *, all_solutions: bool = False, seeds: int | None = None, seed: int = 0,
+       degrees: bool = False, progress: Progress | None = None) -> FKResult:
+    """Forward position: platform pose(s) for actuator values (``actuators``: a sequence in the
+    order of ``mechanism.actuators`` or a mapping by freedom name; lengths in the model's unit,
+    rotations in radians, or degrees with ``degrees=True``).
+
+    From the reference configuration by Newton; ``all_solutions``: every assembly mode a
+    multi-start search finds (``seeds`` starts: default 200, 512 on the 4-SPS/CU closed form).
+    Nothing is raised when no assembly is found: see ``converged`` and ``to_dict()``.
+
+    >>> import spatialmech as sm
+    >>> r = sm.fk("stewart-6sps", [1.2] * 6)
+    >>> r.converged, len(r.poses)
+    (True, 1)
+    >>> r = sm.fk("four-sps-cu", [0.216745, 0.23896, 0.227321, 0.206933], all_solutions=True)   # closed form
+    >>> sorted(round(float(P.p[2]), 3) for P in r.poses)      # the pose z = 0.12 m, another mode, two mirrors
+    [-0.149, -0.12, 0.12, 0.149]
+    """
+    mech = as_mechanism(model)
+    degrees = check_bool(degrees, "degrees")
+    all_solutions = check_bool(all_solutions, "all_solutions")
+    acts = list(mech.actuators)
+    if not acts:
+        raise InputError(f"model: {mech.name} has no actuators")
+    if isinstance(actuators, Mapping):
+        vals = {}
+        for k, v in actuators.items():
+            if not isinstance(k, str):
+                raise TypeError(f"actuators: expected freedom names as keys, got {describe(k)}")
+            x = float(check_numbers(v, f"actuators[{k!r}]", shape=()))
+            vals[mech.freedom(k).id] = np.radians(x) if degrees and mech.freedom(k).freedom.kind != "P" else x
+        missing = [a for a in acts if a not in vals]
+        if missing:
+            raise InputError(f"actuators: missing values for {', '.join(missing)} (actuators: {', '.join(acts)})")
+        extra = sorted(set(vals) - set(acts))
+        if extra:
+            raise InputError(f"actuators: {', '.join(extra)} are not actuated in {mech.name} (actuators: {', '.join(acts)})")
+        values = np.array([vals[a] for a in acts])
+    else:
+        raw = check_numbers(actuators, "actuators")
+        if raw.shape != (len(acts),):
+            raise InputError(f"actuators: {mech.name} has {len(acts)} actuators ({', '.join(acts)}), got shape {raw.shape}")
+        values = np.array([np.radians(v) if degrees and mech.freedom(a).freedom.kind != "P" else v
+                           for a, v in zip(acts, raw, strict=True)])
+    if seeds is not None:
+        seeds = check_int(seeds, "seeds", minimum=1)
+    seed = check_int(seed, "seed")
+    progress = optional_progress(progress)
+    if all_solutions:
+        from ..kinematics.closed_forms import four_sps_cu as k4
+        from ..kinematics.closed_forms import four_sps_cu_forward as k4f
+
+        geom = k4.geometry_of(mech)
+        if geom is not None:
+            fa = k4f.forward_all(values, geometry=geom, **({} if seeds is None else {"n_seeds": seeds}))
+            return FKResult(mech, values, fa, True)
+    res: ForwardResult = forward_position(mech, values, all_solutions=all_solutions,
+                                          n_seeds=200 if seeds is None else seeds, seed=seed, progress=progress)
+    return FKResult(mech, values, res)
+
+
+# ============================================================================ Jacobian, velocity
+@dataclass(frozen=True, eq=False)
+class JacobianResult:
+    """The complete Jacobian (:attr:`jacobian`) at one configuration, and the fit of the
+    requested pose onto the closure (``None`` when a configuration was given)."""
+
+    mechanism: Mechanism
+    config: Configuration
+    jacobian: CompleteJacobian
+    pose_fit: PoseFit | None = None
+    pose: Pose | None = None  # the requested pose (default: the configuration's)
+    #: Lower-mobility models: the input-output Jacobian over the given task coordinates
+    #: (``None`` when the output link has six freedoms).
+    task: TaskJacobian | None = None
+
+    @property
+    def det(self) -> float | None:
+        return self.jacobian.det
+
+    @property
+    def sigma_min(self) -> float:
+        return self.jacobian.sigma_min
+
+    def to_dict(self) -> dict:
+        P = self.pose if self.pose is not None else platform_pose(self.mechanism, self.config)
+        return {"result": "complete_jacobian", "pose": pose_dict(P.R, P.p), **self.jacobian.to_dict(),
+                "pose_fit": None if self.pose_fit is None else self.pose_fit.to_dict(),
+                "task_jacobian": None if self.task is None else self.task.to_dict(self.mechanism)}
+
+
+def jacobian(model: ModelLike, pose=None, *, config: Configuration | None = None, drivers=None,
+             degrees: bool = False, free=None) -> JacobianResult:
+    """The complete Jacobian (constraint + actuation wrenches), ``det J`` and its conditioning at
+    a pose (fitted onto the closure), a configuration, or the reference configuration; for a
+    lower-mobility model also :attr:`JacobianResult.task`, the input-output Jacobian over the
+    given task coordinates (the parasitic ones solved).
+
+    ``drivers``: the actuated freedom(s) (default: the model's actuators).  ``free``: as in
+    :func:`ik`, task coordinates to solve, the others held at the pose's values (and the
+    coordinates of the input-output Jacobian; default: the model's task).
+
+    >>> import spatialmech as sm
+    >>> J = sm.jacobian("five-cs-1", 3, drivers="rot1")
+    >>> J.det > 0, J.jacobian.matrix.shape, J.pose_fit.exact
+    (True, (6, 6), False)
+    >>> J = sm.jacobian("three-rps", ([0, 0, 0.33], ("ZYX", 0, 5, 5)), degrees=True, free=["x", "y", "a1"])
+    >>> J.task.given, J.task.matrix.shape
+    (('z', 'a2', 'a3'), (3, 3))
+    """
+    mech = as_mechanism(model)
+    degrees = check_bool(degrees, "degrees")
+    drivers = check_names(drivers, "drivers")
+    task = None
+    if free is not None:
+        if pose is None or config is not None:
+            raise InputError("free: needs a pose (and no config): the coordinates not named are held at its values")
+        names = check_names(free, "free") or []
+        P, _ = as_pose(mech, pose, degrees)
+        sol = solve_pose(mech, P, names, euler=pose_sequence(pose))
+        if not sol.converged:
+            raise InputError(f"free: the held coordinates do not close with {', '.join(names)} solved ({sol.status}, "
+                             f"residual {sol.residual:.2e}); the pose is out of reach")
+        task = sol.task
+        solved = Pose(sol.D[:3, :3], sol.D[:3, :3] @ mech.platform_point + sol.D[:3, 3], "requested, solved")
+        fit = configuration_at_pose(mech, solved, start=sol.config)
+        if not fit.converged:
+            raise InputError(f"pose: no closed configuration near it (residual {fit.ik_residual:.2e})")
+        c, requested = fit.config, solved
+    else:
+        c, fit = as_configuration(mech, pose, config, degrees)
+        requested = as_pose(mech, pose, degrees)[0] if pose is not None else None
+    return JacobianResult(mech, c, complete_jacobian(mech, c, drivers), fit, requested,
+                          task_jacobian_at(mech, c, drivers, task=task))
+
+
+@dataclass(frozen=True, eq=False)
+class VelocityResult:
+    """Platform twist ``(omega ; v)`` (rad/s; ``v``: velocity of the body point at the origin,
+    length unit/s) and every joint rate (local coordinates, rad/s or length/s) at one
+    configuration.  ``given``: ``"twist"`` (inverse velocity) or ``"actuator_rates"`` (forward)."""
+
+    mechanism: Mechanism
+    config: Configuration
+    twist: np.ndarray
+    joint_rates: np.ndarray
+    given: str
+    pose_fit: PoseFit | None = None
+
+    @property
+    def actuator_rates(self) -> dict[str, float]:
+        """The actuators' rates (SI), by freedom id."""
+        ids = [r.id for r in self.mechanism.freedom_refs]
+        return {a: float(self.joint_rates[ids.index(a)]) for a in self.mechanism.actuators}
+
+    def to_dict(self) -> dict:
+        from ..serialize import freedom_values_dict
+
+        ids = [r.id for r in self.mechanism.freedom_refs]
+        rates = freedom_values_dict(self.mechanism, dict(zip(ids, self.joint_rates, strict=True)), "joint_rates")
+        d = {
+            "given": self.given,
+            "twist_convention": "(omega ; v), v = velocity of the body point at the origin",
+            "omega_deg_per_s": [float(x) for x in np.degrees(self.twist[:3])],
+            "v_len_per_s": [float(x) for x in self.twist[3:]],
+            "joint_rates_deg_per_s": rates["joint_rates_deg"],
+            "joint_rates_len_per_s": rates["joint_rates_len"],
+            "actuators": list(self.mechanism.actuators),
+        }
+        if self.pose_fit is not None:
+            d["pose_fit"] = self.pose_fit.to_dict()
+        return d
+
+
+def velocity(model: ModelLike, pose=None, *, config: Configuration | None = None, twist=None, actuator_rates=None,
+             drivers=None, degrees: bool = False) -> VelocityResult:
+    """Velocity analysis at a pose (fitted onto the closure), a configuration or the reference
+    configuration: give the platform ``twist`` ``(omega ; v)`` (inverse velocity: the joint
+    rates) or the ``actuator_rates`` of ``drivers`` (default: the model's actuators; forward
+    velocity: the twist and the joint rates).  Rates in SI (rad/s, length/s); ``degrees=True``:
+    angular rates and pose angles in degrees.
+
+    >>> import spatialmech as sm
+    >>> v = sm.velocity("four-sps-cu", ([0, 0, 0.12], ("ZYX", 30, -5, 10)), twist=[0, 0, 0, 0, 0, 0.01], degrees=True)
+    >>> sorted(round(r, 4) for r in v.actuator_rates.values())
+    [0.0047, 0.0053, 0.0059, 0.0064]
+    """
+    from ..kinematics.velocity import forward_velocity, inverse_velocity
+
+    mech = as_mechanism(model)
+    degrees = check_bool(degrees, "degrees")
+    if (twist is None) == (actuator_rates is None):
+        raise InputError("twist/actuator_rates: give exactly one of them")
+    drivers = check_names(drivers, "drivers")
+    c, fit = as_configuration(mech, pose, config, degrees)
+    if twist is not None:
+        V = check_numbers(twist, "twist", shape=(6,))
+        if degrees:
+            V = np.r_[np.radians(V[:3]), V[3:]]
+        qd = inverse_velocity(mech, c, V)
+        return VelocityResult(mech, c, V, qd, "twist", fit)
+    ids = drivers if drivers is not None else list(mech.actuators)
+    r = check_numbers(actuator_rates, "actuator_rates", shape=(len(ids),))
+    if degrees:
+        r = np.array([np.radians(x) if mech.freedom(a).freedom.kind != "P" else x for a, x in zip(ids, r, strict=True)])
+    V, qd = forward_velocity(mech, c, r, drivers)
+    return VelocityResult(mech, c, np.asarray(V, float), qd, "actuator_rates", fit)
+
+
+# ============================================================================ singularity, workspace
+@dataclass(frozen=True, eq=False)
+class SingularityAnalysis:
+    """The singularity analysis at one configuration (:attr:`result`, a
+    :class:`~spatialmech.analysis.singularity.SingularityResult`: ``kind``, ``rank``, ``twist``,
+    ``line_geometry``, ``self_motion`` ...; its attributes are readable here directly)."""
+
+    mechanism: Mechanism
+    config: Configuration
+    result: object
+    pose_fit: PoseFit | None = None
+
+    def __getattr__(self, name):
+        if name.startswith("_") or name == "result":
+            raise AttributeError(name)
+        return getattr(self.result, name)
+
+    def to_dict(self) -> dict:
+        return {"result": "singularity", **self.result.to_dict()}
+
+
+def singularity(model: ModelLike, pose=None, *, config: Configuration | None = None, drivers=None,
+                degrees: bool = False) -> SingularityAnalysis:
+    """Singularity analysis at a pose (fitted onto the closure), a configuration, or the
+    reference configuration: rank and kind (:class:`~spatialmech.results.SingularityKind`),
+    uncontrolled twists, line geometry of the wrenches, finite self-motion.
+
+    >>> import spatialmech as sm
+    >>> r = sm.singularity("four-sps-cu")            # the reference pose, alpha = beta = 0
+    >>> r.kind, r.kind.singular
+    (<SingularityKind.DIRECT: 'direct'>, True)
+    """
+    from ..analysis.singularity import singularity as _singularity
+
+    mech = as_mechanism(model)
+    degrees = check_bool(degrees, "degrees")
+    drivers = check_names(drivers, "drivers")
+    c, fit = as_configuration(mech, pose, config, degrees)
+    return SingularityAnalysis(mech, c, _singularity(mech, c, drivers), fit)
+
+
+def workspace(model: ModelLike, *, kind: str = "orientation", at: Mapping[str, float] | None = None,
+              step: float | None = None, tol=None, bounds=None, method: str = "auto",
+              link_diameter: float | None = None, interference: bool = True, max_poses: int | None = None,
+              progress: Progress | None = None, over: Mapping | None = None, free=None, limits=None):
+    """Workspace under joint limits (strokes, joint cones, link interference), sampled and
+    refined at the boundary: ``kind="orientation"`` at a fixed position (free angles alpha,
+    beta, gamma of ``R = Rz(gamma) Ry(beta) Rx(alpha)``), or ``"position"`` at a fixed
+    orientation.  SI and radians: ``at`` fixes coordinates (``x, y, z`` length,
+    ``alpha, beta, gamma`` rad); ``step``/``tol`` are radians (orientation; default 2 deg and
+    0.001 deg) or lengths (position).  ``link_diameter`` overrides the interference check's
+    capsules, ``interference=False`` skips it; ``limits`` (a
+    :class:`~spatialmech.analysis.workspace.WorkspaceLimits`) replaces the default limits.
+    Returns a :class:`~spatialmech.analysis.workspace.WorkspaceResult`.
+
+    ``kind="task"``: over the task coordinates of a lower-mobility mechanism (docs/workspace.md):
+    ``over`` maps 1 to 3 given task coordinates (``x, y, z`` length, ``a1, a2, a3`` rad) to
+    ``(lo, hi, n)`` or grid values, ``at`` holds other given ones, ``free`` names the coordinates
+    to solve (default: the model's task); ``tol`` is the boundary tolerance (a number, or by
+    coordinate; default 1e-3 of the grid step), ``max_poses`` the largest grid.  The parasitic
+    coordinates are solved at every cell.  Returns a
+    :class:`~spatialmech.analysis.workspace.TaskWorkspaceResult`.
+
+    >>> import numpy as np, spatialmech as sm
+    >>> ws = sm.workspace("four-sps-cu", at={"z": 0.1}, step=np.radians(10))
+    >>> round(float(np.degrees(ws.alone["alpha"].hi)), 1), ws.alone["alpha"].hi_limit
+    (26.6, 'A1 cone')
+    >>> t = sm.workspace("three-rps", kind="task", over={"a2": (-0.2, 0.2, 3), "a3": (-0.2, 0.2, 3)}, at={"z": 0.33})
+    >>> t.solved, t.reachable_fraction
+    (('x', 'y', 'a1'), 1.0)
+    """
+    from ..analysis.workspace import WorkspaceLimits, default_limits, orientation_workspace, position_workspace
+
+    mech = as_mechanism(model)
+    kind = check_choice(kind, "kind", ("orientation", "position", "task"))
+    method = check_choice(method, "method", ("auto", "closed-form", "general"))
+    interference = check_bool(interference, "interference")
+    if at is not None and not isinstance(at, Mapping):
+        raise TypeError(f"at: expected a mapping of coordinate -> value (SI, rad), got {describe(at)}")
+    step = check_number(step, "step", positive=True, optional=True)
+    if kind != "task" or not isinstance(tol, Mapping):
+        tol = check_number(tol, "tol", positive=True, optional=True)
+    link_diameter = check_number(link_diameter, "link_diameter", optional=True)
+    if link_diameter is not None and link_diameter < 0:
+        raise InputError(f"link_diameter: expected a non-negative length, got {link_diameter}")
+    if max_poses is not None:
+        max_poses = check_int(max_poses, "max_poses", minimum=1)
+    if limits is not None and not isinstance(limits, WorkspaceLimits):
+        raise TypeError(f"limits: expected a WorkspaceLimits, got {describe(limits)}")
+    limits = default_limits(mech) if limits is None else limits
+    if link_diameter is not None or not interference:
+        limits = WorkspaceLimits(limits.cones, link_diameter if interference else None, limits.freedom_limits, limits.source)
+    if kind == "task":
+        return _task_workspace(mech, over, at, free, limits, tol, step, bounds, max_poses, progress)
+    for name, value in (("over", over), ("free", free)):
+        if value is not None:
+            raise InputError(f"{name}: only with kind='task' (the workspace over task coordinates)")
+    kw = dict(at=at, limits=limits, bounds=bounds, method=method, max_poses=max_poses, progress=optional_progress(progress))
+    if kind == "orientation":
+        return orientation_workspace(mech, step=np.radians(2.0) if step is None else step,
+                                     tol=np.radians(1e-3) if tol is None else tol, **kw)
+    return position_workspace(mech, step=step, tol=tol, **kw)
+
+
+def _task_workspace(mech: Mechanism, over, at, free, limits, tol, step, bounds, max_poses, progress):
+    """``workspace(kind="task")``: the checks of its own arguments, then the analysis."""
+    from ..analysis.workspace import task_workspace
+    from ..model.task import TASK_NAMES, TaskCoordinates
+
+    if over is None:
+        raise InputError("over: kind='task' needs the grid: {coordinate: (lo, hi, n)} over task coordinates "
+                         "(x, y, z length; a1, a2, a3 rad)")
+    if not isinstance(over, Mapping):
+        raise TypeError(f"over: expected a mapping of task coordinate -> (lo, hi, n) or values, got {describe(over)}")
+    for name, value in (("step", step), ("bounds", bounds)):
+        if value is not None:
+            raise InputError(f"{name}: not with kind='task' (the grid is given by over)")
+    task = None
+    if free is not None:
+        names = [free] if isinstance(free, str) else free
+        if not isinstance(names, Sequence) or not all(isinstance(n, str) for n in names):
+            raise TypeError(f"free: expected task coordinate names, got {describe(free)}")
+        own = mech.task.euler if mech.task is not None else "ZYX"
+        for n in names:
+            if n not in TASK_NAMES:
+                raise InputError(f"free: unknown task coordinate {n!r}; expected some of {', '.join(TASK_NAMES)}")
+        task = TaskCoordinates(tuple(n for n in TASK_NAMES if n not in names), own)
+    return task_workspace(mech, over, at=at, task=task, limits=limits, tol=tol, max_cells=max_poses,
+                          progress=optional_progress(progress))
+
+
+def parasitic(model: ModelLike, over: Mapping, *, at: Mapping[str, float] | None = None, free=None,
+              euler: str | None = None, plot=None, progress: Progress | None = None):
+    """The parasitic motion of a lower-mobility mechanism: its solved task coordinates over a grid
+    of one or two given ones (``spatialmech parasitic``, docs/lower-mobility.md).
+
+    SI and radians: ``over`` maps the grid's given coordinates (``x, y, z`` length, ``a1, a2, a3``
+    rad) to ``(lo, hi, n)`` or increasing values; ``at`` holds other given ones (default: their
+    reference values); ``free`` names the coordinates to solve (default: those the model's task
+    does not give) and ``euler`` the sequence of ``a1, a2, a3`` (default: the model's task's, else
+    ``"ZYX"``).  ``plot``: a figure file (.png, .pdf, .svg), one panel per solved coordinate.
+    Returns a :class:`~spatialmech.analysis.parasitic.ParasiticTable` (``values(name)``,
+    ``ranges``, ``to_dict()``).
+
+    >>> import spatialmech as sm
+    >>> t = sm.parasitic("three-rps", {"a2": (-0.1, 0.1, 3), "a3": (-0.1, 0.1, 3)}, at={"z": 0.33})
+    >>> t.solved, {n: round(hi, 6) for n, (lo, hi) in t.ranges.items()}
+    (('x', 'y', 'a1'), {'x': 0.000747, 'y': 0.000375, 'a1': 0.005008})
+    """
+    from ..analysis.parasitic import parasitic_table
+    from ..kinematics.task import default_task
+    from ..model.task import TASK_NAMES, TaskCoordinates
+
+    mech = as_mechanism(model)
+    if not isinstance(over, Mapping):
+        raise TypeError(f"over: expected a mapping of task coordinate -> (lo, hi, n) or values, got {describe(over)}")
+    if at is not None and not isinstance(at, Mapping):
+        raise TypeError(f"at: expected a mapping of task coordinate -> value (SI, rad), got {describe(at)}")
+    if euler is not None and not isinstance(euler, str):
+        raise TypeError(f"euler: expected a named Euler sequence such as 'ZYX', got {describe(euler)}")
+    task = None
+    if free is not None or euler is not None:
+        seq = euler if euler is not None else (mech.task.euler if mech.task is not None else "ZYX")
+        if free is None:
+            given = default_task(mech, seq).given  # the model's own task, else the default
+        else:
+            names = check_names(free, "free") or []
+            for n in names:
+                if n not in TASK_NAMES:
+                    raise InputError(f"free: unknown task coordinate {n!r}; expected some of {', '.join(TASK_NAMES)}")
+            given = tuple(n for n in TASK_NAMES if n not in names)
+        task = TaskCoordinates(given, seq)
+    path = None if plot is None else check_path(plot, "plot")
+    if path is not None and path.suffix.lower() not in (".png", ".pdf", ".svg"):
+        raise InputError(f"plot: expected a .png, .pdf or .svg file, got {str(path)!r}")
+    table = parasitic_table(mech, over, at=at, task=task, progress=optional_progress(progress))
+    if path is not None:
+        from ..present.parasitic import parasitic_figure
+
+        parasitic_figure(table.grid, path)
+    return table

@@ -1,0 +1,264 @@
+"""The public API: one-degree-of-freedom linkages and synthesis -- tracking, DJ tables,
+defects, RCCC and CS-dyad synthesis (``sm.track``, ``sm.dj_table``, ``sm.defects``,
+``sm.synth_rccc``, ``sm.synth_cs``)."""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import catalog
+from ..errors import InputError, describe
+from ..kinematics.closure import Configuration
+from ..kinematics.position import freedom_values, platform_pose
+from ..model.mechanism import Mechanism, Pose
+from ..results import Progress, TrackStatus
+from .checks import (
+    ModelLike,
+    as_configuration,
+    as_mechanism,
+    as_positions,
+    check_bool,
+    check_choice,
+    check_int,
+    check_names,
+    check_number,
+    optional_progress,
+)
+
+
+# ============================================================================ tracking
+@dataclass(frozen=True, eq=False)
+class TraceResult:
+    """The one-degree-of-freedom motion traced by continuation (:attr:`result`, a
+    :class:`~spatialmech.kinematics.tracking.TrackResult` whose points are configurations), with
+    the sign changes of DJ of the actuators as events (zeros: branch points)."""
+
+    mechanism: Mechanism
+    result: object
+
+    @property
+    def status(self) -> TrackStatus:
+        return self.result.status
+
+    @property
+    def closed(self) -> bool:
+        return self.result.closed
+
+    @property
+    def configurations(self) -> list[Configuration]:
+        return self.result.points
+
+    @property
+    def poses(self) -> list[Pose]:
+        return [platform_pose(self.mechanism, c) for c in self.result.points]
+
+    def to_dict(self) -> dict:
+        from ..serialize import freedom_values_dict
+
+        tr, mech = self.result, self.mechanism
+        ids = [r.id for r in mech.freedom_refs]
+        q = np.array([freedom_values(mech, c.q) for c in tr.points]).reshape(len(tr.points), len(ids))
+        values = freedom_values_dict(mech, dict.fromkeys(ids, 0.0), "joint_values")
+        deg = {fid: [float(x) for x in np.degrees(q[:, ids.index(fid)])] for fid in values["joint_values_deg"]}
+        lin = {fid: [float(x) for x in q[:, ids.index(fid)]] for fid in values["joint_values_len"]}
+        return {
+            "status": tr.status,
+            "reason": tr.reason,
+            "ok": tr.ok,
+            "closed": tr.closed,
+            "points": len(tr.points),
+            "arc_length": float(tr.s[-1]),
+            "arc": [float(s) for s in tr.s],
+            "events": [{"name": e.name, "arc": float(e.s), "kind": e.kind} for e in tr.events],
+            "rejected_steps": tr.rejected,
+            "platform_points_len": [[float(x) for x in p.p] for p in self.poses],
+            "joint_values_deg": deg,
+            "joint_values_len": lin,
+            "units": {"arc": "nondimensional arc length (joint rad, lengths / characteristic length)"},
+        }
+
+
+def track(model: ModelLike, start=None, *, increasing: str | None = None, sense: int = 1, max_arc: float = 50.0,
+          max_steps: int = 20000, h0: float = 0.02, degrees: bool = False,
+          progress: Progress | None = None) -> TraceResult:
+    """Follow the one-degree-of-freedom motion by pseudo-arclength continuation from ``start``
+    (a pose, fitted onto the closure; a Configuration; default the reference) until it closes
+    (``status`` closed) or the arc length reaches ``max_arc`` (nondimensional).  ``increasing``:
+    a freedom whose variable grows at the start (``sense=-1``: decreases).  The sign changes of
+    DJ of the actuators are located as events.
+
+    >>> import spatialmech as sm
+    >>> m = sm.track("bennett")
+    >>> m.status, m.closed
+    (<TrackStatus.CLOSED: 'closed'>, True)
+    """
+    from ..analysis.defects import dj_function
+    from ..kinematics.tracking import trace_motion
+
+    mech = as_mechanism(model)
+    degrees = check_bool(degrees, "degrees")
+    if increasing is not None and not isinstance(increasing, str):
+        raise TypeError(f"increasing: expected a freedom name (str) or None, got {describe(increasing)}")
+    sense = check_int(sense, "sense")
+    if sense not in (-1, 1):
+        raise InputError(f"sense: expected +1 or -1, got {sense}")
+    max_arc = check_number(max_arc, "max_arc", positive=True)
+    h0 = check_number(h0, "h0", positive=True)
+    max_steps = check_int(max_steps, "max_steps", minimum=1)
+    if isinstance(start, Configuration):
+        c, _ = as_configuration(mech, None, start, degrees)
+    else:
+        c, _ = as_configuration(mech, start, None, degrees, pose_name="start")
+    acts = list(mech.actuators)
+    mon = None
+    if acts:
+        try:
+            f, _ = dj_function(mech, acts, c)
+            mon = (["DJ " + a for a in acts], f)
+        except InputError:
+            mon = None  # DJ undefined here (e.g. an actuator is locked): trace without events
+    tr = trace_motion(mech, c, increasing=increasing, sense=sense, vector_monitor=mon, max_arc=max_arc,
+                      max_steps=max_steps, h0=h0, progress=optional_progress(progress))
+    return TraceResult(mech, tr)
+
+
+# ============================================================================ defects
+def dj_table(model: ModelLike, drivers=None, positions=None):
+    """DJ (det of the complete Jacobian) at the model's task positions, per driver (default:
+    every base-joint freedom); only the signs along one driver are comparable.  Returns a
+    :class:`~spatialmech.analysis.defects.DJTable`.
+
+    >>> import spatialmech as sm
+    >>> t = sm.dj_table("five-cs-3", ["rot1", "rot3"])
+    >>> t.keeps_sign("rot1"), t.keeps_sign("rot3")
+    (True, False)
+    """
+    from ..analysis.defects import dj_table as _dj_table
+
+    mech = as_mechanism(model)
+    return _dj_table(mech, check_names(drivers, "drivers"), as_positions(positions))
+
+
+def defects(model: ModelLike, positions=None, *, drivers=None, pose_tol: float | None = None,
+            angle_tol_deg: float = 1.0, monte_carlo: int = 0, seed: int = 0, precision: float = 5e-4,
+            progress: Progress | None = None):
+    """Circuit, branch and order defects of a one-degree-of-freedom linkage for its task
+    positions (``positions``: default the model's own; a sequence of Pose or a TOML file),
+    the drivers that can be used, and a dual-drive plan when no single one can (paper A).
+    Returns a :class:`~spatialmech.analysis.defects.DefectResult` (``circuit_status``:
+    :class:`~spatialmech.results.TrackStatus`).
+
+    >>> import spatialmech as sm
+    >>> motion = sm.track("planar-4r")                  # three positions on its circuit, in order
+    >>> P = [motion.poses[k] for k in (0, 9, 18)]
+    >>> r = sm.defects("planar-4r", P)
+    >>> r.circuit_defect, r.order_defect, r.usable_drivers, r.circuit_status
+    (False, False, ('A0.rot',), (<TrackStatus.CLOSED: 'closed'>,))
+    """
+    from ..analysis.defects import defect_analysis
+
+    mech = as_mechanism(model)
+    positions = as_positions(positions)
+    pose_tol = check_number(pose_tol, "pose_tol", positive=True, optional=True)
+    angle_tol_deg = check_number(angle_tol_deg, "angle_tol_deg", positive=True)
+    precision = check_number(precision, "precision")
+    return defect_analysis(mech, positions, drivers=check_names(drivers, "drivers"), pose_tol=pose_tol,
+                           angle_tol_deg=angle_tol_deg, monte_carlo=check_int(monte_carlo, "monte_carlo", minimum=0),
+                           seed=check_int(seed, "seed"), precision=precision, progress=optional_progress(progress))
+
+
+# ============================================================================ synthesis
+def synth_rccc(task="rccc-four-positions", *, pick: str = "best-rc", samples: int = 360):
+    """Four-position RCCC synthesis by solution regions (paper D).  ``task``: a ready-made task
+    name, a TOML task file, or a ``TaskPositions``; ``pick``: ``"best-rc"`` (the smallest
+    largest input slide) or ``"interior"`` (the most interior defect-free crank-rocker);
+    ``samples`` per Burmester-curve branch.  Returns a
+    :class:`~spatialmech.synthesis.RCCCResult` (``linkage`` is a Mechanism).
+
+    >>> import spatialmech as sm
+    >>> r = sm.synth_rccc(samples=60)
+    >>> r.linkage_type, r.defects
+    ('crank-rocker', 0)
+    """
+    from ..synthesis.rccc import synthesize_rccc
+    from ..synthesis.tasks import TaskPositions, resolve_task
+
+    if not isinstance(task, (str, os.PathLike, TaskPositions)):
+        raise TypeError(f"task: expected a task name, a TOML file path or a TaskPositions, got {describe(task)}")
+    pick = check_choice(pick, "pick", ("best-rc", "interior"))
+    samples = check_int(samples, "samples", minimum=8)
+    return synthesize_rccc(resolve_task(task), pick=pick, samples=samples)
+
+
+@dataclass(frozen=True, eq=False)
+class CSSynthesisResult:
+    """Seven-position CS dyad synthesis (paper A): the one-parameter ``family`` of dyads, the
+    picked dyads (``family.picks``), and with five picks the assembled 5-CS ``linkage`` and its
+    ``check`` at the seven positions."""
+
+    family: object
+    positions_source: str
+    samples: int
+    linkage: Mechanism | None = None
+    check: object | None = None
+
+    @property
+    def success(self) -> bool | None:
+        """The 5-CS closes at the seven positions with one degree of freedom and (when its defects
+        were checked) is defect-free for some driver; ``None`` without a 5-CS."""
+        return None if self.check is None else self.check.success
+
+    def to_dict(self) -> dict:
+        d = {**self.family.to_dict(samples=self.samples), "positions_source": self.positions_source,
+             "five_cs": None, "success": None, "verdict": None}
+        if self.check is not None:
+            d["five_cs"] = self.check.to_dict()
+            d["success"] = self.check.success
+            d["verdict"] = self.check.verdict()
+        return d
+
+
+def synth_cs(positions=None, *, pick: int = 5, starts: int = 60, seed: int = 0, samples: int = 40,
+             check_defects: bool = True, progress: Progress | None = None) -> CSSynthesisResult:
+    """Seven-position synthesis of CS dyads and a 5-CS linkage (paper A, section 3).
+    ``positions``: seven task poses -- default paper A's table 9; a model name or Mechanism (its
+    task positions), a TOML file of ``[[positions]]``, or a sequence of Pose.  ``starts`` random
+    starts (``seed``); ``pick`` small-slide dyads (5: also assemble and check the 5-CS, and with
+    ``check_defects`` its circuit, order and branch defects, about a minute; ``progress``
+    reports on it); ``samples``: family points listed in ``to_dict()``.
+
+    >>> import spatialmech as sm
+    >>> r = sm.synth_cs(pick=0, starts=4)
+    >>> len(r.family.branches) >= 1, r.linkage is None
+    (True, True)
+    """
+    from ..synthesis.cs_dyads import synthesize_cs
+    from ..synthesis.five_cs import assemble_5cs, check_5cs
+
+    pick = check_int(pick, "pick", minimum=0)
+    check_defects = check_bool(check_defects, "check_defects")
+    progress = optional_progress(progress)
+    starts = check_int(starts, "starts", minimum=1)
+    seed = check_int(seed, "seed")
+    samples = check_int(samples, "samples", minimum=2)
+    if positions is None:
+        from ..catalog.papers import five_cs_positions
+
+        poses, source = five_cs_positions(), "paper A table 9"
+    elif isinstance(positions, Mechanism) or (isinstance(positions, str) and positions in catalog.REGISTRY):
+        mech = as_mechanism(positions, "positions")
+        poses, source = mech.positions, f"the task positions of {mech.name}"
+    else:
+        poses = as_positions(positions)
+        source = os.fspath(positions) if isinstance(positions, (str, os.PathLike)) else "given poses"
+    fam = synthesize_cs(poses, n_starts=starts, seed=seed, pick=pick)
+    if pick != 5:
+        return CSSynthesisResult(fam, source, samples)
+    if len(fam.picks) < 5:
+        raise InputError(f"pick: only {len(fam.picks)} well separated dyads found; try more starts")
+    linkage = assemble_5cs(fam.task, fam.picks)
+    check = check_5cs(linkage, fam.picks, defects=check_defects, progress=progress)
+    return CSSynthesisResult(fam, source, samples, linkage, check)

@@ -1,0 +1,126 @@
+"""The public API: what is written to files -- a model's report and its 3-D viewer
+(``sm.report``, ``sm.view``)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..analysis.mobility import mobility as _mobility
+from ..errors import InputError
+from ..results import Progress, check_progress
+from .checks import ModelLike, as_mechanism, check_bool, check_choice, check_int, check_path
+
+
+# ============================================================================ report, viewer
+@dataclass(frozen=True, eq=False)
+class ReportResult:
+    """A report written into ``out``: ``index.html`` (opens offline), ``results.json`` (every
+    number: :attr:`data`) and ``figures/``.  ``to_dict()`` is ``data`` without the model name
+    (the payload of ``spatialmech report --json``, whose envelope names the model)."""
+
+    out: Path
+    data: dict
+
+    @property
+    def index_html(self) -> Path:
+        return self.out / "index.html"
+
+    @property
+    def results_json(self) -> Path:
+        return self.out / "results.json"
+
+    def to_dict(self) -> dict:
+        return {k: v for k, v in self.data.items() if k != "model"}
+
+
+def report(model: ModelLike, out=None, *, trace: bool = True, progress: bool | Progress | None = None) -> ReportResult:
+    """Every analysis that applies to one model, written as a report into the directory
+    ``out`` (default ``report-NAME``): mobility of every mode, the complete Jacobian, DJ at the
+    task positions, the traced motion (1 DOF; ``trace=False`` skips it) and a 3-D viewer.
+    ``progress``: True prints on stderr, or a callback.
+
+    >>> import spatialmech as sm, tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     r = sm.report("planar-4r", d, trace=False)
+    ...     r.index_html.exists(), r.data["model"]
+    (True, 'planar-4r')
+    """
+    from ..present.report import build_model_report
+
+    mech = as_mechanism(model)
+    trace = check_bool(trace, "trace")
+    if progress is not None and not isinstance(progress, bool):
+        progress = check_progress(progress)
+    out = Path(f"report-{mech.name}") if out is None else check_path(out, "out")
+    if out.exists() and not out.is_dir():
+        raise InputError(f"out: {out} is a file, not a directory")
+    out.mkdir(parents=True, exist_ok=True)  # fail now on an unwritable directory, not after the work
+    data = build_model_report(mech, out, progress=False if progress is None else progress, trace=trace)
+    return ReportResult(out, data)
+
+
+#: The motions :func:`view` can animate.
+VIEW_MOTIONS = ("auto", "trace", "demo")
+
+
+@dataclass(frozen=True, eq=False)
+class ViewResult:
+    """The viewer page written (:attr:`file`: ``out``, ``frames``, ``bytes``) and the motion shown
+    (``"trace"`` or ``"demo"``)."""
+
+    file: object
+    motion: str
+
+    @property
+    def out(self) -> str:
+        return self.file.out
+
+    @property
+    def frames(self) -> int:
+        return self.file.frames
+
+    @property
+    def bytes(self) -> int:
+        return self.file.bytes
+
+    def to_dict(self) -> dict:
+        return {**self.file.to_dict(), "motion": self.motion}
+
+
+def view(model: ModelLike, out, *, motion: str = "auto", frames: int = 60) -> ViewResult:
+    """Write the interactive 3-D viewer of a model (one self-contained HTML file, opens
+    offline) animated along a motion: ``"trace"`` (1 DOF: the whole circuit by continuation,
+    with the zeros of DJ marked), ``"demo"`` (a short loop along the closure manifold, any
+    mobility) or ``"auto"`` (trace when the mechanism has one degree of freedom).
+
+    >>> import spatialmech as sm, tempfile, os
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     v = sm.view("rssr", os.path.join(d, "rssr.html"), frames=12)
+    ...     v.frames, v.bytes > 100_000
+    (12, True)
+    """
+    from ..analysis.traced_motion import traced_motion
+    from ..kinematics.motion import sample_motion
+    from ..present.viewer import write_viewer
+
+    mech = as_mechanism(model)
+    motion = check_choice(motion, "motion", VIEW_MOTIONS)
+    frames = check_int(frames, "frames", minimum=2)
+    out = check_path(out, "out")
+    if out.is_dir():
+        raise InputError(f"out: {out} is a directory; give a file name")
+    if not out.parent.is_dir():
+        raise InputError(f"out: cannot write {out}: the directory {out.parent} does not exist")
+    singular = ()
+    if motion == "auto":
+        motion = "trace" if (not mech.is_metamorphic and _mobility(mech).dof_instantaneous == 1) else "demo"
+    if motion == "trace":
+        configs, singular = traced_motion(mech, frames=frames)
+        title = (f"{mech.name}: the traced circuit ({len(configs)} frames); x: DJ zeros of "
+                 f"{', '.join(mech.actuators[:1]) or '-'}")
+    else:
+        configs = sample_motion(mech, n=frames)
+        title = f"{mech.name}: a demonstration loop, {len(configs)} configurations (not the tracker)"
+    written = write_viewer(out, mech, configs, title=title, task_positions=mech.positions, singular_points=singular)
+    return ViewResult(written, motion)

@@ -1,0 +1,90 @@
+"""The public API: the ready-made models, loading a model, and mobility (``sm.models``,
+``sm.load_model``, ``sm.mobility``, ``sm.mobility_modes``)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from .. import catalog
+from ..analysis.mobility import MobilityResult
+from ..analysis.mobility import mobility as _mobility
+from ..analysis.mobility import mobility_modes as _mobility_modes
+from ..errors import describe
+from ..model.mechanism import Mechanism
+from .checks import ModelLike, as_mechanism, check_int
+
+
+# ============================================================================ models
+def models() -> dict[str, str]:
+    """The ready-made models: name -> one-line description.
+
+    >>> import spatialmech as sm
+    >>> "bennett" in sm.models() and "four-sps-cu" in sm.models()
+    True
+    """
+    return {n: catalog.describe(n) for n in catalog.names()}
+
+
+def load_model(model: ModelLike) -> Mechanism:
+    """A mechanism from a ready-made name, a TOML file path, or a Mechanism (returned as is).
+
+    Unknown names raise :class:`~spatialmech.UnknownNameError` (listing the known ones); a
+    malformed file :class:`~spatialmech.ModelFileError` naming the file and the field.
+
+    >>> import spatialmech as sm
+    >>> mech = sm.load_model("rssr")
+    >>> mech.name, mech.actuators
+    ('rssr', ('A0.rot',))
+    """
+    return as_mechanism(model)
+
+
+# ============================================================================ mobility
+def mobility(model: ModelLike, mode: str | None = None, *, seed: int = 0, tol=None) -> MobilityResult:
+    """Mobility by the modified Kutzbach-Grübler formula, checked numerically (one mode of a
+    metamorphic mechanism: ``mode``; every mode: :func:`mobility_modes`).  ``tol``: a
+    :class:`~spatialmech.geometry.tolerances.Tolerances` or the rank tolerance (default: the
+    tolerances in force).
+
+    >>> import spatialmech as sm
+    >>> r = sm.mobility("four-sps-cu")
+    >>> (r.dof, r.motion)
+    (4, 'RxRyRzTz')
+    """
+    mech = as_mechanism(model)
+    if mode is not None and not isinstance(mode, str):
+        raise TypeError(f"mode: expected a mode name (str) or None, got {describe(mode)}")
+    return _mobility(mech, mode, seed=check_int(seed, "seed"), tol=tol)
+
+
+@dataclass(frozen=True, eq=False)
+class MobilityModes:
+    """The mobility of every motion mode (a sequence of
+    :class:`~spatialmech.analysis.mobility.MobilityResult`; one for an ordinary mechanism)."""
+
+    mechanism: Mechanism
+    modes: tuple[MobilityResult, ...]
+
+    def __iter__(self):
+        return iter(self.modes)
+
+    def __len__(self) -> int:
+        return len(self.modes)
+
+    def __getitem__(self, k):
+        return self.modes[k]
+
+    def to_dict(self) -> dict:
+        return {"metamorphic": self.mechanism.is_metamorphic, "modes": [r.to_dict() for r in self.modes]}
+
+
+def mobility_modes(model: ModelLike, *, seed: int = 0, tol=None) -> MobilityModes:
+    """Mobility of every motion mode (one result for a mechanism that is not metamorphic);
+    ``to_dict()`` is the payload of ``spatialmech mobility --json``.
+
+    >>> import spatialmech as sm
+    >>> [r.dof for r in sm.mobility_modes("three-rrr-sm")]
+    [1, 1, 1, 2, 2, 2, 3]
+    """
+    mech = as_mechanism(model)
+    return MobilityModes(mech, tuple(_mobility_modes(mech, seed=check_int(seed, "seed"), tol=tol)))

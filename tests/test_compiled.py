@@ -1,0 +1,319 @@
+"""The compiled engine (kinematics/compiled.py) against the pure-Python reference on every
+ready-made model: residuals and Jacobians, Gauss-Newton corrections (forward position with the
+actuators held, inverse position with the output held), retraction, tracking, driver
+determinants and limb inverse position.  ``SPATIALMECH_PURE=1`` selects the reference path."""
+
+from __future__ import annotations
+
+import os
+from contextlib import contextmanager
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+pytest.importorskip("numba")
+if os.environ.get("SPATIALMECH_PURE", "").strip() not in ("", "0"):
+    pytest.skip("SPATIALMECH_PURE is set: both paths would be the reference", allow_module_level=True)
+
+from spatialmech import catalog
+from spatialmech.analysis.defects import candidate_drivers
+from spatialmech.errors import InputError
+from spatialmech.geometry.rotations import exp_twist
+from spatialmech.kinematics import compiled
+from spatialmech.kinematics.closed_forms import four_sps_cu
+from spatialmech.kinematics.closure import (
+    Configuration,
+    active_mask,
+    closure_jacobian,
+    closure_residual,
+    correct,
+    generic_configuration,
+    hub_count,
+    retract,
+)
+from spatialmech.kinematics.jacobian import driver_determinants
+from spatialmech.kinematics.position import inverse_position, platform_pose
+from spatialmech.kinematics.tracking import MotionProblem, trace_motion
+
+NAMES = catalog.names()
+ONE_DOF = ["five-cs-1", "five-cs-2", "five-cs-3", "planar-4r", "bennett", "rssr", "spatial-six-bar"]
+
+
+@contextmanager
+def pure():
+    """Run the block on the pure-Python reference path."""
+    old = os.environ.get(compiled.PURE_ENV)
+    os.environ[compiled.PURE_ENV] = "1"
+    try:
+        yield
+    finally:
+        if old is None:
+            del os.environ[compiled.PURE_ENV]
+        else:
+            os.environ[compiled.PURE_ENV] = old
+
+
+_GENERIC: dict[str, Configuration] = {}
+
+
+def generic(name: str) -> Configuration:
+    if name not in _GENERIC:
+        _GENERIC[name] = generic_configuration(catalog.build(name), seed=7)
+    return _GENERIC[name]
+
+
+def perturbed(mech, config: Configuration, seed: int, size: float = 0.05) -> Configuration:
+    """An open (not closed) configuration near ``config``: joints, output and bodies moved."""
+    rng = np.random.default_rng(seed)
+    q = config.q + size * rng.standard_normal(len(config.q))
+    D = exp_twist(size * rng.standard_normal(6), 1.0) @ config.D
+    B = np.array([exp_twist(size * rng.standard_normal(6), 1.0) @ b for b in config.B]).reshape(config.B.shape)
+    return Configuration(q, D, B)
+
+
+def close(a, b, tol):
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    assert a.shape == b.shape
+    np.testing.assert_allclose(a, b, rtol=0, atol=tol * max(1.0, float(np.max(np.abs(b), initial=0.0))))
+
+
+def test_the_compiled_path_is_on_by_default_and_pure_switches_it_off():
+    assert compiled.enabled()
+    with pure():
+        assert not compiled.enabled()
+    assert compiled.enabled()
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_residual_and_jacobian_match_the_reference(name):
+    mech = catalog.build(name)
+    for config in (generic(name), perturbed(mech, generic(name), 1)):
+        with pure():
+            r0 = closure_residual(mech, config)
+            A0, s0 = closure_jacobian(mech, config)
+        r1 = closure_residual(mech, config)
+        A1, s1 = closure_jacobian(mech, config)
+        close(r1, r0, 1e-12)
+        close(s1, s0, 1e-12)
+        close(A1, A0, 1e-12)
+        if len(config.q) > 1:  # another active mask: the columns follow it
+            act = active_mask(mech)
+            act[0] = False
+            with pure():
+                A0, _ = closure_jacobian(mech, config, active=act)
+            close(closure_jacobian(mech, config, active=act)[0], A0, 1e-12)
+
+
+def _held(mech) -> np.ndarray:
+    mask = active_mask(mech)
+    for a in mech.actuators:
+        mask[mech.freedom_refs.index(mech.freedom(a))] = False
+    return mask
+
+
+def same_correction(r1, r0, tol=1e-10):
+    assert (r1.converged, r1.stationary) == (r0.converged, r0.stationary)
+    assert r1.iterations == r0.iterations
+    if r0.converged:
+        close(r1.config.q, r0.config.q, tol)
+        close(r1.config.D, r0.config.D, tol)
+        close(r1.config.B, r0.config.B, tol)
+        assert r1.residual < 1e-11 and r0.residual < 1e-11
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_forward_position_from_the_reference_matches(name):
+    """``correct()`` with the actuators held at a generic configuration's values, started from the
+    reference configuration: the same statuses, iterations and result."""
+    mech = catalog.build(name)
+    target = generic(name)
+    mask = _held(mech)
+    ref = Configuration.reference(mech)
+    q = ref.q.copy()
+    q[~mask] = target.q[~mask]
+    start = Configuration(q, ref.D, ref.B)
+    with pure():
+        r0 = correct(mech, start, active=mask)
+    r1 = correct(mech, start, active=mask)
+    same_correction(r1, r0)
+    # and near a solution (a few iterations), plus the inverse position (output held)
+    near = perturbed(mech, target, 2, size=0.01)
+    for kw in ({"active": mask}, {"fix_platform": True}, {}):
+        with pure():
+            r0 = correct(mech, near, **kw)
+        same_correction(correct(mech, near, **kw), r0)
+
+
+@pytest.mark.parametrize("name", ["stewart-6sps", "delta", "five-cs-3"])
+def test_retraction_and_tracker_differences_match(name):
+    mech = catalog.build(name)
+    c = generic(name)
+    act = active_mask(mech)
+    rng = np.random.default_rng(3)
+    for n_hubs in (hub_count(mech), 1, 0):  # a shorter step leaves the remaining hubs where they are
+        step = 0.05 * rng.standard_normal(int(act.sum()) + 6 * n_hubs)
+        for fix in (False, True):
+            with pure():
+                c0 = retract(mech, c, act, step, fix)
+            c1 = retract(mech, c, act, step, fix)
+            close(c1.q, c0.q, 1e-12)
+            close(c1.D, c0.D, 1e-12)
+            close(c1.B, c0.B, 1e-12)
+    prob = MotionProblem(mech)
+    other = perturbed(mech, c, 4, size=0.3)
+    with pure():
+        d0 = prob.difference(c, other)
+    close(prob.difference(c, other), d0, 1e-12)
+    with pytest.raises(InputError, match="step"):
+        retract(mech, c, act, np.zeros(2))
+
+
+@pytest.mark.parametrize("name", ONE_DOF)
+def test_tracking_matches_the_reference(name):
+    """A few steps of the continuation tracker (predictor, corrector, guards, monitors) give the
+    same points on both paths."""
+    mech = catalog.build(name)
+    start = generic(name)
+    drivers = candidate_drivers(mech)
+    if not np.all(np.isfinite(driver_determinants(mech, start, drivers))):
+        drivers = []  # DJ is NaN (not square) here: NaN monitors would only add spurious events
+
+    def run():
+        return trace_motion(mech, start, max_steps=6, h0=0.05,
+                            vector_monitor=(drivers, lambda c: driver_determinants(mech, c, drivers)))
+
+    with pure():
+        t0 = run()
+    t1 = run()
+    assert len(t1.points) == len(t0.points) and t1.status == t0.status and t1.rejected == t0.rejected
+    for a, b in zip(t1.points, t0.points, strict=True):
+        close(a.q, b.q, 1e-10)
+        close(a.D, b.D, 1e-10)
+    for k in t0.monitors:
+        close(t1.monitors[k], t0.monitors[k], 1e-10)
+
+
+@pytest.mark.parametrize("name", ["five-cs-1", "five-cs-2", "five-cs-3", "spatial-six-bar", "delta", "rssr"])
+def test_driver_determinants_match(name):
+    mech = catalog.build(name)
+    drivers = candidate_drivers(mech)
+    for seed in range(3):
+        c = generic_configuration(mech, seed=seed) if seed else generic(name)
+        with pure():
+            d0 = driver_determinants(mech, c, drivers)
+        d1 = driver_determinants(mech, c, drivers)
+        assert np.array_equal(np.isnan(d0), np.isnan(d1))
+        ok = ~np.isnan(d0)
+        close(d1[ok], d0[ok], 1e-10)
+    if name.startswith("five-cs"):  # the compiled kernel itself runs (no fallback) and batches
+        c = generic(name)
+        many = compiled.driver_determinants_many(mech, np.stack([c.q, c.q]), np.stack([c.D, c.D]), None, drivers)
+        assert many is not None
+        close(many[1], driver_determinants(mech, c, drivers), 1e-14)
+    if name == "rssr":  # a limb of one twist: the kernel declines, the Python path answers
+        assert compiled.driver_determinants(mech, generic(name), drivers) is None
+
+
+@pytest.mark.parametrize("name", ["stewart-6sps", "four-sps-cu"])
+def test_limb_inverse_position_matches(name):
+    mech = catalog.build(name)
+    pose = platform_pose(mech, generic(name))
+    with pure():
+        i0 = inverse_position(mech, pose, all_solutions=True, n_seeds=6)
+    i1 = inverse_position(mech, pose, all_solutions=True, n_seeds=6)
+    assert i1.reachable and i0.reachable
+    for a, b in zip(i1.limbs, i0.limbs, strict=True):
+        assert len(a.solutions) == len(b.solutions)
+        for x, y in zip(a.solutions, b.solutions, strict=True):
+            close(x, y, 1e-10)
+    close(i1.config.q, i0.config.q, 1e-10)
+    # batched: many poses at once, the same as one by one
+    Ds = np.stack([generic(name).D, generic_configuration(mech, seed=11).D])
+    q, res, ok = compiled.limb_inverse_many(mech, Ds)
+    assert ok.all() and res.max() < 1e-10
+    for k in range(2):
+        one = inverse_position(mech, platform_pose(mech, Configuration(q[k], Ds[k])))
+        assert one.reachable
+        assert np.max(np.abs(closure_residual(mech, Configuration(q[k], Ds[k])))) < 1e-9
+
+
+def test_batched_entry_points_equal_single_calls():
+    mech = catalog.build("delta")
+    cs = [generic("delta"), perturbed(mech, generic("delta"), 6), perturbed(mech, generic("delta"), 7)]
+    q = np.stack([c.q for c in cs])
+    D = np.stack([c.D for c in cs])
+    B = np.stack([c.B for c in cs])
+    A, r = compiled.closure_jacobians(mech, q, D, B)
+    res = compiled.closure_residuals(mech, q, D, B)
+    for k, c in enumerate(cs):
+        A1, r1 = closure_jacobian(mech, c)
+        assert np.array_equal(A[k], A1) and np.array_equal(r[k], r1) and np.array_equal(res[k], r1)
+    mask = _held(mech)
+    many = compiled.correct_many(mech, cs, active=mask)
+    for c, m in zip(cs, many, strict=True):
+        one = correct(mech, c, active=mask)
+        assert (m.converged, m.iterations) == (one.converged, one.iterations)
+        assert np.array_equal(m.config.q, one.config.q)
+    with pytest.raises(InputError, match="q: expected shape"):
+        compiled.closure_residuals(mech, q[:, :3], D, B)
+
+
+def test_errors_name_the_argument_on_both_paths():
+    mech = catalog.build("stewart-6sps")
+    bad = Configuration(np.zeros(3), np.eye(4))
+    for ctx in (pure, _nothing):
+        with ctx():
+            with pytest.raises(InputError, match=r"config\.q"):
+                closure_jacobian(mech, bad)
+            with pytest.raises(InputError, match="NaN"):
+                correct(mech, Configuration(np.full(len(mech.freedom_refs), np.nan), np.eye(4)))
+    with pytest.raises(InputError, match="active"):
+        closure_jacobian(mech, Configuration.reference(mech), active=np.ones(3, bool))
+
+
+@contextmanager
+def _nothing():
+    yield
+
+
+def test_sps_leg_lengths_agree_with_the_closed_form():
+    rng = np.random.default_rng(1)
+    phi = np.column_stack([rng.uniform(0.08, 0.3, 50), rng.uniform(-0.5, 0.5, (50, 3))])  # z, alpha, beta, gamma
+    g = four_sps_cu.PAPER_B
+    s1 = np.array([1, 1, -1, -1.0])
+    s2 = np.array([-1, 1, 1, -1.0])
+    plat = np.column_stack([g.a * s1, g.a * s2, np.zeros(4)])
+    base = np.column_stack([g.b * s1, g.b * s2, np.zeros(4)])
+    poses = np.column_stack([np.zeros((50, 2)), phi[:, 0], phi[:, 3], phi[:, 2], phi[:, 1]])
+    close(compiled.sps_leg_lengths(poses, base, plat), four_sps_cu.leg_lengths(phi, g), 1e-14)
+
+
+def test_without_numba_the_python_path_runs_with_a_note(monkeypatch):
+    monkeypatch.setattr(compiled, "AVAILABLE", False)
+    with pytest.warns(RuntimeWarning, match="numba"):
+        assert not compiled.enabled()
+    mech = catalog.build("rssr")
+    assert np.allclose(closure_residual(mech, Configuration.reference(mech)), 0, atol=1e-12)
+
+
+MODELS_H = ["stewart-6sps", "five-cs-3", "delta", "three-rps", "spatial-six-bar"]
+
+
+@settings(max_examples=25)
+@given(st.sampled_from(MODELS_H), st.integers(0, 2**31 - 1), st.floats(0.01, 1.5))
+def test_random_configurations_match(name, seed, size):
+    """Residual, Jacobian and one Gauss-Newton correction at random (open) configurations."""
+    mech = catalog.build(name)
+    c = perturbed(mech, Configuration.reference(mech), seed, size)
+    with pure():
+        r0 = closure_residual(mech, c)
+        A0, _ = closure_jacobian(mech, c)
+        k0 = correct(mech, c, max_iter=1)
+    close(closure_residual(mech, c), r0, 1e-12)
+    close(closure_jacobian(mech, c)[0], A0, 1e-12)
+    k1 = correct(mech, c, max_iter=1)
+    close(k1.config.q, k0.config.q, 1e-10)
+    close(k1.config.D, k0.config.D, 1e-10)
+    assert k1.residual == pytest.approx(k0.residual, rel=1e-9, abs=1e-14)

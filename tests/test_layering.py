@@ -1,0 +1,174 @@
+"""The numerical core (geometry, model, kinematics, analysis, synthesis) never imports plotting,
+the model catalogue, the presentation layer, the command line or the API facade (issue 10, "Code
+health"): figures live in ``spatialmech.present``, ready-made models in ``spatialmech.catalog``.
+
+Two checks, each able to fail (the last tests feed them a violation):
+
+- static: every ``import`` / ``from ... import`` statement of every core module, module level
+  and inside functions (lazy imports included), relative ones resolved, and every
+  ``importlib.import_module("...")`` / ``__import__("...")`` with a literal name;
+- at run time: every core module imported in a fresh interpreter, one after the other, and
+  ``sys.modules`` inspected after each; this also catches what the core's third-party imports
+  drag in.  The package's own ``spatialmech/__init__.py`` is not run there (it imports the API
+  facade, which may use the catalogue): a bare package object with the same ``__path__`` stands in
+  for it, so each core module is imported exactly with what it imports itself.
+"""
+
+from __future__ import annotations
+
+import ast
+import importlib.util
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).parent.parent
+PKG = ROOT / "src" / "spatialmech"
+CORE = ("geometry", "model", "kinematics", "analysis", "synthesis")
+#: Third-party packages the core must not import (by top-level name).
+FORBIDDEN_THIRD_PARTY = ("matplotlib", "plotly")
+#: Parts of spatialmech the core must not import (each with its sub-modules).
+FORBIDDEN_OWN = ("spatialmech.catalog", "spatialmech.present", "spatialmech.interfaces", "spatialmech.api")
+
+
+def module_name(path: Path) -> str:
+    """``src/spatialmech/a/b.py`` -> ``spatialmech.a.b`` (a package's ``__init__.py``: the package)."""
+    parts = list(path.relative_to(PKG.parent).with_suffix("").parts)
+    if parts[-1] == "__init__":
+        parts.pop()
+    return ".".join(parts)
+
+
+def core_files() -> list[Path]:
+    return sorted(p for c in CORE for p in (PKG / c).rglob("*.py") if "__pycache__" not in p.parts)
+
+
+def forbidden(name: str) -> str | None:
+    """The rule ``name`` (an absolute module name) breaks, or ``None``."""
+    if name.split(".")[0] in FORBIDDEN_THIRD_PARTY:
+        return name.split(".")[0]
+    for own in FORBIDDEN_OWN:
+        if name == own or name.startswith(own + "."):
+            return own
+    return None
+
+
+def imported_names(source: str, module: str, is_package: bool) -> list[tuple[int, str]]:
+    """``(line, absolute module name)`` of every import in ``source`` (the module ``module``):
+    for ``from X import a, b`` both ``X`` and ``X.a``, ``X.b`` (``a`` may be a sub-module)."""
+    package = module if is_package else module.rpartition(".")[0]
+    out: list[tuple[int, str]] = []
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.Import):
+            out += [(node.lineno, a.name) for a in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                base = importlib.util.resolve_name("." * node.level + base, package)
+            out.append((node.lineno, base))
+            out += [(node.lineno, f"{base}.{a.name}") for a in node.names if a.name != "*"]
+        elif isinstance(node, ast.Call) and node.args and isinstance(node.args[0], ast.Constant):
+            f = node.func
+            called = f.id if isinstance(f, ast.Name) else f.attr if isinstance(f, ast.Attribute) else ""
+            arg = node.args[0].value
+            if called in ("import_module", "__import__") and isinstance(arg, str):
+                name = importlib.util.resolve_name(arg, package) if arg.startswith(".") else arg
+                out.append((node.lineno, name))
+    return out
+
+
+def static_violations(path: Path, source: str | None = None) -> list[str]:
+    """Messages ``file:line: imports NAME (RULE)`` for one core file."""
+    source = path.read_text(encoding="utf-8") if source is None else source
+    mod = module_name(path)
+    rel = path.relative_to(ROOT) if path.is_relative_to(ROOT) else path
+    first: dict[int, tuple[str, str]] = {}  # one message per statement: its first forbidden name
+    for line, name in imported_names(source, mod, path.name == "__init__.py"):
+        if (rule := forbidden(name)) is not None:
+            first.setdefault(line, (name, rule))
+    return [f"{rel}:{line}: imports {name} ({rule} is not allowed in the numerical core)"
+            for line, (name, rule) in sorted(first.items())]
+
+
+#: Run in a fresh interpreter: argv[1] is a JSON list of modules to import in order; prints a JSON
+#: object {module: [forbidden modules that appeared in sys.modules while importing it]}.
+_PROBE = r"""
+import importlib, importlib.util, json, sys, types
+spec = importlib.util.find_spec("spatialmech")
+bare = types.ModuleType("spatialmech")
+bare.__path__ = list(spec.submodule_search_locations)
+bare.__spec__ = spec
+sys.modules["spatialmech"] = bare   # the package, without running its __init__ (the API facade)
+third, own = json.loads(sys.argv[2]), json.loads(sys.argv[3])
+
+def bad(name):
+    return name.split(".")[0] in third or any(name == o or name.startswith(o + ".") for o in own)
+
+seen, out = set(), {}
+for mod in json.loads(sys.argv[1]):
+    importlib.import_module(mod)
+    new = sorted(m for m in sys.modules if m not in seen and bad(m))
+    seen.update(sys.modules)
+    if new:
+        out[mod] = new
+print(json.dumps(out))
+"""
+
+
+def runtime_violations(modules: list[str]) -> dict[str, list[str]]:
+    p = subprocess.run([sys.executable, "-c", _PROBE, json.dumps(modules), json.dumps(FORBIDDEN_THIRD_PARTY),
+                        json.dumps(FORBIDDEN_OWN)], cwd=ROOT, capture_output=True, text=True, timeout=300)
+    assert p.returncode == 0, p.stderr
+    return json.loads(p.stdout.strip().splitlines()[-1])
+
+
+# ------------------------------------------------------------------ the checks
+def test_the_core_is_where_the_test_looks():
+    files = core_files()
+    assert {f.relative_to(PKG).parts[0] for f in files} == set(CORE)
+    assert len(files) > 30, files  # a moved tree would make the checks below vacuous
+
+
+def test_no_core_module_imports_plotting_or_presentation_statically():
+    problems = [m for f in core_files() for m in static_violations(f)]
+    assert not problems, "the numerical core must not import these (draw in spatialmech.present):\n" + "\n".join(
+        problems)
+
+
+def test_importing_every_core_module_loads_no_plotting_or_presentation():
+    modules = [module_name(f) for f in core_files()]
+    found = runtime_violations(modules)
+    assert not found, "importing these core modules loaded forbidden modules: " + json.dumps(found, indent=1)
+
+
+# ------------------------------------------------------------------ the checks can fail
+@pytest.mark.parametrize(("where", "source", "expected"), [
+    ("analysis/example.py", "import matplotlib.pyplot as plt\n", "matplotlib"),
+    ("synthesis/example.py", "def f():\n    from plotly import graph_objects\n", "plotly"),
+    ("analysis/example.py", "from ..present.viewer import write_viewer\n", "spatialmech.present"),
+    ("kinematics/closed_forms/example.py", "from ... import catalog\n", "spatialmech.catalog"),
+    ("model/__init__.py", "from ..catalog.papers import five_cs_positions\n", "spatialmech.catalog"),
+    ("geometry/example.py", "from spatialmech.interfaces import cli\n", "spatialmech.interfaces"),
+    ("analysis/workspace/example.py", "def f():\n    from ...api import mobility\n", "spatialmech.api"),
+    ("kinematics/example.py", "import importlib\nm = importlib.import_module('matplotlib')\n", "matplotlib"),
+    ("synthesis/example.py", "cmap = __import__('matplotlib').colormaps\n", "matplotlib"),
+])
+def test_the_static_check_flags_a_forbidden_import(where, source, expected):
+    found = static_violations(PKG / where, source)  # the file is not written: its source is given
+    assert len(found) >= 1 and all(expected in m for m in found), found
+
+
+def test_the_static_check_accepts_allowed_imports():
+    source = ("import numpy as np\nfrom ..closure import correct\nfrom ...errors import InputError\n"
+              "from .. import tracking\nimport scipy.linalg\nfrom ...analysis.catalogue_free import x\n")
+    assert static_violations(PKG / "kinematics" / "closed_forms" / "example.py", source) == []
+
+
+def test_the_runtime_check_flags_a_module_that_loads_plotting():
+    # a presentation module imported after a core one: its imports are attributed to it
+    found = runtime_violations(["spatialmech.geometry.screws", "spatialmech.present.viewer"])
+    assert "spatialmech.geometry.screws" not in found
+    assert "plotly" in {m.split(".")[0] for m in found["spatialmech.present.viewer"]}, found
