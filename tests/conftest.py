@@ -29,3 +29,14 @@ seeds = st.integers(0, 2**32 - 1)
 def random_transform(seed: int) -> np.ndarray:
     r = np.random.default_rng(seed)
     return transform(Rotation.random(random_state=seed).as_matrix(), r.uniform(-5, 5, 3))
+
+
+@pytest.fixture(scope="session")
+def demo_report(tmp_path_factory):
+    """``spatialmech demo`` built once for the whole session (about 45 s): ``(out_dir, results)``.
+    The report tests, the regression test of its rows and the JSON-schema test of the ``demo``
+    command all read this one run; nothing may modify ``results``."""
+    from spatialmech.present.report import build_demo
+
+    out = tmp_path_factory.mktemp("demo")
+    return out, build_demo(out, progress=False)

@@ -41,18 +41,7 @@ NAMES = catalog.names()
 ONE_DOF = ["five-cs-1", "five-cs-2", "five-cs-3", "planar-4r", "bennett", "rssr", "spatial-six-bar"]
 
 
-@contextmanager
-def pure():
-    """Run the block on the pure-Python reference path."""
-    old = os.environ.get(compiled.PURE_ENV)
-    os.environ[compiled.PURE_ENV] = "1"
-    try:
-        yield
-    finally:
-        if old is None:
-            del os.environ[compiled.PURE_ENV]
-        else:
-            os.environ[compiled.PURE_ENV] = old
+pure = compiled.python_reference
 
 
 _GENERIC: dict[str, Configuration] = {}
@@ -317,3 +306,65 @@ def test_random_configurations_match(name, seed, size):
     close(k1.config.q, k0.config.q, 1e-10)
     close(k1.config.D, k0.config.D, 1e-10)
     assert k1.residual == pytest.approx(k0.residual, rel=1e-9, abs=1e-14)
+
+
+def test_minimum_norm_solver_equals_lstsq_and_falls_back_on_rank_deficiency():
+    """The QR path of the compiled least squares gives numpy's minimum-norm solution; a rank
+    deficient system (two equal rows) goes to the SVD and still matches lstsq."""
+    rng = np.random.default_rng(4)
+    for m, n in ((36, 42), (6, 6), (5, 12), (12, 7)):
+        A, b = rng.standard_normal((m, n)), rng.standard_normal(m)
+        close(compiled.lstsq(A, b), np.linalg.lstsq(A, b, rcond=None)[0], 1e-12)
+    A = rng.standard_normal((6, 9))
+    A[3] = A[1]
+    b = rng.standard_normal(6)
+    b[3] = b[1]
+    close(compiled.lstsq(A, b), np.linalg.lstsq(A, b, rcond=None)[0], 1e-10)
+
+
+def test_batched_general_pose_checker_equals_pose_by_pose():
+    """The general workspace checker solves many poses in one compiled batch; its margins equal
+    those of the pose-by-pose path (which also searches other assemblies where a limit is
+    broken) on feasible, infeasible and unreachable poses."""
+    from spatialmech.analysis.workspace import pose_checker, with_freedom_limits
+    from spatialmech.kinematics.position import platform_pose
+
+    for name in ("three-rps", "stewart-6sps"):
+        mech = catalog.build(name)
+        L = mech.characteristic_length
+        mech = with_freedom_limits(mech, {a: (mech.freedom(a).freedom.offset - 0.1 * L,
+                                              mech.freedom(a).freedom.offset + 0.1 * L) for a in mech.actuators})
+        checker = pose_checker(mech, method="general")
+        rng = np.random.default_rng(2)
+        Rs, ps = [], []
+        for k in range(12):
+            config = generic_configuration(mech, seed=k, step=0.02 + 0.04 * k)
+            pose = platform_pose(mech, config)
+            Rs.append(pose.R)
+            ps.append(pose.p + (0.0 if k % 4 else 0.05 * rng.standard_normal(3)))  # some off the closure
+        R, p = np.array(Rs), np.array(ps)
+        batch = checker.margins(R, p)
+        single = np.array([checker.margins(R[i : i + 1], p[i : i + 1])[0] for i in range(len(R))])
+        close(batch, single, 1e-12)
+        feasible = np.all(batch >= 0, axis=1)
+        assert feasible.any() and not feasible.all(), name
+        if name == "three-rps":  # a 3-DOF platform cannot reach the poses moved off its closure
+            assert np.any(batch[:, -1] < 0)
+
+
+@settings(max_examples=20, deadline=None)
+@given(st.integers(0, 2**31 - 1))
+def test_cs_dyad_equations_compiled_equal_the_vectorised_form(seed):
+    """The compiled one-dyad residual and Jacobian (the synthesis tracker's inner loop) equal the
+    vectorised NumPy form (a stack of one dyad takes that path) and the pure path."""
+    from spatialmech.synthesis.cs_dyads import dyad_jacobian, dyad_residual
+
+    rng = np.random.default_rng(seed)
+    x = rng.standard_normal(15)
+    D = np.array([exp_twist(rng.standard_normal(6), 1.0) for _ in range(7)])
+    r, J = dyad_residual(x, D), dyad_jacobian(x, D)
+    close(r, dyad_residual(x[None], D)[0], 1e-13)
+    close(J, dyad_jacobian(x[None], D)[0], 1e-13)
+    with pure():
+        close(r, dyad_residual(x, D), 1e-13)
+        close(J, dyad_jacobian(x, D), 1e-13)

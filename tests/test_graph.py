@@ -21,7 +21,8 @@ from spatialmech.kinematics.closure import (
     retract,
 )
 from spatialmech.kinematics.jacobian import complete_jacobian
-from spatialmech.kinematics.position import forward_position, inverse_position, platform_pose
+from spatialmech.kinematics.position import inverse_position, platform_pose
+from spatialmech.kinematics.forward import forward_position
 from spatialmech.kinematics.velocity import forward_velocity, inverse_velocity
 from spatialmech.model import schema
 from spatialmech.model.joints import R, S, U

@@ -126,8 +126,16 @@ def test_report_json(tmp_path, registry):
 
 
 @pytest.mark.slow
-def test_demo_json(tmp_path, registry):
+def test_demo_json(tmp_path, registry, demo_report, monkeypatch):
+    """The command's JSON of the session's one demo run (the build itself is not repeated: the
+    CLI's call of build_demo answers that run's results)."""
+    import spatialmech.present.report as report_module
+
+    _, results = demo_report
+    calls = []
+    monkeypatch.setattr(report_module, "build_demo", lambda out, progress: calls.append(out) or results)
     d = check(run_json("demo", "--out", str(tmp_path / "demo")), "demo", None, registry)
+    assert calls == [tmp_path / "demo"]
     assert d["summary"]["claims"] == len(d["claims"]) > 0 and d["length_unit"] is None
     units = {s["key"]: s["length_unit"] for s in d["sections"]}
     assert (units["paper-a"], units["paper-b"], units["paper-d"]) == ("unit", "m", "mm")

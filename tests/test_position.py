@@ -12,12 +12,8 @@ import spatialmech as sm
 from spatialmech import catalog
 from spatialmech.interfaces.cli import cli
 from spatialmech.kinematics.closure import generic_configuration
-from spatialmech.kinematics.position import (
-    forward_position,
-    freedom_values,
-    inverse_position,
-    platform_pose,
-)
+from spatialmech.kinematics.position import freedom_values, inverse_position, platform_pose
+from spatialmech.kinematics.forward import forward_position
 
 STEWART = catalog.build("stewart-6sps")
 DELTA = catalog.build("delta")

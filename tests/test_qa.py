@@ -15,7 +15,8 @@ from click.testing import CliRunner
 import spatialmech as sm
 from spatialmech.analysis.defects import defect_analysis
 from spatialmech.interfaces.cli import cli
-from spatialmech.kinematics.position import configuration_at_pose, forward_position, inverse_position
+from spatialmech.kinematics.position import configuration_at_pose, inverse_position
+from spatialmech.kinematics.forward import forward_position
 
 
 def run(*args):

@@ -38,7 +38,7 @@ from spatialmech.kinematics.assembly import (
 from spatialmech.kinematics.closed_forms import four_sps_cu as k
 from spatialmech.kinematics.closed_forms import four_sps_cu_forward as kf
 from spatialmech.kinematics.closed_forms import four_sps_cu_paper as kp
-from spatialmech.kinematics.position import forward_conditioning, forward_position
+from spatialmech.kinematics.forward import forward_conditioning, forward_position
 from spatialmech.present.report import Claim, join_names, render_html, summary
 
 SRC = Path(__file__).resolve().parents[1] / "src" / "spatialmech"
@@ -278,11 +278,9 @@ def test_paper_b_workspace_row_is_consistent_with_its_closed_forms():
 
 
 @pytest.mark.slow
-def test_every_demo_report_row_is_consistent(tmp_path):
+def test_every_demo_report_row_is_consistent(demo_report):
     """Every claim row that cross-checks its explanation against its measured values agrees."""
-    from spatialmech.present.report import build_demo
-
-    data = build_demo(tmp_path, progress=False)
+    _, data = demo_report
     bad = [c["claim"] for c in data["claims"] if c["consistent"] is False]
     assert not bad and data["summary"]["inconsistent"] == 0
     assert any(c["consistent"] for c in data["claims"])  # the workspace row has its check

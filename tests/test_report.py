@@ -24,7 +24,7 @@ from spatialmech.kinematics.position import configuration_at_pose, freedom_value
 from spatialmech.kinematics.tracking import trace_motion
 from spatialmech.present import paper_b
 from spatialmech.analysis.defects import dj_table
-from spatialmech.present.report import VERDICTS, Claim, Progress, Table, build_demo, build_model_report
+from spatialmech.present.report import VERDICTS, Claim, Progress, Table, build_model_report
 
 ROOT = Path(__file__).parent.parent
 DOCS = sorted((ROOT / "docs").glob("*.md"))
@@ -37,10 +37,9 @@ def run(*args):
 
 
 @pytest.fixture(scope="module")
-def demo(tmp_path_factory):
-    out = tmp_path_factory.mktemp("demo")
-    data = build_demo(out, progress=False)
-    return out, data
+def demo(demo_report):
+    """The session's one demo run (tests/conftest.py)."""
+    return demo_report
 
 
 # ------------------------------------------------------------------ the demo report

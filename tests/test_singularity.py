@@ -82,7 +82,7 @@ def test_inverse_singularity_of_the_rssr_at_the_rocker_limit():
     # the coupler line nearly meets the crank axis: the crank can barely act (transmission ~ 0)
     assert r.transmission[0] < 0.05 < singularity(m, c, ["A0"]).transmission[0]
     # exactly at crank -90 deg the coupler (in the plane x = 0) meets the crank axis: inverse singular
-    from spatialmech.kinematics.position import forward_position
+    from spatialmech.kinematics.forward import forward_position
     fk = forward_position(m, [tr.points[k].q[i] / abs(tr.points[k].q[i]) * np.pi / 2], start=tr.points[k])
     assert fk.converged
     r = singularity(m, fk.solutions[0].config, ["A0"])

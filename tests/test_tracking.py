@@ -6,7 +6,8 @@ import pytest
 from spatialmech import catalog
 from spatialmech.kinematics.closure import Configuration, closure_residual, generic_configuration
 from spatialmech.kinematics.jacobian import complete_jacobian
-from spatialmech.kinematics.position import forward_position, freedom_values
+from spatialmech.kinematics.position import freedom_values
+from spatialmech.kinematics.forward import forward_position
 from spatialmech.kinematics.tracking import ActuatorPathProblem, EuclideanProblem, track, trace_motion
 
 

@@ -37,7 +37,8 @@ from ..geometry import screws as sc
 from ..geometry.line_geometry import classify_lines, json_dict
 from ..kinematics.closure import Configuration
 from ..kinematics.jacobian import CompleteJacobian, complete_jacobian
-from ..kinematics.position import configuration_at_pose, locked_actuators
+from ..kinematics.position import configuration_at_pose
+from ..kinematics.forward import locked_actuators
 from ..kinematics.tracking import MotionProblem, track
 from ..geometry.tolerances import current as current_tolerances
 from ..model.mechanism import Mechanism, Pose

@@ -48,13 +48,8 @@ import numpy as np
 from ..errors import ConvergenceError, InputError
 from ..geometry.rotations import rotation_angle, rotvec_matrix
 from ..kinematics.closure import Configuration
-from ..kinematics.position import (
-    configuration_at_pose,
-    forward_conditioning,
-    forward_position,
-    freedom_values,
-    platform_pose,
-)
+from ..kinematics.position import configuration_at_pose, freedom_values, platform_pose
+from ..kinematics.forward import forward_conditioning, forward_position
 from ..model.mechanism import Mechanism, Pose
 from ..serialize import freedom_values_dict, pose_dict
 

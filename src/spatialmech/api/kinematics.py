@@ -13,15 +13,8 @@ from ..errors import InputError, describe
 from ..geometry.tolerances import resolve as resolve_tolerances
 from ..kinematics.closure import Configuration
 from ..kinematics.jacobian import CompleteJacobian, complete_jacobian
-from ..kinematics.position import (
-    ForwardResult,
-    InverseResult,
-    PoseFit,
-    configuration_at_pose,
-    forward_position,
-    inverse_position,
-    platform_pose,
-)
+from ..kinematics.position import InverseResult, PoseFit, configuration_at_pose, inverse_position, platform_pose
+from ..kinematics.forward import ForwardResult, forward_position
 from ..kinematics.task import TaskJacobian, TaskSolution, solve_pose, task_jacobian_at, task_solution_dict
 from ..model.mechanism import Mechanism, Pose
 from ..results import Progress
@@ -131,7 +124,7 @@ def ik(model: ModelLike, pose, *, all_solutions: bool = False, n_seeds: int = 48
 class FKResult:
     """Forward position: the platform pose(s) for actuator values.
 
-    ``result`` is the general engine's :class:`~spatialmech.kinematics.position.ForwardResult`, or,
+    ``result`` is the general engine's :class:`~spatialmech.kinematics.forward.ForwardResult`, or,
     for ``all_solutions`` on a 4-SPS/CU of paper B's layout, the closed form's
     ``ForwardAllResult`` (``closed_form`` is True)."""
 

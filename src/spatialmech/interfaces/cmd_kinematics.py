@@ -17,7 +17,8 @@ from ..errors import InputError
 from ..geometry.rotations import euler_matrix, matrix_euler
 from ..geometry.tolerances import current as current_tolerances
 from ..kinematics.jacobian import complete_jacobian
-from ..kinematics.position import configuration_at_pose, forward_position, inverse_position
+from ..kinematics.position import configuration_at_pose, inverse_position
+from ..kinematics.forward import forward_position
 from ..kinematics.task import TaskJacobian, default_task, solve_pose, task_jacobian_at, task_solution_dict
 from ..model.mechanism import Mechanism, Pose
 from ..serialize import pose_dict

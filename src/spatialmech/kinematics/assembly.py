@@ -1,6 +1,6 @@
 """What forward position reports about each root: conditioning, distinctness, self-motions.
 
-Shared by the general engine (:func:`spatialmech.kinematics.position.forward_position`) and the
+Shared by the general engine (:func:`spatialmech.kinematics.forward.forward_position`) and the
 closed forms (:func:`spatialmech.kinematics.closed_forms.four_sps_cu_forward.forward_all`), so that both
 say the same things in the same words.
 

@@ -1,11 +1,9 @@
-"""Position analysis on the general closure engine: inverse, forward, and poses onto the manifold.
+"""Position analysis on the general closure engine: inverse position and poses onto the manifold.
 
 - :func:`inverse_position`: platform pose -> every limb's joint values; all real solutions
   (multi-start Gauss-Newton per limb, deduplicated by the limb's joint geometry), with joint
   limits checked and positive-dimensional (passive) solution sets reported.
-- :func:`forward_position`: actuator values -> platform pose from a seed with a convergence
-  status; ``all_solutions=True`` searches many seeds (random walks along the closure manifold)
-  and deduplicates, and says how it searched.
+- forward position (actuator values -> platform pose) is in :mod:`.forward`.
 - :func:`configuration_at_pose`: the closed configuration nearest to a given (possibly
   inexact, e.g. printed and rounded) platform pose, with the pose error it implies.
 
@@ -23,9 +21,7 @@ from ..errors import InputError
 from ..geometry.rotations import inverse_transform, log_transform, rotation_angle
 from ..geometry.tolerances import Tolerances
 from ..geometry.tolerances import resolve as resolve_tolerances
-from ..geometry import screws as sc
 from ..model.mechanism import Mechanism, Pose
-from ..results import Progress
 from ..serialize import freedom_values_dict, pose_dict
 from . import compiled
 from .closure import (
@@ -35,42 +31,26 @@ from .closure import (
     closure_jacobian,
     closure_scales,
     correct,
-    generic_configuration,
     hub_displacements,
-    joint_twists,
     limb_chains,
     limb_slices,
-    placed_configuration,
     recentre_balls,
     retract,
 )
-from .assembly import (
-    AssemblyKind,
-    Conditioning,
-    SelfMotion,
-    dedup_tolerances,
-    group_roots,
-    pose_keys,
-    singular_threshold,
-    trace_set,
-)
-from .tracking import MotionProblem
 
 __all__ = [
-    "FK_CONDITIONING_MEASURE",
-    "ForwardResult",
-    "ForwardSolution",
     "InverseResult",
     "LimbSolutions",
     "PoseFit",
+    "cluster_newton",
+    "cluster_system",
     "configuration_at_pose",
-    "forward_conditioning",
-    "forward_position",
     "freedom_values",
     "inverse_position",
     "limb_clusters",
-    "locked_actuators",
+    "limb_gauss_newton",
     "platform_pose",
+    "random_joint_values",
     "within_limits",
     "wrap_rotations",
 ]
@@ -177,12 +157,12 @@ def configuration_at_pose(
         refs = mech.freedom_refs[sl]
         lin = np.array([r.freedom.kind == "P" for r in refs])
         hold = np.array([r.freedom.locked for r in refs])
-        qk, rn, _ = _limb_gn(ch, D, q[sl].copy(), lin, L, tol=tol, max_iter=100, hold=hold)
+        qk, rn, _ = limb_gauss_newton(ch, D, q[sl].copy(), lin, L, tol=tol, max_iter=100, hold=hold)
         if rn > restart_tol:
             for _ in range(n_restarts):
                 q0 = np.where(lin, rng.uniform(-1, 1, len(refs)) * L, rng.uniform(-np.pi, np.pi, len(refs)))
                 q0 = np.where(hold, q[sl], q0)
-                qt, rt, _ = _limb_gn(ch, D, q0, lin, L, tol=tol, max_iter=100, hold=hold)
+                qt, rt, _ = limb_gauss_newton(ch, D, q0, lin, L, tol=tol, max_iter=100, hold=hold)
                 if rt < rn:
                     qk, rn = qt, rt
         q[sl] = qk
@@ -282,7 +262,7 @@ def _violation(mech: Mechanism, sl: slice, q_limb) -> float:
     return total
 
 
-def _limb_gn(chain, D, q, lin, L, tol=1e-12, max_iter=60, hold=None):
+def limb_gauss_newton(chain, D, q, lin, L, tol=1e-12, max_iter=60, hold=None):
     """Gauss-Newton for one limb with the platform held at ``D``, in local coordinates (S
     joints updated by composing rotations); freedoms in the ``hold`` mask keep their value."""
     if compiled.enabled():
@@ -450,7 +430,7 @@ def _inverse(mech: Mechanism, pose: Pose, all_solutions: bool, n_seeds: int, see
     return InverseResult(pose, tuple(x for x in out if x is not None), config, search)
 
 
-def _random_q(mech: Mechanism, rng: np.random.Generator, sl: slice, keep: np.ndarray, held) -> np.ndarray:
+def random_joint_values(mech: Mechanism, rng: np.random.Generator, sl: slice, keep: np.ndarray, held) -> np.ndarray:
     """Random joint values for the freedoms of ``sl`` (slides within +-L, angles within +-pi);
     freedoms in the ``held`` mask keep ``keep``."""
     refs = mech.freedom_refs[sl]
@@ -479,13 +459,13 @@ def _inverse_limb(mech: Mechanism, li: int, D: np.ndarray, q_start: np.ndarray, 
     locked = np.array([r.freedom.locked for r in refs])
     starts = [q_start[sl].copy()]
     if all_solutions:
-        starts += [_random_q(mech, rng, sl, q_start[sl], locked) for _ in range(n_seeds)]
+        starts += [random_joint_values(mech, rng, sl, q_start[sl], locked) for _ in range(n_seeds)]
     sols: list[np.ndarray] = []
     res: list[float] = []
     sigs: list[np.ndarray] = []
     best = (None, np.inf)
     for q0 in starts:
-        q, rn, ok = _limb_gn(ch, D, q0.astype(float), lin, L, tol=tol)
+        q, rn, ok = limb_gauss_newton(ch, D, q0.astype(float), lin, L, tol=tol)
         if not ok:
             if rn < best[1]:
                 best = (q, rn)
@@ -507,7 +487,7 @@ def _inverse_limb(mech: Mechanism, li: int, D: np.ndarray, q_start: np.ndarray, 
         # joint far from the reference): prefer one within the limits, else the least violation
         best_v = _violation(mech, sl, sols[0])
         for _ in range(n_seeds):
-            qs, rn, ok = _limb_gn(ch, D, _random_q(mech, rng, sl, q_start[sl], locked), lin, L, tol=tol)
+            qs, rn, ok = limb_gauss_newton(ch, D, random_joint_values(mech, rng, sl, q_start[sl], locked), lin, L, tol=tol)
             if ok:
                 qs = wrap_rotations(mech, qs, range(sl.start, sl.stop))
                 v = _violation(mech, sl, qs)
@@ -527,7 +507,7 @@ def _inverse_limb(mech: Mechanism, li: int, D: np.ndarray, q_start: np.ndarray, 
     return LimbSolutions(mech.limbs[li].name, tuple(sols), tuple(float(r) for r in res), reachable, passive, viol)
 
 
-def _cluster_newton(mech: Mechanism, config: Configuration, rows: np.ndarray, cols: np.ndarray, tol: float,
+def cluster_newton(mech: Mechanism, config: Configuration, rows: np.ndarray, cols: np.ndarray, tol: float,
                     max_iter: int = 60) -> tuple[Configuration, float, bool]:
     """Gauss-Newton on the closure equations ``rows`` in the unknowns ``cols`` (of the
     nondimensional closure system with every unlocked freedom active), output link held."""
@@ -552,7 +532,7 @@ def _cluster_newton(mech: Mechanism, config: Configuration, rows: np.ndarray, co
     return config, rn, rn < tol
 
 
-def _cluster_system(mech: Mechanism, cl: list[int], held=()) -> tuple[np.ndarray, list[int], np.ndarray, np.ndarray]:
+def cluster_system(mech: Mechanism, cl: list[int], held=()) -> tuple[np.ndarray, list[int], np.ndarray, np.ndarray]:
     """For a group of limbs: their freedoms' indices, the hub indices of their bodies, and the
     rows and columns of the closure system (every unlocked freedom active) that are theirs; the
     freedoms in ``held`` are not unknowns."""
@@ -580,7 +560,7 @@ def _inverse_cluster(mech: Mechanism, cl: list[int], D: np.ndarray, q_start: np.
     L = mech.characteristic_length
     sls = limb_slices(mech)
     locked = ~active_mask(mech)
-    idx, bodies, rows, cols = _cluster_system(mech, cl)
+    idx, bodies, rows, cols = cluster_system(mech, cl)
     found: list[tuple[np.ndarray, np.ndarray, float]] = []  # (q, B, residual)
     keys: list[np.ndarray] = []
     best: tuple[np.ndarray | None, np.ndarray | None, float] = (None, None, np.inf)
@@ -590,12 +570,12 @@ def _inverse_cluster(mech: Mechanism, cl: list[int], D: np.ndarray, q_start: np.
         q0[idx] = q_start[idx]
         if s > 0:
             for i in cl:
-                q0[sls[i]] = _random_q(mech, rng, sls[i], q_start[sls[i]], locked[sls[i]])
+                q0[sls[i]] = random_joint_values(mech, rng, sls[i], q_start[sls[i]], locked[sls[i]])
         B0 = B_all.copy()
         for h in bodies:
             B0[h - 1] = np.nan
         c0 = Configuration(q0, D, hub_displacements(mech, q0, D, B0))
-        c, rn, ok = _cluster_newton(mech, c0, rows, cols, t.closure)
+        c, rn, ok = cluster_newton(mech, c0, rows, cols, t.closure)
         if not ok:
             if rn < best[2]:
                 best = (c.q, c.B, rn)
@@ -630,336 +610,3 @@ def _inverse_cluster(mech: Mechanism, cl: list[int], D: np.ndarray, q_start: np.
 
 
 # ------------------------------------------------------------------------------ forward
-@dataclass(frozen=True, eq=False)
-class ForwardSolution:
-    config: Configuration
-    pose: Pose
-    converged: bool
-    residual: float
-    iterations: int
-    outside_limits: tuple[str, ...]
-    conditioning: Conditioning | None = None  # of a converged root (None for a failed attempt)
-    kind: AssemblyKind | None = None  # regular, singular or self-motion (None for a failed attempt)
-    members: int = 1  # converged runs that this result stands for
-    self_motion: SelfMotion | None = None  # the continuum traced through a self-motion result
-
-    @property
-    def singular(self) -> bool:
-        return self.conditioning is not None and self.conditioning.singular
-
-    def to_dict(self, mech: Mechanism) -> dict:
-        """JSON (docs/json.md), the same fields as the closed forms' forward solutions: status,
-        nondimensional closure ``residual``, the platform ``pose`` (position, named Euler angles
-        in degrees, rotation matrix), limits, and the conditioning (:func:`forward_conditioning`:
-        scale-free ``sigma_min``, ``condition`` = sigma_min / sigma_max, ``singular`` below
-        ``singular_below``); ``kind`` (regular, singular, self-motion), ``members`` (converged
-        runs standing for this result) and, for a self-motion, what its trace found."""
-        c = self.conditioning
-        return {
-            "status": "converged" if self.converged else "not_converged",
-            "converged": bool(self.converged),
-            "iterations": int(self.iterations),
-            "residual": float(self.residual),
-            "pose": pose_dict(self.pose.R, self.pose.p),
-            "within_limits": not self.outside_limits,
-            "outside_limits": list(self.outside_limits),
-            "sigma_min": c.sigma_min if c is not None else None,
-            "singular": c.singular if c is not None else None,
-            "condition": c.condition if c is not None else None,
-            "singular_below": c.threshold if c is not None else None,
-            "conditioning_measure": c.measure if c is not None else None,
-            "kind": str(self.kind) if self.kind is not None else None,
-            "members": self.members,
-            "self_motion": self.self_motion.to_dict() if self.self_motion is not None else None,
-        }
-
-
-@dataclass(frozen=True, eq=False)
-class ForwardResult:
-    solutions: tuple[ForwardSolution, ...]
-    search: dict
-
-    @property
-    def converged(self) -> bool:
-        return bool(self.solutions) and self.solutions[0].converged
-
-    def to_dict(self, mech: Mechanism) -> dict:
-        """JSON (docs/json.md), the same fields as the closed forms' (e.g.
-        :meth:`..closed_forms.four_sps_cu.ForwardAllResult.to_dict`): the actuator values held,
-        the converged solutions (or the failed attempt), and the search."""
-        acts = {}
-        if self.solutions:  # the actuators are held at their values in every solution
-            vals = freedom_values(mech, self.solutions[0].config.q)
-            acts = {r.id: float(vals[i]) for i, r in enumerate(mech.freedom_refs) if r.id in mech.actuators}
-        sols = [s for s in self.solutions if s.converged] or list(self.solutions[:1])
-        names = {"seeds": "n_seeds", "converged_runs": "n_converged", "distinct": "n_distinct", "regular": "n_regular",
-                 "singular": "n_singular", "self_motion_sets": "n_self_motion_sets"}  # as the closed forms
-        return {
-            "method": self.search.get("method", ""),
-            **freedom_values_dict(mech, acts, "actuators"),
-            "n_solutions": sum(s.converged for s in self.solutions),
-            "n_within_limits": sum(s.converged and not s.outside_limits for s in self.solutions),
-            "solutions": [s.to_dict(mech) for s in sols],
-            "search": {names.get(k, k): v for k, v in self.search.items()},
-        }
-
-
-def _actuator_q(mech: Mechanism, values) -> dict[int, float]:
-    acts = list(mech.actuators)
-    if isinstance(values, dict):
-        items = {mech.freedom(k).id: float(v) for k, v in values.items()}
-        missing = set(acts) - set(items)
-        if missing:
-            raise InputError(f"actuators: missing values for {sorted(missing)}")
-        extra = set(items) - set(acts)
-        if extra:
-            raise InputError(f"actuators: {sorted(extra)} are not actuated in this mechanism (actuators: {acts})")
-    else:
-        vals = np.asarray(values, dtype=float).ravel()
-        if vals.size != len(acts):
-            raise InputError(f"actuators: expected {len(acts)} values ({', '.join(acts)}), got {vals.size}")
-        items = dict(zip(acts, vals, strict=True))
-    out = {}
-    for k, v in items.items():
-        if not np.isfinite(v):
-            raise InputError(f"actuators: value of {k} is not finite")
-        r = mech.freedom(k)
-        out[mech.freedom_refs.index(r)] = v - r.freedom.offset
-    return out
-
-
-def _pose_seed(mech: Mechanism, rng: np.random.Generator, targets: dict[int, float]) -> Configuration:
-    """A start for the assembly-mode search: a random platform pose (any orientation, position
-    within a few characteristic lengths, mirrored through the base half of the time) with every
-    limb solved for it in the least-squares sense from random joint values, its actuators held
-    at their target values."""
-    from scipy.spatial.transform import Rotation as _R
-
-    from ..geometry.rotations import transform
-
-    L = mech.characteristic_length
-    p0 = mech.platform_point
-    if rng.random() < 0.5:  # any orientation
-        R = _R.random(random_state=int(rng.integers(2**31))).as_matrix()
-    else:  # near the reference orientation (mirror-image modes keep it)
-        R = _R.from_rotvec(rng.normal(scale=0.3, size=3)).as_matrix()
-    p = p0 * (1 if rng.random() < 0.5 else -1) + rng.normal(scale=L, size=3)
-    D = transform(R, p - R @ p0)
-    q = np.zeros(len(mech.freedom_refs))
-    if mech.bodies:  # a link-and-joint graph: random joint values, the bodies placed through the limbs
-        for sl in limb_slices(mech):
-            q[sl] = _random_q(mech, rng, sl, q[sl], np.zeros(sl.stop - sl.start, bool))
-        for i, v in targets.items():
-            q[i] = v
-        if rng.random() < 0.25:  # the output placed through the limbs too
-            return placed_configuration(mech, q)
-        c = Configuration(q, D, hub_displacements(mech, q, D))
-        for cl in limb_clusters(mech):  # each group of limbs fitted to the pose (least squares)
-            _, _, rows, cols = _cluster_system(mech, cl, held=targets)
-            c = _cluster_newton(mech, c, rows, cols, 1e-12, max_iter=30)[0]
-        return c
-    for ch, sl in zip(limb_chains(mech), limb_slices(mech), strict=True):
-        refs = mech.freedom_refs[sl]
-        lin = np.array([r.freedom.kind == "P" for r in refs])
-        q0 = np.where(lin, rng.uniform(-1, 1, len(refs)) * L, rng.uniform(-np.pi, np.pi, len(refs)))
-        hold = np.zeros(len(refs), bool)
-        for i, v in targets.items():
-            if sl.start <= i < sl.stop:
-                q0[i - sl.start] = v
-                hold[i - sl.start] = True
-        q[sl] = _limb_gn(ch, D, q0, lin, L, max_iter=30, hold=hold)[0]
-    return Configuration(q, D)
-
-
-#: What :func:`forward_conditioning` measures (stated in every forward-position result).
-FK_CONDITIONING_MEASURE = (
-    "singular values of the stacked orthonormal bases of the limbs' wrench systems with the actuators locked "
-    "(moments / L): zero when the platform can move with the actuators held"
-)
-
-
-def forward_conditioning(mech: Mechanism, config: Configuration) -> Conditioning:
-    """Whether the actuators hold the platform at ``config``: for every limb, an orthonormal
-    basis of the screws reciprocal to its joint twists with the actuators locked (in
-    nondimensional coordinates, moments / L), stacked; its smallest singular value is 0 exactly
-    when a platform twist is compatible with every limb (a direct singularity; passive spins
-    inside a limb do not count), and ``sigma_min / sigma_max`` is the inverse condition number.
-    Where no actuator is serially singular this equals the scale-free ``sigma_min`` of the complete
-    Jacobian (``kinematics.jacobian``)."""
-    from ..geometry.tolerances import current
-
-    rank_tol = current().rank
-    if mech.bodies:
-        return _graph_forward_conditioning(mech, config, rank_tol)
-    L = mech.characteristic_length
-    acts = set(mech.actuators)
-    refs = mech.freedom_refs
-    rows = []
-    for T, sl in zip(joint_twists(mech, config), limb_slices(mech), strict=True):
-        keep = [i - sl.start for i in range(sl.start, sl.stop) if not refs[i].freedom.locked and refs[i].id not in acts]
-        if keep:
-            _, sv, vt = np.linalg.svd(sc.nondimensional(T[:, keep].T, L), full_matrices=True)
-            r = int(np.sum(sv > rank_tol * max(1.0, sv[0])))
-            rows.append(vt[r:])
-        else:
-            rows.append(np.eye(6))
-    C = np.vstack(rows)
-    sv = np.linalg.svd(C, compute_uv=False) if C.shape[0] else np.zeros(0)
-    return Conditioning.from_singular_values(sv, FK_CONDITIONING_MEASURE, n_required=6, threshold=singular_threshold())
-
-
-def _graph_forward_conditioning(mech: Mechanism, config: Configuration, rank_tol: float) -> Conditioning:
-    """:func:`forward_conditioning` of a mechanism with internal bodies: with the actuators
-    locked, the part of the output link's columns of the nondimensional closure Jacobian that
-    the other unknowns (passive joints, bodies) cannot absorb; its singular values equal those
-    of the stacked limb wrench bases when every limb runs from the ground to the output."""
-    mask = active_mask(mech)
-    acts = set(mech.actuators)
-    for i, r in enumerate(mech.freedom_refs):
-        if r.id in acts:
-            mask[i] = False
-    A, _ = closure_jacobian(mech, config, active=mask)
-    row, col = closure_scales(mech, mask)
-    As = row[:, None] * A * col[None, :]
-    na = int(mask.sum())
-    out = As[:, na : na + 6]
-    other = np.delete(As, np.s_[na : na + 6], axis=1)
-    if other.shape[1]:
-        U, sv, _ = np.linalg.svd(other, full_matrices=False)
-        Q = U[:, : int(np.sum(sv > rank_tol * max(1.0, sv[0] if sv.size else 0.0)))]
-        out = out - Q @ (Q.T @ out)
-    sv = np.linalg.svd(out, compute_uv=False)
-    return Conditioning.from_singular_values(sv, FK_CONDITIONING_MEASURE, n_required=6, threshold=singular_threshold())
-
-
-def locked_actuators(mech: Mechanism, actuators=None) -> Mechanism:
-    """``mech`` with its actuators (or the freedoms named in ``actuators``, by id or alias)
-    locked and no longer actuated: the structure that must hold the platform (forward position's
-    self-motions, the singularity analysis)."""
-    ids = {mech.freedom(a).id for a in (actuators if actuators is not None else mech.actuators)}
-    limbs = []
-    for limb in mech.limbs:
-        joints = []
-        for j in limb.joints:
-            for f in j.freedoms:
-                if f"{j.name}.{f.name}" in ids:
-                    j = j.with_freedom(f.name, locked=True, actuated=False)
-            joints.append(j)
-        limbs.append(limb.with_joints(joints))
-    return replace(mech, limbs=tuple(limbs), modes=())
-
-
-def _pose_key(mech: Mechanism, config: Configuration) -> np.ndarray:
-    pose = platform_pose(mech, config)
-    return pose_keys(pose.R, pose.p, mech.characteristic_length)
-
-
-def _trace_self_motion(mech: Mechanism, locked: Mechanism, config: Configuration):
-    """The solution set through a singular root, followed with the actuators held."""
-    return trace_set(MotionProblem(locked), config, lambda c: _pose_key(mech, c), h0=0.05, h_max=0.3, max_steps=600)
-
-
-def _fk_from(mech, config, targets, mask, max_iter, patience=None):
-    q = config.q.copy()
-    for i, v in targets.items():
-        q[i] = v
-    c = config.with_q(q)
-    if patience is not None:  # abandon starts that are not converging after a few steps
-        res = correct(mech, c, active=mask, max_iter=patience)
-        if res.converged or res.residual > 1e-1:
-            return res
-        c = res.config
-    return correct(mech, c, active=mask, max_iter=max_iter)
-
-
-def forward_position(
-    mech: Mechanism,
-    actuator_values,
-    *,
-    start: Configuration | None = None,
-    all_solutions: bool = False,
-    n_seeds: int = 200,
-    seed: int = 0,
-    max_iter: int = 60,
-    progress: Progress | None = None,
-) -> ForwardResult:
-    """Platform pose(s) for given actuator values (physical units, in ``mech.actuators`` order
-    or a dict by name).
-
-    From ``start`` (default: the reference) by Gauss-Newton with the actuators held; with
-    ``all_solutions``, also from ``n_seeds`` configurations reached by random walks along the
-    closure manifold (actuators free).  Every converged root states its conditioning
-    (:func:`forward_conditioning`) and its ``kind``: roots are distinct when their platform poses
-    differ (scale-free pose distance, :mod:`spatialmech.kinematics.assembly`); a singular root
-    is followed along its self-motion with the actuators held, and all roots on one such
-    continuum are one result of kind ``self-motion`` (not many assembly modes).
-    Non-converged runs are reported (``converged = False``), never returned as solutions of
-    the all-solutions search.  ``progress(k, n_seeds, "assembly modes")`` after each start.
-    """
-    targets = _actuator_q(mech, actuator_values)
-    if all_solutions and (int(n_seeds) != n_seeds or n_seeds < 1):
-        raise InputError(f"n_seeds: expected a positive number of starts, got {n_seeds}")
-    mask = active_mask(mech)
-    for i in targets:
-        mask[i] = False
-    L = mech.characteristic_length
-    first = _fk_from(mech, start or Configuration.reference(mech), targets, mask, max_iter)
-    runs = [first]
-    if all_solutions:
-        rng = np.random.default_rng(seed)
-        for s in range(n_seeds):
-            if s % 2 == 0:
-                c = _pose_seed(mech, rng, targets)
-            else:
-                try:
-                    c = generic_configuration(mech, seed=int(rng.integers(2**31)), step=float(rng.uniform(0.3, 1.2)), steps=4)
-                except RuntimeError:
-                    continue
-            runs.append(_fk_from(mech, c, targets, mask, max_iter, patience=12))
-            if progress is not None:
-                progress(s + 1, n_seeds, "assembly modes")
-    thr = singular_threshold()
-    dedup, sdedup = dedup_tolerances()
-    locked = locked_actuators(mech)
-    if not all_solutions:
-        r = first
-        if not r.converged:  # the failed attempt, with the conditioning where it stopped
-            sols = [ForwardSolution(r.config, platform_pose(mech, r.config), False, r.residual, r.iterations,
-                                    tuple(within_limits(mech, r.config.q)), forward_conditioning(mech, r.config))]
-        else:
-            cond = forward_conditioning(mech, r.config)
-            groups = group_roots(_pose_key(mech, r.config)[None, :], [cond.singular], [r.residual],
-                                 lambda i: _trace_self_motion(mech, locked, r.config), dedup_tol=dedup,
-                                 singular_dedup_tol=sdedup, free_dims=[cond.free_dim])
-            g = groups[0]
-            sols = [ForwardSolution(r.config, platform_pose(mech, r.config), True, r.residual, r.iterations,
-                                    tuple(within_limits(mech, r.config.q)), cond, g.kind, 1,
-                                    g.self_motion(np.atleast_2d(_pose_key(mech, r.config)), L))]
-    else:
-        conv = [r for r in runs if r.converged]
-        keys = np.array([_pose_key(mech, r.config) for r in conv]).reshape(-1, 12)
-        conds = [forward_conditioning(mech, r.config) for r in conv]
-        groups = group_roots(keys, [c.singular for c in conds], [r.residual for r in conv],
-                             lambda i: _trace_self_motion(mech, locked, conv[i].config), dedup_tol=dedup,
-                             singular_dedup_tol=sdedup, prefer=[not within_limits(mech, r.config.q) for r in conv],
-                             free_dims=[c.free_dim for c in conds])
-        groups.sort(key=lambda g: min(g.members))  # in the order found (the start's own root first)
-        sols = []
-        for g in groups:
-            r = conv[g.rep]
-            sols.append(ForwardSolution(r.config, platform_pose(mech, r.config), True, r.residual, r.iterations,
-                                        tuple(within_limits(mech, r.config.q)), conds[g.rep], g.kind, len(g.members),
-                                        g.self_motion(keys, L)))
-    kinds = [s.kind for s in sols if s.converged]
-    search = {"method": "Gauss-Newton with the actuators held" + (", multi-start" if all_solutions else ""),
-              "seeds": 1 + (n_seeds if all_solutions else 0), "seed": seed if all_solutions else None,
-              "converged_runs": sum(r.converged for r in runs), "distinct": len(kinds),
-              "n_regular": kinds.count(AssemblyKind.REGULAR), "n_singular": kinds.count(AssemblyKind.SINGULAR),
-              "n_self_motion_sets": kinds.count(AssemblyKind.SELF_MOTION),
-              "seeding": ("random platform poses with least-squares limb solutions, and random walks along the closure "
-                          "manifold with the actuators free, alternately") if all_solutions else "start configuration",
-              "distinct_by": (f"platform pose distance sqrt(|dp / L|^2 + (2 sin(theta / 2))^2): regular roots within "
-                              f"{dedup:g} are one, isolated singular roots within {sdedup:g}; singular roots on one "
-                              "self-motion traced with the actuators held are one result"),
-              "singular_below": thr}
-    return ForwardResult(tuple(sols), search)

@@ -62,6 +62,8 @@ from scipy.optimize import least_squares, minimize_scalar
 from ..errors import InputError
 from ..geometry.rotations import inverse_transform, rotation_angle, transform
 from ..geometry.validate import as_finite_array, as_unit_vector
+from ..kinematics import compiled
+from ..kinematics.jit import njit
 from ..kinematics.tracking import EuclideanProblem, correct_on_hyperplane, track
 from ..model.mechanism import Pose
 from ..results import BranchEnd
@@ -191,6 +193,57 @@ def _link_vectors(x: np.ndarray, D: np.ndarray):
     return d, s_all
 
 
+@njit(cache=True)
+def _dyad_system(x, D, want_J, r, J):
+    """:func:`dyad_residual` (into ``r``) and, when ``want_J``, :func:`dyad_jacobian` (into
+    ``J``, which must be zero) of one dyad ``x`` (15,), compiled: the same sums in the same order."""
+    B1, M1, u = x[0:3], x[3:6], x[6:9]
+    d = np.empty((7, 3))
+    s_all = np.zeros(7)
+    for j in range(1, 7):
+        s_all[j] = x[8 + j]
+    for j in range(7):
+        for a in range(3):
+            Mj = D[j, a, 0] * M1[0] + D[j, a, 1] * M1[1] + D[j, a, 2] * M1[2] + D[j, a, 3]
+            d[j, a] = Mj - B1[a] - s_all[j] * u[a]
+    n2 = np.empty(7)
+    du = np.empty(7)
+    for j in range(7):
+        n2[j] = d[j, 0] * d[j, 0] + d[j, 1] * d[j, 1] + d[j, 2] * d[j, 2]
+        du[j] = d[j, 0] * u[0] + d[j, 1] * u[1] + d[j, 2] * u[2]
+    uu = u[0] * u[0] + u[1] * u[1] + u[2] * u[2]
+    for j in range(6):
+        r[j] = n2[j + 1] - n2[0]
+    for j in range(7):
+        r[6 + j] = du[j]
+    r[13] = uu - 1.0
+    if not want_J:
+        return
+    for k in range(6):
+        j = k + 1
+        for b in range(3):
+            gM_j = 2 * (d[j, 0] * D[j, 0, b] + d[j, 1] * D[j, 1, b] + d[j, 2] * D[j, 2, b])
+            gM_0 = 2 * (d[0, 0] * D[0, 0, b] + d[0, 1] * D[0, 1, b] + d[0, 2] * D[0, 2, b])
+            J[k, b] = -2 * d[j, b] - (-2 * d[0, b])
+            J[k, 3 + b] = gM_j - gM_0
+            J[k, 6 + b] = -2 * s_all[j] * d[j, b] - (-2 * s_all[0] * d[0, b])
+        J[k, 9 + k] = -2 * du[j]
+    for j in range(7):
+        for b in range(3):
+            J[6 + j, b] = -u[b]
+            J[6 + j, 3 + b] = u[0] * D[j, 0, b] + u[1] * D[j, 1, b] + u[2] * D[j, 2, b]
+            J[6 + j, 6 + b] = d[j, b] - s_all[j] * u[b]
+    for k in range(6):
+        J[7 + k, 9 + k] = -uu
+    for b in range(3):
+        J[13, 6 + b] = 2 * u[b]
+
+
+def _one_dyad(x, D) -> bool:
+    """True when the compiled single-dyad kernel serves this call."""
+    return compiled.enabled() and x.shape == (_NX,) and D.shape == (N_POSITIONS, 4, 4)
+
+
 def dyad_residual(x, D) -> np.ndarray:
     """Residual of eqs 24-26 (paper A) for dyads ``x = (B1, M1, u, s2..s7)``.
 
@@ -201,6 +254,10 @@ def dyad_residual(x, D) -> np.ndarray:
     """
     x = np.asarray(x, dtype=float)
     D = np.asarray(D, dtype=float)
+    if _one_dyad(x, D):
+        r = np.empty(_NF)
+        _dyad_system(x, D, False, r, np.empty((0, 0)))
+        return r
     d, _ = _link_vectors(x, D)
     u = x[..., 6:9]
     n2 = np.einsum("...ja,...ja->...j", d, d)
@@ -214,6 +271,10 @@ def dyad_jacobian(x, D) -> np.ndarray:
     """Jacobian of :func:`dyad_residual` with respect to ``x``: (..., 14, 15)."""
     x = np.asarray(x, dtype=float)
     D = np.asarray(D, dtype=float)
+    if _one_dyad(x, D):
+        J1 = np.zeros((_NF, _NX))
+        _dyad_system(x, D, True, np.empty(_NF), J1)
+        return J1
     d, s_all = _link_vectors(x, D)
     u = x[..., 6:9]
     R = D[:, :3, :3]

@@ -345,10 +345,47 @@ def pose_checker(mech: Mechanism, limits: WorkspaceLimits | None = None, *, meth
         cols.append(np.array([[1e-9 * L]]))  # reachable: the same closure margin as the closed form
         return np.concatenate(cols, axis=1)[0]
 
-    def fn_general(R, p):
+    from ...kinematics import compiled
+    from ...kinematics.closure import recentre_balls
+
+    batchable = all(ends == (None, 0) for ends in mech.limb_ends)
+    s_limits = any(mech.limbs[refs[k].limb].joints[refs[k].joint].type == "S" for k in fl)
+    simple = not cones and not pairs
+
+    def fn_batch(R, p) -> tuple[np.ndarray, np.ndarray]:
+        """Rows of the poses whose every limb closes from the reference (compiled, batched) and
+        which violate no limit: exactly the rows the per-pose path gives them (its first attempt
+        is this one); ``done`` marks them, the rest go through the per-pose path."""
         n = R.shape[0]
         out = np.empty((n, len(names)))
-        for i in range(n):
+        D = np.zeros((n, 4, 4))
+        D[:, :3, :3] = R
+        D[:, :3, 3] = p - np.einsum("nij,j->ni", R, mech.platform_point)
+        D[:, 3, 3] = 1.0
+        q, _res, ok = compiled.limb_inverse_many(mech, D)
+        done = np.all(ok, axis=1)
+        idx = np.flatnonzero(done)
+        if simple:
+            qq = q[idx]
+            if s_limits:
+                qq = np.array([recentre_balls(mech, row) for row in qq]).reshape(qq.shape)
+            cols = [_freedom_margins(offs[fl] + qq[:, fl], los, his, rot)] if fl else []
+            cols.append(np.full((idx.size, 1), 1e-9 * L))
+            out[idx] = np.concatenate(cols, axis=1)
+        else:
+            for i in idx:
+                qi = recentre_balls(mech, q[i])
+                out[i] = _general_row(Configuration(qi, D[i], hub_displacements(mech, qi, D[i])), R[i : i + 1])
+        done[idx] = np.all(out[idx] >= 0.0, axis=1)
+        return out, done
+
+    def fn_general(R, p):
+        n = R.shape[0]
+        if batchable and n > 1 and compiled.enabled():
+            out, done = fn_batch(R, p)
+        else:
+            out, done = np.empty((n, len(names))), np.zeros(n, dtype=bool)
+        for i in np.flatnonzero(~done):
             pose = Pose(R[i], p[i])
             res = inverse_position(mech, pose)
             best = None

@@ -198,7 +198,7 @@ class ForwardResult:
 
     def to_dict(self, *, actuators=None) -> dict:
         """JSON (docs/json.md), the same fields as the general engine's forward solutions
-        (:meth:`spatialmech.kinematics.position.ForwardSolution.to_dict`): the pose as the
+        (:meth:`spatialmech.kinematics.forward.ForwardSolution.to_dict`): the pose as the
         platform point ``(0, 0, z)``, ``euler_deg`` of "ZYX" = ``(gamma, beta, alpha)`` in
         degrees and the rotation matrix; ``residual`` = largest leg-length error / ``b``;
         ``outside_limits`` names the legs (``actuators``, default ``l1..l4``) and ``"z"`` (the
@@ -522,7 +522,7 @@ class ForwardAllResult:
 
     def to_dict(self, *, actuators=None) -> dict:
         """JSON (docs/json.md), the same fields as the general engine's
-        (:meth:`spatialmech.kinematics.position.ForwardResult.to_dict`): the leg lengths held as
+        (:meth:`spatialmech.kinematics.forward.ForwardResult.to_dict`): the leg lengths held as
         ``actuators_len`` (named by ``actuators``, default ``l1..l4``), the distinct assembly
         modes and the search."""
         names = _leg_names(actuators)

@@ -1,0 +1,366 @@
+"""Benchmark: the compiled core (kinematics/compiled.py) against baselines measured in the same
+run, with the targets of the compiled-core issue.
+
+    python benchmarks/bench_core.py [--json] [--quick]
+
+Every target is printed with "met" or "NOT met" and the measured ratio or rate:
+
+- ``fk_solve_us``: one forward-position solve of stewart-6sps from the reference with the legs
+  held (the general engine: Newton on the whole closure, 42 joint variables and the platform
+  twist), against ``fk_scipy_root_us`` (scipy ``root``, hybr, on the 6-equation leg-length residual
+  of the same platform) and ``fk_handwritten_us`` (a minimal hand-written numba Newton on that
+  6x6 residual). Targets: >= 10x faster than scipy, within 5x of the hand-written Newton.
+- ``circuit_five_cs_3_s``: the whole circuit of 5-CS linkage 3 (paper A) with the ten driver
+  determinants as monitors, compiled, and ``circuit_python_s`` the same on the Python reference
+  (``SPATIALMECH_PURE=1``). Targets: < 1 s and >= 10x.
+- ``workspace_general_poses_per_s``: the general pose checker of three-rps (no closed form; the
+  poses carry their parasitic coordinates). Target: >= 1e4 poses/s.
+- ``dj_per_s``: driver determinants of five-cs-3 (one evaluation = one driver at one
+  configuration), batched over the traced circuit. Target: >= 1e5 /s.
+- ``ik_batch_vs_loop``: batched 4-SPS/CU inverse position against a plain-math Python loop.
+  Target: >= 100x.
+- ``first_call_cached_s`` / ``first_call_cold_s``: the compile cost a user pays: a fresh process
+  loading every kernel from numba's on-disk cache, and compiling them into an empty cache.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+from numba import njit
+from scipy.optimize import root
+
+from spatialmech import catalog
+from spatialmech.analysis.defects import candidate_drivers
+from spatialmech.analysis.workspace.checker import pose_checker
+from spatialmech.kinematics import compiled
+from spatialmech.kinematics.closed_forms import four_sps_cu as k4
+from spatialmech.kinematics.closure import Configuration, active_mask, correct, generic_configuration
+from spatialmech.kinematics.jacobian import driver_determinants
+from spatialmech.kinematics.position import configuration_at_pose, platform_pose
+from spatialmech.kinematics.tracking import trace_motion
+
+TARGETS = {
+    "fk_vs_scipy_root": 10.0,  # at least this many times faster
+    "fk_vs_handwritten": 5.0,  # at most this many times slower
+    "circuit_s": 1.0,
+    "circuit_speedup": 10.0,
+    "workspace_general_poses_per_s": 1e4,
+    "dj_per_s": 1e5,
+    "ik_batch_vs_loop": 100.0,
+}
+
+
+pure = compiled.python_reference
+
+
+def best_time(fn, repeat: int, number: int) -> float:
+    """Best of ``repeat`` runs of ``number`` calls, seconds per call."""
+    best = math.inf
+    for _ in range(repeat):
+        t = time.perf_counter()
+        for _ in range(number):
+            fn()
+        best = min(best, (time.perf_counter() - t) / number)
+    return best
+
+
+# ---------------------------------------------------------------------- Stewart forward position
+@njit(cache=True)
+def _rodrigues(w):
+    th = math.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
+    R = np.eye(3)
+    if th < 1e-300:
+        return R
+    k0, k1, k2 = w[0] / th, w[1] / th, w[2] / th
+    s, c = math.sin(th), math.cos(th)
+    K = np.array([[0.0, -k2, k1], [k2, 0.0, -k0], [-k1, k0, 0.0]])
+    return R + s * K + (1.0 - c) * (K @ K)
+
+
+@njit(cache=True)
+def handwritten_stewart_newton(A, B, target, R0, t0, tol, max_iter):
+    """Minimal Newton on the six leg lengths ``|R A_i + t - B_i| - target_i`` of a 6-6 Stewart
+    platform: rows ``[(x_i x u_i)^T, u_i^T]`` (spatial twist), update ``R <- exp(w) R``,
+    ``t <- exp(w) t + v``.  Returns ``R, t, iterations, converged``."""
+    R = R0.copy()
+    t = t0.copy()
+    J = np.empty((6, 6))
+    r = np.empty(6)
+    for it in range(max_iter):
+        worst = 0.0
+        for i in range(6):
+            x = R @ A[i] + t
+            d = x - B[i]
+            ln = math.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+            u = d / ln
+            r[i] = ln - target[i]
+            worst = max(worst, abs(r[i]))
+            J[i, 0] = x[1] * u[2] - x[2] * u[1]
+            J[i, 1] = x[2] * u[0] - x[0] * u[2]
+            J[i, 2] = x[0] * u[1] - x[1] * u[0]
+            J[i, 3], J[i, 4], J[i, 5] = u[0], u[1], u[2]
+        if worst < tol:
+            return R, t, it, True
+        dx = np.linalg.solve(J, -r)
+        Rw = _rodrigues(dx[:3])
+        R = Rw @ R
+        t = Rw @ t + dx[3:]
+    return R, t, max_iter, False
+
+
+def stewart_case():
+    """stewart-6sps, leg lengths of a generic pose, the anchors of its legs, the start."""
+    mech = catalog.build("stewart-6sps")
+    goal = generic_configuration(mech, seed=3, step=0.25)
+    refs = mech.freedom_refs
+    act = [i for i, r in enumerate(refs) if r.freedom.actuated]
+    B = np.array([lb.joints[0].point for lb in mech.limbs])  # base S centres
+    A = np.array([lb.joints[-1].point for lb in mech.limbs])  # platform S centres (reference)
+    legs = np.linalg.norm((A @ goal.D[:3, :3].T + goal.D[:3, 3]) - B, axis=1)
+    return mech, goal, act, A, B, legs
+
+
+def bench_fk(quick: bool) -> dict:
+    mech, goal, act, A, B, legs = stewart_case()
+    start = Configuration.reference(mech)
+    q0 = start.q.copy()
+    q0[act] = goal.q[act]
+    seed = start.with_q(q0)
+    mask = active_mask(mech)
+    mask[act] = False
+    tol = 1e-12
+    # the engine (compiled), then the Python reference
+    res = correct(mech, seed, active=mask)
+    assert res.converged, "the engine's forward solve did not converge"
+    D = res.config.D
+    err_engine = float(np.max(np.abs(D - goal.D)))
+    rep, num = (2, 3) if quick else (5, 40)
+    t_engine = best_time(lambda: correct(mech, seed, active=mask), rep, num)
+    with pure():
+        t_python = best_time(lambda: correct(mech, seed, active=mask), 2, 2 if quick else 5)
+
+    # scipy root on the 6-equation leg-length residual (platform twist from the reference)
+    def F(x):  # lean on purpose: the baseline is not slowed by the library's checks
+        w = x[:3]
+        th = math.sqrt(w @ w)
+        if th > 0.0:
+            k = w / th
+            K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+            Rw = np.eye(3) + math.sin(th) * K + (1.0 - math.cos(th)) * (K @ K)
+        else:
+            Rw = np.eye(3)
+        return np.linalg.norm(A @ Rw.T + x[3:] - B, axis=1) - legs
+
+    sol = root(F, np.zeros(6), method="hybr", tol=tol)
+    assert sol.success, "scipy root did not converge"
+    t_scipy = best_time(lambda: root(F, np.zeros(6), method="hybr", tol=tol), rep, max(1, num // 4))
+    # the hand-written numba Newton on the same residual
+    R0, t0 = np.eye(3), np.zeros(3)
+    Rh, th, it, ok = handwritten_stewart_newton(A, B, legs, R0, t0, tol, 50)
+    assert ok, "the hand-written Newton did not converge"
+    err_hand = float(max(np.max(np.abs(Rh - goal.D[:3, :3])), np.max(np.abs(th - goal.D[:3, 3]))))
+    t_hand = best_time(lambda: handwritten_stewart_newton(A, B, legs, R0, t0, tol, 50), rep, num * 20)
+    return {
+        "fk_solve_us": t_engine * 1e6,
+        "fk_python_us": t_python * 1e6,
+        "fk_scipy_root_us": t_scipy * 1e6,
+        "fk_handwritten_us": t_hand * 1e6,
+        "fk_engine_iterations": int(res.iterations),
+        "fk_handwritten_iterations": int(it),
+        "fk_engine_max_error": err_engine,
+        "fk_handwritten_max_error": err_hand,
+        "fk_vs_scipy_root": t_scipy / t_engine,
+        "fk_vs_handwritten": t_engine / t_hand,
+        "fk_vs_python": t_python / t_engine,
+    }
+
+
+# ---------------------------------------------------------------------- 5-CS circuit and DJ
+def five_cs_case():
+    mech = catalog.build("five-cs-3")
+    drivers = candidate_drivers(mech)
+    prev = None
+    fits = []
+    for P in mech.positions:
+        prev = configuration_at_pose(mech, P, start=prev).config
+        fits.append(prev)
+    return mech, drivers, fits
+
+
+def circuit(mech, drivers, start, max_arc):
+    return trace_motion(mech, start, increasing="rot1", max_arc=max_arc,
+                        vector_monitor=(drivers, lambda c: driver_determinants(mech, c, drivers)))
+
+
+def bench_circuit(quick: bool) -> dict:
+    mech, drivers, fits = five_cs_case()
+    max_arc = 3.0 if quick else 400.0
+    circuit(mech, drivers, fits[0], 0.2)  # compile / load everything it uses
+    t = time.perf_counter()
+    tr = circuit(mech, drivers, fits[0], max_arc)
+    t_fast = time.perf_counter() - t
+    with pure():
+        t = time.perf_counter()
+        tr_py = circuit(mech, drivers, fits[0], max_arc)
+        t_py = time.perf_counter() - t
+    # the same curve: every compiled point lies within 1e-8 of the Python one (joint space)
+    n = min(len(tr.points), len(tr_py.points))
+    diff = max(float(np.max(np.abs(tr.points[i].q - tr_py.points[i].q))) for i in range(n)) if n else math.nan
+    # DJ of every driver, batched over the traced points
+    pts = tr.points
+    qs = np.array([c.q for c in pts])
+    Ds = np.array([c.D for c in pts])
+    compiled.driver_determinants_many(mech, qs[:2], Ds[:2], None, drivers)
+    rep = 2 if quick else 5
+    t_dj = best_time(lambda: compiled.driver_determinants_many(mech, qs, Ds, None, drivers), rep, 1)
+    t_one = best_time(lambda: driver_determinants(mech, pts[0], drivers), rep, 20)
+    return {
+        "circuit_five_cs_3_s": t_fast,
+        "circuit_points": len(tr.points),
+        "circuit_closed": bool(tr.closed),
+        "circuit_events": len(tr.events),
+        "circuit_python_s": t_py,
+        "circuit_python_points": len(tr_py.points),
+        "circuit_speedup": t_py / t_fast,
+        "circuit_max_joint_difference": diff,
+        "dj_per_s": len(pts) * len(drivers) / t_dj,
+        "dj_single_call_per_s": len(drivers) / t_one,
+    }
+
+
+# ---------------------------------------------------------------------- general workspace checker
+def bench_workspace(quick: bool) -> dict:
+    from spatialmech.kinematics.task import solve_task
+
+    mech = catalog.build("three-rps")
+    checker = pose_checker(mech, method="general")
+    rng = np.random.default_rng(0)
+    n = 20 if quick else 400
+    Rs, ps = [], []
+    while len(Rs) < n:  # poses with their parasitic coordinates solved
+        given = {"z": float(rng.uniform(0.25, 0.35)), "a2": float(rng.uniform(-0.3, 0.3)),
+                 "a3": float(rng.uniform(-0.3, 0.3))}
+        s = solve_task(mech, given)
+        if s.converged:
+            pose = platform_pose(mech, s.config)
+            Rs.append(pose.R)
+            ps.append(pose.p)
+    R = np.array(Rs)
+    p = np.array(ps, dtype=float)
+    checker.feasible(R[:2], p[:2])
+    t = time.perf_counter()
+    ok = checker.feasible(R, p)
+    dt = time.perf_counter() - t
+    return {"workspace_general_poses_per_s": n / dt, "workspace_poses": n,
+            "workspace_feasible_fraction": float(np.mean(ok)), "workspace_model": "three-rps"}
+
+
+# ---------------------------------------------------------------------- 4-SPS/CU batched IK
+def _loop_legs(poses, a, b):
+    out = []
+    for z, al, be, ga in poses:
+        sa, ca, sb, cb, sg, cg = math.sin(al), math.cos(al), math.sin(be), math.cos(be), math.sin(ga), math.cos(ga)
+        U, V = -sb, cb * sa
+        P = cb * cg + sa * sb * sg + ca * cg
+        Q = cb * sg + sa * sb * cg - ca * sg
+        row = []
+        for s1, s2 in ((1, 1), (-1, 1), (-1, -1), (1, -1)):
+            l2 = 2 * a * a + 2 * b * b + z * z + 2 * a * z * (s1 * U + s2 * V) - 2 * a * b * (P + s1 * s2 * Q)
+            row.append(math.sqrt(max(l2, 0.0)))
+        out.append(row)
+    return out
+
+
+def bench_ik(quick: bool) -> dict:
+    geom = k4.PAPER_B
+    rng = np.random.default_rng(1)
+    n, loop_n = (20_000, 2_000) if quick else (2_000_000, 20_000)
+    phi = np.column_stack([rng.uniform(0.15, 0.3, n), *(rng.uniform(-0.4, 0.4, n) for _ in range(3))])
+    k4.leg_lengths(phi[:10], geom)
+    rep = 2 if quick else 3
+    t_vec = best_time(lambda: k4.leg_lengths(phi, geom), rep, 1) / n
+    loop_in = phi[:loop_n].tolist()
+    t_loop = best_time(lambda: _loop_legs(loop_in, geom.a, geom.b), rep, 1) / loop_n
+    diff = float(np.max(np.abs(np.array(_loop_legs(loop_in, geom.a, geom.b)) - k4.leg_lengths(phi[:loop_n], geom))))
+    return {"ik_batch_poses_per_s": 1 / t_vec, "ik_loop_poses_per_s": 1 / t_loop, "ik_batch_vs_loop": t_loop / t_vec,
+            "ik_max_abs_difference_m": diff}
+
+
+# ---------------------------------------------------------------------- first-call cost
+def bench_first_call() -> dict:
+    code = ("import time; t = time.perf_counter(); from spatialmech.kinematics import compiled; "
+            "compiled.warm_up(); print(time.perf_counter() - t)")
+    out = {}
+    cached = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    out["first_call_cached_s"] = float(cached.stdout.split()[-1])
+    with tempfile.TemporaryDirectory() as d:
+        env = {**os.environ, "NUMBA_CACHE_DIR": d}
+        cold = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, env=env)
+    out["first_call_cold_s"] = float(cold.stdout.split()[-1])
+    return out
+
+
+def verdicts(out: dict) -> dict:
+    return {
+        "fk_vs_scipy_root": out["fk_vs_scipy_root"] >= TARGETS["fk_vs_scipy_root"],
+        "fk_vs_handwritten": out["fk_vs_handwritten"] <= TARGETS["fk_vs_handwritten"],
+        "circuit_s": out["circuit_five_cs_3_s"] < TARGETS["circuit_s"],
+        "circuit_speedup": out["circuit_speedup"] >= TARGETS["circuit_speedup"],
+        "workspace_general_poses_per_s": out["workspace_general_poses_per_s"] >= TARGETS["workspace_general_poses_per_s"],
+        "dj_per_s": out["dj_per_s"] >= TARGETS["dj_per_s"],
+        "ik_batch_vs_loop": out["ik_batch_vs_loop"] >= TARGETS["ik_batch_vs_loop"],
+    }
+
+
+def main(argv=None) -> dict:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--json", action="store_true", help="print the results as JSON")
+    ap.add_argument("--quick", action="store_true", help="tiny sizes (a smoke test; the targets mean nothing then)")
+    args = ap.parse_args(argv)
+    if not compiled.enabled():
+        raise SystemExit("the compiled core is not in use (numba missing or SPATIALMECH_PURE set)")
+    out: dict = {"quick": bool(args.quick)}
+    out.update(bench_fk(args.quick))
+    out.update(bench_circuit(args.quick))
+    out.update(bench_workspace(args.quick))
+    out.update(bench_ik(args.quick))
+    if not args.quick:
+        out.update(bench_first_call())
+    out["targets"] = TARGETS
+    out["met"] = verdicts(out)
+    if args.json:
+        print(json.dumps(out, indent=2))
+        return out
+    met = out["met"]
+    word = {True: "met", False: "NOT met"}
+    print(f"FK solve, stewart-6sps      engine {out['fk_solve_us']:.1f} us, scipy root {out['fk_scipy_root_us']:.1f} us, "
+          f"hand-written numba {out['fk_handwritten_us']:.2f} us, Python path {out['fk_python_us']:.0f} us")
+    print(f"  vs scipy root             {out['fk_vs_scipy_root']:.1f}x faster (target >= 10x): {word[met['fk_vs_scipy_root']]}")
+    print(f"  vs hand-written Newton    {out['fk_vs_handwritten']:.1f}x slower (target <= 5x): {word[met['fk_vs_handwritten']]}")
+    print(f"circuit of five-cs-3        {out['circuit_five_cs_3_s']:.2f} s, {out['circuit_points']} points, "
+          f"{out['circuit_events']} events (target < 1 s): {word[met['circuit_s']]}")
+    print(f"  Python path               {out['circuit_python_s']:.2f} s, {out['circuit_speedup']:.1f}x "
+          f"(target >= 10x): {word[met['circuit_speedup']]}")
+    print(f"general checker, three-rps  {out['workspace_general_poses_per_s']:.3g} poses/s (target >= 1e4): "
+          f"{word[met['workspace_general_poses_per_s']]}")
+    print(f"driver determinants         {out['dj_per_s']:.3g} /s batched, {out['dj_single_call_per_s']:.3g} /s one call "
+          f"(target >= 1e5): {word[met['dj_per_s']]}")
+    print(f"4-SPS/CU batched IK         {out['ik_batch_vs_loop']:.0f}x the plain loop (target >= 100x): "
+          f"{word[met['ik_batch_vs_loop']]}")
+    if "first_call_cached_s" in out:
+        print(f"first call                  {out['first_call_cached_s']:.2f} s from the disk cache, "
+              f"{out['first_call_cold_s']:.1f} s compiling into an empty cache")
+    return out
+
+
+if __name__ == "__main__":
+    main()

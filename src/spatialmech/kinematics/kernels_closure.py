@@ -1,0 +1,475 @@
+"""Compiled kernels of the closure engine (:mod:`.compiled`): limb chains by products of
+exponentials, the closure residual and Jacobian, Newton correction with retraction, and the
+per-limb Gauss-Newton of inverse position; the same steps as :mod:`.closure` and :mod:`.position`."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .kernels_se3 import (
+    nb_copy44,
+    nb_exp_twist,
+    nb_inverse_into,
+    nb_log,
+    nb_lstsq,
+    nb_matrix_rotvec,
+    nb_mm,
+    nb_mm4,
+    nb_orthonormal,
+    nb_quat_rotvec,
+    nb_rotvec_matrix,
+)
+from .jit import njit
+
+__all__ = [
+    "nb_adjoint_columns",
+    "nb_chain",
+    "nb_closure_system",
+    "nb_colmap",
+    "nb_correct",
+    "nb_hub",
+    "nb_limb_gn",
+    "nb_max_limb",
+    "nb_norm",
+    "nb_retract",
+    "nb_rodrigues",
+    "nb_scales",
+    "nb_systems",
+]
+
+
+# ---------------------------------------------------------------------------- chain and closure
+@njit(cache=True)
+def nb_rodrigues(w0, w1, w2, s, c, out):
+    """``I + s W + c W W`` with ``W = skew(w)`` (``W W = w w^T - |w|^2 I``)."""
+    n2 = w0 * w0 + w1 * w1 + w2 * w2
+    out[0, 0] = 1.0 + c * (w0 * w0 - n2)
+    out[1, 1] = 1.0 + c * (w1 * w1 - n2)
+    out[2, 2] = 1.0 + c * (w2 * w2 - n2)
+    out[0, 1] = -s * w2 + c * w0 * w1
+    out[1, 0] = s * w2 + c * w0 * w1
+    out[0, 2] = s * w1 + c * w0 * w2
+    out[2, 0] = -s * w1 + c * w0 * w2
+    out[1, 2] = -s * w0 + c * w1 * w2
+    out[2, 1] = s * w0 + c * w1 * w2
+
+
+@njit(cache=True)
+def nb_chain(S, ball_of, ball_axes, ball_centre, q, lo, hi, T, J):
+    """:func:`.closure.chain_forward` (``local=True``) of the freedoms ``lo:hi``: ``T`` (4x4) and
+    the spatial Jacobian ``J[:, :hi - lo]``, in local coordinates for balls (their axes moved by
+    the preceding freedoms).  Each joint (one freedom, or a ball's three) contributes columns
+    ``(R a ; R m + p x R a)`` for its reference directions ``a`` and moments ``m``, then moves
+    the chain's displacement ``(R, p)`` by its own ``(Rb, u)``: ``p += R u``, ``R = R Rb``."""
+    R = np.zeros((3, 3))
+    R[0, 0] = R[1, 1] = R[2, 2] = 1.0
+    p = np.zeros(3)
+    Rb = np.empty((3, 3))
+    Rn = np.empty((3, 3))
+    u = np.empty(3)
+    ax = np.empty((3, 3))
+    mo = np.empty((3, 3))
+    i = lo
+    while i < hi:
+        g = ball_of[i]
+        if g >= 0:
+            k = 3
+            A = ball_axes[g]
+            c = ball_centre[g]
+            for j in range(3):
+                for a in range(3):
+                    ax[a, j] = A[a, j]
+                mo[0, j] = c[1] * A[2, j] - c[2] * A[1, j]
+                mo[1, j] = c[2] * A[0, j] - c[0] * A[2, j]
+                mo[2, j] = c[0] * A[1, j] - c[1] * A[0, j]
+            f0 = A[0, 0] * q[i] + A[0, 1] * q[i + 1] + A[0, 2] * q[i + 2]
+            f1 = A[1, 0] * q[i] + A[1, 1] * q[i + 1] + A[1, 2] * q[i + 2]
+            f2 = A[2, 0] * q[i] + A[2, 1] * q[i + 1] + A[2, 2] * q[i + 2]
+            th = np.sqrt(f0 * f0 + f1 * f1 + f2 * f2)
+            if th > 1e-12:
+                nb_rodrigues(f0 / th, f1 / th, f2 / th, np.sin(th), 1.0 - np.cos(th), Rb)
+            else:
+                nb_rodrigues(0.0, 0.0, 0.0, 0.0, 0.0, Rb)
+            for a in range(3):  # T <- T [Rb, c - Rb c]
+                u[a] = c[a] - (Rb[a, 0] * c[0] + Rb[a, 1] * c[1] + Rb[a, 2] * c[2])
+        else:
+            k = 1
+            w0, w1, w2 = S[i, 0], S[i, 1], S[i, 2]
+            v0, v1, v2 = S[i, 3], S[i, 4], S[i, 5]
+            ax[0, 0], ax[1, 0], ax[2, 0] = w0, w1, w2
+            mo[0, 0], mo[1, 0], mo[2, 0] = v0, v1, v2
+            t = q[i]
+            if np.sqrt(w0 * w0 + w1 * w1 + w2 * w2) > 1e-12:
+                st = np.sin(t)
+                ct = 1.0 - np.cos(t)
+                nb_rodrigues(w0, w1, w2, st, ct, Rb)
+                x0 = w1 * v2 - w2 * v1  # w x v
+                x1 = w2 * v0 - w0 * v2
+                x2 = w0 * v1 - w1 * v0
+                u[0] = t * v0 + ct * x0 + (t - st) * (w1 * x2 - w2 * x1)
+                u[1] = t * v1 + ct * x1 + (t - st) * (w2 * x0 - w0 * x2)
+                u[2] = t * v2 + ct * x2 + (t - st) * (w0 * x1 - w1 * x0)
+            else:
+                nb_rodrigues(0.0, 0.0, 0.0, 0.0, 0.0, Rb)
+                u[0], u[1], u[2] = t * v0, t * v1, t * v2
+        for j in range(k):
+            col = i - lo + j
+            for a in range(3):
+                J[a, col] = R[a, 0] * ax[0, j] + R[a, 1] * ax[1, j] + R[a, 2] * ax[2, j]
+                J[3 + a, col] = R[a, 0] * mo[0, j] + R[a, 1] * mo[1, j] + R[a, 2] * mo[2, j]
+            J[3, col] += p[1] * J[2, col] - p[2] * J[1, col]
+            J[4, col] += p[2] * J[0, col] - p[0] * J[2, col]
+            J[5, col] += p[0] * J[1, col] - p[1] * J[0, col]
+        for a in range(3):
+            p[a] += R[a, 0] * u[0] + R[a, 1] * u[1] + R[a, 2] * u[2]
+        for a in range(3):
+            for b in range(3):
+                Rn[a, b] = R[a, 0] * Rb[0, b] + R[a, 1] * Rb[1, b] + R[a, 2] * Rb[2, b]
+        for a in range(3):
+            for b in range(3):
+                R[a, b] = Rn[a, b]
+        i += k
+    for a in range(3):
+        for b in range(3):
+            T[a, b] = R[a, b]
+        T[a, 3] = p[a]
+        T[3, a] = 0.0
+    T[3, 3] = 1.0
+
+
+@njit(cache=True)
+def nb_hub(h, D, B):
+    if h == 0:
+        return D
+    return B[h - 1]
+
+
+@njit(cache=True)
+def nb_adjoint_columns(H, J, m):
+    """``J[:, :m] <- Ad(H) J[:, :m]`` in place."""
+    top = np.empty(3)
+    bot = np.empty(3)
+    x = np.empty(3)
+    for c in range(m):
+        for a in range(3):
+            top[a] = H[a, 0] * J[0, c] + H[a, 1] * J[1, c] + H[a, 2] * J[2, c]
+            bot[a] = H[a, 0] * J[3, c] + H[a, 1] * J[4, c] + H[a, 2] * J[5, c]
+        x[0] = H[1, 3] * top[2] - H[2, 3] * top[1]
+        x[1] = H[2, 3] * top[0] - H[0, 3] * top[2]
+        x[2] = H[0, 3] * top[1] - H[1, 3] * top[0]
+        for a in range(3):
+            J[a, c] = top[a]
+            J[3 + a, c] = x[a] + bot[a]
+
+
+@njit(cache=True)
+def nb_max_limb(limb_start):
+    m = 0
+    for k in range(len(limb_start) - 1):
+        m = max(m, limb_start[k + 1] - limb_start[k])
+    return m
+
+
+@njit(cache=True)
+def nb_closure_system(S, ball_of, ball_axes, ball_centre, limb_start, ends, q, D, B, colmap, na, want_A, A, r):
+    """Residual ``r`` (6K,) and, when ``want_A``, the closure Jacobian ``A`` (6K, na + 6h):
+    active joint columns at ``colmap[i]`` (-1: not active), then a twist per moving hub."""
+    K = len(limb_start) - 1
+    J = np.empty((6, max(nb_max_limb(limb_start), 1)))
+    T = np.empty((4, 4))
+    T2 = np.empty((4, 4))
+    Hi = np.empty((4, 4))
+    res = np.empty(6)
+    if want_A:
+        for i in range(A.shape[0]):
+            for c in range(A.shape[1]):
+                A[i, c] = 0.0
+    for k in range(K):
+        lo = limb_start[k]
+        hi = limb_start[k + 1]
+        nb_chain(S, ball_of, ball_axes, ball_centre, q, lo, hi, T, J)
+        a = ends[k, 0]
+        b = ends[k, 1]
+        r0 = 6 * k
+        if a >= 0:
+            Ha = nb_hub(a, D, B)
+            if want_A:
+                nb_adjoint_columns(Ha, J, hi - lo)
+                for i in range(6):
+                    A[r0 + i, na + 6 * a + i] += 1.0
+            nb_mm4(Ha, T, T2)
+            nb_copy44(T2, T)
+        if want_A:
+            if b >= 0:
+                for i in range(6):
+                    A[r0 + i, na + 6 * b + i] -= 1.0
+            for i in range(lo, hi):
+                c = colmap[i]
+                if c >= 0:
+                    for x in range(6):
+                        A[r0 + x, c] = J[x, i - lo]
+        if b >= 0:
+            nb_inverse_into(nb_hub(b, D, B), Hi)
+            nb_mm4(T, Hi, T2)
+            nb_log(T2, True, res)
+        else:
+            nb_log(T, True, res)
+        for i in range(6):
+            r[r0 + i] = res[i]
+
+
+@njit(cache=True)
+def nb_colmap(active):
+    n = len(active)
+    out = np.empty(n, dtype=np.int64)
+    na = 0
+    for i in range(n):
+        out[i] = -1
+        if active[i]:
+            out[i] = na
+            na += 1
+    return out, na
+
+
+@njit(cache=True)
+def nb_scales(linear, active, K, h, L):
+    """:func:`.closure.closure_scales`."""
+    row = np.empty(6 * K)
+    for k in range(K):
+        for i in range(3):
+            row[6 * k + i] = 1.0
+            row[6 * k + 3 + i] = 1.0 / L
+    na = 0
+    for i in range(len(active)):
+        if active[i]:
+            na += 1
+    col = np.empty(na + 6 * h)
+    j = 0
+    for i in range(len(active)):
+        if active[i]:
+            col[j] = L if linear[i] else 1.0
+            j += 1
+    for x in range(h):
+        for i in range(3):
+            col[na + 6 * x + i] = 1.0
+            col[na + 6 * x + 3 + i] = L
+    return row, col
+
+
+@njit(cache=True)
+def nb_retract(ball_first, ball_axes, q, D, B, active, step, na, fix_platform, q_out, D_out, B_out):
+    """:func:`.closure.retract` into ``q_out``, ``D_out``, ``B_out``."""
+    n = len(q)
+    dq = np.zeros(n)
+    j = 0
+    for i in range(n):
+        if active[i]:
+            dq[i] = step[j]
+            j += 1
+    for i in range(n):
+        q_out[i] = q[i] + dq[i]
+    a = np.empty(3)
+    b = np.empty(3)
+    Ra = np.empty((3, 3))
+    Rb = np.empty((3, 3))
+    Rn = np.empty((3, 3))
+    rv = np.empty(3)
+    for g in range(len(ball_first)):
+        i = ball_first[g]
+        A = ball_axes[g]
+        for x in range(3):
+            a[x] = A[x, 0] * dq[i] + A[x, 1] * dq[i + 1] + A[x, 2] * dq[i + 2]
+            b[x] = A[x, 0] * q[i] + A[x, 1] * q[i + 1] + A[x, 2] * q[i + 2]
+        nb_rotvec_matrix(a, Ra)
+        nb_rotvec_matrix(b, Rb)
+        nb_mm(Ra, Rb, Rn)
+        nb_matrix_rotvec(Rn, rv)
+        for x in range(3):
+            q_out[i + x] = A[0, x] * rv[0] + A[1, x] * rv[1] + A[2, x] * rv[2]
+    nv = len(step) - na
+    E = np.empty((4, 4))
+    if fix_platform or nv < 6:
+        nb_copy44(D, D_out)
+    else:
+        nb_exp_twist(step[na : na + 6], E)
+        nb_mm4(E, D, D_out)
+        nb_orthonormal(D_out)
+    for bi in range(B.shape[0]):
+        if nv >= 12 + 6 * bi:
+            nb_exp_twist(step[na + 6 + 6 * bi : na + 12 + 6 * bi], E)
+            nb_mm4(E, B[bi], B_out[bi])
+            nb_orthonormal(B_out[bi])
+        else:
+            nb_copy44(B[bi], B_out[bi])
+
+
+@njit(cache=True)
+def nb_norm(x):
+    s = 0.0
+    for v in x:
+        s += v * v
+    return np.sqrt(s)
+
+
+@njit(cache=True)
+def nb_correct(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends, linear, L, qs, Ds, Bs, active,
+             fix_platform, tol, max_iter, q_out, D_out, B_out, status, iters, resid):
+    """:func:`.closure.correct` from each seed ``qs[s], Ds[s], Bs[s]``: the result in ``q_out[s]``,
+    ``D_out[s]``, ``B_out[s]``, with ``status[s]`` 1 converged, 2 stationary (steps vanished
+    without closure), 0 not converged, the iterations and the residual."""
+    K = len(limb_start) - 1
+    h = 1 + Bs.shape[1]
+    n = qs.shape[1]
+    colmap, na = nb_colmap(active)
+    row, col = nb_scales(linear, active, K, h, L)
+    nc = na + 6 * h
+    keep = np.ones(nc, dtype=np.bool_)
+    if fix_platform:
+        for i in range(na, na + 6):
+            keep[i] = False
+    nk = 0
+    for i in range(nc):
+        if keep[i]:
+            nk += 1
+    A = np.zeros((6 * K, nc))
+    r = np.zeros(6 * K)
+    As = np.empty((6 * K, nk))
+    rhs = np.empty(6 * K)
+    step = np.zeros(nc)
+    q2 = np.empty(n)
+    D2 = np.empty((4, 4))
+    B2 = np.empty((h - 1, 4, 4))
+    for s in range(qs.shape[0]):
+        q = q_out[s]
+        D = D_out[s]
+        B = B_out[s]
+        for i in range(n):
+            q[i] = qs[s, i]
+        nb_copy44(Ds[s], D)
+        for b in range(h - 1):
+            nb_copy44(Bs[s, b], B[b])
+        st = 0
+        rn = np.inf
+        it = 0
+        for it in range(max_iter + 1):
+            nb_closure_system(S, ball_of, ball_axes, ball_centre, limb_start, ends, q, D, B, colmap, na, True, A, r)
+            sq = 0.0
+            for i in range(6 * K):
+                rhs[i] = -row[i] * r[i]
+                sq += rhs[i] * rhs[i]
+            rn = np.sqrt(sq)
+            if rn < tol:
+                st = 1
+                break
+            if it == max_iter or not np.isfinite(rn):
+                break
+            for i in range(6 * K):
+                j = 0
+                for c in range(nc):
+                    if keep[c]:
+                        As[i, j] = row[i] * A[i, c] * col[c]
+                        j += 1
+            x = nb_lstsq(As, rhs)
+            if nb_norm(x) < 1e-13 * max(1.0, rn):
+                st = 2
+                break
+            j = 0
+            for c in range(nc):
+                if keep[c]:
+                    step[c] = col[c] * x[j]
+                    j += 1
+                else:
+                    step[c] = 0.0
+            nb_retract(ball_first, ball_axes, q, D, B, active, step, na, fix_platform, q2, D2, B2)
+            for i in range(n):
+                q[i] = q2[i]
+            nb_copy44(D2, D)
+            for b in range(h - 1):
+                nb_copy44(B2[b], B[b])
+        status[s] = st
+        iters[s] = it
+        resid[s] = rn
+
+
+@njit(cache=True)
+def nb_systems(S, ball_of, ball_axes, ball_centre, limb_start, ends, qs, Ds, Bs, active, want_A, A_out, r_out):
+    """Residuals ``r_out[s]`` and, when ``want_A``, closure Jacobians ``A_out[s]`` of many configurations."""
+    colmap, na = nb_colmap(active)
+    for s in range(qs.shape[0]):
+        nb_closure_system(S, ball_of, ball_axes, ball_centre, limb_start, ends, qs[s], Ds[s], Bs[s], colmap, na, want_A,
+                        A_out[s] if want_A else A_out[0], r_out[s])
+
+
+# ---------------------------------------------------------------------------- limb inverse position
+@njit(cache=True)
+def nb_limb_gn(S, ball_of, ball_first, ball_axes, ball_centre, Ds, q0s, lin, L, tol, max_iter, hold, has_hold, q_out,
+             res_out, ok_out):
+    """``position._limb_gn`` for one chain at each tip displacement ``Ds[s]`` from ``q0s[s]``:
+    Gauss-Newton in local coordinates (S joints updated by composing rotations); the result in
+    ``q_out[s]``, its nondimensional residual and whether it converged."""
+    m = q0s.shape[1]
+    colscale = np.empty(m)
+    for i in range(m):
+        colscale[i] = L if lin[i] else 1.0
+        if has_hold and hold[i]:
+            colscale[i] = 0.0
+    row = np.empty(6)
+    for i in range(3):
+        row[i] = 1.0
+        row[3 + i] = 1.0 / L
+    Dinv = np.empty((4, 4))
+    T = np.empty((4, 4))
+    T2 = np.empty((4, 4))
+    J = np.empty((6, max(m, 1)))
+    M = np.empty((6, m))
+    r = np.empty(6)
+    rhs = np.empty(6)
+    qn = np.empty(m)
+    a = np.empty(3)
+    b = np.empty(3)
+    Ra = np.empty((3, 3))
+    Rb = np.empty((3, 3))
+    Rn = np.empty((3, 3))
+    rv = np.empty(3)
+    for s in range(Ds.shape[0]):
+        nb_inverse_into(Ds[s], Dinv)
+        q = q_out[s]
+        for i in range(m):
+            q[i] = q0s[s, i]
+        rn = np.inf
+        for _ in range(max_iter):
+            nb_chain(S, ball_of, ball_axes, ball_centre, q, 0, m, T, J)
+            nb_mm4(T, Dinv, T2)
+            nb_log(T2, False, r)
+            sq = 0.0
+            for i in range(6):
+                rhs[i] = -row[i] * r[i]
+                sq += rhs[i] * rhs[i]
+            rn = np.sqrt(sq)
+            if rn < tol:
+                break
+            for i in range(6):
+                for j in range(m):
+                    M[i, j] = row[i] * J[i, j] * colscale[j]
+            x = nb_lstsq(M, rhs)
+            if nb_norm(x) < 1e-14:
+                break
+            for j in range(m):
+                qn[j] = q[j] + colscale[j] * x[j]
+            for g in range(len(ball_first)):
+                i = ball_first[g]
+                A = ball_axes[g]
+                for t in range(3):
+                    a[t] = (A[t, 0] * colscale[i] * x[i] + A[t, 1] * colscale[i + 1] * x[i + 1]
+                            + A[t, 2] * colscale[i + 2] * x[i + 2])
+                    b[t] = A[t, 0] * q[i] + A[t, 1] * q[i + 1] + A[t, 2] * q[i + 2]
+                nb_rotvec_matrix(a, Ra)
+                nb_rotvec_matrix(b, Rb)
+                nb_mm(Ra, Rb, Rn)
+                nb_quat_rotvec(Rn, rv)
+                for t in range(3):
+                    qn[i + t] = A[0, t] * rv[0] + A[1, t] * rv[1] + A[2, t] * rv[2]
+            for j in range(m):
+                q[j] = qn[j]
+        res_out[s] = rn
+        ok_out[s] = rn < tol

@@ -1,0 +1,402 @@
+"""Small compiled kernels of the closure engine (:mod:`.compiled`): 3-vector and matrix products,
+rotation vectors, SE(3) exponential and logarithm, least squares and determinants, on plain
+float64 arrays, writing into ``out`` arguments (no allocation in the inner loops)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .jit import njit
+
+__all__ = [
+    "EPS",
+    "nb_copy44",
+    "nb_cross",
+    "nb_det",
+    "nb_exp_twist",
+    "nb_inverse_into",
+    "nb_log",
+    "nb_lstsq",
+    "nb_matrix_rotvec",
+    "nb_minnorm_qr",
+    "nb_mm",
+    "nb_mm4",
+    "nb_mv",
+    "nb_orthonormal",
+    "nb_quat_rotvec",
+    "nb_rotvec_matrix",
+    "nb_series",
+    "nb_skew",
+    "nb_svd",
+]
+
+
+# ---------------------------------------------------------------------------- small kernels
+@njit(cache=True)
+def nb_cross(a, b, out):
+    out[0] = a[1] * b[2] - a[2] * b[1]
+    out[1] = a[2] * b[0] - a[0] * b[2]
+    out[2] = a[0] * b[1] - a[1] * b[0]
+
+
+@njit(cache=True)
+def nb_mv(M, v, out):
+    for i in range(3):
+        out[i] = M[i, 0] * v[0] + M[i, 1] * v[1] + M[i, 2] * v[2]
+
+
+@njit(cache=True)
+def nb_mm(A, B, out):
+    for i in range(3):
+        for j in range(3):
+            out[i, j] = A[i, 0] * B[0, j] + A[i, 1] * B[1, j] + A[i, 2] * B[2, j]
+
+
+@njit(cache=True)
+def nb_skew(w, out):
+    out[0, 0] = 0.0
+    out[0, 1] = -w[2]
+    out[0, 2] = w[1]
+    out[1, 0] = w[2]
+    out[1, 1] = 0.0
+    out[1, 2] = -w[0]
+    out[2, 0] = -w[1]
+    out[2, 1] = w[0]
+    out[2, 2] = 0.0
+
+
+@njit(cache=True)
+def nb_series(W, a, b, out):
+    """``I + a W + b W W``."""
+    W2 = np.empty((3, 3))
+    nb_mm(W, W, W2)
+    for i in range(3):
+        for j in range(3):
+            out[i, j] = a * W[i, j] + b * W2[i, j]
+        out[i, i] += 1.0
+
+
+@njit(cache=True)
+def nb_rotvec_matrix(phi, out):
+    """:func:`..geometry.rotations.rotvec_matrix`."""
+    th = np.sqrt(phi[0] * phi[0] + phi[1] * phi[1] + phi[2] * phi[2])
+    W = np.empty((3, 3))
+    if th < 1e-12:
+        nb_skew(phi, W)
+        for i in range(3):
+            for j in range(3):
+                out[i, j] = W[i, j]
+            out[i, i] += 1.0
+        return
+    k = np.empty(3)
+    for i in range(3):
+        k[i] = phi[i] / th
+    nb_skew(k, W)
+    nb_series(W, np.sin(th), 1.0 - np.cos(th), out)
+
+
+@njit(cache=True)
+def nb_quat_rotvec(R, out):
+    """scipy's ``Rotation.from_matrix(R).as_rotvec()`` for a rotation matrix (Shepperd's
+    quaternion, canonical sign, then the rotation vector)."""
+    tr = R[0, 0] + R[1, 1] + R[2, 2]
+    choice = 3
+    best = tr
+    for i in range(3):
+        if R[i, i] > best:
+            best = R[i, i]
+            choice = i
+    qt = np.empty(4)
+    if choice == 3:
+        qt[0] = R[2, 1] - R[1, 2]
+        qt[1] = R[0, 2] - R[2, 0]
+        qt[2] = R[1, 0] - R[0, 1]
+        qt[3] = 1.0 + tr
+    else:
+        i = choice
+        j = (i + 1) % 3
+        k = (j + 1) % 3
+        qt[i] = 1.0 - tr + 2.0 * R[i, i]
+        qt[j] = R[j, i] + R[i, j]
+        qt[k] = R[k, i] + R[i, k]
+        qt[3] = R[k, j] - R[j, k]
+    nq = np.sqrt(qt[0] ** 2 + qt[1] ** 2 + qt[2] ** 2 + qt[3] ** 2)
+    for i in range(4):
+        qt[i] /= nq
+    if qt[3] < 0.0:
+        for i in range(4):
+            qt[i] = -qt[i]
+    ax = np.sqrt(qt[0] ** 2 + qt[1] ** 2 + qt[2] ** 2)
+    angle = 2.0 * np.arctan2(ax, qt[3])
+    if angle <= 1e-3:
+        a2 = angle * angle
+        scale = 2.0 + a2 / 12.0 + 7.0 * a2 * a2 / 2880.0
+    else:
+        scale = angle / np.sin(angle / 2.0)
+    for i in range(3):
+        out[i] = scale * qt[i]
+
+
+@njit(cache=True)
+def nb_matrix_rotvec(R, out):
+    """:func:`..geometry.rotations.matrix_rotvec`."""
+    c = (R[0, 0] + R[1, 1] + R[2, 2] - 1.0) / 2.0
+    if c < -0.999:
+        nb_quat_rotvec(R, out)
+        return
+    w0 = R[2, 1] - R[1, 2]
+    w1 = R[0, 2] - R[2, 0]
+    w2 = R[1, 0] - R[0, 1]
+    sn = 0.5 * np.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
+    th = np.arctan2(sn, c)
+    f = 0.5 if th < 1e-12 else th / (2.0 * sn)
+    out[0] = w0 * f
+    out[1] = w1 * f
+    out[2] = w2 * f
+
+
+@njit(cache=True)
+def nb_log(T, fast, out):
+    """The twist ``out`` (6,) of a displacement ``T``: :func:`.closure._log_single` when ``fast``
+    (the rotation angle by ``arctan2`` away from a half turn), else
+    :func:`..geometry.rotations.log_transform` (scipy's rotation vector)."""
+    c = (T[0, 0] + T[1, 1] + T[2, 2] - 1.0) / 2.0
+    p0, p1, p2 = T[0, 3], T[1, 3], T[2, 3]
+    if fast and c >= -0.999:
+        w0 = T[2, 1] - T[1, 2]
+        w1 = T[0, 2] - T[2, 0]
+        w2 = T[1, 0] - T[0, 1]
+        sn = 0.5 * np.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
+        th = np.arctan2(sn, c)
+        if th < 1e-8:
+            out[0], out[1], out[2] = 0.5 * w0, 0.5 * w1, 0.5 * w2
+            out[3], out[4], out[5] = p0, p1, p2
+            return
+        f = 1.0 / (2.0 * sn)
+        w0, w1, w2 = w0 * f, w1 * f, w2 * f
+    else:
+        Rc = np.empty((3, 3))
+        for i in range(3):
+            for j in range(3):
+                Rc[i, j] = T[i, j]
+        rv = np.empty(3)
+        nb_quat_rotvec(Rc, rv)
+        th = np.sqrt(rv[0] ** 2 + rv[1] ** 2 + rv[2] ** 2)
+        if th < 1e-12:
+            out[0] = out[1] = out[2] = 0.0
+            out[3], out[4], out[5] = p0, p1, p2
+            return
+        w0, w1, w2 = rv[0] / th, rv[1] / th, rv[2] / th
+    # G^-1 p = p / th - 0.5 w x p + a w x (w x p),  a = 1 / th - cot(th / 2) / 2
+    a = 1.0 / th - 0.5 / np.tan(th / 2.0)
+    x0 = w1 * p2 - w2 * p1
+    x1 = w2 * p0 - w0 * p2
+    x2 = w0 * p1 - w1 * p0
+    y0 = w1 * x2 - w2 * x1
+    y1 = w2 * x0 - w0 * x2
+    y2 = w0 * x1 - w1 * x0
+    out[0], out[1], out[2] = w0 * th, w1 * th, w2 * th
+    out[3] = (p0 / th - 0.5 * x0 + a * y0) * th
+    out[4] = (p1 / th - 0.5 * x1 + a * y1) * th
+    out[5] = (p2 / th - 0.5 * x2 + a * y2) * th
+
+
+@njit(cache=True)
+def nb_inverse_into(T, out):
+    for i in range(3):
+        for j in range(3):
+            out[i, j] = T[j, i]
+    for i in range(3):
+        out[i, 3] = -(T[0, i] * T[0, 3] + T[1, i] * T[1, 3] + T[2, i] * T[2, 3])
+        out[3, i] = 0.0
+    out[3, 3] = 1.0
+
+
+@njit(cache=True)
+def nb_copy44(src, dst):
+    """``dst[:] = src`` for 4x4 arrays (element loops: numba's slice assignment is slow to compile)."""
+    for i in range(4):
+        for j in range(4):
+            dst[i, j] = src[i, j]
+
+
+@njit(cache=True)
+def nb_mm4(A, B, out):
+    for i in range(4):
+        for j in range(4):
+            out[i, j] = A[i, 0] * B[0, j] + A[i, 1] * B[1, j] + A[i, 2] * B[2, j] + A[i, 3] * B[3, j]
+
+
+@njit(cache=True)
+def nb_exp_twist(V, out):
+    """:func:`..geometry.rotations.exp_twist` of one twist at ``theta = 1``."""
+    wn = np.sqrt(V[0] * V[0] + V[1] * V[1] + V[2] * V[2])
+    for i in range(4):
+        for j in range(4):
+            out[i, j] = 0.0
+    out[3, 3] = 1.0
+    if wn > 0.0:
+        ws = np.empty(3)
+        vs = np.empty(3)
+        for i in range(3):
+            ws[i] = V[i] / wn
+            vs[i] = V[3 + i] / wn
+        W = np.empty((3, 3))
+        nb_skew(ws, W)
+        W2 = np.empty((3, 3))
+        nb_mm(W, W, W2)
+        s = np.sin(wn)
+        c = 1.0 - np.cos(wn)
+        for i in range(3):
+            for j in range(3):
+                out[i, j] = s * W[i, j] + c * W2[i, j]
+            out[i, i] += 1.0
+        for i in range(3):
+            acc = 0.0
+            for j in range(3):
+                G = c * W[i, j] + (wn - s) * W2[i, j]
+                if i == j:
+                    G += wn
+                acc += G * vs[j]
+            out[i, 3] = acc
+    else:
+        for i in range(3):
+            out[i, i] = 1.0
+            out[i, 3] = V[3 + i]
+
+
+EPS = float(np.finfo(np.float64).eps)
+
+
+@njit(cache=True)
+def nb_svd(A):
+    """``np.linalg.svd(A, full_matrices=False)``: the one LAPACK routine the kernels use (each
+    distinct numba linalg call adds seconds to the first compilation)."""
+    return np.linalg.svd(A, full_matrices=False)
+
+
+@njit(cache=True)
+def nb_minnorm_qr(A, b, x):
+    """Minimum-norm solution of the underdetermined ``A x = b`` (m <= n) by Householder QR of
+    ``A^T`` into ``x``; ``False`` (x untouched) when a diagonal entry of R is below 1e-8 times the
+    largest, i.e. ``A`` may be rank deficient and the SVD must decide."""
+    m, n = A.shape
+    M = np.empty((n, m))
+    for i in range(m):
+        for j in range(n):
+            M[j, i] = A[i, j]
+    V = np.zeros((m, n))
+    d = np.empty(m)
+    for j in range(m):
+        nrm = 0.0
+        for i in range(j, n):
+            nrm += M[i, j] * M[i, j]
+        nrm = np.sqrt(nrm)
+        alpha = -nrm if M[j, j] >= 0.0 else nrm
+        vn = 0.0
+        for i in range(j, n):
+            V[j, i] = M[i, j]
+        V[j, j] -= alpha
+        for i in range(j, n):
+            vn += V[j, i] * V[j, i]
+        vn = np.sqrt(vn)
+        d[j] = alpha
+        if vn > 0.0:
+            for i in range(j, n):
+                V[j, i] /= vn
+            for c in range(j + 1, m):
+                dot = 0.0
+                for i in range(j, n):
+                    dot += V[j, i] * M[i, c]
+                for i in range(j, n):
+                    M[i, c] -= 2.0 * dot * V[j, i]
+    big = 0.0
+    for j in range(m):
+        big = max(big, abs(d[j]))
+    for j in range(m):
+        if not abs(d[j]) > 1e-8 * big:
+            return False
+    # R^T y = b (R upper triangular: R[j, j] = d[j], R[j, c] = M[j, c] for c > j)
+    z = np.zeros(n)
+    for j in range(m):
+        acc = b[j]
+        for k in range(j):
+            acc -= M[k, j] * z[k]
+        z[j] = acc / d[j]
+    # x = H_0 H_1 ... H_{m-1} z
+    for j in range(m - 1, -1, -1):
+        dot = 0.0
+        for i in range(j, n):
+            dot += V[j, i] * z[i]
+        for i in range(j, n):
+            z[i] -= 2.0 * dot * V[j, i]
+    for i in range(n):
+        x[i] = z[i]
+    return True
+
+
+@njit(cache=True)
+def nb_lstsq(A, b):
+    """Minimum-norm least squares, as ``np.linalg.lstsq(A, b, rcond=None)``: singular values at
+    or below ``eps max(m, n)`` times the largest count as zero.  A well-conditioned
+    underdetermined system is solved by QR (the same solution to rounding, several times faster
+    than the SVD); everything else by the SVD."""
+    m, n = A.shape
+    x = np.zeros(n)
+    if m == 0 or n == 0:
+        return x
+    if m <= n and nb_minnorm_qr(A, b, x):
+        return x
+    U, s, Vt = nb_svd(A)
+    cut = EPS * max(m, n) * s[0]
+    for i in range(len(s)):
+        if s[i] > cut:
+            c = 0.0
+            for k in range(m):
+                c += U[k, i] * b[k]
+            c /= s[i]
+            for j in range(n):
+                x[j] += c * Vt[i, j]
+    return x
+
+
+@njit(cache=True)
+def nb_det(M):
+    """Determinant by LU with partial pivoting (LAPACK getrf's pivoting, as ``np.linalg.det``)."""
+    n = M.shape[0]
+    A = M.copy()
+    det = 1.0
+    for k in range(n):
+        p = k
+        best = abs(A[k, k])
+        for i in range(k + 1, n):
+            if abs(A[i, k]) > best:
+                best = abs(A[i, k])
+                p = i
+        if A[p, k] == 0.0:
+            return 0.0
+        if p != k:
+            for j in range(n):
+                t = A[k, j]
+                A[k, j] = A[p, j]
+                A[p, j] = t
+            det = -det
+        det *= A[k, k]
+        for i in range(k + 1, n):
+            f = A[i, k] / A[k, k]
+            for j in range(k + 1, n):
+                A[i, j] -= f * A[k, j]
+    return det
+
+
+@njit(cache=True)
+def nb_orthonormal(D):
+    """Keep the rotation of ``D`` orthonormal (``U Vt`` of its SVD: the nearest rotation), in place."""
+    R = np.empty((3, 3))
+    for i in range(3):
+        for j in range(3):
+            R[i, j] = D[i, j]
+    U, _, Vt = nb_svd(R)
+    for i in range(3):
+        for j in range(3):
+            D[i, j] = U[i, 0] * Vt[0, j] + U[i, 1] * Vt[1, j] + U[i, 2] * Vt[2, j]
