@@ -265,34 +265,19 @@ def bench_workspace(quick: bool) -> dict:
 
 
 # ---------------------------------------------------------------------- 4-SPS/CU batched IK
-def _loop_legs(poses, a, b):
-    out = []
-    for z, al, be, ga in poses:
-        sa, ca, sb, cb, sg, cg = math.sin(al), math.cos(al), math.sin(be), math.cos(be), math.sin(ga), math.cos(ga)
-        U, V = -sb, cb * sa
-        P = cb * cg + sa * sb * sg + ca * cg
-        Q = cb * sg + sa * sb * cg - ca * sg
-        row = []
-        for s1, s2 in ((1, 1), (-1, 1), (-1, -1), (1, -1)):
-            l2 = 2 * a * a + 2 * b * b + z * z + 2 * a * z * (s1 * U + s2 * V) - 2 * a * b * (P + s1 * s2 * Q)
-            row.append(math.sqrt(max(l2, 0.0)))
-        out.append(row)
-    return out
-
-
 def bench_ik(quick: bool) -> dict:
-    geom = k4.PAPER_B
-    rng = np.random.default_rng(1)
-    n, loop_n = (20_000, 2_000) if quick else (2_000_000, 20_000)
-    phi = np.column_stack([rng.uniform(0.15, 0.3, n), *(rng.uniform(-0.4, 0.4, n) for _ in range(3))])
-    k4.leg_lengths(phi[:10], geom)
-    rep = 2 if quick else 3
-    t_vec = best_time(lambda: k4.leg_lengths(phi, geom), rep, 1) / n
-    loop_in = phi[:loop_n].tolist()
-    t_loop = best_time(lambda: _loop_legs(loop_in, geom.a, geom.b), rep, 1) / loop_n
-    diff = float(np.max(np.abs(np.array(_loop_legs(loop_in, geom.a, geom.b)) - k4.leg_lengths(phi[:loop_n], geom))))
-    return {"ik_batch_poses_per_s": 1 / t_vec, "ik_loop_poses_per_s": 1 / t_loop, "ik_batch_vs_loop": t_loop / t_vec,
-            "ik_max_abs_difference_m": diff}
+    """benchmarks/bench_four_sps_cu.py's inverse-position measurement (its plain-math loop is
+    checked against the batched closed form there)."""
+    import importlib.util
+    from pathlib import Path
+
+    spec = importlib.util.spec_from_file_location("bench_four_sps_cu", Path(__file__).with_name("bench_four_sps_cu.py"))
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    n, loop_n, fk_n, rep = (20_000, 2_000, 2, 2) if quick else (2_000_000, 20_000, 2, 3)
+    inv = mod.run(n, loop_n, fk_n, rep)["inverse"]
+    return {"ik_batch_poses_per_s": inv["vectorised_poses_per_s"], "ik_loop_poses_per_s": inv["loop_poses_per_s"],
+            "ik_batch_vs_loop": inv["ratio"], "ik_max_abs_difference_m": inv["max_abs_diff_m"]}
 
 
 # ---------------------------------------------------------------------- first-call cost

@@ -227,7 +227,7 @@ def synth_cs(positions=None, *, pick: int = 5, starts: int = 60, seed: int = 0, 
     ``positions``: seven task poses -- default paper A's table 9; a model name or Mechanism (its
     task positions), a TOML file of ``[[positions]]``, or a sequence of Pose.  ``starts`` random
     starts (``seed``); ``pick`` small-slide dyads (5: also assemble and check the 5-CS, and with
-    ``check_defects`` its circuit, order and branch defects, about a minute; ``progress``
+    ``check_defects`` its circuit, order and branch defects, about 10 s; ``progress``
     reports on it); ``samples``: family points listed in ``to_dict()``.
 
     >>> import spatialmech as sm

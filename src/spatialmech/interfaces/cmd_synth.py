@@ -114,7 +114,7 @@ def cs(positions_file, as_json, samples, pick, save_file, starts, seed, skip_def
     eqs 22-26): traced by continuation, then the dyads with the smallest largest C slide are
     picked; five of them make a 5-CS linkage, checked at the seven positions (pose errors,
     mobility) and by the defect analysis (circuit, order and branch defects for every candidate
-    driver, as `spatialmech defects`; about a minute).  The synthesis is reported a success only
+    driver, as `spatialmech defects`; about 10 s).  The synthesis is reported a success only
     when the linkage is defect-free for at least one driver; otherwise the output says what is
     wrong.  Lengths in the positions' unit, angles in degrees.
 

@@ -16,6 +16,7 @@ __all__ = [
     "nb_exp_twist",
     "nb_inverse_into",
     "nb_log",
+    "nb_lsq_qr",
     "nb_lstsq",
     "nb_matrix_rotvec",
     "nb_minnorm_qr",
@@ -336,16 +337,71 @@ def nb_minnorm_qr(A, b, x):
 
 
 @njit(cache=True)
+def nb_lsq_qr(A, b, x):
+    """Least-squares solution of the overdetermined ``A x = b`` (m >= n) by Householder QR of
+    ``A`` into ``x``; ``False`` (x untouched) when a diagonal entry of R is below 1e-8 times the
+    largest (``A`` may be rank deficient: the SVD must decide)."""
+    m, n = A.shape
+    M = A.copy()
+    y = b.copy()
+    d = np.empty(n)
+    v = np.empty(m)
+    for j in range(n):
+        nrm = 0.0
+        for i in range(j, m):
+            nrm += M[i, j] * M[i, j]
+        nrm = np.sqrt(nrm)
+        alpha = -nrm if M[j, j] >= 0.0 else nrm
+        vn = 0.0
+        for i in range(j, m):
+            v[i] = M[i, j]
+        v[j] -= alpha
+        for i in range(j, m):
+            vn += v[i] * v[i]
+        vn = np.sqrt(vn)
+        d[j] = alpha
+        if vn > 0.0:
+            for i in range(j, m):
+                v[i] /= vn
+            for c in range(j + 1, n):
+                dot = 0.0
+                for i in range(j, m):
+                    dot += v[i] * M[i, c]
+                for i in range(j, m):
+                    M[i, c] -= 2.0 * dot * v[i]
+            dot = 0.0
+            for i in range(j, m):
+                dot += v[i] * y[i]
+            for i in range(j, m):
+                y[i] -= 2.0 * dot * v[i]
+    big = 0.0
+    for j in range(n):
+        big = max(big, abs(d[j]))
+    for j in range(n):
+        if not abs(d[j]) > 1e-8 * big:
+            return False
+    for j in range(n - 1, -1, -1):  # R x = (Q^T b)[:n]
+        acc = y[j]
+        for c in range(j + 1, n):
+            acc -= M[j, c] * x[c]
+        x[j] = acc / d[j]
+    return True
+
+
+@njit(cache=True)
 def nb_lstsq(A, b):
     """Minimum-norm least squares, as ``np.linalg.lstsq(A, b, rcond=None)``: singular values at
     or below ``eps max(m, n)`` times the largest count as zero.  A well-conditioned
-    underdetermined system is solved by QR (the same solution to rounding, several times faster
-    than the SVD); everything else by the SVD."""
+    system is solved by QR (minimum norm through ``A^T`` when underdetermined, least squares
+    through ``A`` when overdetermined: the same solution to rounding, several times faster than
+    the SVD); a possibly rank-deficient one by the SVD."""
     m, n = A.shape
     x = np.zeros(n)
     if m == 0 or n == 0:
         return x
     if m <= n and nb_minnorm_qr(A, b, x):
+        return x
+    if m > n and nb_lsq_qr(A, b, x):
         return x
     U, s, Vt = nb_svd(A)
     cut = EPS * max(m, n) * s[0]

@@ -199,7 +199,9 @@ def correct_on_hyperplane(problem, xp, t, tol, max_iter, contraction=0.6):
             return xp, True, it, moved
         A = problem.jacobian(xp)
         M = np.vstack([A, t[None, :]])
-        d, *_ = np.linalg.lstsq(M, np.r_[-r, 0.0], rcond=None)
+        rhs = np.r_[-r, 0.0]
+        # minimum-norm least squares: the compiled solver when in use (the same solution to rounding)
+        d = compiled.lstsq(M, rhs) if compiled.enabled() else np.linalg.lstsq(M, rhs, rcond=None)[0]
         dn = float(np.linalg.norm(d))
         if it > 0 and dn > contraction * prev:
             return xp, False, it, moved

@@ -267,9 +267,10 @@ def _legs_sq_block(ph: np.ndarray, a: float, b: float, out: np.ndarray) -> None:
     np.subtract(c, m, out=out[:, 3])
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath=True)
 def _legs_kernel(ph, a, b, squared, out):
-    """:func:`_legs_sq_block` pose by pose (compiled), square roots unless ``squared``."""
+    """:func:`_legs_sq_block` pose by pose (compiled, fastmath: last-bit differences from the
+    NumPy form), square roots unless ``squared``."""
     k = 2.0 * a * a + 2.0 * b * b
     ab2 = 2.0 * a * b
     for i in range(ph.shape[0]):
