@@ -7,17 +7,14 @@ from __future__ import annotations
 import numpy as np
 
 from .kernels_se3 import (
+    nb_ball_product,
     nb_copy44,
     nb_exp_twist,
     nb_inverse_into,
     nb_log,
     nb_lstsq,
-    nb_matrix_rotvec,
-    nb_mm,
     nb_mm4,
     nb_orthonormal,
-    nb_quat_rotvec,
-    nb_rotvec_matrix,
 )
 from .jit import njit
 
@@ -268,24 +265,9 @@ def nb_retract(ball_first, ball_axes, q, D, B, active, step, na, fix_platform, q
             j += 1
     for i in range(n):
         q_out[i] = q[i] + dq[i]
-    a = np.empty(3)
-    b = np.empty(3)
-    Ra = np.empty((3, 3))
-    Rb = np.empty((3, 3))
-    Rn = np.empty((3, 3))
-    rv = np.empty(3)
     for g in range(len(ball_first)):
         i = ball_first[g]
-        A = ball_axes[g]
-        for x in range(3):
-            a[x] = A[x, 0] * dq[i] + A[x, 1] * dq[i + 1] + A[x, 2] * dq[i + 2]
-            b[x] = A[x, 0] * q[i] + A[x, 1] * q[i + 1] + A[x, 2] * q[i + 2]
-        nb_rotvec_matrix(a, Ra)
-        nb_rotvec_matrix(b, Rb)
-        nb_mm(Ra, Rb, Rn)
-        nb_matrix_rotvec(Rn, rv)
-        for x in range(3):
-            q_out[i + x] = A[0, x] * rv[0] + A[1, x] * rv[1] + A[2, x] * rv[2]
+        nb_ball_product(ball_axes[g], dq[i : i + 3], q[i : i + 3], False, False, q_out[i : i + 3])
     nv = len(step) - na
     E = np.empty((4, 4))
     if fix_platform or nv < 6:
@@ -426,11 +408,6 @@ def nb_limb_gn(S, ball_of, ball_first, ball_axes, ball_centre, Ds, q0s, lin, L, 
     rhs = np.empty(6)
     qn = np.empty(m)
     a = np.empty(3)
-    b = np.empty(3)
-    Ra = np.empty((3, 3))
-    Rb = np.empty((3, 3))
-    Rn = np.empty((3, 3))
-    rv = np.empty(3)
     for s in range(Ds.shape[0]):
         nb_inverse_into(Ds[s], Dinv)
         q = q_out[s]
@@ -458,17 +435,9 @@ def nb_limb_gn(S, ball_of, ball_first, ball_axes, ball_centre, Ds, q0s, lin, L, 
                 qn[j] = q[j] + colscale[j] * x[j]
             for g in range(len(ball_first)):
                 i = ball_first[g]
-                A = ball_axes[g]
                 for t in range(3):
-                    a[t] = (A[t, 0] * colscale[i] * x[i] + A[t, 1] * colscale[i + 1] * x[i + 1]
-                            + A[t, 2] * colscale[i + 2] * x[i + 2])
-                    b[t] = A[t, 0] * q[i] + A[t, 1] * q[i + 1] + A[t, 2] * q[i + 2]
-                nb_rotvec_matrix(a, Ra)
-                nb_rotvec_matrix(b, Rb)
-                nb_mm(Ra, Rb, Rn)
-                nb_quat_rotvec(Rn, rv)
-                for t in range(3):
-                    qn[i + t] = A[0, t] * rv[0] + A[1, t] * rv[1] + A[2, t] * rv[2]
+                    a[t] = colscale[i + t] * x[i + t]
+                nb_ball_product(ball_axes[g], a, q[i : i + 3], False, True, qn[i : i + 3])
             for j in range(m):
                 q[j] = qn[j]
         res_out[s] = rn

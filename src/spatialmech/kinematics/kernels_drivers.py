@@ -7,12 +7,11 @@ from __future__ import annotations
 import numpy as np
 
 from .kernels_se3 import (
+    nb_ball_product,
     nb_det,
     nb_inverse_into,
     nb_log,
     nb_mm4,
-    nb_quat_rotvec,
-    nb_rotvec_matrix,
     nb_svd,
 )
 from .kernels_closure import (
@@ -342,26 +341,9 @@ def nb_difference(ball_first, ball_axes, qa, Da, Ba, qb, Db, Bb, active, wrap, c
     dq = np.empty(n)
     for i in range(n):
         dq[i] = qb[i] - qa[i]
-    a = np.empty(3)
-    b = np.empty(3)
-    Ra = np.empty((3, 3))
-    Rb = np.empty((3, 3))
-    Rn = np.empty((3, 3))
-    rv = np.empty(3)
     for g in range(len(ball_first)):
         i = ball_first[g]
-        A = ball_axes[g]
-        for x in range(3):
-            a[x] = A[x, 0] * qa[i] + A[x, 1] * qa[i + 1] + A[x, 2] * qa[i + 2]
-            b[x] = A[x, 0] * qb[i] + A[x, 1] * qb[i + 1] + A[x, 2] * qb[i + 2]
-        nb_rotvec_matrix(a, Ra)
-        nb_rotvec_matrix(b, Rb)
-        for x in range(3):  # Rb Ra^T
-            for y in range(3):
-                Rn[x, y] = Rb[x, 0] * Ra[y, 0] + Rb[x, 1] * Ra[y, 1] + Rb[x, 2] * Ra[y, 2]
-        nb_quat_rotvec(Rn, rv)
-        for x in range(3):
-            dq[i + x] = A[0, x] * rv[0] + A[1, x] * rv[1] + A[2, x] * rv[2]
+        nb_ball_product(ball_axes[g], qb[i : i + 3], qa[i : i + 3], True, True, dq[i : i + 3])  # Rb Ra^T
     j = 0
     for i in range(n):
         if active[i]:
