@@ -42,7 +42,6 @@ from spatialmech import catalog
 from spatialmech.analysis.defects import candidate_drivers
 from spatialmech.analysis.workspace.checker import pose_checker
 from spatialmech.kinematics import compiled
-from spatialmech.kinematics.closed_forms import four_sps_cu as k4
 from spatialmech.kinematics.closure import Configuration, active_mask, correct, generic_configuration
 from spatialmech.kinematics.jacobian import driver_determinants
 from spatialmech.kinematics.position import configuration_at_pose, platform_pose
