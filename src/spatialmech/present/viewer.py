@@ -52,7 +52,7 @@ from ..geometry.validate import as_finite_array
 from ..kinematics.closure import Configuration, joint_points, joint_twists
 from ..model.mechanism import GROUND, Mechanism, Pose
 
-__all__ = ["DIV_ID", "SINGULAR_SYMBOL", "Drawing", "ViewerFile", "drawing", "viewer_figure", "viewer_html", "write_viewer"]
+__all__ = ["DIV_ID", "LIMB_COLOURS", "SINGULAR_SYMBOL", "Drawing", "ViewerFile", "drawing", "viewer_figure", "viewer_html", "write_viewer"]
 
 #: ``id`` of the plotly graph ``<div>`` in the page (the browser test reads it).
 DIV_ID = "spatialmech-viewer"
@@ -70,7 +70,8 @@ COINCIDENT = 1e-9
 #: emoji that shows as an empty box without an emoji font; "cross" is the ASCII "+", which every
 #: font has (the task positions' "diamond" is U+25C6, in the basic Geometric Shapes block).
 SINGULAR_SYMBOL = "cross"
-_PALETTE = ("#1f77b4", "#2ca02c", "#9467bd", "#8c564b", "#e377c2", "#17becf", "#bcbd22", "#7f7f7f")
+#: Colours of the limbs, by limb index (cycled); the studio uses the same.
+LIMB_COLOURS = _PALETTE = ("#1f77b4", "#2ca02c", "#9467bd", "#8c564b", "#e377c2", "#17becf", "#bcbd22", "#7f7f7f")
 _FRAME_COLOURS = ("#d62728", "#2ca02c", "#1f77b4")  # platform frame x, y, z
 
 
