@@ -124,3 +124,38 @@ def view(model: ModelLike, out, *, motion: str = "auto", frames: int = 60) -> Vi
         title = f"{mech.name}: a demonstration loop, {len(configs)} configurations (not the tracker)"
     written = write_viewer(out, mech, configs, title=title, task_positions=mech.positions, singular_points=singular)
     return ViewResult(written, motion)
+
+
+# ============================================================================ design studio
+def studio_session(model: ModelLike = "five-cs-3"):
+    """A design-studio session on ``model`` (what ``spatialmech studio`` serves, without HTTP):
+    ``drive(values)`` moves the actuators (model units, degrees for rotations) along the current
+    branch by continuation and says how it went; ``state()`` is the readout (JSON payload,
+    docs/studio.md); ``set_drivers``, ``fk_all``, ``pick_mode``.
+
+    >>> import spatialmech as sm
+    >>> s = sm.studio_session("rssr")
+    >>> r = s.drive([10.0])                                  # the crank to 10 degrees
+    >>> r.status, round(s.state()["actuators_deg"]["A0.rot"], 9)
+    ('reached', 10.0)
+    """
+    from ..interfaces.studio.session import Session
+
+    return Session(as_mechanism(model))
+
+
+def studio_app(model: ModelLike = "five-cs-3"):
+    """The design studio's web app (FastAPI) on a new session: serve it with uvicorn, or call
+    its JSON API directly (docs/studio.md).
+
+    >>> import spatialmech as sm
+    >>> from fastapi.testclient import TestClient
+    >>> client = TestClient(sm.studio_app("rssr"))
+    >>> client.post("/api/drive", json={"actuators": [10.0]}).json()["status"]
+    'reached'
+    >>> client.post("/api/drive", json={"actuators": [1, 2]}).json()["error"]
+    'actuators: expected 1 values (A0.rot), got 2'
+    """
+    from ..interfaces.studio.app import create_app
+
+    return create_app(studio_session(model))

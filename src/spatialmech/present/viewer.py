@@ -39,6 +39,7 @@ angles.  Example::
 from __future__ import annotations
 
 import html as _html
+import weakref
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -193,10 +194,18 @@ def _attachments(mech: Mechanism, pts: list[np.ndarray], link: str) -> np.ndarra
     return np.array(out).reshape(-1, 3)
 
 
+_ORDERS: weakref.WeakKeyDictionary[Mechanism, np.ndarray] = weakref.WeakKeyDictionary()
+
+
 def _platform_order(mech: Mechanism) -> np.ndarray:
+    """The platform outline's corner order, from the reference configuration (cached per
+    mechanism: the studio redraws at every drag)."""
+    if mech in _ORDERS:
+        return _ORDERS[mech]
     ref = Configuration.reference(mech)
     last = _attachments(mech, joint_points(mech, ref), mech.output)
-    return _outline_order(last, mech.characteristic_length)
+    _ORDERS[mech] = order = _outline_order(last, mech.characteristic_length)
+    return order
 
 
 def drawing(mech: Mechanism, config: Configuration) -> Drawing:

@@ -103,6 +103,10 @@ def create_app(session: Session) -> FastAPI:
     def index():
         return HTMLResponse(_static("index.html").decode("utf-8"))
 
+    @app.get("/favicon.ico")
+    def favicon():
+        return Response(status_code=204)
+
     @app.get("/static/{name}")
     def static(name: str):
         types = {"studio.js": "text/javascript", "studio.css": "text/css"}

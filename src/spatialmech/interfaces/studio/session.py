@@ -113,16 +113,22 @@ class Session:
         c = Configuration.reference(mech)
         L = mech.characteristic_length
         if float(np.linalg.norm(closure_residual(mech, c))) > 1e-8 * max(1.0, L) or self._sigma(c) < NEAR_SINGULAR:
-            for seed in range(8):  # a nearby generic, regular configuration
-                try:
-                    g = generic_configuration(mech, seed=seed, step=0.3, steps=3)
-                except ConvergenceError:
-                    continue
-                if self._sigma(g) >= NEAR_SINGULAR:
-                    c = g
-                    self.note = ("the reference configuration is singular or open: started at a nearby regular "
-                                 f"configuration (random steps along the closure, seed {seed})")
+            best, best_sigma, how = c, self._sigma(c), ""
+            for seed in range(6):  # the most regular of a few nearby generic configurations
+                for step in (0.3, 1.0):
+                    try:
+                        g = generic_configuration(mech, seed=seed, step=step, steps=3)
+                    except ConvergenceError:
+                        continue
+                    sg = self._sigma(g)
+                    if sg > best_sigma:
+                        best, best_sigma, how = g, sg, f"seed {seed}, step {step}"
+                if best_sigma >= 2 * NEAR_SINGULAR:
                     break
+            if how:
+                c = best
+                self.note = ("the reference configuration is singular or open: started at a nearby, more regular "
+                             f"configuration (random steps along the closure, {how})")
         self.config = c
         self.start_values = self.actuator_values()
         self.history = [self._platform_point(c)]
@@ -189,13 +195,13 @@ class Session:
                 out.append(r.id)
         return out
 
-    def _dj(self, c: Configuration) -> float | None:
+    def _dj(self, c: Configuration, J=None) -> float | None:
         """DJ of the chosen drivers: ``det`` of the complete Jacobian (one driver: the
         sign-continuous driver determinant); ``None`` where it is not square."""
         if len(self.mech.actuators) == 1:
             v = float(driver_determinants(self.mech, c, list(self.mech.actuators))[0])
         else:
-            d = complete_jacobian(self.mech, c).det
+            d = (J if J is not None else complete_jacobian(self.mech, c)).det
             v = float("nan") if d is None else float(d)
         return v if np.isfinite(v) else None
 
@@ -230,7 +236,7 @@ class Session:
             "slider_ranges_len": {k: list(v) for k, v in lo.items() if not _is_rot(m, k)},
             **joints,
             "pose": pose_dict(pose.R, pose.p),
-            "dj": self._dj(c),
+            "dj": self._dj(c, J),
             "dj_by_driver": self._dj_by_driver(c),
             "sigma_min": sig,
             "singular": bool(sig < current().singular),
@@ -340,12 +346,19 @@ class Session:
             return cfg.with_q(q)
 
         own0 = self._dj(self.config)
+        memo: dict = {}
+
+        def own_dj(x) -> float | None:  # evaluated once per tracked point (monitor and stop share it)
+            if memo.get("x") is not x:
+                memo["x"], memo["v"] = x, self._dj(with_actuators(x))
+            return memo["v"]
+
         cands = self._candidates()
         names = [f"DJ {d}" for d in cands if d not in m.actuators]
         others = [d for d in cands if d not in m.actuators]
         monitors = {}
         if own0 is not None:
-            monitors["DJ (drivers)"] = lambda x: float(self._dj(with_actuators(x)) or 0.0)
+            monitors["DJ (drivers)"] = lambda x: float(own_dj(x) or 0.0)
         vector = ((names, lambda x: driver_determinants(m, with_actuators(x), others)) if others else None)
         why = {"reason": ""}
         lam_prev = [0.0]
@@ -360,7 +373,7 @@ class Session:
                 return True
             lam_prev[0] = lam
             if own0 is not None:
-                v = self._dj(with_actuators(x))
+                v = own_dj(x)
                 if v is not None and np.sign(v) != np.sign(own0) and v != 0:
                     why["reason"] = "dj"
                     return True
