@@ -19,6 +19,7 @@ __all__ = ["studio"]
 
 def _free(port: int) -> bool:
     with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+        s.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)  # as uvicorn: a closed server's port is free
         try:
             s.bind(("127.0.0.1", port))
         except OSError:

@@ -53,7 +53,8 @@ from ..geometry.validate import as_finite_array
 from ..kinematics.closure import Configuration, joint_points, joint_twists
 from ..model.mechanism import GROUND, Mechanism, Pose
 
-__all__ = ["DIV_ID", "LIMB_COLOURS", "SINGULAR_SYMBOL", "Drawing", "ViewerFile", "drawing", "viewer_figure", "viewer_html", "write_viewer"]
+__all__ = ["DIV_ID", "LIMB_COLOURS", "SINGULAR_SYMBOL", "Drawing", "ViewerFile", "drawing", "viewer_figure", "viewer_html",
+           "write_viewer"]
 
 #: ``id`` of the plotly graph ``<div>`` in the page (the browser test reads it).
 DIV_ID = "spatialmech-viewer"

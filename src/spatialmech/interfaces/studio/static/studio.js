@@ -198,7 +198,7 @@ function update(st) {
       (st.singular ? " singular" : st.near_singular ? " near a singularity (< " + st.near_singular_below + ")" : "")],
     ["closure residual", fmt(st.residual, 3)],
   ];
-  actuatorEntries(st).forEach(a => rows.splice(0, 0, [a.name + " [" + a.unit + "]", fmt(a.value, 7)]));
+  rows.unshift(...actuatorEntries(st).map(a => [a.name + " [" + a.unit + "]", fmt(a.value, 7)]));
   document.getElementById("readouts").innerHTML = rows.map(r => `<tr><td>${r[0]}</td><td>${r[1]}</td></tr>`).join("");
   const j = Object.entries(st.joints_deg).map(([k, v]) => [k, fmt(v, 6) + " deg"])
     .concat(Object.entries(st.joints_len).map(([k, v]) => [k, fmt(v, 6) + " " + S.unit]));
