@@ -158,3 +158,21 @@ def test_studio_command_errors_are_one_line():
     assert r.exit_code == 2 and r.output.startswith("error: ") and r.output.count("\n") == 1
     h = CliRunner().invoke(cli, ["studio", "--help"])
     assert h.exit_code == 0 and "--no-browser" in h.output
+
+
+def test_studio_command_json_before_serving(monkeypatch, validator):
+    """``studio --json`` prints the address and the start state, then serves (uvicorn.run is
+    replaced here: the app it would serve is checked instead)."""
+    import json
+
+    import uvicorn
+
+    served = {}
+    monkeypatch.setattr(uvicorn, "run", lambda app, host, port, **kw: served.update(app=app, host=host, port=port))
+    r = CliRunner().invoke(cli, ["studio", "rssr", "--port", "0", "--no-browser", "--json"])
+    assert r.exit_code == 0, r.output
+    doc = json.loads(r.output)
+    errors = [e.message[:200] for e in validator.iter_errors(doc)]
+    assert not errors and unit_rule_violations(doc) == []
+    assert served["host"] == "127.0.0.1" and doc["url"] == f"http://127.0.0.1:{served['port']}/" == f"http://127.0.0.1:{doc['port']}/"
+    assert TestClient(served["app"]).get("/api/state").json()["state"]["drivers"] == doc["state"]["drivers"] == ["A0.rot"]
