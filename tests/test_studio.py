@@ -176,3 +176,15 @@ def test_studio_command_json_before_serving(monkeypatch, validator):
     assert not errors and unit_rule_violations(doc) == []
     assert served["host"] == "127.0.0.1" and doc["url"] == f"http://127.0.0.1:{served['port']}/" == f"http://127.0.0.1:{doc['port']}/"
     assert TestClient(served["app"]).get("/api/state").json()["state"]["drivers"] == doc["state"]["drivers"] == ["A0.rot"]
+
+
+def test_the_traced_circuit_passes_through_the_current_configuration(validator):
+    session = Session("rssr")
+    c = TestClient(create_app(session))
+    d = ok(c.get("/api/circuit"), validator)
+    pts = np.array(d["circuit_len"])
+    here = np.array(session.state()["scene"]["platform_point_len"])
+    assert len(pts) > 20 and np.min(np.linalg.norm(pts - here, axis=1)) < 1e-9
+    assert np.linalg.norm(pts[0] - pts[-1]) < 1e-6  # a closed circuit
+    r = TestClient(create_app(Session("stewart-6sps"))).get("/api/circuit")
+    assert r.status_code == 422 and r.json()["error"].startswith("circuit:")

@@ -43,7 +43,7 @@ def server():
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         port = s.getsockname()[1]
-    srv = uvicorn.Server(uvicorn.Config(sm.studio_app("five-cs-3"), host="127.0.0.1", port=port, log_level="warning"))
+    srv = uvicorn.Server(uvicorn.Config(sm.studio_app("rssr"), host="127.0.0.1", port=port, log_level="warning"))
     th = threading.Thread(target=srv.run, daemon=True)
     th.start()
     t0 = time.time()
@@ -108,17 +108,17 @@ def test_dragging_a_slider_moves_the_mechanism(server, browser, tmp_path):
     before = browser.execute_script("return window.studio.state")
     readout = browser.find_element(By.ID, "readouts").text
     img0 = pixels(browser, tmp_path, "before.png")
-    browser.execute_script("const el = document.getElementById('slider-0'); el.value = Number(el.value) - 30;"
+    browser.execute_script("const el = document.getElementById('slider-0'); el.value = Number(el.value) + 40;"
                            "el.dispatchEvent(new Event('input'));")
-    wait(browser, "return window.studio.state.actuators_deg['C1.rot'] < -29.9 && !window.studio.inFlight")
+    wait(browser, "return window.studio.state.actuators_deg['A0.rot'] > 39.9 && !window.studio.inFlight")
     time.sleep(0.5)
     after = browser.execute_script("return window.studio.state")
-    assert after["actuators_deg"]["C1.rot"] == pytest.approx(-30.0, abs=1e-6)
+    assert after["actuators_deg"]["A0.rot"] == pytest.approx(40.0, abs=1e-6)
     moved = np.linalg.norm(np.subtract(after["scene"]["platform_point_len"], before["scene"]["platform_point_len"]))
     assert moved > 0.1 * after["scene"]["scale_len"]
-    # what the page holds is what the library computes at -30 deg along the branch
-    ref = sm.studio_session("five-cs-3")
-    assert ref.drive([-30.0]).status == "reached"
+    # what the page holds is what the library computes at 40 deg along the branch
+    ref = sm.studio_session("rssr")
+    assert ref.drive([40.0]).status == "reached"
     assert np.allclose(after["scene"]["platform_point_len"], ref.state()["scene"]["platform_point_len"], atol=1e-9)
     assert browser.find_element(By.ID, "readouts").text != readout
     assert "reached" in browser.find_element(By.ID, "status").text

@@ -7,6 +7,8 @@ and units in the field names; bad input answers 4xx with ``{"error": "<field>: .
 =====================  ==================================================================
 ``GET /api/model``     the model (``model_info``) and the current ``state``
 ``GET /api/state``     the current ``state``
+``GET /api/circuit``   a 1-DOF model's traced circuit through the current configuration
+                       (``circuit_len``) and the DJ zeros of its driver (``dj_zeros_len``)
 ``POST /api/drive``    ``{"actuators": [...]}`` (model units, degrees for rotations; a list in
                        the order of ``drivers`` or a map by name): drive along the current
                        branch; answers ``status``, ``message``, ``events`` and the new ``state``
@@ -127,6 +129,10 @@ def create_app(session: Session) -> FastAPI:
         with lock:
             return _json(doc({"state": session.state()}))
 
+    async def circuit(request: Request):
+        with lock:
+            return _json(doc(session.circuit()))
+
     async def drive(request: Request):
         data = await body(request, "actuators")
         with lock:
@@ -159,6 +165,7 @@ def create_app(session: Session) -> FastAPI:
             session.load(data["model"])
             return _json(doc({"model_info": session.model_info(), "state": session.state()}))
 
+    app.add_api_route("/api/circuit", guarded(circuit), methods=["GET"])
     for path, fn in (("/api/drive", drive), ("/api/drivers", drivers), ("/api/fk_all", fk_all), ("/api/mode", mode),
                      ("/api/load", load)):
         app.add_api_route(path, guarded(fn), methods=["POST"])

@@ -109,6 +109,8 @@ class Session:
         self.mech = mech
         self.note = ""
         self.fk_modes: list = []
+        self.fk_branch: object = object()  # a new object whenever the branch is changed on purpose
+        self._circuit: dict = {}
         self.history: list[np.ndarray] = []  # platform-point path, for the page's trail
         c = Configuration.reference(mech)
         L = mech.characteristic_length
@@ -454,6 +456,23 @@ class Session:
         self.history.append(self._platform_point(config))
         del self.history[:-400]
 
+    def circuit(self, frames: int = 240) -> dict:
+        """The whole circuit through the current configuration of a one-degree-of-freedom model
+        (the tracker, as ``view --motion trace``): the platform point along it and where DJ of
+        the chosen driver vanishes (its branch points).  Cached per driver and branch start."""
+        if len(self.mech.actuators) != 1:
+            raise InputError(f"circuit: {self.mech.name} is driven by {len(self.mech.actuators)} actuators; the traced "
+                             "circuit is drawn for one-degree-of-freedom linkages")
+        from ...analysis.traced_motion import traced_motion
+
+        key = (self.mech.actuators, id(self.fk_branch))
+        if self._circuit.get("key") != key:
+            configs, zeros = traced_motion(self.mech, frames=frames, start=self.config)
+            pts = [self._platform_point(c) for c in configs]
+            self._circuit = {"key": key, "circuit_len": [p.tolist() for p in pts],
+                             "dj_zeros_len": [self._platform_point(z).tolist() for z in zeros]}
+        return {k: v for k, v in self._circuit.items() if k != "key"}
+
     def fk_all(self, seeds: int = FK_ALL_SEEDS) -> list[dict]:
         """Every assembly mode a multi-start search finds at the current actuator values
         (``fk --all``); the current configuration's mode is first."""
@@ -478,4 +497,5 @@ class Session:
         if not 1 <= number <= len(self.fk_modes):
             raise InputError(f"mode_number: expected 1 to {len(self.fk_modes)}, got {number}")
         self.config = self.fk_modes[number - 1].config
+        self.fk_branch = object()
         self.history = [self._platform_point(self.config)]

@@ -3,7 +3,7 @@
 // answer has arrived (no websockets).  window.studio exposes the last state for tests.
 "use strict";
 
-const S = { state: null, unit: "", inFlight: false, pending: null, range: null, drawn: 0, errors: [] };
+const S = { state: null, circuit: null, unit: "", inFlight: false, pending: null, range: null, drawn: 0, errors: [] };
 window.studio = S;
 
 async function api(path, body) {
@@ -104,6 +104,12 @@ function traces(sc) {
     const e = add(p, mul([sc.platform_frame[0][a], sc.platform_frame[1][a], sc.platform_frame[2][a]], 0.3 * s));
     out.push({ type: "scatter3d", mode: "lines", ...xyz([p, e]), line: { color: cols[a], width: 6 }, name: "platform frame", showlegend: a === 0 });
   });
+  if (S.circuit && S.circuit.circuit_len.length > 1) {
+    out.push({ type: "scatter3d", mode: "lines", ...xyz(S.circuit.circuit_len), line: { color: "#888888", width: 2 },
+      name: "traced circuit", hoverinfo: "skip" });
+    if (S.circuit.dj_zeros_len.length) out.push({ type: "scatter3d", mode: "markers", ...xyz(S.circuit.dj_zeros_len),
+      marker: { size: 6, color: "#d62728", symbol: "cross" }, name: "DJ zeros of " + S.state.drivers[0] });
+  }
   if (sc.trail_len.length > 1) out.push({ type: "scatter3d", mode: "lines", ...xyz(sc.trail_len), line: { color: "#ff7f0e", width: 2, dash: "dot" }, name: "platform point path" });
   if (sc.task_positions_len.length) out.push({ type: "scatter3d", mode: "markers+text", ...xyz(sc.task_positions_len),
     text: sc.task_positions_len.map((_, k) => "P" + (k + 1)), marker: { size: 4, color: "#000", symbol: "diamond" }, name: "task positions" });
@@ -229,6 +235,13 @@ async function loadDoc(doc) {
   buildSliders();
   update(doc.state);
   setStatus("", "ready: drag a slider");
+  loadCircuit();
+}
+
+async function loadCircuit() {  // one-degree-of-freedom models: the traced circuit, drawn when it arrives
+  S.circuit = null;
+  if (S.state.drivers.length !== 1) return;
+  try { S.circuit = await api("/api/circuit"); draw(); } catch (e) { S.circuit = null; }
 }
 
 async function main() {
@@ -241,7 +254,7 @@ async function main() {
   document.getElementById("driver-apply").addEventListener("click", async () => {
     try {
       const doc = await api("/api/drivers", { drivers: document.getElementById("driver-select").value.split(",") });
-      S.state = doc.state; buildSliders(); update(doc.state); setStatus("", "driving with " + doc.state.drivers.join(", "));
+      S.state = doc.state; buildSliders(); update(doc.state); setStatus("", "driving with " + doc.state.drivers.join(", ")); loadCircuit();
     } catch (e) { setStatus("error", String(e)); }
   });
   document.getElementById("fk-all").addEventListener("click", async () => {
@@ -253,7 +266,7 @@ async function main() {
         `mode ${s.mode_number}: (${s.pose.position_len.map(x => fmt(x, 3)).join(", ")})${s.singular ? " singular" : ""}</button>`).join("");
       box.querySelectorAll("button").forEach(b => b.addEventListener("click", async () => {
         const d = await api("/api/mode", { mode_number: Number(b.dataset.mode) });
-        update(d.state); setStatus("", "moved to assembly mode " + b.dataset.mode + " (a branch change you asked for)");
+        update(d.state); setStatus("", "moved to assembly mode " + b.dataset.mode + " (a branch change you asked for)"); loadCircuit();
       }));
       setStatus("", doc.n_solutions + " assembly mode(s) found; mode 1 is the current one");
     } catch (e) { setStatus("error", String(e)); }
