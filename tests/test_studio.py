@@ -54,6 +54,9 @@ def test_drive_linkage3_from_p1_to_p7_follows_the_circuit_and_reports_dj_events(
     rot1 = [float(np.degrees(sm.Configuration(c.q, c.D).q[k_rot1])) for c in fits]  # offsets are 0 here
     start = ok(five_cs.get("/api/model"), validator)["state"]
     assert start["drivers"] == ["C1.rot"] and start["actuators_deg"]["C1.rot"] == pytest.approx(rot1[0], abs=1e-9)
+    sc = start["scene"]  # the folded coupler is drawn as a solid: the hull of its 5 S centres and the platform point
+    assert len(sc["platform_hull_len"]) == 6 and len(sc["hull_faces"]) == 8
+    assert {i for f in sc["hull_faces"] for i in f} == set(range(6))
     drivers = [mech.freedom(d).id for d in table.drivers]
     for k in range(1, len(fits)):
         events: list[str] = []
@@ -82,6 +85,7 @@ def test_drive_linkage3_from_p1_to_p7_follows_the_circuit_and_reports_dj_events(
 def test_drive_a_parallel_mechanism_checked_by_inverse_position(validator):
     c = TestClient(create_app(Session("stewart-6sps")))
     st = ok(c.get("/api/state"), validator)["state"]
+    assert st["scene"]["hull_faces"] == [] and len(st["scene"]["platform_len"]) == 7  # a planar hexagon
     legs = np.array(list(st["actuators_len"].values()))
     target = legs + np.array([0.04, -0.02, 0.03, 0.0, 0.05, -0.01])
     d = ok(c.post("/api/drive", json={"actuators": target.tolist()}), validator)

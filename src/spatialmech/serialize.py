@@ -214,6 +214,7 @@ UNIT_FREE_KEYS: dict[str, str] = {
     # table cells (their units are in the column titles)
     "rows": "table cells; the table's columns name their units",
     "dj_by_driver": "DJ of each candidate single driver at the studio's configuration, by name",
+    "hull_faces": "triangles of a convex hull, as index triples into its vertices (studio scene)",
     "joint_axes": "unit directions of a joint's axes (studio scene)",
     "limb_index": "index of a limb (from 0)",
     "mode_number": "assembly mode number (from 1)",

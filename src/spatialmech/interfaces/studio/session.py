@@ -83,6 +83,26 @@ class DriveResult:
                 "tracker_steps": self.steps, "elapsed_s": self.elapsed_s, **self.requested}
 
 
+def _platform_hull(ends: np.ndarray, point: np.ndarray) -> tuple[list, list]:
+    """A non-planar platform (its attachment points and the platform point not in one plane,
+    e.g. a 5-CS coupler) as the convex hull of those points: (vertices, triangles as index
+    triples); empty lists for a planar one (drawn as its polygon)."""
+    from scipy.spatial import ConvexHull, QhullError
+
+    pts = np.vstack([ends, point[None, :]])
+    if len(pts) < 4:
+        return [], []
+    c = pts - pts.mean(axis=0)
+    sv = np.linalg.svd(c, compute_uv=False)
+    if sv[2] <= 1e-3 * max(sv[0], 1e-300):  # planar (to a thousandth of its size)
+        return [], []
+    try:
+        hull = ConvexHull(pts)
+    except QhullError:
+        return [], []
+    return pts.tolist(), hull.simplices.tolist()
+
+
 def _is_rot(mech: Mechanism, fid: str) -> bool:
     return mech.freedom(fid).freedom.kind != "P"
 
@@ -270,6 +290,8 @@ class Session:
                     if not any(abs(float(v @ np.array(e))) > 1 - 1e-9 for e in dirs):
                         dirs.append(v.tolist())
                 joints.append({"name": joint.name, "type": joint.type, "limb_index": li, "joint_axes": dirs})
+        ends = [l[-1] for limb, l in zip(m.limbs, d.limbs, strict=True) if m.limb_tip(limb) == m.output]
+        hull_pts, faces = _platform_hull(np.array(ends).reshape(-1, 3), d.platform_point)
         centres = d.joints.tolist()
         for jd, p in zip(joints, centres, strict=True):
             jd["centre_len"] = p
@@ -279,6 +301,8 @@ class Session:
             "limb_colours": [LIMB_COLOURS[i % len(LIMB_COLOURS)] for i in range(len(m.limbs))],
             "base_len": d.base.tolist(),
             "platform_len": d.platform.tolist(),
+            "platform_hull_len": hull_pts,
+            "hull_faces": faces,
             "bodies_len": d.bodies.tolist(),
             "joints": joints,
             "platform_point_len": d.platform_point.tolist(),

@@ -75,7 +75,8 @@ function traces(sc) {
   const base = fan(sc.base_len);
   if (base) out.push({ type: "mesh3d", ...base, color: "#999999", opacity: 0.35, name: "base (ground)", hoverinfo: "skip", showlegend: true });
   out.push({ type: "scatter3d", mode: "lines", ...xyz(sc.base_len), line: { color: "#555555", width: 5 }, name: "base outline", showlegend: false });
-  const plat = fan(sc.platform_len);
+  const plat = sc.hull_faces.length ? { ...xyz(sc.platform_hull_len), i: sc.hull_faces.map(f => f[0]),
+    j: sc.hull_faces.map(f => f[1]), k: sc.hull_faces.map(f => f[2]) } : fan(sc.platform_len);
   if (plat) out.push({ type: "mesh3d", ...plat, color: "#ff7f0e", opacity: 0.4, name: "platform", hoverinfo: "skip", showlegend: true });
   out.push({ type: "scatter3d", mode: "lines", ...xyz(sc.platform_len), line: { color: "#ff7f0e", width: 6 }, name: "platform outline", showlegend: false });
   sc.limbs_len.forEach((pl, li) => out.push({ type: "scatter3d", mode: "lines", ...xyz(pl), line: { color: sc.limb_colours[li], width: 9 },
