@@ -411,6 +411,7 @@ class Session:
                   detect_closure=False, stop=stop)
         steps = len(r.points) - 1
         events = []
+        step_of: dict[int, int] = {}  # event -> index of the tracked point its step starts from
         own_crossed = None
         for e in r.events:
             if float(e.x[1]) > ell:  # in the overshoot of the last step: not on the way to the target
@@ -425,6 +426,7 @@ class Session:
                 ev["driver"] = e.name[3:]
                 ev["meaning"] = f"{e.name[3:]} could not drive through this point (its DJ changes sign)"
             events.append(ev)
+            step_of[id(ev)] = e.step
         reason = why["reason"]
         elapsed = lambda: time.perf_counter() - t_start  # noqa: E731
         if reason == "reached":
@@ -448,6 +450,8 @@ class Session:
                                          f"{res.residual:.2e}); stopped at the last closed configuration on the path",
                                          events, steps, elapsed, requested, with_actuators)
         if reason in ("dj", "turned") or own_crossed is not None:
+            # the configuration stays before the last step: the other drivers' events on it are not passed
+            events = [ev for ev in events if ev is own_crossed or step_of[id(ev)] < len(r.points) - 2]
             where = own_crossed or {}
             at = ", ".join(f"{k} = {v:.6g} deg" for k, v in where.get("actuators_deg", {}).items())
             at += ", ".join(f"{k} = {v:.6g} {m.length_unit}" for k, v in where.get("actuators_len", {}).items())
