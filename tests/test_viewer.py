@@ -4,6 +4,7 @@
 import json
 import math
 import re
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -327,9 +328,31 @@ def test_page_is_self_contained(tmp_path, motions):
     assert len(tags) >= 2 and not any("src=" in t for t in tags)  # every script is inline
     assert "plotly.js v" in page  # the library itself is in the page
     assert json.loads(json.dumps(info.to_dict())) == {"out": str(tmp_path / "b.html"), "frames": len(cs),
-                                                      "bytes": info.bytes}
+                                                      "bytes": info.bytes, "plotly": "inline"}
     div = viewer_html(mech, cs, full_html=False, include_plotlyjs=False)
     assert len(div) < 200_000 and "<html" not in div
+
+
+def test_smaller_pages_load_plotly_once_from_a_directory_or_the_cdn(tmp_path, motions):
+    """--plotly directory: two small pages share one plotly.min.js written next to them (it is
+    written once: its modification time does not change); cdn: a small page with one script
+    from cdn.plot.ly."""
+    mech, cs = motions["bennett"]
+    a = write_viewer(tmp_path / "a.html", mech, cs, plotly="directory")
+    js = tmp_path / "plotly.min.js"
+    stamp = js.stat().st_mtime_ns
+    b = write_viewer(tmp_path / "b.html", mech, cs, plotly="directory")
+    assert js.stat().st_mtime_ns == stamp and js.stat().st_size > 3_000_000 and "plotly.js v" in js.read_text()
+    for info in (a, b):
+        page = Path(info.out).read_text(encoding="utf-8")
+        assert info.plotly == "directory" and info.bytes < 1_000_000
+        srcs = [t for t in re.findall(r"<script[^>]*>", page) if "src=" in t]
+        assert len(srcs) == 1 and 'src="plotly.min.js"' in srcs[0]
+    c = write_viewer(tmp_path / "c.html", mech, cs, plotly="cdn")
+    srcs = [t for t in re.findall(r"<script[^>]*>", Path(c.out).read_text(encoding="utf-8")) if "src=" in t]
+    assert c.bytes < 1_000_000 and len(srcs) == 1 and "cdn.plot.ly" in srcs[0]
+    with pytest.raises(ValueError, match="plotly: expected one of inline, cdn, directory"):
+        write_viewer(tmp_path / "d.html", mech, cs, plotly="web")
 
 
 # ------------------------------------------------------------------ CLI
@@ -339,7 +362,7 @@ def test_cli_view_json(tmp_path):
     assert r.exit_code == 0, r.output
     d = json.loads(r.output)
     assert d == {"schema_version": "2", "command": "view", "model": "three-rrr-sm", "length_unit": "m",
-                 "out": str(out), "frames": 6, "bytes": out.stat().st_size, "motion": "demo"}
+                 "out": str(out), "frames": 6, "bytes": out.stat().st_size, "plotly": "inline", "motion": "demo"}
 
 
 @pytest.mark.slow

@@ -8,7 +8,8 @@ plots), always labelled; Euler sequences always named explicitly (``"ZXY"`` intr
 Every analysis by a short name (one page: docs/api.md; the functions are in
 :mod:`spatialmech.api`): ``sm.load_model``, ``sm.mobility``, ``sm.ik``, ``sm.fk``,
 ``sm.jacobian``, ``sm.velocity``, ``sm.singularity``, ``sm.workspace``, ``sm.parasitic``, ``sm.track``,
-``sm.defects``, ``sm.synth_rccc``, ``sm.synth_cs``, ``sm.report``, ``sm.view``.  Each takes a
+``sm.defects``, ``sm.synth_rccc``, ``sm.synth_cs``, ``sm.report``, ``sm.view``, ``sm.studio_session``,
+``sm.studio_app``.  Each takes a
 :class:`Mechanism`, a ready-made model name or a TOML file path, checks its arguments
 (``TypeError``, :class:`InputError`) and returns a result whose ``to_dict()`` is its JSON.
 
@@ -38,6 +39,8 @@ from .api import (
     parasitic,
     report,
     singularity,
+    studio_app,
+    studio_session,
     synth_cs,
     synth_rccc,
     track,
@@ -114,6 +117,8 @@ __all__ = [
     "report",
     "results",
     "singularity",
+    "studio_app",
+    "studio_session",
     "synth_cs",
     "synth_rccc",
     "track",

@@ -213,12 +213,20 @@ UNIT_FREE_KEYS: dict[str, str] = {
     "traced_arc": "arc length of a traced self-motion, nondimensional",
     # table cells (their units are in the column titles)
     "rows": "table cells; the table's columns name their units",
+    "dj_by_driver": "DJ of each candidate single driver at the studio's configuration, by name",
+    "hull_faces": "triangles of a convex hull, as index triples into its vertices (studio scene)",
+    "joint_axes": "unit directions of a joint's axes (studio scene)",
+    "limb_index": "index of a limb (from 0)",
+    "mode_number": "assembly mode number (from 1)",
+    "near_singular_below": "sigma_min below which the studio warns of a nearby singularity",
+    "port": "TCP port number",
+    "tracker_steps": "accepted continuation steps",
 }
 
 #: Unit-free keys that hold a map by name (actuator, limit, monomial) of unit-free numbers; any
 #: other object under a unit-free key names the units of its own fields.
 UNIT_FREE_MAPS: frozenset[str] = frozenset({"active_limits", "branch_point_arcs", "center_cubic", "circle_cubic",
-                                            "residuals", "sign_changes_after", "signs", "trace_sigma_min",
+                                            "residuals", "sign_changes_after", "dj_by_driver", "signs", "trace_sigma_min",
                                             "transmission"})
 
 #: Keys holding screws: ``(direction ; moment)`` 6-vectors (or matrices of them) whose direction

@@ -50,7 +50,7 @@ from .kinematics import (
 )
 from .linkages import CSSynthesisResult, TraceResult, defects, dj_table, synth_cs, synth_rccc, track
 from .outputs import VIEW_MOTIONS as VIEW_MOTIONS  # the motions view() animates
-from .outputs import ReportResult, ViewResult, report, view
+from .outputs import ReportResult, ViewResult, report, studio_app, studio_session, view
 from .structure import MobilityModes, load_model, mobility, mobility_modes, models
 
 __all__ = [
@@ -76,6 +76,8 @@ __all__ = [
     "parasitic",
     "report",
     "singularity",
+    "studio_app",
+    "studio_session",
     "synth_cs",
     "synth_rccc",
     "track",

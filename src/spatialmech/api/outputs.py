@@ -88,11 +88,13 @@ class ViewResult:
         return {**self.file.to_dict(), "motion": self.motion}
 
 
-def view(model: ModelLike, out, *, motion: str = "auto", frames: int = 60) -> ViewResult:
+def view(model: ModelLike, out, *, motion: str = "auto", frames: int = 60, plotly: str = "inline") -> ViewResult:
     """Write the interactive 3-D viewer of a model (one self-contained HTML file, opens
     offline) animated along a motion: ``"trace"`` (1 DOF: the whole circuit by continuation,
     with the zeros of DJ marked), ``"demo"`` (a short loop along the closure manifold, any
-    mobility) or ``"auto"`` (trace when the mechanism has one degree of freedom).
+    mobility) or ``"auto"`` (trace when the mechanism has one degree of freedom).  ``plotly``:
+    ``"inline"`` (plotly.js in the page), ``"cdn"`` (loaded from cdn.plot.ly: needs the network)
+    or ``"directory"`` (``plotly.min.js`` written once next to the page: small pages, offline).
 
     >>> import spatialmech as sm, tempfile, os
     >>> with tempfile.TemporaryDirectory() as d:
@@ -102,10 +104,11 @@ def view(model: ModelLike, out, *, motion: str = "auto", frames: int = 60) -> Vi
     """
     from ..analysis.traced_motion import traced_motion
     from ..kinematics.motion import sample_motion
-    from ..present.viewer import write_viewer
+    from ..present.viewer import PLOTLY_MODES, write_viewer
 
     mech = as_mechanism(model)
     motion = check_choice(motion, "motion", VIEW_MOTIONS)
+    plotly = check_choice(plotly, "plotly", PLOTLY_MODES)
     frames = check_int(frames, "frames", minimum=2)
     out = check_path(out, "out")
     if out.is_dir():
@@ -122,5 +125,41 @@ def view(model: ModelLike, out, *, motion: str = "auto", frames: int = 60) -> Vi
     else:
         configs = sample_motion(mech, n=frames)
         title = f"{mech.name}: a demonstration loop, {len(configs)} configurations (not the tracker)"
-    written = write_viewer(out, mech, configs, title=title, task_positions=mech.positions, singular_points=singular)
+    written = write_viewer(out, mech, configs, title=title, task_positions=mech.positions, singular_points=singular,
+                           plotly=plotly)
     return ViewResult(written, motion)
+
+
+# ============================================================================ design studio
+def studio_session(model: ModelLike = "five-cs-3"):
+    """A design-studio session on ``model`` (what ``spatialmech studio`` serves, without HTTP):
+    ``drive(values)`` moves the actuators (model units, degrees for rotations) along the current
+    branch by continuation and says how it went; ``state()`` is the readout (JSON payload,
+    docs/studio.md); ``set_drivers``, ``fk_all``, ``pick_mode``.
+
+    >>> import spatialmech as sm
+    >>> s = sm.studio_session("rssr")
+    >>> r = s.drive([10.0])                                  # the crank to 10 degrees
+    >>> r.status, round(s.state()["actuators_deg"]["A0.rot"], 9)
+    ('reached', 10.0)
+    """
+    from ..interfaces.studio.session import Session
+
+    return Session(as_mechanism(model))
+
+
+def studio_app(model: ModelLike = "five-cs-3"):
+    """The design studio's web app (FastAPI) on a new session: serve it with uvicorn, or call
+    its JSON API directly (docs/studio.md).
+
+    >>> import spatialmech as sm
+    >>> from fastapi.testclient import TestClient
+    >>> client = TestClient(sm.studio_app("rssr"))
+    >>> client.post("/api/drive", json={"actuators": [10.0]}).json()["status"]
+    'reached'
+    >>> client.post("/api/drive", json={"actuators": [1, 2]}).json()["error"]
+    'actuators: expected 1 values (A0.rot), got 2'
+    """
+    from ..interfaces.studio.app import create_app
+
+    return create_app(studio_session(model))

@@ -44,7 +44,7 @@ import numpy as np
 
 from ..errors import InputError
 
-__all__ = ["DEFAULT", "Tolerances", "characteristic_length", "current", "use"]
+__all__ = ["DEFAULT", "NEAR_SINGULAR", "Tolerances", "characteristic_length", "current", "use"]
 
 
 @dataclass(frozen=True)
@@ -143,6 +143,11 @@ class Tolerances:
 
 #: The tolerances used when none are given.
 DEFAULT = Tolerances()
+
+#: Scale-free smallest singular value of the complete Jacobian below which the design studio
+#: (``spatialmech studio``) warns that the configuration is near a singularity (colour warning);
+#: a reading aid, not a verdict (``singular`` above decides that).
+NEAR_SINGULAR = 0.02
 
 #: Points whose spread is below this, relative to their coordinates, are the same point (round-off).
 _SAME_POINT = 1e-13

@@ -47,9 +47,12 @@ class _Error(click.ClickException):
               help="The HTML file to write (self-contained: plotly.js is inlined, it opens offline).")
 @click.option("--frames", type=click.IntRange(min=2, max=MAX_FRAMES), default=60, show_default=True,
               help=f"Number of configurations (animation frames, at most {MAX_FRAMES}).")
+@click.option("--plotly", "plotly", type=click.Choice(["inline", "cdn", "directory"]), default="inline", show_default=True,
+              help="How the page gets plotly.js: inline (self-contained, ~4.8 MB, offline), cdn (small, needs the "
+                   "network), directory (small; plotly.min.js written once next to the page, offline).")
 @click.option("--json", "as_json", is_flag=True,
-              help="Print what was written (out, frames, bytes, motion) as JSON (docs/json.md).")
-def view(model, motion, out, frames, as_json):
+              help="Print what was written (out, frames, bytes, plotly, motion) as JSON (docs/json.md).")
+def view(model, motion, out, frames, plotly, as_json):
     """Write an interactive 3-D viewer of MODEL (base, platform, limbs, joint axes, task
     positions) animated along a motion, with a slider and play / pause buttons.
 
@@ -58,6 +61,7 @@ def view(model, motion, out, frames, as_json):
       spatialmech view four-sps-cu --out four-sps-cu.html
       spatialmech view five-cs-1 --frames 120 --out five-cs-1.html --json
       spatialmech view bennett --motion trace --out bennett.html
+      spatialmech view rssr --out pages/rssr.html --plotly directory
     """
     from ..analysis.traced_motion import traced_motion
     from ..kinematics.motion import sample_motion
@@ -83,7 +87,8 @@ def view(model, motion, out, frames, as_json):
     except ConvergenceError as e:
         raise _Error(str(e), code=1) from None
     try:
-        written = write_viewer(out, mech, configs, title=title, task_positions=mech.positions, singular_points=singular)
+        written = write_viewer(out, mech, configs, title=title, task_positions=mech.positions, singular_points=singular,
+                               plotly=plotly)
     except OSError as e:
         raise _Error(f"--out: cannot write {out}: {e.strerror or e}") from None
     if as_json:

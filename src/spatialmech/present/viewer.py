@@ -39,6 +39,7 @@ angles.  Example::
 from __future__ import annotations
 
 import html as _html
+import weakref
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -52,7 +53,8 @@ from ..geometry.validate import as_finite_array
 from ..kinematics.closure import Configuration, joint_points, joint_twists
 from ..model.mechanism import GROUND, Mechanism, Pose
 
-__all__ = ["DIV_ID", "SINGULAR_SYMBOL", "Drawing", "ViewerFile", "drawing", "viewer_figure", "viewer_html", "write_viewer"]
+__all__ = ["DIV_ID", "LIMB_COLOURS", "PLOTLY_MODES", "SINGULAR_SYMBOL", "Drawing", "ViewerFile", "drawing", "viewer_figure",
+           "viewer_html", "write_viewer"]
 
 #: ``id`` of the plotly graph ``<div>`` in the page (the browser test reads it).
 DIV_ID = "spatialmech-viewer"
@@ -70,7 +72,8 @@ COINCIDENT = 1e-9
 #: emoji that shows as an empty box without an emoji font; "cross" is the ASCII "+", which every
 #: font has (the task positions' "diamond" is U+25C6, in the basic Geometric Shapes block).
 SINGULAR_SYMBOL = "cross"
-_PALETTE = ("#1f77b4", "#2ca02c", "#9467bd", "#8c564b", "#e377c2", "#17becf", "#bcbd22", "#7f7f7f")
+#: Colours of the limbs, by limb index (cycled); the studio uses the same.
+LIMB_COLOURS = _PALETTE = ("#1f77b4", "#2ca02c", "#9467bd", "#8c564b", "#e377c2", "#17becf", "#bcbd22", "#7f7f7f")
 _FRAME_COLOURS = ("#d62728", "#2ca02c", "#1f77b4")  # platform frame x, y, z
 
 
@@ -120,16 +123,24 @@ class Drawing:
         }
 
 
+#: How a written page gets plotly.js: ``inline`` (in the page: one self-contained file that opens
+#: offline, about 4.8 MB), ``cdn`` (a ``<script>`` from cdn.plot.ly: a small page that needs the
+#: network), ``directory`` (a ``<script src="plotly.min.js">`` next to the page, the file copied
+#: there once: small pages that share it, offline).
+PLOTLY_MODES = ("inline", "cdn", "directory")
+
+
 @dataclass(frozen=True)
 class ViewerFile:
-    """What :func:`write_viewer` wrote."""
+    """What :func:`write_viewer` wrote (``plotly``: one of :data:`PLOTLY_MODES`)."""
 
     out: str
     frames: int
     bytes: int
+    plotly: str = "inline"
 
     def to_dict(self) -> dict:
-        return {"out": self.out, "frames": self.frames, "bytes": self.bytes}
+        return {"out": self.out, "frames": self.frames, "bytes": self.bytes, "plotly": self.plotly}
 
 
 # ---------------------------------------------------------------------------- geometry
@@ -192,10 +203,18 @@ def _attachments(mech: Mechanism, pts: list[np.ndarray], link: str) -> np.ndarra
     return np.array(out).reshape(-1, 3)
 
 
+_ORDERS: weakref.WeakKeyDictionary[Mechanism, np.ndarray] = weakref.WeakKeyDictionary()
+
+
 def _platform_order(mech: Mechanism) -> np.ndarray:
+    """The platform outline's corner order, from the reference configuration (cached per
+    mechanism: the studio redraws at every drag)."""
+    if mech in _ORDERS:
+        return _ORDERS[mech]
     ref = Configuration.reference(mech)
     last = _attachments(mech, joint_points(mech, ref), mech.output)
-    return _outline_order(last, mech.characteristic_length)
+    _ORDERS[mech] = order = _outline_order(last, mech.characteristic_length)
+    return order
 
 
 def drawing(mech: Mechanism, config: Configuration) -> Drawing:
@@ -479,11 +498,25 @@ def write_viewer(
     title: str | None = None,
     task_positions: Sequence[Pose] = (),
     singular_points: Sequence = (),
+    plotly: str = "inline",
 ) -> ViewerFile:
-    """Write :func:`viewer_html` (a full, self-contained page) to ``path`` (UTF-8)."""
+    """Write :func:`viewer_html` (a full page) to ``path`` (UTF-8); ``plotly`` says how the page
+    gets plotly.js (:data:`PLOTLY_MODES`; ``directory`` also writes ``plotly.min.js`` next to
+    the page unless the same file is there already)."""
+    if plotly not in PLOTLY_MODES:
+        raise InputError(f"plotly: expected one of {', '.join(PLOTLY_MODES)}, got {plotly!r}")
     configs = list(configs)
-    page = viewer_html(mech, configs, title=title, task_positions=task_positions, singular_points=singular_points)
+    include: bool | str = True if plotly == "inline" else plotly
+    page = viewer_html(mech, configs, title=title, task_positions=task_positions, singular_points=singular_points,
+                       include_plotlyjs=include)
     data = page.encode("utf-8")
     p = Path(path)
     p.write_bytes(data)
-    return ViewerFile(str(p), len(configs), len(data))
+    if plotly == "directory":
+        from plotly.offline import get_plotlyjs
+
+        js = get_plotlyjs().encode("utf-8")
+        target = p.parent / "plotly.min.js"
+        if not (target.is_file() and target.stat().st_size == len(js) and target.read_bytes() == js):
+            target.write_bytes(js)
+    return ViewerFile(str(p), len(configs), len(data), plotly)

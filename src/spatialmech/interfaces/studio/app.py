@@ -1,0 +1,172 @@
+"""The design studio's web app (FastAPI): the page, plotly.js from the installed plotly package
+(nothing from a CDN: it works offline), and a JSON API over one :class:`~.session.Session`.
+
+Every API answer is a JSON document with the envelope of docs/json.md (``command: "studio"``)
+and units in the field names; bad input answers 4xx with ``{"error": "<field>: ..."}``.
+
+=====================  ==================================================================
+``GET /api/model``     the model (``model_info``) and the current ``state``
+``GET /api/state``     the current ``state``
+``GET /api/circuit``   a 1-DOF model's traced circuit through the current configuration
+                       (``circuit_len``) and the DJ zeros of its driver (``dj_zeros_len``)
+``POST /api/drive``    ``{"actuators": [...]}`` (model units, degrees for rotations; a list in
+                       the order of ``drivers`` or a map by name): drive along the current
+                       branch; answers ``status``, ``message``, ``events`` and the new ``state``
+``POST /api/drivers``  ``{"drivers": [...]}``: switch the driving freedoms
+``POST /api/fk_all``   ``{"seeds": n}`` (optional): every assembly mode at the current values
+``POST /api/mode``     ``{"mode_number": k}``: move to mode k of the last ``fk_all``
+``POST /api/load``     ``{"model": "name or path"}``: another model
+=====================  ==================================================================
+
+Updates are answered by POST (the page sends the next slider value when the previous answer
+has arrived); there are no websockets.
+"""
+
+from __future__ import annotations
+
+import json
+import threading
+from importlib.resources import files
+from pathlib import Path
+
+from fastapi import FastAPI, Request
+from fastapi.responses import HTMLResponse, Response
+
+from ...errors import ConvergenceError, InputError
+from ...serialize import envelope, json_default
+from .session import Session
+
+__all__ = ["COMMAND", "create_app", "plotly_js_path"]
+
+#: The ``command`` of every API document (and of ``spatialmech studio --json``).
+COMMAND = "studio"
+
+
+def plotly_js_path() -> Path:
+    """``plotly.min.js`` shipped inside the installed plotly package."""
+    import plotly
+
+    p = Path(plotly.__file__).parent / "package_data" / "plotly.min.js"
+    if not p.is_file():  # pragma: no cover - a broken plotly installation
+        raise InputError(f"plotly: {p} is missing; reinstall plotly")
+    return p
+
+
+def _static(name: str) -> bytes:
+    return files("spatialmech.interfaces.studio").joinpath("static", name).read_bytes()
+
+
+def _json(doc: dict, status: int = 200) -> Response:
+    return Response(json.dumps(doc, default=json_default, allow_nan=False), status_code=status,
+                    media_type="application/json")
+
+
+def create_app(session: Session) -> FastAPI:
+    """The app over ``session`` (one model at a time, one user: each call holds a lock)."""
+    app = FastAPI(title="spatialmech studio", docs_url=None, redoc_url=None, openapi_url=None)
+    lock = threading.Lock()
+    app.state.session = session
+
+    def doc(payload: dict) -> dict:
+        m = session.mech
+        return envelope(COMMAND, m.name, payload, length_unit=m.length_unit)
+
+    def error(msg: str, status: int = 422) -> Response:
+        return _json({"error": msg}, status)
+
+    async def body(request: Request, required: str | None) -> dict:
+        raw = await request.body()
+        if not raw.strip():
+            if required:
+                raise InputError(f"body: expected a JSON object with {required!r}")
+            return {}
+        try:
+            data = json.loads(raw)
+        except ValueError as e:
+            raise InputError(f"body: not JSON ({e})") from None
+        if not isinstance(data, dict):
+            raise InputError(f"body: expected a JSON object, got {type(data).__name__}")
+        if required and required not in data:
+            raise InputError(f"{required}: missing from the body (got {', '.join(map(repr, data)) or 'nothing'})")
+        return data
+
+    def guarded(fn):
+        async def run(request: Request):
+            try:
+                return await fn(request)
+            except InputError as e:
+                return error(str(e))
+            except ConvergenceError as e:
+                return error(f"the computation failed: {e}", 409)
+        run.__name__ = fn.__name__
+        return run
+
+    @app.get("/", response_class=HTMLResponse)
+    def index():
+        return HTMLResponse(_static("index.html").decode("utf-8"))
+
+    @app.get("/favicon.ico")
+    def favicon():
+        return Response(status_code=204)
+
+    @app.get("/static/{name}")
+    def static(name: str):
+        types = {"studio.js": "text/javascript", "studio.css": "text/css"}
+        if name == "plotly.min.js":
+            return Response(plotly_js_path().read_bytes(), media_type="text/javascript",
+                            headers={"Cache-Control": "max-age=86400"})
+        if name not in types:
+            return error(f"name: no static file {name!r}", 404)
+        return Response(_static(name), media_type=types[name])
+
+    @app.get("/api/model")
+    def model():
+        with lock:
+            return _json(doc({"model_info": session.model_info(), "state": session.state()}))
+
+    @app.get("/api/state")
+    def state():
+        with lock:
+            return _json(doc({"state": session.state()}))
+
+    async def circuit(request: Request):
+        with lock:
+            return _json(doc(session.circuit()))
+
+    async def drive(request: Request):
+        data = await body(request, "actuators")
+        with lock:
+            r = session.drive(data["actuators"])
+            return _json(doc({**r.to_dict(), "state": session.state()}))
+
+    async def drivers(request: Request):
+        data = await body(request, "drivers")
+        with lock:
+            session.set_drivers(data["drivers"])
+            return _json(doc({"state": session.state()}))
+
+    async def fk_all(request: Request):
+        data = await body(request, None)
+        with lock:
+            sols = session.fk_all(data.get("seeds", 40))
+            return _json(doc({"n_solutions": len(sols), "solutions": sols}))
+
+    async def mode(request: Request):
+        data = await body(request, "mode_number")
+        with lock:
+            session.pick_mode(data["mode_number"])
+            return _json(doc({"state": session.state()}))
+
+    async def load(request: Request):
+        data = await body(request, "model")
+        if not isinstance(data["model"], str):
+            raise InputError(f"model: expected a model name or file path, got {data['model']!r}")
+        with lock:
+            session.load(data["model"])
+            return _json(doc({"model_info": session.model_info(), "state": session.state()}))
+
+    app.add_api_route("/api/circuit", guarded(circuit), methods=["GET"])
+    for path, fn in (("/api/drive", drive), ("/api/drivers", drivers), ("/api/fk_all", fk_all), ("/api/mode", mode),
+                     ("/api/load", load)):
+        app.add_api_route(path, guarded(fn), methods=["POST"])
+    return app

@@ -1,0 +1,529 @@
+"""The state of one design-studio session, without HTTP: a model, its current configuration, the
+chosen drivers, and the operations the page asks for.
+
+* :meth:`Session.drive` moves the actuators to new values by pseudo-arclength continuation along
+  the current branch (:class:`~spatialmech.kinematics.tracking.ActuatorPathProblem`), never by
+  a fresh Newton solve from somewhere else: the mechanism follows the assembly mode it is in.
+  It stops, and says so, when the chosen drivers lose control (their DJ changes sign, or the
+  path turns back in the actuator values: a dead point / direct singularity), when the tracker
+  cannot make a step (a bifurcation or a branch crossing), or when closure fails.  Sign changes
+  of DJ of the *other* candidate drivers are reported as events (the places where they could
+  not drive), the configuration moves on.
+* :meth:`Session.state` is the readout: actuator and joint values (degrees / length unit), the
+  output pose, DJ of the chosen drivers, the scale-free sigma_min of the complete Jacobian
+  with a near-singular flag (:data:`~spatialmech.geometry.tolerances.NEAR_SINGULAR`), and the
+  geometry the page draws.
+* :meth:`Session.set_drivers` switches the actuated freedoms (same count), :meth:`Session.fk_all`
+  runs the multi-start forward position at the current actuator values, :meth:`Session.pick_mode`
+  moves to one of the modes found (an explicit branch change).
+
+Values in and out are in the model's units with rotations in degrees (the edge of the
+library); inside, SI and radians.  Every method raises :class:`~spatialmech.errors.InputError`
+naming the field on bad input.  Not thread-safe: the web app holds a lock around each call.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ... import catalog
+from ...errors import ConvergenceError, InputError
+from ...geometry.tolerances import NEAR_SINGULAR, current
+from ...kinematics.closure import (
+    Configuration,
+    active_mask,
+    closure_residual,
+    correct,
+    generic_configuration,
+    joint_twists,
+)
+from ...kinematics.jacobian import complete_jacobian, driver_determinants
+from ...kinematics.position import forward_position, freedom_values, platform_pose
+from ...kinematics.tracking import ActuatorPathProblem, track
+from ...model.mechanism import Mechanism
+from ...present.viewer import LIMB_COLOURS, drawing
+from ...serialize import freedom_values_dict, pose_dict
+
+__all__ = ["DriveResult", "Session"]
+
+#: Drive statuses (the ``status`` field of ``POST /api/drive``).
+REACHED = "reached"  # the requested actuator values, on the same branch
+STOPPED_SINGULAR = "stopped_at_singularity"  # the drivers lost control: DJ zero / dead point ahead
+STOPPED_TRACKER = "stopped"  # the tracker could not step on (bifurcation, branch crossing, no closure)
+UNCHANGED = "unchanged"  # nothing to do (the values are the current ones)
+DRIVE_STATUSES = (REACHED, STOPPED_SINGULAR, STOPPED_TRACKER, UNCHANGED)
+
+#: Half-width of the slider ranges around the start values: rotations (degrees) and slides
+#: (in characteristic lengths).
+SLIDER_HALF_DEG = 360.0
+SLIDER_HALF_L = 1.0
+#: Largest number of tracker steps per drive (a drag is answered quickly or stops).
+MAX_STEPS = 400
+#: Default number of starts of fk_all (the ready-made models' modes are found with this many).
+FK_ALL_SEEDS = 40
+
+
+@dataclass(frozen=True)
+class DriveResult:
+    """What one drive did: ``status`` (one of :data:`DRIVE_STATUSES`), a sentence, the events
+    met (DJ sign changes, in the order met), the tracker steps and the time taken."""
+
+    status: str
+    message: str
+    events: tuple[dict, ...] = ()
+    steps: int = 0
+    elapsed_s: float = 0.0
+    requested: dict = field(default_factory=dict)
+
+    def to_dict(self) -> dict:
+        return {"status": self.status, "message": self.message, "events": list(self.events),
+                "tracker_steps": self.steps, "elapsed_s": self.elapsed_s, **self.requested}
+
+
+def _platform_hull(ends: np.ndarray, point: np.ndarray) -> tuple[list, list]:
+    """A non-planar platform (its attachment points and the platform point not in one plane,
+    e.g. a 5-CS coupler) as the convex hull of those points: (vertices, triangles as index
+    triples); empty lists for a planar one (drawn as its polygon)."""
+    from scipy.spatial import ConvexHull, QhullError
+
+    pts = np.vstack([ends, point[None, :]])
+    if len(pts) < 4:
+        return [], []
+    c = pts - pts.mean(axis=0)
+    sv = np.linalg.svd(c, compute_uv=False)
+    if sv[2] <= 1e-3 * max(sv[0], 1e-300):  # planar (to a thousandth of its size)
+        return [], []
+    try:
+        hull = ConvexHull(pts)
+    except QhullError:
+        return [], []
+    return pts.tolist(), hull.simplices.tolist()
+
+
+def _is_rot(mech: Mechanism, fid: str) -> bool:
+    return mech.freedom(fid).freedom.kind != "P"
+
+
+class Session:
+    """One studio session on ``model`` (a ready-made name, a TOML path or a Mechanism)."""
+
+    def __init__(self, model="five-cs-3"):
+        self.load(model)
+
+    # ------------------------------------------------------------------ model and start
+    def load(self, model) -> None:
+        """Load ``model`` and place it at its reference configuration (or, when that one is
+        singular, at a nearby generic one: the page says so in ``note``)."""
+        if not isinstance(model, (str, Mechanism)) and not hasattr(model, "__fspath__"):
+            raise InputError(f"model: expected a model name or a file path, got {type(model).__name__}")
+        mech = catalog.resolve(model)
+        if not mech.actuators:
+            raise InputError(f"model: {mech.name} has no actuators to drive")
+        if mech.is_metamorphic:
+            raise InputError(f"model: {mech.name} is metamorphic; the studio drives one motion mode (export it "
+                             "with 'spatialmech export MODEL FILE --mode M' and open the file)")
+        self.base = mech
+        self.mech = mech
+        self.note = ""
+        self.fk_modes: list = []
+        self.fk_branch: object = object()  # a new object whenever the branch is changed on purpose
+        self._circuit: dict = {}
+        self.history: list[np.ndarray] = []  # platform-point path, for the page's trail
+        c = Configuration.reference(mech)
+        L = mech.characteristic_length
+        if float(np.linalg.norm(closure_residual(mech, c))) > 1e-8 * max(1.0, L) or self._sigma(c) < NEAR_SINGULAR:
+            best, best_sigma, how = c, self._sigma(c), ""
+            for seed in range(6):  # the most regular of a few nearby generic configurations
+                for step in (0.3, 1.0):
+                    try:
+                        g = generic_configuration(mech, seed=seed, step=step, steps=3)
+                    except ConvergenceError:
+                        continue
+                    sg = self._sigma(g)
+                    if sg > best_sigma:
+                        best, best_sigma, how = g, sg, f"seed {seed}, step {step}"
+                if best_sigma >= 2 * NEAR_SINGULAR:
+                    break
+            if how:
+                c = best
+                self.note = ("the reference configuration is singular or open: started at a nearby, more regular "
+                             f"configuration (random steps along the closure, {how})")
+        self.config = c
+        self.start_values = self.actuator_values()
+        self.history = [self._platform_point(c)]
+
+    def _sigma(self, c: Configuration) -> float:
+        try:
+            return float(complete_jacobian(self.mech, c).sigma_min)
+        except InputError:
+            return 0.0
+
+    def _platform_point(self, c: Configuration) -> np.ndarray:
+        return c.D[:3, :3] @ self.mech.platform_point + c.D[:3, 3]
+
+    # ------------------------------------------------------------------ actuator values
+    def actuator_values(self, config: Configuration | None = None) -> np.ndarray:
+        """The current actuator values (SI, radians), in the order of ``mech.actuators``."""
+        c = self.config if config is None else config
+        vals = freedom_values(self.mech, c.q)
+        ids = [r.id for r in self.mech.freedom_refs]
+        return np.array([vals[ids.index(a)] for a in self.mech.actuators])
+
+    def _display(self, values: np.ndarray) -> dict:
+        return freedom_values_dict(self.mech, dict(zip(self.mech.actuators, values, strict=True)), "actuators")
+
+    def parse_actuators(self, values, name: str = "actuators") -> np.ndarray:
+        """Actuator values from the page (model units, degrees for rotations): a list in the
+        order of ``drivers`` or a map by freedom name; SI / radians out."""
+        acts = list(self.mech.actuators)
+        if isinstance(values, dict):
+            try:
+                given = {self.mech.freedom(k).id: v for k, v in values.items()}
+            except KeyError as e:
+                raise InputError(f"{name}: {e.args[0] if e.args else e}") from None
+            missing = [a for a in acts if a not in given]
+            extra = sorted(set(given) - set(acts))
+            if missing or extra:
+                raise InputError(f"{name}: expected values for exactly {', '.join(acts)}"
+                                 + (f"; missing {', '.join(missing)}" if missing else "")
+                                 + (f"; not driven: {', '.join(extra)}" if extra else ""))
+            values = [given[a] for a in acts]
+        if not isinstance(values, (list, tuple)):
+            raise InputError(f"{name}: expected a list of {len(acts)} numbers ({', '.join(acts)}), "
+                             f"got {type(values).__name__}")
+        if len(values) != len(acts):
+            raise InputError(f"{name}: expected {len(acts)} values ({', '.join(acts)}), got {len(values)}")
+        out = []
+        for k, (a, v) in enumerate(zip(acts, values, strict=True)):
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not np.isfinite(v):
+                raise InputError(f"{name}[{k}] ({a}): expected a finite number, got {v!r}")
+            out.append(np.radians(v) if _is_rot(self.mech, a) else float(v))
+        return np.array(out, dtype=float)
+
+    # ------------------------------------------------------------------ monitors
+    def _candidates(self) -> list[str]:
+        """Single drivers whose DJ is watched (a one-degree-of-freedom model: every unlocked
+        non-spherical freedom; otherwise none)."""
+        if len(self.mech.actuators) != 1:
+            return []
+        refs = self.mech.freedom_refs
+        out = []
+        for r in refs:
+            j = self.mech.limbs[r.limb].joints[r.joint]
+            if not r.freedom.locked and j.type not in ("S", "U"):
+                out.append(r.id)
+        return out
+
+    def _dj(self, c: Configuration, J=None) -> float | None:
+        """DJ of the chosen drivers: ``det`` of the complete Jacobian (one driver: the
+        sign-continuous driver determinant); ``None`` where it is not square."""
+        if len(self.mech.actuators) == 1:
+            v = float(driver_determinants(self.mech, c, list(self.mech.actuators))[0])
+        else:
+            d = (J if J is not None else complete_jacobian(self.mech, c)).det
+            v = float("nan") if d is None else float(d)
+        return v if np.isfinite(v) else None
+
+    def _dj_by_driver(self, c: Configuration) -> dict[str, float]:
+        cands = self._candidates()
+        if not cands:
+            return {}
+        vals = driver_determinants(self.mech, c, cands)
+        return {d: float(v) for d, v in zip(cands, vals, strict=True) if np.isfinite(v)}
+
+    # ------------------------------------------------------------------ readouts
+    def state(self) -> dict:
+        """The readout of the current configuration (JSON payload, docs/studio.md)."""
+        m, c = self.mech, self.config
+        a = self.actuator_values()
+        J = complete_jacobian(m, c)
+        sig = float(J.sigma_min)
+        pose = platform_pose(m, c)
+        vals = freedom_values(m, c.q)
+        joints = freedom_values_dict(m, {r.id: v for r, v in zip(m.freedom_refs, vals, strict=True)}, "joints")
+        lo = {}
+        half_len = SLIDER_HALF_L * m.characteristic_length
+        for aid, v0 in zip(m.actuators, self.start_values if len(self.start_values) == len(a) else a, strict=True):
+            lo[aid] = ((np.degrees(v0) - SLIDER_HALF_DEG, np.degrees(v0) + SLIDER_HALF_DEG) if _is_rot(m, aid)
+                       else (v0 - half_len, v0 + half_len))
+        return {
+            "mechanism": m.name,
+            "drivers": list(m.actuators),
+            "candidate_drivers": self._candidates(),
+            **self._display(a),
+            "slider_ranges_deg": {k: list(v) for k, v in lo.items() if _is_rot(m, k)},
+            "slider_ranges_len": {k: list(v) for k, v in lo.items() if not _is_rot(m, k)},
+            **joints,
+            "pose": pose_dict(pose.R, pose.p),
+            "dj": self._dj(c, J),
+            "dj_by_driver": self._dj_by_driver(c),
+            "sigma_min": sig,
+            "singular": bool(sig < current().singular),
+            "near_singular": bool(sig < NEAR_SINGULAR),
+            "near_singular_below": NEAR_SINGULAR,
+            "residual": float(np.linalg.norm(closure_residual(m, c))) / max(m.characteristic_length, 1e-300),
+            "note": self.note,
+            "scene": self.scene(),
+        }
+
+    def scene(self) -> dict:
+        """What the page draws (model length unit): limb polylines, base and platform outlines,
+        every joint with its type, limb and axis directions, the platform point and frame,
+        the platform point's trail, and the task positions."""
+        m, c = self.mech, self.config
+        d = drawing(m, c)
+        tw = joint_twists(m, c)
+        joints = []
+        for li, limb in enumerate(m.limbs):
+            refs = [r for r in m.freedom_refs if r.limb == li]
+            for j, joint in enumerate(limb.joints):
+                dirs: list[list[float]] = []
+                for k, r in enumerate(refs):
+                    if r.joint != j or joint.type == "S":
+                        continue
+                    t = tw[li][:, k]
+                    v = t[3:] if r.freedom.kind == "P" else t[:3]
+                    v = v / max(float(np.linalg.norm(v)), 1e-300)
+                    if not any(abs(float(v @ np.array(e))) > 1 - 1e-9 for e in dirs):
+                        dirs.append(v.tolist())
+                joints.append({"name": joint.name, "type": joint.type, "limb_index": li, "joint_axes": dirs})
+        ends = [l[-1] for limb, l in zip(m.limbs, d.limbs, strict=True) if m.limb_tip(limb) == m.output]
+        hull_pts, faces = _platform_hull(np.array(ends).reshape(-1, 3), d.platform_point)
+        centres = d.joints.tolist()
+        for jd, p in zip(joints, centres, strict=True):
+            jd["centre_len"] = p
+        return {
+            "limbs_len": [l.tolist() for l in d.limbs],
+            "limb_names": [l.name for l in m.limbs],
+            "limb_colours": [LIMB_COLOURS[i % len(LIMB_COLOURS)] for i in range(len(m.limbs))],
+            "base_len": d.base.tolist(),
+            "platform_len": d.platform.tolist(),
+            "platform_hull_len": hull_pts,
+            "hull_faces": faces,
+            "bodies_len": d.bodies.tolist(),
+            "joints": joints,
+            "platform_point_len": d.platform_point.tolist(),
+            "platform_frame": d.platform_frame.tolist(),
+            "scale_len": float(d.scale),
+            "trail_len": [p.tolist() for p in self.history[-400:]],
+            "task_positions_len": [pz.p.tolist() for pz in m.positions],
+        }
+
+    def model_info(self) -> dict:
+        """The model: name, description, limbs, freedoms with their kinds, the ready-made models."""
+        m = self.mech
+        return {
+            "mechanism": m.name,
+            "description": catalog.describe(m.name) if m.name in catalog.names() else "",
+            "limb_names": [l.name for l in m.limbs],
+            "freedoms": [{"name": r.id, "kind": r.freedom.kind, "locked": bool(r.freedom.locked)} for r in m.freedom_refs],
+            "ready_made": list(catalog.names()),
+            "task_positions": len(m.positions),
+        }
+
+    # ------------------------------------------------------------------ operations
+    def set_drivers(self, drivers) -> None:
+        """Drive with the freedoms ``drivers`` (names or aliases, as many as now)."""
+        if not isinstance(drivers, (list, tuple)) or not all(isinstance(x, str) for x in drivers):
+            raise InputError(f"drivers: expected a list of freedom names, got {drivers!r}")
+        n = len(self.base.actuators)
+        if len(drivers) != n:
+            raise InputError(f"drivers: {self.base.name} is driven by {n} freedom(s), got {len(drivers)}")
+        try:
+            ids = [self.base.freedom(x).id for x in drivers]
+        except KeyError as e:
+            raise InputError(f"drivers: {e.args[0] if e.args else e}") from None
+        if len(set(ids)) != len(ids):
+            raise InputError(f"drivers: repeated freedom in {list(drivers)}")
+        for i in ids:
+            if self.base.freedom(i).freedom.locked:
+                raise InputError(f"drivers: {i} is locked")
+        self.mech = self.base.with_actuators(ids)
+        self.start_values = self.actuator_values()
+
+    def drive(self, values, *, name: str = "actuators") -> DriveResult:
+        """Move the actuators to ``values`` (model units, degrees for rotations) along the
+        current branch (see the module docstring)."""
+        t_start = time.perf_counter()
+        m = self.mech
+        a1 = self.parse_actuators(values, name)
+        a0 = self.actuator_values()
+        requested = {f"requested_{k.split('_', 1)[1]}": v for k, v in self._display(a1).items()}
+        L = m.characteristic_length
+        rot = np.array([_is_rot(m, a) for a in m.actuators])
+        delta = a1 - a0
+        delta = np.where(rot, (delta + np.pi) % (2 * np.pi) - np.pi, delta)  # the short way round
+        nd = np.where(rot, delta, delta / L)
+        ell = float(np.linalg.norm(nd))
+        if ell < 1e-12:
+            return DriveResult(UNCHANGED, "already at these values", requested=requested,
+                               elapsed_s=time.perf_counter() - t_start)
+        prob = ActuatorPathProblem(m, lambda lam: a0 + (lam / ell) * delta, lambda lam: delta / ell)
+        act_idx = [[r.id for r in m.freedom_refs].index(a) for a in m.actuators]
+        offsets = np.array([m.freedom_refs[i].freedom.offset for i in act_idx])
+
+        def with_actuators(x) -> Configuration:
+            cfg, lam = x
+            q = cfg.q.copy()
+            q[act_idx] = a0 + (lam / ell) * delta - offsets
+            return cfg.with_q(q)
+
+        own0 = self._dj(self.config)
+        memo: dict = {}
+
+        def own_dj(x) -> float | None:  # evaluated once per tracked point (monitor and stop share it)
+            if memo.get("x") is not x:
+                memo["x"], memo["v"] = x, self._dj(with_actuators(x))
+            return memo["v"]
+
+        cands = self._candidates()
+        names = [f"DJ {d}" for d in cands if d not in m.actuators]
+        others = [d for d in cands if d not in m.actuators]
+        monitors = {}
+        if own0 is not None:
+            monitors["DJ (drivers)"] = lambda x: float(own_dj(x) or 0.0)
+        vector = ((names, lambda x: driver_determinants(m, with_actuators(x), others)) if others else None)
+        why = {"reason": ""}
+        lam_prev = [0.0]
+
+        def stop(x, s) -> bool:
+            lam = float(x[1])
+            if lam >= ell:
+                why["reason"] = "reached"
+                return True
+            if lam < lam_prev[0] - 1e-12:
+                why["reason"] = "turned"
+                return True
+            lam_prev[0] = lam
+            if own0 is not None:
+                v = own_dj(x)
+                if v is not None and np.sign(v) != np.sign(own0) and v != 0:
+                    why["reason"] = "dj"
+                    return True
+            return False
+
+        h = min(0.05, max(ell, 1e-6))
+        r = track(prob, (self.config, 0.0), direction=np.r_[np.zeros(prob.na + prob.nh), 1.0], h0=h, h_max=0.1,
+                  max_arc=200.0 * ell + 2.0, max_steps=MAX_STEPS, monitors=monitors, vector_monitor=vector,
+                  detect_closure=False, stop=stop)
+        steps = len(r.points) - 1
+        events = []
+        step_of: dict[int, int] = {}  # event -> index of the tracked point its step starts from
+        own_crossed = None
+        for e in r.events:
+            if float(e.x[1]) > ell:  # in the overshoot of the last step: not on the way to the target
+                continue
+            a_e = a0 + (float(e.x[1]) / ell) * delta
+            ev = {"name": e.name, "kind": str(e.kind), **self._display(a_e)}
+            if e.name == "DJ (drivers)":
+                own_crossed = ev
+                ev["driver"] = ", ".join(m.actuators)
+                ev["meaning"] = "the chosen drivers lose control here (DJ = 0): a dead point / direct singularity"
+            else:
+                ev["driver"] = e.name[3:]
+                ev["meaning"] = f"{e.name[3:]} could not drive through this point (its DJ changes sign)"
+            events.append(ev)
+            step_of[id(ev)] = e.step
+        reason = why["reason"]
+        elapsed = lambda: time.perf_counter() - t_start  # noqa: E731
+        if reason == "reached":
+            last = r.points[-1][0]
+            mask = active_mask(m)
+            for i in act_idx:
+                mask[i] = False
+            q = last.q.copy()
+            q[act_idx] = a1 - offsets
+            res = correct(m, last.with_q(q), active=mask, max_iter=30)
+            if res.converged:
+                fin = self._dj(res.config)
+                if own0 is not None and fin is not None and np.sign(fin) != np.sign(own0) and fin != 0:
+                    reason = "dj"
+                else:
+                    self._accept(res.config, r.points[1:])
+                    return DriveResult(REACHED, "reached the requested values along the current branch",
+                                       tuple(events), steps, elapsed(), requested)
+            else:
+                return self._stop_before(r, STOPPED_TRACKER, "closure failed at the requested values (residual "
+                                         f"{res.residual:.2e}); stopped at the last closed configuration on the path",
+                                         events, steps, elapsed, requested, with_actuators)
+        if reason in ("dj", "turned") or own_crossed is not None:
+            # the configuration stays before the last step: the other drivers' events on it are not passed
+            events = [ev for ev in events if ev is own_crossed or step_of[id(ev)] < len(r.points) - 2]
+            where = own_crossed or {}
+            at = ", ".join(f"{k} = {v:.6g} deg" for k, v in where.get("actuators_deg", {}).items())
+            at += ", ".join(f"{k} = {v:.6g} {m.length_unit}" for k, v in where.get("actuators_len", {}).items())
+            msg = ("the drivers lose control before the requested values (DJ of the drivers changes sign"
+                   + (f" at {at}" if at else "") + "): a dead point of this branch; stopped just before it "
+                   "(drive back, or switch drivers to pass it)")
+            if reason == "turned" and own_crossed is None:
+                msg = ("the path turns back in the actuator values (a dead point / direct singularity) before the "
+                       "requested values; stopped just before it (drive back, or switch drivers)")
+            return self._stop_before(r, STOPPED_SINGULAR, msg, events, steps, elapsed, requested, with_actuators)
+        if r.status == "max_arc" or steps >= MAX_STEPS:
+            msg = (f"moved part of the way ({steps} steps): the mechanism moves fast for these actuator values (near a "
+                   "singularity); drive again to go on")
+        else:
+            msg = f"the tracker stopped on this branch: {r.message}"
+        return self._stop_before(r, STOPPED_TRACKER, msg, events, steps, elapsed,
+                                 requested, with_actuators)
+
+    def _stop_before(self, r, status, msg, events, steps, elapsed, requested, with_actuators) -> DriveResult:
+        """Keep the last tracked point before the step that crossed (still on the branch)."""
+        pts = r.points
+        k = len(pts) - 2 if status == STOPPED_SINGULAR and len(pts) >= 2 else len(pts) - 1
+        if k > 0:
+            self._accept(with_actuators(pts[k]), pts[1 : k + 1])
+        return DriveResult(status, msg, tuple(events), steps, elapsed(), requested)
+
+    def _accept(self, config: Configuration, passed) -> None:
+        self.config = config
+        self.history.extend(self._platform_point(p[0]) for p in passed[-20:])
+        self.history.append(self._platform_point(config))
+        del self.history[:-400]
+
+    def circuit(self, frames: int = 240) -> dict:
+        """The whole circuit through the current configuration of a one-degree-of-freedom model
+        (the tracker, as ``view --motion trace``): the platform point along it and where DJ of
+        the chosen driver vanishes (its branch points).  Cached per driver and branch start."""
+        if len(self.mech.actuators) != 1:
+            raise InputError(f"circuit: {self.mech.name} is driven by {len(self.mech.actuators)} actuators; the traced "
+                             "circuit is drawn for one-degree-of-freedom linkages")
+        from ...analysis.traced_motion import traced_motion
+
+        key = (self.mech.actuators, id(self.fk_branch))
+        if self._circuit.get("key") != key:
+            configs, zeros = traced_motion(self.mech, frames=frames, start=self.config)
+            pts = [self._platform_point(c) for c in configs]
+            self._circuit = {"key": key, "circuit_len": [p.tolist() for p in pts],
+                             "dj_zeros_len": [self._platform_point(z).tolist() for z in zeros]}
+        return {k: v for k, v in self._circuit.items() if k != "key"}
+
+    def fk_all(self, seeds: int = FK_ALL_SEEDS) -> list[dict]:
+        """Every assembly mode a multi-start search finds at the current actuator values
+        (``fk --all``); the current configuration's mode is first."""
+        if isinstance(seeds, bool) or not isinstance(seeds, int) or not 1 <= seeds <= 2000:
+            raise InputError(f"seeds: expected a whole number of starts from 1 to 2000, got {seeds!r}")
+        res = forward_position(self.mech, self.actuator_values(), start=self.config, all_solutions=True, n_seeds=seeds)
+        self.fk_modes = [s for s in res.solutions if s.converged]
+        out = []
+        for k, s in enumerate(self.fk_modes):
+            out.append({"mode_number": k + 1, "kind": str(s.kind), "pose": pose_dict(s.pose.R, s.pose.p),
+                        "sigma_min": float(s.conditioning.sigma_min), "singular": bool(s.singular),
+                        "within_limits": not s.outside_limits})
+        return out
+
+    def pick_mode(self, number) -> None:
+        """Move to assembly mode ``number`` (from 1) of the last :meth:`fk_all` (an explicit
+        branch change)."""
+        if isinstance(number, bool) or not isinstance(number, int):
+            raise InputError(f"mode_number: expected a whole number, got {number!r}")
+        if not self.fk_modes:
+            raise InputError("mode_number: run fk_all first (POST /api/fk_all)")
+        if not 1 <= number <= len(self.fk_modes):
+            raise InputError(f"mode_number: expected 1 to {len(self.fk_modes)}, got {number}")
+        self.config = self.fk_modes[number - 1].config
+        self.fk_branch = object()
+        self.history = [self._platform_point(self.config)]

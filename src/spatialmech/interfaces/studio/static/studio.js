@@ -1,0 +1,277 @@
+// spatialmech studio page: draws what the server computes (the solver runs in the server).
+// Sliders post the actuator values to /api/drive; the next value is sent when the previous
+// answer has arrived (no websockets).  window.studio exposes the last state for tests.
+"use strict";
+
+const S = { state: null, circuit: null, unit: "", inFlight: false, pending: null, range: null, drawn: 0, errors: [] };
+window.studio = S;
+
+async function api(path, body) {
+  const opts = body === undefined ? {} : { method: "POST", headers: { "Content-Type": "application/json" }, body: JSON.stringify(body) };
+  const r = await fetch(path, opts);
+  const doc = await r.json();
+  if (!r.ok) throw new Error(doc.error || ("HTTP " + r.status));
+  return doc;
+}
+
+function fmt(x, d = 4) { return (x === null || x === undefined) ? "-" : Number(x).toPrecision(d); }
+
+// ------------------------------------------------------------------ shapes
+function sub(a, b) { return [a[0] - b[0], a[1] - b[1], a[2] - b[2]]; }
+function add(a, b) { return [a[0] + b[0], a[1] + b[1], a[2] + b[2]]; }
+function mul(a, s) { return [a[0] * s, a[1] * s, a[2] * s]; }
+function cross(a, b) { return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]; }
+function norm(a) { return Math.hypot(a[0], a[1], a[2]); }
+function unit(a) { const n = norm(a) || 1; return mul(a, 1 / n); }
+function perp(d) { const t = Math.abs(d[0]) < 0.9 ? [1, 0, 0] : [0, 1, 0]; return unit(cross(d, t)); }
+
+function Mesh() { return { x: [], y: [], z: [], i: [], j: [], k: [] }; }
+function vert(m, p) { m.x.push(p[0]); m.y.push(p[1]); m.z.push(p[2]); return m.x.length - 1; }
+function tri(m, a, b, c) { m.i.push(a); m.j.push(b); m.k.push(c); }
+
+function cylinder(m, c, d, r, h, n = 12) {  // closed cylinder centred on c along unit d
+  const u = perp(d), v = cross(d, u), a = add(c, mul(d, -h / 2)), b = add(c, mul(d, h / 2));
+  const ia = [], ib = [];
+  for (let s = 0; s < n; s++) {
+    const t = 2 * Math.PI * s / n, o = add(mul(u, r * Math.cos(t)), mul(v, r * Math.sin(t)));
+    ia.push(vert(m, add(a, o))); ib.push(vert(m, add(b, o)));
+  }
+  const ca = vert(m, a), cb = vert(m, b);
+  for (let s = 0; s < n; s++) {
+    const s2 = (s + 1) % n;
+    tri(m, ia[s], ia[s2], ib[s]); tri(m, ib[s], ia[s2], ib[s2]);
+    tri(m, ca, ia[s2], ia[s]); tri(m, cb, ib[s], ib[s2]);
+  }
+}
+
+function sphere(m, c, r, n = 8) {
+  const idx = [];
+  for (let a = 0; a <= n; a++) {
+    const th = Math.PI * a / n, row = [];
+    for (let b = 0; b < 2 * n; b++) {
+      const ph = Math.PI * b / n;
+      row.push(vert(m, [c[0] + r * Math.sin(th) * Math.cos(ph), c[1] + r * Math.sin(th) * Math.sin(ph), c[2] + r * Math.cos(th)]));
+    }
+    idx.push(row);
+  }
+  for (let a = 0; a < n; a++) for (let b = 0; b < 2 * n; b++) {
+    const b2 = (b + 1) % (2 * n);
+    tri(m, idx[a][b], idx[a + 1][b], idx[a][b2]); tri(m, idx[a][b2], idx[a + 1][b], idx[a + 1][b2]);
+  }
+}
+
+function xyz(pts) { return { x: pts.map(p => p[0]), y: pts.map(p => p[1]), z: pts.map(p => p[2]) }; }
+
+function fan(pts) {  // a closed outline (last = first) as a translucent polygon
+  const P = pts.slice(0, -1), m = Mesh();
+  if (P.length < 3) return null;
+  P.forEach(p => vert(m, p));
+  for (let q = 1; q + 1 < P.length; q++) tri(m, 0, q, q + 1);
+  return m;
+}
+
+function traces(sc) {
+  const s = sc.scale_len, out = [];
+  const base = fan(sc.base_len);
+  if (base) out.push({ type: "mesh3d", ...base, color: "#999999", opacity: 0.35, name: "base (ground)", hoverinfo: "skip", showlegend: true });
+  out.push({ type: "scatter3d", mode: "lines", ...xyz(sc.base_len), line: { color: "#555555", width: 5 }, name: "base outline", showlegend: false });
+  const plat = sc.hull_faces.length ? { ...xyz(sc.platform_hull_len), i: sc.hull_faces.map(f => f[0]),
+    j: sc.hull_faces.map(f => f[1]), k: sc.hull_faces.map(f => f[2]) } : fan(sc.platform_len);
+  if (plat) out.push({ type: "mesh3d", ...plat, color: "#ff7f0e", opacity: 0.4, name: "platform", hoverinfo: "skip", showlegend: true });
+  out.push({ type: "scatter3d", mode: "lines", ...xyz(sc.platform_len), line: { color: "#ff7f0e", width: 6 }, name: "platform outline", showlegend: false });
+  sc.limbs_len.forEach((pl, li) => out.push({ type: "scatter3d", mode: "lines", ...xyz(pl), line: { color: sc.limb_colours[li], width: 9 },
+    name: "limb " + sc.limb_names[li] }));
+  if (sc.bodies_len.length) {
+    const pts = []; sc.bodies_len.forEach(sg => { pts.push(sg[0], sg[1], [null, null, null]); });
+    out.push({ type: "scatter3d", mode: "lines", ...xyz(pts), line: { color: "#7f7f7f", width: 9 }, name: "internal bodies" });
+  }
+  const shapes = sc.limb_names.map(() => Mesh());
+  sc.joints.forEach(j => {
+    const m = shapes[j.limb_index], c = j.centre_len;
+    if (j.type === "S") { sphere(m, c, 0.06 * s); return; }
+    j.joint_axes.forEach(d => {
+      if (j.type === "P") cylinder(m, c, d, 0.025 * s, 0.5 * s, 6);
+      else if (j.type === "C") cylinder(m, c, d, 0.04 * s, 0.45 * s);
+      else cylinder(m, c, d, 0.05 * s, 0.25 * s);
+    });
+  });
+  shapes.forEach((m, li) => { if (m.i.length) out.push({ type: "mesh3d", ...m, color: sc.limb_colours[li], opacity: 1.0, flatshading: true,
+    name: "joints of " + sc.limb_names[li], hoverinfo: "skip", showlegend: false }); });
+  const names = sc.joints.map(j => j.name + " (" + j.type + ")");
+  out.push({ type: "scatter3d", mode: "markers", ...xyz(sc.joints.map(j => j.centre_len)), marker: { size: 2, color: "#222" },
+    text: names, hovertemplate: "%{text}<extra></extra>", name: "joint centres", showlegend: false });
+  const cols = ["#d62728", "#2ca02c", "#1f77b4"], p = sc.platform_point_len;
+  [0, 1, 2].forEach(a => {
+    const e = add(p, mul([sc.platform_frame[0][a], sc.platform_frame[1][a], sc.platform_frame[2][a]], 0.3 * s));
+    out.push({ type: "scatter3d", mode: "lines", ...xyz([p, e]), line: { color: cols[a], width: 6 }, name: "platform frame", showlegend: a === 0 });
+  });
+  if (S.circuit && S.circuit.circuit_len.length > 1) {
+    out.push({ type: "scatter3d", mode: "lines", ...xyz(S.circuit.circuit_len), line: { color: "#888888", width: 2 },
+      name: "traced circuit", hoverinfo: "skip" });
+    if (S.circuit.dj_zeros_len.length) out.push({ type: "scatter3d", mode: "markers", ...xyz(S.circuit.dj_zeros_len),
+      marker: { size: 6, color: "#d62728", symbol: "cross" }, name: "DJ zeros of " + S.state.drivers[0] });
+  }
+  if (sc.trail_len.length > 1) out.push({ type: "scatter3d", mode: "lines", ...xyz(sc.trail_len), line: { color: "#ff7f0e", width: 2, dash: "dot" }, name: "platform point path" });
+  if (sc.task_positions_len.length) out.push({ type: "scatter3d", mode: "markers+text", ...xyz(sc.task_positions_len),
+    text: sc.task_positions_len.map((_, k) => "P" + (k + 1)), marker: { size: 4, color: "#000", symbol: "diamond" }, name: "task positions" });
+  return out;
+}
+
+function sceneRange(sc) {
+  const pts = [].concat(sc.base_len, sc.platform_len, sc.task_positions_len, ...sc.limbs_len, sc.joints.map(j => j.centre_len));
+  const lo = [0, 1, 2].map(a => Math.min(...pts.map(p => p[a]))), hi = [0, 1, 2].map(a => Math.max(...pts.map(p => p[a])));
+  const half = Math.max(...[0, 1, 2].map(a => hi[a] - lo[a])) / 2 + 0.8 * sc.scale_len;
+  return [0, 1, 2].map(a => [(lo[a] + hi[a]) / 2 - half, (lo[a] + hi[a]) / 2 + half]);
+}
+
+function draw() {
+  const sc = S.state.scene;
+  if (!S.range) S.range = sceneRange(sc);
+  const ax = (r, n) => ({ range: r, autorange: false, title: n + " [" + S.unit + "]" });
+  const layout = { uirevision: "studio", margin: { l: 0, r: 0, t: 30, b: 0 }, title: S.state.mechanism,
+    scene: { aspectmode: "cube", xaxis: ax(S.range[0], "x"), yaxis: ax(S.range[1], "y"), zaxis: ax(S.range[2], "z") },
+    legend: { itemsizing: "constant" } };
+  Plotly.react("plot", traces(sc), layout, { displaylogo: false, responsive: true });
+  S.drawn += 1;
+}
+
+// ------------------------------------------------------------------ controls and readouts
+function actuatorEntries(st) {
+  return st.drivers.map(d => (d in st.actuators_deg)
+    ? { name: d, value: st.actuators_deg[d], unit: "deg", range: st.slider_ranges_deg[d] }
+    : { name: d, value: st.actuators_len[d], unit: S.unit, range: st.slider_ranges_len[d] });
+}
+
+function buildSliders() {
+  const box = document.getElementById("sliders");
+  box.innerHTML = "";
+  actuatorEntries(S.state).forEach((a, k) => {
+    const div = document.createElement("div");
+    div.className = "slider";
+    const step = a.unit === "deg" ? 0.1 : (a.range[1] - a.range[0]) / 2000;
+    div.innerHTML = `<label for="slider-${k}">${a.name} [${a.unit}]: <span id="slider-val-${k}"></span></label>` +
+      `<input type="range" id="slider-${k}" data-index="${k}" min="${a.range[0]}" max="${a.range[1]}" step="${step}" value="${a.value}">`;
+    box.appendChild(div);
+    div.querySelector("input").addEventListener("input", onSlide);
+  });
+  syncSliders();
+}
+
+function syncSliders() {
+  actuatorEntries(S.state).forEach((a, k) => {
+    const el = document.getElementById("slider-" + k);
+    if (!el) return;
+    el.value = a.value;
+    document.getElementById("slider-val-" + k).textContent = fmt(a.value, 6) + " " + a.unit;
+  });
+}
+
+function sliderValues() { return actuatorEntries(S.state).map((_, k) => Number(document.getElementById("slider-" + k).value)); }
+
+function onSlide() { S.pending = sliderValues(); pump(); }
+
+async function pump() {
+  if (S.inFlight || S.pending === null) return;
+  const values = S.pending; S.pending = null; S.inFlight = true;
+  try {
+    const doc = await api("/api/drive", { actuators: values });
+    setStatus(doc.status === "reached" || doc.status === "unchanged" ? "" : "stopped", doc.status + ": " + doc.message);
+    doc.events.forEach(e => logEvent(e));
+    update(doc.state);
+    if (doc.status !== "reached" && doc.status !== "unchanged") { S.pending = null; syncSliders(); }
+  } catch (e) { setStatus("error", String(e)); }
+  S.inFlight = false;
+  if (S.pending !== null) pump(); else syncSliders();
+}
+
+function setStatus(cls, text) { const el = document.getElementById("status"); el.className = "status " + cls; el.textContent = text; }
+
+function logEvent(e) {
+  const li = document.createElement("li");
+  const vals = Object.entries(e.actuators_deg).map(([k, v]) => k + " = " + fmt(v, 6) + " deg")
+    .concat(Object.entries(e.actuators_len).map(([k, v]) => k + " = " + fmt(v, 6) + " " + S.unit));
+  li.textContent = e.name + " (" + e.kind + ") at " + vals.join(", ") + ": " + e.meaning;
+  const ol = document.getElementById("events"); ol.insertBefore(li, ol.firstChild);
+}
+
+function update(st) {
+  S.state = st;
+  const sig = st.sigma_min, cls = st.singular ? "sing" : (st.near_singular ? "near" : "ok");
+  const p = st.pose, rows = [
+    ["output point [" + S.unit + "]", p.position_len.map(x => fmt(x, 5)).join(", ")],
+    ["orientation " + p.euler_sequence + " [deg]", p.euler_deg.map(x => fmt(x, 5)).join(", ")],
+    ["DJ of the drivers", fmt(st.dj, 5)],
+    ["sigma_min (complete J)", `<span id="sigma" class="${cls}">${fmt(sig, 4)}</span>` +
+      (st.singular ? " singular" : st.near_singular ? " near a singularity (< " + st.near_singular_below + ")" : "")],
+    ["closure residual", fmt(st.residual, 3)],
+  ];
+  rows.unshift(...actuatorEntries(st).map(a => [a.name + " [" + a.unit + "]", fmt(a.value, 7)]));
+  document.getElementById("readouts").innerHTML = rows.map(r => `<tr><td>${r[0]}</td><td>${r[1]}</td></tr>`).join("");
+  const j = Object.entries(st.joints_deg).map(([k, v]) => [k, fmt(v, 6) + " deg"])
+    .concat(Object.entries(st.joints_len).map(([k, v]) => [k, fmt(v, 6) + " " + S.unit]));
+  document.getElementById("joints").innerHTML = j.map(r => `<tr><td>${r[0]}</td><td>${r[1]}</td></tr>`).join("");
+  document.getElementById("note").textContent = st.note;
+  syncSliders();
+  draw();
+}
+
+function fillDrivers(st) {
+  const sel = document.getElementById("driver-select");
+  const opts = st.candidate_drivers.length ? st.candidate_drivers : [st.drivers.join(",")];
+  sel.innerHTML = opts.map(o => `<option value="${o}"${st.drivers.join(",") === o ? " selected" : ""}>${o}</option>`).join("");
+  document.getElementById("driver-apply").disabled = st.candidate_drivers.length === 0;
+}
+
+async function loadDoc(doc) {
+  S.unit = doc.length_unit || "";
+  S.range = null;
+  document.getElementById("description").textContent = doc.model_info.description;
+  const sel = document.getElementById("model-select");
+  sel.innerHTML = doc.model_info.ready_made.map(n => `<option${n === doc.model ? " selected" : ""}>${n}</option>`).join("");
+  if (!doc.model_info.ready_made.includes(doc.model)) sel.insertAdjacentHTML("afterbegin", `<option selected>${doc.model}</option>`);
+  document.getElementById("events").innerHTML = "";
+  document.getElementById("modes").innerHTML = "";
+  S.state = doc.state;
+  fillDrivers(doc.state);
+  buildSliders();
+  update(doc.state);
+  setStatus("", "ready: drag a slider");
+  loadCircuit();
+}
+
+async function loadCircuit() {  // one-degree-of-freedom models: the traced circuit, drawn when it arrives
+  S.circuit = null;
+  if (S.state.drivers.length !== 1) return;
+  try { S.circuit = await api("/api/circuit"); draw(); } catch (e) { S.circuit = null; }
+}
+
+async function main() {
+  window.addEventListener("error", e => S.errors.push(String(e.message)));
+  loadDoc(await api("/api/model"));
+  document.getElementById("model-select").addEventListener("change", async ev => {
+    setStatus("", "loading " + ev.target.value + " ...");
+    try { loadDoc(await api("/api/load", { model: ev.target.value })); } catch (e) { setStatus("error", String(e)); }
+  });
+  document.getElementById("driver-apply").addEventListener("click", async () => {
+    try {
+      const doc = await api("/api/drivers", { drivers: document.getElementById("driver-select").value.split(",") });
+      S.state = doc.state; buildSliders(); update(doc.state); setStatus("", "driving with " + doc.state.drivers.join(", ")); loadCircuit();
+    } catch (e) { setStatus("error", String(e)); }
+  });
+  document.getElementById("fk-all").addEventListener("click", async () => {
+    setStatus("", "searching assembly modes ...");
+    try {
+      const doc = await api("/api/fk_all", {});
+      const box = document.getElementById("modes");
+      box.innerHTML = doc.solutions.map(s => `<button data-mode="${s.mode_number}" title="sigma_min ${fmt(s.sigma_min, 3)}">` +
+        `mode ${s.mode_number}: (${s.pose.position_len.map(x => fmt(x, 3)).join(", ")})${s.singular ? " singular" : ""}</button>`).join("");
+      box.querySelectorAll("button").forEach(b => b.addEventListener("click", async () => {
+        const d = await api("/api/mode", { mode_number: Number(b.dataset.mode) });
+        update(d.state); setStatus("", "moved to assembly mode " + b.dataset.mode + " (a branch change you asked for)"); loadCircuit();
+      }));
+      setStatus("", doc.n_solutions + " assembly mode(s) found; mode 1 is the current one");
+    } catch (e) { setStatus("error", String(e)); }
+  });
+}
+
+main().catch(e => { S.errors.push(String(e)); setStatus("error", String(e)); });

@@ -1,0 +1,194 @@
+"""The design studio's HTTP API (issue 16), called through FastAPI's TestClient: the answers are
+checked against the library (the task positions fitted by ``dj_table``, inverse position, the
+closure residual) and against the studio's JSON Schema and the unit rule of docs/json.md."""
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+from fastapi.testclient import TestClient
+from jsonschema import Draft202012Validator
+from referencing import Registry, Resource
+
+import spatialmech as sm
+from spatialmech import catalog
+from spatialmech.interfaces.cli import cli
+from spatialmech.interfaces.common import load_schema
+from spatialmech.interfaces.studio.app import create_app
+from spatialmech.interfaces.studio.session import Session
+from spatialmech.kinematics.closure import closure_residual
+from spatialmech.serialize import unit_rule_violations
+
+
+@pytest.fixture(scope="module")
+def validator():
+    common = load_schema("common")
+    reg = Registry().with_resource(common["$id"], Resource.from_contents(common))
+    return Draft202012Validator(load_schema("studio"), registry=reg)
+
+
+def ok(r, validator) -> dict:
+    assert r.status_code == 200, r.text
+    doc = r.json()
+    assert doc["command"] == "studio" and doc["schema_version"] == "2"
+    errors = [(list(e.absolute_path), e.message[:200]) for e in validator.iter_errors(doc)]
+    assert not errors, errors[:3]
+    assert unit_rule_violations(doc) == []
+    return doc
+
+
+@pytest.fixture(scope="module")
+def five_cs():
+    return TestClient(create_app(Session("five-cs-3")))
+
+
+@pytest.fixture(scope="module")
+def table():
+    return sm.dj_table("five-cs-3")
+
+
+def test_drive_linkage3_from_p1_to_p7_follows_the_circuit_and_reports_dj_events(five_cs, table, validator):
+    mech = catalog.build("five-cs-3")
+    ids = [r.id for r in mech.freedom_refs]
+    k_rot1 = ids.index("C1.rot")
+    fits = [f.config for f in table.fits]
+    rot1 = [float(np.degrees(sm.Configuration(c.q, c.D).q[k_rot1])) for c in fits]  # offsets are 0 here
+    start = ok(five_cs.get("/api/model"), validator)["state"]
+    assert start["drivers"] == ["C1.rot"] and start["actuators_deg"]["C1.rot"] == pytest.approx(rot1[0], abs=1e-9)
+    sc = start["scene"]  # the folded coupler is drawn as a solid: the hull of its 5 S centres and the platform point
+    assert len(sc["platform_hull_len"]) == 6 and len(sc["hull_faces"]) == 8
+    assert {i for f in sc["hull_faces"] for i in f} == set(range(6))
+    drivers = [mech.freedom(d).id for d in table.drivers]
+    for k in range(1, len(fits)):
+        events: list[str] = []
+        for target in np.linspace(rot1[k - 1], rot1[k], 3)[1:]:  # two drags per stretch
+            d = ok(five_cs.post("/api/drive", json={"actuators": [float(target)]}), validator)
+            assert d["status"] == "reached", d["message"]
+            events += [e["driver"] for e in d["events"]]
+            st = d["state"]
+            assert st["actuators_deg"]["C1.rot"] == pytest.approx(target, abs=1e-9)
+            assert st["residual"] < 1e-9
+        # at P(k+1): the pose of the fitted configuration, i.e. the same circuit, not another branch
+        pose = st["pose"]
+        D = fits[k].D
+        p_fit = D[:3, :3] @ mech.platform_point + D[:3, 3]
+        assert np.allclose(pose["position_len"], p_fit, atol=1e-7)
+        assert np.allclose(pose["rotation_matrix"], D[:3, :3], atol=1e-7)
+        # every sign change of another driver's DJ between the positions is reported (parity)
+        for i, drv in enumerate(drivers):
+            if drv == "C1.rot":
+                continue
+            changed = bool(table.signs[i, k - 1] != table.signs[i, k])
+            assert (events.count(drv) % 2 == 1) == changed, (k, drv, events)
+    assert table.keeps_sign("rot1") and not any(e.startswith("C1.rot") for e in events)
+
+
+def test_drive_a_parallel_mechanism_checked_by_inverse_position(validator):
+    c = TestClient(create_app(Session("stewart-6sps")))
+    st = ok(c.get("/api/state"), validator)["state"]
+    assert st["scene"]["hull_faces"] == [] and len(st["scene"]["platform_len"]) == 7  # a planar hexagon
+    legs = np.array(list(st["actuators_len"].values()))
+    target = legs + np.array([0.04, -0.02, 0.03, 0.0, 0.05, -0.01])
+    d = ok(c.post("/api/drive", json={"actuators": target.tolist()}), validator)
+    assert d["status"] == "reached" and d["events"] == []
+    s = d["state"]
+    assert np.allclose(list(s["actuators_len"].values()), target, atol=1e-12)
+    pose = (s["pose"]["position_len"], np.array(s["pose"]["rotation_matrix"]))
+    inv = sm.ik("stewart-6sps", pose)  # the legs of the returned pose, by inverse position
+    assert inv.reachable and np.allclose(list(inv.actuators.values()), target, atol=1e-8)
+    # by name, in the model's units, with a map
+    named = {k: v - 0.01 for k, v in s["actuators_len"].items()}
+    d2 = ok(c.post("/api/drive", json={"actuators": named}), validator)
+    assert d2["status"] == "reached" and d2["state"]["actuators_len"] == pytest.approx(named, abs=1e-12)
+    modes = ok(c.post("/api/fk_all", json={"seeds": 12}), validator)
+    assert modes["n_solutions"] >= 1 and modes["solutions"][0]["mode_number"] == 1
+    back = ok(c.post("/api/mode", json={"mode_number": 1}), validator)["state"]
+    assert np.allclose(back["pose"]["position_len"], modes["solutions"][0]["pose"]["position_len"], atol=1e-9)
+
+
+def test_a_rocker_driven_past_its_dead_point_stops_before_it(validator):
+    session = Session("rssr")
+    c = TestClient(create_app(session))
+    st = ok(c.post("/api/drivers", json={"drivers": ["B0.rot"]}), validator)["state"]
+    assert st["drivers"] == ["B0.rot"] and set(st["candidate_drivers"]) == {"A0.rot", "B0.rot"}
+    dj0 = st["dj"]
+    a0 = st["actuators_deg"]["B0.rot"]
+    d = ok(c.post("/api/drive", json={"actuators": [a0 + 170.0]}), validator)
+    assert d["status"] == "stopped_at_singularity", d["message"]
+    assert any(e["name"] == "DJ (drivers)" for e in d["events"]) or "turns back" in d["message"]
+    s = d["state"]
+    assert np.sign(s["dj"]) == np.sign(dj0)  # still on the branch it started on
+    assert a0 < s["actuators_deg"]["B0.rot"] < a0 + 170.0
+    assert np.linalg.norm(closure_residual(session.mech, session.config)) < 1e-9
+    # driving back works from there
+    back = ok(c.post("/api/drive", json={"actuators": [a0]}), validator)
+    assert back["status"] == "reached"
+
+
+@pytest.mark.parametrize("path, body, field", [
+    ("/api/drive", {"actuators": [1.0, 2.0]}, "actuators"),
+    ("/api/drive", {"actuators": ["x"]}, "actuators[0]"),
+    ("/api/drive", {"actuators": {"nope": 1.0}}, "actuators"),
+    ("/api/drive", {"actuator": [1.0]}, "actuators"),
+    ("/api/drive", [1.0], "body"),
+    ("/api/drivers", {"drivers": ["C9.rot"]}, "drivers"),
+    ("/api/drivers", {"drivers": "C1.rot"}, "drivers"),
+    ("/api/fk_all", {"seeds": 0}, "seeds"),
+    ("/api/load", {"model": "no-such-model"}, "no-such-model"),
+])
+def test_bad_bodies_answer_4xx_naming_the_field(five_cs, path, body, field):
+    before = five_cs.get("/api/state").json()["state"]["actuators_deg"]
+    r = five_cs.post(path, json=body)
+    assert 400 <= r.status_code < 500 and r.json()["error"].startswith(field), r.text
+    assert five_cs.get("/api/state").json()["state"]["actuators_deg"] == before  # nothing moved
+
+
+def test_not_json_and_mode_before_fk_all(five_cs):
+    r = five_cs.post("/api/drive", content=b"{oops", headers={"Content-Type": "application/json"})
+    assert r.status_code == 422 and r.json()["error"].startswith("body: not JSON")
+    r = TestClient(create_app(Session("rssr"))).post("/api/mode", json={"mode_number": 1})
+    assert r.status_code == 422 and "fk_all" in r.json()["error"]
+
+
+def test_the_page_and_plotly_are_served_from_the_package(five_cs):
+    page = five_cs.get("/")
+    assert page.status_code == 200 and "/static/plotly.min.js" in page.text and "cdn" not in page.text.lower()
+    js = five_cs.get("/static/plotly.min.js")
+    assert js.status_code == 200 and len(js.content) > 1_000_000
+    assert five_cs.get("/static/studio.js").status_code == 200 and five_cs.get("/static/x.js").status_code == 404
+
+
+def test_studio_command_errors_are_one_line():
+    r = CliRunner().invoke(cli, ["studio", "no-such-model", "--no-browser"])
+    assert r.exit_code == 2 and r.output.startswith("error: ") and r.output.count("\n") == 1
+    h = CliRunner().invoke(cli, ["studio", "--help"])
+    assert h.exit_code == 0 and "--no-browser" in h.output
+
+
+def test_studio_command_json_before_serving(monkeypatch, validator):
+    """``studio --json`` prints the address and the start state, then serves (uvicorn.run is
+    replaced here: the app it would serve is checked instead)."""
+    import json
+
+    import uvicorn
+
+    served = {}
+    monkeypatch.setattr(uvicorn, "run", lambda app, host, port, **kw: served.update(app=app, host=host, port=port))
+    r = CliRunner().invoke(cli, ["studio", "rssr", "--port", "0", "--no-browser", "--json"])
+    assert r.exit_code == 0, r.output
+    doc = json.loads(r.output)
+    errors = [e.message[:200] for e in validator.iter_errors(doc)]
+    assert not errors and unit_rule_violations(doc) == []
+    assert served["host"] == "127.0.0.1" and doc["url"] == f"http://127.0.0.1:{served['port']}/" == f"http://127.0.0.1:{doc['port']}/"
+    assert TestClient(served["app"]).get("/api/state").json()["state"]["drivers"] == doc["state"]["drivers"] == ["A0.rot"]
+
+
+def test_the_traced_circuit_passes_through_the_current_configuration(validator):
+    session = Session("rssr")
+    c = TestClient(create_app(session))
+    d = ok(c.get("/api/circuit"), validator)
+    pts = np.array(d["circuit_len"])
+    here = np.array(session.state()["scene"]["platform_point_len"])
+    assert len(pts) > 20 and np.min(np.linalg.norm(pts - here, axis=1)) < 1e-9
+    assert np.linalg.norm(pts[0] - pts[-1]) < 1e-6  # a closed circuit
+    r = TestClient(create_app(Session("stewart-6sps"))).get("/api/circuit")
+    assert r.status_code == 422 and r.json()["error"].startswith("circuit:")
