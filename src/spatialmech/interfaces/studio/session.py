@@ -41,7 +41,8 @@ from ...kinematics.closure import (
     joint_twists,
 )
 from ...kinematics.jacobian import complete_jacobian, driver_determinants
-from ...kinematics.position import forward_position, freedom_values, platform_pose
+from ...kinematics.forward import forward_position
+from ...kinematics.position import freedom_values, platform_pose
 from ...kinematics.tracking import ActuatorPathProblem, track
 from ...model.mechanism import Mechanism
 from ...present.viewer import LIMB_COLOURS, drawing
