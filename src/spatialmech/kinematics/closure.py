@@ -313,6 +313,9 @@ def recentre_balls(mech: Mechanism, q: np.ndarray) -> np.ndarray:
 
 def joint_twists(mech: Mechanism, config: Configuration) -> list[np.ndarray]:
     """Per limb, the (6, m_k) spatial twists of all its freedoms at ``config``."""
+    if (fast := _compiled()) is not None:  # the joint columns of the closure Jacobian, every freedom active
+        A, _ = fast.closure_jacobian(mech, config, active=np.ones(len(mech.freedom_refs), dtype=bool))
+        return [A[6 * k : 6 * k + 6, sl].copy() for k, sl in enumerate(limb_slices(mech))]
     check_configuration(mech, config)
     out = []
     for (a, _), ch, sl in zip(mech.limb_ends, limb_chains(mech), limb_slices(mech), strict=True):

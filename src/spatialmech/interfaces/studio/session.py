@@ -158,9 +158,20 @@ class Session:
 
     def _sigma(self, c: Configuration) -> float:
         try:
-            return float(complete_jacobian(self.mech, c).sigma_min)
+            return float(self._jacobian(c).sigma_min)
         except InputError:
             return 0.0
+
+    def _jacobian(self, c: Configuration):
+        """The complete Jacobian at ``c``, remembered for the last configuration asked (a drive
+        evaluates it at its end, and the readout that follows, and the next drive's start, at
+        the same configuration object)."""
+        last = getattr(self, "_last_jacobian", None)
+        if last is not None and last[0] is c:
+            return last[1]
+        J = complete_jacobian(self.mech, c)
+        self._last_jacobian = (c, J)
+        return J
 
     def _platform_point(self, c: Configuration) -> np.ndarray:
         return c.D[:3, :3] @ self.mech.platform_point + c.D[:3, 3]
@@ -224,7 +235,7 @@ class Session:
         if len(self.mech.actuators) == 1:
             v = float(driver_determinants(self.mech, c, list(self.mech.actuators))[0])
         else:
-            d = (J if J is not None else complete_jacobian(self.mech, c)).det
+            d = (J if J is not None else self._jacobian(c)).det
             v = float("nan") if d is None else float(d)
         return v if np.isfinite(v) else None
 
@@ -240,7 +251,7 @@ class Session:
         """The readout of the current configuration (JSON payload, docs/studio.md)."""
         m, c = self.mech, self.config
         a = self.actuator_values()
-        J = complete_jacobian(m, c)
+        J = self._jacobian(c)
         sig = float(J.sigma_min)
         pose = platform_pose(m, c)
         vals = freedom_values(m, c.q)
