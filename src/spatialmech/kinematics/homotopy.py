@@ -1,0 +1,462 @@
+"""Every assembly mode of a 6-leg S-P-S (Gough-Stewart) platform by homotopy continuation.
+
+Formulation.  The platform displacement is written in Study parameters ``x = (e ; g)`` (two
+quaternions, projective): rotation ``R v = e v e* / (e.e)``, translation ``p = 2 g e* / (e.e)``.
+A leg from base point ``a`` to platform point ``b`` (its reference placement, both divided by
+the characteristic length ``L``) of length ``l`` is then one homogeneous quadric
+
+    |e b - a e + 2 g|^2 - (l / L)^2 (e.e) = 0,
+
+the squared leg length entering linearly.  With the Study quadric ``e.g = 0`` and a random
+complex affine patch ``c.x = 1`` this is a square system of 7 quadrics and 1 linear equation
+in 8 unknowns (Bezout number 128).  Points with ``e.e = 0`` are the exceptional generator of
+the Study quadric: translation at infinity, never a pose; a generic instance has a
+two-dimensional component of them (``e = 0``, ``g.g = 0``), where 88 of the 128 paths end.
+
+Method.  (1) A total-degree homotopy ``(1 - t) gamma G + t F`` (``G_j = x_j^2 - x_7^2``, 128
+start points, random complex ``gamma``) to a generic complex instance (random complex squared
+leg lengths), once per geometry (cached in memory): every path must end either at a finite
+nonsingular point or at the exceptional set, or the run is repeated with other random numbers;
+by the gamma trick every isolated solution of the generic instance is the end of a path, so the
+finite nonsingular end points are all of them (40 for a general 6-6 geometry).  (2) A parameter
+homotopy along the straight segment from the generic squared lengths to the requested ones
+tracks exactly those paths: every isolated solution of the request is the end of one of them
+(the segment from a generic complex point avoids the discriminant before its end).
+
+The tracker is vectorised over paths in NumPy: 4th-order Runge-Kutta predictor on the
+Davidenko equation, Newton corrector with a path-jumping guard (the first update must be small
+and the second must contract), step halved on rejection and grown on acceptance.  End game:
+a path that cannot reach ``t = 1`` (its step falls below ``1e-14``) is classified at its last
+point: at infinity when ``|e.e| / |x|^2`` is small (the platform escapes), else singular. End
+points are classified by the inverse condition number of the row-normalised Jacobian
+(singular), ``|e.e| / |x|^2`` (at infinity) and the size of the imaginary part after removing
+the projective phase (real).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import InputError
+from ..geometry.tolerances import HOMOTOPY_INFINITY, HOMOTOPY_JUMP, HOMOTOPY_NEWTON, HOMOTOPY_REAL, HOMOTOPY_SINGULAR
+from ..model.mechanism import Mechanism
+
+__all__ = [
+    "HomotopyResult",
+    "HomotopySolution",
+    "StewartSystem",
+    "homotopy_forward",
+    "stewart_system",
+    "system_from_points",
+    "study_to_pose",
+    "track",
+    "unsupported_reason",
+]
+
+_N = 8  # unknowns: e0..e3, g0..g3
+
+
+def _qmat_left(q) -> np.ndarray:
+    """``L(q)`` with ``q r = L(q) r`` (quaternions scalar first)."""
+    w, x, y, z = q
+    return np.array([[w, -x, -y, -z], [x, w, -z, y], [y, z, w, -x], [z, -y, x, w]], dtype=float)
+
+
+def _qmat_right(r) -> np.ndarray:
+    """``R(r)`` with ``q r = R(r) q``."""
+    w, x, y, z = r
+    return np.array([[w, -x, -y, -z], [x, w, z, -y], [y, -z, w, x], [z, y, -x, w]], dtype=float)
+
+
+def _qmul(q, r):
+    w1, x1, y1, z1 = q
+    w2, x2, y2, z2 = r
+    return np.array([w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2, w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+                     w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2, w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2])
+
+
+@dataclass(frozen=True, eq=False)
+class StewartSystem:
+    """The polynomial system of a 6-leg S-P-S platform (see the module docstring).
+
+    ``base``, ``platform``: the legs' base and platform centres at the reference (model units);
+    the squared leg length of leg ``k`` is ``(d_ref[k] + sign[k] * (v_k - offset[k]))^2`` for
+    the actuator value ``v_k``."""
+
+    base: np.ndarray  # (6, 3)
+    platform: np.ndarray  # (6, 3)
+    d_ref: np.ndarray
+    sign: np.ndarray
+    offset: np.ndarray
+    L: float
+    Q: np.ndarray = field(repr=False)  # (7, 8, 8): Study quadric, then the legs without the length term
+
+    def lengths(self, values) -> np.ndarray:
+        """Leg lengths (model units) for actuator values."""
+        v = np.asarray(values, dtype=float)
+        return self.d_ref + self.sign * (v - self.offset)
+
+    def key(self) -> bytes:
+        return np.round(np.r_[self.base.ravel(), self.platform.ravel()] / self.L, 12).tobytes()
+
+
+def unsupported_reason(mech: Mechanism) -> str | None:
+    """``None`` when the homotopy formulation covers ``mech``, else why not (one sentence)."""
+    if mech.bodies:
+        return "a link-and-joint graph (internal bodies)"
+    if len(mech.limbs) != 6:
+        return f"{len(mech.limbs)} limbs (the formulation covers six S-P-S legs)"
+    for limb in mech.limbs:
+        types = [j.type for j in limb.joints]
+        if len(types) != 3 or types[1] != "P" or not set(types[::2]) <= {"S", "U"} or types[::2] == ["U", "U"]:
+            return f"limb {limb.name} is {'-'.join(types)} (the formulation covers S-P-S, U-P-S and S-P-U legs)"
+        if limb.base != "ground" or limb.tip is not None:
+            return f"limb {limb.name} does not run from the ground to the platform"
+        slide = limb.joints[1].freedoms[0]
+        if not slide.actuated:
+            return f"limb {limb.name}: its slide is not the actuator"
+        for j in limb.joints[::2]:
+            if j.type == "U" and np.linalg.norm(j.freedoms[0].point - j.freedoms[1].point) > 1e-9 * mech.characteristic_length:
+                return f"limb {limb.name}: the axes of {j.name} do not meet"
+        d = limb.joints[2].point - limb.joints[0].point
+        nd = float(np.linalg.norm(d))
+        if nd < 1e-9 * mech.characteristic_length or abs(abs(float(d @ slide.direction)) - nd) > 1e-9 * nd:
+            return f"limb {limb.name}: the slide does not run along the line of its two centres"
+    others = [r.id for r in mech.freedom_refs if r.freedom.actuated and r.freedom.kind != "P"]
+    if others or len(mech.actuators) != 6:
+        return "actuators other than the six leg slides"
+    return None
+
+
+def stewart_system(mech: Mechanism) -> StewartSystem:
+    """The system of ``mech`` (``InputError`` naming the reason when it is not covered)."""
+    why = unsupported_reason(mech)
+    if why is not None:
+        raise InputError(f"model: homotopy forward position does not cover {mech.name}: {why}; use method='multistart'")
+    L = float(mech.characteristic_length)
+    a = np.array([limb.joints[0].point for limb in mech.limbs], dtype=float)
+    b = np.array([limb.joints[2].point for limb in mech.limbs], dtype=float)
+    acts = list(mech.actuators)
+    slides = {f"{limb.joints[1].name}.{limb.joints[1].freedoms[0].name}": k for k, limb in enumerate(mech.limbs)}
+    order = []
+    for act in acts:
+        ref = mech.freedom(act)
+        k = slides.get(act)
+        if k is None:  # match by identity of the freedom
+            k = next(i for i, limb in enumerate(mech.limbs) if limb.joints[1].freedoms[0] is ref.freedom)
+        order.append(k)
+    a, b = a[order], b[order]
+    d = b - a
+    d_ref = np.linalg.norm(d, axis=1)
+    sign = np.array([np.sign(float(d[i] @ mech.limbs[k].joints[1].freedoms[0].direction)) for i, k in enumerate(order)])
+    offset = np.array([mech.limbs[k].joints[1].freedoms[0].offset for k in order])
+    return system_from_points(a, b, L=L, d_ref=d_ref, sign=sign, offset=offset)
+
+
+def system_from_points(base, platform, *, L: float | None = None, d_ref=None, sign=None, offset=None) -> StewartSystem:
+    """The system of six legs from ``base[k]`` to ``platform[k]`` (reference placement; by
+    default the actuator values are the leg lengths)."""
+    a = np.asarray(base, dtype=float).reshape(6, 3)
+    b = np.asarray(platform, dtype=float).reshape(6, 3)
+    if L is None:
+        pts = np.vstack([a, b])
+        L = float(np.sqrt(np.mean(np.sum((pts - pts.mean(axis=0)) ** 2, axis=1))))
+    if d_ref is None:
+        d_ref = np.linalg.norm(b - a, axis=1)
+        sign, offset = np.ones(6), d_ref.copy()
+    Q = np.zeros((7, _N, _N))
+    Q[0, :4, 4:] = Q[0, 4:, :4] = 0.5 * np.eye(4)
+    for i in range(6):
+        K = np.hstack([_qmat_right(np.r_[0.0, b[i] / L]) - _qmat_left(np.r_[0.0, a[i] / L]), 2 * np.eye(4)])
+        Q[i + 1] = K.T @ K
+    return StewartSystem(a, b, d_ref, sign, offset, L, Q)
+
+
+# ------------------------------------------------------------------------------ evaluation
+def _eval_target(Q: np.ndarray, c: np.ndarray, X: np.ndarray, l2: np.ndarray):
+    """F and its Jacobian for points ``X`` (n, 8) and squared lengths ``l2`` (n, 6)."""
+    QX = np.einsum("kij,nj->nki", Q, X)  # (n, 7, 8)
+    F = np.empty((len(X), _N), dtype=complex)
+    J = np.empty((len(X), _N, _N), dtype=complex)
+    F[:, :7] = np.einsum("nki,ni->nk", QX, X)
+    E = np.einsum("ni,ni->n", X[:, :4], X[:, :4])
+    F[:, 1:7] -= l2 * E[:, None]
+    J[:, :7] = 2 * QX
+    J[:, 1:7, :4] -= 2 * l2[:, :, None] * X[:, None, :4]
+    F[:, 7] = X @ c - 1
+    J[:, 7] = c
+    return F, J, E
+
+
+def track(fun, X0: np.ndarray, *, h0: float = 0.02, hmin: float = 1e-14, max_steps: int = 4000):
+    """Track the paths ``H(x, t) = 0`` from ``t = 0`` (points ``X0``, (n, m)) to ``t = 1``.
+
+    ``fun(X, t)`` (``t``: (n,)) returns ``H`` (n, m), ``H_x`` (n, m, m) and ``H_t`` (n, m).
+    Returns ``(X, t, ok, steps)``: the end points, the ``t`` reached, whether ``t = 1`` was
+    reached with a converged corrector, and the accepted steps per path."""
+    X = np.array(X0, dtype=complex)
+    n = len(X)
+    t = np.zeros(n)
+    h = np.full(n, h0)
+    done = np.zeros(n, bool)
+    failed = np.zeros(n, bool)
+    steps = np.zeros(n, int)
+    good = np.zeros(n, int)
+
+    def vel(x, tt):
+        _, Hx, Ht = fun(x, tt)
+        return -np.linalg.solve(Hx, Ht[..., None])[..., 0]
+
+    for _ in range(max_steps):
+        idx = np.flatnonzero(~done & ~failed)
+        if idx.size == 0:
+            break
+        x, tt = X[idx], t[idx]
+        hh = np.minimum(h[idx], 1.0 - tt)
+        with np.errstate(all="ignore"):
+            try:
+                k1 = vel(x, tt)
+                k2 = vel(x + 0.5 * hh[:, None] * k1, tt + 0.5 * hh)
+                k3 = vel(x + 0.5 * hh[:, None] * k2, tt + 0.5 * hh)
+                k4 = vel(x + hh[:, None] * k3, tt + hh)
+                xc = x + hh[:, None] / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+                tn = tt + hh
+                nx = 1 + np.linalg.norm(xc, axis=1)
+                H, Hx, _ = fun(xc, tn)
+                dx = np.linalg.solve(Hx, H[..., None])[..., 0]
+                d0 = np.linalg.norm(dx, axis=1) / nx
+                xc = xc - dx
+                H, Hx, _ = fun(xc, tn)
+                dx = np.linalg.solve(Hx, H[..., None])[..., 0]
+                d1 = np.linalg.norm(dx, axis=1) / nx
+                xc = xc - dx
+            except np.linalg.LinAlgError:  # a singular Jacobian in the batch: go path by path
+                ok = np.zeros(idx.size, bool)
+                h[idx] *= 0.5
+                failed[idx[h[idx] < hmin]] = True
+                continue
+            ok = np.isfinite(d0) & np.isfinite(d1) & (d0 < HOMOTOPY_JUMP) & ((d1 < 0.1 * d0) | (d1 < HOMOTOPY_NEWTON))
+        acc = idx[ok]
+        X[acc] = xc[ok]
+        t[acc] = tn[ok]
+        steps[acc] += 1
+        good[acc] += 1
+        h[acc] = np.where(good[acc] >= 2, 2.0 * h[acc], h[acc])
+        good[acc] = np.where(good[acc] >= 2, 0, good[acc])
+        rej = idx[~ok]
+        h[rej] *= 0.5
+        good[rej] = 0
+        done[acc[t[acc] >= 1.0]] = True
+        failed[rej[h[rej] < hmin]] = True
+    return X, t, done, steps
+
+
+def _refine(Q, c, X, l2, iters: int = 4):
+    """Newton at ``t = 1``; the residual after."""
+    with np.errstate(all="ignore"):
+        for _ in range(iters):
+            F, J, _ = _eval_target(Q, c, X, l2)
+            try:
+                dx = np.linalg.lstsq(J[0], F[0], rcond=None)[0] if len(X) == 1 else np.linalg.solve(J, F[..., None])[..., 0]
+            except np.linalg.LinAlgError:
+                break
+            Xn = X - dx
+            if not np.all(np.isfinite(Xn)):
+                break
+            X = Xn
+        F, J, E = _eval_target(Q, c, X, l2)
+    return X, F, J, E
+
+
+def _classify(Q, c, X, l2):
+    """Status of each end point: (status, rcond, rel_inf, imag_rel, residual, X refined)."""
+    out = []
+    for x in X:
+        xr, F, J, E = _refine(Q, c, x[None, :], l2[:1] if l2.ndim == 2 else l2[None, :])
+        xr, F, J, E = xr[0], F[0], J[0], E[0]
+        nx = float(np.linalg.norm(xr))
+        rel_inf = float(abs(E)) / nx**2 if nx > 0 and np.isfinite(nx) else 0.0
+        rows = J / np.maximum(np.linalg.norm(J, axis=1, keepdims=True), 1e-300)
+        sv = np.linalg.svd(rows, compute_uv=False) if np.all(np.isfinite(rows)) else np.array([1.0, 0.0])
+        rcond = float(sv[-1] / sv[0])
+        k = int(np.argmax(np.abs(xr)))
+        y = xr * (abs(xr[k]) / xr[k]) if xr[k] != 0 else xr
+        imag = float(np.linalg.norm(y.imag) / max(np.linalg.norm(y), 1e-300))
+        res = float(np.linalg.norm(F[:7]) / max(nx**2, 1e-300))
+        if not np.isfinite(nx) or rel_inf < HOMOTOPY_INFINITY:
+            st = "at_infinity"
+        elif rcond < HOMOTOPY_SINGULAR:
+            st = "singular"
+        elif imag < HOMOTOPY_REAL:
+            st = "real"
+        else:
+            st = "complex"
+        out.append((st, rcond, rel_inf, imag, res, y, xr))
+    return out
+
+
+def study_to_pose(x, L: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+    """Rotation and translation (model units, ``L`` the length scale) of real Study parameters."""
+    x = np.real(np.asarray(x))
+    e, g = x[:4], x[4:]
+    E = float(e @ e)
+    q = e / np.sqrt(E)
+    w, i, j, k = q
+    R = np.array([[1 - 2 * (j * j + k * k), 2 * (i * j - w * k), 2 * (i * k + w * j)],
+                  [2 * (i * j + w * k), 1 - 2 * (i * i + k * k), 2 * (j * k - w * i)],
+                  [2 * (i * k - w * j), 2 * (j * k + w * i), 1 - 2 * (i * i + j * j)]])
+    p = 2 * _qmul(g, e * np.array([1, -1, -1, -1]))[1:] / E * L
+    return R, p
+
+
+# ------------------------------------------------------------------------------ generic instance
+@dataclass(frozen=True, eq=False)
+class _Generic:
+    c: np.ndarray
+    l2: np.ndarray
+    X: np.ndarray  # (N, 8) the isolated solutions
+    n_paths: int
+    n_at_infinity: int
+    attempts: int
+    seconds: float
+
+
+_CACHE: dict[bytes, _Generic] = {}
+
+
+def _generic_solve(sysm: StewartSystem, seed: int = 0, max_attempts: int = 3) -> tuple[_Generic, bool]:
+    """Total-degree homotopy to a generic complex instance; (result, every path accounted for)."""
+    key = sysm.key()
+    if key in _CACHE:
+        return _CACHE[key], True
+    t0 = time.perf_counter()
+    rng = np.random.default_rng(seed)
+    best = None
+    for attempt in range(1, max_attempts + 1):
+        c = rng.normal(size=_N) + 1j * rng.normal(size=_N)
+        l2 = (1 + rng.random(6)) * np.exp(1j * rng.uniform(-np.pi, np.pi, 6))
+        gamma = np.exp(1j * rng.uniform(0, 2 * np.pi))
+        signs = np.array(np.meshgrid(*[[1.0, -1.0]] * 7, indexing="ij")).reshape(7, -1).T  # (128, 7)
+        S = np.hstack([signs, np.ones((len(signs), 1))]).astype(complex)
+        X0 = S / (S @ c)[:, None]
+        Q = sysm.Q
+
+        def fun(X, t, c=c, l2=l2, gamma=gamma):
+            F, J, _ = _eval_target(Q, c, X, np.broadcast_to(l2, (len(X), 6)))
+            G = np.empty_like(F)
+            JG = np.zeros_like(J)
+            G[:, :7] = X[:, :7] ** 2 - X[:, 7:8] ** 2
+            idx = np.arange(7)
+            JG[:, idx, idx] = 2 * X[:, :7]
+            JG[:, :7, 7] = -2 * X[:, 7:8]
+            s = t[:, None]
+            H = (1 - s) * gamma * G + s * F
+            H[:, 7] = F[:, 7]
+            Hx = (1 - s[..., None]) * gamma * JG + s[..., None] * J
+            Hx[:, 7] = J[:, 7]
+            Ht = F - gamma * G
+            Ht[:, 7] = 0
+            return H, Hx, Ht
+
+        X, _, _, _ = track(fun, X0)
+        cls = _classify(Q, c, X, l2)
+        fin = [i for i, r in enumerate(cls) if r[0] in ("real", "complex")]
+        inf = [i for i, r in enumerate(cls) if r[0] == "at_infinity"]
+        pts = np.array([cls[i][6] for i in fin]).reshape(-1, _N)
+        distinct = _distinct(pts)
+        accounted = len(fin) + len(inf) == len(X) and distinct
+        g = _Generic(c, l2, pts, len(X), len(inf), attempt, time.perf_counter() - t0)
+        if accounted:
+            _CACHE[key] = g
+            return g, True
+        if best is None or len(fin) > len(best.X):
+            best = g
+    assert best is not None
+    return best, False
+
+
+def _distinct(P: np.ndarray) -> bool:
+    if len(P) < 2:
+        return True
+    Pn = P / np.linalg.norm(P, axis=1, keepdims=True)
+    G = np.abs(Pn.conj() @ Pn.T)
+    np.fill_diagonal(G, 0)
+    return bool(np.all(G < 1 - 1e-8))
+
+
+# ------------------------------------------------------------------------------ results
+@dataclass(frozen=True, eq=False)
+class HomotopySolution:
+    """One end point: ``status`` real / complex / singular / at_infinity, the Study parameters
+    (projective, phase removed), the inverse condition number of the row-normalised Jacobian,
+    ``|e.e| / |x|^2``, the relative residual and, for a real end point, the displacement."""
+
+    status: str
+    study: np.ndarray
+    rcond: float
+    infinity_ratio: float
+    imag_ratio: float
+    residual: float
+    R: np.ndarray | None = None
+    p: np.ndarray | None = None
+
+    def to_dict(self) -> dict:
+        return {"status": self.status, "study_parameters_real": [float(v) for v in self.study.real],
+                "study_parameters_imag": [float(v) for v in self.study.imag], "inverse_condition": self.rcond,
+                "infinity_ratio": self.infinity_ratio, "imaginary_ratio": self.imag_ratio, "residual": self.residual}
+
+
+@dataclass(frozen=True, eq=False)
+class HomotopyResult:
+    solutions: tuple[HomotopySolution, ...]
+    complete: bool
+    completeness: str
+    n_generic: int
+    n_paths_total_degree: int
+    seconds_generic: float
+    seconds: float
+    cached: bool
+
+    def count(self, status: str) -> int:
+        return sum(s.status == status for s in self.solutions)
+
+
+def homotopy_forward(mech: Mechanism | StewartSystem, actuator_values, *, seed: int = 0) -> HomotopyResult:
+    """Every complex solution of the forward position of a 6-leg S-P-S platform for actuator
+    values (model units, in ``mech.actuators`` order): see the module docstring."""
+    t0 = time.perf_counter()
+    sysm = mech if isinstance(mech, StewartSystem) else stewart_system(mech)
+    vals = np.asarray(actuator_values, dtype=float).ravel()
+    if vals.shape != (6,) or not np.all(np.isfinite(vals)):
+        raise InputError(f"actuators: expected 6 finite values, got {vals.tolist()}")
+    cached = sysm.key() in _CACHE
+    gen, accounted = _generic_solve(sysm, seed=seed)
+    l2t = (sysm.lengths(vals) / sysm.L) ** 2
+    l20 = gen.l2
+    Q, c = sysm.Q, gen.c
+
+    def fun(X, t):
+        lt = (1 - t)[:, None] * l20 + t[:, None] * l2t
+        F, J, E = _eval_target(Q, c, X, lt)
+        Ht = np.zeros_like(F)
+        Ht[:, 1:7] = -(l2t - l20)[None, :] * E[:, None]
+        return F, J, Ht
+
+    X, _, _, _ = track(fun, gen.X) if len(gen.X) else (gen.X, None, None, None)
+    sols = []
+    for st, rc, ri, im, res, y, _ in _classify(Q, c, X, np.broadcast_to(l2t, (max(len(X), 1), 6))):
+        R = p = None
+        if st in ("real", "singular") and im < HOMOTOPY_REAL and ri >= HOMOTOPY_INFINITY:
+            R, p = study_to_pose(y / np.linalg.norm(y), sysm.L)
+        sols.append(HomotopySolution(st, y, rc, ri, im, res, R, p))
+    how = (f"total-degree homotopy ({gen.n_paths} paths, gamma trick) to a generic complex instance: every path "
+           f"accounted for ({len(gen.X)} finite nonsingular, {gen.n_at_infinity} at the exceptional generator e.e = 0); "
+           f"parameter homotopy of those {len(gen.X)} paths to the requested leg lengths")
+    if not accounted:
+        how = (f"NOT complete: {gen.n_paths - len(gen.X) - gen.n_at_infinity} of the {gen.n_paths} total-degree paths "
+               f"ended neither at a finite nonsingular point nor at infinity after {gen.attempts} attempts")
+    return HomotopyResult(tuple(sols), accounted, how, len(gen.X), gen.n_paths, gen.seconds, time.perf_counter() - t0,
+                          cached)
