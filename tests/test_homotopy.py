@@ -32,7 +32,7 @@ def general():
 
 
 def test_general_6_6_has_40_solutions_proven(general):
-    sysm, R, p, lengths, r = general
+    r = general[4]
     assert r.complete and "every path accounted for" in r.completeness
     assert r.n_generic == 40 and len(r.solutions) == 40
     assert r.count("at_infinity") + r.count("singular") == 0
@@ -51,7 +51,7 @@ def test_every_real_solution_closes_and_the_pose_is_among_them(general):
 
 
 def test_parameter_homotopy_resolve_is_fast_and_consistent(general):
-    sysm, R, p, lengths, _ = general
+    sysm, lengths = general[0], general[3]
     r2 = hc.homotopy_forward(sysm, lengths * 1.03)
     assert r2.cached and r2.complete and r2.seconds < 2.0
     for s in r2.solutions:

@@ -50,8 +50,8 @@ __all__ = [
     "StewartSystem",
     "homotopy_forward",
     "stewart_system",
-    "system_from_points",
     "study_to_pose",
+    "system_from_points",
     "track",
     "unsupported_reason",
 ]
@@ -344,7 +344,7 @@ def _generic_solve(sysm: StewartSystem, seed: int = 0, max_attempts: int = 3) ->
         X0 = S / (S @ c)[:, None]
         Q = sysm.Q
 
-        def fun(X, t, c=c, l2=l2, gamma=gamma):
+        def fun(X, t, c=c, l2=l2, gamma=gamma, Q=Q):
             F, J, _ = _eval_target(Q, c, X, np.broadcast_to(l2, (len(X), 6)))
             G = np.empty_like(F)
             JG = np.zeros_like(J)
