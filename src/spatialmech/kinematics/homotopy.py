@@ -255,38 +255,45 @@ def track(fun, X0: np.ndarray, *, h0: float = 0.02, hmin: float = 1e-14, max_ste
 
 
 def _refine(Q, c, X, l2, iters: int = 4):
-    """Newton at ``t = 1``; the residual after."""
+    """Newton at ``t = 1`` (batched; a point whose step fails keeps its last value)."""
+    X = X.copy()
     with np.errstate(all="ignore"):
         for _ in range(iters):
             F, J, _ = _eval_target(Q, c, X, l2)
-            try:
-                dx = np.linalg.lstsq(J[0], F[0], rcond=None)[0] if len(X) == 1 else np.linalg.solve(J, F[..., None])[..., 0]
-            except np.linalg.LinAlgError:
+            ok = np.all(np.isfinite(J), axis=(1, 2)) & np.all(np.isfinite(F), axis=1)
+            ok &= np.abs(np.linalg.det(np.where(ok[:, None, None], J, np.eye(_N)))) > 0
+            if not ok.any():
                 break
-            Xn = X - dx
-            if not np.all(np.isfinite(Xn)):
-                break
-            X = Xn
+            dx = np.linalg.solve(J[ok], F[ok][..., None])[..., 0]
+            Xn = X[ok] - dx
+            fin = np.all(np.isfinite(Xn), axis=1)
+            X[np.flatnonzero(ok)[fin]] = Xn[fin]
         F, J, E = _eval_target(Q, c, X, l2)
     return X, F, J, E
 
 
 def _classify(Q, c, X, l2):
-    """Status of each end point: (status, rcond, rel_inf, imag_rel, residual, X refined)."""
+    """Status of each end point: (status, rcond, rel_inf, imag_rel, residual, y, x refined),
+    ``y`` the point with its projective phase removed, ``x`` in the affine patch."""
+    if len(X) == 0:
+        return []
+    l2 = np.broadcast_to(l2, (len(X), 6))
+    xr, F, J, E = _refine(Q, c, X, l2)
     out = []
-    for x in X:
-        xr, F, J, E = _refine(Q, c, x[None, :], l2[:1] if l2.ndim == 2 else l2[None, :])
-        xr, F, J, E = xr[0], F[0], J[0], E[0]
-        nx = float(np.linalg.norm(xr))
-        rel_inf = float(abs(E)) / nx**2 if nx > 0 and np.isfinite(nx) else 0.0
-        rows = J / np.maximum(np.linalg.norm(J, axis=1, keepdims=True), 1e-300)
-        sv = np.linalg.svd(rows, compute_uv=False) if np.all(np.isfinite(rows)) else np.array([1.0, 0.0])
-        rcond = float(sv[-1] / sv[0])
-        k = int(np.argmax(np.abs(xr)))
-        y = xr * (abs(xr[k]) / xr[k]) if xr[k] != 0 else xr
+    with np.errstate(all="ignore"):
+        nx = np.linalg.norm(xr, axis=1)
+        rows = J / np.maximum(np.linalg.norm(J, axis=2, keepdims=True), 1e-300)
+        finite = np.all(np.isfinite(rows), axis=(1, 2))
+        sv = np.linalg.svd(np.where(finite[:, None, None], rows, np.eye(_N)), compute_uv=False)
+    for n in range(len(X)):
+        x = xr[n]
+        rel_inf = float(abs(E[n])) / nx[n] ** 2 if nx[n] > 0 and np.isfinite(nx[n]) else 0.0
+        rcond = float(sv[n, -1] / sv[n, 0]) if finite[n] else 0.0
+        k = int(np.argmax(np.abs(x)))
+        y = x * (abs(x[k]) / x[k]) if x[k] != 0 else x
         imag = float(np.linalg.norm(y.imag) / max(np.linalg.norm(y), 1e-300))
-        res = float(np.linalg.norm(F[:7]) / max(nx**2, 1e-300))
-        if not np.isfinite(nx) or rel_inf < HOMOTOPY_INFINITY:
+        res = float(np.linalg.norm(F[n, :7]) / max(nx[n] ** 2, 1e-300))
+        if not np.isfinite(nx[n]) or rel_inf < HOMOTOPY_INFINITY:
             st = "at_infinity"
         elif rcond < HOMOTOPY_SINGULAR:
             st = "singular"
@@ -294,7 +301,7 @@ def _classify(Q, c, X, l2):
             st = "real"
         else:
             st = "complex"
-        out.append((st, rcond, rel_inf, imag, res, y, xr))
+        out.append((st, rcond, rel_inf, imag, res, y, x))
     return out
 
 
@@ -447,7 +454,7 @@ def homotopy_forward(mech: Mechanism | StewartSystem, actuator_values, *, seed: 
 
     X, _, _, _ = track(fun, gen.X) if len(gen.X) else (gen.X, None, None, None)
     sols = []
-    for st, rc, ri, im, res, y, _ in _classify(Q, c, X, np.broadcast_to(l2t, (max(len(X), 1), 6))):
+    for st, rc, ri, im, res, y, _ in _classify(Q, c, X, l2t):
         R = p = None
         if st in ("real", "singular") and im < HOMOTOPY_REAL and ri >= HOMOTOPY_INFINITY:
             R, p = study_to_pose(y / np.linalg.norm(y), sysm.L)
