@@ -3,6 +3,9 @@
 from __future__ import annotations
 
 import json
+import re
+import shutil
+import subprocess
 
 import numpy as np
 import pytest
@@ -110,3 +113,42 @@ def test_uncovered_model_clear_message():
     assert out.exit_code != 0 and "does not cover three-rps" in out.output and "Traceback" not in out.output
     with pytest.raises(sm.InputError, match="method"):
         sm.fk("stewart-6sps", [1.2] * 6, all_solutions=True, method="newton")
+
+
+def _phc_system(sysm, lengths, c) -> str:
+    """The same polynomial system in PHCpack's input format."""
+    names = ["e0", "e1", "e2", "e3", "g0", "g1", "g2", "g3"]
+    l2 = (np.asarray(lengths) / sysm.L) ** 2
+    Pe = np.diag([1.0, 1, 1, 1, 0, 0, 0, 0])
+
+    def quad(M):
+        return " ".join(f"{(M[i, j] if i == j else M[i, j] + M[j, i]):+.17e}*{names[i]}*{names[j]}"
+                        for i in range(8) for j in range(i, 8)) + ";"
+
+    eqs = [quad(sysm.Q[0])] + [quad(sysm.Q[k + 1] - l2[k] * Pe) for k in range(6)]
+    eqs.append(" ".join(f"{c[i]:+.17e}*{names[i]}" for i in range(8)) + " - 1;")
+    return "8\n" + "\n".join(eqs) + "\n"
+
+
+@pytest.mark.skipif(shutil.which("phc") is None, reason="PHCpack (Debian phcpack) not installed")
+def test_phcpack_agrees_on_the_stewart_model(stewart, tmp_path):
+    """Independent check: PHCpack's blackbox solver on the same system finds the same number of
+    regular solutions and the same real ones (about 13 s)."""
+    mech, res = stewart
+    sysm = hc.stewart_system(mech)
+    c = np.random.default_rng(3).normal(size=8)
+    (tmp_path / "in.txt").write_text(_phc_system(sysm, sysm.lengths([1.2] * 6), c))
+    subprocess.run(["phc", "-b", str(tmp_path / "in.txt"), str(tmp_path / "out.txt")], check=True,
+                   capture_output=True, timeout=120)
+    out = (tmp_path / "out.txt").read_text()
+    n_regular = int(re.findall(r"Number of regular solutions\s*:\s*(\d+)", out)[-1])
+    assert n_regular == res.search["n_generic"] == res.search["n_real"] + res.search["n_complex"]
+    phc_real = []
+    for block in out[out.rfind("THE SOLUTIONS"):].split("solution ")[1:]:
+        vals = {k: complex(float(x), float(y)) for k, x, y in re.findall(r"\b([eg]\d) :\s+(\S+)\s+(\S+)", block)}
+        if len(vals) == 8 and "real regular" in block:
+            phc_real.append(hc.study_to_pose(np.array([vals[k] for k in sorted(vals)]).real, sysm.L)[1])
+    assert len(phc_real) == res.search["n_real"]
+    ours = [s.config.D[:3, 3] for s in res.solutions]
+    for p in phc_real:
+        assert min(np.linalg.norm(p - q) for q in ours) < 1e-6
