@@ -152,3 +152,18 @@ def test_phcpack_agrees_on_the_stewart_model(stewart, tmp_path):
     ours = [s.config.D[:3, 3] for s in res.solutions]
     for p in phc_real:
         assert min(np.linalg.norm(p - q) for q in ours) < 1e-6
+
+
+@pytest.mark.parametrize("phi", [[0.12, 0.2, -0.1, 0.6], [0.15, -0.3, 0.2, -0.4]])
+def test_four_sps_cu_agrees_with_the_closed_form(phi):
+    from spatialmech.kinematics.closed_forms import four_sps_cu as k4
+    from spatialmech.kinematics.closed_forms import four_sps_cu_forward as k4f
+
+    mech = catalog.resolve("four-sps-cu")
+    legs = k4.leg_lengths(phi)
+    closed = k4f.forward_all(np.asarray(legs), geometry=k4.geometry_of(mech))
+    res = forward_position(mech, legs, all_solutions=True, method="homotopy")
+    assert res.search["complete"] and res.search["n_generic"] == res.search["n_real"] + res.search["n_complex"]
+    assert len(res.solutions) == len(closed.solutions) > 0
+    for s in closed.solutions:  # every real assembly mode of the closed form: same height, same rotation
+        assert min(abs(h.pose.p[2] - s.phi[0]) + np.linalg.norm(h.pose.R - s.rotation) for h in res.solutions) < 1e-6

@@ -217,8 +217,10 @@ def fk(model: ModelLike, actuators, *, all_solutions: bool = False, seeds: int |
         raise InputError(f"method: expected 'auto', 'homotopy' or 'multistart', got {method!r}")
     if all_solutions and method != "multistart":
         from ..kinematics import homotopy as hc
+        from ..kinematics.closed_forms import four_sps_cu as k4c
 
-        if hc.unsupported_reason(mech) is None or method == "homotopy":
+        closed = method == "auto" and k4c.geometry_of(mech) is not None  # the 4-SPS/CU keeps its closed form
+        if (hc.unsupported_reason(mech) is None and not closed) or method == "homotopy":
             return FKResult(mech, values, forward_position(mech, values, all_solutions=True, seed=seed, method="homotopy"))
     if all_solutions:
         from ..kinematics.closed_forms import four_sps_cu as k4

@@ -250,7 +250,8 @@ def fk(model, values, all_solutions, method, seeds, as_json):
     from ..kinematics.closed_forms import four_sps_cu as k4
     from ..kinematics.closed_forms import four_sps_cu_forward as k4f
 
-    if all_solutions and method != "multistart":
+    closed = all_solutions and method == "auto" and k4.geometry_of(mech) is not None  # the 4-SPS/CU keeps its closed form
+    if all_solutions and method != "multistart" and not closed:
         from ..kinematics import homotopy as hc
 
         why = hc.unsupported_reason(mech)

@@ -1,4 +1,5 @@
-"""Every assembly mode of a 6-leg S-P-S (Gough-Stewart) platform by homotopy continuation.
+"""Every assembly mode of a platform on S-P-S legs (Gough-Stewart; with passive C-U / C-S
+limbs, e.g. the 4-SPS/CU) by homotopy continuation.
 
 Formulation.  The platform displacement is written in Study parameters ``x = (e ; g)`` (two
 quaternions, projective): rotation ``R v = e v e* / (e.e)``, translation ``p = 2 g e* / (e.e)``.
@@ -9,7 +10,8 @@ the characteristic length ``L``) of length ``l`` is then one homogeneous quadric
 
 the squared leg length entering linearly.  With the Study quadric ``e.g = 0`` and a random
 complex affine patch ``c.x = 1`` this is a square system of 7 quadrics and 1 linear equation
-in 8 unknowns (Bezout number 128).  Points with ``e.e = 0`` are the exceptional generator of
+in 8 unknowns (Bezout number 128).  A passive C-U or C-S limb keeps its centre on the C
+axis: two more quadrics instead of two legs.  Points with ``e.e = 0`` are the exceptional generator of
 the Study quadric: translation at infinity, never a pose; a generic instance has a
 two-dimensional component of them (``e = 0``, ``g.g = 0``), where 88 of the 128 paths end.
 
@@ -41,7 +43,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError
-from ..geometry.tolerances import HOMOTOPY_INFINITY, HOMOTOPY_JUMP, HOMOTOPY_NEWTON, HOMOTOPY_REAL, HOMOTOPY_SINGULAR
+from ..geometry.tolerances import (
+    HOMOTOPY_INFINITY,
+    HOMOTOPY_JUMP,
+    HOMOTOPY_NEAR_REAL,
+    HOMOTOPY_NEWTON,
+    HOMOTOPY_REAL,
+    HOMOTOPY_SINGULAR,
+)
 from ..model.mechanism import Mechanism
 
 __all__ = [
@@ -80,19 +89,27 @@ def _qmul(q, r):
 
 @dataclass(frozen=True, eq=False)
 class StewartSystem:
-    """The polynomial system of a 6-leg S-P-S platform (see the module docstring).
+    """The polynomial system of a platform on actuated S-P-S legs and passive point-on-line
+    limbs (see the module docstring).
 
     ``base``, ``platform``: the legs' base and platform centres at the reference (model units);
     the squared leg length of leg ``k`` is ``(d_ref[k] + sign[k] * (v_k - offset[k]))^2`` for
-    the actuator value ``v_k``."""
+    the actuator value ``v_k``.  ``lines``: per point-on-line limb, the platform point at the
+    reference, a point of the base line and its direction (a C-U or C-S limb: the U or S centre
+    stays on the C axis; two quadrics each)."""
 
-    base: np.ndarray  # (6, 3)
-    platform: np.ndarray  # (6, 3)
+    base: np.ndarray  # (n_legs, 3)
+    platform: np.ndarray  # (n_legs, 3)
     d_ref: np.ndarray
     sign: np.ndarray
     offset: np.ndarray
     L: float
-    Q: np.ndarray = field(repr=False)  # (7, 8, 8): Study quadric, then the legs without the length term
+    Q: np.ndarray = field(repr=False)  # (7, 8, 8): Study quadric, the legs without the length term, the lines
+    lines: tuple = ()
+
+    @property
+    def n_legs(self) -> int:
+        return len(self.base)
 
     def lengths(self, values) -> np.ndarray:
         """Leg lengths (model units) for actuator values."""
@@ -100,34 +117,61 @@ class StewartSystem:
         return self.d_ref + self.sign * (v - self.offset)
 
     def key(self) -> bytes:
-        return np.round(np.r_[self.base.ravel(), self.platform.ravel()] / self.L, 12).tobytes()
+        return np.round(self.Q, 12).tobytes()
+
+
+def _point_on_line(limb, L: float) -> tuple | None:
+    """(platform point, line point, line direction) of a C-U / C-S limb whose centre is on the C
+    axis, else ``None``."""
+    types = [j.type for j in limb.joints]
+    if types not in (["C", "U"], ["C", "S"]) or any(f.actuated for j in limb.joints for f in j.freedoms):
+        return None
+    c, t = limb.joints
+    rot = next(f for f in c.freedoms if f.kind == "R")
+    sl = next(f for f in c.freedoms if f.kind == "P")
+    d = rot.direction / np.linalg.norm(rot.direction)
+    if np.linalg.norm(np.cross(d, sl.direction)) > 1e-9:
+        return None
+    u = t.point
+    if np.linalg.norm(np.cross(u - rot.point, d)) > 1e-9 * L:
+        return None
+    if t.type == "U" and np.linalg.norm(t.freedoms[0].point - t.freedoms[1].point) > 1e-9 * L:
+        return None
+    return u, rot.point, d
 
 
 def unsupported_reason(mech: Mechanism) -> str | None:
     """``None`` when the homotopy formulation covers ``mech``, else why not (one sentence)."""
     if mech.bodies:
         return "a link-and-joint graph (internal bodies)"
-    if len(mech.limbs) != 6:
-        return f"{len(mech.limbs)} limbs (the formulation covers six S-P-S legs)"
+    L = mech.characteristic_length
+    n_eq = 0
     for limb in mech.limbs:
         types = [j.type for j in limb.joints]
-        if len(types) != 3 or types[1] != "P" or not set(types[::2]) <= {"S", "U"} or types[::2] == ["U", "U"]:
-            return f"limb {limb.name} is {'-'.join(types)} (the formulation covers S-P-S, U-P-S and S-P-U legs)"
         if limb.base != "ground" or limb.tip is not None:
             return f"limb {limb.name} does not run from the ground to the platform"
+        if _point_on_line(limb, L) is not None:
+            n_eq += 2
+            continue
+        if len(types) != 3 or types[1] != "P" or not set(types[::2]) <= {"S", "U"} or types[::2] == ["U", "U"]:
+            return (f"limb {limb.name} is {'-'.join(types)} (the formulation covers S-P-S, U-P-S and S-P-U legs and "
+                    "C-U / C-S limbs with the centre on the C axis)")
         slide = limb.joints[1].freedoms[0]
         if not slide.actuated:
             return f"limb {limb.name}: its slide is not the actuator"
         for j in limb.joints[::2]:
-            if j.type == "U" and np.linalg.norm(j.freedoms[0].point - j.freedoms[1].point) > 1e-9 * mech.characteristic_length:
+            if j.type == "U" and np.linalg.norm(j.freedoms[0].point - j.freedoms[1].point) > 1e-9 * L:
                 return f"limb {limb.name}: the axes of {j.name} do not meet"
         d = limb.joints[2].point - limb.joints[0].point
         nd = float(np.linalg.norm(d))
-        if nd < 1e-9 * mech.characteristic_length or abs(abs(float(d @ slide.direction)) - nd) > 1e-9 * nd:
+        if nd < 1e-9 * L or abs(abs(float(d @ slide.direction)) - nd) > 1e-9 * nd:
             return f"limb {limb.name}: the slide does not run along the line of its two centres"
+        n_eq += 1
     others = [r.id for r in mech.freedom_refs if r.freedom.actuated and r.freedom.kind != "P"]
-    if others or len(mech.actuators) != 6:
-        return "actuators other than the six leg slides"
+    if others:
+        return "actuators other than the leg slides"
+    if n_eq != 6:
+        return f"its limbs give {n_eq} equations on the platform pose, not 6"
     return None
 
 
@@ -137,55 +181,82 @@ def stewart_system(mech: Mechanism) -> StewartSystem:
     if why is not None:
         raise InputError(f"model: homotopy forward position does not cover {mech.name}: {why}; use method='multistart'")
     L = float(mech.characteristic_length)
-    a = np.array([limb.joints[0].point for limb in mech.limbs], dtype=float)
-    b = np.array([limb.joints[2].point for limb in mech.limbs], dtype=float)
-    acts = list(mech.actuators)
-    slides = {f"{limb.joints[1].name}.{limb.joints[1].freedoms[0].name}": k for k, limb in enumerate(mech.limbs)}
+    legs = [limb for limb in mech.limbs if _point_on_line(limb, L) is None]
+    lines = tuple(x for x in (_point_on_line(limb, L) for limb in mech.limbs) if x is not None)
     order = []
-    for act in acts:
+    for act in mech.actuators:
         ref = mech.freedom(act)
-        k = slides.get(act)
-        if k is None:  # match by identity of the freedom
-            k = next(i for i, limb in enumerate(mech.limbs) if limb.joints[1].freedoms[0] is ref.freedom)
-        order.append(k)
-    a, b = a[order], b[order]
+        order.append(next(i for i, limb in enumerate(legs) if limb.joints[1].freedoms[0] is ref.freedom))
+    legs = [legs[k] for k in order]
+    a = np.array([limb.joints[0].point for limb in legs], dtype=float).reshape(-1, 3)
+    b = np.array([limb.joints[2].point for limb in legs], dtype=float).reshape(-1, 3)
     d = b - a
     d_ref = np.linalg.norm(d, axis=1)
-    sign = np.array([np.sign(float(d[i] @ mech.limbs[k].joints[1].freedoms[0].direction)) for i, k in enumerate(order)])
-    offset = np.array([mech.limbs[k].joints[1].freedoms[0].offset for k in order])
-    return system_from_points(a, b, L=L, d_ref=d_ref, sign=sign, offset=offset)
+    sign = np.array([np.sign(float(d[i] @ limb.joints[1].freedoms[0].direction)) for i, limb in enumerate(legs)])
+    offset = np.array([limb.joints[1].freedoms[0].offset for limb in legs])
+    return system_from_points(a, b, L=L, d_ref=d_ref, sign=sign, offset=offset, lines=lines)
 
 
-def system_from_points(base, platform, *, L: float | None = None, d_ref=None, sign=None, offset=None) -> StewartSystem:
-    """The system of six legs from ``base[k]`` to ``platform[k]`` (reference placement; by
-    default the actuator values are the leg lengths)."""
-    a = np.asarray(base, dtype=float).reshape(6, 3)
-    b = np.asarray(platform, dtype=float).reshape(6, 3)
+def _line_quadrics(u, o, d, L: float) -> list[np.ndarray]:
+    """Two quadrics ``n_k . vec((e u - o e + 2 g) e*) = 0``: the platform point ``u`` on the
+    line through ``o`` along ``d`` (``n_k`` perpendicular to ``d``)."""
+    K = np.hstack([_qmat_right(np.r_[0.0, u / L]) - _qmat_left(np.r_[0.0, o / L]), 2 * np.eye(4)])
+    conj = np.diag([1.0, -1, -1, -1])
+    n1 = np.cross(d, [1.0, 0, 0] if abs(d[0]) < 0.9 else [0, 1.0, 0])
+    n1 /= np.linalg.norm(n1)
+    n2 = np.cross(d, n1)
+    out = []
+    for n in (n1, n2):
+        M = np.zeros((_N, _N))
+        for i in range(_N):
+            for j in range(4):  # e components of the second argument
+                M[i, j] = n @ _qmul(K[:, i], conj[:, j])[1:]
+        out.append(0.5 * (M + M.T))
+    return out
+
+
+def system_from_points(base, platform, *, L: float | None = None, d_ref=None, sign=None, offset=None,
+                       lines: tuple = ()) -> StewartSystem:
+    """The system of legs from ``base[k]`` to ``platform[k]`` (reference placement; by default
+    the actuator values are the leg lengths) and point-on-line constraints ``lines``
+    (``(platform point, line point, direction)``); six equations in all."""
+    a = np.asarray(base, dtype=float).reshape(-1, 3)
+    b = np.asarray(platform, dtype=float).reshape(-1, 3)
+    if len(a) + 2 * len(lines) != 6 or b.shape != a.shape:
+        raise InputError(f"base, platform: {len(a)} legs and {len(lines)} lines give {len(a) + 2 * len(lines)} "
+                         "equations, not 6")
     if L is None:
         pts = np.vstack([a, b])
         L = float(np.sqrt(np.mean(np.sum((pts - pts.mean(axis=0)) ** 2, axis=1))))
     if d_ref is None:
         d_ref = np.linalg.norm(b - a, axis=1)
-        sign, offset = np.ones(6), d_ref.copy()
+        sign, offset = np.ones(len(a)), d_ref.copy()
     Q = np.zeros((7, _N, _N))
     Q[0, :4, 4:] = Q[0, 4:, :4] = 0.5 * np.eye(4)
-    for i in range(6):
+    for i in range(len(a)):
         K = np.hstack([_qmat_right(np.r_[0.0, b[i] / L]) - _qmat_left(np.r_[0.0, a[i] / L]), 2 * np.eye(4)])
         Q[i + 1] = K.T @ K
-    return StewartSystem(a, b, d_ref, sign, offset, L, Q)
+    row = 1 + len(a)
+    for u, o, d in lines:
+        for M in _line_quadrics(np.asarray(u, float), np.asarray(o, float), np.asarray(d, float), L):
+            Q[row] = M
+            row += 1
+    return StewartSystem(a, b, np.asarray(d_ref, float), np.asarray(sign, float), np.asarray(offset, float), L, Q,
+                         tuple(lines))
 
 
 # ------------------------------------------------------------------------------ evaluation
 def _eval_target(Q: np.ndarray, c: np.ndarray, X: np.ndarray, l2: np.ndarray):
-    """F and its Jacobian for points ``X`` (n, 8) and squared lengths ``l2`` (n, 6)."""
+    """F and its Jacobian for points ``X`` (n, 8) and squared lengths ``l2`` (n, legs)."""
+    m = l2.shape[1]
     QX = np.einsum("kij,nj->nki", Q, X)  # (n, 7, 8)
     F = np.empty((len(X), _N), dtype=complex)
     J = np.empty((len(X), _N, _N), dtype=complex)
     F[:, :7] = np.einsum("nki,ni->nk", QX, X)
     E = np.einsum("ni,ni->n", X[:, :4], X[:, :4])
-    F[:, 1:7] -= l2 * E[:, None]
+    F[:, 1 : 1 + m] -= l2 * E[:, None]
     J[:, :7] = 2 * QX
-    J[:, 1:7, :4] -= 2 * l2[:, :, None] * X[:, None, :4]
+    J[:, 1 : 1 + m, :4] -= 2 * l2[:, :, None] * X[:, None, :4]
     F[:, 7] = X @ c - 1
     J[:, 7] = c
     return F, J, E
@@ -277,7 +348,7 @@ def _classify(Q, c, X, l2):
     ``y`` the point with its projective phase removed, ``x`` in the affine patch."""
     if len(X) == 0:
         return []
-    l2 = np.broadcast_to(l2, (len(X), 6))
+    l2 = np.broadcast_to(l2, (len(X), np.shape(l2)[-1]))
     xr, F, J, E = _refine(Q, c, X, l2)
     out = []
     with np.errstate(all="ignore"):
@@ -344,7 +415,8 @@ def _generic_solve(sysm: StewartSystem, seed: int = 0, max_attempts: int = 3) ->
     best = None
     for attempt in range(1, max_attempts + 1):
         c = rng.normal(size=_N) + 1j * rng.normal(size=_N)
-        l2 = (1 + rng.random(6)) * np.exp(1j * rng.uniform(-np.pi, np.pi, 6))
+        nl = sysm.n_legs
+        l2 = (1 + rng.random(nl)) * np.exp(1j * rng.uniform(-np.pi, np.pi, nl))
         gamma = np.exp(1j * rng.uniform(0, 2 * np.pi))
         signs = np.array(np.meshgrid(*[[1.0, -1.0]] * 7, indexing="ij")).reshape(7, -1).T  # (128, 7)
         S = np.hstack([signs, np.ones((len(signs), 1))]).astype(complex)
@@ -352,7 +424,7 @@ def _generic_solve(sysm: StewartSystem, seed: int = 0, max_attempts: int = 3) ->
         Q = sysm.Q
 
         def fun(X, t, c=c, l2=l2, gamma=gamma, Q=Q):
-            F, J, _ = _eval_target(Q, c, X, np.broadcast_to(l2, (len(X), 6)))
+            F, J, _ = _eval_target(Q, c, X, np.broadcast_to(l2, (len(X), len(l2))))
             G = np.empty_like(F)
             JG = np.zeros_like(J)
             G[:, :7] = X[:, :7] ** 2 - X[:, 7:8] ** 2
@@ -437,8 +509,8 @@ def homotopy_forward(mech: Mechanism | StewartSystem, actuator_values, *, seed: 
     t0 = time.perf_counter()
     sysm = mech if isinstance(mech, StewartSystem) else stewart_system(mech)
     vals = np.asarray(actuator_values, dtype=float).ravel()
-    if vals.shape != (6,) or not np.all(np.isfinite(vals)):
-        raise InputError(f"actuators: expected 6 finite values, got {vals.tolist()}")
+    if vals.shape != (sysm.n_legs,) or not np.all(np.isfinite(vals)):
+        raise InputError(f"actuators: expected {sysm.n_legs} finite values, got {vals.tolist()}")
     cached = sysm.key() in _CACHE
     gen, accounted = _generic_solve(sysm, seed=seed)
     l2t = (sysm.lengths(vals) / sysm.L) ** 2
@@ -449,21 +521,25 @@ def homotopy_forward(mech: Mechanism | StewartSystem, actuator_values, *, seed: 
         lt = (1 - t)[:, None] * l20 + t[:, None] * l2t
         F, J, E = _eval_target(Q, c, X, lt)
         Ht = np.zeros_like(F)
-        Ht[:, 1:7] = -(l2t - l20)[None, :] * E[:, None]
+        Ht[:, 1 : 1 + len(l2t)] = -(l2t - l20)[None, :] * E[:, None]
         return F, J, Ht
 
     X, _, _, _ = track(fun, gen.X) if len(gen.X) else (gen.X, None, None, None)
     sols = []
     for st, rc, ri, im, res, y, _ in _classify(Q, c, X, l2t):
         R = p = None
-        if st in ("real", "singular") and im < HOMOTOPY_REAL and ri >= HOMOTOPY_INFINITY:
+        if (st == "real" or (st == "singular" and im < HOMOTOPY_NEAR_REAL)) and ri >= HOMOTOPY_INFINITY:
             R, p = study_to_pose(y / np.linalg.norm(y), sysm.L)
         sols.append(HomotopySolution(st, y, rc, ri, im, res, R, p))
     how = (f"total-degree homotopy ({gen.n_paths} paths, gamma trick) to a generic complex instance: every path "
            f"accounted for ({len(gen.X)} finite nonsingular, {gen.n_at_infinity} at the exceptional generator e.e = 0); "
            f"parameter homotopy of those {len(gen.X)} paths to the requested leg lengths")
+    n_sing = sum(s.status == "singular" for s in sols)
+    if accounted and n_sing:
+        how += (f"; but {n_sing} end point(s) are singular (a continuum of solutions or a multiple root at these values, "
+                "located to a few digits only): not proven complete there, real points near them polished and reported")
     if not accounted:
         how = (f"NOT complete: {gen.n_paths - len(gen.X) - gen.n_at_infinity} of the {gen.n_paths} total-degree paths "
                f"ended neither at a finite nonsingular point nor at infinity after {gen.attempts} attempts")
-    return HomotopyResult(tuple(sols), accounted, how, len(gen.X), gen.n_paths, gen.seconds, time.perf_counter() - t0,
-                          cached)
+    return HomotopyResult(tuple(sols), accounted and not n_sing, how, len(gen.X), gen.n_paths, gen.seconds,
+                          time.perf_counter() - t0, cached)
