@@ -109,8 +109,9 @@ def test_cli_json_and_text(stewart):
 
 def test_uncovered_model_clear_message():
     runner = CliRunner()
-    out = runner.invoke(main, ["fk", "three-rps", "--actuators", "1,1,1", "--all", "--method", "homotopy"])
-    assert out.exit_code != 0 and "does not cover three-rps" in out.output and "Traceback" not in out.output
+    out = runner.invoke(main, ["fk", "three-upu", "--actuators", "0.3,0.3,0.3", "--all", "--method", "homotopy"])
+    assert out.exit_code != 0 and "does not cover three-upu" in out.output and "U-P-U" in out.output
+    assert "Traceback" not in out.output
     with pytest.raises(sm.InputError, match="method"):
         sm.fk("stewart-6sps", [1.2] * 6, all_solutions=True, method="newton")
 
@@ -167,3 +168,14 @@ def test_four_sps_cu_agrees_with_the_closed_form(phi):
     assert len(res.solutions) == len(closed.solutions) > 0
     for s in closed.solutions:  # every real assembly mode of the closed form: same height, same rotation
         assert min(abs(h.pose.p[2] - s.phi[0]) + np.linalg.norm(h.pose.R - s.rotation) for h in res.solutions) < 1e-6
+
+
+def test_three_rps_has_16_solutions_and_every_multistart_mode():
+    mech = catalog.resolve("three-rps")
+    legs = [0.34, 0.36, 0.32]
+    res = forward_position(mech, legs, all_solutions=True, method="homotopy")
+    assert res.search["complete"] and res.search["n_generic"] == 16  # the known count of the 3-RPS
+    assert len(res.solutions) == res.search["n_real"] and all(s.residual < 1e-10 for s in res.solutions)
+    ms = forward_position(mech, legs, all_solutions=True, n_seeds=40)
+    for m in ms.solutions:
+        assert min(np.linalg.norm(m.pose.p - h.pose.p) + np.linalg.norm(m.pose.R - h.pose.R) for h in res.solutions) < 1e-6

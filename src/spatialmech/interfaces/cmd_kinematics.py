@@ -220,7 +220,7 @@ def ik(model, xyz, euler, position, all_solutions, free, as_json):
               help="All real assembly modes: homotopy continuation (proven complete) where it covers the model, "
                    "else multi-start.")
 @click.option("--method", type=click.Choice(["auto", "homotopy", "multistart"]), default="auto", show_default=True,
-              help="Method of --all (homotopy: S-P-S legs, passive C-U limbs; see docs/homotopy.md).")
+              help="Method of --all (homotopy: S-P-S and R-P-S legs, passive C-U limbs; see docs/homotopy.md).")
 @click.option("--seeds", type=click.IntRange(min=1, max=MAX_SEEDS), default=None,
               help=f"Number of starts for --all (default: 200; 512 on the 4-SPS/CU closed form; at most {MAX_SEEDS}).")
 @tol_option("newton")

@@ -1,5 +1,5 @@
 """Every assembly mode of a platform on S-P-S legs (Gough-Stewart; with passive C-U / C-S
-limbs, e.g. the 4-SPS/CU) by homotopy continuation.
+limbs, e.g. the 4-SPS/CU) or R-P-S legs (the 3-RPS) by homotopy continuation.
 
 Formulation.  The platform displacement is written in Study parameters ``x = (e ; g)`` (two
 quaternions, projective): rotation ``R v = e v e* / (e.e)``, translation ``p = 2 g e* / (e.e)``.
@@ -11,7 +11,8 @@ the characteristic length ``L``) of length ``l`` is then one homogeneous quadric
 the squared leg length entering linearly.  With the Study quadric ``e.g = 0`` and a random
 complex affine patch ``c.x = 1`` this is a square system of 7 quadrics and 1 linear equation
 in 8 unknowns (Bezout number 128).  A passive C-U or C-S limb keeps its centre on the C
-axis: two more quadrics instead of two legs.  Points with ``e.e = 0`` are the exceptional generator of
+axis: two more quadrics instead of two legs; an R-P-S leg adds to its leg quadric that its S
+centre stays in the plane normal to the R axis.  Points with ``e.e = 0`` are the exceptional generator of
 the Study quadric: translation at infinity, never a pose; a generic instance has a
 two-dimensional component of them (``e = 0``, ``g.g = 0``), where 88 of the 128 paths end.
 
@@ -137,7 +138,26 @@ def _point_on_line(limb, L: float) -> tuple | None:
         return None
     if t.type == "U" and np.linalg.norm(t.freedoms[0].point - t.freedoms[1].point) > 1e-9 * L:
         return None
-    return u, rot.point, d
+    n1 = np.cross(d, [1.0, 0, 0] if abs(d[0]) < 0.9 else [0, 1.0, 0])
+    n1 /= np.linalg.norm(n1)
+    return u, rot.point, (n1, np.cross(d, n1))
+
+
+def _rps_plane(limb, L: float) -> tuple | None:
+    """(platform centre, base point, (axis,)) of an R-P-S leg whose slide is perpendicular to the
+    R axis and runs from the axis to the S centre (the centre stays in the plane normal to the
+    axis through the base point), else ``None``."""
+    if [j.type for j in limb.joints] != ["R", "P", "S"]:
+        return None
+    r, pj, sj = limb.joints
+    n = r.freedoms[0].direction / np.linalg.norm(r.freedoms[0].direction)
+    d = sj.point - r.freedoms[0].point
+    nd = float(np.linalg.norm(d))
+    sl = pj.freedoms[0]
+    if (nd < 1e-9 * L or abs(float(d @ n)) > 1e-9 * nd or abs(abs(float(d @ sl.direction)) - nd) > 1e-9 * nd
+            or not sl.actuated):
+        return None
+    return sj.point, r.freedoms[0].point, (n,)
 
 
 def unsupported_reason(mech: Mechanism) -> str | None:
@@ -153,9 +173,12 @@ def unsupported_reason(mech: Mechanism) -> str | None:
         if _point_on_line(limb, L) is not None:
             n_eq += 2
             continue
+        if _rps_plane(limb, L) is not None:
+            n_eq += 2
+            continue
         if len(types) != 3 or types[1] != "P" or not set(types[::2]) <= {"S", "U"} or types[::2] == ["U", "U"]:
-            return (f"limb {limb.name} is {'-'.join(types)} (the formulation covers S-P-S, U-P-S and S-P-U legs and "
-                    "C-U / C-S limbs with the centre on the C axis)")
+            return (f"limb {limb.name} is {'-'.join(types)} (the formulation covers S-P-S, U-P-S, S-P-U and R-P-S legs "
+                    "and C-U / C-S limbs with the centre on the C axis)")
         slide = limb.joints[1].freedoms[0]
         if not slide.actuated:
             return f"limb {limb.name}: its slide is not the actuator"
@@ -182,7 +205,7 @@ def stewart_system(mech: Mechanism) -> StewartSystem:
         raise InputError(f"model: homotopy forward position does not cover {mech.name}: {why}; use method='multistart'")
     L = float(mech.characteristic_length)
     legs = [limb for limb in mech.limbs if _point_on_line(limb, L) is None]
-    lines = tuple(x for x in (_point_on_line(limb, L) for limb in mech.limbs) if x is not None)
+    lines = tuple(x for x in (_point_on_line(limb, L) or _rps_plane(limb, L) for limb in mech.limbs) if x is not None)
     order = []
     for act in mech.actuators:
         ref = mech.freedom(act)
@@ -197,16 +220,13 @@ def stewart_system(mech: Mechanism) -> StewartSystem:
     return system_from_points(a, b, L=L, d_ref=d_ref, sign=sign, offset=offset, lines=lines)
 
 
-def _line_quadrics(u, o, d, L: float) -> list[np.ndarray]:
-    """Two quadrics ``n_k . vec((e u - o e + 2 g) e*) = 0``: the platform point ``u`` on the
-    line through ``o`` along ``d`` (``n_k`` perpendicular to ``d``)."""
+def _line_quadrics(u, o, normals, L: float) -> list[np.ndarray]:
+    """Quadrics ``n . vec((e u - o e + 2 g) e*) = 0``: the platform point ``u`` in the planes
+    through ``o`` normal to each ``n`` (two normals: on a line)."""
     K = np.hstack([_qmat_right(np.r_[0.0, u / L]) - _qmat_left(np.r_[0.0, o / L]), 2 * np.eye(4)])
     conj = np.diag([1.0, -1, -1, -1])
-    n1 = np.cross(d, [1.0, 0, 0] if abs(d[0]) < 0.9 else [0, 1.0, 0])
-    n1 /= np.linalg.norm(n1)
-    n2 = np.cross(d, n1)
     out = []
-    for n in (n1, n2):
+    for n in normals:
         M = np.zeros((_N, _N))
         for i in range(_N):
             for j in range(4):  # e components of the second argument
@@ -219,12 +239,13 @@ def system_from_points(base, platform, *, L: float | None = None, d_ref=None, si
                        lines: tuple = ()) -> StewartSystem:
     """The system of legs from ``base[k]`` to ``platform[k]`` (reference placement; by default
     the actuator values are the leg lengths) and point-on-line constraints ``lines``
-    (``(platform point, line point, direction)``); six equations in all."""
+    (``(platform point, base point, normals)``: one normal, a plane; two, a line); six
+    equations in all."""
     a = np.asarray(base, dtype=float).reshape(-1, 3)
     b = np.asarray(platform, dtype=float).reshape(-1, 3)
-    if len(a) + 2 * len(lines) != 6 or b.shape != a.shape:
-        raise InputError(f"base, platform: {len(a)} legs and {len(lines)} lines give {len(a) + 2 * len(lines)} "
-                         "equations, not 6")
+    n_eq = len(a) + sum(len(x[2]) for x in lines)
+    if n_eq != 6 or b.shape != a.shape:
+        raise InputError(f"base, platform: {len(a)} legs and {len(lines)} point constraints give {n_eq} equations, not 6")
     if L is None:
         pts = np.vstack([a, b])
         L = float(np.sqrt(np.mean(np.sum((pts - pts.mean(axis=0)) ** 2, axis=1))))
@@ -237,8 +258,8 @@ def system_from_points(base, platform, *, L: float | None = None, d_ref=None, si
         K = np.hstack([_qmat_right(np.r_[0.0, b[i] / L]) - _qmat_left(np.r_[0.0, a[i] / L]), 2 * np.eye(4)])
         Q[i + 1] = K.T @ K
     row = 1 + len(a)
-    for u, o, d in lines:
-        for M in _line_quadrics(np.asarray(u, float), np.asarray(o, float), np.asarray(d, float), L):
+    for u, o, normals in lines:
+        for M in _line_quadrics(np.asarray(u, float), np.asarray(o, float), normals, L):
             Q[row] = M
             row += 1
     return StewartSystem(a, b, np.asarray(d_ref, float), np.asarray(sign, float), np.asarray(offset, float), L, Q,
