@@ -324,7 +324,7 @@ def test_results_are_frozen_dataclasses():
 @pytest.mark.slow
 def test_one_progress_signature_for_fk_and_track():
     calls = []
-    sm.fk("stewart-6sps", [1.2] * 6, all_solutions=True, seeds=5,
+    sm.fk("stewart-6sps", [1.2] * 6, all_solutions=True, seeds=5, method="multistart",
           progress=lambda done, total, msg: calls.append(("fk", done, total, msg)))
     assert [c[1] for c in calls] == [1, 2, 3, 4, 5] and {c[2] for c in calls} == {5}
     calls.clear()

@@ -73,6 +73,7 @@ CASES = [
     (["fk", "four-sps-cu", "--actuators", FK_ACTUATORS, "--all", "--seeds", "16"], "fk", "four-sps-cu"),  # closed form
     (["fk", "four-sps-cu", "--actuators", FK_ACTUATORS], "fk", "four-sps-cu"),  # general engine
     (["fk", "stewart-6sps", "--actuators", "1.2,1.2,1.2,1.2,1.2,1.2"], "fk", "stewart-6sps"),
+    (["fk", "stewart-6sps", "--actuators", "1.2,1.2,1.2,1.2,1.2,1.2", "--all"], "fk", "stewart-6sps"),  # homotopy
     (["jacobian", "four-sps-cu", *POSE], "jacobian", "four-sps-cu"),
     (["jacobian", "five-cs-1", "--position", "3", "--driver", "rot1"], "jacobian", "five-cs-1"),
     (["jacobian", "five-cs-3", "--dj-table"], "jacobian", "five-cs-3"),

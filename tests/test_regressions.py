@@ -56,13 +56,19 @@ def run(*args):
 def test_fk_all_without_any_assembly_says_so_instead_of_crashing(model, values):
     """Absurd actuator values on general-engine models: a one-line error naming the number of
     starts and saying it is not a proof, exit code 2 (as the single-start 'no assembly found')."""
-    r = run("fk", model, "--actuators", values, "--all", "--seeds", "2")
+    r = run("fk", model, "--actuators", values, "--all", "--seeds", "2", "--method", "multistart")
     assert r.exit_code == 2, r.output
     assert "IndexError" not in r.output and "Traceback" not in r.output
     assert re.search(r"no assembly found among 3 starts \(0 converged\); not a proof that none exists", r.output), r.output
     # the JSON says the same with data: no solutions, nothing invented
-    d = json.loads(run("fk", model, "--actuators", values, "--all", "--seeds", "2", "--json").output)
+    d = json.loads(run("fk", model, "--actuators", values, "--all", "--seeds", "2", "--method", "multistart",
+                       "--json").output)
     assert d["n_solutions"] == 0 and not any(s["converged"] for s in d["solutions"])
+    # by homotopy (the default where it covers the model) the absence is proven: no real end point
+    r = run("fk", model, "--actuators", values, "--all")
+    assert r.exit_code == 0 and "0 real assembly modes" in r.output and "complete (proven)" in r.output, r.output
+    d = json.loads(run("fk", model, "--actuators", values, "--all", "--json").output)
+    assert d["complete"] is True and d["n_real"] == 0 and d["n_solutions"] == 0
 
 
 def test_fk_single_start_without_assembly_keeps_its_message():

@@ -155,13 +155,17 @@ class FKResult:
 
 
 def fk(model: ModelLike, actuators, *, all_solutions: bool = False, seeds: int | None = None, seed: int = 0,
-       degrees: bool = False, progress: Progress | None = None) -> FKResult:
+       degrees: bool = False, progress: Progress | None = None, method: str = "auto") -> FKResult:
     """Forward position: platform pose(s) for actuator values (``actuators``: a sequence in the
     order of ``mechanism.actuators`` or a mapping by freedom name; lengths in the model's unit,
     rotations in radians, or degrees with ``degrees=True``).
 
     From the reference configuration by Newton; ``all_solutions``: every assembly mode a
     multi-start search finds (``seeds`` starts: default 200, 512 on the 4-SPS/CU closed form).
+    ``method`` (with ``all_solutions``): ``"auto"`` (default: homotopy continuation where it
+    covers the model (S-P-S and R-P-S legs, passive C-U limbs), proven complete; on the 4-SPS/CU its closed form; else the
+    multi-start), ``"homotopy"`` or ``"multistart"``; see docs/homotopy.md.  The result's
+    ``to_dict()`` says ``complete`` and ``completeness``.
     Nothing is raised when no assembly is found: see ``converged`` and ``to_dict()``.
 
     >>> import spatialmech as sm
@@ -202,6 +206,15 @@ def fk(model: ModelLike, actuators, *, all_solutions: bool = False, seeds: int |
         seeds = check_int(seeds, "seeds", minimum=1)
     seed = check_int(seed, "seed")
     progress = optional_progress(progress)
+    if method not in ("auto", "homotopy", "multistart"):
+        raise InputError(f"method: expected 'auto', 'homotopy' or 'multistart', got {method!r}")
+    if all_solutions and method != "multistart":
+        from ..kinematics import homotopy as hc
+        from ..kinematics.closed_forms import four_sps_cu as k4c
+
+        closed = method == "auto" and k4c.geometry_of(mech) is not None  # the 4-SPS/CU keeps its closed form
+        if (hc.unsupported_reason(mech) is None and not closed) or method == "homotopy":
+            return FKResult(mech, values, forward_position(mech, values, all_solutions=True, seed=seed, method="homotopy"))
     if all_solutions:
         from ..kinematics.closed_forms import four_sps_cu as k4
         from ..kinematics.closed_forms import four_sps_cu_forward as k4f
@@ -211,7 +224,8 @@ def fk(model: ModelLike, actuators, *, all_solutions: bool = False, seeds: int |
             fa = k4f.forward_all(values, geometry=geom, **({} if seeds is None else {"n_seeds": seeds}))
             return FKResult(mech, values, fa, True)
     res: ForwardResult = forward_position(mech, values, all_solutions=all_solutions,
-                                          n_seeds=200 if seeds is None else seeds, seed=seed, progress=progress)
+                                          n_seeds=200 if seeds is None else seeds, seed=seed, progress=progress,
+                                          method="multistart" if method == "multistart" else "auto")
     return FKResult(mech, values, res)
 
 

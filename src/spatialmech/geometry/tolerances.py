@@ -44,7 +44,20 @@ import numpy as np
 
 from ..errors import InputError
 
-__all__ = ["DEFAULT", "NEAR_SINGULAR", "Tolerances", "characteristic_length", "current", "use"]
+__all__ = [
+    "DEFAULT",
+    "HOMOTOPY_INFINITY",
+    "HOMOTOPY_JUMP",
+    "HOMOTOPY_NEAR_REAL",
+    "HOMOTOPY_NEWTON",
+    "HOMOTOPY_REAL",
+    "HOMOTOPY_SINGULAR",
+    "NEAR_SINGULAR",
+    "Tolerances",
+    "characteristic_length",
+    "current",
+    "use",
+]
 
 
 @dataclass(frozen=True)
@@ -227,3 +240,17 @@ def characteristic_length(points, *, tol: Tolerances | None = None, field: str =
             "move the origin near the mechanism"
         )
     return L
+
+
+#: Homotopy continuation (:mod:`spatialmech.kinematics.homotopy`), all nondimensional: Newton
+#: corrector stopping size (relative to the point's norm), the largest first Newton update that
+#: a step may take (path-jumping guard), the inverse condition number below which an end point
+#: is singular, the ``|e.e| / |x|^2`` below which an end point is at infinity (the exceptional
+#: generator of the Study quadric), the imaginary part (relative) below which it is real, and
+#: below which a singular end point (located to a few digits only) seeds a real Newton polish.
+HOMOTOPY_NEWTON = 1e-11
+HOMOTOPY_JUMP = 1e-3
+HOMOTOPY_SINGULAR = 1e-7
+HOMOTOPY_INFINITY = 1e-7
+HOMOTOPY_REAL = 1e-7
+HOMOTOPY_NEAR_REAL = 1e-3

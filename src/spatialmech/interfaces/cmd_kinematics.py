@@ -217,18 +217,23 @@ def ik(model, xyz, euler, position, all_solutions, free, as_json):
 @click.argument("model")
 @click.option("--actuators", "values", required=True,
               help="Comma-separated actuator values in mechanism order (degrees / length).")
-@click.option("--all", "all_solutions", is_flag=True, help="Search all real assembly modes (multi-start).")
+@click.option("--all", "all_solutions", is_flag=True,
+              help="All real assembly modes: homotopy continuation (proven complete) where it covers the model, "
+                   "else multi-start.")
+@click.option("--method", type=click.Choice(["auto", "homotopy", "multistart"]), default="auto", show_default=True,
+              help="Method of --all (homotopy: S-P-S and R-P-S legs, passive C-U limbs; see docs/homotopy.md).")
 @click.option("--seeds", type=click.IntRange(min=1, max=MAX_SEEDS), default=None,
               help=f"Number of starts for --all (default: 200; 512 on the 4-SPS/CU closed form; at most {MAX_SEEDS}).")
 @tol_option("newton")
 @json_option
-def fk(model, values, all_solutions, seeds, as_json):
+def fk(model, values, all_solutions, method, seeds, as_json):
     """Forward position: platform pose(s) for actuator values.
 
     \b
     Examples:
       spatialmech fk stewart-6sps --actuators 1.2,1.2,1.2,1.2,1.2,1.2
       spatialmech fk four-sps-cu --actuators 0.21,0.25,0.22,0.19 --all --json
+      spatialmech fk stewart-6sps --actuators 1.2,1.2,1.2,1.2,1.2,1.2 --all
     """
     mech = catalog.resolve(model)
     raw = parse_numbers(values, "--actuators")
@@ -246,7 +251,17 @@ def fk(model, values, all_solutions, seeds, as_json):
     from ..kinematics.closed_forms import four_sps_cu as k4
     from ..kinematics.closed_forms import four_sps_cu_forward as k4f
 
-    geom = k4.geometry_of(mech) if all_solutions else None
+    closed = all_solutions and method == "auto" and k4.geometry_of(mech) is not None  # the 4-SPS/CU keeps its closed form
+    if all_solutions and method != "multistart" and not closed:
+        from ..kinematics import homotopy as hc
+
+        why = hc.unsupported_reason(mech)
+        if why is None:
+            _fk_homotopy(mech, vals, as_json)
+            return
+        if method == "homotopy":
+            raise InputError(f"--method: homotopy does not cover {mech.name}: {why}; use --method multistart")
+    geom = k4.geometry_of(mech) if all_solutions and method != "multistart" else None
     if geom is not None:  # the closed form of this limb layout: faster and more thorough
         fa = k4f.forward_all(np.asarray(vals), geometry=geom, **({} if seeds is None else {"n_seeds": seeds}))
         if as_json:
@@ -286,6 +301,12 @@ def fk(model, values, all_solutions, seeds, as_json):
         raise InputError(f"actuators: no assembly found (Newton did not converge; residual {r0:.2e}); try --all")
     click.echo(_fk_header(mech, [s.kind for s in converged], res.search["method"], res.search["seeds"],
                           res.search["converged_runs"]))
+    if all_solutions:
+        click.echo(f"  NOT proven complete: {res.search['completeness']}")
+    _fk_solution_lines(mech, converged)
+
+
+def _fk_solution_lines(mech: Mechanism, converged) -> None:
     for k, s in enumerate(converged):
         e = matrix_euler("ZYX", s.pose.R, degrees=True)
         lim = "within limits" if not s.outside_limits else "outside limits: " + ", ".join(s.outside_limits)
@@ -294,6 +315,25 @@ def fk(model, values, all_solutions, seeds, as_json):
         c = s.conditioning
         _fk_conditioning_lines(s.kind, c.sigma_min, c.condition, c.threshold, s.members, s.self_motion, mech.length_unit,
                                c.free_dim)
+
+
+def _fk_homotopy(mech: Mechanism, vals, as_json: bool) -> None:
+    """``fk --all`` by homotopy continuation: counts, completeness, the real assembly modes."""
+    res = forward_position(mech, vals, all_solutions=True, method="homotopy")
+    if as_json:
+        emit_json("fk", mech, res.to_dict(mech))
+        return
+    sr = res.search
+    sols = list(res.solutions)
+    kinds = [s.kind for s in sols]
+    n_sm = sum(k == "self-motion" for k in kinds)
+    click.echo(f"{mech.name}: {len(sols)} real assembly mode{'s' if len(sols) != 1 else ''}"
+               + (f" ({n_sm} of them self-motion sets)" if n_sm else "")
+               + f"; end points: {sr['n_real']} real, {sr['n_complex']} complex, {sr['n_singular']} singular, "
+               f"{sr['n_at_infinity']} at infinity, of {sr['n_generic']} generic solutions "
+               f"(homotopy continuation, {sr['elapsed_s']:.2f} s)")
+    click.echo(("  complete (proven): " if sr["complete"] else "  NOT proven complete: ") + sr["completeness"])
+    _fk_solution_lines(mech, sols)
 
 
 def _fk_header(mech: Mechanism, kinds, method: str, seeds: int, converged: int) -> str:

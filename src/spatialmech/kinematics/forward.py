@@ -17,6 +17,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..errors import InputError
+from ..geometry.tolerances import resolve as resolve_tolerances
 from ..geometry import screws as sc
 from ..model.mechanism import Mechanism, Pose
 from ..results import Progress
@@ -129,6 +130,7 @@ class ForwardResult:
             vals = freedom_values(mech, self.solutions[0].config.q)
             acts = {r.id: float(vals[i]) for i, r in enumerate(mech.freedom_refs) if r.id in mech.actuators}
         sols = [s for s in self.solutions if s.converged] or list(self.solutions[:1])
+        lift = _COMPLETENESS_KEYS if "endpoints" in self.search else _COMPLETENESS_KEYS[:2]
         names = {"seeds": "n_seeds", "converged_runs": "n_converged", "distinct": "n_distinct", "regular": "n_regular",
                  "singular": "n_singular", "self_motion_sets": "n_self_motion_sets"}  # as the closed forms
         return {
@@ -137,8 +139,13 @@ class ForwardResult:
             "n_solutions": sum(s.converged for s in self.solutions),
             "n_within_limits": sum(s.converged and not s.outside_limits for s in self.solutions),
             "solutions": [s.to_dict(mech) for s in sols],
-            "search": {names.get(k, k): v for k, v in self.search.items()},
+            **{k: self.search[k] for k in lift if k in self.search},
+            "search": {names.get(k, k): v for k, v in self.search.items() if k not in lift},
         }
+
+
+#: Search entries that ``ForwardResult.to_dict`` lifts to the top level of the JSON.
+_COMPLETENESS_KEYS = ("complete", "completeness", "n_complex", "n_real", "n_singular", "n_at_infinity", "endpoints")
 
 
 def _actuator_q(mech: Mechanism, values) -> dict[int, float]:
@@ -319,6 +326,7 @@ def forward_position(
     seed: int = 0,
     max_iter: int = 60,
     progress: Progress | None = None,
+    method: str = "multistart",
 ) -> ForwardResult:
     """Platform pose(s) for given actuator values (physical units, in ``mech.actuators`` order
     or a dict by name).
@@ -332,8 +340,26 @@ def forward_position(
     continuum are one result of kind ``self-motion`` (not many assembly modes).
     Non-converged runs are reported (``converged = False``), never returned as solutions of
     the all-solutions search.  ``progress(k, n_seeds, "assembly modes")`` after each start.
+
+    ``method`` (with ``all_solutions``): ``"multistart"`` (the search above, never a proof of
+    completeness), ``"homotopy"`` (every complex solution by homotopy continuation,
+    :mod:`spatialmech.kinematics.homotopy`; S-P-S and R-P-S legs and passive C-U / C-S limbs only, else ``InputError``) or
+    ``"auto"`` (homotopy where it covers the model).  The homotopy's real end points are
+    polished by the same Newton step and classified as the multi-start roots; the search then
+    holds ``complete``, ``completeness`` and the counts of every end point's status.
     """
+    if method not in ("multistart", "homotopy", "auto"):
+        raise InputError(f"method: expected 'multistart', 'homotopy' or 'auto', got {method!r}")
     targets = _actuator_q(mech, actuator_values)
+    if all_solutions and method != "multistart":
+        from . import homotopy as hc
+
+        why = hc.unsupported_reason(mech)
+        if why is None:
+            return _forward_homotopy(mech, targets, seed, max_iter)
+        if method == "homotopy":
+            raise InputError(f"method: homotopy forward position does not cover {mech.name}: {why}; "
+                             "use method='multistart'")
     if all_solutions and (int(n_seeds) != n_seeds or n_seeds < 1):
         raise InputError(f"n_seeds: expected a positive number of starts, got {n_seeds}")
     mask = active_mask(mech)
@@ -399,4 +425,84 @@ def forward_position(
                               f"{dedup:g} are one, isolated singular roots within {sdedup:g}; singular roots on one "
                               "self-motion traced with the actuators held are one result"),
               "singular_below": thr}
+    if all_solutions:
+        search["complete"] = False
+        search["completeness"] = ("multi-start search: not a proof; assembly modes may be missing" +
+                                  ("" if method == "multistart" else f" (homotopy does not cover {mech.name}: "
+                                   f"{hc.unsupported_reason(mech)})"))
+    return ForwardResult(tuple(sols), search)
+
+
+def _limbs_at(mech: Mechanism, D: np.ndarray, q0: np.ndarray, targets: dict[int, float], seed: int) -> Configuration:
+    """Every limb solved for the platform displacement ``D`` with its actuator held at its value
+    (from ``q0``, then from seeded random starts: an S-P-S leg also reaches its platform point
+    reversed through its base, with the opposite slide)."""
+    rng = np.random.default_rng(seed)
+    L = mech.characteristic_length
+    q = q0.copy()
+    tol = resolve_tolerances(None).closure
+    for ch, sl in zip(limb_chains(mech), limb_slices(mech), strict=True):
+        refs = mech.freedom_refs[sl]
+        lin = np.array([r.freedom.kind == "P" for r in refs])
+        hold = np.array([sl.start + k in targets for k in range(len(refs))])
+        best, rb, _ = limb_gauss_newton(ch, D, q[sl].copy(), lin, L, tol=tol, max_iter=100, hold=hold)
+        for _ in range(24):
+            if rb <= tol:
+                break
+            qs = np.where(hold, q[sl], np.where(lin, rng.uniform(-1, 1, len(refs)) * L, rng.uniform(-np.pi, np.pi, len(refs))))
+            qt, rt, _ = limb_gauss_newton(ch, D, qs, lin, L, tol=tol, max_iter=100, hold=hold)
+            if rt < rb:
+                best, rb = qt, rt
+        q[sl] = best
+    return Configuration(q, D)
+
+
+def _forward_homotopy(mech: Mechanism, targets: dict[int, float], seed: int, max_iter: int) -> ForwardResult:
+    """``forward_position(..., method="homotopy")``: the real end points polished with the
+    actuators held, grouped and classified as the multi-start roots."""
+    from ..geometry.rotations import transform
+    from . import homotopy as hc
+
+    refs = mech.freedom_refs
+    vals = [targets[refs.index(mech.freedom(a))] + mech.freedom(a).freedom.offset for a in mech.actuators]
+    hr = hc.homotopy_forward(mech, vals, seed=seed)
+    mask = active_mask(mech)
+    for i in targets:
+        mask[i] = False
+    L = mech.characteristic_length
+    runs = []
+    q0 = np.zeros(len(refs))
+    for i, v in targets.items():  # the slides start at their values (not the leg reversed through its base)
+        q0[i] = v
+    for e in hr.solutions:
+        if e.R is None or e.p is None:
+            continue
+        D = transform(e.R, e.p)
+        runs.append(_fk_from(mech, _limbs_at(mech, D, q0, targets, seed), targets, mask, max_iter))
+    conv = [r for r in runs if r.converged]
+    dedup, sdedup = dedup_tolerances()
+    locked = locked_actuators(mech)
+    keys = np.array([_pose_key(mech, r.config) for r in conv]).reshape(-1, 12)
+    conds = [forward_conditioning(mech, r.config) for r in conv]
+    groups = group_roots(keys, [c.singular for c in conds], [r.residual for r in conv],
+                         lambda i: _trace_self_motion(mech, locked, conv[i].config), dedup_tol=dedup,
+                         singular_dedup_tol=sdedup, prefer=[not within_limits(mech, r.config.q) for r in conv],
+                         free_dims=[c.free_dim for c in conds])
+    sols = []
+    for g in sorted(groups, key=lambda g: min(g.members)):
+        r = conv[g.rep]
+        sols.append(ForwardSolution(r.config, platform_pose(mech, r.config), True, r.residual, r.iterations,
+                                    tuple(within_limits(mech, r.config.q)), conds[g.rep], g.kind, len(g.members),
+                                    g.self_motion(keys, L)))
+    kinds = [s.kind for s in sols]
+    search = {"method": "homotopy continuation (Study parameters), real end points polished by Newton",
+              "seeds": 0, "seed": seed, "converged_runs": len(conv), "distinct": len(kinds),
+              "n_regular": kinds.count(AssemblyKind.REGULAR), "n_singular_roots": kinds.count(AssemblyKind.SINGULAR),
+              "n_self_motion_sets": kinds.count(AssemblyKind.SELF_MOTION),
+              "complete": hr.complete, "completeness": hr.completeness,
+              "n_complex": hr.count("complex"), "n_real": hr.count("real"), "n_singular": hr.count("singular"),
+              "n_at_infinity": hr.count("at_infinity"), "n_generic": hr.n_generic,
+              "n_paths": hr.n_paths_total_degree, "elapsed_s": hr.seconds, "generic_elapsed_s": hr.seconds_generic,
+              "generic_cached": hr.cached, "endpoints": [e.to_dict() for e in hr.solutions],
+              "singular_below": singular_threshold()}
     return ForwardResult(tuple(sols), search)

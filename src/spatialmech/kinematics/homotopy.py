@@ -1,0 +1,566 @@
+"""Every assembly mode of a platform on S-P-S legs (Gough-Stewart; with passive C-U / C-S
+limbs, e.g. the 4-SPS/CU) or R-P-S legs (the 3-RPS) by homotopy continuation.
+
+Formulation.  The platform displacement is written in Study parameters ``x = (e ; g)`` (two
+quaternions, projective): rotation ``R v = e v e* / (e.e)``, translation ``p = 2 g e* / (e.e)``.
+A leg from base point ``a`` to platform point ``b`` (its reference placement, both divided by
+the characteristic length ``L``) of length ``l`` is then one homogeneous quadric
+
+    |e b - a e + 2 g|^2 - (l / L)^2 (e.e) = 0,
+
+the squared leg length entering linearly.  With the Study quadric ``e.g = 0`` and a random
+complex affine patch ``c.x = 1`` this is a square system of 7 quadrics and 1 linear equation
+in 8 unknowns (Bezout number 128).  A passive C-U or C-S limb keeps its centre on the C
+axis: two more quadrics instead of two legs; an R-P-S leg adds to its leg quadric that its S
+centre stays in the plane normal to the R axis.  Points with ``e.e = 0`` are the exceptional generator of
+the Study quadric: translation at infinity, never a pose; a generic instance has a
+two-dimensional component of them (``e = 0``, ``g.g = 0``), where 88 of the 128 paths end.
+
+Method.  (1) A total-degree homotopy ``(1 - t) gamma G + t F`` (``G_j = x_j^2 - x_7^2``, 128
+start points, random complex ``gamma``) to a generic complex instance (random complex squared
+leg lengths), once per geometry (cached in memory): every path must end either at a finite
+nonsingular point or at the exceptional set, or the run is repeated with other random numbers;
+by the gamma trick every isolated solution of the generic instance is the end of a path, so the
+finite nonsingular end points are all of them (40 for a general 6-6 geometry).  (2) A parameter
+homotopy along the straight segment from the generic squared lengths to the requested ones
+tracks exactly those paths: every isolated solution of the request is the end of one of them
+(the segment from a generic complex point avoids the discriminant before its end).
+
+The tracker is vectorised over paths in NumPy: 4th-order Runge-Kutta predictor on the
+Davidenko equation, Newton corrector with a path-jumping guard (the first update must be small
+and the second must contract), step halved on rejection and grown on acceptance.  End game:
+a path that cannot reach ``t = 1`` (its step falls below ``1e-14``) is classified at its last
+point: at infinity when ``|e.e| / |x|^2`` is small (the platform escapes), else singular. End
+points are classified by the inverse condition number of the row-normalised Jacobian
+(singular), ``|e.e| / |x|^2`` (at infinity) and the size of the imaginary part after removing
+the projective phase (real).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import InputError
+from ..geometry.tolerances import (
+    HOMOTOPY_INFINITY,
+    HOMOTOPY_JUMP,
+    HOMOTOPY_NEAR_REAL,
+    HOMOTOPY_NEWTON,
+    HOMOTOPY_REAL,
+    HOMOTOPY_SINGULAR,
+)
+from ..model.mechanism import Mechanism
+
+__all__ = [
+    "HomotopyResult",
+    "HomotopySolution",
+    "StewartSystem",
+    "homotopy_forward",
+    "stewart_system",
+    "study_to_pose",
+    "system_from_points",
+    "track",
+    "unsupported_reason",
+]
+
+_N = 8  # unknowns: e0..e3, g0..g3
+
+
+def _qmat_left(q) -> np.ndarray:
+    """``L(q)`` with ``q r = L(q) r`` (quaternions scalar first)."""
+    w, x, y, z = q
+    return np.array([[w, -x, -y, -z], [x, w, -z, y], [y, z, w, -x], [z, -y, x, w]], dtype=float)
+
+
+def _qmat_right(r) -> np.ndarray:
+    """``R(r)`` with ``q r = R(r) q``."""
+    w, x, y, z = r
+    return np.array([[w, -x, -y, -z], [x, w, z, -y], [y, -z, w, x], [z, y, -x, w]], dtype=float)
+
+
+def _qmul(q, r):
+    w1, x1, y1, z1 = q
+    w2, x2, y2, z2 = r
+    return np.array([w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2, w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+                     w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2, w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2])
+
+
+@dataclass(frozen=True, eq=False)
+class StewartSystem:
+    """The polynomial system of a platform on actuated S-P-S legs and passive point-on-line
+    limbs (see the module docstring).
+
+    ``base``, ``platform``: the legs' base and platform centres at the reference (model units);
+    the squared leg length of leg ``k`` is ``(d_ref[k] + sign[k] * (v_k - offset[k]))^2`` for
+    the actuator value ``v_k``.  ``lines``: per point-on-line limb, the platform point at the
+    reference, a point of the base line and its direction (a C-U or C-S limb: the U or S centre
+    stays on the C axis; two quadrics each)."""
+
+    base: np.ndarray  # (n_legs, 3)
+    platform: np.ndarray  # (n_legs, 3)
+    d_ref: np.ndarray
+    sign: np.ndarray
+    offset: np.ndarray
+    L: float
+    Q: np.ndarray = field(repr=False)  # (7, 8, 8): Study quadric, the legs without the length term, the lines
+    lines: tuple = ()
+
+    @property
+    def n_legs(self) -> int:
+        return len(self.base)
+
+    def lengths(self, values) -> np.ndarray:
+        """Leg lengths (model units) for actuator values."""
+        v = np.asarray(values, dtype=float)
+        return self.d_ref + self.sign * (v - self.offset)
+
+    def key(self) -> bytes:
+        return np.round(self.Q, 12).tobytes()
+
+
+def _point_on_line(limb, L: float) -> tuple | None:
+    """(platform point, line point, line direction) of a C-U / C-S limb whose centre is on the C
+    axis, else ``None``."""
+    types = [j.type for j in limb.joints]
+    if types not in (["C", "U"], ["C", "S"]) or any(f.actuated for j in limb.joints for f in j.freedoms):
+        return None
+    c, t = limb.joints
+    rot = next(f for f in c.freedoms if f.kind == "R")
+    sl = next(f for f in c.freedoms if f.kind == "P")
+    d = rot.direction / np.linalg.norm(rot.direction)
+    if np.linalg.norm(np.cross(d, sl.direction)) > 1e-9:
+        return None
+    u = t.point
+    if np.linalg.norm(np.cross(u - rot.point, d)) > 1e-9 * L:
+        return None
+    if t.type == "U" and np.linalg.norm(t.freedoms[0].point - t.freedoms[1].point) > 1e-9 * L:
+        return None
+    n1 = np.cross(d, [1.0, 0, 0] if abs(d[0]) < 0.9 else [0, 1.0, 0])
+    n1 /= np.linalg.norm(n1)
+    return u, rot.point, (n1, np.cross(d, n1))
+
+
+def _rps_plane(limb, L: float) -> tuple | None:
+    """(platform centre, base point, (axis,)) of an R-P-S leg whose slide is perpendicular to the
+    R axis and runs from the axis to the S centre (the centre stays in the plane normal to the
+    axis through the base point), else ``None``."""
+    if [j.type for j in limb.joints] != ["R", "P", "S"]:
+        return None
+    r, pj, sj = limb.joints
+    n = r.freedoms[0].direction / np.linalg.norm(r.freedoms[0].direction)
+    d = sj.point - r.freedoms[0].point
+    nd = float(np.linalg.norm(d))
+    sl = pj.freedoms[0]
+    if (nd < 1e-9 * L or abs(float(d @ n)) > 1e-9 * nd or abs(abs(float(d @ sl.direction)) - nd) > 1e-9 * nd
+            or not sl.actuated):
+        return None
+    return sj.point, r.freedoms[0].point, (n,)
+
+
+def unsupported_reason(mech: Mechanism) -> str | None:
+    """``None`` when the homotopy formulation covers ``mech``, else why not (one sentence)."""
+    if mech.bodies:
+        return "a link-and-joint graph (internal bodies)"
+    L = mech.characteristic_length
+    n_eq = 0
+    for limb in mech.limbs:
+        types = [j.type for j in limb.joints]
+        if limb.base != "ground" or limb.tip is not None:
+            return f"limb {limb.name} does not run from the ground to the platform"
+        if _point_on_line(limb, L) is not None:
+            n_eq += 2
+            continue
+        if _rps_plane(limb, L) is not None:
+            n_eq += 2
+            continue
+        if len(types) != 3 or types[1] != "P" or not set(types[::2]) <= {"S", "U"} or types[::2] == ["U", "U"]:
+            return (f"limb {limb.name} is {'-'.join(types)} (the formulation covers S-P-S, U-P-S, S-P-U and R-P-S legs "
+                    "and C-U / C-S limbs with the centre on the C axis)")
+        slide = limb.joints[1].freedoms[0]
+        if not slide.actuated:
+            return f"limb {limb.name}: its slide is not the actuator"
+        for j in limb.joints[::2]:
+            if j.type == "U" and np.linalg.norm(j.freedoms[0].point - j.freedoms[1].point) > 1e-9 * L:
+                return f"limb {limb.name}: the axes of {j.name} do not meet"
+        d = limb.joints[2].point - limb.joints[0].point
+        nd = float(np.linalg.norm(d))
+        if nd < 1e-9 * L or abs(abs(float(d @ slide.direction)) - nd) > 1e-9 * nd:
+            return f"limb {limb.name}: the slide does not run along the line of its two centres"
+        n_eq += 1
+    others = [r.id for r in mech.freedom_refs if r.freedom.actuated and r.freedom.kind != "P"]
+    if others:
+        return "actuators other than the leg slides"
+    if n_eq != 6:
+        return f"its limbs give {n_eq} equations on the platform pose, not 6"
+    return None
+
+
+def stewart_system(mech: Mechanism) -> StewartSystem:
+    """The system of ``mech`` (``InputError`` naming the reason when it is not covered)."""
+    why = unsupported_reason(mech)
+    if why is not None:
+        raise InputError(f"model: homotopy forward position does not cover {mech.name}: {why}; use method='multistart'")
+    L = float(mech.characteristic_length)
+    legs = [limb for limb in mech.limbs if _point_on_line(limb, L) is None]
+    lines = tuple(x for x in (_point_on_line(limb, L) or _rps_plane(limb, L) for limb in mech.limbs) if x is not None)
+    order = []
+    for act in mech.actuators:
+        ref = mech.freedom(act)
+        order.append(next(i for i, limb in enumerate(legs) if limb.joints[1].freedoms[0] is ref.freedom))
+    legs = [legs[k] for k in order]
+    a = np.array([limb.joints[0].point for limb in legs], dtype=float).reshape(-1, 3)
+    b = np.array([limb.joints[2].point for limb in legs], dtype=float).reshape(-1, 3)
+    d = b - a
+    d_ref = np.linalg.norm(d, axis=1)
+    sign = np.array([np.sign(float(d[i] @ limb.joints[1].freedoms[0].direction)) for i, limb in enumerate(legs)])
+    offset = np.array([limb.joints[1].freedoms[0].offset for limb in legs])
+    return system_from_points(a, b, L=L, d_ref=d_ref, sign=sign, offset=offset, lines=lines)
+
+
+def _line_quadrics(u, o, normals, L: float) -> list[np.ndarray]:
+    """Quadrics ``n . vec((e u - o e + 2 g) e*) = 0``: the platform point ``u`` in the planes
+    through ``o`` normal to each ``n`` (two normals: on a line)."""
+    K = np.hstack([_qmat_right(np.r_[0.0, u / L]) - _qmat_left(np.r_[0.0, o / L]), 2 * np.eye(4)])
+    conj = np.diag([1.0, -1, -1, -1])
+    out = []
+    for n in normals:
+        M = np.zeros((_N, _N))
+        for i in range(_N):
+            for j in range(4):  # e components of the second argument
+                M[i, j] = n @ _qmul(K[:, i], conj[:, j])[1:]
+        out.append(0.5 * (M + M.T))
+    return out
+
+
+def system_from_points(base, platform, *, L: float | None = None, d_ref=None, sign=None, offset=None,
+                       lines: tuple = ()) -> StewartSystem:
+    """The system of legs from ``base[k]`` to ``platform[k]`` (reference placement; by default
+    the actuator values are the leg lengths) and point-on-line constraints ``lines``
+    (``(platform point, base point, normals)``: one normal, a plane; two, a line); six
+    equations in all."""
+    a = np.asarray(base, dtype=float).reshape(-1, 3)
+    b = np.asarray(platform, dtype=float).reshape(-1, 3)
+    n_eq = len(a) + sum(len(x[2]) for x in lines)
+    if n_eq != 6 or b.shape != a.shape:
+        raise InputError(f"base, platform: {len(a)} legs and {len(lines)} point constraints give {n_eq} equations, not 6")
+    if L is None:
+        pts = np.vstack([a, b])
+        L = float(np.sqrt(np.mean(np.sum((pts - pts.mean(axis=0)) ** 2, axis=1))))
+    if d_ref is None:
+        d_ref = np.linalg.norm(b - a, axis=1)
+        sign, offset = np.ones(len(a)), d_ref.copy()
+    Q = np.zeros((7, _N, _N))
+    Q[0, :4, 4:] = Q[0, 4:, :4] = 0.5 * np.eye(4)
+    for i in range(len(a)):
+        K = np.hstack([_qmat_right(np.r_[0.0, b[i] / L]) - _qmat_left(np.r_[0.0, a[i] / L]), 2 * np.eye(4)])
+        Q[i + 1] = K.T @ K
+    row = 1 + len(a)
+    for u, o, normals in lines:
+        for M in _line_quadrics(np.asarray(u, float), np.asarray(o, float), normals, L):
+            Q[row] = M
+            row += 1
+    return StewartSystem(a, b, np.asarray(d_ref, float), np.asarray(sign, float), np.asarray(offset, float), L, Q,
+                         tuple(lines))
+
+
+# ------------------------------------------------------------------------------ evaluation
+def _eval_target(Q: np.ndarray, c: np.ndarray, X: np.ndarray, l2: np.ndarray):
+    """F and its Jacobian for points ``X`` (n, 8) and squared lengths ``l2`` (n, legs)."""
+    m = l2.shape[1]
+    QX = np.einsum("kij,nj->nki", Q, X)  # (n, 7, 8)
+    F = np.empty((len(X), _N), dtype=complex)
+    J = np.empty((len(X), _N, _N), dtype=complex)
+    F[:, :7] = np.einsum("nki,ni->nk", QX, X)
+    E = np.einsum("ni,ni->n", X[:, :4], X[:, :4])
+    F[:, 1 : 1 + m] -= l2 * E[:, None]
+    J[:, :7] = 2 * QX
+    J[:, 1 : 1 + m, :4] -= 2 * l2[:, :, None] * X[:, None, :4]
+    F[:, 7] = X @ c - 1
+    J[:, 7] = c
+    return F, J, E
+
+
+def track(fun, X0: np.ndarray, *, h0: float = 0.02, hmin: float = 1e-14, max_steps: int = 4000):
+    """Track the paths ``H(x, t) = 0`` from ``t = 0`` (points ``X0``, (n, m)) to ``t = 1``.
+
+    ``fun(X, t)`` (``t``: (n,)) returns ``H`` (n, m), ``H_x`` (n, m, m) and ``H_t`` (n, m).
+    Returns ``(X, t, ok, steps)``: the end points, the ``t`` reached, whether ``t = 1`` was
+    reached with a converged corrector, and the accepted steps per path."""
+    X = np.array(X0, dtype=complex)
+    n = len(X)
+    t = np.zeros(n)
+    h = np.full(n, h0)
+    done = np.zeros(n, bool)
+    failed = np.zeros(n, bool)
+    steps = np.zeros(n, int)
+    good = np.zeros(n, int)
+
+    def vel(x, tt):
+        _, Hx, Ht = fun(x, tt)
+        return -np.linalg.solve(Hx, Ht[..., None])[..., 0]
+
+    for _ in range(max_steps):
+        idx = np.flatnonzero(~done & ~failed)
+        if idx.size == 0:
+            break
+        x, tt = X[idx], t[idx]
+        hh = np.minimum(h[idx], 1.0 - tt)
+        with np.errstate(all="ignore"):
+            try:
+                k1 = vel(x, tt)
+                k2 = vel(x + 0.5 * hh[:, None] * k1, tt + 0.5 * hh)
+                k3 = vel(x + 0.5 * hh[:, None] * k2, tt + 0.5 * hh)
+                k4 = vel(x + hh[:, None] * k3, tt + hh)
+                xc = x + hh[:, None] / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+                tn = tt + hh
+                nx = 1 + np.linalg.norm(xc, axis=1)
+                H, Hx, _ = fun(xc, tn)
+                dx = np.linalg.solve(Hx, H[..., None])[..., 0]
+                d0 = np.linalg.norm(dx, axis=1) / nx
+                xc = xc - dx
+                H, Hx, _ = fun(xc, tn)
+                dx = np.linalg.solve(Hx, H[..., None])[..., 0]
+                d1 = np.linalg.norm(dx, axis=1) / nx
+                xc = xc - dx
+            except np.linalg.LinAlgError:  # a singular Jacobian in the batch: go path by path
+                ok = np.zeros(idx.size, bool)
+                h[idx] *= 0.5
+                failed[idx[h[idx] < hmin]] = True
+                continue
+            ok = np.isfinite(d0) & np.isfinite(d1) & (d0 < HOMOTOPY_JUMP) & ((d1 < 0.1 * d0) | (d1 < HOMOTOPY_NEWTON))
+        acc = idx[ok]
+        X[acc] = xc[ok]
+        t[acc] = tn[ok]
+        steps[acc] += 1
+        good[acc] += 1
+        h[acc] = np.where(good[acc] >= 2, 2.0 * h[acc], h[acc])
+        good[acc] = np.where(good[acc] >= 2, 0, good[acc])
+        rej = idx[~ok]
+        h[rej] *= 0.5
+        good[rej] = 0
+        done[acc[t[acc] >= 1.0]] = True
+        failed[rej[h[rej] < hmin]] = True
+    return X, t, done, steps
+
+
+def _refine(Q, c, X, l2, iters: int = 4):
+    """Newton at ``t = 1`` (batched; a point whose step fails keeps its last value)."""
+    X = X.copy()
+    with np.errstate(all="ignore"):
+        for _ in range(iters):
+            F, J, _ = _eval_target(Q, c, X, l2)
+            ok = np.all(np.isfinite(J), axis=(1, 2)) & np.all(np.isfinite(F), axis=1)
+            ok &= np.abs(np.linalg.det(np.where(ok[:, None, None], J, np.eye(_N)))) > 0
+            if not ok.any():
+                break
+            dx = np.linalg.solve(J[ok], F[ok][..., None])[..., 0]
+            Xn = X[ok] - dx
+            fin = np.all(np.isfinite(Xn), axis=1)
+            X[np.flatnonzero(ok)[fin]] = Xn[fin]
+        F, J, E = _eval_target(Q, c, X, l2)
+    return X, F, J, E
+
+
+def _classify(Q, c, X, l2):
+    """Status of each end point: (status, rcond, rel_inf, imag_rel, residual, y, x refined),
+    ``y`` the point with its projective phase removed, ``x`` in the affine patch."""
+    if len(X) == 0:
+        return []
+    l2 = np.broadcast_to(l2, (len(X), np.shape(l2)[-1]))
+    xr, F, J, E = _refine(Q, c, X, l2)
+    out = []
+    with np.errstate(all="ignore"):
+        nx = np.linalg.norm(xr, axis=1)
+        rows = J / np.maximum(np.linalg.norm(J, axis=2, keepdims=True), 1e-300)
+        finite = np.all(np.isfinite(rows), axis=(1, 2))
+        sv = np.linalg.svd(np.where(finite[:, None, None], rows, np.eye(_N)), compute_uv=False)
+    for n in range(len(X)):
+        x = xr[n]
+        rel_inf = float(abs(E[n])) / nx[n] ** 2 if nx[n] > 0 and np.isfinite(nx[n]) else 0.0
+        rcond = float(sv[n, -1] / sv[n, 0]) if finite[n] else 0.0
+        k = int(np.argmax(np.abs(x)))
+        y = x * (abs(x[k]) / x[k]) if x[k] != 0 else x
+        imag = float(np.linalg.norm(y.imag) / max(float(np.linalg.norm(y)), 1e-300))
+        res = float(np.linalg.norm(F[n, :7]) / max(nx[n] ** 2, 1e-300))
+        if not np.isfinite(nx[n]) or rel_inf < HOMOTOPY_INFINITY:
+            st = "at_infinity"
+        elif rcond < HOMOTOPY_SINGULAR:
+            st = "singular"
+        elif imag < HOMOTOPY_REAL:
+            st = "real"
+        else:
+            st = "complex"
+        out.append((st, rcond, rel_inf, imag, res, y, x))
+    return out
+
+
+def study_to_pose(x, L: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+    """Rotation and translation (model units, ``L`` the length scale) of real Study parameters."""
+    x = np.real(np.asarray(x))
+    e, g = x[:4], x[4:]
+    E = float(e @ e)
+    q = e / np.sqrt(E)
+    w, i, j, k = q
+    R = np.array([[1 - 2 * (j * j + k * k), 2 * (i * j - w * k), 2 * (i * k + w * j)],
+                  [2 * (i * j + w * k), 1 - 2 * (i * i + k * k), 2 * (j * k - w * i)],
+                  [2 * (i * k - w * j), 2 * (j * k + w * i), 1 - 2 * (i * i + j * j)]])
+    p = 2 * _qmul(g, e * np.array([1, -1, -1, -1]))[1:] / E * L
+    return R, p
+
+
+# ------------------------------------------------------------------------------ generic instance
+@dataclass(frozen=True, eq=False)
+class _Generic:
+    c: np.ndarray
+    l2: np.ndarray
+    X: np.ndarray  # (N, 8) the isolated solutions
+    n_paths: int
+    n_at_infinity: int
+    attempts: int
+    seconds: float
+
+
+_CACHE: dict[bytes, _Generic] = {}
+
+
+def _generic_solve(sysm: StewartSystem, seed: int = 0, max_attempts: int = 3) -> tuple[_Generic, bool]:
+    """Total-degree homotopy to a generic complex instance; (result, every path accounted for)."""
+    key = sysm.key()
+    if key in _CACHE:
+        return _CACHE[key], True
+    t0 = time.perf_counter()
+    rng = np.random.default_rng(seed)
+    best = None
+    for attempt in range(1, max_attempts + 1):
+        c = rng.normal(size=_N) + 1j * rng.normal(size=_N)
+        nl = sysm.n_legs
+        l2 = (1 + rng.random(nl)) * np.exp(1j * rng.uniform(-np.pi, np.pi, nl))
+        gamma = np.exp(1j * rng.uniform(0, 2 * np.pi))
+        signs = np.array(np.meshgrid(*[[1.0, -1.0]] * 7, indexing="ij")).reshape(7, -1).T  # (128, 7)
+        S = np.hstack([signs, np.ones((len(signs), 1))]).astype(complex)
+        X0 = S / (S @ c)[:, None]
+        Q = sysm.Q
+
+        def fun(X, t, c=c, l2=l2, gamma=gamma, Q=Q):
+            F, J, _ = _eval_target(Q, c, X, np.broadcast_to(l2, (len(X), len(l2))))
+            G = np.empty_like(F)
+            JG = np.zeros_like(J)
+            G[:, :7] = X[:, :7] ** 2 - X[:, 7:8] ** 2
+            idx = np.arange(7)
+            JG[:, idx, idx] = 2 * X[:, :7]
+            JG[:, :7, 7] = -2 * X[:, 7:8]
+            s = t[:, None]
+            H = (1 - s) * gamma * G + s * F
+            H[:, 7] = F[:, 7]
+            Hx = (1 - s[..., None]) * gamma * JG + s[..., None] * J
+            Hx[:, 7] = J[:, 7]
+            Ht = F - gamma * G
+            Ht[:, 7] = 0
+            return H, Hx, Ht
+
+        X, _, _, _ = track(fun, X0)
+        cls = _classify(Q, c, X, l2)
+        fin = [i for i, r in enumerate(cls) if r[0] in ("real", "complex")]
+        inf = [i for i, r in enumerate(cls) if r[0] == "at_infinity"]
+        pts = np.array([cls[i][6] for i in fin]).reshape(-1, _N)
+        distinct = _distinct(pts)
+        accounted = len(fin) + len(inf) == len(X) and distinct
+        g = _Generic(c, l2, pts, len(X), len(inf), attempt, time.perf_counter() - t0)
+        if accounted:
+            _CACHE[key] = g
+            return g, True
+        if best is None or len(fin) > len(best.X):
+            best = g
+    assert best is not None
+    return best, False
+
+
+def _distinct(P: np.ndarray) -> bool:
+    if len(P) < 2:
+        return True
+    Pn = P / np.linalg.norm(P, axis=1, keepdims=True)
+    G = np.abs(Pn.conj() @ Pn.T)
+    np.fill_diagonal(G, 0)
+    return bool(np.all(G < 1 - 1e-8))
+
+
+# ------------------------------------------------------------------------------ results
+@dataclass(frozen=True, eq=False)
+class HomotopySolution:
+    """One end point: ``status`` real / complex / singular / at_infinity, the Study parameters
+    (projective, phase removed), the inverse condition number of the row-normalised Jacobian,
+    ``|e.e| / |x|^2``, the relative residual and, for a real end point, the displacement."""
+
+    status: str
+    study: np.ndarray
+    rcond: float
+    infinity_ratio: float
+    imag_ratio: float
+    residual: float
+    R: np.ndarray | None = None
+    p: np.ndarray | None = None
+
+    def to_dict(self) -> dict:
+        return {"status": self.status, "study_parameters_real": [float(v) for v in self.study.real],
+                "study_parameters_imag": [float(v) for v in self.study.imag], "inverse_condition": self.rcond,
+                "infinity_ratio": self.infinity_ratio, "imaginary_ratio": self.imag_ratio, "residual": self.residual}
+
+
+@dataclass(frozen=True, eq=False)
+class HomotopyResult:
+    solutions: tuple[HomotopySolution, ...]
+    complete: bool
+    completeness: str
+    n_generic: int
+    n_paths_total_degree: int
+    seconds_generic: float
+    seconds: float
+    cached: bool
+
+    def count(self, status: str) -> int:
+        return sum(s.status == status for s in self.solutions)
+
+
+def homotopy_forward(mech: Mechanism | StewartSystem, actuator_values, *, seed: int = 0) -> HomotopyResult:
+    """Every complex solution of the forward position of a 6-leg S-P-S platform for actuator
+    values (model units, in ``mech.actuators`` order): see the module docstring."""
+    t0 = time.perf_counter()
+    sysm = mech if isinstance(mech, StewartSystem) else stewart_system(mech)
+    vals = np.asarray(actuator_values, dtype=float).ravel()
+    if vals.shape != (sysm.n_legs,) or not np.all(np.isfinite(vals)):
+        raise InputError(f"actuators: expected {sysm.n_legs} finite values, got {vals.tolist()}")
+    cached = sysm.key() in _CACHE
+    gen, accounted = _generic_solve(sysm, seed=seed)
+    l2t = (sysm.lengths(vals) / sysm.L) ** 2
+    l20 = gen.l2
+    Q, c = sysm.Q, gen.c
+
+    def fun(X, t):
+        lt = (1 - t)[:, None] * l20 + t[:, None] * l2t
+        F, J, E = _eval_target(Q, c, X, lt)
+        Ht = np.zeros_like(F)
+        Ht[:, 1 : 1 + len(l2t)] = -(l2t - l20)[None, :] * E[:, None]
+        return F, J, Ht
+
+    X, _, _, _ = track(fun, gen.X) if len(gen.X) else (gen.X, None, None, None)
+    sols = []
+    for st, rc, ri, im, res, y, _ in _classify(Q, c, X, l2t):
+        R = p = None
+        if (st == "real" or (st == "singular" and im < HOMOTOPY_NEAR_REAL)) and ri >= HOMOTOPY_INFINITY:
+            R, p = study_to_pose(y / np.linalg.norm(y), sysm.L)
+        sols.append(HomotopySolution(st, y, rc, ri, im, res, R, p))
+    how = (f"total-degree homotopy ({gen.n_paths} paths, gamma trick) to a generic complex instance: every path "
+           f"accounted for ({len(gen.X)} finite nonsingular, {gen.n_at_infinity} at the exceptional generator e.e = 0); "
+           f"parameter homotopy of those {len(gen.X)} paths to the requested leg lengths")
+    n_sing = sum(s.status == "singular" for s in sols)
+    if accounted and n_sing:
+        how += (f"; but {n_sing} end point(s) are singular (a continuum of solutions or a multiple root at these values, "
+                "located to a few digits only): not proven complete there, real points near them polished and reported")
+    if not accounted:
+        how = (f"NOT complete: {gen.n_paths - len(gen.X) - gen.n_at_infinity} of the {gen.n_paths} total-degree paths "
+               f"ended neither at a finite nonsingular point nor at infinity after {gen.attempts} attempts")
+    return HomotopyResult(tuple(sols), accounted and not n_sing, how, len(gen.X), gen.n_paths, gen.seconds,
+                          time.perf_counter() - t0, cached)

@@ -1,0 +1,181 @@
+"""Forward position of 6-leg S-P-S platforms by homotopy continuation (issue 13)."""
+
+from __future__ import annotations
+
+import json
+import re
+import shutil
+import subprocess
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+from scipy.spatial.transform import Rotation
+
+import spatialmech as sm
+from spatialmech import catalog
+from spatialmech.interfaces.cli import cli as main
+from spatialmech.kinematics import homotopy as hc
+from spatialmech.kinematics.forward import forward_position
+
+
+def _lengths(sysm, R, p):
+    return np.linalg.norm((R @ sysm.platform.T).T + p - sysm.base, axis=1)
+
+
+@pytest.fixture(scope="module")
+def general():
+    """A general 6-6 geometry and a real pose of it (its leg lengths)."""
+    rng = np.random.default_rng(11)
+    sysm = hc.system_from_points(rng.normal(size=(6, 3)), rng.normal(size=(6, 3)) * 0.7 + [0, 0, 1.5])
+    R = Rotation.from_rotvec([0.2, -0.1, 0.3]).as_matrix()
+    p = np.array([0.1, -0.05, 0.2])
+    lengths = _lengths(sysm, R, p)
+    return sysm, R, p, lengths, hc.homotopy_forward(sysm, lengths)
+
+
+def test_general_6_6_has_40_solutions_proven(general):
+    r = general[4]
+    assert r.complete and "every path accounted for" in r.completeness
+    assert r.n_generic == 40 and len(r.solutions) == 40
+    assert r.count("at_infinity") + r.count("singular") == 0
+    assert r.count("real") + r.count("complex") == 40
+    assert r.count("real") % 2 == 0  # complex solutions come in conjugate pairs
+
+
+def test_every_real_solution_closes_and_the_pose_is_among_them(general):
+    sysm, R, p, lengths, r = general
+    real = [s for s in r.solutions if s.status == "real"]
+    assert real
+    for s in real:  # closure residual of each real solution (leg lengths round trip)
+        assert np.allclose(_lengths(sysm, s.R, s.p), lengths, atol=1e-9)
+        assert np.allclose(s.R @ s.R.T, np.eye(3), atol=1e-10)
+    assert min(np.linalg.norm(s.p - p) + np.linalg.norm(s.R - R) for s in real) < 1e-8
+
+
+def test_parameter_homotopy_resolve_is_fast_and_consistent(general):
+    sysm, lengths = general[0], general[3]
+    r2 = hc.homotopy_forward(sysm, lengths * 1.03)
+    assert r2.cached and r2.complete and r2.seconds < 2.0
+    for s in r2.solutions:
+        if s.status == "real":
+            assert np.allclose(_lengths(sysm, s.R, s.p), lengths * 1.03, atol=1e-9)
+
+
+def test_study_parameters_round_trip():
+    R = Rotation.from_rotvec([0.3, 0.2, -0.4]).as_matrix()
+    p = np.array([0.3, -0.2, 0.5])
+    q = Rotation.from_matrix(R).as_quat()
+    e = np.r_[q[3], q[:3]]
+    g = np.array([-p @ e[1:], *(p * e[0] + np.cross(p, e[1:]))]) / 2  # (0, p) e / 2
+    R2, p2 = hc.study_to_pose(np.r_[e, g] * 3.7)  # projective: any scale
+    assert np.allclose(R2, R) and np.allclose(p2, p)
+
+
+@pytest.fixture(scope="module")
+def stewart():
+    mech = catalog.resolve("stewart-6sps")
+    return mech, forward_position(mech, [1.2] * 6, all_solutions=True, method="homotopy")
+
+
+def test_stewart_model_superset_of_multistart_and_verified(stewart):
+    mech, res = stewart
+    ms = forward_position(mech, [1.2] * 6, all_solutions=True, n_seeds=30)
+    assert res.search["complete"] and res.search["n_real"] >= len(res.solutions)
+    for s in res.solutions:  # each real mode: closed, actuators held, inverse position round trip
+        assert s.converged and s.residual < 1e-10
+        ik = sm.ik(mech, s.pose)
+        assert ik.reachable
+    keys = [np.r_[s.pose.p, s.pose.R.ravel()] for s in res.solutions]
+    for m in ms.solutions:
+        if m.converged:
+            k = np.r_[m.pose.p, m.pose.R.ravel()]
+            assert min(np.linalg.norm(k - x) for x in keys) < 1e-6, "multi-start found a mode homotopy missed"
+
+
+def test_cli_json_and_text(stewart):
+    runner = CliRunner()
+    out = runner.invoke(main, ["fk", "stewart-6sps", "--actuators", "1.2,1.2,1.2,1.2,1.2,1.2", "--all", "--json"])
+    assert out.exit_code == 0, out.output
+    d = json.loads(out.output)
+    assert d["complete"] is True and d["n_real"] + d["n_complex"] + d["n_singular"] + d["n_at_infinity"] == len(d["endpoints"])
+    assert {e["status"] for e in d["endpoints"]} <= {"real", "complex", "singular", "at_infinity"}
+    txt = runner.invoke(main, ["fk", "stewart-6sps", "--actuators", "1.2,1.2,1.2,1.2,1.2,1.2", "--all"])
+    assert "complete (proven)" in txt.output
+    ms = runner.invoke(main, ["fk", "stewart-6sps", "--actuators", "1.2,1.2,1.2,1.2,1.2,1.2", "--all", "--method",
+                              "multistart", "--seeds", "4", "--json"])
+    assert json.loads(ms.output)["complete"] is False
+
+
+def test_uncovered_model_clear_message():
+    runner = CliRunner()
+    out = runner.invoke(main, ["fk", "three-upu", "--actuators", "0.3,0.3,0.3", "--all", "--method", "homotopy"])
+    assert out.exit_code != 0 and "does not cover three-upu" in out.output and "U-P-U" in out.output
+    assert "Traceback" not in out.output
+    with pytest.raises(sm.InputError, match="method"):
+        sm.fk("stewart-6sps", [1.2] * 6, all_solutions=True, method="newton")
+
+
+def _phc_system(sysm, lengths, c) -> str:
+    """The same polynomial system in PHCpack's input format."""
+    names = ["e0", "e1", "e2", "e3", "g0", "g1", "g2", "g3"]
+    l2 = (np.asarray(lengths) / sysm.L) ** 2
+    Pe = np.diag([1.0, 1, 1, 1, 0, 0, 0, 0])
+
+    def quad(M):
+        return " ".join(f"{(M[i, j] if i == j else M[i, j] + M[j, i]):+.17e}*{names[i]}*{names[j]}"
+                        for i in range(8) for j in range(i, 8)) + ";"
+
+    eqs = [quad(sysm.Q[0])] + [quad(sysm.Q[k + 1] - l2[k] * Pe) for k in range(6)]
+    eqs.append(" ".join(f"{c[i]:+.17e}*{names[i]}" for i in range(8)) + " - 1;")
+    return "8\n" + "\n".join(eqs) + "\n"
+
+
+@pytest.mark.skipif(shutil.which("phc") is None, reason="PHCpack (Debian phcpack) not installed")
+def test_phcpack_agrees_on_the_stewart_model(stewart, tmp_path):
+    """Independent check: PHCpack's blackbox solver on the same system finds the same number of
+    regular solutions and the same real ones (about 13 s)."""
+    mech, res = stewart
+    sysm = hc.stewart_system(mech)
+    c = np.random.default_rng(3).normal(size=8)
+    (tmp_path / "in.txt").write_text(_phc_system(sysm, sysm.lengths([1.2] * 6), c))
+    subprocess.run(["phc", "-b", str(tmp_path / "in.txt"), str(tmp_path / "out.txt")], check=True,
+                   capture_output=True, timeout=120)
+    out = (tmp_path / "out.txt").read_text()
+    n_regular = int(re.findall(r"Number of regular solutions\s*:\s*(\d+)", out)[-1])
+    assert n_regular == res.search["n_generic"] == res.search["n_real"] + res.search["n_complex"]
+    phc_real = []
+    for block in out[out.rfind("THE SOLUTIONS"):].split("solution ")[1:]:
+        vals = {k: complex(float(x), float(y)) for k, x, y in re.findall(r"\b([eg]\d) :\s+(\S+)\s+(\S+)", block)}
+        if len(vals) == 8 and "real regular" in block:
+            phc_real.append(hc.study_to_pose(np.array([vals[k] for k in sorted(vals)]).real, sysm.L)[1])
+    assert len(phc_real) == res.search["n_real"]
+    ours = [s.config.D[:3, 3] for s in res.solutions]
+    for p in phc_real:
+        assert min(np.linalg.norm(p - q) for q in ours) < 1e-6
+
+
+@pytest.mark.parametrize("phi", [[0.12, 0.2, -0.1, 0.6], [0.15, -0.3, 0.2, -0.4]])
+def test_four_sps_cu_agrees_with_the_closed_form(phi):
+    from spatialmech.kinematics.closed_forms import four_sps_cu as k4
+    from spatialmech.kinematics.closed_forms import four_sps_cu_forward as k4f
+
+    mech = catalog.resolve("four-sps-cu")
+    legs = k4.leg_lengths(phi)
+    closed = k4f.forward_all(np.asarray(legs), geometry=k4.geometry_of(mech))
+    res = forward_position(mech, legs, all_solutions=True, method="homotopy")
+    assert res.search["complete"] and res.search["n_generic"] == res.search["n_real"] + res.search["n_complex"]
+    assert len(res.solutions) == len(closed.solutions) > 0
+    for s in closed.solutions:  # every real assembly mode of the closed form: same height, same rotation
+        assert min(abs(h.pose.p[2] - s.phi[0]) + np.linalg.norm(h.pose.R - s.rotation) for h in res.solutions) < 1e-6
+
+
+def test_three_rps_has_16_solutions_and_every_multistart_mode():
+    mech = catalog.resolve("three-rps")
+    legs = [0.34, 0.36, 0.32]
+    res = forward_position(mech, legs, all_solutions=True, method="homotopy")
+    assert res.search["complete"] and res.search["n_generic"] == 16  # the known count of the 3-RPS
+    assert len(res.solutions) == res.search["n_real"] and all(s.residual < 1e-10 for s in res.solutions)
+    ms = forward_position(mech, legs, all_solutions=True, n_seeds=40)
+    for m in ms.solutions:
+        assert min(np.linalg.norm(m.pose.p - h.pose.p) + np.linalg.norm(m.pose.R - h.pose.R) for h in res.solutions) < 1e-6
