@@ -116,21 +116,6 @@ def test_uncovered_model_clear_message():
         sm.fk("stewart-6sps", [1.2] * 6, all_solutions=True, method="newton")
 
 
-def _phc_system(sysm, lengths, c) -> str:
-    """The same polynomial system in PHCpack's input format."""
-    names = ["e0", "e1", "e2", "e3", "g0", "g1", "g2", "g3"]
-    l2 = (np.asarray(lengths) / sysm.L) ** 2
-    Pe = np.diag([1.0, 1, 1, 1, 0, 0, 0, 0])
-
-    def quad(M):
-        return " ".join(f"{(M[i, j] if i == j else M[i, j] + M[j, i]):+.17e}*{names[i]}*{names[j]}"
-                        for i in range(8) for j in range(i, 8)) + ";"
-
-    eqs = [quad(sysm.Q[0])] + [quad(sysm.Q[k + 1] - l2[k] * Pe) for k in range(6)]
-    eqs.append(" ".join(f"{c[i]:+.17e}*{names[i]}" for i in range(8)) + " - 1;")
-    return "8\n" + "\n".join(eqs) + "\n"
-
-
 @pytest.mark.skipif(shutil.which("phc") is None, reason="PHCpack (Debian phcpack) not installed")
 def test_phcpack_agrees_on_the_stewart_model(stewart, tmp_path):
     """Independent check: PHCpack's blackbox solver on the same system finds the same number of
@@ -138,7 +123,7 @@ def test_phcpack_agrees_on_the_stewart_model(stewart, tmp_path):
     mech, res = stewart
     sysm = hc.stewart_system(mech)
     c = np.random.default_rng(3).normal(size=8)
-    (tmp_path / "in.txt").write_text(_phc_system(sysm, sysm.lengths([1.2] * 6), c))
+    (tmp_path / "in.txt").write_text(hc.phc_input(sysm, sysm.lengths([1.2] * 6), c))
     subprocess.run(["phc", "-b", str(tmp_path / "in.txt"), str(tmp_path / "out.txt")], check=True,
                    capture_output=True, timeout=120)
     out = (tmp_path / "out.txt").read_text()
@@ -179,3 +164,18 @@ def test_three_rps_has_16_solutions_and_every_multistart_mode():
     ms = forward_position(mech, legs, all_solutions=True, n_seeds=40)
     for m in ms.solutions:
         assert min(np.linalg.norm(m.pose.p - h.pose.p) + np.linalg.norm(m.pose.R - h.pose.R) for h in res.solutions) < 1e-6
+
+
+def test_homotopy_benchmark_runs_and_reports_its_targets():
+    """benchmarks/bench_homotopy.py --quick: one case, a verdict per target."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "benchmarks" / "bench_homotopy.py"
+    spec = importlib.util.spec_from_file_location("bench_homotopy", path)
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    out = bench.main(["--quick", "--json"])
+    (c,) = out["cases"]
+    assert c["complete"] and c["n_generic"] == 28 and c["first_solve_s"] > 0 and c["resolve_median_ms"] > 0
+    assert isinstance(c["first_met"], bool) and isinstance(c["resolve_met"], bool)

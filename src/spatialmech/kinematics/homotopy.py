@@ -58,7 +58,9 @@ __all__ = [
     "HomotopyResult",
     "HomotopySolution",
     "StewartSystem",
+    "clear_cache",
     "homotopy_forward",
+    "phc_input",
     "stewart_system",
     "study_to_pose",
     "system_from_points",
@@ -424,6 +426,31 @@ class _Generic:
 
 
 _CACHE: dict[bytes, _Generic] = {}
+
+
+def clear_cache() -> None:
+    """Forget every cached generic solve (the next solve of each geometry starts from the
+    total-degree homotopy again; benchmarks time that first solve)."""
+    _CACHE.clear()
+
+
+def phc_input(sysm: StewartSystem, lengths, c) -> str:
+    """The system of ``sysm`` at leg ``lengths`` (model units), with the affine normalisation
+    ``c . x = 1`` (8 coefficients), in PHCpack's input format: for an independent solve by
+    ``phc -b`` (tests, benchmarks/bench_homotopy.py).  Only for systems of six S-P-S legs."""
+    if sysm.n_legs != 6 or sysm.lines:
+        raise InputError("sysm: the PHCpack export covers six S-P-S legs (seven quadrics) only")
+    names = ["e0", "e1", "e2", "e3", "g0", "g1", "g2", "g3"]
+    l2 = (np.asarray(lengths, dtype=float) / sysm.L) ** 2
+    Pe = np.diag([1.0, 1, 1, 1, 0, 0, 0, 0])
+
+    def quad(M):
+        return " ".join(f"{(M[i, j] if i == j else M[i, j] + M[j, i]):+.17e}*{names[i]}*{names[j]}"
+                        for i in range(8) for j in range(i, 8)) + ";"
+
+    eqs = [quad(sysm.Q[0])] + [quad(sysm.Q[k + 1] - l2[k] * Pe) for k in range(6)]
+    eqs.append(" ".join(f"{c[i]:+.17e}*{names[i]}" for i in range(8)) + " - 1;")
+    return "8\n" + "\n".join(eqs) + "\n"
 
 
 def _generic_solve(sysm: StewartSystem, seed: int = 0, max_attempts: int = 3) -> tuple[_Generic, bool]:
