@@ -53,6 +53,8 @@ from ..geometry.tolerances import (
     HOMOTOPY_SINGULAR,
 )
 from ..model.mechanism import Mechanism
+from . import compiled
+from .jit import njit
 
 __all__ = [
     "HomotopyResult",
@@ -65,6 +67,7 @@ __all__ = [
     "study_to_pose",
     "system_from_points",
     "track",
+    "track_parameter",
     "unsupported_reason",
 ]
 
@@ -348,6 +351,193 @@ def track(fun, X0: np.ndarray, *, h0: float = 0.02, hmin: float = 1e-14, max_ste
     return X, t, done, steps
 
 
+# ------------------------------------------------------------------------------ compiled parameter homotopy
+@njit(cache=True)
+def _lu_solve(A, b, out):
+    """``A x = b`` (complex, small) by LU with partial pivoting into ``out``; False when a pivot
+    is zero or not finite (the batched NumPy tracker's LinAlgError)."""
+    n = A.shape[0]
+    M = A.copy()
+    y = b.copy()
+    for k in range(n):
+        p = k
+        big = abs(M[k, k])
+        for i in range(k + 1, n):
+            if abs(M[i, k]) > big:
+                big = abs(M[i, k])
+                p = i
+        if not big > 0.0 or not np.isfinite(big):
+            return False
+        if p != k:
+            for j in range(n):
+                M[k, j], M[p, j] = M[p, j], M[k, j]
+            y[k], y[p] = y[p], y[k]
+        for i in range(k + 1, n):
+            f = M[i, k] / M[k, k]
+            for j in range(k, n):
+                M[i, j] -= f * M[k, j]
+            y[i] -= f * y[k]
+    for i in range(n - 1, -1, -1):
+        acc = y[i]
+        for j in range(i + 1, n):
+            acc -= M[i, j] * out[j]
+        out[i] = acc / M[i, i]
+    return True
+
+
+@njit(cache=True)
+def _param_system(Q, c, x, l20, l2t, t, F, J, Ht):
+    """:func:`_eval_target` of one point on the straight parameter path ``l2(t)`` and ``H_t``."""
+    m = l20.shape[0]
+    n = x.shape[0]
+    E = x[0] * x[0] + x[1] * x[1] + x[2] * x[2] + x[3] * x[3]
+    for k in range(7):
+        acc = 0.0j
+        for i in range(n):
+            qx = 0.0j
+            for j in range(n):
+                qx += Q[k, i, j] * x[j]
+            J[k, i] = 2.0 * qx
+            acc += qx * x[i]
+        F[k] = acc
+        Ht[k] = 0.0
+    for k in range(m):
+        lt = (1.0 - t) * l20[k] + t * l2t[k]
+        F[1 + k] -= lt * E
+        for i in range(4):
+            J[1 + k, i] -= 2.0 * lt * x[i]
+        Ht[1 + k] = -(l2t[k] - l20[k]) * E
+    acc = -1.0 + 0.0j
+    for i in range(n):
+        acc += x[i] * c[i]
+        J[7, i] = c[i]
+    F[7] = acc
+    Ht[7] = 0.0
+
+
+@njit(cache=True)
+def _param_vel(Q, c, x, l20, l2t, t, F, J, Ht, out):
+    ok = True
+    _param_system(Q, c, x, l20, l2t, t, F, J, Ht)
+    for i in range(Ht.shape[0]):
+        Ht[i] = -Ht[i]
+    ok = _lu_solve(J, Ht, out)
+    return ok
+
+
+@njit(cache=True)
+def _track_param(Q, c, X0, l20, l2t, h0, hmin, max_steps, jump, newton, X, T, done):
+    """:func:`track` of the parameter homotopy, path by path (compiled): the same RK4 predictor,
+    two Newton corrections, acceptance test and step control."""
+    n = X0.shape[1]
+    F = np.empty(n, dtype=np.complex128)
+    J = np.empty((n, n), dtype=np.complex128)
+    Ht = np.empty(n, dtype=np.complex128)
+    k1 = np.empty(n, dtype=np.complex128)
+    k2 = np.empty(n, dtype=np.complex128)
+    k3 = np.empty(n, dtype=np.complex128)
+    k4 = np.empty(n, dtype=np.complex128)
+    xs = np.empty(n, dtype=np.complex128)
+    xc = np.empty(n, dtype=np.complex128)
+    dx = np.empty(n, dtype=np.complex128)
+    for p in range(X0.shape[0]):
+        x = X[p]
+        for i in range(n):
+            x[i] = X0[p, i]
+        t = 0.0
+        h = h0
+        good = 0
+        fin = False
+        for _ in range(max_steps):
+            hh = min(h, 1.0 - t)
+            ok = _param_vel(Q, c, x, l20, l2t, t, F, J, Ht, k1)
+            if ok:
+                for i in range(n):
+                    xs[i] = x[i] + 0.5 * hh * k1[i]
+                ok = _param_vel(Q, c, xs, l20, l2t, t + 0.5 * hh, F, J, Ht, k2)
+            if ok:
+                for i in range(n):
+                    xs[i] = x[i] + 0.5 * hh * k2[i]
+                ok = _param_vel(Q, c, xs, l20, l2t, t + 0.5 * hh, F, J, Ht, k3)
+            if ok:
+                for i in range(n):
+                    xs[i] = x[i] + hh * k3[i]
+                ok = _param_vel(Q, c, xs, l20, l2t, t + hh, F, J, Ht, k4)
+            d0 = np.inf
+            d1 = np.inf
+            tn = t + hh
+            if ok:
+                nx = 0.0
+                for i in range(n):
+                    xc[i] = x[i] + hh / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+                    nx += abs(xc[i]) ** 2
+                nx = 1.0 + np.sqrt(nx)
+                _param_system(Q, c, xc, l20, l2t, tn, F, J, Ht)
+                ok = _lu_solve(J, F, dx)
+                if ok:
+                    s0 = 0.0
+                    for i in range(n):
+                        s0 += abs(dx[i]) ** 2
+                        xc[i] -= dx[i]
+                    d0 = np.sqrt(s0) / nx
+                    _param_system(Q, c, xc, l20, l2t, tn, F, J, Ht)
+                    ok = _lu_solve(J, F, dx)
+                if ok:
+                    s1 = 0.0
+                    for i in range(n):
+                        s1 += abs(dx[i]) ** 2
+                        xc[i] -= dx[i]
+                    d1 = np.sqrt(s1) / nx
+            acc = ok and np.isfinite(d0) and np.isfinite(d1) and d0 < jump and (d1 < 0.1 * d0 or d1 < newton)
+            if acc:
+                for i in range(n):
+                    x[i] = xc[i]
+                t = tn
+                good += 1
+                if good >= 2:
+                    h *= 2.0
+                    good = 0
+                if t >= 1.0:
+                    fin = True
+                    break
+            else:
+                h *= 0.5
+                good = 0
+                if h < hmin:
+                    break
+        T[p] = t
+        done[p] = fin
+
+
+def track_parameter(Q: np.ndarray, c: np.ndarray, X0: np.ndarray, l20: np.ndarray, l2t: np.ndarray, *,
+                    h0: float = 0.02, hmin: float = 1e-14, max_steps: int = 4000):
+    """The parameter homotopy from the squared leg lengths ``l20`` (points ``X0``) to ``l2t``:
+    :func:`track` of the straight parameter path, compiled and path by path when the compiled
+    core is in use (the batched NumPy :func:`track` otherwise).  Returns ``(X, t, done)``."""
+    X0 = np.ascontiguousarray(X0, dtype=complex)
+    l20 = np.ascontiguousarray(l20, dtype=complex)
+    l2t = np.ascontiguousarray(l2t, dtype=complex)
+    if compiled.enabled():
+        X = np.empty_like(X0)
+        T = np.zeros(len(X0))
+        done = np.zeros(len(X0), dtype=np.bool_)
+        if len(X0):
+            _track_param(np.ascontiguousarray(Q, dtype=float), np.ascontiguousarray(c, dtype=complex), X0, l20, l2t,
+                         float(h0), float(hmin), int(max_steps), float(HOMOTOPY_JUMP), float(HOMOTOPY_NEWTON),
+                         X, T, done)
+        return X, T, done
+
+    def fun(X, t):
+        lt = (1 - t)[:, None] * l20 + t[:, None] * l2t
+        F, J, E = _eval_target(Q, c, X, lt)
+        Ht = np.zeros_like(F)
+        Ht[:, 1 : 1 + len(l2t)] = -(l2t - l20)[None, :] * E[:, None]
+        return F, J, Ht
+
+    X, T, done, _ = track(fun, X0, h0=h0, hmin=hmin, max_steps=max_steps)
+    return X, T, done
+
+
 def _refine(Q, c, X, l2, iters: int = 4):
     """Newton at ``t = 1`` (batched; a point whose step fails keeps its last value)."""
     X = X.copy()
@@ -565,14 +755,7 @@ def homotopy_forward(mech: Mechanism | StewartSystem, actuator_values, *, seed: 
     l20 = gen.l2
     Q, c = sysm.Q, gen.c
 
-    def fun(X, t):
-        lt = (1 - t)[:, None] * l20 + t[:, None] * l2t
-        F, J, E = _eval_target(Q, c, X, lt)
-        Ht = np.zeros_like(F)
-        Ht[:, 1 : 1 + len(l2t)] = -(l2t - l20)[None, :] * E[:, None]
-        return F, J, Ht
-
-    X, _, _, _ = track(fun, gen.X) if len(gen.X) else (gen.X, None, None, None)
+    X = track_parameter(Q, c, gen.X, l20, l2t)[0] if len(gen.X) else gen.X
     sols = []
     for st, rc, ri, im, res, y, _ in _classify(Q, c, X, l2t):
         R = p = None
