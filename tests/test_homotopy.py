@@ -198,3 +198,20 @@ def test_compiled_parameter_tracker_equals_the_numpy_reference(name):
         if a.status != "at_infinity":
             ya, yb = a.study / np.linalg.norm(a.study), b.study / np.linalg.norm(b.study)
             assert min(np.linalg.norm(ya - yb * ph) for ph in (1, -1)) < 1e-8
+
+
+def test_a_continuum_is_reported_as_one_self_motion_set_not_as_points():
+    """At the 4-SPS/CU's home leg lengths the platform has a self-motion: the homotopy's end
+    points there are singular, so completeness is not claimed, and the result is one
+    self-motion set (as the closed form says), not a scatter of singular points."""
+    from spatialmech.kinematics.assembly import AssemblyKind
+    from spatialmech.kinematics.closed_forms import four_sps_cu_forward as k4f
+
+    mech = catalog.resolve("four-sps-cu")
+    legs = [float(np.sqrt(0.06))] * 4
+    res = forward_position(mech, legs, all_solutions=True, method="homotopy", n_seeds=16)
+    assert res.search["complete"] is False and res.search["n_singular"] > 0
+    assert "self-motion" in res.search["completeness"]
+    kinds = [s.kind for s in res.solutions]
+    closed = k4f.forward_all(np.array(legs))
+    assert kinds.count(AssemblyKind.SELF_MOTION) == 1 == len(closed.solutions)

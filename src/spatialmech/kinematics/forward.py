@@ -356,7 +356,7 @@ def forward_position(
 
         why = hc.unsupported_reason(mech)
         if why is None:
-            return _forward_homotopy(mech, targets, seed, max_iter)
+            return _forward_homotopy(mech, targets, seed, max_iter, n_seeds)
         if method == "homotopy":
             raise InputError(f"method: homotopy forward position does not cover {mech.name}: {why}; "
                              "use method='multistart'")
@@ -369,18 +369,7 @@ def forward_position(
     first = _fk_from(mech, start or Configuration.reference(mech), targets, mask, max_iter)
     runs = [first]
     if all_solutions:
-        rng = np.random.default_rng(seed)
-        for s in range(n_seeds):
-            if s % 2 == 0:
-                c = _pose_seed(mech, rng, targets)
-            else:
-                try:
-                    c = generic_configuration(mech, seed=int(rng.integers(2**31)), step=float(rng.uniform(0.3, 1.2)), steps=4)
-                except RuntimeError:
-                    continue
-            runs.append(_fk_from(mech, c, targets, mask, max_iter, patience=12))
-            if progress is not None:
-                progress(s + 1, n_seeds, "assembly modes")
+        runs += _multistart_runs(mech, targets, mask, n_seeds, seed, max_iter, progress)
     thr = singular_threshold()
     dedup, sdedup = dedup_tolerances()
     locked = locked_actuators(mech)
@@ -457,7 +446,28 @@ def _limbs_at(mech: Mechanism, D: np.ndarray, q0: np.ndarray, targets: dict[int,
     return Configuration(q, D)
 
 
-def _forward_homotopy(mech: Mechanism, targets: dict[int, float], seed: int, max_iter: int) -> ForwardResult:
+def _multistart_runs(mech: Mechanism, targets: dict[int, float], mask: np.ndarray, n_seeds: int, seed: int,
+                     max_iter: int, progress: Progress | None = None) -> list:
+    """Newton with the actuators held from ``n_seeds`` starts (alternately a random output pose
+    with the limbs fitted, and a random walk along the closure manifold)."""
+    rng = np.random.default_rng(seed)
+    runs = []
+    for s in range(n_seeds):
+        if s % 2 == 0:
+            c = _pose_seed(mech, rng, targets)
+        else:
+            try:
+                c = generic_configuration(mech, seed=int(rng.integers(2**31)), step=float(rng.uniform(0.3, 1.2)), steps=4)
+            except RuntimeError:
+                continue
+        runs.append(_fk_from(mech, c, targets, mask, max_iter, patience=12))
+        if progress is not None:
+            progress(s + 1, n_seeds, "assembly modes")
+    return runs
+
+
+def _forward_homotopy(mech: Mechanism, targets: dict[int, float], seed: int, max_iter: int,
+                      n_seeds: int = 200) -> ForwardResult:
     """``forward_position(..., method="homotopy")``: the real end points polished with the
     actuators held, grouped and classified as the multi-start roots."""
     from ..geometry.rotations import transform
@@ -479,6 +489,12 @@ def _forward_homotopy(mech: Mechanism, targets: dict[int, float], seed: int, max
             continue
         D = transform(e.R, e.p)
         runs.append(_fk_from(mech, _limbs_at(mech, D, q0, targets, seed), targets, mask, max_iter))
+    n_endpoint_runs = len(runs)
+    if hr.count("singular"):
+        # singular end points (a continuum, as the 4-SPS/CU's self-motion at its home legs, or a
+        # multiple root) are located to a few digits only: the multi-start search adds its roots,
+        # and a singular root is followed along its self-motion and reported as one continuum
+        runs += _multistart_runs(mech, targets, mask, n_seeds, seed, max_iter)
     conv = [r for r in runs if r.converged]
     dedup, sdedup = dedup_tolerances()
     locked = locked_actuators(mech)
@@ -495,8 +511,10 @@ def _forward_homotopy(mech: Mechanism, targets: dict[int, float], seed: int, max
                                     tuple(within_limits(mech, r.config.q)), conds[g.rep], g.kind, len(g.members),
                                     g.self_motion(keys, L)))
     kinds = [s.kind for s in sols]
-    search = {"method": "homotopy continuation (Study parameters), real end points polished by Newton",
-              "seeds": 0, "seed": seed, "converged_runs": len(conv), "distinct": len(kinds),
+    extra = len(runs) - n_endpoint_runs
+    search = {"method": "homotopy continuation (Study parameters), real end points polished by Newton"
+                        + (f"; singular end points: {extra} multi-start seeds added" if extra else ""),
+              "seeds": extra, "seed": seed, "converged_runs": len(conv), "distinct": len(kinds),
               "n_regular": kinds.count(AssemblyKind.REGULAR), "n_singular_roots": kinds.count(AssemblyKind.SINGULAR),
               "n_self_motion_sets": kinds.count(AssemblyKind.SELF_MOTION),
               "complete": hr.complete, "completeness": hr.completeness,

@@ -768,7 +768,8 @@ def homotopy_forward(mech: Mechanism | StewartSystem, actuator_values, *, seed: 
     n_sing = sum(s.status == "singular" for s in sols)
     if accounted and n_sing:
         how += (f"; but {n_sing} end point(s) are singular (a continuum of solutions or a multiple root at these values, "
-                "located to a few digits only): not proven complete there, real points near them polished and reported")
+                "located to a few digits only): not proven complete there; real points near them polished, the multi-start "
+                "roots added, and a continuum reported as one self-motion set")
     if not accounted:
         how = (f"NOT complete: {gen.n_paths - len(gen.X) - gen.n_at_infinity} of the {gen.n_paths} total-degree paths "
                f"ended neither at a finite nonsingular point nor at infinity after {gen.attempts} attempts")
