@@ -135,3 +135,20 @@ def scalar_field(ax, x, y, values, *, xlabel: str, ylabel: str, label: str, titl
     if title:
         ax.set_title(title, fontsize=10)
     return im
+
+
+def legend_once(ax, fontsize: float = 7) -> None:
+    """A legend with each label once (the first handle drawn with it), if anything is labelled."""
+    seen: dict = {}
+    for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):
+        seen.setdefault(label, handle)
+    if seen:
+        ax.legend(seen.values(), seen.keys(), fontsize=fontsize, loc="best")
+
+
+def figure_path(path, name: str = "plot") -> Path:
+    """``path`` as a Path, checked to end in .png, .svg or .pdf (else an error naming ``name``)."""
+    p = Path(path)
+    if p.suffix.lower() not in (".png", ".svg", ".pdf"):
+        raise InputError(f"{name}: expected a .png, .svg or .pdf file name, got {str(p)!r}")
+    return p

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError
+from .figures import figure_path, legend_once
 
 __all__ = ["task_workspace_figure", "write_task_workspace_plot"]
 
@@ -58,7 +58,7 @@ def task_workspace_figure(result):
         for xb, n in zip(result.boundary_points[:, 0], result.boundary_limits, strict=True):
             ax.plot(_conv(c, xb), 0, "o", color=colour[n], label=n)
         ax.set_yticks([])
-        _legend(ax)
+        legend_once(ax)
         for a, s in zip(axes[1:], solved, strict=True):
             a.plot(x, _conv(s, result.values[:, _TASK_NAMES.index(s)]), "-", color="tab:blue")
             a.set_ylabel(_label(s, length_unit))
@@ -79,7 +79,7 @@ def task_workspace_figure(result):
         ax.set_xlabel(_label(over[0], length_unit))
         ax.set_ylabel(_label(over[1], length_unit))
         ax.set_zlabel(_label(over[2], length_unit))
-        _legend(ax)
+        legend_once(ax)
         fig.suptitle(title, fontsize=8)
         return fig
     u, v = (_conv(c, g) for c, g in zip(over, result.grid, strict=True))
@@ -103,7 +103,7 @@ def task_workspace_figure(result):
     ax.set_title(f"reachable (grey): {result.n_feasible} of {result.feasible.size} cells", fontsize=9)
     ax.set_xlabel(_label(over[0], length_unit))
     ax.set_ylabel(_label(over[1], length_unit))
-    _legend(ax)
+    legend_once(ax)
     for a, s in zip(axes[1:], solved, strict=True):
         z = _conv(s, result.values[..., _TASK_NAMES.index(s)]).T
         if np.isfinite(z).any():
@@ -119,18 +119,9 @@ def task_workspace_figure(result):
     return fig
 
 
-def _legend(ax) -> None:
-    handles, labels = ax.get_legend_handles_labels()
-    seen = dict(zip(labels, handles, strict=True))
-    if seen:
-        ax.legend(seen.values(), seen.keys(), fontsize=7, loc="best")
-
-
 def write_task_workspace_plot(result, path) -> Path:
     """Write :func:`task_workspace_figure` to ``path`` (.png, .svg or .pdf)."""
-    p = Path(path)
-    if p.suffix.lower() not in (".png", ".svg", ".pdf"):
-        raise InputError(f"plot: expected a .png, .svg or .pdf file name, got {p}")
+    p = figure_path(path)
     fig = task_workspace_figure(result)
     fig.savefig(p, dpi=110)
     return p

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError
+from .figures import figure_path, legend_once
 
 __all__ = ["workspace_figure", "write_workspace_plot"]
 
@@ -51,7 +51,7 @@ def workspace_figure(result):
             ax.plot(_conv(c, x), 0, "o", color=colour[n], label=n)
         ax.set_xlabel(_label(c))
         ax.set_yticks([])
-        _legend(ax)
+        legend_once(ax, 6)
         fig.suptitle(title, fontsize=8)
         return fig
     planes = [(0, 1)] if d == 2 else [(0, 1), (0, 2), (1, 2)]
@@ -80,7 +80,7 @@ def workspace_figure(result):
         ax.set_ylabel(_label(free[j]))
         if other:
             ax.set_title(f"slice {free[other[0]]} = {_conv(free[other[0]], result.center[free[other[0]]]):.4g}", fontsize=9)
-        _legend(ax)
+        legend_once(ax, 6)
     if d == 3:
         ax = fig.add_subplot(1, n_pan, n_pan, projection="3d")
         bp = result.boundary_points
@@ -97,20 +97,9 @@ def workspace_figure(result):
     return fig
 
 
-def _legend(ax):
-    h, lab = ax.get_legend_handles_labels()
-    seen: dict = {}
-    for hh, ll in zip(h, lab, strict=True):
-        seen.setdefault(ll, hh)
-    if seen:
-        ax.legend(seen.values(), seen.keys(), fontsize=6, loc="best")
-
-
 def write_workspace_plot(result, path) -> Path:
     """Write :func:`workspace_figure` to ``path`` (format from the suffix: .png, .svg, .pdf)."""
-    path = Path(path)
-    if path.suffix.lower() not in (".png", ".svg", ".pdf"):
-        raise InputError(f"plot: expected a .png, .svg or .pdf file name, got {str(path)!r}")
+    path = figure_path(path)
     fig = workspace_figure(result)
     fig.savefig(path, dpi=120)
     return path

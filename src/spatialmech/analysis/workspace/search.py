@@ -293,7 +293,8 @@ def _refine_runs(ev, F, grid, axis, tol):
     return lines, lo, hi, lo_lim, hi_lim, xin_lo, xin_hi
 
 
-def _trapezoid_weights(v: np.ndarray) -> np.ndarray:
+def trapezoid_weights(v: np.ndarray) -> np.ndarray:
+    """Trapezoid-rule weights of the grid values ``v`` (a single value weighs 1)."""
     if v.size == 1:
         return np.ones(1)
     h = np.diff(v)
@@ -436,7 +437,7 @@ def _analyse(mech, kind, free, values, bounds, step, tol, limits, method, chunk,
         if k == 0:
             w = np.ones(lines.shape[0])
             for j, kk in enumerate([m for m in range(d) if m != k]):
-                w *= _trapezoid_weights(grid[kk])[lines[:, j]]
+                w *= trapezoid_weights(grid[kk])[lines[:, j]]
             volume = float(np.sum(w * (hi - lo)))
         if lo.size == 0:
             extents[c] = None

@@ -54,7 +54,7 @@ from ...model.task import TaskCoordinates
 from ...results import Progress, check_progress
 from .checker import ConfigurationChecker, configuration_checker
 from .limits import BOX, CLOSURE, WorkspaceLimits, default_limits
-from .search import Extent
+from .search import Extent, trapezoid_weights
 
 __all__ = ["TASK_PATH", "TaskWorkspaceResult", "euler_convention", "task_workspace"]
 
@@ -289,16 +289,6 @@ def _bracket(probe: _Probe, k: int, x_in: np.ndarray, c_in: Configuration, v_in:
     return x_in, c_in, v_in, x_out, lim_out
 
 
-def _trapezoid_weights(v: np.ndarray) -> np.ndarray:
-    if v.size == 1:
-        return np.ones(1)
-    h = np.diff(v)
-    w = np.zeros(v.size)
-    w[:-1] += 0.5 * h
-    w[1:] += 0.5 * h
-    return w
-
-
 def _parse_over(over) -> dict[str, np.ndarray]:
     """``{name: values}`` or ``{name: (lo, hi, n)}`` -> ``{name: values}`` (SI, rad)."""
     if not isinstance(over, Mapping) or not over:
@@ -440,7 +430,7 @@ def task_workspace(
 
     # ---- measure: refined run lengths along the first grid coordinate, trapezoid over the others
     volume = 0.0
-    w_other = [_trapezoid_weights(a) for a in grid[1:]]
+    w_other = [trapezoid_weights(a) for a in grid[1:]]
     for row in cell_idx:
         idx = tuple(int(i) for i in row)
         lo = refined_axis0.get((idx, -1))
