@@ -73,7 +73,7 @@ def best_time(fn, repeat: int, number: int) -> float:
 
 
 # ---------------------------------------------------------------------- Stewart forward position
-@njit(cache=True)
+@njit(cache=False)  # not cached: a script and an imported module would share (and confuse) one cache
 def _rodrigues(w):
     th = math.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
     R = np.eye(3)
@@ -85,7 +85,7 @@ def _rodrigues(w):
     return R + s * K + (1.0 - c) * (K @ K)
 
 
-@njit(cache=True)
+@njit(cache=False)  # not cached: a script and an imported module would share (and confuse) one cache
 def handwritten_stewart_newton(A, B, target, R0, t0, tol, max_iter):
     """Minimal Newton on the six leg lengths ``|R A_i + t - B_i| - target_i`` of a 6-6 Stewart
     platform: rows ``[(x_i x u_i)^T, u_i^T]`` (spatial twist), update ``R <- exp(w) R``,

@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from .kernels_se3 import (
+    nb_lsq_qr,
     nb_ball_product,
     nb_copy44,
     nb_exp_twist,
@@ -428,7 +429,12 @@ def nb_limb_gn(S, ball_of, ball_first, ball_axes, ball_centre, Ds, q0s, lin, L, 
             for i in range(6):
                 for j in range(m):
                     M[i, j] = row[i] * J[i, j] * colscale[j]
-            x = nb_lstsq(M, rhs)
+            if m < 6:  # overdetermined (6 rows): QR when full rank, else the SVD
+                x = np.zeros(m)
+                if not nb_lsq_qr(M, rhs, x):
+                    x = nb_lstsq(M, rhs)
+            else:
+                x = nb_lstsq(M, rhs)
             if nb_norm(x) < 1e-14:
                 break
             for j in range(m):

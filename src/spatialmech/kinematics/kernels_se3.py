@@ -17,6 +17,7 @@ __all__ = [
     "nb_exp_twist",
     "nb_inverse_into",
     "nb_log",
+    "nb_lsq_qr",
     "nb_lstsq",
     "nb_matrix_rotvec",
     "nb_minnorm_qr",
@@ -333,6 +334,59 @@ def nb_minnorm_qr(A, b, x):
             z[i] -= 2.0 * dot * V[j, i]
     for i in range(n):
         x[i] = z[i]
+    return True
+
+
+@njit(cache=True)
+def nb_lsq_qr(A, b, x):
+    """Least-squares solution of the overdetermined ``A x = b`` (m >= n) by Householder QR of
+    ``A`` into ``x``; ``False`` (x untouched) when a diagonal entry of R is below 1e-8 times the
+    largest (``A`` may be rank deficient: the SVD must decide).  Used by the limb Gauss-Newton,
+    whose small systems (6 rows, at most 6 columns) are full rank away from singularities."""
+    m, n = A.shape
+    M = A.copy()
+    y = b.copy()
+    d = np.empty(n)
+    v = np.empty(m)
+    for j in range(n):
+        nrm = 0.0
+        for i in range(j, m):
+            nrm += M[i, j] * M[i, j]
+        nrm = np.sqrt(nrm)
+        alpha = -nrm if M[j, j] >= 0.0 else nrm
+        for i in range(j, m):
+            v[i] = M[i, j]
+        v[j] -= alpha
+        vn = 0.0
+        for i in range(j, m):
+            vn += v[i] * v[i]
+        vn = np.sqrt(vn)
+        d[j] = alpha
+        if vn > 0.0:
+            for i in range(j, m):
+                v[i] /= vn
+            for c in range(j + 1, n):
+                dot = 0.0
+                for i in range(j, m):
+                    dot += v[i] * M[i, c]
+                for i in range(j, m):
+                    M[i, c] -= 2.0 * dot * v[i]
+            dot = 0.0
+            for i in range(j, m):
+                dot += v[i] * y[i]
+            for i in range(j, m):
+                y[i] -= 2.0 * dot * v[i]
+    big = 0.0
+    for j in range(n):
+        big = max(big, abs(d[j]))
+    for j in range(n):
+        if not abs(d[j]) > 1e-8 * big:
+            return False
+    for j in range(n - 1, -1, -1):  # R x = (Q^T b)[:n]
+        acc = y[j]
+        for c in range(j + 1, n):
+            acc -= M[j, c] * x[c]
+        x[j] = acc / d[j]
     return True
 
 
