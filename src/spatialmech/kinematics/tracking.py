@@ -402,8 +402,15 @@ class _MechanismBase:
         self.kinds = np.array([r.freedom.kind for r in refs])[active]
 
     def _closure(self, config):
+        # the corrector asks for the residual and then the Jacobian at the same configuration:
+        # remember the last one (configurations are never changed in place)
+        last = getattr(self, "_last_closure", None)
+        if last is not None and last[0] is config:
+            return last[1]
         A, r = closure_jacobian(self.mech, config, active=self.active)
-        return self.row[:, None] * A * self.col[None, :], self.row * r
+        out = (self.row[:, None] * A * self.col[None, :], self.row * r)
+        self._last_closure = (config, out)
+        return out
 
     def _config_step(self, config, dx):
         return retract(self.mech, config, self.active, self.col * dx)
