@@ -8,7 +8,7 @@ plots), always labelled; Euler sequences always named explicitly (``"ZXY"`` intr
 Every analysis by a short name (one page: docs/api.md; the functions are in
 :mod:`spatialmech.api`): ``sm.load_model``, ``sm.mobility``, ``sm.ik``, ``sm.fk``,
 ``sm.jacobian``, ``sm.velocity``, ``sm.singularity``, ``sm.workspace``, ``sm.parasitic``, ``sm.track``,
-``sm.defects``, ``sm.synth_rccc``, ``sm.synth_cs``, ``sm.report``, ``sm.view``, ``sm.studio_session``,
+``sm.defects``, ``sm.synth_rccc``, ``sm.synth_cs``, ``sm.screen``, ``sm.report``, ``sm.view``, ``sm.studio_session``,
 ``sm.studio_app``.  Each takes a
 :class:`Mechanism`, a ready-made model name or a TOML file path, checks its arguments
 (``TypeError``, :class:`InputError`) and returns a result whose ``to_dict()`` is its JSON.
@@ -41,6 +41,7 @@ from .api import (
     singularity,
     studio_app,
     studio_session,
+    screen,
     synth_cs,
     synth_rccc,
     track,
@@ -116,6 +117,7 @@ __all__ = [
     "parasitic",
     "report",
     "results",
+    "screen",
     "singularity",
     "studio_app",
     "studio_session",

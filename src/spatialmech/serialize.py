@@ -64,6 +64,8 @@ UNIT_SUFFIXES: dict[str, str] = {
     "_len_per_s": "length_unit per second",
     "_len_per_s2": "length_unit per second squared",
     "_s": "seconds",
+    "_per_s": "per second (a rate)",
+    "seconds": "seconds (the key is the unit)",
 }
 
 #: Keys whose numbers have no unit, with their meaning: counts, indices, signs, nondimensional
@@ -232,13 +234,28 @@ UNIT_FREE_KEYS: dict[str, str] = {
     "near_singular_below": "sigma_min below which the studio warns of a nearby singularity",
     "port": "TCP port number",
     "tracker_steps": "accepted continuation steps",
+    # defect screening (screen)
+    "candidates": "candidate linkages formed (screen)",
+    "judged": "candidates with a verdict in the dataset (screen)",
+    "judged_this_run": "candidates judged by this run (screen)",
+    "chunks": "chunks (Parquet files) of the screen",
+    "chunks_resumed": "chunks already written by an earlier run (screen)",
+    "rejected_by_stage": "candidates rejected by each stage of the screen, by stage",
+    "usable": "usable candidates found (screen)",
+    "workers": "Dask workers used (0: serial)",
+    "candidate": "candidate number (from 0) in a screen",
+    "dyads": "indices (from 0) of a candidate's dyads in the screen's pool; in pool: how many were sampled",
+    "place": "place in the ranking (from 1)",
+    "density": "dyads sampled per unit nondimensional arc length of the family",
+    "separation": "smallest nondimensional distance between two limbs of a candidate",
+    "min_closure_sigma_at_positions": "smallest scale-free closure sigma over the task positions",
 }
 
 #: Unit-free keys that hold a map by name (actuator, limit, monomial) of unit-free numbers; any
 #: other object under a unit-free key names the units of its own fields.
 UNIT_FREE_MAPS: frozenset[str] = frozenset({"active_limits", "branch_point_arcs", "center_cubic", "circle_cubic",
-                                            "residuals", "sign_changes_after", "dj_by_driver", "signs", "trace_sigma_min",
-                                            "transmission"})
+                                            "residuals", "rejected_by_stage", "sign_changes_after", "dj_by_driver",
+                                            "signs", "trace_sigma_min", "transmission"})
 
 #: Keys holding screws: ``(direction ; moment)`` 6-vectors (or matrices of them) whose direction
 #: part is unit-free and whose moment part is in ``length_unit`` (the Jacobian ``matrix`` rows

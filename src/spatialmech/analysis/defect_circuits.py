@@ -14,6 +14,7 @@ from collections.abc import Callable
 from itertools import combinations
 
 import numpy as np
+from scipy.optimize import minimize_scalar
 
 from ..geometry.rotations import rotation_angle
 from ..kinematics.closure import Configuration
@@ -48,7 +49,7 @@ def arc_on_curve(problem: MotionProblem, tr: TrackResult, config: Configuration,
 
     The nearest sample and its neighbours are each corrected onto the curve along their tangent
     (the hyperplane through ``config``); the closest corrected point gives the arc."""
-    d = np.array([np.linalg.norm(problem.difference(x, config)) for x in tr.points])
+    d = np.linalg.norm(problem.differences(tr.points, config), axis=1)
     k0 = int(np.argmin(d))
     best: tuple[float, float | None] = (np.inf, None)
     for k in {max(0, k0 - 1), k0, min(len(tr.points) - 1, k0 + 1)}:
@@ -73,24 +74,27 @@ def pose_distance(mech: Mechanism, prob: MotionProblem, tr: TrackResult, pose: P
                   angle_tol: float) -> tuple[float, float, float, float]:
     """Distance of a printed pose from a traced curve, normalised by the tolerances
     (``hypot(|dp| / pose_tol, dtheta / angle_tol)``, ``angle_tol`` in rad), refined along the
-    curve between samples by golden-section search.  Returns (normalised distance, arc, |dp|,
+    curve between samples by bounded Brent search.  Returns (normalised distance, arc, |dp|,
     dtheta)."""
 
-    def meas(x):
-        R, p = _pose_of(mech, x)
-        dp = float(np.linalg.norm(p - pose.p))
-        th = float(rotation_angle(R @ pose.R.T))
-        return float(np.hypot(dp / pose_tol, th / angle_tol)), dp, th
+    def meas_many(xs):
+        R = np.array([x.D[:3, :3] for x in xs])
+        p = R @ mech.platform_point + np.array([x.D[:3, 3] for x in xs])
+        dp = np.linalg.norm(p - pose.p, axis=1)
+        th = rotation_angle(R @ pose.R.T)
+        return np.hypot(dp / pose_tol, th / angle_tol), dp, th
 
-    vals = [meas(x)[0] for x in tr.points]
+    def meas(x):
+        v, dp, th = meas_many([x])
+        return float(v[0]), float(dp[0]), float(th[0])
+
+    vals = meas_many(tr.points)[0]
     k0 = int(np.argmin(vals))
-    best = (vals[k0], float(tr.s[k0]), *meas(tr.points[k0])[1:])
+    best = (float(vals[k0]), float(tr.s[k0]), *meas(tr.points[k0])[1:])
     for k in (k0 - 1, k0):
         if k < 0 or k + 1 >= len(tr.points):
             continue
         x, t, h = tr.points[k], tr.tangents[k], float(tr.s[k + 1] - tr.s[k])
-        g = (np.sqrt(5) - 1) / 2
-        lo, hi = 0.0, h
         cache: dict[float, tuple[float, float, float]] = {}
 
         def at(a, x=x, t=t, cache=cache):
@@ -99,13 +103,10 @@ def pose_distance(mech: Mechanism, prob: MotionProblem, tr: TrackResult, pose: P
                 cache[a] = meas(xa) if ok else (np.inf, np.inf, np.inf)
             return cache[a]
 
-        for _ in range(30):
-            a1, a2 = hi - g * (hi - lo), lo + g * (hi - lo)
-            if at(a1)[0] < at(a2)[0]:
-                hi = a2
-            else:
-                lo = a1
-        a = 0.5 * (lo + hi)
+        # the distance along one step of the curve: bounded Brent (golden section with parabolic steps)
+        opt = minimize_scalar(lambda a, at=at: at(a)[0], bounds=(0.0, h), method="bounded",
+                              options={"xatol": 1e-6 * max(h, 1e-12)})
+        a = float(opt.x)
         m = at(a)
         if m[0] < best[0]:
             best = (m[0], float(tr.s[k] + a), m[1], m[2])

@@ -48,7 +48,7 @@ from .kinematics import (
     velocity,
     workspace,
 )
-from .linkages import CSSynthesisResult, TraceResult, defects, dj_table, synth_cs, synth_rccc, track
+from .linkages import CSSynthesisResult, TraceResult, defects, dj_table, screen, synth_cs, synth_rccc, track
 from .outputs import VIEW_MOTIONS as VIEW_MOTIONS  # the motions view() animates
 from .outputs import ReportResult, ViewResult, report, studio_app, studio_session, view
 from .structure import MobilityModes, load_model, mobility, mobility_modes, models
@@ -75,6 +75,7 @@ __all__ = [
     "models",
     "parasitic",
     "report",
+    "screen",
     "singularity",
     "studio_app",
     "studio_session",

@@ -221,6 +221,25 @@ class CSSynthesisResult:
         return d
 
 
+#: The name of paper A's seven task positions (table 9) where a positions argument is expected.
+FIVE_CS_POSITIONS = "five-cs-positions"
+
+
+def seven_positions(positions) -> tuple[tuple[Pose, ...], str]:
+    """The task poses of a CS synthesis or screen, and where they came from: ``None`` or
+    ``"five-cs-positions"`` (paper A's table 9), a model name or Mechanism (its task positions),
+    a TOML file of ``[[positions]]``, or a sequence of Pose."""
+    if positions is None or (isinstance(positions, str) and positions == FIVE_CS_POSITIONS):
+        from ..catalog.papers import five_cs_positions
+
+        return five_cs_positions(), "paper A table 9"
+    if isinstance(positions, Mechanism) or (isinstance(positions, str) and positions in catalog.REGISTRY):
+        mech = as_mechanism(positions, "positions")
+        return mech.positions, f"the task positions of {mech.name}"
+    poses = as_positions(positions) or ()
+    return poses, os.fspath(positions) if isinstance(positions, (str, os.PathLike)) else "given poses"
+
+
 def synth_cs(positions=None, *, pick: int = 5, starts: int = 60, seed: int = 0, samples: int = 40,
              check_defects: bool = True, progress: Progress | None = None) -> CSSynthesisResult:
     """Seven-position synthesis of CS dyads and a 5-CS linkage (paper A, section 3).
@@ -244,16 +263,7 @@ def synth_cs(positions=None, *, pick: int = 5, starts: int = 60, seed: int = 0, 
     starts = check_int(starts, "starts", minimum=1)
     seed = check_int(seed, "seed")
     samples = check_int(samples, "samples", minimum=2)
-    if positions is None:
-        from ..catalog.papers import five_cs_positions
-
-        poses, source = five_cs_positions(), "paper A table 9"
-    elif isinstance(positions, Mechanism) or (isinstance(positions, str) and positions in catalog.REGISTRY):
-        mech = as_mechanism(positions, "positions")
-        poses, source = mech.positions, f"the task positions of {mech.name}"
-    else:
-        poses = as_positions(positions)
-        source = os.fspath(positions) if isinstance(positions, (str, os.PathLike)) else "given poses"
+    poses, source = seven_positions(positions)
     fam = synthesize_cs(poses, n_starts=starts, seed=seed, pick=pick)
     if pick != 5:
         return CSSynthesisResult(fam, source, samples)
@@ -262,3 +272,39 @@ def synth_cs(positions=None, *, pick: int = 5, starts: int = 60, seed: int = 0, 
     linkage = assemble_5cs(fam.task, fam.picks)
     check = check_5cs(linkage, fam.picks, defects=check_defects, progress=progress)
     return CSSynthesisResult(fam, source, samples, linkage, check)
+
+
+# ============================================================================ screening
+def screen(task=None, out: str | os.PathLike = "screen.parquet", *, candidates: int = 1000, density: float = 0.5,
+           workers: int | None = None, scheduler: str | None = None, top: int = 5, seed: int = 0, starts: int = 60,
+           separation: float = 0.5, chunk_size: int = 20, progress: Progress | None = None):
+    """Defect screening of 5-CS linkages for seven task positions (docs/screening.md): the CS
+    dyad family is sampled (``density`` dyads per unit nondimensional arc length), up to
+    ``candidates`` sets of five dyads are formed (small slides preferred, limbs at least
+    ``separation`` apart), each is judged in stages (assembly at the positions, DJ signs, the
+    full defect analysis) on Dask -- a local cluster of ``workers`` processes (``None``: one per
+    core, ``0``: serial without Dask) or the cluster at ``scheduler`` -- and the verdicts go to
+    the Parquet dataset ``out`` (resumable: a rerun with the same arguments skips finished
+    chunks).  The ``top`` usable linkages are written as model files (``out/_top/``).
+
+    ``task``: ``None``/``"five-cs-positions"`` (paper A table 9), a model with seven task
+    positions, a positions TOML file or seven Pose.  Returns a
+    :class:`~spatialmech.interfaces.batch_screen.ScreenSummary` (``to_dict()`` for JSON).
+
+    >>> import tempfile
+    >>> import spatialmech as sm
+    >>> s = sm.screen(out=tempfile.mkdtemp() + "/s.parquet", candidates=2, starts=4, workers=0, top=0)
+    >>> s.judged, sum(s.rejected_by_stage.values()) + s.usable
+    (2, 2)
+    """
+    from ..interfaces.batch_screen import run_screen
+
+    poses, _ = seven_positions(task)
+    for nm, v, lo in (("candidates", candidates, 1), ("top", top, 0), ("starts", starts, 1),
+                      ("chunk_size", chunk_size, 1)):
+        check_int(v, nm, minimum=lo)
+    if workers is not None:
+        check_int(workers, "workers", minimum=0)
+    return run_screen(poses, out, candidates=candidates, density=check_number(density, "density"), seed=check_int(seed, "seed"),
+                      starts=starts, separation=check_number(separation, "separation"), chunk_size=chunk_size,
+                      workers=workers, scheduler=scheduler, top=top, progress=optional_progress(progress))

@@ -61,6 +61,7 @@ from .kernels_closure import (
 from .kernels_drivers import (
     nb_dets_many,
     nb_difference,
+    nb_differences,
     nb_sps_legs,
 )
 from .kernels_se3 import (
@@ -79,6 +80,7 @@ __all__ = [
     "closure_residuals",
     "compile_mechanism",
     "config_difference",
+    "config_differences",
     "correct",
     "correct_many",
     "driver_determinants",
@@ -403,6 +405,25 @@ def config_difference(mech: Mechanism, a: Configuration, b: Configuration, activ
     w = _bools(wrap, (int(act.sum()),))
     out = np.empty(len(c))
     nb_difference(cm.ball_first, cm.ball_axes, qa, Da, Ba, qb, Db, Bb, act, w, c, out)
+    return out
+
+
+def config_differences(mech: Mechanism, points: Sequence[Configuration], b: Configuration, active, wrap,
+                       col) -> np.ndarray:
+    """:func:`config_difference` of ``b`` relative to each of ``points``, in one compiled loop:
+    ``(len(points), n_local)``."""
+    cm = compile_mechanism(mech)
+    act = _mask(mech, cm, active)
+    Qa = np.array([p.q for p in points], dtype=float).reshape(len(points), cm.n)
+    DAs = np.array([p.D for p in points], dtype=float).reshape(len(points), 4, 4)
+    BAs = np.array([p.B for p in points], dtype=float).reshape(len(points), cm.n_bodies, 4, 4)
+    if not np.isfinite(Qa.sum() + DAs.sum() + BAs.sum()):
+        raise InputError("points: a configuration holds NaN or infinity")
+    qb, Db, Bb = _config_arrays(cm, b)
+    c = _f64(col).reshape(-1)
+    w = _bools(wrap, (int(act.sum()),))
+    out = np.empty((len(points), len(c)))
+    nb_differences(cm.ball_first, cm.ball_axes, Qa, DAs, BAs, qb, Db, Bb, act, w, c, out)
     return out
 
 

@@ -32,6 +32,7 @@ __all__ = [
     "nb_det5_reciprocal",
     "nb_dets_many",
     "nb_difference",
+    "nb_differences",
     "nb_driver_dets",
     "nb_null_rows",
     "nb_sps_legs",
@@ -383,3 +384,11 @@ def nb_sps_legs(poses, base, plat, out):
             dy = r10 * bx + r11 * by + r12 * bz + y - base[i, 1]
             dz = r20 * bx + r21 * by + r22 * bz + z - base[i, 2]
             out[s, i] = np.sqrt(dx * dx + dy * dy + dz * dz)
+
+
+@njit(cache=True)
+def nb_differences(ball_first, ball_axes, Qa, DAs, BAs, qb, Db, Bb, active, wrap, col, out):
+    """:func:`nb_difference` of one configuration ``b`` relative to each of many ``a`` (stacked
+    ``Qa`` (m, n), ``DAs`` (m, 4, 4), ``BAs`` (m, n_bodies, 4, 4)); ``out`` (m, n_local)."""
+    for k in range(Qa.shape[0]):
+        nb_difference(ball_first, ball_axes, Qa[k], DAs[k], BAs[k], qb, Db, Bb, active, wrap, col, out[k])

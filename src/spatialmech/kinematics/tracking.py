@@ -451,6 +451,12 @@ class MotionProblem(_MechanismBase):
     def difference(self, x, y):
         return self._config_diff(x, y)
 
+    def differences(self, xs, y) -> np.ndarray:
+        """:meth:`difference` of ``y`` relative to each of ``xs`` (rows), compiled in one loop."""
+        if compiled.enabled() and len(xs):
+            return compiled.config_differences(self.mech, xs, y, self.active, self.kinds != "P", self.col)
+        return np.array([self._config_diff(x, y) for x in xs])
+
     def tangent(self, x):
         return _observable_tangent(self.jacobian(x), self.nh)
 

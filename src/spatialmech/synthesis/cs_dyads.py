@@ -77,6 +77,7 @@ __all__ = [
     "Projection",
     "cs_task",
     "dyad_from_limb",
+    "dyad_from_vector",
     "dyad_jacobian",
     "dyad_residual",
     "pick_small_slides",
@@ -368,6 +369,14 @@ def _dyad(task: CSTask, x_phys: np.ndarray) -> CSDyad:
         u=np.array(u), B1=np.array(B1), M1=np.array(M1), slides=np.r_[0.0, s],
         link_length=float(np.linalg.norm(M1 - B1)), residual=_dyad_errors(x_phys, task),
     )
+
+
+def dyad_from_vector(task_poses, x) -> CSDyad:
+    """The :class:`CSDyad` of a family point ``x = (B1, M1, u, s2..s7)`` in the task's length unit
+    (as in :attr:`CSBranch.points`); ``residual`` says how well it satisfies eqs 24-25."""
+    task = cs_task(task_poses)
+    x = as_finite_array(x, "x", shape=(_NX,))
+    return _dyad(task, x)
 
 
 def dyad_from_limb(task_poses, u, B1, M1, slides=None) -> CSDyad:

@@ -42,6 +42,7 @@ __all__ = [
     "PaperACheck",
     "assemble_5cs",
     "check_5cs",
+    "cs_configuration",
     "paper_a_check",
 ]
 
@@ -173,7 +174,7 @@ class FiveCSCheck:
         }
 
 
-def _cs_start(mech: Mechanism, pose: Pose):
+def cs_configuration(mech: Mechanism, pose: Pose):
     """Closed-form joint values of a mechanism of C-S limbs at a pose (the start of the pose
     fit; Gauss-Newton from all-zero joint values can stop at a wrong local minimum when a C
     rotation is near 180 degrees).  Per limb: slide ``s = u . (M_j - M1)``, rotation = signed
@@ -219,7 +220,7 @@ def check_5cs(mech: Mechanism, dyads: Sequence[CSDyad] | None = None, *, defects
     sl_idx = [ids.index(f"{lb.joints[0].name}.slide") for lb in mech.limbs]
     pe, ae, ik, ex, cv, sl = [], [], [], [], [], []
     for P in mech.positions:
-        fit = configuration_at_pose(mech, P, start=_cs_start(mech, P))
+        fit = configuration_at_pose(mech, P, start=cs_configuration(mech, P))
         pe.append(fit.position_error)
         ae.append(fit.angle_error)
         ik.append(fit.ik_residual)

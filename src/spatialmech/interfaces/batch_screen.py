@@ -1,0 +1,361 @@
+"""Defect screening at scale: the candidates of :mod:`spatialmech.synthesis.screening` judged
+in chunks on Dask (a ``LocalCluster`` of processes by default, or an existing cluster), the
+verdicts streamed into a Parquet dataset, chunk by chunk, so that an interrupted screen resumes
+where it stopped; the best usable linkages written as model files.
+
+The dataset directory (``OUT``, e.g. ``screen.parquet``)::
+
+    OUT/part-00000.parquet ...   one file per chunk of candidates (the verdict rows)
+    OUT/_screen.json             the arguments, the task, the candidate fingerprint, the summary
+    OUT/_pool.parquet            the sampled dyads (the candidates' limbs)
+    OUT/_top/rank-01.toml ...    the best usable linkages as model files
+
+Files and folders whose names start with ``_`` are skipped by Parquet readers, so
+``pyarrow.parquet.read_table(OUT)`` (or pandas, Dask, DuckDB) reads the verdicts alone.
+
+Determinism: the family, the pool and the candidates depend only on the task and the
+arguments (seeded), and each judgement only on its candidate, so a screen on any number of
+workers gives the same rows as the serial one (``workers=0``), up to the ``seconds`` and
+``worker`` columns.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import os
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError
+from ..model.mechanism import Pose
+from ..results import Progress, check_progress
+from ..synthesis.cs_dyads import CSFamily, cs_task, synthesize_cs
+from ..synthesis.screening import STAGES, DyadPool, candidate_linkage, candidate_sets, dyad_pool, judge_candidates, rank_key
+
+__all__ = ["MANIFEST", "ScreenSummary", "read_rows", "row_schema", "run_screen"]
+
+#: The dataset's description file.
+MANIFEST = "_screen.json"
+_POOL = "_pool.parquet"
+_TOP = "_top"
+_FORMAT = "spatialmech-screen/1"
+
+
+def row_schema():
+    """The pyarrow schema of one verdict row (docs/screening.md describes the columns)."""
+    import pyarrow as pa
+
+    strings = pa.list_(pa.string())
+    return pa.schema([
+        ("candidate", pa.int64()), ("chunk", pa.int32()), ("dyads", pa.list_(pa.int32())),
+        ("rejected_by", pa.string()), ("usable", pa.bool_()), ("keeps_sign", strings), ("usable_drivers", strings),
+        ("branch_defect_drivers", strings), ("circuit_defect", pa.bool_()), ("order_defect", pa.bool_()),
+        ("n_circuits", pa.int32()), ("min_closure_sigma_at_positions", pa.float64()),
+        ("min_closure_sigma_on_path", pa.float64()), ("min_sigma_on_path", pa.float64()),
+        ("best_driver", pa.string()), ("stroke_len", pa.float64()), ("max_abs_slide_len", pa.float64()),
+        ("seconds", pa.float64()), ("error", pa.string()), ("worker", pa.string()),
+    ])
+
+
+def judge_chunk(pool: DyadPool, sets: np.ndarray, first: int, chunk: int) -> list[dict]:
+    """The verdict rows of one chunk (runs on a worker): candidates ``first, first + 1, ...``."""
+    import socket
+
+    who = f"{socket.gethostname()}:{os.getpid()}"
+    rows = []
+    for v in judge_candidates(pool, sets, first):
+        rows.append({**v.row(), "chunk": int(chunk), "worker": who})
+    return rows
+
+
+# ------------------------------------------------------------------------------ the summary
+@dataclass
+class ScreenSummary:
+    """What a screen did: the counts per stage over the whole dataset (earlier runs included),
+    the time and candidates judged by this run, the workers, and the best usable linkages."""
+
+    out: Path
+    candidates: int
+    mode: str
+    judged: int
+    judged_this_run: int
+    chunks: int
+    chunks_resumed: int
+    rejected_by_stage: dict
+    usable: int
+    seconds: float
+    workers: int
+    scheduler: str
+    pool: dict
+    family: dict
+    top: list = field(default_factory=list)
+
+    @property
+    def rate(self) -> float | None:
+        """Candidates judged per second by this run."""
+        return self.judged_this_run / self.seconds if self.seconds > 0 and self.judged_this_run else None
+
+    def to_dict(self) -> dict:
+        """JSON (docs/json.md, ``screen``): counts, ``seconds`` and the rate of this run, the top list."""
+        return {
+            "out": str(self.out), "candidates": self.candidates, "candidate_mode": self.mode, "judged": self.judged,
+            "judged_this_run": self.judged_this_run, "chunks": self.chunks, "chunks_resumed": self.chunks_resumed,
+            "rejected_by_stage": dict(self.rejected_by_stage), "usable": self.usable, "seconds": self.seconds,
+            "candidates_per_s": self.rate, "workers": self.workers, "scheduler": self.scheduler,
+            "pool": dict(self.pool), "family": dict(self.family), "top": list(self.top),
+            "ranking": "min_sigma_on_path (larger first), then stroke_len (smaller first)",
+        }
+
+
+# ------------------------------------------------------------------------------ helpers
+def _poses_json(poses: Sequence[Pose]) -> list[dict]:
+    return [{"name": p.name, "R": np.asarray(p.R).tolist(), "p": np.asarray(p.p).tolist()} for p in poses]
+
+
+def _fingerprint(pool: DyadPool, sets: np.ndarray) -> str:
+    h = hashlib.sha256()
+    h.update(np.ascontiguousarray(np.round(pool.vectors, 8)).tobytes())
+    h.update(np.ascontiguousarray(sets, dtype=np.int64).tobytes())
+    return h.hexdigest()
+
+
+def _part(out: Path, chunk: int) -> Path:
+    return out / f"part-{chunk:05d}.parquet"
+
+
+def _write_rows(path: Path, rows: list[dict]) -> None:
+    """Write one chunk atomically (a temporary file renamed into place)."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    tmp = path.with_name("_tmp-" + path.name)
+    pq.write_table(pa.Table.from_pylist(rows, schema=row_schema()), tmp)
+    os.replace(tmp, path)
+
+
+def read_rows(out: str | os.PathLike) -> list[dict]:
+    """Every verdict row of a screening dataset, in candidate order."""
+    import pyarrow.parquet as pq
+
+    out = Path(out)
+    parts = sorted(out.glob("part-*.parquet"))
+    rows = [r for p in parts for r in pq.read_table(p, schema=row_schema()).to_pylist()]
+    return sorted(rows, key=lambda r: r["candidate"])
+
+
+def _check_out(out: Path, manifest: dict) -> int:
+    """Prepare ``out``; returns how many chunks are already there (a resume).  An existing
+    directory must be a screen with the same arguments and candidates, or empty."""
+    if out.exists() and not out.is_dir():
+        raise InputError(f"out: {out} exists and is not a directory")
+    mf = out / MANIFEST
+    if mf.exists():
+        try:
+            old = json.loads(mf.read_text(encoding="utf-8"))
+        except (OSError, ValueError) as e:
+            raise InputError(f"out: {mf} is not readable ({e}); use a new directory") from None
+        if old.get("format") != _FORMAT or old.get("arguments") != manifest["arguments"] \
+                or old.get("fingerprint") != manifest["fingerprint"]:
+            raise InputError(f"out: {out} holds a screen with other arguments or candidates; use a new directory "
+                             "(or the same arguments to resume it)")
+        return sum(1 for k in range(manifest["chunks"]) if _part(out, k).exists())
+    if out.exists() and any(out.iterdir()):
+        raise InputError(f"out: {out} is not empty and holds no screen ({MANIFEST} missing); use a new directory")
+    out.mkdir(parents=True, exist_ok=True)
+    (out / MANIFEST).write_text(json.dumps(manifest, indent=2), encoding="utf-8")
+    return 0
+
+
+def _write_pool(out: Path, pool: DyadPool) -> None:
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    names = ["B1_x", "B1_y", "B1_z", "M1_x", "M1_y", "M1_z", "u_x", "u_y", "u_z"] + [f"s{j}" for j in range(2, 8)]
+    cols = {"dyad": np.arange(len(pool)), "branch": pool.branch, "arc": pool.arc}
+    cols.update({n: pool.vectors[:, k] for k, n in enumerate(names)})
+    pq.write_table(pa.table(cols), out / _POOL)
+
+
+class _Reporter:
+    """Progress of the judgements: candidates done, rate, ETA, usable so far."""
+
+    def __init__(self, progress: Callable, total: int, done: int):
+        self.progress, self.total, self.done0, self.done = progress, total, done, done
+        self.usable = 0
+        self.t0 = time.perf_counter()
+
+    def __call__(self, n: int, usable: int) -> None:
+        self.done += n
+        self.usable += usable
+        dt = time.perf_counter() - self.t0
+        rate = (self.done - self.done0) / dt if dt > 0 else 0.0
+        eta = (self.total - self.done) / rate if rate > 0 else math.inf
+        eta_s = f"{eta:.0f} s" if math.isfinite(eta) else "?"
+        self.progress(self.done, self.total, f"{self.done}/{self.total} candidates, {rate:.2f} /s, ETA {eta_s}, "
+                                             f"{self.usable} usable so far")
+
+
+def _local_cluster(workers: int):
+    import logging
+
+    from distributed import Client, LocalCluster
+
+    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
+                           dashboard_address=None, silence_logs=logging.ERROR)
+    return cluster, Client(cluster)
+
+
+def _run_distributed(client, pool, todo, report, write) -> None:
+    from distributed import as_completed
+
+    pool_f = client.scatter(pool, broadcast=True)
+    futures = {client.submit(judge_chunk, pool_f, sets, first, k, pure=False): k for k, first, sets in todo}
+    try:
+        for fut in as_completed(futures):
+            rows = fut.result()  # a worker's exception is raised here, with its traceback
+            write(futures[fut], rows)
+            report(len(rows), sum(r["usable"] for r in rows))
+    except BaseException:
+        client.cancel(list(futures))
+        raise
+
+
+# ------------------------------------------------------------------------------ the screen
+def run_screen(
+    positions: Sequence[Pose],
+    out: str | os.PathLike,
+    *,
+    candidates: int = 1000,
+    density: float = 0.5,
+    seed: int = 0,
+    starts: int = 60,
+    separation: float = 0.5,
+    chunk_size: int = 20,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    top: int = 5,
+    family: CSFamily | None = None,
+    progress: Progress | None = None,
+) -> ScreenSummary:
+    """Screen 5-CS linkages for seven task ``positions`` (see the module docstring).
+
+    ``candidates``, ``density``, ``seed``, ``separation``: :func:`~..synthesis.screening.dyad_pool`
+    and :func:`~..synthesis.screening.candidate_sets`; ``starts``: random starts of the family
+    synthesis (:func:`~..synthesis.cs_dyads.synthesize_cs`, same ``seed``), or a ready ``family``
+    of these positions; ``chunk_size``: candidates per Parquet file and per Dask task;
+    ``workers``: local worker processes (``None``: one per core; ``0``: serial, in this
+    process, no Dask); ``scheduler``: the address of an existing Dask scheduler (then
+    ``workers`` is ignored; the workers need spatialmech installed); ``top``: how many of the
+    best usable linkages to write as model files.  ``progress(done, total, message)`` is called
+    after every chunk.  A rerun with the same arguments into the same ``out`` skips the chunks
+    already written.
+    """
+    from ..model.schema import dump
+
+    say = check_progress(progress)
+    for nm, v, lo in (("candidates", candidates, 1), ("chunk_size", chunk_size, 1), ("top", top, 0),
+                      ("starts", starts, 1)):
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < lo:
+            raise InputError(f"{nm}: expected a whole number >= {lo}, got {v!r}")
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, (int, np.integer)) or workers < 0):
+        raise InputError(f"workers: expected a whole number >= 0 (0: serial), got {workers!r}")
+    if scheduler is not None and not str(scheduler).strip():
+        raise InputError("scheduler: expected a Dask scheduler address such as tcp://10.0.0.5:8786, got an empty value")
+    for nm, v in (("density", density), ("separation", separation)):
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v < 0 \
+                or (nm == "density" and v == 0):
+            raise InputError(f"{nm}: expected a {'positive' if nm == 'density' else 'non-negative'} number, got {v!r}")
+    out = Path(out)
+    task = cs_task(positions)
+    if family is None:
+        say(0, None, "synthesising the CS dyad family of the seven positions")
+        family = synthesize_cs(task, n_starts=int(starts), seed=seed, pick=0)
+    elif family.task.D.shape != task.D.shape or not np.allclose(family.task.D, task.D, atol=1e-12):
+        raise InputError("family: it was synthesised for other positions")
+    pool = dyad_pool(family, density)
+    sets, mode = candidate_sets(pool, int(candidates), seed=seed, separation=separation)
+    if len(sets) == 0:
+        raise InputError(f"candidates: no well spread set of five dyads found (pool of {len(pool)}, separation "
+                         f"{separation}); raise --density")
+    n_chunks = math.ceil(len(sets) / chunk_size)
+    manifest = {
+        "format": _FORMAT,
+        "arguments": {"candidates": int(candidates), "density": float(density), "seed": int(seed), "starts": int(starts),
+                      "separation": float(separation), "chunk_size": int(chunk_size)},
+        "positions": _poses_json(task.poses),
+        "fingerprint": _fingerprint(pool, sets),
+        "n_candidates": len(sets), "candidate_mode": mode, "chunks": n_chunks, "pool_size": len(pool),
+    }
+    resumed = _check_out(out, manifest)
+    if not (out / _POOL).exists():
+        _write_pool(out, pool)
+    todo = [(k, k * chunk_size, sets[k * chunk_size:(k + 1) * chunk_size]) for k in range(n_chunks)
+            if not _part(out, k).exists()]
+    done_before = len(sets) - sum(len(s) for _, _, s in todo)
+    report = _Reporter(say, len(sets), done_before)
+
+    def write(k, rows):
+        _write_rows(_part(out, k), rows)
+
+    t0 = time.perf_counter()
+    n_workers, where = 0, "serial (this process)"
+    if todo:
+        if scheduler is None and workers == 0:
+            for k, first, s in todo:
+                rows = judge_chunk(pool, s, first, k)
+                write(k, rows)
+                report(len(rows), sum(r["usable"] for r in rows))
+        else:
+            from distributed import Client
+
+            if scheduler is not None:
+                cluster, client = None, Client(str(scheduler), timeout="20s")
+                where = str(scheduler)
+            else:
+                cluster, client = _local_cluster(int(workers or os.cpu_count() or 1))
+                where = "local cluster (127.0.0.1)"
+            try:
+                n_workers = len(client.scheduler_info().get("workers", {}))
+                say(done_before, len(sets), f"judging {len(sets) - done_before} candidates on {n_workers} workers")
+                _run_distributed(client, pool, todo, report, write)
+            finally:
+                client.close()
+                if cluster is not None:
+                    cluster.close()
+    seconds = time.perf_counter() - t0
+    rows = read_rows(out)
+    counts = dict.fromkeys((*STAGES, "error"), 0)
+    for r in rows:
+        if r["rejected_by"] is not None:
+            counts[r["rejected_by"]] += 1
+    usable = sorted((r for r in rows if r["usable"]), key=rank_key)
+    top_dir = out / _TOP
+    top_rows = []
+    if usable and top:
+        top_dir.mkdir(exist_ok=True)
+        for old in top_dir.glob("rank-*.toml"):
+            old.unlink()
+    for rank, r in enumerate(usable[:top], start=1):
+        path = top_dir / f"rank-{rank:02d}.toml"
+        mech = candidate_linkage(pool, r["dyads"], name=f"five-cs-screened-{r['candidate']}")
+        dump(mech, path)
+        top_rows.append({"place": rank, "candidate": r["candidate"], "dyads": r["dyads"],
+                         **{k: r[k] for k in ("usable_drivers", "best_driver", "min_sigma_on_path",
+                                              "min_closure_sigma_on_path", "stroke_len", "max_abs_slide_len")},
+                         "model_file": str(path)})
+    summary = ScreenSummary(
+        out=out, candidates=len(sets), mode=mode, judged=len(rows), judged_this_run=len(sets) - done_before,
+        chunks=n_chunks, chunks_resumed=resumed, rejected_by_stage=counts, usable=len(usable), seconds=seconds,
+        workers=n_workers, scheduler=where,
+        pool={"dyads": len(pool), "density": float(density), "separation": float(separation)},
+        family={"n_branches": len(family.branches), "n_points": family.n_points}, top=top_rows,
+    )
+    doc = {**manifest, "summary": summary.to_dict()}
+    (out / MANIFEST).write_text(json.dumps(doc, indent=2, default=float), encoding="utf-8")
+    return summary

@@ -1,0 +1,325 @@
+"""Defect screening of 5-CS linkages drawn from a seven-position CS dyad family (paper A's
+workflow taken to scale): sample dyads along every branch of the family (:func:`dyad_pool`),
+form candidate linkages of five of them (:func:`candidate_sets`), and judge each one
+(:func:`judge_candidate`) in stages, cheapest first:
+
+1. ``assembly``: the linkage is built from its dyads (:func:`~.five_cs.assemble_5cs`), put at
+   each task position in closed form (:func:`~.five_cs.cs_configuration`), and must close there
+   (closure residual) with one degree of freedom (the scale-free smallest singular value of the
+   closure Jacobian above the rank tolerance);
+2. ``dj_signs``: DJ of every candidate driver (the rotation and the slide of each C joint) at the
+   seven positions; a driver whose DJ changes sign between two positions has a zero (a branch
+   point) or a pole of DJ between them, and is dropped; no driver left: rejected.  This is the
+   fast rejection of the issue; a pole of DJ (the driver's own limb serially singular) would
+   make it reject a usable driver, which the benchmark measures by judging rejected candidates
+   in full;
+3. ``circuits``: the defect analysis of ``spatialmech defects``
+   (:func:`~spatialmech.analysis.defects.defect_analysis`) with the drivers left: circuit and
+   order defects, branch points per driver along the path, the usable drivers, and the closest
+   approach of the path to a singularity.
+
+A candidate is *usable* when it passes all three with at least one usable driver.  Ranking
+(:func:`rank_key`): the largest, over the usable drivers, of the smallest scale-free singular
+value of the driver's complete Jacobian along the task path (the distance to a singularity),
+then the total C-slide stroke over the positions (smaller first).
+
+Everything here is serial and pure: the Dask / Parquet orchestration is in
+:mod:`spatialmech.interfaces.batch`.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import InputError
+from ..geometry.tolerances import current as current_tolerances
+from ..model.mechanism import Mechanism
+from .cs_dyads import CSDyad, CSFamily, CSTask, cs_task, dyad_from_vector
+from .five_cs import assemble_5cs, cs_configuration
+
+__all__ = [
+    "STAGES",
+    "CandidateVerdict",
+    "DyadPool",
+    "candidate_linkage",
+    "candidate_sets",
+    "canonical",
+    "dyad_pool",
+    "judge_candidate",
+    "judge_candidates",
+    "nondimensional",
+    "rank_key",
+]
+
+#: The stages of the judgement, in order; a rejected candidate names the stage that rejected it.
+STAGES = ("assembly", "dj_signs", "circuits")
+
+
+# ------------------------------------------------------------------------------ coordinates
+def nondimensional(task_poses, x) -> np.ndarray:
+    """Family points ``x = (B1, M1, u, s2..s7)`` (``(..., 15)``, task unit) in the family's
+    nondimensional coordinates (points from the task centre, lengths divided by the task scale,
+    ``u`` unchanged): the coordinates in which the family is traced and dyads are compared."""
+    task = cs_task(task_poses)
+    x = np.asarray(x, dtype=float)
+    c, L = task.centre, task.scale
+    return np.concatenate([(x[..., 0:3] - c) / L, (x[..., 3:6] - c) / L, x[..., 6:9], x[..., 9:15] / L], axis=-1)
+
+
+def canonical(x) -> np.ndarray:
+    """Family points ``x`` (``(..., 15)``) with the sign convention of picked dyads: the largest
+    component of ``u`` positive (``u -> -u`` with ``s -> -s`` is the same dyad)."""
+    x = np.array(x, dtype=float, copy=True)
+    k = np.argmax(np.abs(x[..., 6:9]), axis=-1)
+    neg = np.take_along_axis(x[..., 6:9], k[..., None], axis=-1)[..., 0] < 0
+    x[neg, 6:15] *= -1
+    return x
+
+
+# ------------------------------------------------------------------------------ the dyad pool
+@dataclass(frozen=True, eq=False)
+class DyadPool:
+    """Dyads sampled along the family: ``vectors[i] = (B1, M1, u, s2..s7)`` (task length unit,
+    the sign convention of :func:`~.cs_dyads.canonical`), the ``branch`` (from 0) and ``arc``
+    (nondimensional arc length along its branch) each came from; ``density`` = dyads per unit of
+    nondimensional arc length."""
+
+    task: CSTask
+    vectors: np.ndarray
+    branch: np.ndarray
+    arc: np.ndarray
+    density: float
+
+    def __len__(self) -> int:
+        return len(self.vectors)
+
+    @property
+    def max_abs_slide(self) -> np.ndarray:
+        """Largest |C slide| of each dyad over the positions (task length unit)."""
+        return np.max(np.abs(self.vectors[:, 9:15]), axis=1)
+
+    def dyad(self, i: int) -> CSDyad:
+        return dyad_from_vector(self.task, self.vectors[int(i)])
+
+    def dyads(self, idx: Sequence[int]) -> tuple[CSDyad, ...]:
+        return tuple(self.dyad(i) for i in idx)
+
+
+def dyad_pool(family: CSFamily, density: float) -> DyadPool:
+    """Dyads spread evenly in arc length along every branch of ``family``: ``max(2, round(density
+    * arc length))`` per branch (ends included), ``density`` in dyads per unit of nondimensional
+    arc length (the family is traced in task scales)."""
+    if not (isinstance(density, (int, float)) and math.isfinite(density) and density > 0):
+        raise InputError(f"density: expected a positive number of dyads per unit arc length, got {density!r}")
+    vecs, br, arc = [], [], []
+    for k, b in enumerate(family.branches):
+        n = max(2, round(density * float(b.arc[-1] - b.arc[0])))
+        idx = b.sample(n)
+        vecs.append(b.points[idx])
+        br.append(np.full(len(idx), k))
+        arc.append(b.arc[idx])
+    if not vecs:
+        raise InputError("family: it has no branches to sample")
+    return DyadPool(family.task, canonical(np.concatenate(vecs)), np.concatenate(br), np.concatenate(arc),
+                    float(density))
+
+
+# ------------------------------------------------------------------------------ candidates
+def _separated(Y: np.ndarray, idx, separation: float) -> bool:
+    """Every pair of ``Y[idx]`` (nondimensional) at least ``separation`` apart, up to the u flip."""
+    P = Y[list(idx)]
+    flipped = P.copy()
+    flipped[:, 6:15] *= -1
+    for a, b in itertools.combinations(range(len(P)), 2):
+        if min(np.linalg.norm(P[a] - P[b]), np.linalg.norm(P[a] - flipped[b])) < separation:
+            return False
+    return True
+
+
+def candidate_sets(pool: DyadPool, n: int, *, seed: int = 0, separation: float = 0.5,
+                   max_tries: int | None = None) -> tuple[np.ndarray, str]:
+    """Up to ``n`` candidate linkages as sorted index quintuples into ``pool`` (``(m, 5)``, in a
+    fixed order) and how they were formed:
+
+    - ``"all"``: when the pool has at most ``n`` combinations of five, every combination whose
+      dyads are pairwise at least ``separation`` apart (nondimensional, up to the u flip);
+    - ``"weighted sample"``: otherwise, distinct quintuples drawn with a generator seeded with
+      ``seed``, each dyad with probability proportional to ``(s_min / s)^2`` (``s`` its largest
+      |slide|, ``s_min`` the pool's smallest: small slides preferred), kept when well spread
+      (``separation``); at most ``max_tries`` draws (default ``50 n``).
+    """
+    if not (isinstance(n, (int, np.integer)) and n >= 1):
+        raise InputError(f"candidates: expected a positive whole number, got {n!r}")
+    if not (math.isfinite(separation) and separation >= 0):
+        raise InputError(f"separation: expected a number >= 0, got {separation!r}")
+    m = len(pool)
+    if m < 5:
+        raise InputError(f"density: only {m} dyads sampled from the family; a 5-CS needs 5 (raise the density)")
+    Y = nondimensional(pool.task, pool.vectors)
+    if math.comb(m, 5) <= n:
+        out = [c for c in itertools.combinations(range(m), 5) if _separated(Y, c, separation)]
+        return np.array(out, dtype=np.int64).reshape(-1, 5), "all"
+    s = pool.max_abs_slide
+    w = (np.min(s) / np.maximum(s, 1e-300)) ** 2
+    w = w / w.sum()
+    rng = np.random.default_rng(seed)
+    seen: set[tuple[int, ...]] = set()
+    out = []
+    tries = 50 * n if max_tries is None else int(max_tries)
+    for _ in range(tries):
+        if len(out) >= n:
+            break
+        c = tuple(sorted(int(i) for i in rng.choice(m, 5, replace=False, p=w)))
+        if c in seen:
+            continue
+        seen.add(c)
+        if _separated(Y, c, separation):
+            out.append(c)
+    return np.array(out, dtype=np.int64).reshape(-1, 5), "weighted sample"
+
+
+def candidate_linkage(pool: DyadPool, idx: Sequence[int], *, name: str | None = None) -> Mechanism:
+    """The 5-CS linkage of the pool's dyads ``idx`` (:func:`~.five_cs.assemble_5cs`)."""
+    idx = [int(i) for i in idx]
+    return assemble_5cs(pool.task, pool.dyads(idx), name=name or "five-cs-" + "-".join(map(str, idx)))
+
+
+# ------------------------------------------------------------------------------ judging
+@dataclass(frozen=True)
+class CandidateVerdict:
+    """The judgement of one candidate (:func:`judge_candidate`): ``rejected_by`` = the stage
+    that rejected it (``None``: it passed every stage; ``"error"``: a numerical routine failed,
+    ``error`` says how), the drivers whose DJ keeps its sign at the positions, the drivers the
+    full analysis found usable or with a branch defect, its circuit/order defects, the closest
+    approach to a singularity (closure, and the best usable driver), the C-slide stroke
+    (sum over the limbs of max - min slide over the positions, task unit) and the time taken."""
+
+    candidate: int
+    dyads: tuple[int, ...]
+    rejected_by: str | None
+    keeps_sign: tuple[str, ...] = ()
+    usable_drivers: tuple[str, ...] = ()
+    branch_defect_drivers: tuple[str, ...] = ()
+    circuit_defect: bool | None = None
+    order_defect: bool | None = None
+    n_circuits: int | None = None
+    min_closure_sigma_positions: float | None = None
+    min_closure_sigma_path: float | None = None
+    min_driver_sigma_path: float | None = None
+    best_driver: str | None = None
+    stroke: float = math.nan
+    max_abs_slide: float = math.nan
+    seconds: float = 0.0
+    error: str | None = None
+
+    @property
+    def usable(self) -> bool:
+        return self.rejected_by is None and bool(self.usable_drivers)
+
+    def row(self) -> dict:
+        """One row of the screening dataset (docs/screening.md names the columns)."""
+        return {
+            "candidate": self.candidate,
+            "dyads": list(self.dyads),
+            "rejected_by": self.rejected_by,
+            "usable": self.usable,
+            "keeps_sign": list(self.keeps_sign),
+            "usable_drivers": list(self.usable_drivers),
+            "branch_defect_drivers": list(self.branch_defect_drivers),
+            "circuit_defect": self.circuit_defect,
+            "order_defect": self.order_defect,
+            "n_circuits": self.n_circuits,
+            "min_closure_sigma_at_positions": self.min_closure_sigma_positions,
+            "min_closure_sigma_on_path": self.min_closure_sigma_path,
+            "min_sigma_on_path": self.min_driver_sigma_path,
+            "best_driver": self.best_driver,
+            "stroke_len": self.stroke,
+            "max_abs_slide_len": self.max_abs_slide,
+            "seconds": self.seconds,
+            "error": self.error,
+        }
+
+
+def rank_key(row) -> tuple[float, float]:
+    """Sort key of usable candidates (a :class:`CandidateVerdict` or its :meth:`row`), best
+    first: the larger distance to a singularity along the path, then the smaller stroke."""
+    r = row.row() if isinstance(row, CandidateVerdict) else row
+    sig = r["min_sigma_on_path"]
+    return (-(sig if sig is not None and math.isfinite(sig) else -1.0), float(r["stroke_len"]))
+
+
+def _closure_at_positions(mech: Mechanism, configs) -> tuple[float, float]:
+    """Largest nondimensional closure residual and smallest scale-free closure sigma over ``configs``."""
+    from ..kinematics.closure import active_mask, closure_jacobian, closure_residual, closure_scales
+
+    L = mech.characteristic_length
+    active = active_mask(mech)
+    row, col = closure_scales(mech, active)
+    worst_res, min_sig = 0.0, math.inf
+    for c in configs:
+        r = np.asarray(closure_residual(mech, c), dtype=float).reshape(-1, 6)
+        worst_res = max(worst_res, float(np.max(np.abs(r[:, :3]))), float(np.max(np.abs(r[:, 3:]))) / L)
+        A, _ = closure_jacobian(mech, c, active=active)
+        sv = np.linalg.svd(row[:, None] * A * col[None, :], compute_uv=False)
+        min_sig = min(min_sig, float(sv[-1] / sv[0]))
+    return worst_res, min_sig
+
+
+def judge_candidate(pool: DyadPool, idx: Sequence[int], *, candidate: int = 0, h0: float = 0.02,
+                    max_arc: float = 400.0) -> CandidateVerdict:
+    """Judge the 5-CS of the pool's dyads ``idx`` in the stages of the module docstring.  A
+    failure of a numerical routine inside a stage (``InputError``/``ValueError``/
+    ``RuntimeError``, e.g. a position that cannot be fitted, a circuit that cannot be traced)
+    rejects the candidate as ``"error"`` with the message; it is never dropped silently."""
+    from ..analysis.defects import candidate_drivers, defect_analysis, dj_function
+
+    t0 = time.perf_counter()
+    idx = tuple(int(i) for i in idx)
+    V = pool.vectors[list(idx)]
+    slides = np.concatenate([np.zeros((5, 1)), V[:, 9:15]], axis=1)
+    base = dict(candidate=int(candidate), dyads=idx, stroke=float(np.sum(np.ptp(slides, axis=1))),
+                max_abs_slide=float(np.max(np.abs(slides))))
+
+    def done(**kw) -> CandidateVerdict:
+        return CandidateVerdict(**base, **kw, seconds=time.perf_counter() - t0)
+
+    tol = current_tolerances()
+    try:
+        mech = candidate_linkage(pool, idx)
+        configs = [cs_configuration(mech, P) for P in mech.positions]
+        if any(c is None for c in configs):
+            raise InputError("dyads: a candidate limb is not a C-S chain")
+        res, sig = _closure_at_positions(mech, configs)
+        if not (res <= tol.reachability and sig > tol.rank):
+            return done(rejected_by="assembly", min_closure_sigma_positions=sig)
+        drivers = candidate_drivers(mech)
+        djf, _ = dj_function(mech, drivers, configs[0])
+        dj = np.array([djf(c) for c in configs])
+        s = np.sign(dj)
+        keeps = tuple(d for k, d in enumerate(drivers) if np.all(s[:, k] == s[0, k]) and s[0, k] != 0)
+        if not keeps:
+            return done(rejected_by="dj_signs", min_closure_sigma_positions=sig)
+        r = defect_analysis(mech, drivers=list(keeps), h0=h0, max_arc=max_arc)
+    except (InputError, ValueError, RuntimeError, np.linalg.LinAlgError) as e:
+        return done(rejected_by="error", error=f"{type(e).__name__}: {e}")
+    usable = tuple(r.usable_drivers)
+    sig_d = {v.driver: v.min_sigma_on_path for v in r.drivers if v.usable and v.min_sigma_on_path is not None}
+    best = max(sig_d, key=lambda d: sig_d[d]) if sig_d else None
+    return done(
+        rejected_by=None if usable else "circuits", keeps_sign=keeps, usable_drivers=usable,
+        branch_defect_drivers=tuple(v.driver for v in r.drivers if v.branch_defect),
+        circuit_defect=bool(r.circuit_defect), order_defect=bool(r.order_defect), n_circuits=len(r.circuits),
+        min_closure_sigma_positions=sig, min_closure_sigma_path=r.min_closure_sigma,
+        min_driver_sigma_path=sig_d[best] if best else None, best_driver=best,
+    )
+
+
+def judge_candidates(pool: DyadPool, sets: np.ndarray, first: int = 0, **kw) -> list[CandidateVerdict]:
+    """:func:`judge_candidate` over the rows of ``sets`` (candidate numbers from ``first``)."""
+    return [judge_candidate(pool, c, candidate=first + k, **kw) for k, c in enumerate(np.asarray(sets))]
