@@ -16,7 +16,6 @@ from itertools import combinations
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from ..geometry.rotations import rotation_angle
 from ..kinematics.closure import Configuration
 from ..kinematics.tracking import MotionProblem, TrackResult, correct_on_hyperplane, track
 from ..model.mechanism import Mechanism, Pose
@@ -81,7 +80,9 @@ def pose_distance(mech: Mechanism, prob: MotionProblem, tr: TrackResult, pose: P
         R = np.array([x.D[:3, :3] for x in xs])
         p = R @ mech.platform_point + np.array([x.D[:3, 3] for x in xs])
         dp = np.linalg.norm(p - pose.p, axis=1)
-        th = rotation_angle(R @ pose.R.T)
+        Q = R @ pose.R.T  # the rotation angle: atan2(|axial vector|, (trace - 1) / 2), exact to rounding up to pi
+        ax = np.stack([Q[:, 2, 1] - Q[:, 1, 2], Q[:, 0, 2] - Q[:, 2, 0], Q[:, 1, 0] - Q[:, 0, 1]], axis=1)
+        th = np.arctan2(0.5 * np.linalg.norm(ax, axis=1), 0.5 * (np.trace(Q, axis1=1, axis2=2) - 1.0))
         return np.hypot(dp / pose_tol, th / angle_tol), dp, th
 
     def meas(x):

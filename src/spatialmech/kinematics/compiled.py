@@ -54,6 +54,7 @@ from .closure import (
 from .jit import AVAILABLE, UNAVAILABLE_REASON
 from .kernels_closure import (
     nb_correct,
+    nb_correct_hyperplane,
     nb_limb_gn,
     nb_retract,
     nb_systems,
@@ -81,6 +82,7 @@ __all__ = [
     "compile_mechanism",
     "config_difference",
     "config_differences",
+    "correct_on_hyperplane",
     "correct",
     "correct_many",
     "driver_determinants",
@@ -427,6 +429,25 @@ def config_differences(mech: Mechanism, points: Sequence[Configuration], b: Conf
     return out
 
 
+def correct_on_hyperplane(mech: Mechanism, config: Configuration, active, row, col, t, tol: float, max_iter: int,
+                          contraction: float) -> tuple[Configuration, bool, int, float]:
+    """``tracking.correct_on_hyperplane`` of a ``MotionProblem`` (row and column scales ``row``,
+    ``col`` of :func:`.closure.closure_scales`), the whole Newton loop compiled:
+    ``(config, converged, iterations, total correction length)``."""
+    cm = compile_mechanism(mech)
+    act = _mask(mech, cm, active)
+    _check(mech, cm, config)
+    q0, D0, B0 = _config_arrays(cm, config)
+    q, D, B = np.empty_like(q0), np.empty_like(D0), np.empty_like(B0)
+    info = np.zeros(3)
+    nb_correct_hyperplane(cm.screws, cm.ball_of, cm.ball_first, cm.ball_axes, cm.ball_centre, cm.limb_start, cm.ends,
+                          q0, D0, B0, act, _f64(row), _f64(col), _f64(t), float(tol), int(max_iter), float(contraction),
+                          q, D, B, info)
+    it = int(info[1])
+    out = config if it == 0 else Configuration(q, D, B)
+    return out, bool(info[0]), it, float(info[2])
+
+
 def _run_limb_gn(chain: Chain, Ds, q0s, lin, L, tol, max_iter, hold):
     ca = _chain_arrays(chain)
     m = len(ca.screws)
@@ -516,10 +537,15 @@ def driver_determinants(mech: Mechanism, config: Configuration, drivers) -> np.n
     """:func:`.jacobian.driver_determinants`, compiled, or ``None`` for a mechanism this kernel
     does not handle (a limb with fewer than five active twists, or five dependent ones): the
     caller then runs the Python path."""
-    _check(mech, compile_mechanism(mech), config)
-    out = driver_determinants_many(mech, np.asarray(config.q)[None], np.asarray(config.D)[None],
-                                   None if not len(config.B) else np.asarray(config.B)[None], drivers)
-    return None if out is None else out[0]
+    cm = compile_mechanism(mech)
+    _check(mech, cm, config)
+    q, D, B = _config_arrays(cm, config)  # checked: the batch of one goes straight to the kernel
+    idx = _driver_indices(mech, drivers)
+    out = np.empty((1, len(idx)))
+    pos = (np.cumsum(cm.active) - 1)[idx]
+    flag = nb_dets_many(*_system_args(cm), cm.linear, cm.active, cm.length, current_tolerances().rank, q[None], D[None],
+                        B[None], idx, pos, cm.n_bodies > 0, out)
+    return None if flag == 2 else out[0]
 
 
 def driver_determinants_many(mech: Mechanism, q, D, B, drivers) -> np.ndarray | None:

@@ -25,6 +25,7 @@ __all__ = [
     "nb_closure_system",
     "nb_colmap",
     "nb_correct",
+    "nb_correct_hyperplane",
     "nb_hub",
     "nb_limb_gn",
     "nb_max_limb",
@@ -372,6 +373,78 @@ def nb_correct(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends,
         status[s] = st
         iters[s] = it
         resid[s] = rn
+
+
+@njit(cache=True)
+def nb_correct_hyperplane(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends, q0, D0, B0, active, row, col,
+                          t, tol, max_iter, contraction, q, D, B, info):
+    """``tracking.correct_on_hyperplane`` for a mechanism's motion (``tracking.MotionProblem``):
+    Newton on the row-scaled closure with every correction orthogonal to ``t`` (local coordinates
+    scaled by ``col``), from ``q0, D0, B0`` into ``q, D, B``; ``info`` = (converged, iterations,
+    total correction length)."""
+    K = len(limb_start) - 1
+    m = 6 * K
+    colmap, na = nb_colmap(active)
+    nc = na + 6 * (1 + B0.shape[0])
+    A = np.zeros((m, nc))
+    r = np.zeros(m)
+    M = np.empty((m + 1, nc))
+    rhs = np.empty(m + 1)
+    step = np.empty(nc)
+    n = len(q0)
+    q2 = np.empty(n)
+    D2 = np.empty((4, 4))
+    B2 = np.empty(B0.shape)
+    for i in range(n):
+        q[i] = q0[i]
+    nb_copy44(D0, D)
+    for b in range(B0.shape[0]):
+        nb_copy44(B0[b], B[b])
+    moved = 0.0
+    prev = np.inf
+    for it in range(max_iter):
+        nb_closure_system(S, ball_of, ball_axes, ball_centre, limb_start, ends, q, D, B, colmap, na, True, A, r)
+        sq = 0.0
+        for i in range(m):
+            v = row[i] * r[i]
+            rhs[i] = -v
+            sq += v * v
+        if np.sqrt(sq) < tol:
+            info[0] = 1.0
+            info[1] = it
+            info[2] = moved
+            return
+        for i in range(m):
+            for c in range(nc):
+                M[i, c] = row[i] * A[i, c] * col[c]
+        for c in range(nc):
+            M[m, c] = t[c]
+        rhs[m] = 0.0
+        d = nb_lstsq(M, rhs)
+        dn = nb_norm(d)
+        if it > 0 and dn > contraction * prev:
+            info[0] = 0.0
+            info[1] = it
+            info[2] = moved
+            return
+        prev = dn
+        moved += dn
+        for c in range(nc):
+            step[c] = col[c] * d[c]
+        nb_retract(ball_first, ball_axes, q, D, B, active, step, na, False, q2, D2, B2)
+        for i in range(n):
+            q[i] = q2[i]
+        nb_copy44(D2, D)
+        for b in range(B0.shape[0]):
+            nb_copy44(B2[b], B[b])
+    nb_closure_system(S, ball_of, ball_axes, ball_centre, limb_start, ends, q, D, B, colmap, na, False, A, r)
+    sq = 0.0
+    for i in range(m):
+        v = row[i] * r[i]
+        sq += v * v
+    info[0] = 1.0 if np.sqrt(sq) < tol else 0.0
+    info[1] = max_iter
+    info[2] = moved
 
 
 @njit(cache=True)

@@ -70,11 +70,25 @@ def _null_tangent(A: np.ndarray) -> np.ndarray:
     return vt[-1]
 
 
+_LAST_SVD: list = [None, None]  # the last full SVD and the array it belongs to (see _full_svd)
+
+
+def _full_svd(A: np.ndarray):
+    """``np.linalg.svd(A, full_matrices=True)``, remembered for the last array: the tracker asks
+    for the tangent and then for Keller's frame of the same Jacobian (the array object returned
+    by the problem's memo; arrays are not changed in place here)."""
+    if _LAST_SVD[0] is A:
+        return _LAST_SVD[1]
+    out = np.linalg.svd(A, full_matrices=True)
+    _LAST_SVD[0], _LAST_SVD[1] = A, out
+    return out
+
+
 def _observable_tangent(A: np.ndarray, n_obs: int) -> np.ndarray:
     """Unit tangent of a curve whose Jacobian ``A`` may also vanish on passive directions (those
     that leave the last ``n_obs`` coordinates, e.g. the platform twist, at rest): the null
     vector with the largest observable part, which has no passive component."""
-    _, sv, vt = np.linalg.svd(A, full_matrices=True)
+    _, sv, vt = _full_svd(A)
     r = int(np.sum(sv > current_tolerances().rank * max(1.0, sv[0]))) if sv.size else 0
     N = vt[r:]
     if N.shape[0] == 0:
@@ -161,8 +175,13 @@ class TrackResult:
 def _frame(A: np.ndarray, t: np.ndarray):
     """Row-space projection ``P`` and passive null directions ``G`` of ``A`` at a point, such that
     ``[P A; G; t]`` is square.  Kept fixed while a step is checked."""
-    U, sv, vt = np.linalg.svd(A, full_matrices=True)
+    U, sv, vt = _full_svd(A)
     r = int(np.sum(sv > current_tolerances().rank * max(1.0, sv[0]))) if sv.size else 0
+    if r == A.shape[0] and A.shape[1] == r + 1:
+        # full row rank, a one-dimensional null space: P = U^T is orthogonal and G is empty, so
+        # det [P A; t] = det(U^T) det [A; t], and det(U^T) is the same for every check made
+        # with this frame: Keller's test compares the signs of det [A; t] alone
+        return None, None
     P = U[:, :r].T
     N = vt[r:]
     Nt = N - np.outer(N @ t, t)  # null directions other than the tangent
@@ -178,7 +197,7 @@ def _orientation(A: np.ndarray, t: np.ndarray, frame) -> float:
     """Sign of ``det [P A; G; t]``: constant along a regular branch with a continuously oriented
     tangent; it flips when a step crosses to another branch (Keller's test)."""
     P, G = frame
-    M = np.vstack([P @ A, G, t[None, :]])
+    M = np.vstack([A, t[None, :]]) if P is None else np.vstack([P @ A, G, t[None, :]])
     if M.shape[0] != M.shape[1]:
         return 0.0
     sign, _ = np.linalg.slogdet(M)
@@ -190,6 +209,9 @@ def correct_on_hyperplane(problem, xp, t, tol, max_iter, contraction=0.6):
     corrector; also used to land on a curve at a given distance along a tangent).  Returns
     ``(x, converged, iterations, total correction length)``; it stops early when the corrections
     stop contracting."""
+    fast = getattr(problem, "compiled_correct", None)
+    if fast is not None and compiled.enabled():
+        return fast(xp, t, tol, max_iter, contraction)
     moved = 0.0
     prev = np.inf
     for it in range(max_iter):
@@ -450,6 +472,11 @@ class MotionProblem(_MechanismBase):
 
     def difference(self, x, y):
         return self._config_diff(x, y)
+
+    def compiled_correct(self, xp, t, tol, max_iter, contraction):
+        """:func:`correct_on_hyperplane` with the whole Newton loop compiled (same steps)."""
+        return compiled.correct_on_hyperplane(self.mech, xp, self.active, self.row, self.col, t, tol, max_iter,
+                                              contraction)
 
     def differences(self, xs, y) -> np.ndarray:
         """:meth:`difference` of ``y`` relative to each of ``xs`` (rows), compiled in one loop."""
