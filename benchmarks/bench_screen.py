@@ -60,15 +60,26 @@ def main() -> None:
         say(f"serial: {s0.judged} candidates in {s0.seconds:.1f} s = {s0.rate:.2f} /s; {s0.rejected_by_stage}, "
             f"usable {s0.usable}")
 
+        marks: dict = {}
+
+        def watch(done, total, msg):
+            if msg.startswith("judging"):  # the cluster is up: the workers start judging
+                marks["ready"] = time.perf_counter()
+
         t = time.perf_counter()
-        s2 = run_screen(five_cs_positions(), d / "two.parquet", candidates=a.candidates, workers=2, family=fam, top=5)
+        s2 = run_screen(five_cs_positions(), d / "two.parquet", candidates=a.candidates, workers=2, family=fam, top=5,
+                        progress=watch)
         wall = time.perf_counter() - t
+        steady = (time.perf_counter() - marks["ready"]) if "ready" in marks else None
         res["two_workers"] = {"candidates": s2.judged, "seconds": s2.seconds, "candidates_per_s": s2.rate,
-                              "wall_s_with_startup": wall, "rejected_by_stage": s2.rejected_by_stage,
+                              "wall_s_with_startup": wall, "cluster_startup_s": wall - steady if steady else None,
+                              "candidates_per_s_after_startup": s2.judged / steady if steady else None,
+                              "rejected_by_stage": s2.rejected_by_stage,
                               "usable": s2.usable, "top": s2.top}
         res["speedup_2_workers"] = s2.rate / s0.rate if s0.rate and s2.rate else None
         say(f"2 workers: {s2.judged} candidates in {s2.seconds:.1f} s = {s2.rate:.2f} /s (x{res['speedup_2_workers']:.2f}"
-            f" the serial rate); {s2.rejected_by_stage}, usable {s2.usable}")
+            f" the serial rate; cluster start-up {res['two_workers']['cluster_startup_s']:.1f} s, then "
+            f"{res['two_workers']['candidates_per_s_after_startup']:.2f} /s); {s2.rejected_by_stage}, usable {s2.usable}")
         same = list(read_rows(d / "two.parquet")[: a.serial])
         ref = read_rows(d / "serial.parquet")
         res["serial_rows_equal"] = [{k: v for k, v in r.items() if k not in ("seconds", "worker")} for r in same] == \

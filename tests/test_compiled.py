@@ -279,6 +279,20 @@ def test_sps_leg_lengths_agree_with_the_closed_form():
     close(compiled.sps_leg_lengths(poses, base, plat), four_sps_cu.leg_lengths(phi, g), 1e-14)
 
 
+def test_batched_4sps_cu_legs_on_all_cores_equal_the_reference():
+    """From ``PARALLEL_FROM`` poses the legs are computed on every core (prange): the numbers are
+    those of the one-thread kernel and, to rounding, of the NumPy reference."""
+    rng = np.random.default_rng(2)
+    n = four_sps_cu.PARALLEL_FROM + 17
+    phi = np.column_stack([rng.uniform(0.08, 0.3, n), rng.uniform(-3, 3, (n, 3))])
+    big = four_sps_cu.leg_lengths(phi)
+    one = np.concatenate([four_sps_cu.leg_lengths(phi[i:i + 1000]) for i in range(0, n, 1000)])
+    assert np.array_equal(big, one)
+    with compiled.python_reference():
+        ref = four_sps_cu.leg_lengths(phi)
+    close(big, ref, 1e-14)
+
+
 def test_without_numba_the_python_path_runs_with_a_note(monkeypatch):
     monkeypatch.setattr(compiled, "AVAILABLE", False)
     with pytest.warns(RuntimeWarning, match="numba"):

@@ -4,10 +4,10 @@ run: :func:`.compiled.enabled` is false and the Python reference path runs)."""
 
 from __future__ import annotations
 
-__all__ = ["AVAILABLE", "UNAVAILABLE_REASON", "njit"]
+__all__ = ["AVAILABLE", "UNAVAILABLE_REASON", "njit", "prange"]
 
 try:  # numba is a runtime dependency; without it the Python path runs (slower, same results)
-    from numba import njit
+    from numba import njit, prange
 
     AVAILABLE = True
     UNAVAILABLE_REASON = ""
@@ -19,3 +19,5 @@ except ImportError as exc:  # pragma: no cover - exercised only where numba is m
         if args and callable(args[0]):
             return args[0]
         return lambda f: f
+
+    prange = range

@@ -63,7 +63,7 @@ from ...errors import InputError
 from ...geometry.rotations import euler_matrix, transform
 from ...geometry.validate import as_finite_array
 from .. import compiled
-from ..jit import njit
+from ..jit import njit, prange
 from . import sps
 
 __all__ = [
@@ -267,6 +267,34 @@ def _legs_sq_block(ph: np.ndarray, a: float, b: float, out: np.ndarray) -> None:
     np.subtract(c, m, out=out[:, 3])
 
 
+def _legs_pose(ph, i, k, ab2, a, squared, out):
+    """One pose of :func:`_legs_kernel` (the closed form of :func:`_legs_sq_block`)."""
+    z = ph[i, 0]
+    sa, ca = np.sin(ph[i, 1]), np.cos(ph[i, 1])
+    sb, cb = np.sin(ph[i, 2]), np.cos(ph[i, 2])
+    sg, cg = np.sin(ph[i, 3]), np.cos(ph[i, 3])
+    t = sa * sb
+    P = ab2 * (cb * cg + ca * cg + t * sg)
+    Q = ab2 * (t * cg + cb * sg - ca * sg)
+    az2 = 2.0 * a * z
+    m = -az2 * sb
+    n = az2 * cb * sa
+    c = z * z + k - P
+    c1 = c + Q
+    c -= Q
+    v0, v1, v2, v3 = c1 + (m - n), c + (m + n), c1 - (m - n), c - (m + n)
+    if squared:
+        out[i, 0], out[i, 1], out[i, 2], out[i, 3] = v0, v1, v2, v3
+    else:
+        out[i, 0] = np.sqrt(max(v0, 0.0))
+        out[i, 1] = np.sqrt(max(v1, 0.0))
+        out[i, 2] = np.sqrt(max(v2, 0.0))
+        out[i, 3] = np.sqrt(max(v3, 0.0))
+
+
+_legs_pose_nb = njit(cache=True, fastmath=True, inline="always")(_legs_pose)
+
+
 @njit(cache=True, fastmath=True)
 def _legs_kernel(ph, a, b, squared, out):
     """:func:`_legs_sq_block` pose by pose (compiled, fastmath: last-bit differences from the
@@ -274,27 +302,22 @@ def _legs_kernel(ph, a, b, squared, out):
     k = 2.0 * a * a + 2.0 * b * b
     ab2 = 2.0 * a * b
     for i in range(ph.shape[0]):
-        z = ph[i, 0]
-        sa, ca = np.sin(ph[i, 1]), np.cos(ph[i, 1])
-        sb, cb = np.sin(ph[i, 2]), np.cos(ph[i, 2])
-        sg, cg = np.sin(ph[i, 3]), np.cos(ph[i, 3])
-        t = sa * sb
-        P = ab2 * (cb * cg + ca * cg + t * sg)
-        Q = ab2 * (t * cg + cb * sg - ca * sg)
-        az2 = 2.0 * a * z
-        m = -az2 * sb
-        n = az2 * cb * sa
-        c = z * z + k - P
-        c1 = c + Q
-        c -= Q
-        v0, v1, v2, v3 = c1 + (m - n), c + (m + n), c1 - (m - n), c - (m + n)
-        if squared:
-            out[i, 0], out[i, 1], out[i, 2], out[i, 3] = v0, v1, v2, v3
-        else:
-            out[i, 0] = np.sqrt(max(v0, 0.0))
-            out[i, 1] = np.sqrt(max(v1, 0.0))
-            out[i, 2] = np.sqrt(max(v2, 0.0))
-            out[i, 3] = np.sqrt(max(v3, 0.0))
+        _legs_pose_nb(ph, i, k, ab2, a, squared, out)
+
+
+@njit(cache=True, fastmath=True, parallel=True)
+def _legs_kernel_parallel(ph, a, b, squared, out):
+    """:func:`_legs_kernel` with the poses shared among the cores (numba's ``prange``): the same
+    numbers, pose by pose."""
+    k = 2.0 * a * a + 2.0 * b * b
+    ab2 = 2.0 * a * b
+    for i in prange(ph.shape[0]):
+        _legs_pose_nb(ph, i, k, ab2, a, squared, out)
+
+
+#: Poses from which :func:`leg_lengths` shares the work among the cores (below: one thread; the
+#: threads' start-up would cost more than they save).
+PARALLEL_FROM = 16384
 
 
 def leg_lengths(phi, geometry: FourSpsCuGeometry = PAPER_B, *, squared: bool = False) -> np.ndarray:
@@ -308,7 +331,8 @@ def leg_lengths(phi, geometry: FourSpsCuGeometry = PAPER_B, *, squared: bool = F
     flat = np.ascontiguousarray(phi.reshape(-1, 4))
     out = np.empty_like(flat)
     if compiled.enabled():
-        _legs_kernel(flat, float(geometry.a), float(geometry.b), bool(squared), out)
+        kernel = _legs_kernel_parallel if flat.shape[0] >= PARALLEL_FROM else _legs_kernel
+        kernel(flat, float(geometry.a), float(geometry.b), bool(squared), out)
         return out.reshape(phi.shape)
     for s in range(0, flat.shape[0], _CHUNK):
         blk = out[s : s + _CHUNK]
