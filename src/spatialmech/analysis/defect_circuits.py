@@ -17,7 +17,7 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from ..kinematics.closure import Configuration
-from ..kinematics.tracking import MotionProblem, TrackResult, correct_on_hyperplane, track
+from ..kinematics.tracking import MotionProblem, TrackResult, predict_correct, track
 from ..model.mechanism import Mechanism, Pose
 from ..results import Progress
 
@@ -54,7 +54,7 @@ def arc_on_curve(problem: MotionProblem, tr: TrackResult, config: Configuration,
     for k in {max(0, k0 - 1), k0, min(len(tr.points) - 1, k0 + 1)}:
         x, t = tr.points[k], tr.tangents[k]
         a = float(t @ problem.difference(x, config))
-        xs, ok, _, _ = correct_on_hyperplane(problem, problem.retract(x, a * t), t, 1e-11, 30)
+        xs, ok, _, _ = predict_correct(problem, x, a * t, t, 1e-11, 30)
         if not ok:
             continue
         dist = float(np.linalg.norm(problem.difference(xs, config)))
@@ -100,7 +100,7 @@ def pose_distance(mech: Mechanism, prob: MotionProblem, tr: TrackResult, pose: P
 
         def at(a, x=x, t=t, cache=cache):
             if a not in cache:
-                xa, ok, _, _ = correct_on_hyperplane(prob, prob.retract(x, a * t), t, 1e-11, 20)
+                xa, ok, _, _ = predict_correct(prob, x, a * t, t, 1e-11, 20)
                 cache[a] = meas(xa) if ok else (np.inf, np.inf, np.inf)
             return cache[a]
 

@@ -430,21 +430,27 @@ def config_differences(mech: Mechanism, points: Sequence[Configuration], b: Conf
 
 
 def correct_on_hyperplane(mech: Mechanism, config: Configuration, active, row, col, t, tol: float, max_iter: int,
-                          contraction: float) -> tuple[Configuration, bool, int, float]:
+                          contraction: float, predictor=None) -> tuple[Configuration, bool, int, float]:
     """``tracking.correct_on_hyperplane`` of a ``MotionProblem`` (row and column scales ``row``,
     ``col`` of :func:`.closure.closure_scales`), the whole Newton loop compiled:
-    ``(config, converged, iterations, total correction length)``."""
+    ``(config, converged, iterations, total correction length)``.  With ``predictor`` (a step in
+    the problem's local coordinates) the Newton loop starts from ``config`` moved by it (the
+    problem's ``retract``), in the same call."""
     cm = compile_mechanism(mech)
     act = _mask(mech, cm, active)
     _check(mech, cm, config)
     q0, D0, B0 = _config_arrays(cm, config)
     q, D, B = np.empty_like(q0), np.empty_like(D0), np.empty_like(B0)
     info = np.zeros(3)
+    tt = _f64(t)
+    pred = tt if predictor is None else _f64(predictor)
+    if pred.shape != tt.shape:
+        raise InputError(f"predictor: expected {tt.shape[0]} local coordinates, got shape {pred.shape}")
     nb_correct_hyperplane(cm.screws, cm.ball_of, cm.ball_first, cm.ball_axes, cm.ball_centre, cm.limb_start, cm.ends,
-                          q0, D0, B0, act, _f64(row), _f64(col), _f64(t), float(tol), int(max_iter), float(contraction),
-                          q, D, B, info)
+                          q0, D0, B0, act, _f64(row), _f64(col), tt, float(tol), int(max_iter), float(contraction), pred,
+                          predictor is not None, q, D, B, info)
     it = int(info[1])
-    out = config if it == 0 else Configuration(q, D, B)
+    out = config if it == 0 and predictor is None else Configuration(q, D, B)
     return out, bool(info[0]), it, float(info[2])
 
 
@@ -522,6 +528,16 @@ def _driver_indices(mech: Mechanism, drivers) -> np.ndarray:
     return known[key]
 
 
+def _driver_columns(mech: Mechanism, cm: CompiledMechanism, drivers) -> tuple[np.ndarray, np.ndarray]:
+    """The drivers' joint indices and their places among the active joints (remembered)."""
+    key = ("columns", tuple(drivers))
+    known = _DRIVERS.setdefault(mech, {})
+    if key not in known:
+        idx = _driver_indices(mech, drivers)
+        known[key] = (idx, (np.cumsum(cm.active) - 1)[idx])
+    return known[key]
+
+
 def _find_drivers(mech: Mechanism, drivers) -> np.ndarray:
     refs = mech.freedom_refs
     idx = []
@@ -540,9 +556,8 @@ def driver_determinants(mech: Mechanism, config: Configuration, drivers) -> np.n
     cm = compile_mechanism(mech)
     _check(mech, cm, config)
     q, D, B = _config_arrays(cm, config)  # checked: the batch of one goes straight to the kernel
-    idx = _driver_indices(mech, drivers)
+    idx, pos = _driver_columns(mech, cm, drivers)
     out = np.empty((1, len(idx)))
-    pos = (np.cumsum(cm.active) - 1)[idx]
     flag = nb_dets_many(*_system_args(cm), cm.linear, cm.active, cm.length, current_tolerances().rank, q[None], D[None],
                         B[None], idx, pos, cm.n_bodies > 0, out)
     return None if flag == 2 else out[0]

@@ -377,10 +377,11 @@ def nb_correct(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends,
 
 @njit(cache=True)
 def nb_correct_hyperplane(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends, q0, D0, B0, active, row, col,
-                          t, tol, max_iter, contraction, q, D, B, info):
+                          t, tol, max_iter, contraction, pred, has_pred, q, D, B, info):
     """``tracking.correct_on_hyperplane`` for a mechanism's motion (``tracking.MotionProblem``):
     Newton on the row-scaled closure with every correction orthogonal to ``t`` (local coordinates
-    scaled by ``col``), from ``q0, D0, B0`` into ``q, D, B``; ``info`` = (converged, iterations,
+    scaled by ``col``), from ``q0, D0, B0`` -- first moved by the predictor step ``pred`` (local
+    coordinates) when ``has_pred`` -- into ``q, D, B``; ``info`` = (converged, iterations,
     total correction length)."""
     K = len(limb_start) - 1
     m = 6 * K
@@ -395,11 +396,16 @@ def nb_correct_hyperplane(S, ball_of, ball_first, ball_axes, ball_centre, limb_s
     q2 = np.empty(n)
     D2 = np.empty((4, 4))
     B2 = np.empty(B0.shape)
-    for i in range(n):
-        q[i] = q0[i]
-    nb_copy44(D0, D)
-    for b in range(B0.shape[0]):
-        nb_copy44(B0[b], B[b])
+    if has_pred:
+        for c in range(nc):
+            step[c] = col[c] * pred[c]
+        nb_retract(ball_first, ball_axes, q0, D0, B0, active, step, na, False, q, D, B)
+    else:
+        for i in range(n):
+            q[i] = q0[i]
+        nb_copy44(D0, D)
+        for b in range(B0.shape[0]):
+            nb_copy44(B0[b], B[b])
     moved = 0.0
     prev = np.inf
     for it in range(max_iter):

@@ -44,6 +44,7 @@ __all__ = [
     "MotionProblem",
     "TrackResult",
     "correct_on_hyperplane",
+    "predict_correct",
     "trace_motion",
     "track",
 ]
@@ -233,6 +234,15 @@ def correct_on_hyperplane(problem, xp, t, tol, max_iter, contraction=0.6):
     return xp, float(np.linalg.norm(problem.residual(xp))) < tol, max_iter, moved
 
 
+def predict_correct(problem, x, step, t, tol, max_iter, contraction=0.6):
+    """``correct_on_hyperplane(problem, problem.retract(x, step), t, ...)``: the predictor step
+    and the corrector, in one compiled call for a mechanism's motion."""
+    fast = getattr(problem, "compiled_correct", None)
+    if fast is not None and compiled.enabled():
+        return fast(x, t, tol, max_iter, contraction, predictor=step)
+    return correct_on_hyperplane(problem, problem.retract(x, step), t, tol, max_iter, contraction)
+
+
 def track(
     problem,
     x0,
@@ -288,6 +298,7 @@ def track(
     frame = _frame(A_x, t)
     orient = _orientation(A_x, t, frame)
     flips = 0
+    d_last: tuple | None = None  # (point, difference of it from x0) of the last accepted step
     rejected = 0
     total_iters = 0
     cos_max = np.cos(np.radians(max_turn_deg))
@@ -297,8 +308,7 @@ def track(
     steps = 0
     while s < max_arc and steps < max_steps:
         h = min(h, h_max, max_arc - s + 1e-15)
-        xp = problem.retract(x, h * t)
-        xn, ok, iters, moved = correct_on_hyperplane(problem, xp, t, tol, 12)
+        xn, ok, iters, moved = predict_correct(problem, x, h * t, t, tol, 12)
         total_iters += iters
         tn: np.ndarray | None = None
         A_n: np.ndarray | None = None
@@ -333,8 +343,11 @@ def track(
             if np.sign(a) != np.sign(b) and a != 0:
                 events.append(_locate(problem, x, t, h, monitors[k], k, a, b, s, len(xs) - 1, tol, event_tol))
         if detect_closure and s_new > 4 * h0 and len(xs) > 3:
-            d_prev = problem.difference(x0, x)
-            d_new = problem.difference(x0, xn)
+            # the start point seen from the last point: remembered from the step before
+            d_prev = d_last if d_last is not None and d_last[0] is x else (x, problem.difference(x0, x))
+            d_new = (xn, problem.difference(x0, xn))
+            d_last = d_new
+            d_prev, d_new = d_prev[1], d_new[1]
             g0, g1 = float(t0 @ d_prev), float(t0 @ d_new)
             if g0 < 0 <= g1 and np.linalg.norm(d_new) < 3 * h + 1e-9 and float(tn @ t0) > 0:
                 # land exactly on the start point's plane: the last point is the start again
@@ -389,7 +402,7 @@ def _locate(problem, x, t, h, f, name, fa, fb, s, step, tol, event_tol):
                 mid = 0.5 * (lo + hi)
         else:
             mid = 0.5 * (lo + hi)
-        xm, ok, _, _ = correct_on_hyperplane(problem, problem.retract(x, mid * t), t, tol, 20)
+        xm, ok, _, _ = predict_correct(problem, x, mid * t, t, tol, 20)
         fm = float(f(xm))
         best = (mid, xm)
         if not ok or fm == 0.0:
@@ -473,10 +486,11 @@ class MotionProblem(_MechanismBase):
     def difference(self, x, y):
         return self._config_diff(x, y)
 
-    def compiled_correct(self, xp, t, tol, max_iter, contraction):
-        """:func:`correct_on_hyperplane` with the whole Newton loop compiled (same steps)."""
+    def compiled_correct(self, xp, t, tol, max_iter, contraction, predictor=None):
+        """:func:`correct_on_hyperplane` with the whole Newton loop compiled (same steps); with
+        ``predictor``, from ``retract(xp, predictor)`` (:func:`predict_correct`)."""
         return compiled.correct_on_hyperplane(self.mech, xp, self.active, self.row, self.col, t, tol, max_iter,
-                                              contraction)
+                                              contraction, predictor)
 
     def differences(self, xs, y) -> np.ndarray:
         """:meth:`difference` of ``y`` relative to each of ``xs`` (rows), compiled in one loop."""
