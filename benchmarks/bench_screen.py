@@ -84,7 +84,11 @@ def main() -> None:
         ref = read_rows(d / "serial.parquet")
         res["serial_rows_equal"] = [{k: v for k, v in r.items() if k not in ("seconds", "worker")} for r in same] == \
             [{k: v for k, v in r.items() if k not in ("seconds", "worker")} for r in ref]
-        say(f"the first {a.serial} rows of both runs equal: {res['serial_rows_equal']}")
+        # the same candidates' judgement times on a worker and in the serial run: above 1 when the
+        # workers were slowed (other processes on the cores, the scheduler, the client)
+        res["worker_vs_serial_judgement_time"] = sum(r["seconds"] for r in same) / sum(r["seconds"] for r in ref)
+        say(f"the first {a.serial} rows of both runs equal: {res['serial_rows_equal']}; their judgements took "
+            f"{res['worker_vs_serial_judgement_time']:.2f}x as long on the workers")
 
         if s2.top:
             f = s2.top[0]["model_file"]
