@@ -213,6 +213,9 @@ def test_a_usable_linkage_is_written_ranked_and_confirmed_by_defects(pool, tmp_p
     b = {"min_sigma_on_path": 0.002, "stroke_len": 10.0}
     c = {"min_sigma_on_path": 0.01, "stroke_len": 40.0}
     assert sorted([a, b, c], key=rank_key) == [c, a, b]
+    assert sorted([a, b, c], key=lambda r: rank_key(r, "slide")) == [b, c, a]
+    with pytest.raises(InputError, match="rank_by"):
+        rank_key(a, "beauty")
 
 
 def test_sm_screen_is_the_public_entry(family, tmp_path):

@@ -276,8 +276,9 @@ def synth_cs(positions=None, *, pick: int = 5, starts: int = 60, seed: int = 0, 
 
 # ============================================================================ screening
 def screen(task=None, out: str | os.PathLike = "screen.parquet", *, candidates: int = 1000, density: float = 0.5,
-           workers: int | None = None, scheduler: str | None = None, top: int = 5, seed: int = 0, starts: int = 60,
-           separation: float = 0.5, chunk_size: int = 20, progress: Progress | None = None):
+           workers: int | None = None, scheduler: str | None = None, top: int = 5, rank_by: str = "singularity",
+           seed: int = 0, starts: int = 60, separation: float = 0.5, chunk_size: int = 20,
+           progress: Progress | None = None):
     """Defect screening of 5-CS linkages for seven task positions (docs/screening.md): the CS
     dyad family is sampled (``density`` dyads per unit nondimensional arc length), up to
     ``candidates`` sets of five dyads are formed (small slides preferred, limbs at least
@@ -285,7 +286,9 @@ def screen(task=None, out: str | os.PathLike = "screen.parquet", *, candidates: 
     full defect analysis) on Dask -- a local cluster of ``workers`` processes (``None``: one per
     core, ``0``: serial without Dask) or the cluster at ``scheduler`` -- and the verdicts go to
     the Parquet dataset ``out`` (resumable: a rerun with the same arguments skips finished
-    chunks).  The ``top`` usable linkages are written as model files (``out/_top/``).
+    chunks).  The ``top`` usable linkages, ranked by ``rank_by`` (``"singularity"``: the largest
+    distance to a singularity along the path first; ``"slide"``: the smallest C-slide stroke
+    first), are written as model files (``out/_top/``).
 
     ``task``: ``None``/``"five-cs-positions"`` (paper A table 9), a model with seven task
     positions, a positions TOML file or seven Pose.  Returns a
@@ -307,4 +310,4 @@ def screen(task=None, out: str | os.PathLike = "screen.parquet", *, candidates: 
         check_int(workers, "workers", minimum=0)
     return run_screen(poses, out, candidates=candidates, density=check_number(density, "density"), seed=check_int(seed, "seed"),
                       starts=starts, separation=check_number(separation, "separation"), chunk_size=chunk_size,
-                      workers=workers, scheduler=scheduler, top=top, progress=optional_progress(progress))
+                      workers=workers, scheduler=scheduler, top=top, rank_by=rank_by, progress=optional_progress(progress))

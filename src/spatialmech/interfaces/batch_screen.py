@@ -36,7 +36,16 @@ from ..errors import InputError
 from ..model.mechanism import Pose
 from ..results import Progress, check_progress
 from ..synthesis.cs_dyads import CSFamily, cs_task, synthesize_cs
-from ..synthesis.screening import STAGES, DyadPool, candidate_linkage, candidate_sets, dyad_pool, judge_candidates, rank_key
+from ..synthesis.screening import (
+    RANKINGS,
+    STAGES,
+    DyadPool,
+    candidate_linkage,
+    candidate_sets,
+    dyad_pool,
+    judge_candidates,
+    rank_key,
+)
 
 __all__ = ["MANIFEST", "ScreenSummary", "read_rows", "row_schema", "run_screen"]
 
@@ -95,6 +104,7 @@ class ScreenSummary:
     pool: dict
     family: dict
     top: list = field(default_factory=list)
+    rank_by: str = "singularity"
 
     @property
     def rate(self) -> float | None:
@@ -109,7 +119,8 @@ class ScreenSummary:
             "rejected_by_stage": dict(self.rejected_by_stage), "usable": self.usable, "seconds": self.seconds,
             "candidates_per_s": self.rate, "workers": self.workers, "scheduler": self.scheduler,
             "pool": dict(self.pool), "family": dict(self.family), "top": list(self.top),
-            "ranking": "min_sigma_on_path (larger first), then stroke_len (smaller first)",
+            "ranking": ("min_sigma_on_path (larger first), then stroke_len (smaller first)" if self.rank_by == "singularity"
+                        else "stroke_len (smaller first), then min_sigma_on_path (larger first)"),
         }
 
 
@@ -240,6 +251,7 @@ def run_screen(
     workers: int | None = None,
     scheduler: str | None = None,
     top: int = 5,
+    rank_by: str = "singularity",
     family: CSFamily | None = None,
     progress: Progress | None = None,
 ) -> ScreenSummary:
@@ -252,7 +264,8 @@ def run_screen(
     ``workers``: local worker processes (``None``: one per core; ``0``: serial, in this
     process, no Dask); ``scheduler``: the address of an existing Dask scheduler (then
     ``workers`` is ignored; the workers need spatialmech installed); ``top``: how many of the
-    best usable linkages to write as model files.  ``progress(done, total, message)`` is called
+    best usable linkages to write as model files, ranked by ``rank_by``
+    (:func:`~..synthesis.screening.rank_key`).  ``progress(done, total, message)`` is called
     after every chunk.  A rerun with the same arguments into the same ``out`` skips the chunks
     already written.
     """
@@ -263,6 +276,8 @@ def run_screen(
                       ("starts", starts, 1)):
         if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < lo:
             raise InputError(f"{nm}: expected a whole number >= {lo}, got {v!r}")
+    if rank_by not in RANKINGS:
+        raise InputError(f"rank_by: expected one of {', '.join(RANKINGS)}, got {rank_by!r}")
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, (int, np.integer)) or workers < 0):
         raise InputError(f"workers: expected a whole number >= 0 (0: serial), got {workers!r}")
     if scheduler is not None and not str(scheduler).strip():
@@ -334,7 +349,7 @@ def run_screen(
     for r in rows:
         if r["rejected_by"] is not None:
             counts[r["rejected_by"]] += 1
-    usable = sorted((r for r in rows if r["usable"]), key=rank_key)
+    usable = sorted((r for r in rows if r["usable"]), key=lambda r: rank_key(r, rank_by))
     top_dir = out / _TOP
     top_rows = []
     if usable and top:
@@ -354,7 +369,7 @@ def run_screen(
         chunks=n_chunks, chunks_resumed=resumed, rejected_by_stage=counts, usable=len(usable), seconds=seconds,
         workers=n_workers, scheduler=where,
         pool={"dyads": len(pool), "density": float(density), "separation": float(separation)},
-        family={"n_branches": len(family.branches), "n_points": family.n_points}, top=top_rows,
+        family={"n_branches": len(family.branches), "n_points": family.n_points}, top=top_rows, rank_by=rank_by,
     )
     doc = {**manifest, "summary": summary.to_dict()}
     (out / MANIFEST).write_text(json.dumps(doc, indent=2, default=float), encoding="utf-8")

@@ -25,6 +25,9 @@ __all__ = ["screen"]
 @click.option("--scheduler", default=None, help="Address of an existing Dask scheduler (e.g. tcp://10.0.0.5:8786).")
 @click.option("--top", type=click.IntRange(min=0, max=1000), default=5, show_default=True,
               help="Write the best K usable linkages as model files (OUT/_top/rank-KK.toml).")
+@click.option("--rank-by", type=click.Choice(["singularity", "slide"]), default="singularity", show_default=True,
+              help="singularity: the largest distance to a singularity along the task path first, then the smallest "
+                   "C-slide stroke; slide: the smallest stroke first.")
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the family's random starts and of the sample.")
 @click.option("--starts", type=click.IntRange(min=1, max=5000), default=60, show_default=True,
               help="Random starts of the family synthesis.")
@@ -33,7 +36,7 @@ __all__ = ["screen"]
 @click.option("--chunk-size", type=click.IntRange(min=1, max=100_000), default=20, show_default=True,
               help="Candidates per Parquet file and per Dask task.")
 @json_option
-def screen(task, out, candidates, density, workers, scheduler, top, seed, starts, separation, chunk_size, as_json):
+def screen(task, out, candidates, density, workers, scheduler, top, rank_by, seed, starts, separation, chunk_size, as_json):
     """Defect screening of 5-CS linkages for seven task positions (paper A's workflow at scale).
 
     TASK is `five-cs-positions` (paper A table 9, the default), a positions TOML file, or a
@@ -62,7 +65,7 @@ def screen(task, out, candidates, density, workers, scheduler, top, seed, starts
     try:
         summary = run_screen(poses, out, candidates=candidates, density=density, seed=seed, starts=starts,
                              separation=separation, chunk_size=chunk_size, workers=workers, scheduler=scheduler,
-                             top=top, progress=say)
+                             top=top, rank_by=rank_by, progress=say)
     except KeyboardInterrupt:
         click.echo(f"interrupted: the chunks written so far are kept in {out}; rerun the same command to resume",
                    err=True)

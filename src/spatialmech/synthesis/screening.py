@@ -44,6 +44,7 @@ from .cs_dyads import CSDyad, CSFamily, CSTask, cs_task, dyad_from_vector
 from .five_cs import assemble_5cs, cs_configuration
 
 __all__ = [
+    "RANKINGS",
     "STAGES",
     "CandidateVerdict",
     "DyadPool",
@@ -246,12 +247,22 @@ class CandidateVerdict:
         }
 
 
-def rank_key(row) -> tuple[float, float]:
+#: The rankings of usable candidates (:func:`rank_key`), the default first.
+RANKINGS = ("singularity", "slide")
+
+
+def rank_key(row, by: str = "singularity") -> tuple[float, float]:
     """Sort key of usable candidates (a :class:`CandidateVerdict` or its :meth:`row`), best
-    first: the larger distance to a singularity along the path, then the smaller stroke."""
+    first.  ``by="singularity"``: the larger distance to a singularity along the path
+    (``min_sigma_on_path``), then the smaller stroke; ``by="slide"``: the smaller stroke, then
+    the larger distance."""
+    if by not in RANKINGS:
+        raise InputError(f"rank_by: expected one of {', '.join(RANKINGS)}, got {by!r}")
     r = row.row() if isinstance(row, CandidateVerdict) else row
     sig = r["min_sigma_on_path"]
-    return (-(sig if sig is not None and math.isfinite(sig) else -1.0), float(r["stroke_len"]))
+    far = -(sig if sig is not None and math.isfinite(sig) else -1.0)
+    stroke = float(r["stroke_len"])
+    return (far, stroke) if by == "singularity" else (stroke, far)
 
 
 def _closure_at_positions(mech: Mechanism, configs) -> tuple[float, float]:
