@@ -103,6 +103,12 @@ def test_bad_arguments_name_the_field(family, pool, tmp_path):
         other = list(five_cs_positions())
         other[3] = type(other[3])(other[3].R, other[3].p + 1.0, other[3].name)
         run_screen(other, tmp_path / "b", family=family)
+    import spatialmech.interfaces.batch_screen as bs
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(bs, "CONNECT_TIMEOUT", "1s")
+        with pytest.raises(InputError, match="scheduler: cannot reach"):
+            run_screen(five_cs_positions(), tmp_path / "s", candidates=2, family=family, scheduler="tcp://127.0.0.1:9")
     (tmp_path / "c").mkdir()
     (tmp_path / "c" / "x.txt").write_text("not a screen")
     with pytest.raises(InputError, match=r"out: .* not empty"):

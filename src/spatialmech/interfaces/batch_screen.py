@@ -47,10 +47,12 @@ from ..synthesis.screening import (
     rank_key,
 )
 
-__all__ = ["MANIFEST", "ScreenSummary", "read_rows", "row_schema", "run_screen"]
+__all__ = ["CONNECT_TIMEOUT", "MANIFEST", "ScreenSummary", "read_rows", "row_schema", "run_screen"]
 
 #: The dataset's description file.
 MANIFEST = "_screen.json"
+#: How long to wait for an existing Dask scheduler (``scheduler=``) to answer.
+CONNECT_TIMEOUT = "20s"
 _POOL = "_pool.parquet"
 _TOP = "_top"
 _FORMAT = "spatialmech-screen/1"
@@ -330,7 +332,11 @@ def run_screen(
             from distributed import Client
 
             if scheduler is not None:
-                cluster, client = None, Client(str(scheduler), timeout="20s")
+                try:
+                    cluster, client = None, Client(str(scheduler), timeout=CONNECT_TIMEOUT)
+                except (OSError, TimeoutError, ValueError) as e:
+                    raise InputError(f"scheduler: cannot reach a Dask scheduler at {scheduler!r} within "
+                                     f"{CONNECT_TIMEOUT} ({type(e).__name__}: {e})") from None
                 where = str(scheduler)
             else:
                 cluster, client = _local_cluster(int(workers or os.cpu_count() or 1))
