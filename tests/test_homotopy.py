@@ -109,8 +109,8 @@ def test_cli_json_and_text(stewart):
 
 def test_uncovered_model_clear_message():
     runner = CliRunner()
-    out = runner.invoke(main, ["fk", "three-upu", "--actuators", "0.3,0.3,0.3", "--all", "--method", "homotopy"])
-    assert out.exit_code != 0 and "does not cover three-upu" in out.output and "U-P-U" in out.output
+    out = runner.invoke(main, ["fk", "three-rrr-sm", "--actuators", "10,20,30", "--all", "--method", "homotopy"])
+    assert out.exit_code != 0 and "does not cover three-rrr-sm" in out.output and "R-R-R" in out.output
     assert "Traceback" not in out.output
     with pytest.raises(sm.InputError, match="method"):
         sm.fk("stewart-6sps", [1.2] * 6, all_solutions=True, method="newton")
@@ -123,7 +123,7 @@ def test_phcpack_agrees_on_the_stewart_model(stewart, tmp_path):
     mech, res = stewart
     sysm = hc.stewart_system(mech)
     c = np.random.default_rng(3).normal(size=8)
-    (tmp_path / "in.txt").write_text(hc.phc_input(sysm, sysm.lengths([1.2] * 6), c))
+    (tmp_path / "in.txt").write_text(hc.phc_input(sysm, [1.2] * 6, c))
     subprocess.run(["phc", "-b", str(tmp_path / "in.txt"), str(tmp_path / "out.txt")], check=True,
                    capture_output=True, timeout=120)
     out = (tmp_path / "out.txt").read_text()

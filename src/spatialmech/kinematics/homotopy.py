@@ -59,10 +59,12 @@ from .jit import njit
 __all__ = [
     "HomotopyResult",
     "HomotopySolution",
+    "PoseSystem",
     "StewartSystem",
     "clear_cache",
     "homotopy_forward",
     "phc_input",
+    "pose_system",
     "stewart_system",
     "study_to_pose",
     "system_from_points",
@@ -122,6 +124,26 @@ class StewartSystem:
         v = np.asarray(values, dtype=float)
         return self.d_ref + self.sign * (v - self.offset)
 
+    @property
+    def n_act(self) -> int:
+        return len(self.base)
+
+    def coefficients(self, values) -> np.ndarray:
+        """The seven quadrics (7, 8, 8) at actuator values (model units)."""
+        Qv = self.Q.copy()
+        l2 = (self.lengths(values) / self.L) ** 2
+        for k in range(self.n_legs):
+            Qv[1 + k, :4, :4] -= l2[k] * np.eye(4)
+        return Qv
+
+    def affine_span(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(Q0, B, scale)``: every coefficient tensor of the family is ``Q0 + sum z_j B_j``
+        (here ``z`` are the squared leg lengths over ``L^2``), ``scale`` the size of ``z``."""
+        B = np.zeros((self.n_legs, 7, _N, _N))
+        for k in range(self.n_legs):
+            B[k, 1 + k, :4, :4] = -np.eye(4)
+        return self.Q, B, np.ones(self.n_legs)
+
     def key(self) -> bytes:
         return np.round(self.Q, 12).tobytes()
 
@@ -167,6 +189,13 @@ def _rps_plane(limb, L: float) -> tuple | None:
 
 def unsupported_reason(mech: Mechanism) -> str | None:
     """``None`` when the homotopy formulation covers ``mech``, else why not (one sentence)."""
+    if _stewart_reason(mech) is None:
+        return None
+    return _general(mech)[0]
+
+
+def _stewart_reason(mech: Mechanism) -> str | None:
+    """``None`` when :func:`stewart_system` covers ``mech``."""
     if mech.bodies:
         return "a link-and-joint graph (internal bodies)"
     L = mech.characteristic_length
@@ -205,7 +234,7 @@ def unsupported_reason(mech: Mechanism) -> str | None:
 
 def stewart_system(mech: Mechanism) -> StewartSystem:
     """The system of ``mech`` (``InputError`` naming the reason when it is not covered)."""
-    why = unsupported_reason(mech)
+    why = _stewart_reason(mech)
     if why is not None:
         raise InputError(f"model: homotopy forward position does not cover {mech.name}: {why}; use method='multistart'")
     L = float(mech.characteristic_length)
@@ -271,18 +300,279 @@ def system_from_points(base, platform, *, L: float | None = None, d_ref=None, si
                          tuple(lines))
 
 
+# ------------------------------------------------------------------------------ general limbs
+def _k_matrix(b, c, L: float) -> np.ndarray:
+    """``K`` with ``K x = e b - c e + 2 g`` (a quaternion; ``b``, ``c`` model units over ``L``)."""
+    return np.hstack([_qmat_right(np.r_[0.0, b / L]) - _qmat_left(np.r_[0.0, c / L]), 2 * np.eye(4)])
+
+
+def _sphere_quadric(b, c, r: float, L: float) -> np.ndarray:
+    """The platform point ``b`` (reference) at distance ``r`` from the point ``c``:
+    ``|e b - c e + 2 g|^2 - (r / L)^2 e.e``."""
+    K = _k_matrix(b, c, L)
+    M = K.T @ K
+    M[:4, :4] -= (r / L) ** 2 * np.eye(4)
+    return M
+
+
+def _bilinear_e(K: np.ndarray, f) -> np.ndarray:
+    """The symmetric quadric of ``x -> f(K x, e*)`` for ``f`` bilinear in two quaternions (real
+    result)."""
+    conj = np.diag([1.0, -1, -1, -1])
+    M = np.zeros((_N, _N))
+    for i in range(_N):
+        for j in range(4):
+            M[i, j] = f(K[:, i], conj[:, j])
+    return 0.5 * (M + M.T)
+
+
+def _upu_quadric(b, a, n1, n_p, L: float) -> np.ndarray:
+    """The U-P-U condition ``n1 . ((u - a) x R n_p) = 0`` (the base U's first axis ``n1``, the
+    platform U's platform axis ``n_p``, the two middle axes parallel and normal to the leg) as
+    the quadric ``n1 . vec(v n_p e*) = 0``, ``v = e b - a e + 2 g`` (valid on the Study quadric,
+    where ``v e*`` is a pure quaternion)."""
+    K = _k_matrix(b, a, L)
+    npq = np.r_[0.0, n_p]
+    return _bilinear_e(K, lambda v, ec: float(n1 @ _qmul(_qmul(v, npq), ec)[1:]))
+
+
+def _plane_quadric(b, o, n, L: float) -> np.ndarray:
+    """The platform point ``b`` in the plane through ``o`` normal to ``n``."""
+    return _line_quadrics(np.asarray(b, float), np.asarray(o, float), (np.asarray(n, float),), L)[0]
+
+
+def _unit(v) -> np.ndarray:
+    v = np.asarray(v, dtype=float)
+    return v / np.linalg.norm(v)
+
+
+@dataclass(frozen=True, eq=False)
+class PoseSystem:
+    """The forward position of a platform as six quadrics in the Study parameters whose
+    coefficients depend on the actuator values (see :func:`pose_system`): ``rows(values)``
+    gives the six constraint quadrics (model units), ``reductions`` one line per limb (group)
+    saying what it became, ``scales`` the actuator sample sizes for the affine span."""
+
+    name: str
+    L: float
+    n_act: int
+    rows: object = field(repr=False)  # callable values -> list of six (8, 8)
+    reference: np.ndarray = field(repr=False)  # actuator values at the reference
+    scales: np.ndarray = field(repr=False)
+    reductions: tuple = ()
+    _span: list = field(default_factory=list, repr=False)
+
+    def coefficients(self, values) -> np.ndarray:
+        Qv = np.zeros((7, _N, _N))
+        Qv[0, :4, 4:] = Qv[0, 4:, :4] = 0.5 * np.eye(4)
+        Qv[1:] = np.array(self.rows(np.asarray(values, dtype=float)))
+        return Qv
+
+    def affine_span(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(Q0, B, scale)``: the affine hull of the coefficient tensors over the actuator
+        values, ``Q0 + sum z_j B_j`` (orthonormal ``B``), from seeded random samples around the
+        reference (the coefficients are polynomials in the actuator values or in their cosines
+        and sines, so samples span the hull with probability one)."""
+        if not self._span:
+            rng = np.random.default_rng(12345)
+            Q0 = self.coefficients(self.reference)
+            n_s = 4 * self.n_act + 8
+            D = np.array([(self.coefficients(self.reference + self.scales * rng.normal(size=self.n_act)) - Q0).ravel()
+                          for _ in range(n_s)])
+            _, sv, Vt = np.linalg.svd(D, full_matrices=False)
+            rank = int(np.sum(sv > 1e-9 * max(float(sv[0]), 1e-300)))
+            B = Vt[:rank].reshape(rank, 7, _N, _N)
+            z = D @ Vt[:rank].T
+            self._span.append((Q0, B, np.maximum(z.std(axis=0), 1e-6)))
+        return self._span[0]
+
+    def key(self) -> bytes:
+        Q0, B, _ = self.affine_span()
+        return np.round(Q0, 12).tobytes() + np.round(np.abs(B).sum(axis=0), 10).tobytes()
+
+
+def _slide(limb, k: int):
+    return limb.joints[k].freedoms[0]
+
+
+def _reduce_limb(limb, L: float, act_index: dict, hubs: dict) -> tuple[str | None, list, str]:
+    """(why not, constraint builders ``values -> [quadrics]``, description) of one limb to the
+    platform."""
+    types = [j.type for j in limb.joints]
+    tol = 1e-9
+    if limb.base != "ground":
+        if limb.base not in hubs:
+            return f"limb {limb.name} starts on body {limb.base}, whose pose the actuators do not fix", [], ""
+        if types != ["S", "S"]:
+            return (f"limb {limb.name} from body {limb.base} is {'-'.join(types)} (from a driven body the "
+                    "formulation covers S-S rods)"), [], ""
+        hub = hubs[limb.base]
+        a, b = limb.joints[0].point, limb.joints[1].point
+        r = float(np.linalg.norm(b - a))
+
+        def rod(v, hub=hub, a=a, b=b, r=r):
+            D = hub(v)
+            return [_sphere_quadric(b, D[:3, :3] @ a + D[:3, 3], r, L)]
+
+        return None, [rod], f"{limb.name} (S-S from driven {limb.base}): sphere about a moving centre"
+    if types == ["P", "R", "S"]:
+        sl, rj, sj = _slide(limb, 0), limb.joints[1].freedoms[0], limb.joints[2]
+        if not sl.actuated or id(sl) not in act_index:
+            return f"limb {limb.name}: its slide is not the actuator", [], ""
+        k = act_index[id(sl)]
+        n = _unit(rj.direction)
+        s_dir = _unit(sl.direction)
+        f = rj.point + float((sj.point - rj.point) @ n) * n
+        rho = float(np.linalg.norm(sj.point - f))
+        if rho < tol * L:
+            return f"limb {limb.name}: the S centre is on the R axis", [], ""
+        u = sj.point
+
+        def prs(v, k=k, f=f, s_dir=s_dir, off=sl.offset, rho=rho, u=u, n=n):
+            cen = f + (v[k] - off) * s_dir
+            return [_sphere_quadric(u, cen, rho, L), _plane_quadric(u, cen, n, L)]
+
+        return None, [prs], f"{limb.name} (P-R-S): circle about the slider = sphere and plane, moving with the slide"
+    if types == ["U", "P", "U"]:
+        ub, pj, ua = limb.joints
+        sl = pj.freedoms[0]
+        if not sl.actuated or id(sl) not in act_index:
+            return f"limb {limb.name}: its slide is not the actuator", [], ""
+        for j in (ub, ua):
+            if np.linalg.norm(j.freedoms[0].point - j.freedoms[1].point) > tol * L:
+                return f"limb {limb.name}: the axes of {j.name} do not meet", [], ""
+        a, b = ub.point, ua.point
+        w = b - a
+        d_ref = float(np.linalg.norm(w))
+        if d_ref < tol * L or abs(abs(float(_unit(w) @ _unit(sl.direction))) - 1) > tol:
+            return f"limb {limb.name}: the slide does not run along the line of its two centres", [], ""
+        w = w / d_ref
+        n1, m = _unit(ub.freedoms[0].direction), _unit(ub.freedoms[1].direction)
+        m2, n_p = _unit(ua.freedoms[0].direction), _unit(ua.freedoms[1].direction)
+        if (abs(m @ n1) > tol or abs(m @ w) > tol or np.linalg.norm(np.cross(m, m2)) > tol or abs(n_p @ m2) > tol):
+            return (f"limb {limb.name}: U-P-U with the two middle axes parallel, normal to the leg and to the outer "
+                    "axes is covered; this one is not"), [], ""
+        k = act_index[id(sl)]
+        sign = float(np.sign(w @ sl.direction))
+        upu = _upu_quadric(b, a, n1, n_p, L)
+
+        def upu_rows(v, k=k, a=a, b=b, d_ref=d_ref, sign=sign, off=sl.offset, upu=upu):
+            return [_sphere_quadric(b, a, d_ref + sign * (v[k] - off), L), upu]
+
+        return None, [upu_rows], f"{limb.name} (U-P-U): leg sphere and the U-joint condition n1 . ((u - a) x R n_p) = 0"
+    if len(types) == 3 and types[1] == "P" and set(types[::2]) <= {"S", "U"} and types != ["U", "P", "U"]:
+        sl = _slide(limb, 1)
+        if not sl.actuated or id(sl) not in act_index:
+            return f"limb {limb.name}: its slide is not the actuator", [], ""
+        a, b = limb.joints[0].point, limb.joints[2].point
+        w = b - a
+        d_ref = float(np.linalg.norm(w))
+        if d_ref < tol * L or abs(abs(float(_unit(w) @ _unit(sl.direction))) - 1) > tol:
+            return f"limb {limb.name}: the slide does not run along the line of its two centres", [], ""
+        k = act_index[id(sl)]
+        sign = float(np.sign(w @ sl.direction))
+
+        def sps(v, k=k, a=a, b=b, d_ref=d_ref, sign=sign, off=sl.offset):
+            return [_sphere_quadric(b, a, d_ref + sign * (v[k] - off), L)]
+
+        return None, [sps], f"{limb.name} ({'-'.join(types)}): leg sphere"
+    pol = _point_on_line(limb, L)
+    if pol is not None:
+        u, o, normals = pol
+        qs = [_plane_quadric(u, o, n, L) for n in normals]
+        return None, [lambda v, qs=qs: qs], f"{limb.name} ({'-'.join(types)}): centre on the C axis (two planes)"
+    rps = _rps_plane(limb, L)
+    if rps is not None:
+        u, o, (n,) = rps
+        sl = _slide(limb, 1)
+        k = act_index[id(sl)]
+        d = u - o
+        d_ref = float(np.linalg.norm(d))
+        sign = float(np.sign(d @ sl.direction))
+        pq = _plane_quadric(u, o, n, L)
+
+        def rps_rows(v, k=k, u=u, o=o, d_ref=d_ref, sign=sign, off=sl.offset, pq=pq):
+            return [_sphere_quadric(u, o, d_ref + sign * (v[k] - off), L), pq]
+
+        return None, [rps_rows], f"{limb.name} (R-P-S): leg sphere and the plane normal to the R axis"
+    return (f"limb {limb.name} is {'-'.join(types)} (covered: S-P-S, U-P-S, S-P-U, U-P-U, R-P-S and P-R-S legs, "
+            "C-U / C-S limbs with the centre on the C axis, and S-S rods from a body driven by actuated joints only)"), [], ""
+
+
+def _general(mech: Mechanism) -> tuple[str | None, PoseSystem | None]:
+    """(why not, system) of the general reduction (see :func:`pose_system`)."""
+    from .closure import limb_forward, limb_slices, reference_screws
+
+    L = float(mech.characteristic_length)
+    acts = [mech.freedom(a) for a in mech.actuators]
+    act_index = {id(r.freedom): k for k, r in enumerate(acts)}
+    refs = mech.freedom_refs
+    screws = reference_screws(mech)
+    hubs: dict = {}
+    used: set = set()
+    limbs = list(zip(mech.limbs, limb_slices(mech), strict=True))
+    for limb, sl in limbs:
+        if limb.tip is None:
+            continue
+        frs = refs[sl]
+        if limb.base != "ground" or not all(r.freedom.actuated for r in frs) or limb.tip in hubs:
+            return (f"limb {limb.name} ends on body {limb.tip}: only bodies driven from the ground by actuated joints "
+                    "alone are covered"), None
+        ks = [act_index[id(r.freedom)] for r in frs]
+        offs = np.array([r.freedom.offset for r in frs])
+        S = screws[sl]
+        hubs[limb.tip] = lambda v, ks=ks, offs=offs, S=S: limb_forward(S, np.asarray(v)[ks] - offs)[0]
+        used.update(ks)
+    builders, notes = [], []
+    for limb, _ in limbs:
+        if limb.tip is not None:
+            continue
+        why, bs, note = _reduce_limb(limb, L, act_index, hubs)
+        if why is not None:
+            return why, None
+        builders += bs
+        notes.append(note)
+        for j in limb.joints:
+            for f in j.freedoms:
+                if f.actuated and id(f) in act_index:
+                    used.add(act_index[id(f)])
+    if used != set(range(len(acts))):
+        return "actuators other than the covered leg slides and driving joints", None
+    ref = np.array([r.freedom.offset for r in acts], dtype=float)
+    n_eq = sum(len(b(ref)) for b in builders)
+    if n_eq != 6:
+        return f"its limbs give {n_eq} equations on the platform pose, not 6", None
+    scales = np.array([0.3 * L if r.freedom.kind == "P" else 0.5 for r in acts])
+
+    def rows(v, builders=tuple(builders)):
+        return [q for b in builders for q in b(v)]
+
+    return None, PoseSystem(mech.name, L, len(acts), rows, ref, scales, tuple(notes))
+
+
+def pose_system(mech: Mechanism) -> StewartSystem | PoseSystem:
+    """The polynomial system of ``mech``: :func:`stewart_system` for S-P-S / R-P-S legs and C-U /
+    C-S limbs, else the general reduction (each limb, with the actuators given, to conditions on
+    the platform point it carries: a sphere about a point fixed by the actuators, a plane, a
+    line, the U-P-U condition) when it covers the model; ``InputError`` naming why not."""
+    if _stewart_reason(mech) is None:
+        return stewart_system(mech)
+    why, sysm = _general(mech)
+    if sysm is None:
+        raise InputError(f"model: homotopy forward position does not cover {mech.name}: {why}; use method='multistart'")
+    return sysm
+
+
 # ------------------------------------------------------------------------------ evaluation
-def _eval_target(Q: np.ndarray, c: np.ndarray, X: np.ndarray, l2: np.ndarray):
-    """F and its Jacobian for points ``X`` (n, 8) and squared lengths ``l2`` (n, legs)."""
-    m = l2.shape[1]
-    QX = np.einsum("kij,nj->nki", Q, X)  # (n, 7, 8)
+def _eval_quad(Qc: np.ndarray, c: np.ndarray, X: np.ndarray):
+    """F and its Jacobian for points ``X`` (n, 8): the seven quadrics ``Qc`` ((7, 8, 8), or
+    (n, 7, 8, 8) one set per point) and the patch ``c . x = 1``; and ``e.e``."""
+    QX = np.einsum("kij,nj->nki", Qc, X) if Qc.ndim == 3 else np.einsum("nkij,nj->nki", Qc, X)  # (n, 7, 8)
     F = np.empty((len(X), _N), dtype=complex)
     J = np.empty((len(X), _N, _N), dtype=complex)
     F[:, :7] = np.einsum("nki,ni->nk", QX, X)
     E = np.einsum("ni,ni->n", X[:, :4], X[:, :4])
-    F[:, 1 : 1 + m] -= l2 * E[:, None]
     J[:, :7] = 2 * QX
-    J[:, 1 : 1 + m, :4] -= 2 * l2[:, :, None] * X[:, None, :4]
     F[:, 7] = X @ c - 1
     J[:, 7] = c
     return F, J, E
@@ -386,27 +676,23 @@ def _lu_solve(A, b, out):
 
 
 @njit(cache=True)
-def _param_system(Q, c, x, l20, l2t, t, F, J, Ht):
-    """:func:`_eval_target` of one point on the straight parameter path ``l2(t)`` and ``H_t``."""
-    m = l20.shape[0]
+def _param_system(Q0, dQ, c, x, t, F, J, Ht):
+    """:func:`_eval_quad` of one point on the straight coefficient path ``Q0 + t dQ`` and ``H_t``."""
     n = x.shape[0]
-    E = x[0] * x[0] + x[1] * x[1] + x[2] * x[2] + x[3] * x[3]
     for k in range(7):
         acc = 0.0j
+        acct = 0.0j
         for i in range(n):
             qx = 0.0j
+            dx = 0.0j
             for j in range(n):
-                qx += Q[k, i, j] * x[j]
+                qx += (Q0[k, i, j] + t * dQ[k, i, j]) * x[j]
+                dx += dQ[k, i, j] * x[j]
             J[k, i] = 2.0 * qx
             acc += qx * x[i]
+            acct += dx * x[i]
         F[k] = acc
-        Ht[k] = 0.0
-    for k in range(m):
-        lt = (1.0 - t) * l20[k] + t * l2t[k]
-        F[1 + k] -= lt * E
-        for i in range(4):
-            J[1 + k, i] -= 2.0 * lt * x[i]
-        Ht[1 + k] = -(l2t[k] - l20[k]) * E
+        Ht[k] = acct
     acc = -1.0 + 0.0j
     for i in range(n):
         acc += x[i] * c[i]
@@ -416,9 +702,9 @@ def _param_system(Q, c, x, l20, l2t, t, F, J, Ht):
 
 
 @njit(cache=True)
-def _param_vel(Q, c, x, l20, l2t, t, F, J, Ht, out):
+def _param_vel(Q0, dQ, c, x, t, F, J, Ht, out):
     ok = True
-    _param_system(Q, c, x, l20, l2t, t, F, J, Ht)
+    _param_system(Q0, dQ, c, x, t, F, J, Ht)
     for i in range(Ht.shape[0]):
         Ht[i] = -Ht[i]
     ok = _lu_solve(J, Ht, out)
@@ -426,7 +712,7 @@ def _param_vel(Q, c, x, l20, l2t, t, F, J, Ht, out):
 
 
 @njit(cache=True)
-def _track_param(Q, c, X0, l20, l2t, h0, hmin, max_steps, jump, newton, X, T, done):
+def _track_param(Q0, dQ, c, X0, h0, hmin, max_steps, jump, newton, X, T, done):
     """:func:`track` of the parameter homotopy, path by path (compiled): the same RK4 predictor,
     two Newton corrections, acceptance test and step control."""
     n = X0.shape[1]
@@ -450,19 +736,19 @@ def _track_param(Q, c, X0, l20, l2t, h0, hmin, max_steps, jump, newton, X, T, do
         fin = False
         for _ in range(max_steps):
             hh = min(h, 1.0 - t)
-            ok = _param_vel(Q, c, x, l20, l2t, t, F, J, Ht, k1)
+            ok = _param_vel(Q0, dQ, c, x, t, F, J, Ht, k1)
             if ok:
                 for i in range(n):
                     xs[i] = x[i] + 0.5 * hh * k1[i]
-                ok = _param_vel(Q, c, xs, l20, l2t, t + 0.5 * hh, F, J, Ht, k2)
+                ok = _param_vel(Q0, dQ, c, xs, t + 0.5 * hh, F, J, Ht, k2)
             if ok:
                 for i in range(n):
                     xs[i] = x[i] + 0.5 * hh * k2[i]
-                ok = _param_vel(Q, c, xs, l20, l2t, t + 0.5 * hh, F, J, Ht, k3)
+                ok = _param_vel(Q0, dQ, c, xs, t + 0.5 * hh, F, J, Ht, k3)
             if ok:
                 for i in range(n):
                     xs[i] = x[i] + hh * k3[i]
-                ok = _param_vel(Q, c, xs, l20, l2t, t + hh, F, J, Ht, k4)
+                ok = _param_vel(Q0, dQ, c, xs, t + hh, F, J, Ht, k4)
             d0 = np.inf
             d1 = np.inf
             tn = t + hh
@@ -472,7 +758,7 @@ def _track_param(Q, c, X0, l20, l2t, h0, hmin, max_steps, jump, newton, X, T, do
                     xc[i] = x[i] + hh / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
                     nx += abs(xc[i]) ** 2
                 nx = 1.0 + np.sqrt(nx)
-                _param_system(Q, c, xc, l20, l2t, tn, F, J, Ht)
+                _param_system(Q0, dQ, c, xc, tn, F, J, Ht)
                 ok = _lu_solve(J, F, dx)
                 if ok:
                     s0 = 0.0
@@ -480,7 +766,7 @@ def _track_param(Q, c, X0, l20, l2t, h0, hmin, max_steps, jump, newton, X, T, do
                         s0 += abs(dx[i]) ** 2
                         xc[i] -= dx[i]
                     d0 = np.sqrt(s0) / nx
-                    _param_system(Q, c, xc, l20, l2t, tn, F, J, Ht)
+                    _param_system(Q0, dQ, c, xc, tn, F, J, Ht)
                     ok = _lu_solve(J, F, dx)
                 if ok:
                     s1 = 0.0
@@ -509,41 +795,41 @@ def _track_param(Q, c, X0, l20, l2t, h0, hmin, max_steps, jump, newton, X, T, do
         done[p] = fin
 
 
-def track_parameter(Q: np.ndarray, c: np.ndarray, X0: np.ndarray, l20: np.ndarray, l2t: np.ndarray, *,
+def track_parameter(Q0: np.ndarray, Q1: np.ndarray, c: np.ndarray, X0: np.ndarray, *,
                     h0: float = 0.02, hmin: float = 1e-14, max_steps: int = 4000):
-    """The parameter homotopy from the squared leg lengths ``l20`` (points ``X0``) to ``l2t``:
-    :func:`track` of the straight parameter path, compiled and path by path when the compiled
-    core is in use (the batched NumPy :func:`track` otherwise).  Returns ``(X, t, done)``."""
+    """The parameter homotopy from the quadrics ``Q0`` (7, 8, 8; points ``X0``) to ``Q1`` along
+    the straight segment in the coefficient space: :func:`track`, compiled and path by path when
+    the compiled core is in use (the batched NumPy :func:`track` otherwise).  Returns
+    ``(X, t, done)``."""
     X0 = np.ascontiguousarray(X0, dtype=complex)
-    l20 = np.ascontiguousarray(l20, dtype=complex)
-    l2t = np.ascontiguousarray(l2t, dtype=complex)
+    Q0 = np.ascontiguousarray(Q0, dtype=complex)
+    dQ = np.ascontiguousarray(np.asarray(Q1, dtype=complex) - Q0)
     if compiled.enabled():
         X = np.empty_like(X0)
         T = np.zeros(len(X0))
         done = np.zeros(len(X0), dtype=np.bool_)
         if len(X0):
-            _track_param(np.ascontiguousarray(Q, dtype=float), np.ascontiguousarray(c, dtype=complex), X0, l20, l2t,
+            _track_param(Q0, dQ, np.ascontiguousarray(c, dtype=complex), X0,
                          float(h0), float(hmin), int(max_steps), float(HOMOTOPY_JUMP), float(HOMOTOPY_NEWTON),
                          X, T, done)
         return X, T, done
 
     def fun(X, t):
-        lt = (1 - t)[:, None] * l20 + t[:, None] * l2t
-        F, J, E = _eval_target(Q, c, X, lt)
+        F, J, _ = _eval_quad(Q0[None] + t[:, None, None, None] * dQ[None], c, X)
         Ht = np.zeros_like(F)
-        Ht[:, 1 : 1 + len(l2t)] = -(l2t - l20)[None, :] * E[:, None]
+        Ht[:, :7] = np.einsum("ni,kij,nj->nk", X, dQ, X)
         return F, J, Ht
 
     X, T, done, _ = track(fun, X0, h0=h0, hmin=hmin, max_steps=max_steps)
     return X, T, done
 
 
-def _refine(Q, c, X, l2, iters: int = 4):
+def _refine(Qc, c, X, iters: int = 4):
     """Newton at ``t = 1`` (batched; a point whose step fails keeps its last value)."""
     X = X.copy()
     with np.errstate(all="ignore"):
         for _ in range(iters):
-            F, J, _ = _eval_target(Q, c, X, l2)
+            F, J, _ = _eval_quad(Qc, c, X)
             ok = np.all(np.isfinite(J), axis=(1, 2)) & np.all(np.isfinite(F), axis=1)
             ok &= np.abs(np.linalg.det(np.where(ok[:, None, None], J, np.eye(_N)))) > 0
             if not ok.any():
@@ -552,17 +838,16 @@ def _refine(Q, c, X, l2, iters: int = 4):
             Xn = X[ok] - dx
             fin = np.all(np.isfinite(Xn), axis=1)
             X[np.flatnonzero(ok)[fin]] = Xn[fin]
-        F, J, E = _eval_target(Q, c, X, l2)
+        F, J, E = _eval_quad(Qc, c, X)
     return X, F, J, E
 
 
-def _classify(Q, c, X, l2):
+def _classify(Qc, c, X):
     """Status of each end point: (status, rcond, rel_inf, imag_rel, residual, y, x refined),
     ``y`` the point with its projective phase removed, ``x`` in the affine patch."""
     if len(X) == 0:
         return []
-    l2 = np.broadcast_to(l2, (len(X), np.shape(l2)[-1]))
-    xr, F, J, E = _refine(Q, c, X, l2)
+    xr, F, J, E = _refine(Qc, c, X)
     out = []
     with np.errstate(all="ignore"):
         nx = np.linalg.norm(xr, axis=1)
@@ -607,7 +892,7 @@ def study_to_pose(x, L: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
 @dataclass(frozen=True, eq=False)
 class _Generic:
     c: np.ndarray
-    l2: np.ndarray
+    Q: np.ndarray  # (7, 8, 8) complex: the generic instance's quadrics
     X: np.ndarray  # (N, 8) the isolated solutions
     n_paths: int
     n_at_infinity: int
@@ -624,45 +909,43 @@ def clear_cache() -> None:
     _CACHE.clear()
 
 
-def phc_input(sysm: StewartSystem, lengths, c) -> str:
-    """The system of ``sysm`` at leg ``lengths`` (model units), with the affine normalisation
-    ``c . x = 1`` (8 coefficients), in PHCpack's input format: for an independent solve by
-    ``phc -b`` (tests, benchmarks/bench_homotopy.py).  Only for systems of six S-P-S legs."""
-    if sysm.n_legs != 6 or sysm.lines:
-        raise InputError("sysm: the PHCpack export covers six S-P-S legs (seven quadrics) only")
+def phc_input(sysm: StewartSystem | PoseSystem, values, c) -> str:
+    """The system of ``sysm`` at actuator ``values`` (model units, radians), with the affine
+    normalisation ``c . x = 1`` (8 coefficients), in PHCpack's input format: for an independent
+    solve by ``phc -b`` (tests, benchmarks/bench_homotopy.py)."""
     names = ["e0", "e1", "e2", "e3", "g0", "g1", "g2", "g3"]
-    l2 = (np.asarray(lengths, dtype=float) / sysm.L) ** 2
-    Pe = np.diag([1.0, 1, 1, 1, 0, 0, 0, 0])
+    Qv = sysm.coefficients(np.asarray(values, dtype=float))
 
     def quad(M):
         return " ".join(f"{(M[i, j] if i == j else M[i, j] + M[j, i]):+.17e}*{names[i]}*{names[j]}"
                         for i in range(8) for j in range(i, 8)) + ";"
 
-    eqs = [quad(sysm.Q[0])] + [quad(sysm.Q[k + 1] - l2[k] * Pe) for k in range(6)]
+    eqs = [quad(Qv[k]) for k in range(7)]
     eqs.append(" ".join(f"{c[i]:+.17e}*{names[i]}" for i in range(8)) + " - 1;")
     return "8\n" + "\n".join(eqs) + "\n"
 
 
-def _generic_solve(sysm: StewartSystem, seed: int = 0, max_attempts: int = 3) -> tuple[_Generic, bool]:
-    """Total-degree homotopy to a generic complex instance; (result, every path accounted for)."""
+def _generic_solve(sysm: StewartSystem | PoseSystem, seed: int = 0, max_attempts: int = 3) -> tuple[_Generic, bool]:
+    """Total-degree homotopy to a generic complex instance of the family (a random complex point
+    of the affine span of its coefficient tensors); (result, every path accounted for)."""
     key = sysm.key()
     if key in _CACHE:
         return _CACHE[key], True
     t0 = time.perf_counter()
     rng = np.random.default_rng(seed)
+    Qb, B, scale = sysm.affine_span()
     best = None
     for attempt in range(1, max_attempts + 1):
         c = rng.normal(size=_N) + 1j * rng.normal(size=_N)
-        nl = sysm.n_legs
-        l2 = (1 + rng.random(nl)) * np.exp(1j * rng.uniform(-np.pi, np.pi, nl))
+        z = scale * (1 + rng.random(len(B))) * np.exp(1j * rng.uniform(-np.pi, np.pi, len(B)))
+        Qg = Qb + np.einsum("j,jkab->kab", z, B)
         gamma = np.exp(1j * rng.uniform(0, 2 * np.pi))
         signs = np.array(np.meshgrid(*[[1.0, -1.0]] * 7, indexing="ij")).reshape(7, -1).T  # (128, 7)
         S = np.hstack([signs, np.ones((len(signs), 1))]).astype(complex)
         X0 = S / (S @ c)[:, None]
-        Q = sysm.Q
 
-        def fun(X, t, c=c, l2=l2, gamma=gamma, Q=Q):
-            F, J, _ = _eval_target(Q, c, X, np.broadcast_to(l2, (len(X), len(l2))))
+        def fun(X, t, c=c, gamma=gamma, Qg=Qg):
+            F, J, _ = _eval_quad(Qg, c, X)
             G = np.empty_like(F)
             JG = np.zeros_like(J)
             G[:, :7] = X[:, :7] ** 2 - X[:, 7:8] ** 2
@@ -679,13 +962,13 @@ def _generic_solve(sysm: StewartSystem, seed: int = 0, max_attempts: int = 3) ->
             return H, Hx, Ht
 
         X, _, _, _ = track(fun, X0)
-        cls = _classify(Q, c, X, l2)
+        cls = _classify(Qg, c, X)
         fin = [i for i, r in enumerate(cls) if r[0] in ("real", "complex")]
         inf = [i for i, r in enumerate(cls) if r[0] == "at_infinity"]
         pts = np.array([cls[i][6] for i in fin]).reshape(-1, _N)
         distinct = _distinct(pts)
         accounted = len(fin) + len(inf) == len(X) and distinct
-        g = _Generic(c, l2, pts, len(X), len(inf), attempt, time.perf_counter() - t0)
+        g = _Generic(c, Qg, pts, len(X), len(inf), attempt, time.perf_counter() - t0)
         if accounted:
             _CACHE[key] = g
             return g, True
@@ -741,30 +1024,30 @@ class HomotopyResult:
         return sum(s.status == status for s in self.solutions)
 
 
-def homotopy_forward(mech: Mechanism | StewartSystem, actuator_values, *, seed: int = 0) -> HomotopyResult:
-    """Every complex solution of the forward position of a 6-leg S-P-S platform for actuator
-    values (model units, in ``mech.actuators`` order): see the module docstring."""
+def homotopy_forward(mech: Mechanism | StewartSystem | PoseSystem, actuator_values, *, seed: int = 0) -> HomotopyResult:
+    """Every complex solution of the forward position of a platform for actuator values (model
+    units and radians, in ``mech.actuators`` order): see the module docstring."""
     t0 = time.perf_counter()
-    sysm = mech if isinstance(mech, StewartSystem) else stewart_system(mech)
+    sysm = mech if isinstance(mech, (StewartSystem, PoseSystem)) else pose_system(mech)
     vals = np.asarray(actuator_values, dtype=float).ravel()
-    if vals.shape != (sysm.n_legs,) or not np.all(np.isfinite(vals)):
-        raise InputError(f"actuators: expected {sysm.n_legs} finite values, got {vals.tolist()}")
+    if vals.shape != (sysm.n_act,) or not np.all(np.isfinite(vals)):
+        raise InputError(f"actuators: expected {sysm.n_act} finite values, got {vals.tolist()}")
     cached = sysm.key() in _CACHE
     gen, accounted = _generic_solve(sysm, seed=seed)
-    l2t = (sysm.lengths(vals) / sysm.L) ** 2
-    l20 = gen.l2
-    Q, c = sysm.Q, gen.c
-
-    X = track_parameter(Q, c, gen.X, l20, l2t)[0] if len(gen.X) else gen.X
+    Qt = sysm.coefficients(vals)
+    c = gen.c
+    X = track_parameter(gen.Q, Qt, c, gen.X)[0] if len(gen.X) else gen.X
     sols = []
-    for st, rc, ri, im, res, y, _ in _classify(Q, c, X, l2t):
+    for st, rc, ri, im, res, y, _ in _classify(Qt, c, X):
         R = p = None
         if (st == "real" or (st == "singular" and im < HOMOTOPY_NEAR_REAL)) and ri >= HOMOTOPY_INFINITY:
             R, p = study_to_pose(y / np.linalg.norm(y), sysm.L)
         sols.append(HomotopySolution(st, y, rc, ri, im, res, R, p))
+    n_par = len(sysm.affine_span()[1])
     how = (f"total-degree homotopy ({gen.n_paths} paths, gamma trick) to a generic complex instance: every path "
            f"accounted for ({len(gen.X)} finite nonsingular, {gen.n_at_infinity} at the exceptional generator e.e = 0); "
-           f"parameter homotopy of those {len(gen.X)} paths to the requested leg lengths")
+           f"parameter homotopy of those {len(gen.X)} paths to the requested actuator values (straight segment in the "
+           f"{n_par}-dimensional affine span of the coefficients)")
     n_sing = sum(s.status == "singular" for s in sols)
     if accounted and n_sing:
         how += (f"; but {n_sing} end point(s) are singular (a continuum of solutions or a multiple root at these values, "
