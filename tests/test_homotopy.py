@@ -215,3 +215,80 @@ def test_a_continuum_is_reported_as_one_self_motion_set_not_as_points():
     kinds = [s.kind for s in res.solutions]
     closed = k4f.forward_all(np.array(legs))
     assert kinds.count(AssemblyKind.SELF_MOTION) == 1 == len(closed.solutions)
+
+
+# ------------------------------------------------------------------ limbs reduced with the actuators given (issue 13, part 2)
+def _same_pose(a, b) -> float:
+    return float(np.linalg.norm(a.pose.p - b.pose.p) + np.linalg.norm(a.pose.R - b.pose.R))
+
+
+@pytest.mark.parametrize(("name", "vals", "n_generic"), [
+    ("three-prs", [0.02, -0.01, 0.03], 16),  # the published count of the 3-PRS (as the 3-RPS)
+    ("three-upu", [0.37, 0.36, 0.35], None),
+    ("delta", [0.1, 0.2, -0.1], 40),
+])
+def test_new_limb_types_are_proven_complete_and_contain_the_multistart(name, vals, n_generic):
+    """P-R-S, U-P-U and S-S rods from driven arms: every real end point polishes to a closed
+    assembly with the actuators held, and every mode the multi-start finds is among them."""
+    mech = catalog.resolve(name)
+    assert hc.unsupported_reason(mech) is None
+    res = forward_position(mech, vals, all_solutions=True, method="homotopy")
+    s = res.search
+    assert s["complete"] and s["n_singular"] == 0
+    if n_generic is not None:
+        assert s["n_generic"] == n_generic
+    assert s["n_real"] + s["n_complex"] + s["n_at_infinity"] == s["n_generic"]
+    assert len(res.solutions) == s["n_real"] and all(x.converged and x.residual < 1e-10 for x in res.solutions)
+    for x in res.solutions:
+        q = forward_position(mech, vals, start=x.config)  # the polished pose is a root with the actuators held
+        assert _same_pose(q.solutions[0], x) < 1e-8
+    ms = forward_position(mech, vals, all_solutions=True, method="multistart", n_seeds=12)
+    for m in ms.solutions:
+        assert min(_same_pose(m, h) for h in res.solutions) < 1e-6, "multi-start found a mode homotopy missed"
+
+
+def test_delta_two_translational_modes_among_the_40():
+    """The Delta's six S-S rods from the driven arms: 40 generic complex solutions; the two
+    translational assembly modes (the published count) are among the real ones."""
+    sysm = hc.pose_system(catalog.resolve("delta"))
+    assert isinstance(sysm, hc.PoseSystem) and len(sysm.affine_span()[1]) == 6  # (cos, sin) of each arm
+    for vals in ([0.1, 0.2, -0.1], [0.3, -0.2, 0.5]):
+        r = hc.homotopy_forward(sysm, vals)
+        assert r.complete and r.n_generic == 40
+        rot = [np.linalg.norm(s.R - np.eye(3)) for s in r.solutions if s.status == "real"]
+        assert sum(d < 1e-8 for d in rot) == 2
+
+
+def test_reduced_quadrics_vanish_on_closed_configurations():
+    """Each limb's quadrics hold at assembled configurations away from the reference (random
+    walks along the closure manifold), with the actuator values read from them."""
+    from spatialmech.kinematics.closure import generic_configuration
+
+    for name in ("three-prs", "three-upu", "delta"):
+        mech = catalog.resolve(name)
+        sysm = hc.pose_system(mech)
+        for k in range(2):
+            cfg = generic_configuration(mech, seed=k, step=0.5, steps=3)
+            vals = [cfg.q[mech.freedom_refs.index(mech.freedom(a))] + mech.freedom(a).freedom.offset for a in mech.actuators]
+            D = cfg.D
+            q = Rotation.from_matrix(D[:3, :3]).as_quat()
+            e = np.r_[q[3], q[:3]]
+            p = D[:3, 3] / sysm.L
+            g = np.array([-p @ e[1:], *(p * e[0] + np.cross(p, e[1:]))]) / 2
+            x = np.r_[e, g]
+            Qv = sysm.coefficients(vals)
+            assert max(abs(x @ Qv[i] @ x) for i in range(7)) < 1e-9, name
+
+
+def test_compiled_coefficient_tracker_equals_the_numpy_reference_on_the_delta():
+    from spatialmech.kinematics import compiled
+
+    sysm = hc.pose_system(catalog.resolve("delta"))
+    fast = hc.homotopy_forward(sysm, [0.3, -0.2, 0.5])
+    with compiled.python_reference():
+        ref = hc.homotopy_forward(sysm, [0.3, -0.2, 0.5])
+    assert [s.status for s in fast.solutions] == [s.status for s in ref.solutions]
+    for a, b in zip(fast.solutions, ref.solutions, strict=True):
+        if a.status != "at_infinity":
+            ya, yb = a.study / np.linalg.norm(a.study), b.study / np.linalg.norm(b.study)
+            assert min(np.linalg.norm(ya - yb * ph) for ph in (1, -1)) < 1e-8
