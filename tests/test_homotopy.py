@@ -292,3 +292,29 @@ def test_compiled_coefficient_tracker_equals_the_numpy_reference_on_the_delta():
         if a.status != "at_infinity":
             ya, yb = a.study / np.linalg.norm(a.study), b.study / np.linalg.norm(b.study)
             assert min(np.linalg.norm(ya - yb * ph) for ph in (1, -1)) < 1e-8
+
+
+@pytest.mark.skipif(shutil.which("phc") is None or not __import__("os").environ.get("SPATIALMECH_PHC_LONG"),
+                    reason="PHCpack missing, or SPATIALMECH_PHC_LONG unset (PHCpack's blackbox takes 20-25 s here)")
+def test_phcpack_agrees_on_the_three_rps(tmp_path):
+    """Second independent check (opt-in: about 23 s of PHCpack, over the suite's budget): the
+    3-RPS at legs (0.34, 0.36, 0.32) m, PHCpack's blackbox and ours: 16 regular solutions, the
+    same real ones."""
+    mech = catalog.resolve("three-rps")
+    legs = [0.34, 0.36, 0.32]
+    sysm = hc.pose_system(mech)
+    ours = hc.homotopy_forward(sysm, legs)
+    (tmp_path / "in.txt").write_text(hc.phc_input(sysm, legs, np.random.default_rng(3).normal(size=8)))
+    subprocess.run(["phc", "-b", str(tmp_path / "in.txt"), str(tmp_path / "out.txt")], check=True,
+                   capture_output=True, timeout=300)
+    out = (tmp_path / "out.txt").read_text()
+    assert int(re.findall(r"Number of regular solutions\s*:\s*(\d+)", out)[-1]) == ours.n_generic == 16
+    phc_real = []
+    for block in out[out.rfind("THE SOLUTIONS"):].split("solution ")[1:]:
+        vals = {k: complex(float(x), float(y)) for k, x, y in re.findall(r"\b([eg]\d) :\s+(\S+)\s+(\S+)", block)}
+        if len(vals) == 8 and "real regular" in block:
+            phc_real.append(hc.study_to_pose(np.array([vals[k] for k in sorted(vals)]).real, sysm.L)[1])
+    mine = [s.p for s in ours.solutions if s.status == "real"]
+    assert len(phc_real) == len(mine) > 0
+    for p in phc_real:
+        assert min(np.linalg.norm(p - q) for q in mine) < 1e-6
