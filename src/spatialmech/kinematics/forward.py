@@ -343,7 +343,8 @@ def forward_position(
 
     ``method`` (with ``all_solutions``): ``"multistart"`` (the search above, never a proof of
     completeness), ``"homotopy"`` (every complex solution by homotopy continuation,
-    :mod:`spatialmech.kinematics.homotopy`; S-P-S and R-P-S legs and passive C-U / C-S limbs only, else ``InputError``) or
+    :mod:`spatialmech.kinematics.homotopy`; limbs that reduce to quadrics in the Study parameters only, else
+    ``InputError``) or
     ``"auto"`` (homotopy where it covers the model).  The homotopy's real end points are
     polished by the same Newton step and classified as the multi-start roots; the search then
     holds ``complete``, ``completeness`` and the counts of every end point's status.

@@ -1,30 +1,34 @@
-"""Every assembly mode of a platform on S-P-S legs (Gough-Stewart; with passive C-U / C-S
-limbs, e.g. the 4-SPS/CU) or R-P-S legs (the 3-RPS) by homotopy continuation.
+"""Every assembly mode of a platform by homotopy continuation: Stewart platforms (S-P-S, U-P-S,
+S-P-U legs), R-P-S, P-R-S and U-P-U legs, passive C-U / C-S limbs, and S-S rods from bodies
+driven by actuated joints alone (the Delta).
 
 Formulation.  The platform displacement is written in Study parameters ``x = (e ; g)`` (two
 quaternions, projective): rotation ``R v = e v e* / (e.e)``, translation ``p = 2 g e* / (e.e)``.
-A leg from base point ``a`` to platform point ``b`` (its reference placement, both divided by
-the characteristic length ``L``) of length ``l`` is then one homogeneous quadric
+With the actuator values given, each limb is a set of conditions on the platform point ``b``
+it carries (reference placement, model units over the characteristic length ``L``), each one
+homogeneous quadric in ``x``; with ``v = e b - c e + 2 g``:
 
-    |e b - a e + 2 g|^2 - (l / L)^2 (e.e) = 0,
+    sphere about c, radius r:   |v|^2 - (r / L)^2 (e.e) = 0     (legs, S-S rods, P-R-S)
+    plane through c, normal n:  n . vec(v e*) = 0                (R-P-S, P-R-S; two: a line, C-U)
+    U-P-U:                      n1 . vec(v n_p e*) = 0           (with c the base U centre)
 
-the squared leg length entering linearly.  With the Study quadric ``e.g = 0`` and a random
-complex affine patch ``c.x = 1`` this is a square system of 7 quadrics and 1 linear equation
-in 8 unknowns (Bezout number 128).  A passive C-U or C-S limb keeps its centre on the C
-axis: two more quadrics instead of two legs; an R-P-S leg adds to its leg quadric that its S
-centre stays in the plane normal to the R axis.  Points with ``e.e = 0`` are the exceptional generator of
-the Study quadric: translation at infinity, never a pose; a generic instance has a
-two-dimensional component of them (``e = 0``, ``g.g = 0``), where 88 of the 128 paths end.
+(:class:`StewartSystem` for legs and point-on-line limbs with fixed centres, :class:`PoseSystem`
+for the general reduction, whose centres and radii depend on the actuators).  With the Study
+quadric ``e.g = 0`` and a random complex affine patch ``c.x = 1`` this is a square system of 7
+quadrics and 1 linear equation in 8 unknowns (Bezout number 128).  Points with ``e.e = 0`` are
+the exceptional generator of the Study quadric: translation at infinity, never a pose.
 
 Method.  (1) A total-degree homotopy ``(1 - t) gamma G + t F`` (``G_j = x_j^2 - x_7^2``, 128
-start points, random complex ``gamma``) to a generic complex instance (random complex squared
-leg lengths), once per geometry (cached in memory): every path must end either at a finite
+start points, random complex ``gamma``) to a generic complex instance: a random complex point
+of the affine span of the coefficient tensors over all actuator values (computed once per
+geometry; cached in memory with the solve): every path must end either at a finite
 nonsingular point or at the exceptional set, or the run is repeated with other random numbers;
 by the gamma trick every isolated solution of the generic instance is the end of a path, so the
 finite nonsingular end points are all of them (40 for a general 6-6 geometry).  (2) A parameter
-homotopy along the straight segment from the generic squared lengths to the requested ones
-tracks exactly those paths: every isolated solution of the request is the end of one of them
-(the segment from a generic complex point avoids the discriminant before its end).
+homotopy along the straight segment in that (linear) coefficient space from the generic
+instance to the requested one tracks exactly those paths: every isolated solution of the
+request is the end of one of them (the segment from a generic complex point avoids the
+discriminant before its end).
 
 The tracker is vectorised over paths in NumPy: 4th-order Runge-Kutta predictor on the
 Davidenko equation, Newton corrector with a path-jumping guard (the first update must be small
