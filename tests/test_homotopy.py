@@ -318,3 +318,22 @@ def test_phcpack_agrees_on_the_three_rps(tmp_path):
     assert len(phc_real) == len(mine) > 0
     for p in phc_real:
         assert min(np.linalg.norm(p - q) for q in mine) < 1e-6
+
+
+def test_geometry_family_resolve_matches_a_fresh_solve():
+    """The parameter homotopy in a 96-dimensional coefficient space (the 42 geometry numbers of
+    a 6-6 platform, benchmarks/bench_all_real.py): moving to a new geometry gives the 40
+    solutions and the same real poses as a fresh total-degree solve of that platform."""
+    rng = np.random.default_rng(5)
+    a, b = rng.normal(size=(6, 3)), rng.normal(size=(6, 3)) * 0.7 + [0, 0, 1.5]
+    fam = hc.geometry_family(a, b)
+    assert len(fam.affine_span()[1]) > 42  # products of base and platform coordinates: not the actuator count
+    a2, b2 = a + 0.2 * rng.normal(size=(6, 3)), b + 0.2 * rng.normal(size=(6, 3))
+    legs = np.linalg.norm(b2 - a2, axis=1) * 1.02
+    r = hc.homotopy_forward(fam, np.r_[a2.ravel(), b2.ravel(), legs])
+    fresh = hc.homotopy_forward(hc.system_from_points(a2, b2, d_ref=legs, sign=np.ones(6), offset=legs.copy()), legs, seed=3)
+    assert r.complete and fresh.complete and r.n_generic == fresh.n_generic == 40
+    mine = sorted(tuple(np.round(s.p, 6)) for s in r.solutions if s.status == "real")
+    theirs = sorted(tuple(np.round(s.p, 6)) for s in fresh.solutions if s.status == "real")
+    assert len(mine) == len(theirs) > 0
+    assert np.allclose(np.array(mine), np.array(theirs), atol=1e-5)

@@ -61,6 +61,7 @@ from . import compiled
 from .homotopy_systems import (
     PoseSystem,
     StewartSystem,
+    geometry_family,
     pose_system,
     qmul,
     stewart_system,
@@ -75,6 +76,7 @@ __all__ = [
     "PoseSystem",
     "StewartSystem",
     "clear_cache",
+    "geometry_family",
     "homotopy_forward",
     "phc_input",
     "pose_system",

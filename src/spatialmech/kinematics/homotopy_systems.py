@@ -22,6 +22,7 @@ from ..model.mechanism import Mechanism
 __all__ = [
     "PoseSystem",
     "StewartSystem",
+    "geometry_family",
     "pose_system",
     "qmul",
     "stewart_system",
@@ -518,3 +519,23 @@ def pose_system(mech: Mechanism) -> StewartSystem | PoseSystem:
     if sysm is None:
         raise InputError(f"model: homotopy forward position does not cover {mech.name}: {why}; use method='multistart'")
     return sysm
+
+
+def geometry_family(base, platform, lengths=None) -> PoseSystem:
+    """A 6-6 Stewart platform whose *geometry* is the parameter vector: 42 values (the base
+    centres, the platform centres (reference placement), the leg lengths, model units; the
+    given ones the reference).  Its affine span holds every 6-6 platform, so one generic solve
+    serves every geometry and a new geometry is a parameter-homotopy re-solve (the search for
+    many real solutions in benchmarks/bench_all_real.py)."""
+    a0 = np.asarray(base, dtype=float).reshape(6, 3)
+    b0 = np.asarray(platform, dtype=float).reshape(6, 3)
+    l0 = np.linalg.norm(b0 - a0, axis=1) if lengths is None else np.asarray(lengths, dtype=float).reshape(6)
+    pts = np.vstack([a0, b0])
+    L = float(np.sqrt(np.mean(np.sum((pts - pts.mean(axis=0)) ** 2, axis=1))))
+
+    def rows(v):
+        a, b, r = v[:18].reshape(6, 3), v[18:36].reshape(6, 3), v[36:]
+        return [_sphere_quadric(b[i], a[i], r[i], L) for i in range(6)]
+
+    ref = np.r_[a0.ravel(), b0.ravel(), l0]
+    return PoseSystem("6-6 geometry family", L, 42, rows, ref, np.full(42, 0.3 * L), ("six legs, geometry free",))
