@@ -353,6 +353,14 @@ def _slide(limb, k: int):
     return limb.joints[k].freedoms[0]
 
 
+def _is_rod(joints, L: float) -> bool:
+    """Two joints S-S, S-U or U-S (the U's axes meeting): a rod that keeps only its length."""
+    types = [j.type for j in joints]
+    if len(types) != 2 or types not in (["S", "S"], ["S", "U"], ["U", "S"]):
+        return False
+    return all(j.type != "U" or np.linalg.norm(j.freedoms[0].point - j.freedoms[1].point) <= 1e-9 * L for j in joints)
+
+
 def _reduce_limb(limb, L: float, act_index: dict, hubs: dict) -> tuple[str | None, list, str]:
     """(why not, constraint builders ``values -> [quadrics]``, description) of one limb to the
     platform."""
@@ -361,9 +369,9 @@ def _reduce_limb(limb, L: float, act_index: dict, hubs: dict) -> tuple[str | Non
     if limb.base != "ground":
         if limb.base not in hubs:
             return f"limb {limb.name} starts on body {limb.base}, whose pose the actuators do not fix", [], ""
-        if types != ["S", "S"]:
+        if not _is_rod(limb.joints, L):
             return (f"limb {limb.name} from body {limb.base} is {'-'.join(types)} (from a driven body the "
-                    "formulation covers S-S rods)"), [], ""
+                    "formulation covers S-S, S-U and U-S rods)"), [], ""
         hub = hubs[limb.base]
         a, b = limb.joints[0].point, limb.joints[1].point
         r = float(np.linalg.norm(b - a))
@@ -372,7 +380,22 @@ def _reduce_limb(limb, L: float, act_index: dict, hubs: dict) -> tuple[str | Non
             D = hub(v)
             return [_sphere_quadric(b, D[:3, :3] @ a + D[:3, 3], r, L)]
 
-        return None, [rod], f"{limb.name} (S-S from driven {limb.base}): sphere about a moving centre"
+        return None, [rod], f"{limb.name} ({'-'.join(types)} rod from driven {limb.base}): sphere about a moving centre"
+    prefix = [f for j in limb.joints[:-2] for f in j.freedoms]
+    if len(types) > 2 and _is_rod(limb.joints[-2:], L) and all(f.actuated and id(f) in act_index for f in prefix):
+        from .closure import limb_forward
+
+        S = np.array([f.screw for f in prefix])
+        ks = [act_index[id(f)] for f in prefix]
+        offs = np.array([f.offset for f in prefix])
+        a, b = limb.joints[-2].point, limb.joints[-1].point
+        r = float(np.linalg.norm(b - a))
+
+        def crank(v, S=S, ks=ks, offs=offs, a=a, b=b, r=r):
+            D = limb_forward(S, np.asarray(v)[ks] - offs)[0]
+            return [_sphere_quadric(b, D[:3, :3] @ a + D[:3, 3], r, L)]
+
+        return None, [crank], f"{limb.name} ({'-'.join(types)}): driven crank and rod, sphere about a moving centre"
     if types == ["P", "R", "S"]:
         sl, rj, sj = _slide(limb, 0), limb.joints[1].freedoms[0], limb.joints[2]
         if not sl.actuated or id(sl) not in act_index:
@@ -454,7 +477,8 @@ def _reduce_limb(limb, L: float, act_index: dict, hubs: dict) -> tuple[str | Non
 
         return None, [rps_rows], f"{limb.name} (R-P-S): leg sphere and the plane normal to the R axis"
     return (f"limb {limb.name} is {'-'.join(types)} (covered: S-P-S, U-P-S, S-P-U, U-P-U, R-P-S and P-R-S legs, "
-            "C-U / C-S limbs with the centre on the C axis, and S-S rods from a body driven by actuated joints only)"), [], ""
+            "C-U / C-S limbs with the centre on the C axis, S-S / S-U / U-S rods after actuated joints or from a body "
+            "driven by actuated joints only)"), [], ""
 
 
 def _general(mech: Mechanism) -> tuple[str | None, PoseSystem | None]:
