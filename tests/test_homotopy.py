@@ -350,8 +350,9 @@ def test_a_user_6_rss_with_driven_cranks_is_covered():
         ang = 2 * np.pi * i / 6 + (0.3 if i % 2 else -0.3)
         base = np.array([0.3 * np.cos(ang), 0.3 * np.sin(ang), 0.0])
         pang = 2 * np.pi * i / 6 + (0.4 if i % 2 else -0.4)
+        wrist = [0.12 * np.cos(pang), 0.12 * np.sin(pang), -0.35]
         limbs.append(Limb(f"leg{i + 1}", (R(f"R{i + 1}", base, [-np.sin(ang), np.cos(ang), 0.0], actuated=True),
-                                          S(f"E{i + 1}", base * 1.4), S(f"W{i + 1}", [0.12 * np.cos(pang), 0.12 * np.sin(pang), -0.35]))))
+                                          S(f"E{i + 1}", base * 1.4), S(f"W{i + 1}", wrist))))
     mech = Mechanism("six-rss", tuple(limbs), platform_point=[0, 0, -0.35])
     vals = [0.1, -0.05, 0.08, 0.0, -0.1, 0.05]
     res = forward_position(mech, vals, all_solutions=True, method="homotopy")
