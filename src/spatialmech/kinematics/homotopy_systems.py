@@ -11,6 +11,7 @@ affine span of the coefficient tensors.  See docs/homotopy.md.
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -539,10 +540,16 @@ def pose_system(mech: Mechanism) -> StewartSystem | PoseSystem:
     line, the U-P-U condition) when it covers the model; ``InputError`` naming why not."""
     if _stewart_reason(mech) is None:
         return stewart_system(mech)
+    if mech in _SYSTEMS:  # its affine span computed once per model object
+        return _SYSTEMS[mech]
     why, sysm = _general(mech)
     if sysm is None:
         raise InputError(f"model: homotopy forward position does not cover {mech.name}: {why}; use method='multistart'")
+    _SYSTEMS[mech] = sysm
     return sysm
+
+
+_SYSTEMS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 def geometry_family(base, platform, lengths=None) -> PoseSystem:
