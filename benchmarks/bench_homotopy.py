@@ -30,13 +30,13 @@ TARGET_FIRST_S = 2.0
 TARGET_RESOLVE_MS = 50.0
 
 
-def phc_blackbox(sysm, lengths, c) -> tuple[float, int] | None:
+def phc_blackbox(sysm, values, c) -> tuple[float, int] | None:
     """Seconds of ``phc -b`` on the system and its number of regular solutions (None: no phc)."""
     if shutil.which("phc") is None:
         return None
     with tempfile.TemporaryDirectory() as d:
         src, out = Path(d) / "in.txt", Path(d) / "out.txt"
-        src.write_text(hc.phc_input(sysm, lengths, c))
+        src.write_text(hc.phc_input(sysm, values, c))
         t = time.perf_counter()
         subprocess.run(["phc", "-b", str(src), str(out)], check=True, capture_output=True, timeout=600)
         dt = time.perf_counter() - t
@@ -57,7 +57,7 @@ def case(name: str, sysm, legs: np.ndarray, resolves: int, rng: np.random.Genera
     out = {"case": name, "n_generic": first.n_generic, "n_real": first.count("real"), "complete": first.complete,
            "first_solve_s": t_first, "resolve_median_ms": 1000 * float(np.median(times)) if times else None}
     if phc:
-        got = phc_blackbox(sysm, sysm.lengths(legs), np.random.default_rng(3).normal(size=8))
+        got = phc_blackbox(sysm, legs, np.random.default_rng(3).normal(size=8))
         out["phc_blackbox_s"], out["phc_regular"] = got if got else (None, None)
     return out
 

@@ -109,8 +109,8 @@ def test_cli_json_and_text(stewart):
 
 def test_uncovered_model_clear_message():
     runner = CliRunner()
-    out = runner.invoke(main, ["fk", "three-upu", "--actuators", "0.3,0.3,0.3", "--all", "--method", "homotopy"])
-    assert out.exit_code != 0 and "does not cover three-upu" in out.output and "U-P-U" in out.output
+    out = runner.invoke(main, ["fk", "three-rrr-sm", "--actuators", "10,20,30", "--all", "--method", "homotopy"])
+    assert out.exit_code != 0 and "does not cover three-rrr-sm" in out.output and "R-R-R" in out.output
     assert "Traceback" not in out.output
     with pytest.raises(sm.InputError, match="method"):
         sm.fk("stewart-6sps", [1.2] * 6, all_solutions=True, method="newton")
@@ -123,7 +123,7 @@ def test_phcpack_agrees_on_the_stewart_model(stewart, tmp_path):
     mech, res = stewart
     sysm = hc.stewart_system(mech)
     c = np.random.default_rng(3).normal(size=8)
-    (tmp_path / "in.txt").write_text(hc.phc_input(sysm, sysm.lengths([1.2] * 6), c))
+    (tmp_path / "in.txt").write_text(hc.phc_input(sysm, [1.2] * 6, c))
     subprocess.run(["phc", "-b", str(tmp_path / "in.txt"), str(tmp_path / "out.txt")], check=True,
                    capture_output=True, timeout=120)
     out = (tmp_path / "out.txt").read_text()
@@ -215,3 +215,150 @@ def test_a_continuum_is_reported_as_one_self_motion_set_not_as_points():
     kinds = [s.kind for s in res.solutions]
     closed = k4f.forward_all(np.array(legs))
     assert kinds.count(AssemblyKind.SELF_MOTION) == 1 == len(closed.solutions)
+
+
+# ------------------------------------------------------------------ limbs reduced with the actuators given (issue 13, part 2)
+def _same_pose(a, b) -> float:
+    return float(np.linalg.norm(a.pose.p - b.pose.p) + np.linalg.norm(a.pose.R - b.pose.R))
+
+
+@pytest.mark.parametrize(("name", "vals", "n_generic"), [
+    ("three-prs", [0.02, -0.01, 0.03], 16),  # the published count of the 3-PRS (as the 3-RPS)
+    ("three-upu", [0.37, 0.36, 0.35], None),
+    ("delta", [0.1, 0.2, -0.1], 40),
+])
+def test_new_limb_types_are_proven_complete_and_contain_the_multistart(name, vals, n_generic):
+    """P-R-S, U-P-U and S-S rods from driven arms: every real end point polishes to a closed
+    assembly with the actuators held, and every mode the multi-start finds is among them."""
+    mech = catalog.resolve(name)
+    assert hc.unsupported_reason(mech) is None
+    res = forward_position(mech, vals, all_solutions=True, method="homotopy")
+    s = res.search
+    assert s["complete"] and s["n_singular"] == 0
+    if n_generic is not None:
+        assert s["n_generic"] == n_generic
+    assert s["n_real"] + s["n_complex"] + s["n_at_infinity"] == s["n_generic"]
+    assert len(res.solutions) == s["n_real"] and all(x.converged and x.residual < 1e-10 for x in res.solutions)
+    for x in res.solutions:
+        q = forward_position(mech, vals, start=x.config)  # the polished pose is a root with the actuators held
+        assert _same_pose(q.solutions[0], x) < 1e-8
+    ms = forward_position(mech, vals, all_solutions=True, method="multistart", n_seeds=12)
+    for m in ms.solutions:
+        assert min(_same_pose(m, h) for h in res.solutions) < 1e-6, "multi-start found a mode homotopy missed"
+
+
+def test_delta_two_translational_modes_among_the_40():
+    """The Delta's six S-S rods from the driven arms: 40 generic complex solutions; the two
+    translational assembly modes (the published count) are among the real ones."""
+    sysm = hc.pose_system(catalog.resolve("delta"))
+    assert isinstance(sysm, hc.PoseSystem) and len(sysm.affine_span()[1]) == 6  # (cos, sin) of each arm
+    for vals in ([0.1, 0.2, -0.1], [0.3, -0.2, 0.5]):
+        r = hc.homotopy_forward(sysm, vals)
+        assert r.complete and r.n_generic == 40
+        rot = [np.linalg.norm(s.R - np.eye(3)) for s in r.solutions if s.status == "real"]
+        assert sum(d < 1e-8 for d in rot) == 2
+
+
+def test_reduced_quadrics_vanish_on_closed_configurations():
+    """Each limb's quadrics hold at assembled configurations away from the reference (random
+    walks along the closure manifold), with the actuator values read from them."""
+    from spatialmech.kinematics.closure import generic_configuration
+
+    for name in ("three-prs", "three-upu", "delta"):
+        mech = catalog.resolve(name)
+        sysm = hc.pose_system(mech)
+        for k in range(2):
+            cfg = generic_configuration(mech, seed=k, step=0.5, steps=3)
+            vals = [cfg.q[mech.freedom_refs.index(mech.freedom(a))] + mech.freedom(a).freedom.offset for a in mech.actuators]
+            D = cfg.D
+            q = Rotation.from_matrix(D[:3, :3]).as_quat()
+            e = np.r_[q[3], q[:3]]
+            p = D[:3, 3] / sysm.L
+            g = np.array([-p @ e[1:], *(p * e[0] + np.cross(p, e[1:]))]) / 2
+            x = np.r_[e, g]
+            Qv = sysm.coefficients(vals)
+            assert max(abs(x @ Qv[i] @ x) for i in range(7)) < 1e-9, name
+
+
+def test_compiled_coefficient_tracker_equals_the_numpy_reference_on_the_delta():
+    from spatialmech.kinematics import compiled
+
+    sysm = hc.pose_system(catalog.resolve("delta"))
+    fast = hc.homotopy_forward(sysm, [0.3, -0.2, 0.5])
+    with compiled.python_reference():
+        ref = hc.homotopy_forward(sysm, [0.3, -0.2, 0.5])
+    assert [s.status for s in fast.solutions] == [s.status for s in ref.solutions]
+    for a, b in zip(fast.solutions, ref.solutions, strict=True):
+        if a.status != "at_infinity":
+            ya, yb = a.study / np.linalg.norm(a.study), b.study / np.linalg.norm(b.study)
+            assert min(np.linalg.norm(ya - yb * ph) for ph in (1, -1)) < 1e-8
+
+
+@pytest.mark.skipif(shutil.which("phc") is None or not __import__("os").environ.get("SPATIALMECH_PHC_LONG"),
+                    reason="PHCpack missing, or SPATIALMECH_PHC_LONG unset (PHCpack's blackbox takes 20-25 s here)")
+def test_phcpack_agrees_on_the_three_rps(tmp_path):
+    """Second independent check (opt-in: about 23 s of PHCpack, over the suite's budget): the
+    3-RPS at legs (0.34, 0.36, 0.32) m, PHCpack's blackbox and ours: 16 regular solutions, the
+    same real ones."""
+    mech = catalog.resolve("three-rps")
+    legs = [0.34, 0.36, 0.32]
+    sysm = hc.pose_system(mech)
+    ours = hc.homotopy_forward(sysm, legs)
+    (tmp_path / "in.txt").write_text(hc.phc_input(sysm, legs, np.random.default_rng(3).normal(size=8)))
+    subprocess.run(["phc", "-b", str(tmp_path / "in.txt"), str(tmp_path / "out.txt")], check=True,
+                   capture_output=True, timeout=300)
+    out = (tmp_path / "out.txt").read_text()
+    assert int(re.findall(r"Number of regular solutions\s*:\s*(\d+)", out)[-1]) == ours.n_generic == 16
+    phc_real = []
+    for block in out[out.rfind("THE SOLUTIONS"):].split("solution ")[1:]:
+        vals = {k: complex(float(x), float(y)) for k, x, y in re.findall(r"\b([eg]\d) :\s+(\S+)\s+(\S+)", block)}
+        if len(vals) == 8 and "real regular" in block:
+            phc_real.append(hc.study_to_pose(np.array([vals[k] for k in sorted(vals)]).real, sysm.L)[1])
+    mine = [s.p for s in ours.solutions if s.status == "real"]
+    assert len(phc_real) == len(mine) > 0
+    for p in phc_real:
+        assert min(np.linalg.norm(p - q) for q in mine) < 1e-6
+
+
+def test_geometry_family_resolve_matches_a_fresh_solve():
+    """The parameter homotopy in a 96-dimensional coefficient space (the 42 geometry numbers of
+    a 6-6 platform, benchmarks/bench_all_real.py): moving to a new geometry gives the 40
+    solutions and the same real poses as a fresh total-degree solve of that platform."""
+    rng = np.random.default_rng(5)
+    a, b = rng.normal(size=(6, 3)), rng.normal(size=(6, 3)) * 0.7 + [0, 0, 1.5]
+    fam = hc.geometry_family(a, b)
+    assert len(fam.affine_span()[1]) > 42  # products of base and platform coordinates: not the actuator count
+    a2, b2 = a + 0.2 * rng.normal(size=(6, 3)), b + 0.2 * rng.normal(size=(6, 3))
+    legs = np.linalg.norm(b2 - a2, axis=1) * 1.02
+    r = hc.homotopy_forward(fam, np.r_[a2.ravel(), b2.ravel(), legs])
+    fresh = hc.homotopy_forward(hc.system_from_points(a2, b2, d_ref=legs, sign=np.ones(6), offset=legs.copy()), legs, seed=3)
+    assert r.complete and fresh.complete and r.n_generic == fresh.n_generic == 40
+    mine = sorted(tuple(np.round(s.p, 6)) for s in r.solutions if s.status == "real")
+    theirs = sorted(tuple(np.round(s.p, 6)) for s in fresh.solutions if s.status == "real")
+    assert len(mine) == len(theirs) > 0
+    assert np.allclose(np.array(mine), np.array(theirs), atol=1e-5)
+
+
+def test_a_user_6_rss_with_driven_cranks_is_covered():
+    """A user's 6-RSS (actuated base revolutes, S-S rods): each limb a sphere about its crank's
+    moving elbow; proven complete (40 generic) and containing every multi-start mode."""
+    from spatialmech.model.joints import R, S
+    from spatialmech.model.mechanism import Limb, Mechanism
+
+    limbs = []
+    for i in range(6):
+        ang = 2 * np.pi * i / 6 + (0.3 if i % 2 else -0.3)
+        base = np.array([0.3 * np.cos(ang), 0.3 * np.sin(ang), 0.0])
+        pang = 2 * np.pi * i / 6 + (0.4 if i % 2 else -0.4)
+        wrist = [0.12 * np.cos(pang), 0.12 * np.sin(pang), -0.35]
+        limbs.append(Limb(f"leg{i + 1}", (R(f"R{i + 1}", base, [-np.sin(ang), np.cos(ang), 0.0], actuated=True),
+                                          S(f"E{i + 1}", base * 1.4), S(f"W{i + 1}", wrist))))
+    mech = Mechanism("six-rss", tuple(limbs), platform_point=[0, 0, -0.35])
+    vals = [0.1, -0.05, 0.08, 0.0, -0.1, 0.05]
+    res = forward_position(mech, vals, all_solutions=True, method="homotopy")
+    s = res.search
+    assert s["complete"] and s["n_generic"] == 40 and len(res.solutions) == s["n_real"] > 0
+    assert all(x.residual < 1e-10 for x in res.solutions)
+    ms = forward_position(mech, vals, all_solutions=True, method="multistart", n_seeds=10)
+    for m in ms.solutions:
+        assert min(_same_pose(m, h) for h in res.solutions) < 1e-6

@@ -343,7 +343,8 @@ def forward_position(
 
     ``method`` (with ``all_solutions``): ``"multistart"`` (the search above, never a proof of
     completeness), ``"homotopy"`` (every complex solution by homotopy continuation,
-    :mod:`spatialmech.kinematics.homotopy`; S-P-S and R-P-S legs and passive C-U / C-S limbs only, else ``InputError``) or
+    :mod:`spatialmech.kinematics.homotopy`; limbs that reduce to quadrics in the Study parameters only, else
+    ``InputError``) or
     ``"auto"`` (homotopy where it covers the model).  The homotopy's real end points are
     polished by the same Newton step and classified as the multi-start roots; the search then
     holds ``complete``, ``completeness`` and the counts of every end point's status.
@@ -430,6 +431,25 @@ def _limbs_at(mech: Mechanism, D: np.ndarray, q0: np.ndarray, targets: dict[int,
     L = mech.characteristic_length
     q = q0.copy()
     tol = resolve_tolerances(None).closure
+    if mech.bodies:  # a link-and-joint graph: the bodies placed through the limbs, each group fitted together
+        held = np.zeros(len(q), bool)
+        held[list(targets)] = True
+        best, rb = None, np.inf
+        for attempt in range(12):
+            if attempt:
+                q = np.concatenate([random_joint_values(mech, rng, sl, q0[sl], held[sl]) for sl in limb_slices(mech)])
+            c = Configuration(q, D, hub_displacements(mech, q, D))
+            worst = 0.0
+            for cl in limb_clusters(mech):
+                _, _, rows, cols = cluster_system(mech, cl, held=targets)
+                c, rn, _ = cluster_newton(mech, c, rows, cols, tol, max_iter=60)
+                worst = max(worst, rn)
+            if worst < rb:
+                best, rb = c, worst
+            if rb <= tol:
+                break
+        assert best is not None
+        return best
     for ch, sl in zip(limb_chains(mech), limb_slices(mech), strict=True):
         refs = mech.freedom_refs[sl]
         lin = np.array([r.freedom.kind == "P" for r in refs])

@@ -1,30 +1,34 @@
-"""Every assembly mode of a platform on S-P-S legs (Gough-Stewart; with passive C-U / C-S
-limbs, e.g. the 4-SPS/CU) or R-P-S legs (the 3-RPS) by homotopy continuation.
+"""Every assembly mode of a platform by homotopy continuation: Stewart platforms (S-P-S, U-P-S,
+S-P-U legs), R-P-S, P-R-S and U-P-U legs, passive C-U / C-S limbs, and S-S rods from bodies
+driven by actuated joints alone (the Delta).
 
 Formulation.  The platform displacement is written in Study parameters ``x = (e ; g)`` (two
 quaternions, projective): rotation ``R v = e v e* / (e.e)``, translation ``p = 2 g e* / (e.e)``.
-A leg from base point ``a`` to platform point ``b`` (its reference placement, both divided by
-the characteristic length ``L``) of length ``l`` is then one homogeneous quadric
+With the actuator values given, each limb is a set of conditions on the platform point ``b``
+it carries (reference placement, model units over the characteristic length ``L``), each one
+homogeneous quadric in ``x``; with ``v = e b - c e + 2 g``:
 
-    |e b - a e + 2 g|^2 - (l / L)^2 (e.e) = 0,
+    sphere about c, radius r:   |v|^2 - (r / L)^2 (e.e) = 0     (legs, S-S rods, P-R-S)
+    plane through c, normal n:  n . vec(v e*) = 0                (R-P-S, P-R-S; two: a line, C-U)
+    U-P-U:                      n1 . vec(v n_p e*) = 0           (with c the base U centre)
 
-the squared leg length entering linearly.  With the Study quadric ``e.g = 0`` and a random
-complex affine patch ``c.x = 1`` this is a square system of 7 quadrics and 1 linear equation
-in 8 unknowns (Bezout number 128).  A passive C-U or C-S limb keeps its centre on the C
-axis: two more quadrics instead of two legs; an R-P-S leg adds to its leg quadric that its S
-centre stays in the plane normal to the R axis.  Points with ``e.e = 0`` are the exceptional generator of
-the Study quadric: translation at infinity, never a pose; a generic instance has a
-two-dimensional component of them (``e = 0``, ``g.g = 0``), where 88 of the 128 paths end.
+(:class:`StewartSystem` for legs and point-on-line limbs with fixed centres, :class:`PoseSystem`
+for the general reduction, whose centres and radii depend on the actuators).  With the Study
+quadric ``e.g = 0`` and a random complex affine patch ``c.x = 1`` this is a square system of 7
+quadrics and 1 linear equation in 8 unknowns (Bezout number 128).  Points with ``e.e = 0`` are
+the exceptional generator of the Study quadric: translation at infinity, never a pose.
 
 Method.  (1) A total-degree homotopy ``(1 - t) gamma G + t F`` (``G_j = x_j^2 - x_7^2``, 128
-start points, random complex ``gamma``) to a generic complex instance (random complex squared
-leg lengths), once per geometry (cached in memory): every path must end either at a finite
+start points, random complex ``gamma``) to a generic complex instance: a random complex point
+of the affine span of the coefficient tensors over all actuator values (computed once per
+geometry; cached in memory with the solve): every path must end either at a finite
 nonsingular point or at the exceptional set, or the run is repeated with other random numbers;
 by the gamma trick every isolated solution of the generic instance is the end of a path, so the
 finite nonsingular end points are all of them (40 for a general 6-6 geometry).  (2) A parameter
-homotopy along the straight segment from the generic squared lengths to the requested ones
-tracks exactly those paths: every isolated solution of the request is the end of one of them
-(the segment from a generic complex point avoids the discriminant before its end).
+homotopy along the straight segment in that (linear) coefficient space from the generic
+instance to the requested one tracks exactly those paths: every isolated solution of the
+request is the end of one of them (the segment from a generic complex point avoids the
+discriminant before its end).
 
 The tracker is vectorised over paths in NumPy: 4th-order Runge-Kutta predictor on the
 Davidenko equation, Newton corrector with a path-jumping guard (the first update must be small
@@ -39,7 +43,7 @@ the projective phase (real).
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -54,15 +58,28 @@ from ..geometry.tolerances import (
 )
 from ..model.mechanism import Mechanism
 from . import compiled
+from .homotopy_systems import (
+    PoseSystem,
+    StewartSystem,
+    geometry_family,
+    pose_system,
+    qmul,
+    stewart_system,
+    system_from_points,
+    unsupported_reason,
+)
 from .jit import njit
 
 __all__ = [
     "HomotopyResult",
     "HomotopySolution",
+    "PoseSystem",
     "StewartSystem",
     "clear_cache",
+    "geometry_family",
     "homotopy_forward",
     "phc_input",
+    "pose_system",
     "stewart_system",
     "study_to_pose",
     "system_from_points",
@@ -74,215 +91,16 @@ __all__ = [
 _N = 8  # unknowns: e0..e3, g0..g3
 
 
-def _qmat_left(q) -> np.ndarray:
-    """``L(q)`` with ``q r = L(q) r`` (quaternions scalar first)."""
-    w, x, y, z = q
-    return np.array([[w, -x, -y, -z], [x, w, -z, y], [y, z, w, -x], [z, -y, x, w]], dtype=float)
-
-
-def _qmat_right(r) -> np.ndarray:
-    """``R(r)`` with ``q r = R(r) q``."""
-    w, x, y, z = r
-    return np.array([[w, -x, -y, -z], [x, w, z, -y], [y, -z, w, x], [z, y, -x, w]], dtype=float)
-
-
-def _qmul(q, r):
-    w1, x1, y1, z1 = q
-    w2, x2, y2, z2 = r
-    return np.array([w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2, w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
-                     w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2, w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2])
-
-
-@dataclass(frozen=True, eq=False)
-class StewartSystem:
-    """The polynomial system of a platform on actuated S-P-S legs and passive point-on-line
-    limbs (see the module docstring).
-
-    ``base``, ``platform``: the legs' base and platform centres at the reference (model units);
-    the squared leg length of leg ``k`` is ``(d_ref[k] + sign[k] * (v_k - offset[k]))^2`` for
-    the actuator value ``v_k``.  ``lines``: per point-on-line limb, the platform point at the
-    reference, a point of the base line and its direction (a C-U or C-S limb: the U or S centre
-    stays on the C axis; two quadrics each)."""
-
-    base: np.ndarray  # (n_legs, 3)
-    platform: np.ndarray  # (n_legs, 3)
-    d_ref: np.ndarray
-    sign: np.ndarray
-    offset: np.ndarray
-    L: float
-    Q: np.ndarray = field(repr=False)  # (7, 8, 8): Study quadric, the legs without the length term, the lines
-    lines: tuple = ()
-
-    @property
-    def n_legs(self) -> int:
-        return len(self.base)
-
-    def lengths(self, values) -> np.ndarray:
-        """Leg lengths (model units) for actuator values."""
-        v = np.asarray(values, dtype=float)
-        return self.d_ref + self.sign * (v - self.offset)
-
-    def key(self) -> bytes:
-        return np.round(self.Q, 12).tobytes()
-
-
-def _point_on_line(limb, L: float) -> tuple | None:
-    """(platform point, line point, line direction) of a C-U / C-S limb whose centre is on the C
-    axis, else ``None``."""
-    types = [j.type for j in limb.joints]
-    if types not in (["C", "U"], ["C", "S"]) or any(f.actuated for j in limb.joints for f in j.freedoms):
-        return None
-    c, t = limb.joints
-    rot = next(f for f in c.freedoms if f.kind == "R")
-    sl = next(f for f in c.freedoms if f.kind == "P")
-    d = rot.direction / np.linalg.norm(rot.direction)
-    if np.linalg.norm(np.cross(d, sl.direction)) > 1e-9:
-        return None
-    u = t.point
-    if np.linalg.norm(np.cross(u - rot.point, d)) > 1e-9 * L:
-        return None
-    if t.type == "U" and np.linalg.norm(t.freedoms[0].point - t.freedoms[1].point) > 1e-9 * L:
-        return None
-    n1 = np.cross(d, [1.0, 0, 0] if abs(d[0]) < 0.9 else [0, 1.0, 0])
-    n1 /= np.linalg.norm(n1)
-    return u, rot.point, (n1, np.cross(d, n1))
-
-
-def _rps_plane(limb, L: float) -> tuple | None:
-    """(platform centre, base point, (axis,)) of an R-P-S leg whose slide is perpendicular to the
-    R axis and runs from the axis to the S centre (the centre stays in the plane normal to the
-    axis through the base point), else ``None``."""
-    if [j.type for j in limb.joints] != ["R", "P", "S"]:
-        return None
-    r, pj, sj = limb.joints
-    n = r.freedoms[0].direction / np.linalg.norm(r.freedoms[0].direction)
-    d = sj.point - r.freedoms[0].point
-    nd = float(np.linalg.norm(d))
-    sl = pj.freedoms[0]
-    if (nd < 1e-9 * L or abs(float(d @ n)) > 1e-9 * nd or abs(abs(float(d @ sl.direction)) - nd) > 1e-9 * nd
-            or not sl.actuated):
-        return None
-    return sj.point, r.freedoms[0].point, (n,)
-
-
-def unsupported_reason(mech: Mechanism) -> str | None:
-    """``None`` when the homotopy formulation covers ``mech``, else why not (one sentence)."""
-    if mech.bodies:
-        return "a link-and-joint graph (internal bodies)"
-    L = mech.characteristic_length
-    n_eq = 0
-    for limb in mech.limbs:
-        types = [j.type for j in limb.joints]
-        if limb.base != "ground" or limb.tip is not None:
-            return f"limb {limb.name} does not run from the ground to the platform"
-        if _point_on_line(limb, L) is not None:
-            n_eq += 2
-            continue
-        if _rps_plane(limb, L) is not None:
-            n_eq += 2
-            continue
-        if len(types) != 3 or types[1] != "P" or not set(types[::2]) <= {"S", "U"} or types[::2] == ["U", "U"]:
-            return (f"limb {limb.name} is {'-'.join(types)} (the formulation covers S-P-S, U-P-S, S-P-U and R-P-S legs "
-                    "and C-U / C-S limbs with the centre on the C axis)")
-        slide = limb.joints[1].freedoms[0]
-        if not slide.actuated:
-            return f"limb {limb.name}: its slide is not the actuator"
-        for j in limb.joints[::2]:
-            if j.type == "U" and np.linalg.norm(j.freedoms[0].point - j.freedoms[1].point) > 1e-9 * L:
-                return f"limb {limb.name}: the axes of {j.name} do not meet"
-        d = limb.joints[2].point - limb.joints[0].point
-        nd = float(np.linalg.norm(d))
-        if nd < 1e-9 * L or abs(abs(float(d @ slide.direction)) - nd) > 1e-9 * nd:
-            return f"limb {limb.name}: the slide does not run along the line of its two centres"
-        n_eq += 1
-    others = [r.id for r in mech.freedom_refs if r.freedom.actuated and r.freedom.kind != "P"]
-    if others:
-        return "actuators other than the leg slides"
-    if n_eq != 6:
-        return f"its limbs give {n_eq} equations on the platform pose, not 6"
-    return None
-
-
-def stewart_system(mech: Mechanism) -> StewartSystem:
-    """The system of ``mech`` (``InputError`` naming the reason when it is not covered)."""
-    why = unsupported_reason(mech)
-    if why is not None:
-        raise InputError(f"model: homotopy forward position does not cover {mech.name}: {why}; use method='multistart'")
-    L = float(mech.characteristic_length)
-    legs = [limb for limb in mech.limbs if _point_on_line(limb, L) is None]
-    lines = tuple(x for x in (_point_on_line(limb, L) or _rps_plane(limb, L) for limb in mech.limbs) if x is not None)
-    order = []
-    for act in mech.actuators:
-        ref = mech.freedom(act)
-        order.append(next(i for i, limb in enumerate(legs) if limb.joints[1].freedoms[0] is ref.freedom))
-    legs = [legs[k] for k in order]
-    a = np.array([limb.joints[0].point for limb in legs], dtype=float).reshape(-1, 3)
-    b = np.array([limb.joints[2].point for limb in legs], dtype=float).reshape(-1, 3)
-    d = b - a
-    d_ref = np.linalg.norm(d, axis=1)
-    sign = np.array([np.sign(float(d[i] @ limb.joints[1].freedoms[0].direction)) for i, limb in enumerate(legs)])
-    offset = np.array([limb.joints[1].freedoms[0].offset for limb in legs])
-    return system_from_points(a, b, L=L, d_ref=d_ref, sign=sign, offset=offset, lines=lines)
-
-
-def _line_quadrics(u, o, normals, L: float) -> list[np.ndarray]:
-    """Quadrics ``n . vec((e u - o e + 2 g) e*) = 0``: the platform point ``u`` in the planes
-    through ``o`` normal to each ``n`` (two normals: on a line)."""
-    K = np.hstack([_qmat_right(np.r_[0.0, u / L]) - _qmat_left(np.r_[0.0, o / L]), 2 * np.eye(4)])
-    conj = np.diag([1.0, -1, -1, -1])
-    out = []
-    for n in normals:
-        M = np.zeros((_N, _N))
-        for i in range(_N):
-            for j in range(4):  # e components of the second argument
-                M[i, j] = n @ _qmul(K[:, i], conj[:, j])[1:]
-        out.append(0.5 * (M + M.T))
-    return out
-
-
-def system_from_points(base, platform, *, L: float | None = None, d_ref=None, sign=None, offset=None,
-                       lines: tuple = ()) -> StewartSystem:
-    """The system of legs from ``base[k]`` to ``platform[k]`` (reference placement; by default
-    the actuator values are the leg lengths) and point-on-line constraints ``lines``
-    (``(platform point, base point, normals)``: one normal, a plane; two, a line); six
-    equations in all."""
-    a = np.asarray(base, dtype=float).reshape(-1, 3)
-    b = np.asarray(platform, dtype=float).reshape(-1, 3)
-    n_eq = len(a) + sum(len(x[2]) for x in lines)
-    if n_eq != 6 or b.shape != a.shape:
-        raise InputError(f"base, platform: {len(a)} legs and {len(lines)} point constraints give {n_eq} equations, not 6")
-    if L is None:
-        pts = np.vstack([a, b])
-        L = float(np.sqrt(np.mean(np.sum((pts - pts.mean(axis=0)) ** 2, axis=1))))
-    if d_ref is None:
-        d_ref = np.linalg.norm(b - a, axis=1)
-        sign, offset = np.ones(len(a)), d_ref.copy()
-    Q = np.zeros((7, _N, _N))
-    Q[0, :4, 4:] = Q[0, 4:, :4] = 0.5 * np.eye(4)
-    for i in range(len(a)):
-        K = np.hstack([_qmat_right(np.r_[0.0, b[i] / L]) - _qmat_left(np.r_[0.0, a[i] / L]), 2 * np.eye(4)])
-        Q[i + 1] = K.T @ K
-    row = 1 + len(a)
-    for u, o, normals in lines:
-        for M in _line_quadrics(np.asarray(u, float), np.asarray(o, float), normals, L):
-            Q[row] = M
-            row += 1
-    return StewartSystem(a, b, np.asarray(d_ref, float), np.asarray(sign, float), np.asarray(offset, float), L, Q,
-                         tuple(lines))
-
-
 # ------------------------------------------------------------------------------ evaluation
-def _eval_target(Q: np.ndarray, c: np.ndarray, X: np.ndarray, l2: np.ndarray):
-    """F and its Jacobian for points ``X`` (n, 8) and squared lengths ``l2`` (n, legs)."""
-    m = l2.shape[1]
-    QX = np.einsum("kij,nj->nki", Q, X)  # (n, 7, 8)
+def _eval_quad(Qc: np.ndarray, c: np.ndarray, X: np.ndarray):
+    """F and its Jacobian for points ``X`` (n, 8): the seven quadrics ``Qc`` ((7, 8, 8), or
+    (n, 7, 8, 8) one set per point) and the patch ``c . x = 1``; and ``e.e``."""
+    QX = np.einsum("kij,nj->nki", Qc, X) if Qc.ndim == 3 else np.einsum("nkij,nj->nki", Qc, X)  # (n, 7, 8)
     F = np.empty((len(X), _N), dtype=complex)
     J = np.empty((len(X), _N, _N), dtype=complex)
     F[:, :7] = np.einsum("nki,ni->nk", QX, X)
     E = np.einsum("ni,ni->n", X[:, :4], X[:, :4])
-    F[:, 1 : 1 + m] -= l2 * E[:, None]
     J[:, :7] = 2 * QX
-    J[:, 1 : 1 + m, :4] -= 2 * l2[:, :, None] * X[:, None, :4]
     F[:, 7] = X @ c - 1
     J[:, 7] = c
     return F, J, E
@@ -386,27 +204,23 @@ def _lu_solve(A, b, out):
 
 
 @njit(cache=True)
-def _param_system(Q, c, x, l20, l2t, t, F, J, Ht):
-    """:func:`_eval_target` of one point on the straight parameter path ``l2(t)`` and ``H_t``."""
-    m = l20.shape[0]
+def _param_system(Q0, dQ, c, x, t, F, J, Ht):
+    """:func:`_eval_quad` of one point on the straight coefficient path ``Q0 + t dQ`` and ``H_t``."""
     n = x.shape[0]
-    E = x[0] * x[0] + x[1] * x[1] + x[2] * x[2] + x[3] * x[3]
     for k in range(7):
         acc = 0.0j
+        acct = 0.0j
         for i in range(n):
             qx = 0.0j
+            dx = 0.0j
             for j in range(n):
-                qx += Q[k, i, j] * x[j]
+                qx += (Q0[k, i, j] + t * dQ[k, i, j]) * x[j]
+                dx += dQ[k, i, j] * x[j]
             J[k, i] = 2.0 * qx
             acc += qx * x[i]
+            acct += dx * x[i]
         F[k] = acc
-        Ht[k] = 0.0
-    for k in range(m):
-        lt = (1.0 - t) * l20[k] + t * l2t[k]
-        F[1 + k] -= lt * E
-        for i in range(4):
-            J[1 + k, i] -= 2.0 * lt * x[i]
-        Ht[1 + k] = -(l2t[k] - l20[k]) * E
+        Ht[k] = acct
     acc = -1.0 + 0.0j
     for i in range(n):
         acc += x[i] * c[i]
@@ -416,9 +230,9 @@ def _param_system(Q, c, x, l20, l2t, t, F, J, Ht):
 
 
 @njit(cache=True)
-def _param_vel(Q, c, x, l20, l2t, t, F, J, Ht, out):
+def _param_vel(Q0, dQ, c, x, t, F, J, Ht, out):
     ok = True
-    _param_system(Q, c, x, l20, l2t, t, F, J, Ht)
+    _param_system(Q0, dQ, c, x, t, F, J, Ht)
     for i in range(Ht.shape[0]):
         Ht[i] = -Ht[i]
     ok = _lu_solve(J, Ht, out)
@@ -426,7 +240,7 @@ def _param_vel(Q, c, x, l20, l2t, t, F, J, Ht, out):
 
 
 @njit(cache=True)
-def _track_param(Q, c, X0, l20, l2t, h0, hmin, max_steps, jump, newton, X, T, done):
+def _track_param(Q0, dQ, c, X0, h0, hmin, max_steps, jump, newton, X, T, done):
     """:func:`track` of the parameter homotopy, path by path (compiled): the same RK4 predictor,
     two Newton corrections, acceptance test and step control."""
     n = X0.shape[1]
@@ -450,19 +264,19 @@ def _track_param(Q, c, X0, l20, l2t, h0, hmin, max_steps, jump, newton, X, T, do
         fin = False
         for _ in range(max_steps):
             hh = min(h, 1.0 - t)
-            ok = _param_vel(Q, c, x, l20, l2t, t, F, J, Ht, k1)
+            ok = _param_vel(Q0, dQ, c, x, t, F, J, Ht, k1)
             if ok:
                 for i in range(n):
                     xs[i] = x[i] + 0.5 * hh * k1[i]
-                ok = _param_vel(Q, c, xs, l20, l2t, t + 0.5 * hh, F, J, Ht, k2)
+                ok = _param_vel(Q0, dQ, c, xs, t + 0.5 * hh, F, J, Ht, k2)
             if ok:
                 for i in range(n):
                     xs[i] = x[i] + 0.5 * hh * k2[i]
-                ok = _param_vel(Q, c, xs, l20, l2t, t + 0.5 * hh, F, J, Ht, k3)
+                ok = _param_vel(Q0, dQ, c, xs, t + 0.5 * hh, F, J, Ht, k3)
             if ok:
                 for i in range(n):
                     xs[i] = x[i] + hh * k3[i]
-                ok = _param_vel(Q, c, xs, l20, l2t, t + hh, F, J, Ht, k4)
+                ok = _param_vel(Q0, dQ, c, xs, t + hh, F, J, Ht, k4)
             d0 = np.inf
             d1 = np.inf
             tn = t + hh
@@ -472,7 +286,7 @@ def _track_param(Q, c, X0, l20, l2t, h0, hmin, max_steps, jump, newton, X, T, do
                     xc[i] = x[i] + hh / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
                     nx += abs(xc[i]) ** 2
                 nx = 1.0 + np.sqrt(nx)
-                _param_system(Q, c, xc, l20, l2t, tn, F, J, Ht)
+                _param_system(Q0, dQ, c, xc, tn, F, J, Ht)
                 ok = _lu_solve(J, F, dx)
                 if ok:
                     s0 = 0.0
@@ -480,7 +294,7 @@ def _track_param(Q, c, X0, l20, l2t, h0, hmin, max_steps, jump, newton, X, T, do
                         s0 += abs(dx[i]) ** 2
                         xc[i] -= dx[i]
                     d0 = np.sqrt(s0) / nx
-                    _param_system(Q, c, xc, l20, l2t, tn, F, J, Ht)
+                    _param_system(Q0, dQ, c, xc, tn, F, J, Ht)
                     ok = _lu_solve(J, F, dx)
                 if ok:
                     s1 = 0.0
@@ -509,41 +323,41 @@ def _track_param(Q, c, X0, l20, l2t, h0, hmin, max_steps, jump, newton, X, T, do
         done[p] = fin
 
 
-def track_parameter(Q: np.ndarray, c: np.ndarray, X0: np.ndarray, l20: np.ndarray, l2t: np.ndarray, *,
+def track_parameter(Q0: np.ndarray, Q1: np.ndarray, c: np.ndarray, X0: np.ndarray, *,
                     h0: float = 0.02, hmin: float = 1e-14, max_steps: int = 4000):
-    """The parameter homotopy from the squared leg lengths ``l20`` (points ``X0``) to ``l2t``:
-    :func:`track` of the straight parameter path, compiled and path by path when the compiled
-    core is in use (the batched NumPy :func:`track` otherwise).  Returns ``(X, t, done)``."""
+    """The parameter homotopy from the quadrics ``Q0`` (7, 8, 8; points ``X0``) to ``Q1`` along
+    the straight segment in the coefficient space: :func:`track`, compiled and path by path when
+    the compiled core is in use (the batched NumPy :func:`track` otherwise).  Returns
+    ``(X, t, done)``."""
     X0 = np.ascontiguousarray(X0, dtype=complex)
-    l20 = np.ascontiguousarray(l20, dtype=complex)
-    l2t = np.ascontiguousarray(l2t, dtype=complex)
+    Q0 = np.ascontiguousarray(Q0, dtype=complex)
+    dQ = np.ascontiguousarray(np.asarray(Q1, dtype=complex) - Q0)
     if compiled.enabled():
         X = np.empty_like(X0)
         T = np.zeros(len(X0))
         done = np.zeros(len(X0), dtype=np.bool_)
         if len(X0):
-            _track_param(np.ascontiguousarray(Q, dtype=float), np.ascontiguousarray(c, dtype=complex), X0, l20, l2t,
+            _track_param(Q0, dQ, np.ascontiguousarray(c, dtype=complex), X0,
                          float(h0), float(hmin), int(max_steps), float(HOMOTOPY_JUMP), float(HOMOTOPY_NEWTON),
                          X, T, done)
         return X, T, done
 
     def fun(X, t):
-        lt = (1 - t)[:, None] * l20 + t[:, None] * l2t
-        F, J, E = _eval_target(Q, c, X, lt)
+        F, J, _ = _eval_quad(Q0[None] + t[:, None, None, None] * dQ[None], c, X)
         Ht = np.zeros_like(F)
-        Ht[:, 1 : 1 + len(l2t)] = -(l2t - l20)[None, :] * E[:, None]
+        Ht[:, :7] = np.einsum("ni,kij,nj->nk", X, dQ, X)
         return F, J, Ht
 
     X, T, done, _ = track(fun, X0, h0=h0, hmin=hmin, max_steps=max_steps)
     return X, T, done
 
 
-def _refine(Q, c, X, l2, iters: int = 4):
+def _refine(Qc, c, X, iters: int = 4):
     """Newton at ``t = 1`` (batched; a point whose step fails keeps its last value)."""
     X = X.copy()
     with np.errstate(all="ignore"):
         for _ in range(iters):
-            F, J, _ = _eval_target(Q, c, X, l2)
+            F, J, _ = _eval_quad(Qc, c, X)
             ok = np.all(np.isfinite(J), axis=(1, 2)) & np.all(np.isfinite(F), axis=1)
             ok &= np.abs(np.linalg.det(np.where(ok[:, None, None], J, np.eye(_N)))) > 0
             if not ok.any():
@@ -552,17 +366,16 @@ def _refine(Q, c, X, l2, iters: int = 4):
             Xn = X[ok] - dx
             fin = np.all(np.isfinite(Xn), axis=1)
             X[np.flatnonzero(ok)[fin]] = Xn[fin]
-        F, J, E = _eval_target(Q, c, X, l2)
+        F, J, E = _eval_quad(Qc, c, X)
     return X, F, J, E
 
 
-def _classify(Q, c, X, l2):
+def _classify(Qc, c, X):
     """Status of each end point: (status, rcond, rel_inf, imag_rel, residual, y, x refined),
     ``y`` the point with its projective phase removed, ``x`` in the affine patch."""
     if len(X) == 0:
         return []
-    l2 = np.broadcast_to(l2, (len(X), np.shape(l2)[-1]))
-    xr, F, J, E = _refine(Q, c, X, l2)
+    xr, F, J, E = _refine(Qc, c, X)
     out = []
     with np.errstate(all="ignore"):
         nx = np.linalg.norm(xr, axis=1)
@@ -599,7 +412,7 @@ def study_to_pose(x, L: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
     R = np.array([[1 - 2 * (j * j + k * k), 2 * (i * j - w * k), 2 * (i * k + w * j)],
                   [2 * (i * j + w * k), 1 - 2 * (i * i + k * k), 2 * (j * k - w * i)],
                   [2 * (i * k - w * j), 2 * (j * k + w * i), 1 - 2 * (i * i + j * j)]])
-    p = 2 * _qmul(g, e * np.array([1, -1, -1, -1]))[1:] / E * L
+    p = 2 * qmul(g, e * np.array([1, -1, -1, -1]))[1:] / E * L
     return R, p
 
 
@@ -607,7 +420,7 @@ def study_to_pose(x, L: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
 @dataclass(frozen=True, eq=False)
 class _Generic:
     c: np.ndarray
-    l2: np.ndarray
+    Q: np.ndarray  # (7, 8, 8) complex: the generic instance's quadrics
     X: np.ndarray  # (N, 8) the isolated solutions
     n_paths: int
     n_at_infinity: int
@@ -624,45 +437,43 @@ def clear_cache() -> None:
     _CACHE.clear()
 
 
-def phc_input(sysm: StewartSystem, lengths, c) -> str:
-    """The system of ``sysm`` at leg ``lengths`` (model units), with the affine normalisation
-    ``c . x = 1`` (8 coefficients), in PHCpack's input format: for an independent solve by
-    ``phc -b`` (tests, benchmarks/bench_homotopy.py).  Only for systems of six S-P-S legs."""
-    if sysm.n_legs != 6 or sysm.lines:
-        raise InputError("sysm: the PHCpack export covers six S-P-S legs (seven quadrics) only")
+def phc_input(sysm: StewartSystem | PoseSystem, values, c) -> str:
+    """The system of ``sysm`` at actuator ``values`` (model units, radians), with the affine
+    normalisation ``c . x = 1`` (8 coefficients), in PHCpack's input format: for an independent
+    solve by ``phc -b`` (tests, benchmarks/bench_homotopy.py)."""
     names = ["e0", "e1", "e2", "e3", "g0", "g1", "g2", "g3"]
-    l2 = (np.asarray(lengths, dtype=float) / sysm.L) ** 2
-    Pe = np.diag([1.0, 1, 1, 1, 0, 0, 0, 0])
+    Qv = sysm.coefficients(np.asarray(values, dtype=float))
 
     def quad(M):
         return " ".join(f"{(M[i, j] if i == j else M[i, j] + M[j, i]):+.17e}*{names[i]}*{names[j]}"
                         for i in range(8) for j in range(i, 8)) + ";"
 
-    eqs = [quad(sysm.Q[0])] + [quad(sysm.Q[k + 1] - l2[k] * Pe) for k in range(6)]
+    eqs = [quad(Qv[k]) for k in range(7)]
     eqs.append(" ".join(f"{c[i]:+.17e}*{names[i]}" for i in range(8)) + " - 1;")
     return "8\n" + "\n".join(eqs) + "\n"
 
 
-def _generic_solve(sysm: StewartSystem, seed: int = 0, max_attempts: int = 3) -> tuple[_Generic, bool]:
-    """Total-degree homotopy to a generic complex instance; (result, every path accounted for)."""
+def _generic_solve(sysm: StewartSystem | PoseSystem, seed: int = 0, max_attempts: int = 3) -> tuple[_Generic, bool]:
+    """Total-degree homotopy to a generic complex instance of the family (a random complex point
+    of the affine span of its coefficient tensors); (result, every path accounted for)."""
     key = sysm.key()
     if key in _CACHE:
         return _CACHE[key], True
     t0 = time.perf_counter()
     rng = np.random.default_rng(seed)
+    Qb, B, scale = sysm.affine_span()
     best = None
     for attempt in range(1, max_attempts + 1):
         c = rng.normal(size=_N) + 1j * rng.normal(size=_N)
-        nl = sysm.n_legs
-        l2 = (1 + rng.random(nl)) * np.exp(1j * rng.uniform(-np.pi, np.pi, nl))
+        z = scale * (1 + rng.random(len(B))) * np.exp(1j * rng.uniform(-np.pi, np.pi, len(B)))
+        Qg = Qb + np.einsum("j,jkab->kab", z, B)
         gamma = np.exp(1j * rng.uniform(0, 2 * np.pi))
         signs = np.array(np.meshgrid(*[[1.0, -1.0]] * 7, indexing="ij")).reshape(7, -1).T  # (128, 7)
         S = np.hstack([signs, np.ones((len(signs), 1))]).astype(complex)
         X0 = S / (S @ c)[:, None]
-        Q = sysm.Q
 
-        def fun(X, t, c=c, l2=l2, gamma=gamma, Q=Q):
-            F, J, _ = _eval_target(Q, c, X, np.broadcast_to(l2, (len(X), len(l2))))
+        def fun(X, t, c=c, gamma=gamma, Qg=Qg):
+            F, J, _ = _eval_quad(Qg, c, X)
             G = np.empty_like(F)
             JG = np.zeros_like(J)
             G[:, :7] = X[:, :7] ** 2 - X[:, 7:8] ** 2
@@ -679,13 +490,13 @@ def _generic_solve(sysm: StewartSystem, seed: int = 0, max_attempts: int = 3) ->
             return H, Hx, Ht
 
         X, _, _, _ = track(fun, X0)
-        cls = _classify(Q, c, X, l2)
+        cls = _classify(Qg, c, X)
         fin = [i for i, r in enumerate(cls) if r[0] in ("real", "complex")]
         inf = [i for i, r in enumerate(cls) if r[0] == "at_infinity"]
         pts = np.array([cls[i][6] for i in fin]).reshape(-1, _N)
         distinct = _distinct(pts)
         accounted = len(fin) + len(inf) == len(X) and distinct
-        g = _Generic(c, l2, pts, len(X), len(inf), attempt, time.perf_counter() - t0)
+        g = _Generic(c, Qg, pts, len(X), len(inf), attempt, time.perf_counter() - t0)
         if accounted:
             _CACHE[key] = g
             return g, True
@@ -741,30 +552,30 @@ class HomotopyResult:
         return sum(s.status == status for s in self.solutions)
 
 
-def homotopy_forward(mech: Mechanism | StewartSystem, actuator_values, *, seed: int = 0) -> HomotopyResult:
-    """Every complex solution of the forward position of a 6-leg S-P-S platform for actuator
-    values (model units, in ``mech.actuators`` order): see the module docstring."""
+def homotopy_forward(mech: Mechanism | StewartSystem | PoseSystem, actuator_values, *, seed: int = 0) -> HomotopyResult:
+    """Every complex solution of the forward position of a platform for actuator values (model
+    units and radians, in ``mech.actuators`` order): see the module docstring."""
     t0 = time.perf_counter()
-    sysm = mech if isinstance(mech, StewartSystem) else stewart_system(mech)
+    sysm = mech if isinstance(mech, (StewartSystem, PoseSystem)) else pose_system(mech)
     vals = np.asarray(actuator_values, dtype=float).ravel()
-    if vals.shape != (sysm.n_legs,) or not np.all(np.isfinite(vals)):
-        raise InputError(f"actuators: expected {sysm.n_legs} finite values, got {vals.tolist()}")
+    if vals.shape != (sysm.n_act,) or not np.all(np.isfinite(vals)):
+        raise InputError(f"actuators: expected {sysm.n_act} finite values, got {vals.tolist()}")
     cached = sysm.key() in _CACHE
     gen, accounted = _generic_solve(sysm, seed=seed)
-    l2t = (sysm.lengths(vals) / sysm.L) ** 2
-    l20 = gen.l2
-    Q, c = sysm.Q, gen.c
-
-    X = track_parameter(Q, c, gen.X, l20, l2t)[0] if len(gen.X) else gen.X
+    Qt = sysm.coefficients(vals)
+    c = gen.c
+    X = track_parameter(gen.Q, Qt, c, gen.X)[0] if len(gen.X) else gen.X
     sols = []
-    for st, rc, ri, im, res, y, _ in _classify(Q, c, X, l2t):
+    for st, rc, ri, im, res, y, _ in _classify(Qt, c, X):
         R = p = None
         if (st == "real" or (st == "singular" and im < HOMOTOPY_NEAR_REAL)) and ri >= HOMOTOPY_INFINITY:
             R, p = study_to_pose(y / np.linalg.norm(y), sysm.L)
         sols.append(HomotopySolution(st, y, rc, ri, im, res, R, p))
+    n_par = len(sysm.affine_span()[1])
     how = (f"total-degree homotopy ({gen.n_paths} paths, gamma trick) to a generic complex instance: every path "
            f"accounted for ({len(gen.X)} finite nonsingular, {gen.n_at_infinity} at the exceptional generator e.e = 0); "
-           f"parameter homotopy of those {len(gen.X)} paths to the requested leg lengths")
+           f"parameter homotopy of those {len(gen.X)} paths to the requested actuator values (straight segment in the "
+           f"{n_par}-dimensional affine span of the coefficients)")
     n_sing = sum(s.status == "singular" for s in sols)
     if accounted and n_sing:
         how += (f"; but {n_sing} end point(s) are singular (a continuum of solutions or a multiple root at these values, "
