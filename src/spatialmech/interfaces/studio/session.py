@@ -42,11 +42,15 @@ from ...kinematics.closure import (
 )
 from ...kinematics.jacobian import complete_jacobian, driver_determinants
 from ...kinematics.forward import forward_position
-from ...kinematics.position import freedom_values, platform_pose
+from ...geometry.rotations import check_sequence
+from ...kinematics.position import freedom_values, platform_pose, within_limits
+from ...kinematics.task import default_task, task_values
 from ...kinematics.tracking import ActuatorPathProblem, track
 from ...model.mechanism import Mechanism
+from ...model.task import TASK_NAMES, TaskCoordinates
 from ...present.viewer import LIMB_COLOURS, drawing
 from ...serialize import freedom_values_dict, pose_dict
+from .posing import pose_path
 
 __all__ = ["DriveResult", "Session"]
 
@@ -55,10 +59,14 @@ REACHED = "reached"  # the requested actuator values, on the same branch
 STOPPED_SINGULAR = "stopped_at_singularity"  # the drivers lost control: DJ zero / dead point ahead
 STOPPED_TRACKER = "stopped"  # the tracker could not step on (bifurcation, branch crossing, no closure)
 UNCHANGED = "unchanged"  # nothing to do (the values are the current ones)
-DRIVE_STATUSES = (REACHED, STOPPED_SINGULAR, STOPPED_TRACKER, UNCHANGED)
+STOPPED_LIMIT = "stopped_at_limit"  # POST /api/pose: an actuator would leave its joint limits
+LIMB_SINGULAR = "limb_singular"  # POST /api/pose: a limb reaches an inverse singularity (workspace edge)
+UNREACHABLE = "unreachable"  # POST /api/pose: no closed configuration further along the path
+DRIVE_STATUSES = (REACHED, STOPPED_SINGULAR, STOPPED_TRACKER, UNCHANGED, STOPPED_LIMIT, LIMB_SINGULAR, UNREACHABLE)
 
-#: Half-width of the slider ranges around the start values: rotations (degrees) and slides
-#: (in characteristic lengths).
+#: Half-width of the slider ranges around the start values (where a freedom has no joint
+#: limits; the limits are the range otherwise): rotations (degrees) and slides (in
+#: characteristic lengths).  The pose sliders use the same half-widths around the start pose.
 SLIDER_HALF_DEG = 360.0
 SLIDER_HALF_L = 1.0
 #: Largest number of tracker steps per drive (a drag is answered quickly or stops).
@@ -155,6 +163,9 @@ class Session:
         self.config = c
         self.start_values = self.actuator_values()
         self.history = [self._platform_point(c)]
+        self._tasks: dict[str, TaskCoordinates | None] = {}
+        self.euler = mech.task.euler if mech.task is not None else "ZYX"
+        self.start_task = task_values(mech, c.D, self.euler)
 
     def _sigma(self, c: Configuration) -> float:
         try:
@@ -256,11 +267,8 @@ class Session:
         pose = platform_pose(m, c)
         vals = freedom_values(m, c.q)
         joints = freedom_values_dict(m, {r.id: v for r, v in zip(m.freedom_refs, vals, strict=True)}, "joints")
-        lo = {}
-        half_len = SLIDER_HALF_L * m.characteristic_length
-        for aid, v0 in zip(m.actuators, self.start_values if len(self.start_values) == len(a) else a, strict=True):
-            lo[aid] = ((np.degrees(v0) - SLIDER_HALF_DEG, np.degrees(v0) + SLIDER_HALF_DEG) if _is_rot(m, aid)
-                       else (v0 - half_len, v0 + half_len))
+        lo = {aid: self._slider_range(aid, v0, v) for aid, v0, v in
+              zip(m.actuators, self.start_values if len(self.start_values) == len(a) else a, a, strict=True)}
         return {
             "mechanism": m.name,
             "drivers": list(m.actuators),
@@ -277,9 +285,71 @@ class Session:
             "near_singular": bool(sig < NEAR_SINGULAR),
             "near_singular_below": NEAR_SINGULAR,
             "residual": float(np.linalg.norm(closure_residual(m, c))) / max(m.characteristic_length, 1e-300),
+            "outside_limits": within_limits(m, c.q),
+            "task": self.task_readout(),
             "note": self.note,
             "scene": self.scene(),
         }
+
+    def _slider_range(self, aid: str, start: float, value: float) -> tuple[float, float]:
+        """The slider range of actuator ``aid`` (degrees / length unit): its joint limits where
+        it has them (an angle's shifted by whole turns to hold ``value``), else a half-width
+        around the start value ``start``."""
+        f = self.mech.freedom(aid).freedom
+        rot = f.kind != "P"
+        if f.limits is not None:
+            lo, hi = f.limits
+            if rot:
+                k = np.round((0.5 * (lo + hi) - value) / (2 * np.pi))
+                lo, hi = lo - 2 * np.pi * k, hi - 2 * np.pi * k
+                return float(np.degrees(lo)), float(np.degrees(hi))
+            return float(lo), float(hi)
+        start, value = float(start), float(value)
+        if rot:
+            return float(np.degrees(start)) - SLIDER_HALF_DEG, float(np.degrees(start)) + SLIDER_HALF_DEG
+        h = SLIDER_HALF_L * self.mech.characteristic_length
+        return start - h, start + h
+
+    # ------------------------------------------------------------------ task coordinates (pose)
+    def task(self, euler: str | None = None) -> TaskCoordinates | None:
+        """The task coordinates the output is posed by (in Euler sequence ``euler``, default
+        the session's): the model's own ``task`` or :func:`~spatialmech.kinematics.task.default_task`;
+        ``None`` where the output link cannot move."""
+        euler = self.euler if euler is None else euler
+        if euler not in self._tasks:
+            own = self.mech.task
+            try:
+                self._tasks[euler] = (TaskCoordinates(own.given, euler) if own is not None
+                                      else default_task(self.mech, euler))
+            except InputError:
+                self._tasks[euler] = None
+        return self._tasks[euler]
+
+    def task_values(self, euler: str | None = None) -> np.ndarray:
+        """The six task coordinates of the current configuration (length unit, rad), angles
+        unwrapped to within half a turn of the start pose's."""
+        euler = self.euler if euler is None else euler
+        v = task_values(self.mech, self.config.D, euler)
+        if euler == self.euler:
+            v[3:] = self.start_task[3:] + (v[3:] - self.start_task[3:] + np.pi) % (2 * np.pi) - np.pi
+        return v
+
+    def task_readout(self) -> dict | None:
+        """The pose as task coordinates (``values_len`` x, y, z; ``values_deg`` a1, a2, a3 in
+        the named ``euler`` sequence), which are ``given`` (controlled: the pose sliders) and
+        which ``solved``, and the pose slider ranges of the given ones."""
+        t = self.task()
+        if t is None:
+            return None
+        v, v0 = self.task_values(), self.start_task
+        h = SLIDER_HALF_L * self.mech.characteristic_length
+        return {"given": list(t.given), "solved": list(t.solved), "euler": t.euler,
+                "values_len": {n: float(v[i]) for i, n in enumerate(TASK_NAMES[:3])},
+                "values_deg": {n: float(np.degrees(v[i + 3])) for i, n in enumerate(TASK_NAMES[3:])},
+                "slider_ranges_len": {n: [float(v0[i] - h), float(v0[i] + h)] for i, n in enumerate(TASK_NAMES[:3])
+                                      if n in t.given},
+                "slider_ranges_deg": {n: [float(np.degrees(v0[i + 3])) - 180.0, float(np.degrees(v0[i + 3])) + 180.0]
+                                      for i, n in enumerate(TASK_NAMES[3:]) if n in t.given}}
 
     def scene(self) -> dict:
         """What the page draws (model length unit): limb polylines, base and platform outlines,
@@ -373,6 +443,7 @@ class Session:
         if ell < 1e-12:
             return DriveResult(UNCHANGED, "already at these values", requested=requested,
                                elapsed_s=time.perf_counter() - t_start)
+        self._check_limits(a0, a1, delta, name)
         prob = ActuatorPathProblem(m, lambda lam: a0 + (lam / ell) * delta, lambda lam: delta / ell)
         act_idx = [[r.id for r in m.freedom_refs].index(a) for a in m.actuators]
         offsets = np.array([m.freedom_refs[i].freedom.offset for i in act_idx])
@@ -481,6 +552,95 @@ class Session:
             msg = f"the tracker stopped on this branch: {r.message}"
         return self._stop_before(r, STOPPED_TRACKER, msg, events, steps, elapsed,
                                  requested, with_actuators)
+
+    def parse_pose(self, task_len=None, task_deg=None, *, euler=None, relative=False) -> tuple[TaskCoordinates, np.ndarray]:
+        """The task coordinates and the six target values (SI, rad) of a pose request:
+        ``task_len`` (x, y, z in the model's length unit) and ``task_deg`` (a1, a2, a3 in
+        degrees, Euler sequence ``euler``), each a map by coordinate name, absolute or (``relative``)
+        increments; coordinates not named keep their current values."""
+        if euler is not None:
+            if not isinstance(euler, str):
+                raise InputError(f"euler: expected a sequence name such as 'ZYX', got {euler!r}")
+            try:
+                check_sequence(euler)
+            except InputError as e:
+                raise InputError(f"euler: {e}") from None
+        if not isinstance(relative, bool):
+            raise InputError(f"relative: expected true or false, got {relative!r}")
+        t = self.task(euler)
+        if t is None:
+            raise InputError(f"task_len: {self.mech.name}'s output link cannot move; there is no pose to drive")
+        v = self.task_values(t.euler)
+        target = v.copy()
+        for fname, names, deg, given in (("task_len", TASK_NAMES[:3], False, task_len),
+                                         ("task_deg", TASK_NAMES[3:], True, task_deg)):
+            given = {} if given is None else given
+            if not isinstance(given, dict):
+                raise InputError(f"{fname}: expected a map of coordinate -> value ({', '.join(names)}), "
+                                 f"got {type(given).__name__}")
+            for n, x in given.items():
+                if n not in names:
+                    other = "task_deg" if n in TASK_NAMES[3:] else "task_len" if n in TASK_NAMES else ""
+                    raise InputError(f"{fname}.{n}: unknown coordinate; expected one of {', '.join(names)}"
+                                     + (f" (give {n} in {other})" if other else ""))
+                if n not in t.given:
+                    raise InputError(f"{fname}.{n}: {self.mech.name} controls only {', '.join(t.given)} (Euler sequence "
+                                     f"{t.euler}); {n} is solved (parasitic motion) and cannot be requested")
+                if isinstance(x, bool) or not isinstance(x, (int, float)) or not np.isfinite(x):
+                    raise InputError(f"{fname}.{n}: expected a finite number, got {x!r}")
+                i = TASK_NAMES.index(n)
+                val = np.radians(x) if deg else float(x)
+                target[i] = v[i] + val if relative else val
+        return t, target
+
+    def drive_pose(self, task_len=None, task_deg=None, *, euler=None, relative=False) -> DriveResult:
+        """Move the output link to a pose given by its task coordinates (see
+        :meth:`parse_pose` and :mod:`.posing`) along the current branch."""
+        t_start = time.perf_counter()
+        t, target = self.parse_pose(task_len, task_deg, euler=euler, relative=relative)
+        gi = [TASK_NAMES.index(n) for n in t.given]
+        requested = {"requested_task_len": {n: float(target[i]) for i, n in enumerate(TASK_NAMES[:3]) if n in t.given},
+                     "requested_task_deg": {n: float(np.degrees(target[i + 3])) for i, n in enumerate(TASK_NAMES[3:])
+                                            if n in t.given}}
+        v = self.task_values(t.euler)
+        L = self.mech.characteristic_length
+        d = target[gi] - v[gi]
+        scale = np.array([L if i < 3 else 1.0 for i in gi])
+        if float(np.linalg.norm(d / scale)) < 1e-12:
+            return DriveResult(UNCHANGED, "already at this pose", requested=requested,
+                               elapsed_s=time.perf_counter() - t_start)
+        r = pose_path(self.mech, self.config, t, target, self._dj)
+        events = []
+        if r.event is not None:
+            ev_cfg = r.event["config"]
+            events.append({"name": "DJ (drivers)", "kind": "zero", "driver": ", ".join(self.mech.actuators),
+                           "meaning": "the chosen drivers lose control here (DJ = 0): a direct singularity",
+                           **self._display(self.actuator_values(ev_cfg)),
+                           "task_len": {n: float(r.event["values"][i]) for i, n in enumerate(TASK_NAMES[:3])},
+                           "task_deg": {n: float(np.degrees(r.event["values"][i + 3])) for i, n in enumerate(TASK_NAMES[3:])}})
+        if r.passed:
+            self._accept(r.config, [(c, None) for c in r.passed])
+        return DriveResult(r.status, r.message, tuple(events), r.steps, time.perf_counter() - t_start, requested)
+
+    def _check_limits(self, a0: np.ndarray, a1: np.ndarray, delta: np.ndarray, name: str) -> None:
+        """Refuse a drive whose path (the target and points on the way) leaves an actuator's
+        joint limits."""
+        m = self.mech
+        act_idx = [[r.id for r in m.freedom_refs].index(a) for a in m.actuators]
+        if all(m.freedom_refs[i].freedom.limits is None for i in act_idx):
+            return
+        offsets = np.array([m.freedom_refs[i].freedom.offset for i in act_idx])
+        for lam in np.linspace(0.0, 1.0, 33)[1:]:
+            q = self.config.q.copy()
+            q[act_idx] = a0 + lam * delta - offsets
+            bad = within_limits(m, q, act_idx)
+            if bad:
+                f = m.freedom(bad[0]).freedom
+                lo, hi = f.limits
+                shown = (f"[{np.degrees(lo):.6g}, {np.degrees(hi):.6g}] deg" if f.kind != "P"
+                         else f"[{lo:.6g}, {hi:.6g}] {m.length_unit}")
+                where = "the requested value is" if lam == 1.0 else "the way there is"
+                raise InputError(f"{name}: {where} outside the joint limits of {bad[0]} {shown}")
 
     def _stop_before(self, r, status, msg, events, steps, elapsed, requested, with_actuators) -> DriveResult:
         """Keep the last tracked point before the step that crossed (still on the branch)."""

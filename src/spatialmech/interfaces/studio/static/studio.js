@@ -1,6 +1,7 @@
 // spatialmech studio page: draws what the server computes (the solver runs in the server).
-// Sliders post the actuator values to /api/drive; the next value is sent when the previous
-// answer has arrived (no websockets).  window.studio exposes the last state for tests.
+// Sliders post the actuator values to /api/drive, the pose sliders the output link's task
+// coordinates to /api/pose; the newest request is sent when the previous answer has arrived
+// (no websockets).  window.studio exposes the last state for tests.
 "use strict";
 
 const S = { state: null, circuit: null, unit: "", inFlight: false, pending: null, range: null, drawn: 0, errors: [] };
@@ -164,17 +165,56 @@ function syncSliders() {
     el.value = a.value;
     document.getElementById("slider-val-" + k).textContent = fmt(a.value, 6) + " " + a.unit;
   });
+  poseEntries(S.state).forEach((a, k) => {
+    const el = document.getElementById("pose-" + k);
+    if (!el) return;
+    el.value = a.value;
+    document.getElementById("pose-val-" + k).textContent = fmt(a.value, 6) + " " + a.unit;
+  });
 }
 
 function sliderValues() { return actuatorEntries(S.state).map((_, k) => Number(document.getElementById("slider-" + k).value)); }
 
-function onSlide() { S.pending = sliderValues(); pump(); }
+function onSlide() { S.pending = { path: "/api/drive", body: { actuators: sliderValues() } }; pump(); }
+
+// ------------------------------------------------------------------ pose sliders (inverse position)
+function poseEntries(st) {
+  const t = st.task;
+  if (!t) return [];
+  return t.given.map(n => (n in t.slider_ranges_len)
+    ? { name: n, value: t.values_len[n], unit: S.unit, range: t.slider_ranges_len[n], key: "task_len" }
+    : { name: n, value: t.values_deg[n], unit: "deg", range: t.slider_ranges_deg[n], key: "task_deg" });
+}
+
+function buildPoseSliders() {
+  const box = document.getElementById("pose-sliders");
+  box.innerHTML = "";
+  const t = S.state.task;
+  document.getElementById("pose-help").textContent = !t ? "the output link cannot move" :
+    "drag the output: " + t.given.join(", ") + " (Euler " + t.euler + ")" + (t.solved.length ? "; solved: " + t.solved.join(", ") : "");
+  poseEntries(S.state).forEach((a, k) => {
+    const div = document.createElement("div");
+    div.className = "slider";
+    const step = a.unit === "deg" ? 0.1 : (a.range[1] - a.range[0]) / 2000;
+    div.innerHTML = `<label for="pose-${k}">${a.name} [${a.unit}]: <span id="pose-val-${k}"></span></label>` +
+      `<input type="range" id="pose-${k}" data-index="${k}" min="${a.range[0]}" max="${a.range[1]}" step="${step}" value="${a.value}">`;
+    box.appendChild(div);
+    div.querySelector("input").addEventListener("input", onPoseSlide);
+  });
+  syncSliders();
+}
+
+function onPoseSlide() {
+  const body = { task_len: {}, task_deg: {}, euler: S.state.task.euler };
+  poseEntries(S.state).forEach((a, k) => { body[a.key][a.name] = Number(document.getElementById("pose-" + k).value); });
+  S.pending = { path: "/api/pose", body: body }; pump();
+}
 
 async function pump() {
   if (S.inFlight || S.pending === null) return;
-  const values = S.pending; S.pending = null; S.inFlight = true;
+  const req = S.pending; S.pending = null; S.inFlight = true;
   try {
-    const doc = await api("/api/drive", { actuators: values });
+    const doc = await api(req.path, req.body);
     setStatus(doc.status === "reached" || doc.status === "unchanged" ? "" : "stopped", doc.status + ": " + doc.message);
     doc.events.forEach(e => logEvent(e));
     update(doc.state);
@@ -204,6 +244,7 @@ function update(st) {
     ["sigma_min (complete J)", `<span id="sigma" class="${cls}">${fmt(sig, 4)}</span>` +
       (st.singular ? " singular" : st.near_singular ? " near a singularity (< " + st.near_singular_below + ")" : "")],
     ["closure residual", fmt(st.residual, 3)],
+    ["outside joint limits", st.outside_limits.length ? st.outside_limits.join(", ") : "none"],
   ];
   rows.unshift(...actuatorEntries(st).map(a => [a.name + " [" + a.unit + "]", fmt(a.value, 7)]));
   document.getElementById("readouts").innerHTML = rows.map(r => `<tr><td>${r[0]}</td><td>${r[1]}</td></tr>`).join("");
@@ -234,6 +275,7 @@ async function loadDoc(doc) {
   S.state = doc.state;
   fillDrivers(doc.state);
   buildSliders();
+  buildPoseSliders();
   update(doc.state);
   setStatus("", "ready: drag a slider");
   loadCircuit();
