@@ -62,6 +62,8 @@ UNCHANGED = "unchanged"  # nothing to do (the values are the current ones)
 STOPPED_LIMIT = "stopped_at_limit"  # POST /api/pose: an actuator would leave its joint limits
 LIMB_SINGULAR = "limb_singular"  # POST /api/pose: a limb reaches an inverse singularity (workspace edge)
 UNREACHABLE = "unreachable"  # POST /api/pose: no closed configuration further along the path
+#: The name of the event where a single driver's path turns back (a dead point).
+DEAD_POINT = "dead point (drivers)"
 DRIVE_STATUSES = (REACHED, STOPPED_SINGULAR, STOPPED_TRACKER, UNCHANGED, STOPPED_LIMIT, LIMB_SINGULAR, UNREACHABLE)
 
 #: Half-width of the slider ranges around the start values (where a freedom has no joint
@@ -471,8 +473,29 @@ class Session:
         vector = ((names, lambda x: driver_determinants(m, with_actuators(x), others)) if others else None)
         why = {"reason": ""}
         lam_prev = [0.0]
+        ref_t: dict = {}
+        if len(m.actuators) == 1:
+            # a dead point of a single driver: the path turns back in its value, where the rate of
+            # the driver along the curve (the last component of the tangent, oriented as the last
+            # accepted point's) goes through zero; its DJ need not vanish there (e.g. the rocker of
+            # an RSSR: the passive limb loses a freedom, the rocker's own DJ stays constant)
+            t0 = prob.tangent((self.config, 0.0))
+            ref_t["t"] = t0 if t0[-1] >= 0 else -t0
+
+            def oriented(x) -> np.ndarray:
+                if ref_t.get("x") is x:
+                    return ref_t["tx"]
+                t = prob.tangent(x)
+                t = t / max(float(np.linalg.norm(t)), 1e-300)
+                t = -t if float(t @ ref_t["t"]) < 0 else t
+                ref_t["x"], ref_t["tx"] = x, t
+                return t
+
+            monitors[DEAD_POINT] = lambda x: float(oriented(x)[-1])
 
         def stop(x, s) -> bool:
+            if ref_t:
+                ref_t["t"] = oriented(x)
             lam = float(x[1])
             if lam >= ell:
                 why["reason"] = "reached"
@@ -501,7 +524,14 @@ class Session:
                 continue
             a_e = a0 + (float(e.x[1]) / ell) * delta
             ev = {"name": e.name, "kind": str(e.kind), **self._display(a_e)}
-            if e.name == "DJ (drivers)":
+            if e.name == DEAD_POINT:
+                if str(e.kind) != "zero" or own_crossed is not None:
+                    continue
+                own_crossed = ev
+                ev["driver"] = ", ".join(m.actuators)
+                ev["meaning"] = ("the path turns back in the driver's value here: a dead point, where the driver "
+                                 "loses control of the motion")
+            elif e.name == "DJ (drivers)":
                 own_crossed = ev
                 ev["driver"] = ", ".join(m.actuators)
                 ev["meaning"] = "the chosen drivers lose control here (DJ = 0): a dead point / direct singularity"
@@ -538,7 +568,9 @@ class Session:
             where = own_crossed or {}
             at = ", ".join(f"{k} = {v:.6g} deg" for k, v in where.get("actuators_deg", {}).items())
             at += ", ".join(f"{k} = {v:.6g} {m.length_unit}" for k, v in where.get("actuators_len", {}).items())
-            msg = ("the drivers lose control before the requested values (DJ of the drivers changes sign"
+            what = ("the path turns back in the driver's value" if where.get("name") == DEAD_POINT
+                    else "DJ of the drivers changes sign")
+            msg = (f"the drivers lose control before the requested values ({what}"
                    + (f" at {at}" if at else "") + "): a dead point of this branch; stopped just before it "
                    "(drive back, or switch drivers to pass it)")
             if reason == "turned" and own_crossed is None:
