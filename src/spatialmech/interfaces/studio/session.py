@@ -242,11 +242,24 @@ class Session:
                 out.append(r.id)
         return out
 
+    def _driver_dets(self, c: Configuration) -> dict[str, float]:
+        """The single-driver determinants of every candidate driver and the chosen one at ``c``
+        (one evaluation shared by the readout, the drive's stop test and its monitors; the last
+        configuration asked is remembered)."""
+        last = getattr(self, "_last_dets", None)
+        if last is not None and last[0] is c:
+            return last[1]
+        names = list(dict.fromkeys([*self._candidates(), *self.mech.actuators]))
+        vals = driver_determinants(self.mech, c, names)
+        out = {d: float(v) for d, v in zip(names, vals, strict=True)}
+        self._last_dets = (c, out)
+        return out
+
     def _dj(self, c: Configuration, J=None) -> float | None:
         """DJ of the chosen drivers: ``det`` of the complete Jacobian (one driver: the
         sign-continuous driver determinant); ``None`` where it is not square."""
         if len(self.mech.actuators) == 1:
-            v = float(driver_determinants(self.mech, c, list(self.mech.actuators))[0])
+            v = self._driver_dets(c)[self.mech.actuators[0]]
         else:
             d = (J if J is not None else self._jacobian(c)).det
             v = float("nan") if d is None else float(d)
@@ -256,8 +269,8 @@ class Session:
         cands = self._candidates()
         if not cands:
             return {}
-        vals = driver_determinants(self.mech, c, cands)
-        return {d: float(v) for d, v in zip(cands, vals, strict=True) if np.isfinite(v)}
+        vals = self._driver_dets(c)
+        return {d: vals[d] for d in cands if np.isfinite(vals[d])}
 
     # ------------------------------------------------------------------ readouts
     def state(self) -> dict:
@@ -450,14 +463,20 @@ class Session:
         act_idx = [[r.id for r in m.freedom_refs].index(a) for a in m.actuators]
         offsets = np.array([m.freedom_refs[i].freedom.offset for i in act_idx])
 
-        def with_actuators(x) -> Configuration:
+        x0 = (self.config, 0.0)
+        cfg_memo: dict = {"x": x0, "c": self.config}  # the start (its readouts are remembered)
+
+        def with_actuators(x) -> Configuration:  # one configuration object per tracked point
+            if cfg_memo.get("x") is x:
+                return cfg_memo["c"]
             cfg, lam = x
             q = cfg.q.copy()
             q[act_idx] = a0 + (lam / ell) * delta - offsets
-            return cfg.with_q(q)
+            cfg_memo["x"], cfg_memo["c"] = x, cfg.with_q(q)
+            return cfg_memo["c"]
 
         own0 = self._dj(self.config)
-        memo: dict = {}
+        memo: dict = {"x": x0, "v": own0}  # the start's DJ is known: the tracker's first monitor call reuses it
 
         def own_dj(x) -> float | None:  # evaluated once per tracked point (monitor and stop share it)
             if memo.get("x") is not x:
@@ -470,17 +489,19 @@ class Session:
         monitors = {}
         if own0 is not None:
             monitors["DJ (drivers)"] = lambda x: float(own_dj(x) or 0.0)
-        vector = ((names, lambda x: driver_determinants(m, with_actuators(x), others)) if others else None)
+        vector = ((names, lambda x: [self._driver_dets(with_actuators(x))[d] for d in others]) if others else None)
         why = {"reason": ""}
         lam_prev = [0.0]
         ref_t: dict = {}
+        tan0 = prob.tangent(x0)
+        tan0 = tan0 / max(float(np.linalg.norm(tan0)), 1e-300)
+        tan0 = tan0 if tan0[-1] >= 0 else -tan0
         if len(m.actuators) == 1:
             # a dead point of a single driver: the path turns back in its value, where the rate of
             # the driver along the curve (the last component of the tangent, oriented as the last
             # accepted point's) goes through zero; its DJ need not vanish there (e.g. the rocker of
             # an RSSR: the passive limb loses a freedom, the rocker's own DJ stays constant)
-            t0 = prob.tangent((self.config, 0.0))
-            ref_t["t"] = t0 if t0[-1] >= 0 else -t0
+            ref_t["t"] = tan0
 
             def oriented(x) -> np.ndarray:
                 if ref_t.get("x") is x:
@@ -511,8 +532,10 @@ class Session:
                     return True
             return False
 
-        h = min(0.05, max(ell, 1e-6))
-        r = track(prob, (self.config, 0.0), direction=np.r_[np.zeros(prob.na + prob.nh), 1.0], h0=h, h_max=0.1,
+        # the first step's arc length reaches lam = ell along the start tangent (a small drag is one
+        # step: the monitors are evaluated at one tracked point), at most 0.1 (the largest step)
+        h = min(0.1, max(1.02 * ell / max(abs(float(tan0[-1])), 1e-3), 1e-6))
+        r = track(prob, x0, direction=np.r_[np.zeros(prob.na + prob.nh), 1.0], h0=h, h_max=0.1,
                   max_arc=200.0 * ell + 2.0, max_steps=MAX_STEPS, monitors=monitors, vector_monitor=vector,
                   detect_closure=False, stop=stop)
         steps = len(r.points) - 1
