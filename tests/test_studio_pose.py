@@ -136,3 +136,24 @@ def test_bad_pose_bodies_answer_422_naming_the_field(body, field):
     c = TestClient(create_app(Session("rssr")))
     r = c.post("/api/pose", json=body)
     assert r.status_code == 422 and r.json()["error"].startswith(field), r.text
+
+
+def test_the_static_viewer_draws_the_studios_joint_solids_and_platform_body():
+    """One module draws both (present/shapes.py): at the studio's configuration the viewer's
+    mesh traces are the studio's meshes (a 5-CS coupler: the hull of its joints, not a fold)."""
+    from spatialmech.present.viewer import viewer_figure
+
+    s = Session("five-cs-1")
+    scene = s.state()["scene"]
+    fig = viewer_figure(s.mech, [s.config])
+    meshes = [t for t in fig.frames[0].data if t.type == "mesh3d"]
+    plat, joints = meshes[0], meshes[1:]
+    assert scene["hull_faces"] and len(plat.i) == len(scene["platform_mesh"]["triangles"]) == len(scene["hull_faces"])
+    assert np.allclose(np.c_[plat.x, plat.y, plat.z], scene["platform_mesh"]["vertices_len"], atol=1e-6)
+    assert len(joints) == len(scene["joint_meshes"]) == len(s.mech.limbs)
+    for t, m in zip(joints, scene["joint_meshes"], strict=True):
+        assert np.allclose(np.c_[t.x, t.y, t.z], m["vertices_len"], atol=1e-6)
+        assert np.array_equal(np.c_[t.i, t.j, t.k], m["triangles"])
+    # a ball per S joint and a cylinder per C joint, centred on the joints
+    types = {j["type"] for j in scene["joints"]}
+    assert types == {"C", "S"}

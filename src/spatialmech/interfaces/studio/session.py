@@ -38,7 +38,6 @@ from ...kinematics.closure import (
     closure_residual,
     correct,
     generic_configuration,
-    joint_twists,
 )
 from ...kinematics.jacobian import complete_jacobian, driver_determinants
 from ...kinematics.forward import forward_position
@@ -48,6 +47,7 @@ from ...kinematics.task import default_task, task_values
 from ...kinematics.tracking import ActuatorPathProblem, track
 from ...model.mechanism import Mechanism
 from ...model.task import TASK_NAMES, TaskCoordinates
+from ...present.shapes import joint_list, joint_meshes, mesh_json, platform_solid
 from ...present.viewer import LIMB_COLOURS, drawing
 from ...serialize import freedom_values_dict, pose_dict
 from .posing import pose_path
@@ -92,26 +92,6 @@ class DriveResult:
     def to_dict(self) -> dict:
         return {"status": self.status, "message": self.message, "events": list(self.events),
                 "tracker_steps": self.steps, "elapsed_s": self.elapsed_s, **self.requested}
-
-
-def _platform_hull(ends: np.ndarray, point: np.ndarray) -> tuple[list, list]:
-    """A non-planar platform (its attachment points and the platform point not in one plane,
-    e.g. a 5-CS coupler) as the convex hull of those points: (vertices, triangles as index
-    triples); empty lists for a planar one (drawn as its polygon)."""
-    from scipy.spatial import ConvexHull, QhullError
-
-    pts = np.vstack([ends, point[None, :]])
-    if len(pts) < 4:
-        return [], []
-    c = pts - pts.mean(axis=0)
-    sv = np.linalg.svd(c, compute_uv=False)
-    if sv[2] <= 1e-3 * max(sv[0], 1e-300):  # planar (to a thousandth of its size)
-        return [], []
-    try:
-        hull = ConvexHull(pts)
-    except QhullError:
-        return [], []
-    return pts.tolist(), hull.simplices.tolist()
 
 
 def _is_rot(mech: Mechanism, fid: str) -> bool:
@@ -372,34 +352,21 @@ class Session:
         the platform point's trail, and the task positions."""
         m, c = self.mech, self.config
         d = drawing(m, c)
-        tw = joint_twists(m, c)
-        joints = []
-        for li, limb in enumerate(m.limbs):
-            refs = [r for r in m.freedom_refs if r.limb == li]
-            for j, joint in enumerate(limb.joints):
-                dirs: list[list[float]] = []
-                for k, r in enumerate(refs):
-                    if r.joint != j or joint.type == "S":
-                        continue
-                    t = tw[li][:, k]
-                    v = t[3:] if r.freedom.kind == "P" else t[:3]
-                    v = v / max(float(np.linalg.norm(v)), 1e-300)
-                    if not any(abs(float(v @ np.array(e))) > 1 - 1e-9 for e in dirs):
-                        dirs.append(v.tolist())
-                joints.append({"name": joint.name, "type": joint.type, "limb_index": li, "joint_axes": dirs})
-        ends = [l[-1] for limb, l in zip(m.limbs, d.limbs, strict=True) if m.limb_tip(limb) == m.output]
-        hull_pts, faces = _platform_hull(np.array(ends).reshape(-1, 3), d.platform_point)
-        centres = d.joints.tolist()
-        for jd, p in zip(joints, centres, strict=True):
-            jd["centre_len"] = p
+        jl = joint_list(m, c)
+        joints = [{"name": j["name"], "type": j["type"], "limb_index": j["limb_index"],
+                   "joint_axes": [v.tolist() for v in j["axes"]], "centre_len": j["centre"].tolist()} for j in jl]
+        solid = platform_solid(m, d.platform, d.limbs, d.platform_point)
+        hull = solid is not None and solid["hull"]
         return {
             "limbs_len": [l.tolist() for l in d.limbs],
             "limb_names": [l.name for l in m.limbs],
             "limb_colours": [LIMB_COLOURS[i % len(LIMB_COLOURS)] for i in range(len(m.limbs))],
             "base_len": d.base.tolist(),
             "platform_len": d.platform.tolist(),
-            "platform_hull_len": hull_pts,
-            "hull_faces": faces,
+            "platform_hull_len": solid["vertices"].tolist() if hull else [],
+            "hull_faces": solid["triangles"].tolist() if hull else [],
+            "platform_mesh": mesh_json(solid),
+            "joint_meshes": [mesh_json(x) for x in joint_meshes(jl, len(m.limbs), float(d.scale))],
             "bodies_len": d.bodies.tolist(),
             "joints": joints,
             "platform_point_len": d.platform_point.tolist(),
