@@ -146,7 +146,7 @@ def test_the_static_viewer_draws_the_studios_joint_solids_and_platform_body():
     s = Session("five-cs-1")
     scene = s.state()["scene"]
     fig = viewer_figure(s.mech, [s.config])
-    meshes = [t for t in fig.frames[0].data if t.type == "mesh3d"]
+    meshes = [t for t in fig.data if t.type == "mesh3d" and t.name != "base"]  # the first frame, styled
     plat, joints = meshes[0], meshes[1:]
     assert scene["hull_faces"] and len(plat.i) == len(scene["platform_mesh"]["triangles"]) == len(scene["hull_faces"])
     assert np.allclose(np.c_[plat.x, plat.y, plat.z], scene["platform_mesh"]["vertices_len"], atol=1e-6)

@@ -55,7 +55,7 @@ from ..errors import InputError
 from ..geometry.validate import as_finite_array
 from ..kinematics.closure import Configuration, joint_points, joint_twists
 from ..model.mechanism import GROUND, Mechanism, Pose
-from .shapes import joint_list, joint_meshes, platform_solid, plotly_mesh
+from .shapes import joint_list, joint_meshes, platform_solid
 
 __all__ = ["DIV_ID", "LIMB_COLOURS", "PLOTLY_MODES", "SINGULAR_SYMBOL", "Drawing", "ViewerFile", "drawing", "viewer_figure",
            "viewer_html", "write_viewer"]
@@ -317,16 +317,31 @@ def _solids(mech: Mechanism, config: Configuration, d: Drawing) -> tuple[dict | 
     return solid, joint_meshes(joint_list(mech, config), len(mech.limbs), d.scale)
 
 
-def _animated(d: Drawing, fill: bool, solids: tuple[dict | None, list[dict]]) -> list:
-    """The traces that move, in a fixed order; styles are given only in the first frame."""
+def _mesh3d(mesh: dict | None, faces: bool) -> go.Mesh3d:
+    """A mesh as a plotly trace, compact in the page: float32 vertices and int32 triangles
+    (plotly writes NumPy arrays as base64 typed arrays); ``faces=False`` leaves the triangles
+    out (an animation frame of a mesh whose topology does not change)."""
+    if mesh is None:
+        return go.Mesh3d(x=[], y=[], z=[])
+    V = np.asarray(mesh["vertices"], np.float32)
+    kw = {"x": V[:, 0], "y": V[:, 1], "z": V[:, 2]}
+    if faces:
+        T = np.asarray(mesh["triangles"], np.int32)
+        kw.update(i=T[:, 0], j=T[:, 1], k=T[:, 2])
+    return go.Mesh3d(**kw)
+
+
+def _animated(d: Drawing, fill: bool, solids: tuple[dict | None, list[dict]], first: bool = False) -> list:
+    """The traces that move, in a fixed order; styles (and the joint solids' triangles, the same
+    in every frame) are given only in the first frame."""
     out = [go.Scatter3d(**_xyz(d.platform))]
     x, y, z = _segments(np.array([[d.platform_point, q] for q in d.platform[: max(1, len(d.platform) - 1)]]))
     out.append(go.Scatter3d(x=x, y=y, z=z))
     solid, joints = solids
     if fill:  # the platform body: its polygon, or the hull of a non-planar one (triangles may change)
-        out.append(go.Mesh3d(**plotly_mesh(solid)) if solid is not None else go.Mesh3d(x=[], y=[], z=[]))
+        out.append(_mesh3d(solid, True))
     out += [go.Scatter3d(**_xyz(l)) for l in d.limbs]
-    out += [go.Mesh3d(**plotly_mesh(m)) for m in joints]
+    out += [_mesh3d(m, first) for m in joints]
     if len(d.bodies):
         x, y, z = _segments(d.bodies)
         out.append(go.Scatter3d(x=x, y=y, z=z))
@@ -439,7 +454,7 @@ def viewer_figure(
         extra.append(sing)
 
     solids = [_solids(mech, c, d) for c, d in zip(configs, draws, strict=True)]
-    first = _animated(d0, fill, solids[0])
+    first = _animated(d0, fill, solids[0], first=True)
     _style_animated(first, d0, mech, fill)
     anim_idx = list(range(len(static), len(static) + len(first)))
     frames = [go.Frame(data=_animated(d, fill, so), traces=anim_idx, name=str(k))
