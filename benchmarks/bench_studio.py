@@ -6,8 +6,11 @@ TestClient, in process: the JSON encoding and the app are included, the network 
 Per model, a drag is a sequence of ``POST /api/drive`` with small actuator increments (the page
 sends the next slider value when the previous answer has arrived): 1 degree for the 5-CS
 linkages' crank (P1 towards P7), 2 mm on every leg for the Stewart platform, 1 mm for the
-4-SPS/CU.  Reported: median and 95th percentile of the answer time, and of the time the solver
-took inside it (``elapsed_s``).  The target of issue 16 is under 50 ms per update.
+4-SPS/CU.  A pose drag is a sequence of ``POST /api/pose`` moving one task coordinate of the
+output link (inverse position along the branch): the Stewart platform's z by 2 mm, the
+4-SPS/CU's a3 and the 5-CS linkage 3's y by small steps.  Reported: median and 95th
+percentile of the answer time, and of the time the solver took inside it (``elapsed_s``).
+The target of issue 16 is under 50 ms per update.
 """
 
 from __future__ import annotations
@@ -27,6 +30,12 @@ CASES = [
     ("stewart-6sps", 0.002, 40),
     ("four-sps-cu", 0.001, 40),
     ("rssr", 2.0, 60),
+]
+#: (model, task coordinate, increment per pose update (length unit or degrees), number of updates)
+POSE_CASES = [
+    ("stewart-6sps", "z", 0.002, 40),
+    ("four-sps-cu", "a3", 0.5, 40),
+    ("five-cs-3", "y", 0.05, 40),
 ]
 
 
@@ -52,18 +61,39 @@ def run(model: str, step: float, n: int) -> dict:
             "solver_median_ms": ms(inner, 50), "solver_p95_ms": ms(inner, 95)}
 
 
+def run_pose(model: str, coord: str, step: float, n: int) -> dict:
+    client = TestClient(sm.studio_app(model))
+    key = "task_deg" if coord.startswith("a") else "task_len"
+    body = {key: {coord: step}, "relative": True}
+    client.post("/api/pose", json=body)  # compile / warm up
+    wall, inner, statuses = [], [], []
+    for _ in range(n):
+        t = time.perf_counter()
+        d = client.post("/api/pose", json=body).json()
+        wall.append(time.perf_counter() - t)
+        inner.append(d["elapsed_s"])
+        statuses.append(d["status"])
+        if d["status"] != "reached":
+            break
+    ms = lambda v, q: round(1000 * float(np.percentile(v, q)), 1)  # noqa: E731
+    return {"model": f"{model} pose {coord}", "updates": len(wall), "last_status": statuses[-1],
+            "answer_median_ms": ms(wall, 50), "answer_p95_ms": ms(wall, 95),
+            "solver_median_ms": ms(inner, 50), "solver_p95_ms": ms(inner, 95)}
+
+
 def main(argv=None) -> dict:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--json", action="store_true")
     ap.add_argument("--quick", action="store_true", help="10 updates per model")
     args = ap.parse_args(argv)
     rows = [run(m, s, 10 if args.quick else n) for m, s, n in CASES]
+    rows += [run_pose(m, c, s, 10 if args.quick else n) for m, c, s, n in POSE_CASES]
     out = {"rows": rows}
     if args.json:
         print(json.dumps(out, indent=2))
     else:
         for r in rows:
-            print(f"{r['model']:<14} {r['updates']:>3} updates ({r['last_status']}): answer median {r['answer_median_ms']} ms, "
+            print(f"{r['model']:<22} {r['updates']:>3} updates ({r['last_status']}): answer median {r['answer_median_ms']} ms, "
                   f"p95 {r['answer_p95_ms']} ms; solver median {r['solver_median_ms']} ms, p95 {r['solver_p95_ms']} ms")
     return out
 

@@ -114,10 +114,18 @@ def test_a_rocker_driven_past_its_dead_point_stops_before_it(validator):
     a0 = st["actuators_deg"]["B0.rot"]
     d = ok(c.post("/api/drive", json={"actuators": [a0 + 170.0]}), validator)
     assert d["status"] == "stopped_at_singularity", d["message"]
-    assert any(e["name"] == "DJ (drivers)" for e in d["events"]) or "turns back" in d["message"]
+    # the dead point is located as an event (the rocker's own DJ does not vanish there: the
+    # path turns back in its value) ...
+    [dead] = [e for e in d["events"] if e["name"] == "dead point (drivers)"]
+    assert dead["kind"] == "zero" and dead["driver"] == "B0.rot"
     s = d["state"]
     assert np.sign(s["dj"]) == np.sign(dj0)  # still on the branch it started on
-    assert a0 < s["actuators_deg"]["B0.rot"] < a0 + 170.0
+    assert a0 < s["actuators_deg"]["B0.rot"] < dead["actuators_deg"]["B0.rot"] < a0 + 170.0
+    # ... where the rocker's angle is largest: posed by its angle (inverse position), it stops there too
+    c2 = TestClient(create_app(Session("rssr")))
+    edge = c2.post("/api/pose", json={"task_deg": {"a3": a0 + 170.0}}).json()
+    assert edge["status"] == "limb_singular"
+    assert edge["state"]["task"]["values_deg"]["a3"] == pytest.approx(dead["actuators_deg"]["B0.rot"], abs=0.01)
     assert np.linalg.norm(closure_residual(session.mech, session.config)) < 1e-9
     # driving back works from there
     back = ok(c.post("/api/drive", json={"actuators": [a0]}), validator)

@@ -126,3 +126,15 @@ def test_dragging_a_slider_moves_the_mechanism(server, browser, tmp_path):
     assert img0.shape == img1.shape and float(np.mean(np.any(np.abs(img0 - img1) > 0.05, axis=-1))) > 0.002
     severe = [e for e in browser.get_log("browser") if e["level"] == "SEVERE"]
     assert not severe and browser.execute_script("return window.studio.errors") == []
+    # the output pose slider (the rocker angle a3, inverse position along the branch) moves it back
+    a3 = after["task"]["values_deg"]["a3"]
+    assert browser.execute_script("return document.querySelectorAll('#pose-sliders input').length") == 1
+    target = browser.execute_script("const el = document.getElementById('pose-0'); el.value = Number(el.value) - 5;"
+                                    "el.dispatchEvent(new Event('input')); return Number(el.value);")  # on the slider's step
+    assert target == pytest.approx(a3 - 5, abs=0.1)
+    wait(browser, f"return Math.abs(window.studio.state.task.values_deg.a3 - {target}) < 1e-6 && !window.studio.inFlight")
+    posed = browser.execute_script("return window.studio.state")
+    assert posed["actuators_deg"]["A0.rot"] != pytest.approx(40.0, abs=1e-3)  # the crank followed
+    assert "reached" in browser.find_element(By.ID, "status").text
+    severe = [e for e in browser.get_log("browser") if e["level"] == "SEVERE"]
+    assert not severe and browser.execute_script("return window.studio.errors") == []

@@ -78,8 +78,20 @@ def browser(tmp_path_factory):
 
 _READ = f"""
 const gd = document.getElementById('{DIV_ID}');
+// plotly writes NumPy arrays as base64 typed arrays ({{dtype, bdata}}; the joint solids' float32 vertices)
+const types = {{f4: Float32Array, f8: Float64Array, i4: Int32Array, u4: Uint32Array, i2: Int16Array, u2: Uint16Array,
+               i1: Int8Array, u1: Uint8Array}};
+function values(v) {{
+  if (!v) return [];
+  if (v.bdata !== undefined) {{
+    const raw = atob(v.bdata), bytes = new Uint8Array(raw.length);
+    for (let n = 0; n < raw.length; n++) bytes[n] = raw.charCodeAt(n);
+    return Array.from(new types[v.dtype](bytes.buffer));
+  }}
+  return Array.from(v);
+}}
 return {{active: gd.layout.sliders[0].active,
-        traces: arguments[0].map(i => ['x', 'y', 'z'].map(a => Array.from(gd.data[i][a] || [])))}};
+        traces: arguments[0].map(i => ['x', 'y', 'z'].map(a => values(gd.data[i][a])))}};
 """
 
 

@@ -228,6 +228,7 @@ UNIT_FREE_KEYS: dict[str, str] = {
     "rows": "table cells; the table's columns name their units",
     "dj_by_driver": "DJ of each candidate single driver at the studio's configuration, by name",
     "hull_faces": "triangles of a convex hull, as index triples into its vertices (studio scene)",
+    "triangles": "triangles of a mesh, as index triples into its vertices_len (studio scene: joint solids, platform)",
     "joint_axes": "unit directions of a joint's axes (studio scene)",
     "limb_index": "index of a limb (from 0)",
     "mode_number": "assembly mode number (from 1)",

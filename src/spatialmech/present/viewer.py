@@ -16,8 +16,11 @@ joint points are :func:`~..kinematics.closure.joint_points`; the platform point 
 ``D[:3, :3] p0 + D[:3, 3]`` and the platform frame's axes are the columns of ``D[:3, :3]`` (the
 platform frame is world-aligned at the reference).  A joint axis is the direction part of the
 freedom's current twist (``s`` of ``(s ; s0)``; the moment part ``s0`` for a prismatic
-freedom, whose twist is ``(0 ; v)``), drawn as a segment centred on the joint point for R, P,
-H, C and U joints; S joints are drawn as balls.  The base and platform are the convex outlines
+freedom, whose twist is ``(0 ; v)``).  The figure draws the joints as solids
+(:mod:`.shapes`, shared with the design studio): cylinders along the axes of R, H, U and C
+joints, long thin ones for P, balls for S, in the limb's colour; the platform as a translucent
+body (its polygon, or the convex hull of its attachment points and the platform point when
+they are not in a plane).  :class:`Drawing` keeps the axis segments (``axes``).  The base and platform are the convex outlines
 of the first / last joint points of the limbs (in their best-fit plane); thin lines join the
 platform point to the platform outline's corners (the platform is one rigid body).  When two consecutive
 R, H, C or U joints of a limb share their centre (a spherical linkage such as paper C's
@@ -52,6 +55,7 @@ from ..errors import InputError
 from ..geometry.validate import as_finite_array
 from ..kinematics.closure import Configuration, joint_points, joint_twists
 from ..model.mechanism import GROUND, Mechanism, Pose
+from .shapes import joint_list, joint_meshes, platform_solid
 
 __all__ = ["DIV_ID", "LIMB_COLOURS", "PLOTLY_MODES", "SINGULAR_SYMBOL", "Drawing", "ViewerFile", "drawing", "viewer_figure",
            "viewer_html", "write_viewer"]
@@ -306,16 +310,38 @@ def _frame_segments(origin: np.ndarray, R: np.ndarray, length: float, axis: int)
     return np.array([[origin, origin + length * R[:, axis]]])
 
 
-def _animated(d: Drawing, fill: bool) -> list:
-    """The traces that move, in a fixed order; styles are given only in the first frame."""
+def _solids(mech: Mechanism, config: Configuration, d: Drawing) -> tuple[dict | None, list[dict]]:
+    """The platform body and the joint solids per limb (:mod:`.shapes`, as the studio draws
+    them)."""
+    solid = platform_solid(mech, d.platform, d.limbs, d.platform_point)
+    return solid, joint_meshes(joint_list(mech, config), len(mech.limbs), d.scale)
+
+
+def _mesh3d(mesh: dict | None, faces: bool) -> go.Mesh3d:
+    """A mesh as a plotly trace, compact in the page: float32 vertices and int32 triangles
+    (plotly writes NumPy arrays as base64 typed arrays); ``faces=False`` leaves the triangles
+    out (an animation frame of a mesh whose topology does not change)."""
+    if mesh is None:
+        return go.Mesh3d(x=[], y=[], z=[])
+    V = np.asarray(mesh["vertices"], np.float32)
+    kw = {"x": V[:, 0], "y": V[:, 1], "z": V[:, 2]}
+    if faces:
+        T = np.asarray(mesh["triangles"], np.int32)
+        kw.update(i=T[:, 0], j=T[:, 1], k=T[:, 2])
+    return go.Mesh3d(**kw)
+
+
+def _animated(d: Drawing, fill: bool, solids: tuple[dict | None, list[dict]], first: bool = False) -> list:
+    """The traces that move, in a fixed order; styles (and the joint solids' triangles, the same
+    in every frame) are given only in the first frame."""
     out = [go.Scatter3d(**_xyz(d.platform))]
     x, y, z = _segments(np.array([[d.platform_point, q] for q in d.platform[: max(1, len(d.platform) - 1)]]))
     out.append(go.Scatter3d(x=x, y=y, z=z))
-    if fill:
-        out.append(go.Mesh3d(**_xyz(d.platform[:-1])))
+    solid, joints = solids
+    if fill:  # the platform body: its polygon, or the hull of a non-planar one (triangles may change)
+        out.append(_mesh3d(solid, True))
     out += [go.Scatter3d(**_xyz(l)) for l in d.limbs]
-    x, y, z = _segments(d.axes)
-    out.append(go.Scatter3d(x=x, y=y, z=z))
+    out += [_mesh3d(m, first) for m in joints]
     if len(d.bodies):
         x, y, z = _segments(d.bodies)
         out.append(go.Scatter3d(x=x, y=y, z=z))
@@ -334,15 +360,17 @@ def _style_animated(traces: list, d: Drawing, mech: Mechanism, fill: bool) -> No
                      showlegend=False, line=dict(color="#ff7f0e", width=2), hoverinfo="skip")
     i += 1
     if fill:
-        n = len(d.platform) - 1
-        traces[i].update(i=[0] * (n - 2), j=list(range(1, n - 1)), k=list(range(2, n)), color="#ff7f0e",
-                         opacity=0.35, name="platform", legendgroup="platform", showlegend=False, hoverinfo="skip")
+        traces[i].update(color="#ff7f0e", opacity=0.4, name="platform", legendgroup="platform", showlegend=False,
+                         hoverinfo="skip")
         i += 1
     for li, limb in enumerate(mech.limbs):
         traces[i].update(mode="lines", name=f"limb {limb.name}", line=dict(color=_PALETTE[li % len(_PALETTE)], width=7))
         i += 1
-    traces[i].update(mode="lines", name="joint axes (R, P, H, C, U)", line=dict(color="#333333", width=4))
-    i += 1
+    for li in range(len(mech.limbs)):
+        traces[i].update(color=_PALETTE[li % len(_PALETTE)], opacity=1.0, flatshading=True, hoverinfo="skip",
+                         name="joint solids", legendgroup="joints",
+                         showlegend=li == 0)
+        i += 1
     if len(d.bodies):
         traces[i].update(mode="lines", name=f"internal bodies ({', '.join(mech.bodies)})",
                          line=dict(color="#7f7f7f", width=9))
@@ -425,12 +453,15 @@ def viewer_figure(
                                    marker=dict(size=9, color="#d62728", symbol=SINGULAR_SYMBOL)))
         extra.append(sing)
 
-    first = _animated(d0, fill)
+    solids = [_solids(mech, c, d) for c, d in zip(configs, draws, strict=True)]
+    first = _animated(d0, fill, solids[0], first=True)
     _style_animated(first, d0, mech, fill)
     anim_idx = list(range(len(static), len(static) + len(first)))
-    frames = [go.Frame(data=_animated(d, fill), traces=anim_idx, name=str(k)) for k, d in enumerate(draws)]
+    frames = [go.Frame(data=_animated(d, fill, so), traces=anim_idx, name=str(k))
+              for k, (d, so) in enumerate(zip(draws, solids, strict=True))]
 
-    allp = np.vstack([d.points() for d in draws] + extra)
+    meshes = [m["vertices"] for so in solids for m in ([so[0]] if so[0] is not None else []) + so[1]]
+    allp = np.vstack([d.points() for d in draws] + extra + meshes)
     lo, hi = allp.min(axis=0), allp.max(axis=0)
     centre, half = (lo + hi) / 2, max(float(np.max(hi - lo)) / 2 * 1.08, 1e-9 * s, 1e-12)
     unit = mech.length_unit

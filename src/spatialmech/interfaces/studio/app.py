@@ -12,6 +12,11 @@ and units in the field names; bad input answers 4xx with ``{"error": "<field>: .
 ``POST /api/drive``    ``{"actuators": [...]}`` (model units, degrees for rotations; a list in
                        the order of ``drivers`` or a map by name): drive along the current
                        branch; answers ``status``, ``message``, ``events`` and the new ``state``
+``POST /api/pose``     ``{"task_len": {"z": ...}, "task_deg": {"a2": ...}, "euler": "ZYX",
+                       "relative": false}``: move the output link to a pose (its given task
+                       coordinates; x, y, z in the model's length unit, Euler angles in degrees
+                       in the named sequence; ``relative``: increments) along the current
+                       branch; answers like ``/api/drive``
 ``POST /api/drivers``  ``{"drivers": [...]}``: switch the driving freedoms
 ``POST /api/fk_all``   ``{"seeds": n}`` (optional): every assembly mode at the current values
 ``POST /api/mode``     ``{"mode_number": k}``: move to mode k of the last ``fk_all``
@@ -139,6 +144,18 @@ def create_app(session: Session) -> FastAPI:
             r = session.drive(data["actuators"])
             return _json(doc({**r.to_dict(), "state": session.state()}))
 
+    async def pose(request: Request):
+        data = await body(request, None)
+        extra = sorted(set(data) - {"task_len", "task_deg", "euler", "relative"})
+        if extra:
+            raise InputError(f"{extra[0]}: unknown field; expected task_len, task_deg, euler, relative")
+        if "task_len" not in data and "task_deg" not in data:
+            raise InputError("task_len: give task_len (x, y, z) and/or task_deg (a1, a2, a3) in the body")
+        with lock:
+            r = session.drive_pose(data.get("task_len"), data.get("task_deg"), euler=data.get("euler"),
+                                   relative=data.get("relative", False))
+            return _json(doc({**r.to_dict(), "state": session.state()}))
+
     async def drivers(request: Request):
         data = await body(request, "drivers")
         with lock:
@@ -166,7 +183,8 @@ def create_app(session: Session) -> FastAPI:
             return _json(doc({"model_info": session.model_info(), "state": session.state()}))
 
     app.add_api_route("/api/circuit", guarded(circuit), methods=["GET"])
-    for path, fn in (("/api/drive", drive), ("/api/drivers", drivers), ("/api/fk_all", fk_all), ("/api/mode", mode),
+    for path, fn in (("/api/drive", drive), ("/api/pose", pose),
+                     ("/api/drivers", drivers), ("/api/fk_all", fk_all), ("/api/mode", mode),
                      ("/api/load", load)):
         app.add_api_route(path, guarded(fn), methods=["POST"])
     return app

@@ -38,15 +38,19 @@ from ...kinematics.closure import (
     closure_residual,
     correct,
     generic_configuration,
-    joint_twists,
 )
 from ...kinematics.jacobian import complete_jacobian, driver_determinants
 from ...kinematics.forward import forward_position
-from ...kinematics.position import freedom_values, platform_pose
+from ...geometry.rotations import check_sequence
+from ...kinematics.position import freedom_values, platform_pose, within_limits
+from ...kinematics.task import default_task, task_values
 from ...kinematics.tracking import ActuatorPathProblem, track
 from ...model.mechanism import Mechanism
+from ...model.task import TASK_NAMES, TaskCoordinates
+from ...present.shapes import joint_list, joint_meshes, mesh_json, platform_solid
 from ...present.viewer import LIMB_COLOURS, drawing
 from ...serialize import freedom_values_dict, pose_dict
+from .posing import pose_path
 
 __all__ = ["DriveResult", "Session"]
 
@@ -55,10 +59,16 @@ REACHED = "reached"  # the requested actuator values, on the same branch
 STOPPED_SINGULAR = "stopped_at_singularity"  # the drivers lost control: DJ zero / dead point ahead
 STOPPED_TRACKER = "stopped"  # the tracker could not step on (bifurcation, branch crossing, no closure)
 UNCHANGED = "unchanged"  # nothing to do (the values are the current ones)
-DRIVE_STATUSES = (REACHED, STOPPED_SINGULAR, STOPPED_TRACKER, UNCHANGED)
+STOPPED_LIMIT = "stopped_at_limit"  # POST /api/pose: an actuator would leave its joint limits
+LIMB_SINGULAR = "limb_singular"  # POST /api/pose: a limb reaches an inverse singularity (workspace edge)
+UNREACHABLE = "unreachable"  # POST /api/pose: no closed configuration further along the path
+#: The name of the event where a single driver's path turns back (a dead point).
+DEAD_POINT = "dead point (drivers)"
+DRIVE_STATUSES = (REACHED, STOPPED_SINGULAR, STOPPED_TRACKER, UNCHANGED, STOPPED_LIMIT, LIMB_SINGULAR, UNREACHABLE)
 
-#: Half-width of the slider ranges around the start values: rotations (degrees) and slides
-#: (in characteristic lengths).
+#: Half-width of the slider ranges around the start values (where a freedom has no joint
+#: limits; the limits are the range otherwise): rotations (degrees) and slides (in
+#: characteristic lengths).  The pose sliders use the same half-widths around the start pose.
 SLIDER_HALF_DEG = 360.0
 SLIDER_HALF_L = 1.0
 #: Largest number of tracker steps per drive (a drag is answered quickly or stops).
@@ -82,26 +92,6 @@ class DriveResult:
     def to_dict(self) -> dict:
         return {"status": self.status, "message": self.message, "events": list(self.events),
                 "tracker_steps": self.steps, "elapsed_s": self.elapsed_s, **self.requested}
-
-
-def _platform_hull(ends: np.ndarray, point: np.ndarray) -> tuple[list, list]:
-    """A non-planar platform (its attachment points and the platform point not in one plane,
-    e.g. a 5-CS coupler) as the convex hull of those points: (vertices, triangles as index
-    triples); empty lists for a planar one (drawn as its polygon)."""
-    from scipy.spatial import ConvexHull, QhullError
-
-    pts = np.vstack([ends, point[None, :]])
-    if len(pts) < 4:
-        return [], []
-    c = pts - pts.mean(axis=0)
-    sv = np.linalg.svd(c, compute_uv=False)
-    if sv[2] <= 1e-3 * max(sv[0], 1e-300):  # planar (to a thousandth of its size)
-        return [], []
-    try:
-        hull = ConvexHull(pts)
-    except QhullError:
-        return [], []
-    return pts.tolist(), hull.simplices.tolist()
 
 
 def _is_rot(mech: Mechanism, fid: str) -> bool:
@@ -155,6 +145,9 @@ class Session:
         self.config = c
         self.start_values = self.actuator_values()
         self.history = [self._platform_point(c)]
+        self._tasks: dict[str, TaskCoordinates | None] = {}
+        self.euler = mech.task.euler if mech.task is not None else "ZYX"
+        self.start_task = task_values(mech, c.D, self.euler)
 
     def _sigma(self, c: Configuration) -> float:
         try:
@@ -229,11 +222,24 @@ class Session:
                 out.append(r.id)
         return out
 
+    def _driver_dets(self, c: Configuration) -> dict[str, float]:
+        """The single-driver determinants of every candidate driver and the chosen one at ``c``
+        (one evaluation shared by the readout, the drive's stop test and its monitors; the last
+        configuration asked is remembered)."""
+        last = getattr(self, "_last_dets", None)
+        if last is not None and last[0] is c:
+            return last[1]
+        names = list(dict.fromkeys([*self._candidates(), *self.mech.actuators]))
+        vals = driver_determinants(self.mech, c, names)
+        out = {d: float(v) for d, v in zip(names, vals, strict=True)}
+        self._last_dets = (c, out)
+        return out
+
     def _dj(self, c: Configuration, J=None) -> float | None:
         """DJ of the chosen drivers: ``det`` of the complete Jacobian (one driver: the
         sign-continuous driver determinant); ``None`` where it is not square."""
         if len(self.mech.actuators) == 1:
-            v = float(driver_determinants(self.mech, c, list(self.mech.actuators))[0])
+            v = self._driver_dets(c)[self.mech.actuators[0]]
         else:
             d = (J if J is not None else self._jacobian(c)).det
             v = float("nan") if d is None else float(d)
@@ -243,8 +249,8 @@ class Session:
         cands = self._candidates()
         if not cands:
             return {}
-        vals = driver_determinants(self.mech, c, cands)
-        return {d: float(v) for d, v in zip(cands, vals, strict=True) if np.isfinite(v)}
+        vals = self._driver_dets(c)
+        return {d: vals[d] for d in cands if np.isfinite(vals[d])}
 
     # ------------------------------------------------------------------ readouts
     def state(self) -> dict:
@@ -256,11 +262,8 @@ class Session:
         pose = platform_pose(m, c)
         vals = freedom_values(m, c.q)
         joints = freedom_values_dict(m, {r.id: v for r, v in zip(m.freedom_refs, vals, strict=True)}, "joints")
-        lo = {}
-        half_len = SLIDER_HALF_L * m.characteristic_length
-        for aid, v0 in zip(m.actuators, self.start_values if len(self.start_values) == len(a) else a, strict=True):
-            lo[aid] = ((np.degrees(v0) - SLIDER_HALF_DEG, np.degrees(v0) + SLIDER_HALF_DEG) if _is_rot(m, aid)
-                       else (v0 - half_len, v0 + half_len))
+        lo = {aid: self._slider_range(aid, v0, v) for aid, v0, v in
+              zip(m.actuators, self.start_values if len(self.start_values) == len(a) else a, a, strict=True)}
         return {
             "mechanism": m.name,
             "drivers": list(m.actuators),
@@ -277,9 +280,71 @@ class Session:
             "near_singular": bool(sig < NEAR_SINGULAR),
             "near_singular_below": NEAR_SINGULAR,
             "residual": float(np.linalg.norm(closure_residual(m, c))) / max(m.characteristic_length, 1e-300),
+            "outside_limits": within_limits(m, c.q),
+            "task": self.task_readout(),
             "note": self.note,
             "scene": self.scene(),
         }
+
+    def _slider_range(self, aid: str, start: float, value: float) -> tuple[float, float]:
+        """The slider range of actuator ``aid`` (degrees / length unit): its joint limits where
+        it has them (an angle's shifted by whole turns to hold ``value``), else a half-width
+        around the start value ``start``."""
+        f = self.mech.freedom(aid).freedom
+        rot = f.kind != "P"
+        if f.limits is not None:
+            lo, hi = f.limits
+            if rot:
+                k = np.round((0.5 * (lo + hi) - value) / (2 * np.pi))
+                lo, hi = lo - 2 * np.pi * k, hi - 2 * np.pi * k
+                return float(np.degrees(lo)), float(np.degrees(hi))
+            return float(lo), float(hi)
+        start, value = float(start), float(value)
+        if rot:
+            return float(np.degrees(start)) - SLIDER_HALF_DEG, float(np.degrees(start)) + SLIDER_HALF_DEG
+        h = SLIDER_HALF_L * self.mech.characteristic_length
+        return start - h, start + h
+
+    # ------------------------------------------------------------------ task coordinates (pose)
+    def task(self, euler: str | None = None) -> TaskCoordinates | None:
+        """The task coordinates the output is posed by (in Euler sequence ``euler``, default
+        the session's): the model's own ``task`` or :func:`~spatialmech.kinematics.task.default_task`;
+        ``None`` where the output link cannot move."""
+        euler = self.euler if euler is None else euler
+        if euler not in self._tasks:
+            own = self.mech.task
+            try:
+                self._tasks[euler] = (TaskCoordinates(own.given, euler) if own is not None
+                                      else default_task(self.mech, euler))
+            except InputError:
+                self._tasks[euler] = None
+        return self._tasks[euler]
+
+    def task_values(self, euler: str | None = None) -> np.ndarray:
+        """The six task coordinates of the current configuration (length unit, rad), angles
+        unwrapped to within half a turn of the start pose's."""
+        euler = self.euler if euler is None else euler
+        v = task_values(self.mech, self.config.D, euler)
+        if euler == self.euler:
+            v[3:] = self.start_task[3:] + (v[3:] - self.start_task[3:] + np.pi) % (2 * np.pi) - np.pi
+        return v
+
+    def task_readout(self) -> dict | None:
+        """The pose as task coordinates (``values_len`` x, y, z; ``values_deg`` a1, a2, a3 in
+        the named ``euler`` sequence), which are ``given`` (controlled: the pose sliders) and
+        which ``solved``, and the pose slider ranges of the given ones."""
+        t = self.task()
+        if t is None:
+            return None
+        v, v0 = self.task_values(), self.start_task
+        h = SLIDER_HALF_L * self.mech.characteristic_length
+        return {"given": list(t.given), "solved": list(t.solved), "euler": t.euler,
+                "values_len": {n: float(v[i]) for i, n in enumerate(TASK_NAMES[:3])},
+                "values_deg": {n: float(np.degrees(v[i + 3])) for i, n in enumerate(TASK_NAMES[3:])},
+                "slider_ranges_len": {n: [float(v0[i] - h), float(v0[i] + h)] for i, n in enumerate(TASK_NAMES[:3])
+                                      if n in t.given},
+                "slider_ranges_deg": {n: [float(np.degrees(v0[i + 3])) - 180.0, float(np.degrees(v0[i + 3])) + 180.0]
+                                      for i, n in enumerate(TASK_NAMES[3:]) if n in t.given}}
 
     def scene(self) -> dict:
         """What the page draws (model length unit): limb polylines, base and platform outlines,
@@ -287,34 +352,21 @@ class Session:
         the platform point's trail, and the task positions."""
         m, c = self.mech, self.config
         d = drawing(m, c)
-        tw = joint_twists(m, c)
-        joints = []
-        for li, limb in enumerate(m.limbs):
-            refs = [r for r in m.freedom_refs if r.limb == li]
-            for j, joint in enumerate(limb.joints):
-                dirs: list[list[float]] = []
-                for k, r in enumerate(refs):
-                    if r.joint != j or joint.type == "S":
-                        continue
-                    t = tw[li][:, k]
-                    v = t[3:] if r.freedom.kind == "P" else t[:3]
-                    v = v / max(float(np.linalg.norm(v)), 1e-300)
-                    if not any(abs(float(v @ np.array(e))) > 1 - 1e-9 for e in dirs):
-                        dirs.append(v.tolist())
-                joints.append({"name": joint.name, "type": joint.type, "limb_index": li, "joint_axes": dirs})
-        ends = [l[-1] for limb, l in zip(m.limbs, d.limbs, strict=True) if m.limb_tip(limb) == m.output]
-        hull_pts, faces = _platform_hull(np.array(ends).reshape(-1, 3), d.platform_point)
-        centres = d.joints.tolist()
-        for jd, p in zip(joints, centres, strict=True):
-            jd["centre_len"] = p
+        jl = joint_list(m, c)
+        joints = [{"name": j["name"], "type": j["type"], "limb_index": j["limb_index"],
+                   "joint_axes": [v.tolist() for v in j["axes"]], "centre_len": j["centre"].tolist()} for j in jl]
+        solid = platform_solid(m, d.platform, d.limbs, d.platform_point)
+        hull = solid is not None and solid["hull"]
         return {
             "limbs_len": [l.tolist() for l in d.limbs],
             "limb_names": [l.name for l in m.limbs],
             "limb_colours": [LIMB_COLOURS[i % len(LIMB_COLOURS)] for i in range(len(m.limbs))],
             "base_len": d.base.tolist(),
             "platform_len": d.platform.tolist(),
-            "platform_hull_len": hull_pts,
-            "hull_faces": faces,
+            "platform_hull_len": solid["vertices"].tolist() if hull else [],
+            "hull_faces": solid["triangles"].tolist() if hull else [],
+            "platform_mesh": mesh_json(solid),
+            "joint_meshes": [mesh_json(x) for x in joint_meshes(jl, len(m.limbs), float(d.scale))],
             "bodies_len": d.bodies.tolist(),
             "joints": joints,
             "platform_point_len": d.platform_point.tolist(),
@@ -373,18 +425,25 @@ class Session:
         if ell < 1e-12:
             return DriveResult(UNCHANGED, "already at these values", requested=requested,
                                elapsed_s=time.perf_counter() - t_start)
+        self._check_limits(a0, a1, delta, name)
         prob = ActuatorPathProblem(m, lambda lam: a0 + (lam / ell) * delta, lambda lam: delta / ell)
         act_idx = [[r.id for r in m.freedom_refs].index(a) for a in m.actuators]
         offsets = np.array([m.freedom_refs[i].freedom.offset for i in act_idx])
 
-        def with_actuators(x) -> Configuration:
+        x0 = (self.config, 0.0)
+        cfg_memo: dict = {"x": x0, "c": self.config}  # the start (its readouts are remembered)
+
+        def with_actuators(x) -> Configuration:  # one configuration object per tracked point
+            if cfg_memo.get("x") is x:
+                return cfg_memo["c"]
             cfg, lam = x
             q = cfg.q.copy()
             q[act_idx] = a0 + (lam / ell) * delta - offsets
-            return cfg.with_q(q)
+            cfg_memo["x"], cfg_memo["c"] = x, cfg.with_q(q)
+            return cfg_memo["c"]
 
         own0 = self._dj(self.config)
-        memo: dict = {}
+        memo: dict = {"x": x0, "v": own0}  # the start's DJ is known: the tracker's first monitor call reuses it
 
         def own_dj(x) -> float | None:  # evaluated once per tracked point (monitor and stop share it)
             if memo.get("x") is not x:
@@ -397,11 +456,34 @@ class Session:
         monitors = {}
         if own0 is not None:
             monitors["DJ (drivers)"] = lambda x: float(own_dj(x) or 0.0)
-        vector = ((names, lambda x: driver_determinants(m, with_actuators(x), others)) if others else None)
+        vector = ((names, lambda x: [self._driver_dets(with_actuators(x))[d] for d in others]) if others else None)
         why = {"reason": ""}
         lam_prev = [0.0]
+        ref_t: dict = {}
+        tan0 = prob.tangent(x0)
+        tan0 = tan0 / max(float(np.linalg.norm(tan0)), 1e-300)
+        tan0 = tan0 if tan0[-1] >= 0 else -tan0
+        if len(m.actuators) == 1:
+            # a dead point of a single driver: the path turns back in its value, where the rate of
+            # the driver along the curve (the last component of the tangent, oriented as the last
+            # accepted point's) goes through zero; its DJ need not vanish there (e.g. the rocker of
+            # an RSSR: the passive limb loses a freedom, the rocker's own DJ stays constant)
+            ref_t["t"] = tan0
+
+            def oriented(x) -> np.ndarray:
+                if ref_t.get("x") is x:
+                    return ref_t["tx"]
+                t = prob.tangent(x)
+                t = t / max(float(np.linalg.norm(t)), 1e-300)
+                t = -t if float(t @ ref_t["t"]) < 0 else t
+                ref_t["x"], ref_t["tx"] = x, t
+                return t
+
+            monitors[DEAD_POINT] = lambda x: float(oriented(x)[-1])
 
         def stop(x, s) -> bool:
+            if ref_t:
+                ref_t["t"] = oriented(x)
             lam = float(x[1])
             if lam >= ell:
                 why["reason"] = "reached"
@@ -417,8 +499,10 @@ class Session:
                     return True
             return False
 
-        h = min(0.05, max(ell, 1e-6))
-        r = track(prob, (self.config, 0.0), direction=np.r_[np.zeros(prob.na + prob.nh), 1.0], h0=h, h_max=0.1,
+        # the first step's arc length reaches lam = ell along the start tangent (a small drag is one
+        # step: the monitors are evaluated at one tracked point), at most 0.1 (the largest step)
+        h = min(0.1, max(1.02 * ell / max(abs(float(tan0[-1])), 1e-3), 1e-6))
+        r = track(prob, x0, direction=np.r_[np.zeros(prob.na + prob.nh), 1.0], h0=h, h_max=0.1,
                   max_arc=200.0 * ell + 2.0, max_steps=MAX_STEPS, monitors=monitors, vector_monitor=vector,
                   detect_closure=False, stop=stop)
         steps = len(r.points) - 1
@@ -430,7 +514,14 @@ class Session:
                 continue
             a_e = a0 + (float(e.x[1]) / ell) * delta
             ev = {"name": e.name, "kind": str(e.kind), **self._display(a_e)}
-            if e.name == "DJ (drivers)":
+            if e.name == DEAD_POINT:
+                if str(e.kind) != "zero" or own_crossed is not None:
+                    continue
+                own_crossed = ev
+                ev["driver"] = ", ".join(m.actuators)
+                ev["meaning"] = ("the path turns back in the driver's value here: a dead point, where the driver "
+                                 "loses control of the motion")
+            elif e.name == "DJ (drivers)":
                 own_crossed = ev
                 ev["driver"] = ", ".join(m.actuators)
                 ev["meaning"] = "the chosen drivers lose control here (DJ = 0): a dead point / direct singularity"
@@ -467,7 +558,9 @@ class Session:
             where = own_crossed or {}
             at = ", ".join(f"{k} = {v:.6g} deg" for k, v in where.get("actuators_deg", {}).items())
             at += ", ".join(f"{k} = {v:.6g} {m.length_unit}" for k, v in where.get("actuators_len", {}).items())
-            msg = ("the drivers lose control before the requested values (DJ of the drivers changes sign"
+            what = ("the path turns back in the driver's value" if where.get("name") == DEAD_POINT
+                    else "DJ of the drivers changes sign")
+            msg = (f"the drivers lose control before the requested values ({what}"
                    + (f" at {at}" if at else "") + "): a dead point of this branch; stopped just before it "
                    "(drive back, or switch drivers to pass it)")
             if reason == "turned" and own_crossed is None:
@@ -481,6 +574,95 @@ class Session:
             msg = f"the tracker stopped on this branch: {r.message}"
         return self._stop_before(r, STOPPED_TRACKER, msg, events, steps, elapsed,
                                  requested, with_actuators)
+
+    def parse_pose(self, task_len=None, task_deg=None, *, euler=None, relative=False) -> tuple[TaskCoordinates, np.ndarray]:
+        """The task coordinates and the six target values (SI, rad) of a pose request:
+        ``task_len`` (x, y, z in the model's length unit) and ``task_deg`` (a1, a2, a3 in
+        degrees, Euler sequence ``euler``), each a map by coordinate name, absolute or (``relative``)
+        increments; coordinates not named keep their current values."""
+        if euler is not None:
+            if not isinstance(euler, str):
+                raise InputError(f"euler: expected a sequence name such as 'ZYX', got {euler!r}")
+            try:
+                check_sequence(euler)
+            except InputError as e:
+                raise InputError(f"euler: {e}") from None
+        if not isinstance(relative, bool):
+            raise InputError(f"relative: expected true or false, got {relative!r}")
+        t = self.task(euler)
+        if t is None:
+            raise InputError(f"task_len: {self.mech.name}'s output link cannot move; there is no pose to drive")
+        v = self.task_values(t.euler)
+        target = v.copy()
+        for fname, names, deg, given in (("task_len", TASK_NAMES[:3], False, task_len),
+                                         ("task_deg", TASK_NAMES[3:], True, task_deg)):
+            given = {} if given is None else given
+            if not isinstance(given, dict):
+                raise InputError(f"{fname}: expected a map of coordinate -> value ({', '.join(names)}), "
+                                 f"got {type(given).__name__}")
+            for n, x in given.items():
+                if n not in names:
+                    other = "task_deg" if n in TASK_NAMES[3:] else "task_len" if n in TASK_NAMES else ""
+                    raise InputError(f"{fname}.{n}: unknown coordinate; expected one of {', '.join(names)}"
+                                     + (f" (give {n} in {other})" if other else ""))
+                if n not in t.given:
+                    raise InputError(f"{fname}.{n}: {self.mech.name} controls only {', '.join(t.given)} (Euler sequence "
+                                     f"{t.euler}); {n} is solved (parasitic motion) and cannot be requested")
+                if isinstance(x, bool) or not isinstance(x, (int, float)) or not np.isfinite(x):
+                    raise InputError(f"{fname}.{n}: expected a finite number, got {x!r}")
+                i = TASK_NAMES.index(n)
+                val = np.radians(x) if deg else float(x)
+                target[i] = v[i] + val if relative else val
+        return t, target
+
+    def drive_pose(self, task_len=None, task_deg=None, *, euler=None, relative=False) -> DriveResult:
+        """Move the output link to a pose given by its task coordinates (see
+        :meth:`parse_pose` and :mod:`.posing`) along the current branch."""
+        t_start = time.perf_counter()
+        t, target = self.parse_pose(task_len, task_deg, euler=euler, relative=relative)
+        gi = [TASK_NAMES.index(n) for n in t.given]
+        requested = {"requested_task_len": {n: float(target[i]) for i, n in enumerate(TASK_NAMES[:3]) if n in t.given},
+                     "requested_task_deg": {n: float(np.degrees(target[i + 3])) for i, n in enumerate(TASK_NAMES[3:])
+                                            if n in t.given}}
+        v = self.task_values(t.euler)
+        L = self.mech.characteristic_length
+        d = target[gi] - v[gi]
+        scale = np.array([L if i < 3 else 1.0 for i in gi])
+        if float(np.linalg.norm(d / scale)) < 1e-12:
+            return DriveResult(UNCHANGED, "already at this pose", requested=requested,
+                               elapsed_s=time.perf_counter() - t_start)
+        r = pose_path(self.mech, self.config, t, target, self._dj)
+        events = []
+        if r.event is not None:
+            ev_cfg = r.event["config"]
+            events.append({"name": "DJ (drivers)", "kind": "zero", "driver": ", ".join(self.mech.actuators),
+                           "meaning": "the chosen drivers lose control here (DJ = 0): a direct singularity",
+                           **self._display(self.actuator_values(ev_cfg)),
+                           "task_len": {n: float(r.event["values"][i]) for i, n in enumerate(TASK_NAMES[:3])},
+                           "task_deg": {n: float(np.degrees(r.event["values"][i + 3])) for i, n in enumerate(TASK_NAMES[3:])}})
+        if r.passed:
+            self._accept(r.config, [(c, None) for c in r.passed])
+        return DriveResult(r.status, r.message, tuple(events), r.steps, time.perf_counter() - t_start, requested)
+
+    def _check_limits(self, a0: np.ndarray, a1: np.ndarray, delta: np.ndarray, name: str) -> None:
+        """Refuse a drive whose path (the target and points on the way) leaves an actuator's
+        joint limits."""
+        m = self.mech
+        act_idx = [[r.id for r in m.freedom_refs].index(a) for a in m.actuators]
+        if all(m.freedom_refs[i].freedom.limits is None for i in act_idx):
+            return
+        offsets = np.array([m.freedom_refs[i].freedom.offset for i in act_idx])
+        for lam in np.linspace(0.0, 1.0, 33)[1:]:
+            q = self.config.q.copy()
+            q[act_idx] = a0 + lam * delta - offsets
+            bad = within_limits(m, q, act_idx)
+            if bad:
+                f = m.freedom(bad[0]).freedom
+                lo, hi = f.limits
+                shown = (f"[{np.degrees(lo):.6g}, {np.degrees(hi):.6g}] deg" if f.kind != "P"
+                         else f"[{lo:.6g}, {hi:.6g}] {m.length_unit}")
+                where = "the requested value is" if lam == 1.0 else "the way there is"
+                raise InputError(f"{name}: {where} outside the joint limits of {bad[0]} {shown}")
 
     def _stop_before(self, r, status, msg, events, steps, elapsed, requested, with_actuators) -> DriveResult:
         """Keep the last tracked point before the step that crossed (still on the branch)."""

@@ -1,6 +1,7 @@
 // spatialmech studio page: draws what the server computes (the solver runs in the server).
-// Sliders post the actuator values to /api/drive; the next value is sent when the previous
-// answer has arrived (no websockets).  window.studio exposes the last state for tests.
+// Sliders post the actuator values to /api/drive, the pose sliders the output link's task
+// coordinates to /api/pose; the newest request is sent when the previous answer has arrived
+// (no websockets).  window.studio exposes the last state for tests.
 "use strict";
 
 const S = { state: null, circuit: null, unit: "", inFlight: false, pending: null, range: null, drawn: 0, errors: [] };
@@ -17,57 +18,22 @@ async function api(path, body) {
 function fmt(x, d = 4) { return (x === null || x === undefined) ? "-" : Number(x).toPrecision(d); }
 
 // ------------------------------------------------------------------ shapes
-function sub(a, b) { return [a[0] - b[0], a[1] - b[1], a[2] - b[2]]; }
 function add(a, b) { return [a[0] + b[0], a[1] + b[1], a[2] + b[2]]; }
 function mul(a, s) { return [a[0] * s, a[1] * s, a[2] * s]; }
-function cross(a, b) { return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]; }
-function norm(a) { return Math.hypot(a[0], a[1], a[2]); }
-function unit(a) { const n = norm(a) || 1; return mul(a, 1 / n); }
-function perp(d) { const t = Math.abs(d[0]) < 0.9 ? [1, 0, 0] : [0, 1, 0]; return unit(cross(d, t)); }
 
-function Mesh() { return { x: [], y: [], z: [], i: [], j: [], k: [] }; }
-function vert(m, p) { m.x.push(p[0]); m.y.push(p[1]); m.z.push(p[2]); return m.x.length - 1; }
-function tri(m, a, b, c) { m.i.push(a); m.j.push(b); m.k.push(c); }
-
-function cylinder(m, c, d, r, h, n = 12) {  // closed cylinder centred on c along unit d
-  const u = perp(d), v = cross(d, u), a = add(c, mul(d, -h / 2)), b = add(c, mul(d, h / 2));
-  const ia = [], ib = [];
-  for (let s = 0; s < n; s++) {
-    const t = 2 * Math.PI * s / n, o = add(mul(u, r * Math.cos(t)), mul(v, r * Math.sin(t)));
-    ia.push(vert(m, add(a, o))); ib.push(vert(m, add(b, o)));
-  }
-  const ca = vert(m, a), cb = vert(m, b);
-  for (let s = 0; s < n; s++) {
-    const s2 = (s + 1) % n;
-    tri(m, ia[s], ia[s2], ib[s]); tri(m, ib[s], ia[s2], ib[s2]);
-    tri(m, ca, ia[s2], ia[s]); tri(m, cb, ib[s], ib[s2]);
-  }
-}
-
-function sphere(m, c, r, n = 8) {
-  const idx = [];
-  for (let a = 0; a <= n; a++) {
-    const th = Math.PI * a / n, row = [];
-    for (let b = 0; b < 2 * n; b++) {
-      const ph = Math.PI * b / n;
-      row.push(vert(m, [c[0] + r * Math.sin(th) * Math.cos(ph), c[1] + r * Math.sin(th) * Math.sin(ph), c[2] + r * Math.cos(th)]));
-    }
-    idx.push(row);
-  }
-  for (let a = 0; a < n; a++) for (let b = 0; b < 2 * n; b++) {
-    const b2 = (b + 1) % (2 * n);
-    tri(m, idx[a][b], idx[a + 1][b], idx[a][b2]); tri(m, idx[a][b2], idx[a + 1][b], idx[a + 1][b2]);
-  }
+// The joint solids and the platform body come from the server (spatialmech.present.shapes, the
+// same code as the static viewer's): a mesh is {vertices_len: [[x, y, z]...], triangles: [[i, j, k]...]}.
+function plotlyMesh(m) {
+  return { x: m.vertices_len.map(p => p[0]), y: m.vertices_len.map(p => p[1]), z: m.vertices_len.map(p => p[2]),
+    i: m.triangles.map(t => t[0]), j: m.triangles.map(t => t[1]), k: m.triangles.map(t => t[2]) };
 }
 
 function xyz(pts) { return { x: pts.map(p => p[0]), y: pts.map(p => p[1]), z: pts.map(p => p[2]) }; }
 
-function fan(pts) {  // a closed outline (last = first) as a translucent polygon
-  const P = pts.slice(0, -1), m = Mesh();
+function fan(pts) {  // a closed outline (last = first) as a translucent polygon (the base)
+  const P = pts.slice(0, -1);
   if (P.length < 3) return null;
-  P.forEach(p => vert(m, p));
-  for (let q = 1; q + 1 < P.length; q++) tri(m, 0, q, q + 1);
-  return m;
+  return plotlyMesh({ vertices_len: P, triangles: P.slice(2).map((_, q) => [0, q + 1, q + 2]) });
 }
 
 function traces(sc) {
@@ -75,9 +41,8 @@ function traces(sc) {
   const base = fan(sc.base_len);
   if (base) out.push({ type: "mesh3d", ...base, color: "#999999", opacity: 0.35, name: "base (ground)", hoverinfo: "skip", showlegend: true });
   out.push({ type: "scatter3d", mode: "lines", ...xyz(sc.base_len), line: { color: "#555555", width: 5 }, name: "base outline", showlegend: false });
-  const plat = sc.hull_faces.length ? { ...xyz(sc.platform_hull_len), i: sc.hull_faces.map(f => f[0]),
-    j: sc.hull_faces.map(f => f[1]), k: sc.hull_faces.map(f => f[2]) } : fan(sc.platform_len);
-  if (plat) out.push({ type: "mesh3d", ...plat, color: "#ff7f0e", opacity: 0.4, name: "platform", hoverinfo: "skip", showlegend: true });
+  if (sc.platform_mesh) out.push({ type: "mesh3d", ...plotlyMesh(sc.platform_mesh), color: "#ff7f0e", opacity: 0.4, name: "platform",
+    hoverinfo: "skip", showlegend: true });
   out.push({ type: "scatter3d", mode: "lines", ...xyz(sc.platform_len), line: { color: "#ff7f0e", width: 6 }, name: "platform outline", showlegend: false });
   sc.limbs_len.forEach((pl, li) => out.push({ type: "scatter3d", mode: "lines", ...xyz(pl), line: { color: sc.limb_colours[li], width: 9 },
     name: "limb " + sc.limb_names[li] }));
@@ -85,18 +50,8 @@ function traces(sc) {
     const pts = []; sc.bodies_len.forEach(sg => { pts.push(sg[0], sg[1], [null, null, null]); });
     out.push({ type: "scatter3d", mode: "lines", ...xyz(pts), line: { color: "#7f7f7f", width: 9 }, name: "internal bodies" });
   }
-  const shapes = sc.limb_names.map(() => Mesh());
-  sc.joints.forEach(j => {
-    const m = shapes[j.limb_index], c = j.centre_len;
-    if (j.type === "S") { sphere(m, c, 0.06 * s); return; }
-    j.joint_axes.forEach(d => {
-      if (j.type === "P") cylinder(m, c, d, 0.025 * s, 0.5 * s, 6);
-      else if (j.type === "C") cylinder(m, c, d, 0.04 * s, 0.45 * s);
-      else cylinder(m, c, d, 0.05 * s, 0.25 * s);
-    });
-  });
-  shapes.forEach((m, li) => { if (m.i.length) out.push({ type: "mesh3d", ...m, color: sc.limb_colours[li], opacity: 1.0, flatshading: true,
-    name: "joints of " + sc.limb_names[li], hoverinfo: "skip", showlegend: false }); });
+  sc.joint_meshes.forEach((m, li) => { if (m.triangles.length) out.push({ type: "mesh3d", ...plotlyMesh(m), color: sc.limb_colours[li],
+    opacity: 1.0, flatshading: true, name: "joints of " + sc.limb_names[li], hoverinfo: "skip", showlegend: false }); });
   const names = sc.joints.map(j => j.name + " (" + j.type + ")");
   out.push({ type: "scatter3d", mode: "markers", ...xyz(sc.joints.map(j => j.centre_len)), marker: { size: 2, color: "#222" },
     text: names, hovertemplate: "%{text}<extra></extra>", name: "joint centres", showlegend: false });
@@ -164,17 +119,56 @@ function syncSliders() {
     el.value = a.value;
     document.getElementById("slider-val-" + k).textContent = fmt(a.value, 6) + " " + a.unit;
   });
+  poseEntries(S.state).forEach((a, k) => {
+    const el = document.getElementById("pose-" + k);
+    if (!el) return;
+    el.value = a.value;
+    document.getElementById("pose-val-" + k).textContent = fmt(a.value, 6) + " " + a.unit;
+  });
 }
 
 function sliderValues() { return actuatorEntries(S.state).map((_, k) => Number(document.getElementById("slider-" + k).value)); }
 
-function onSlide() { S.pending = sliderValues(); pump(); }
+function onSlide() { S.pending = { path: "/api/drive", body: { actuators: sliderValues() } }; pump(); }
+
+// ------------------------------------------------------------------ pose sliders (inverse position)
+function poseEntries(st) {
+  const t = st.task;
+  if (!t) return [];
+  return t.given.map(n => (n in t.slider_ranges_len)
+    ? { name: n, value: t.values_len[n], unit: S.unit, range: t.slider_ranges_len[n], key: "task_len" }
+    : { name: n, value: t.values_deg[n], unit: "deg", range: t.slider_ranges_deg[n], key: "task_deg" });
+}
+
+function buildPoseSliders() {
+  const box = document.getElementById("pose-sliders");
+  box.innerHTML = "";
+  const t = S.state.task;
+  document.getElementById("pose-help").textContent = !t ? "the output link cannot move" :
+    "drag the output: " + t.given.join(", ") + " (Euler " + t.euler + ")" + (t.solved.length ? "; solved: " + t.solved.join(", ") : "");
+  poseEntries(S.state).forEach((a, k) => {
+    const div = document.createElement("div");
+    div.className = "slider";
+    const step = a.unit === "deg" ? 0.1 : (a.range[1] - a.range[0]) / 2000;
+    div.innerHTML = `<label for="pose-${k}">${a.name} [${a.unit}]: <span id="pose-val-${k}"></span></label>` +
+      `<input type="range" id="pose-${k}" data-index="${k}" min="${a.range[0]}" max="${a.range[1]}" step="${step}" value="${a.value}">`;
+    box.appendChild(div);
+    div.querySelector("input").addEventListener("input", onPoseSlide);
+  });
+  syncSliders();
+}
+
+function onPoseSlide() {
+  const body = { task_len: {}, task_deg: {}, euler: S.state.task.euler };
+  poseEntries(S.state).forEach((a, k) => { body[a.key][a.name] = Number(document.getElementById("pose-" + k).value); });
+  S.pending = { path: "/api/pose", body: body }; pump();
+}
 
 async function pump() {
   if (S.inFlight || S.pending === null) return;
-  const values = S.pending; S.pending = null; S.inFlight = true;
+  const req = S.pending; S.pending = null; S.inFlight = true;
   try {
-    const doc = await api("/api/drive", { actuators: values });
+    const doc = await api(req.path, req.body);
     setStatus(doc.status === "reached" || doc.status === "unchanged" ? "" : "stopped", doc.status + ": " + doc.message);
     doc.events.forEach(e => logEvent(e));
     update(doc.state);
@@ -204,6 +198,7 @@ function update(st) {
     ["sigma_min (complete J)", `<span id="sigma" class="${cls}">${fmt(sig, 4)}</span>` +
       (st.singular ? " singular" : st.near_singular ? " near a singularity (< " + st.near_singular_below + ")" : "")],
     ["closure residual", fmt(st.residual, 3)],
+    ["outside joint limits", st.outside_limits.length ? st.outside_limits.join(", ") : "none"],
   ];
   rows.unshift(...actuatorEntries(st).map(a => [a.name + " [" + a.unit + "]", fmt(a.value, 7)]));
   document.getElementById("readouts").innerHTML = rows.map(r => `<tr><td>${r[0]}</td><td>${r[1]}</td></tr>`).join("");
@@ -234,6 +229,7 @@ async function loadDoc(doc) {
   S.state = doc.state;
   fillDrivers(doc.state);
   buildSliders();
+  buildPoseSliders();
   update(doc.state);
   setStatus("", "ready: drag a slider");
   loadCircuit();

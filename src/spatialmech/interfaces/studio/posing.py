@@ -1,0 +1,165 @@
+"""Moving the studio's output link by its pose (inverse position), along the current branch.
+
+The output link is posed by its **task coordinates** (:mod:`spatialmech.model.task`): ``x, y, z``
+of its reference point (the model's length unit) and ``a1, a2, a3``, Euler angles in a named
+sequence (degrees at the edge).  A mechanism with ``M < 6`` output freedoms is posed by its
+``M`` *given* coordinates only (:func:`~spatialmech.kinematics.task.default_task`); the others
+are solved (its parasitic motion) and cannot be requested.
+
+:func:`pose_path` moves the given coordinates along the straight path from their current values
+to the requested ones (angles the short way round) by natural-parameter continuation: small
+steps of the path parameter, each corrected by :func:`~spatialmech.kinematics.task.solve_task`
+(Gauss-Newton holding the given coordinates) from the previous configuration.  A step is kept
+only if its Newton converges and no joint moves by more than :data:`MAX_JOINT_STEP` (radians, or
+characteristic lengths for slides); otherwise it is halved.  So the configuration never jumps
+to another branch; where the steps cannot go on (below :data:`MIN_STEP`) the path has reached
+the edge of this branch's workspace: a limb at an inverse singularity (its actuation
+transmission near zero: ``limb_singular``) or no closure beyond (``unreachable``).  A sign
+change of the chosen drivers' DJ (a direct singularity: the actuators lose control of the
+output there) is located by bisection, reported as an event, and the motion stops just before
+it (``stopped_at_singularity``); a joint (actuated or passive) leaving its limits stops it
+before the step (``stopped_at_limit``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ...errors import InputError
+from ...kinematics.closure import Configuration
+from ...kinematics.jacobian import complete_jacobian
+from ...kinematics.position import within_limits
+from ...kinematics.task import solve_task, task_values
+from ...model.mechanism import Mechanism
+from ...model.task import TASK_NAMES, TaskCoordinates
+
+__all__ = ["MAX_JOINT_STEP", "MIN_STEP", "PosePath", "pose_path"]
+
+#: Largest change of any joint in one continuation step (rad; slides in characteristic lengths).
+MAX_JOINT_STEP = 0.15
+#: Smallest step of the path parameter (the path's length in rad / characteristic lengths).
+MIN_STEP = 1e-5
+#: First and largest step of the path parameter.
+MAX_STEP = 0.05
+#: Largest number of continuation steps per request.
+MAX_STEPS = 400
+#: Actuation transmission below which a limb is called singular where the steps stop.
+LIMB_SINGULAR_TRANSMISSION = 0.05
+
+
+@dataclass
+class PosePath:
+    """The outcome of :func:`pose_path`: ``status``, a sentence, the last configuration reached
+    (on the branch), the configurations passed, the DJ event (if any: path parameter and the six
+    task values there) and the number of steps."""
+
+    status: str
+    message: str
+    config: Configuration
+    passed: list = field(default_factory=list)
+    event: dict | None = None
+    steps: int = 0
+
+
+def _joint_change(mech: Mechanism, a: Configuration, b: Configuration) -> float:
+    dq = b.q - a.q
+    rot = np.array([r.freedom.kind != "P" for r in mech.freedom_refs])
+    dq = np.where(rot, (dq + np.pi) % (2 * np.pi) - np.pi, dq / mech.characteristic_length)
+    return float(np.max(np.abs(dq))) if dq.size else 0.0
+
+
+def pose_path(mech: Mechanism, start: Configuration, task: TaskCoordinates, target: np.ndarray,
+              dj: Callable[[Configuration], float | None]) -> PosePath:
+    """Move the given coordinates of ``task`` from their values at ``start`` to those of
+    ``target`` (six task values, SI / rad; the solved ones are ignored); ``dj`` is the chosen
+    drivers' DJ (its sign is watched).  See the module docstring."""
+    L = mech.characteristic_length
+    gi = [TASK_NAMES.index(n) for n in task.given]
+    v0 = task_values(mech, start.D, task.euler)
+    delta = np.zeros(6)
+    delta[gi] = np.asarray(target, dtype=float)[gi] - v0[gi]
+    delta[3:] = (delta[3:] + np.pi) % (2 * np.pi) - np.pi  # angles the short way round
+    nd = np.r_[delta[:3] / L, delta[3:]]
+    ell = float(np.linalg.norm(nd))
+    outside0 = set(within_limits(mech, start.q))  # already outside at the start: not watched
+
+    def at(lam: float, seed: Configuration):
+        v = v0 + (lam / ell) * delta
+        r = solve_task(mech, {n: float(v[TASK_NAMES.index(n)]) for n in task.given}, task=task, seed=seed, max_iter=12)
+        if not r.converged or _joint_change(mech, seed, r.config) > MAX_JOINT_STEP:
+            return None
+        return r.config
+
+    def task_at(lam: float, c: Configuration) -> dict:
+        return {"lambda": lam / ell, "values": v0 + (lam / ell) * delta, "config": c}
+
+    own0 = dj(start)
+    cur, lam, h = start, 0.0, min(MAX_STEP, ell)
+    passed: list[Configuration] = []
+    steps = 0
+    while lam < ell:
+        if steps >= MAX_STEPS:
+            return PosePath("stopped", f"moved part of the way ({steps} steps); request again to go on", cur, passed,
+                            steps=steps)
+        nxt_lam = min(ell, lam + h)
+        nxt = at(nxt_lam, cur)
+        if nxt is None:
+            h *= 0.5
+            if h < MIN_STEP * max(1.0, ell):
+                return _edge(mech, cur, passed, steps)
+            continue
+        steps += 1
+        bad = [b for b in within_limits(mech, nxt.q) if b not in outside0]
+        if bad:
+            lims = ", ".join(f"{b} {_show_limits(mech, b)}" for b in bad)
+            return PosePath("stopped_at_limit", f"joints leave their limits ({lims}) before the requested pose; stopped "
+                            "just before", cur, passed, steps=steps)
+        d1 = dj(nxt)
+        if own0 is not None and d1 is not None and d1 != 0 and np.sign(d1) != np.sign(own0):
+            lo, hi, c_lo = lam, nxt_lam, cur
+            for _ in range(20):  # locate the DJ zero by bisection of the path parameter
+                mid = 0.5 * (lo + hi)
+                c_mid = at(mid, c_lo)
+                if c_mid is None:
+                    break
+                dm = dj(c_mid)
+                if dm is not None and dm != 0 and np.sign(dm) != np.sign(own0):
+                    hi = mid
+                else:
+                    lo, c_lo = mid, c_mid
+            return PosePath("stopped_at_singularity", "the chosen drivers lose control before the requested pose (DJ of "
+                            "the drivers changes sign: a direct singularity); stopped just before it (move back, or "
+                            "switch drivers)", cur, passed, event=task_at(0.5 * (lo + hi), c_lo), steps=steps)
+        cur, lam = nxt, nxt_lam
+        passed.append(cur)
+        h = min(MAX_STEP, 1.5 * h)
+    return PosePath("reached", "reached the requested pose along the current branch", cur, passed, steps=steps)
+
+
+def _show_limits(mech: Mechanism, fid: str) -> str:
+    f = mech.freedom(fid).freedom
+    lo, hi = f.limits
+    if f.kind == "P":
+        return f"[{lo:.6g}, {hi:.6g}] {mech.length_unit}"
+    return f"[{np.degrees(lo):.6g}, {np.degrees(hi):.6g}] deg"
+
+
+def _edge(mech: Mechanism, cur: Configuration, passed: list, steps: int) -> PosePath:
+    """The steps cannot go on from ``cur``: a limb singular there, or no closure beyond."""
+    try:
+        J = complete_jacobian(mech, cur)
+        trans = dict(zip(J.actuators, J.transmission, strict=True)) if J.transmission else {}
+        weak = sorted((t, a) for a, t in trans.items() if t < LIMB_SINGULAR_TRANSMISSION)
+        weak = [(0.0, a) for a in J.inverse_singular] + weak
+    except (InputError, np.linalg.LinAlgError):  # a degenerate Jacobian at the edge: report the edge without it
+        weak = []
+    if weak:
+        t, a = weak[0]
+        limb = mech.limbs[mech.freedom(a).limb].name
+        return PosePath("limb_singular", f"limb {limb} reaches an inverse singularity (actuator {a}, transmission "
+                        f"{t:.2g}): the edge of the workspace of this branch; stopped there", cur, passed, steps=steps)
+    return PosePath("unreachable", "the requested pose is not reachable along this branch (no closed configuration "
+                    "beyond this one); stopped at the last reachable pose", cur, passed, steps=steps)
