@@ -197,6 +197,18 @@ def test_the_cli_screen_on_its_own_local_cluster_and_json(tmp_path):
     assert r.exit_code == 0, r.output
     doc = json.loads(r.stdout)
     assert doc["command"] == "screen" and doc["workers"] == 2 and doc["judged"] == 4
+    # the shipped JSON Schema and the unit rule of docs/json.md
+    from jsonschema import Draft202012Validator
+    from referencing import Registry, Resource
+
+    from spatialmech.interfaces.common import load_schema
+    from spatialmech.serialize import unit_rule_violations
+
+    common = load_schema("common")
+    registry = Registry().with_resource(common["$id"], Resource.from_contents(common))
+    errors = list(Draft202012Validator(load_schema("screen"), registry=registry).iter_errors(doc))
+    assert not errors, [e.message[:200] for e in errors[:3]]
+    assert unit_rule_violations(doc) == []
     assert doc["rejected_by_stage"]["dj_signs"] + doc["rejected_by_stage"]["circuits"] + doc["usable"] \
         + doc["rejected_by_stage"]["assembly"] + doc["rejected_by_stage"]["error"] == 4
 
