@@ -162,6 +162,24 @@ def read_rows(out: str | os.PathLike) -> list[dict]:
     return sorted(rows, key=lambda r: r["candidate"])
 
 
+def _refuse_other_screen(out: Path, arguments: dict, positions: list[dict]) -> None:
+    """An ``InputError`` now when ``out`` already holds a screen of other arguments or positions
+    (:func:`_check_out` checks the candidates themselves once they are formed)."""
+    mf = out / MANIFEST
+    if not mf.is_file():
+        return
+    try:
+        old = json.loads(mf.read_text(encoding="utf-8"))
+    except (OSError, ValueError) as e:
+        raise InputError(f"out: {mf} is not readable ({e}); use a new directory") from None
+    same_pos = isinstance(old.get("positions"), list) and len(old["positions"]) == len(positions) and all(
+        np.allclose(a["R"], b["R"], atol=1e-12) and np.allclose(a["p"], b["p"], atol=1e-12)
+        for a, b in zip(old["positions"], positions, strict=True))
+    if old.get("arguments") != arguments or not same_pos:
+        raise InputError(f"out: {out} holds a screen with other arguments or positions; use a new directory "
+                         "(or the same arguments to resume it)")
+
+
 def _check_out(out: Path, manifest: dict) -> int:
     """Prepare ``out``; returns how many chunks are already there (a resume).  An existing
     directory must be a screen with the same arguments and candidates, or empty."""
@@ -290,6 +308,9 @@ def run_screen(
             raise InputError(f"{nm}: expected a {'positive' if nm == 'density' else 'non-negative'} number, got {v!r}")
     out = Path(out)
     task = cs_task(positions)
+    arguments = {"candidates": int(candidates), "density": float(density), "seed": int(seed), "starts": int(starts),
+                 "separation": float(separation), "chunk_size": int(chunk_size)}
+    _refuse_other_screen(out, arguments, _poses_json(task.poses))  # before the work, not after the family
     if family is None:
         say(0, None, "synthesising the CS dyad family of the seven positions")
         family = synthesize_cs(task, n_starts=int(starts), seed=seed, pick=0)
@@ -303,8 +324,7 @@ def run_screen(
     n_chunks = math.ceil(len(sets) / chunk_size)
     manifest = {
         "format": _FORMAT,
-        "arguments": {"candidates": int(candidates), "density": float(density), "seed": int(seed), "starts": int(starts),
-                      "separation": float(separation), "chunk_size": int(chunk_size)},
+        "arguments": arguments,
         "positions": _poses_json(task.poses),
         "fingerprint": _fingerprint(pool, sets),
         "n_candidates": len(sets), "candidate_mode": mode, "chunks": n_chunks, "pool_size": len(pool),
