@@ -45,18 +45,24 @@ def run(model: str, step: float, n: int) -> dict:
     vals = np.array([st["actuators_deg"].get(d, st["actuators_len"].get(d)) for d in st["drivers"]], dtype=float)
     client.post("/api/drive", json={"actuators": (vals + step).tolist()})  # compile / warm up
     vals = vals + step
+    targets = (vals + step * (k + 1) for k in range(n))
+    return timed_updates(model, n, lambda: client.post("/api/drive", json={"actuators": next(targets).tolist()}))
+
+
+def timed_updates(label: str, n: int, post) -> dict:
+    """``n`` updates ``post()`` (an HTTP answer), stopping at the first that does not reach its
+    target: the answer's wall time and the solver's own time, median and 95th percentile."""
     wall, inner, statuses = [], [], []
     for _ in range(n):
-        vals = vals + step
         t = time.perf_counter()
-        d = client.post("/api/drive", json={"actuators": vals.tolist()}).json()
+        d = post().json()
         wall.append(time.perf_counter() - t)
         inner.append(d["elapsed_s"])
         statuses.append(d["status"])
         if d["status"] != "reached":
             break
     ms = lambda v, q: round(1000 * float(np.percentile(v, q)), 1)  # noqa: E731
-    return {"model": model, "updates": len(wall), "last_status": statuses[-1],
+    return {"model": label, "updates": len(wall), "last_status": statuses[-1],
             "answer_median_ms": ms(wall, 50), "answer_p95_ms": ms(wall, 95),
             "solver_median_ms": ms(inner, 50), "solver_p95_ms": ms(inner, 95)}
 
@@ -66,19 +72,7 @@ def run_pose(model: str, coord: str, step: float, n: int) -> dict:
     key = "task_deg" if coord.startswith("a") else "task_len"
     body = {key: {coord: step}, "relative": True}
     client.post("/api/pose", json=body)  # compile / warm up
-    wall, inner, statuses = [], [], []
-    for _ in range(n):
-        t = time.perf_counter()
-        d = client.post("/api/pose", json=body).json()
-        wall.append(time.perf_counter() - t)
-        inner.append(d["elapsed_s"])
-        statuses.append(d["status"])
-        if d["status"] != "reached":
-            break
-    ms = lambda v, q: round(1000 * float(np.percentile(v, q)), 1)  # noqa: E731
-    return {"model": f"{model} pose {coord}", "updates": len(wall), "last_status": statuses[-1],
-            "answer_median_ms": ms(wall, 50), "answer_p95_ms": ms(wall, 95),
-            "solver_median_ms": ms(inner, 50), "solver_p95_ms": ms(inner, 95)}
+    return timed_updates(f"{model} pose {coord}", n, lambda: client.post("/api/pose", json=body))
 
 
 def main(argv=None) -> dict:

@@ -15,6 +15,20 @@ settings.register_profile("spatialmech-ci", deadline=None, derandomize=True)
 settings.load_profile("spatialmech-ci" if os.environ.get("CI") else "spatialmech")
 
 
+@pytest.fixture(scope="session")
+def schema_validator():
+    """``schema_validator(command)``: a JSON Schema validator of ``command``'s shipped schema
+    (``spatialmech/interfaces/schemas/``), its references to ``common.schema.json`` resolved."""
+    from jsonschema import Draft202012Validator
+    from referencing import Registry, Resource
+
+    from spatialmech.interfaces.common import load_schema
+
+    common = load_schema("common")
+    registry = Registry().with_resource(common["$id"], Resource.from_contents(common))
+    return lambda command: Draft202012Validator(load_schema(command), registry=registry)
+
+
 @pytest.fixture
 def rng():
     return np.random.default_rng(12345)

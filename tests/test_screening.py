@@ -190,7 +190,7 @@ def test_a_local_dask_cluster_gives_the_serial_result(family, serial, tmp_path):
     assert len({r["worker"] for r in rows}) >= 1
 
 
-def test_the_cli_screen_on_its_own_local_cluster_and_json(tmp_path):
+def test_the_cli_screen_on_its_own_local_cluster_and_json(tmp_path, schema_validator):
     out = tmp_path / "cli.parquet"
     r = CliRunner().invoke(cli, ["screen", "--candidates", "4", "--chunk-size", "2", "--workers", "2", "--starts", "20",
                                  "--out", str(out), "--json"], catch_exceptions=False)
@@ -198,15 +198,9 @@ def test_the_cli_screen_on_its_own_local_cluster_and_json(tmp_path):
     doc = json.loads(r.stdout)
     assert doc["command"] == "screen" and doc["workers"] == 2 and doc["judged"] == 4
     # the shipped JSON Schema and the unit rule of docs/json.md
-    from jsonschema import Draft202012Validator
-    from referencing import Registry, Resource
-
-    from spatialmech.interfaces.common import load_schema
     from spatialmech.serialize import unit_rule_violations
 
-    common = load_schema("common")
-    registry = Registry().with_resource(common["$id"], Resource.from_contents(common))
-    errors = list(Draft202012Validator(load_schema("screen"), registry=registry).iter_errors(doc))
+    errors = list(schema_validator("screen").iter_errors(doc))
     assert not errors, [e.message[:200] for e in errors[:3]]
     assert unit_rule_violations(doc) == []
     assert doc["rejected_by_stage"]["dj_signs"] + doc["rejected_by_stage"]["circuits"] + doc["usable"] \

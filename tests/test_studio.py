@@ -6,13 +6,10 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 from fastapi.testclient import TestClient
-from jsonschema import Draft202012Validator
-from referencing import Registry, Resource
 
 import spatialmech as sm
 from spatialmech import catalog
 from spatialmech.interfaces.cli import cli
-from spatialmech.interfaces.common import load_schema
 from spatialmech.interfaces.studio.app import create_app
 from spatialmech.interfaces.studio.session import Session
 from spatialmech.kinematics.closure import closure_residual
@@ -20,10 +17,8 @@ from spatialmech.serialize import unit_rule_violations
 
 
 @pytest.fixture(scope="module")
-def validator():
-    common = load_schema("common")
-    reg = Registry().with_resource(common["$id"], Resource.from_contents(common))
-    return Draft202012Validator(load_schema("studio"), registry=reg)
+def validator(schema_validator):
+    return schema_validator("studio")
 
 
 def ok(r, validator) -> dict:

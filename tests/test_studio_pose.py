@@ -6,22 +6,17 @@ forward position, and refusals are clear."""
 import numpy as np
 import pytest
 from fastapi.testclient import TestClient
-from jsonschema import Draft202012Validator
-from referencing import Registry, Resource
 
 import spatialmech as sm
 from spatialmech.geometry.rotations import euler_matrix
-from spatialmech.interfaces.common import load_schema
 from spatialmech.interfaces.studio.app import create_app
 from spatialmech.interfaces.studio.session import Session
 from spatialmech.serialize import unit_rule_violations
 
 
 @pytest.fixture(scope="module")
-def validator():
-    common = load_schema("common")
-    reg = Registry().with_resource(common["$id"], Resource.from_contents(common))
-    return Draft202012Validator(load_schema("studio"), registry=reg)
+def validator(schema_validator):
+    return schema_validator("studio")
 
 
 def ok(r, validator) -> dict:

@@ -162,16 +162,23 @@ def read_rows(out: str | os.PathLike) -> list[dict]:
     return sorted(rows, key=lambda r: r["candidate"])
 
 
+def _read_manifest(out: Path) -> dict | None:
+    """The manifest of the screen in ``out`` (``None`` when there is none)."""
+    mf = out / MANIFEST
+    if not mf.is_file():
+        return None
+    try:
+        return json.loads(mf.read_text(encoding="utf-8"))
+    except (OSError, ValueError) as e:
+        raise InputError(f"out: {mf} is not readable ({e}); use a new directory") from None
+
+
 def _refuse_other_screen(out: Path, arguments: dict, positions: list[dict]) -> None:
     """An ``InputError`` now when ``out`` already holds a screen of other arguments or positions
     (:func:`_check_out` checks the candidates themselves once they are formed)."""
-    mf = out / MANIFEST
-    if not mf.is_file():
+    old = _read_manifest(out)
+    if old is None:
         return
-    try:
-        old = json.loads(mf.read_text(encoding="utf-8"))
-    except (OSError, ValueError) as e:
-        raise InputError(f"out: {mf} is not readable ({e}); use a new directory") from None
     same_pos = isinstance(old.get("positions"), list) and len(old["positions"]) == len(positions) and all(
         np.allclose(a["R"], b["R"], atol=1e-12) and np.allclose(a["p"], b["p"], atol=1e-12)
         for a, b in zip(old["positions"], positions, strict=True))
@@ -182,17 +189,13 @@ def _refuse_other_screen(out: Path, arguments: dict, positions: list[dict]) -> N
 
 def _check_out(out: Path, manifest: dict) -> int:
     """Prepare ``out``; returns how many chunks are already there (a resume).  An existing
-    directory must be a screen with the same arguments and candidates, or empty."""
+    screen (its arguments and positions already checked by :func:`_refuse_other_screen`) must
+    have the same candidates; any other existing directory must be empty."""
     if out.exists() and not out.is_dir():
         raise InputError(f"out: {out} exists and is not a directory")
-    mf = out / MANIFEST
-    if mf.exists():
-        try:
-            old = json.loads(mf.read_text(encoding="utf-8"))
-        except (OSError, ValueError) as e:
-            raise InputError(f"out: {mf} is not readable ({e}); use a new directory") from None
-        if old.get("format") != _FORMAT or old.get("arguments") != manifest["arguments"] \
-                or old.get("fingerprint") != manifest["fingerprint"]:
+    old = _read_manifest(out)
+    if old is not None:
+        if old.get("format") != _FORMAT or old.get("fingerprint") != manifest["fingerprint"]:
             raise InputError(f"out: {out} holds a screen with other arguments or candidates; use a new directory "
                              "(or the same arguments to resume it)")
         return sum(1 for k in range(manifest["chunks"]) if _part(out, k).exists())

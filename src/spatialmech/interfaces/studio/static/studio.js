@@ -100,31 +100,30 @@ function actuatorEntries(st) {
 function buildSliders() {
   const box = document.getElementById("sliders");
   box.innerHTML = "";
-  actuatorEntries(S.state).forEach((a, k) => {
-    const div = document.createElement("div");
-    div.className = "slider";
-    const step = a.unit === "deg" ? 0.1 : (a.range[1] - a.range[0]) / 2000;
-    div.innerHTML = `<label for="slider-${k}">${a.name} [${a.unit}]: <span id="slider-val-${k}"></span></label>` +
-      `<input type="range" id="slider-${k}" data-index="${k}" min="${a.range[0]}" max="${a.range[1]}" step="${step}" value="${a.value}">`;
-    box.appendChild(div);
-    div.querySelector("input").addEventListener("input", onSlide);
-  });
+  actuatorEntries(S.state).forEach((a, k) => addSlider(box, "slider", a, k, onSlide));
   syncSliders();
 }
 
+// one labelled range input (ids PREFIX-k and PREFIX-val-k) for an entry {name, value, unit, range}
+function addSlider(box, prefix, a, k, onInput) {
+  const div = document.createElement("div");
+  div.className = "slider";
+  const step = a.unit === "deg" ? 0.1 : (a.range[1] - a.range[0]) / 2000;
+  div.innerHTML = `<label for="${prefix}-${k}">${a.name} [${a.unit}]: <span id="${prefix}-val-${k}"></span></label>` +
+    `<input type="range" id="${prefix}-${k}" data-index="${k}" min="${a.range[0]}" max="${a.range[1]}" step="${step}" value="${a.value}">`;
+  box.appendChild(div);
+  div.querySelector("input").addEventListener("input", onInput);
+}
+
 function syncSliders() {
-  actuatorEntries(S.state).forEach((a, k) => {
-    const el = document.getElementById("slider-" + k);
+  const sync = (prefix) => (a, k) => {
+    const el = document.getElementById(prefix + "-" + k);
     if (!el) return;
     el.value = a.value;
-    document.getElementById("slider-val-" + k).textContent = fmt(a.value, 6) + " " + a.unit;
-  });
-  poseEntries(S.state).forEach((a, k) => {
-    const el = document.getElementById("pose-" + k);
-    if (!el) return;
-    el.value = a.value;
-    document.getElementById("pose-val-" + k).textContent = fmt(a.value, 6) + " " + a.unit;
-  });
+    document.getElementById(prefix + "-val-" + k).textContent = fmt(a.value, 6) + " " + a.unit;
+  };
+  actuatorEntries(S.state).forEach(sync("slider"));
+  poseEntries(S.state).forEach(sync("pose"));
 }
 
 function sliderValues() { return actuatorEntries(S.state).map((_, k) => Number(document.getElementById("slider-" + k).value)); }
@@ -146,15 +145,7 @@ function buildPoseSliders() {
   const t = S.state.task;
   document.getElementById("pose-help").textContent = !t ? "the output link cannot move" :
     "drag the output: " + t.given.join(", ") + " (Euler " + t.euler + ")" + (t.solved.length ? "; solved: " + t.solved.join(", ") : "");
-  poseEntries(S.state).forEach((a, k) => {
-    const div = document.createElement("div");
-    div.className = "slider";
-    const step = a.unit === "deg" ? 0.1 : (a.range[1] - a.range[0]) / 2000;
-    div.innerHTML = `<label for="pose-${k}">${a.name} [${a.unit}]: <span id="pose-val-${k}"></span></label>` +
-      `<input type="range" id="pose-${k}" data-index="${k}" min="${a.range[0]}" max="${a.range[1]}" step="${step}" value="${a.value}">`;
-    box.appendChild(div);
-    div.querySelector("input").addEventListener("input", onPoseSlide);
-  });
+  poseEntries(S.state).forEach((a, k) => addSlider(box, "pose", a, k, onPoseSlide));
   syncSliders();
 }
 
