@@ -22,6 +22,7 @@ from spatialmech.analysis.defects import candidate_drivers
 from spatialmech.errors import InputError
 from spatialmech.geometry.rotations import exp_twist
 from spatialmech.kinematics import compiled
+from spatialmech.kinematics import kernels_se3
 from spatialmech.kinematics.closed_forms import four_sps_cu
 from spatialmech.kinematics.closure import (
     Configuration,
@@ -291,6 +292,23 @@ def test_batched_4sps_cu_legs_on_all_cores_equal_the_reference():
     with compiled.python_reference():
         ref = four_sps_cu.leg_lengths(phi)
     close(big, ref, 1e-14)
+    # angles beyond the polynomial sine's range are redone with libm's, on both kernels
+    phi[::97, 2] += 3e6
+    for part in (phi, phi[:500]):
+        with compiled.python_reference():
+            ref = four_sps_cu.leg_lengths(part)
+        close(four_sps_cu.leg_lengths(part), ref, 1e-14)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.floats(-kernels_se3.SINCOS_MAX, kernels_se3.SINCOS_MAX, allow_nan=False),
+       st.integers(-4000, 4000), st.floats(-1e-9, 1e-9))
+def test_vectorisable_sine_cosine_equals_libm(x, k, eps):
+    """The polynomial sine and cosine that let pose loops vectorise agree with libm's to an ulp,
+    anywhere in their range and next to the quarter turns, where the argument reduction counts."""
+    for v in (x, k * np.pi / 2 + eps):
+        s, c = kernels_se3.nb_sincos(v)
+        assert abs(s - np.sin(v)) <= 2.3e-16 and abs(c - np.cos(v)) <= 2.3e-16, v
 
 
 def test_without_numba_the_python_path_runs_with_a_note(monkeypatch):
@@ -334,6 +352,34 @@ def test_minimum_norm_solver_equals_lstsq_and_falls_back_on_rank_deficiency():
     b = rng.standard_normal(6)
     b[3] = b[1]
     close(compiled.lstsq(A, b), np.linalg.lstsq(A, b, rcond=None)[0], 1e-10)
+    # sparse, increasingly ill-conditioned underdetermined systems: the normal-equations path
+    # (cond up to about 1e4), then the QR, then the SVD, each to lstsq's minimum-norm solution
+    for cond in (1e0, 1e2, 1e3, 1e5, 1e9):
+        U, _ = np.linalg.qr(rng.standard_normal((36, 36)))
+        V, _ = np.linalg.qr(rng.standard_normal((42, 36)))
+        A = (U * np.geomspace(1.0, 1.0 / cond, 36)) @ V.T
+        A[np.abs(A) < 0.02] = 0.0  # zeros as in a closure Jacobian
+        b = rng.standard_normal(36)
+        ref = np.linalg.lstsq(A, b, rcond=None)[0]
+        err = np.max(np.abs(compiled.lstsq(A, b) - ref)) / np.max(np.abs(ref))
+        assert err < 1e-13 * max(np.linalg.cond(A), 1.0), (cond, err)
+
+
+def test_nearest_rotation_without_the_svd_equals_the_svd():
+    """The retraction re-orthonormalises rotations by the Bjorck iteration when they drift by
+    rounding, by the SVD otherwise: both give the polar factor ``U Vt``."""
+    from scipy.spatial.transform import Rotation
+
+    from spatialmech.kinematics.kernels_se3 import nb_orthonormal
+
+    rng = np.random.default_rng(5)
+    for _ in range(200):
+        R = Rotation.from_rotvec(rng.standard_normal(3) * 2.0).as_matrix()
+        D = np.eye(4)
+        D[:3, :3] = R + rng.standard_normal((3, 3)) * 10.0 ** rng.uniform(-16, -3)
+        U, _, Vt = np.linalg.svd(D[:3, :3])
+        nb_orthonormal(D)
+        close(D[:3, :3], U @ Vt, 1e-14)
 
 
 def test_batched_general_pose_checker_equals_pose_by_pose():

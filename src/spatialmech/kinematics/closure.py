@@ -21,6 +21,8 @@ divided by ``L``) are used for rank decisions and convergence tests.
 
 from __future__ import annotations
 
+from types import ModuleType
+
 import weakref
 from dataclasses import dataclass, field
 
@@ -380,9 +382,15 @@ def placed_configuration(mech: Mechanism, q) -> Configuration:
 def _compiled():
     """The compiled kernels (:mod:`.compiled`) when they are in use, else ``None``: the Python
     code below runs (``SPATIALMECH_PURE=1``, or numba missing) and is the reference."""
-    from . import compiled  # imported here: it builds on this module
+    global _COMPILED_MODULE
+    if _COMPILED_MODULE is None:
+        from . import compiled  # imported here: it builds on this module
 
-    return compiled if compiled.enabled() else None
+        _COMPILED_MODULE = compiled
+    return _COMPILED_MODULE if _COMPILED_MODULE.enabled() else None
+
+
+_COMPILED_MODULE: ModuleType | None = None
 
 
 def closure_residual(mech: Mechanism, config: Configuration) -> np.ndarray:

@@ -349,9 +349,13 @@ def _run_correct(mech: Mechanism, cm: CompiledMechanism, seeds: Sequence[Configu
     if tol is None:  # the newton tolerance in force (geometry/tolerances.py)
         tol = current_tolerances().newton
     N = len(seeds)
-    qs = _f64([c.q for c in seeds], (N, cm.n))
-    Ds = _f64([c.D for c in seeds], (N, 4, 4))
-    Bs = _f64([c.B for c in seeds], (N, cm.n_bodies, 4, 4))
+    if N == 1:  # one seed (forward position, a tracker step): views, no copies
+        c = seeds[0]
+        qs, Ds, Bs = _f64(c.q, (1, cm.n)), _f64(c.D, (1, 4, 4)), _f64(c.B, (1, cm.n_bodies, 4, 4))
+    else:
+        qs = _f64([c.q for c in seeds], (N, cm.n))
+        Ds = _f64([c.D for c in seeds], (N, 4, 4))
+        Bs = _f64([c.B for c in seeds], (N, cm.n_bodies, 4, 4))
     q_out, D_out, B_out = np.empty_like(qs), np.empty_like(Ds), np.empty_like(Bs)
     status = np.empty(N, dtype=np.int64)
     iters = np.empty(N, dtype=np.int64)
@@ -359,15 +363,26 @@ def _run_correct(mech: Mechanism, cm: CompiledMechanism, seeds: Sequence[Configu
     if N:
         nb_correct(*_correct_args(cm), qs, Ds, Bs, act, bool(fix_platform), float(tol), int(max_iter), q_out, D_out,
                       B_out, status, iters, resid)
+    for s, st in enumerate(status.tolist()):
+        if st < 0:  # NaN or infinity in a seed: the full check names it
+            check_configuration(mech, seeds[s])
     return [_result(seeds[s], q_out[s], D_out[s], B_out[s], int(status[s]), int(iters[s]), float(resid[s]))
             for s in range(N)]
+
+
+def _shapes(mech: Mechanism, cm: CompiledMechanism, config: Configuration) -> None:
+    """The shapes of ``config`` (finiteness is the kernel's check), else the full check's message."""
+    q, D, B = config.q, config.D, config.B
+    if not (type(q) is np.ndarray and type(D) is np.ndarray and type(B) is np.ndarray and q.shape == (cm.n,)
+            and D.shape == (4, 4) and B.shape == (cm.n_bodies, 4, 4)):
+        check_configuration(mech, config)
 
 
 def correct(mech: Mechanism, config: Configuration, *, active: np.ndarray | None = None, fix_platform: bool = False,
             tol: float | None = None, max_iter: int = 50) -> CorrectionResult:
     """:func:`.closure.correct`, compiled (same steps, tolerances and statuses)."""
     cm = compile_mechanism(mech)
-    _check(mech, cm, config)
+    _shapes(mech, cm, config)
     return _run_correct(mech, cm, [config], active, fix_platform, tol, max_iter)[0]
 
 
@@ -377,7 +392,7 @@ def correct_many(mech: Mechanism, seeds: Sequence[Configuration], *, active: np.
     ``active`` without the actuators, and seeds whose actuated variables hold the values)."""
     cm = compile_mechanism(mech)
     for c in seeds:
-        _check(mech, cm, c)
+        _shapes(mech, cm, c)
     return _run_correct(mech, cm, seeds, active, fix_platform, tol, max_iter)
 
 
@@ -470,8 +485,9 @@ def _run_limb_gn(chain: Chain, Ds, q0s, lin, L, tol, max_iter, hold):
 
 def lstsq(A, b) -> np.ndarray:
     """Minimum-norm least-squares solution of ``A x = b`` as ``np.linalg.lstsq(A, b,
-    rcond=None)[0]`` (the solver inside every compiled Newton step: QR when the system is
-    underdetermined and well conditioned, else the SVD)."""
+    rcond=None)[0]`` (the solver inside every compiled Newton step: when the system is
+    underdetermined, the normal equations with one refinement step if it is well conditioned
+    (cond below about 1e4), else the QR; the SVD for everything else)."""
     A = _f64(A)
     b = _f64(b)
     if A.ndim != 2 or b.shape != (A.shape[0],):

@@ -300,7 +300,8 @@ def nb_correct(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends,
              fix_platform, tol, max_iter, q_out, D_out, B_out, status, iters, resid):
     """:func:`.closure.correct` from each seed ``qs[s], Ds[s], Bs[s]``: the result in ``q_out[s]``,
     ``D_out[s]``, ``B_out[s]``, with ``status[s]`` 1 converged, 2 stationary (steps vanished
-    without closure), 0 not converged, the iterations and the residual."""
+    without closure), 0 not converged, -1 a seed holding NaN or infinity (left unsolved: the
+    caller names the problem), the iterations and the residual."""
     K = len(limb_start) - 1
     h = 1 + Bs.shape[1]
     n = qs.shape[1]
@@ -335,6 +336,21 @@ def nb_correct(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends,
         st = 0
         rn = np.inf
         it = 0
+        tot = 0.0
+        for i in range(n):
+            tot += q[i]
+        for i in range(4):
+            for j in range(4):
+                tot += D[i, j]
+        for b in range(h - 1):
+            for i in range(4):
+                for j in range(4):
+                    tot += B[b, i, j]
+        if not np.isfinite(tot):
+            status[s] = -1
+            iters[s] = 0
+            resid[s] = np.nan
+            continue
         for it in range(max_iter + 1):
             nb_closure_system(S, ball_of, ball_axes, ball_centre, limb_start, ends, q, D, B, colmap, na, True, A, r)
             sq = 0.0

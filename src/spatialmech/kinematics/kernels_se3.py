@@ -10,6 +10,7 @@ from .jit import njit
 
 __all__ = [
     "EPS",
+    "SINCOS_MAX",
     "nb_ball_product",
     "nb_copy44",
     "nb_cross",
@@ -20,6 +21,7 @@ __all__ = [
     "nb_lsq_qr",
     "nb_lstsq",
     "nb_matrix_rotvec",
+    "nb_minnorm_normal",
     "nb_minnorm_qr",
     "nb_mm",
     "nb_mm4",
@@ -27,7 +29,8 @@ __all__ = [
     "nb_orthonormal",
     "nb_quat_rotvec",
     "nb_rotvec_matrix",
-    "nb_series",
+    "nb_rotvec_matrix3",
+    "nb_sincos",
     "nb_skew",
     "nb_svd",
 ]
@@ -68,33 +71,32 @@ def nb_skew(w, out):
 
 
 @njit(cache=True)
-def nb_series(W, a, b, out):
-    """``I + a W + b W W``."""
-    W2 = np.empty((3, 3))
-    nb_mm(W, W, W2)
-    for i in range(3):
-        for j in range(3):
-            out[i, j] = a * W[i, j] + b * W2[i, j]
-        out[i, i] += 1.0
+def nb_rotvec_matrix3(p0, p1, p2, out):
+    """:func:`..geometry.rotations.rotvec_matrix` of the rotation vector ``(p0, p1, p2)``:
+    ``I + sin(th) K + (1 - cos(th)) K K`` with ``K = skew(phi / th)``, or ``I + skew(phi)``
+    below 1e-12 rad (no temporaries: the retraction calls this for every ball)."""
+    th = np.sqrt(p0 * p0 + p1 * p1 + p2 * p2)
+    if th < 1e-12:
+        s, c, k0, k1, k2 = 1.0, 0.0, p0, p1, p2
+    else:
+        s, c, k0, k1, k2 = np.sin(th), 1.0 - np.cos(th), p0 / th, p1 / th, p2 / th
+    # K K = k k^T - |k|^2 I
+    n2 = k0 * k0 + k1 * k1 + k2 * k2
+    out[0, 0] = 1.0 + c * (k0 * k0 - n2)
+    out[1, 1] = 1.0 + c * (k1 * k1 - n2)
+    out[2, 2] = 1.0 + c * (k2 * k2 - n2)
+    out[0, 1] = -s * k2 + c * k0 * k1
+    out[1, 0] = s * k2 + c * k0 * k1
+    out[0, 2] = s * k1 + c * k0 * k2
+    out[2, 0] = -s * k1 + c * k0 * k2
+    out[1, 2] = -s * k0 + c * k1 * k2
+    out[2, 1] = s * k0 + c * k1 * k2
 
 
 @njit(cache=True)
 def nb_rotvec_matrix(phi, out):
     """:func:`..geometry.rotations.rotvec_matrix`."""
-    th = np.sqrt(phi[0] * phi[0] + phi[1] * phi[1] + phi[2] * phi[2])
-    W = np.empty((3, 3))
-    if th < 1e-12:
-        nb_skew(phi, W)
-        for i in range(3):
-            for j in range(3):
-                out[i, j] = W[i, j]
-            out[i, i] += 1.0
-        return
-    k = np.empty(3)
-    for i in range(3):
-        k[i] = phi[i] / th
-    nb_skew(k, W)
-    nb_series(W, np.sin(th), 1.0 - np.cos(th), out)
+    nb_rotvec_matrix3(phi[0], phi[1], phi[2], out)
 
 
 @njit(cache=True)
@@ -269,12 +271,124 @@ def nb_exp_twist(V, out):
 
 EPS = float(np.finfo(np.float64).eps)
 
+# pi/2 in three parts (Cody-Waite): k * PIO2_1 is exact for |k| < 2^20, the others carry the rest
+_PIO2_1 = 1.57079632673412561417e00
+_PIO2_2 = 6.07710050630396597660e-11
+_PIO2_3 = 2.02226624879595063154e-21
+_TWO_OVER_PI = 6.36619772367581382433e-01
+#: Largest |x| for :func:`nb_sincos` (2^20 quarter turns); callers take libm's sine beyond it.
+SINCOS_MAX = 1.6e6
+
+
+@njit(cache=True, inline="always")
+def nb_sincos(x):
+    """``(sin x, cos x)`` without a libm call, so that a loop over poses vectorises (PyPI's
+    llvmlite has no vector math library): ``x`` is reduced to ``|r| <= pi/4`` by the nearest
+    quarter turn ``k`` (pi/2 in three parts), then Taylor polynomials of degree 15 and 18 (their
+    truncation error is below 1e-17 there) and the quadrant's swap and signs, as selects.  Within
+    1 ulp of libm's values for ``|x| <= SINCOS_MAX`` (tested); beyond it the reduction loses
+    digits and callers use ``np.sin``.  Inlined into the caller, whose fastmath flags must not
+    reassociate (:data:`.jit.SAFE_FASTMATH`)."""
+    k = np.floor(x * _TWO_OVER_PI + 0.5)
+    r = ((x - k * _PIO2_1) - k * _PIO2_2) - k * _PIO2_3
+    z = r * r
+    sr = r + r * z * (-1.0 / 6.0 + z * (1.0 / 120.0 + z * (-1.0 / 5040.0 + z * (1.0 / 362880.0 + z * (
+        -1.0 / 39916800.0 + z * (1.0 / 6227020800.0 + z * (-1.0 / 1307674368000.0)))))))
+    cr = 1.0 + z * (-0.5 + z * (1.0 / 24.0 + z * (-1.0 / 720.0 + z * (1.0 / 40320.0 + z * (-1.0 / 3628800.0 + z * (
+        1.0 / 479001600.0 + z * (-1.0 / 87178291200.0 + z * (1.0 / 20922789888000.0))))))))
+    q = np.int64(k) & 3
+    s = cr if (q & 1) else sr
+    c = sr if (q & 1) else cr
+    s = -s if (q & 2) else s
+    c = -c if ((q + 1) & 2) else c
+    return s, c
+
+
 
 @njit(cache=True)
 def nb_svd(A):
     """``np.linalg.svd(A, full_matrices=False)``: the one LAPACK routine the kernels use (each
     distinct numba linalg call adds seconds to the first compilation)."""
     return np.linalg.svd(A, full_matrices=False)
+
+
+@njit(cache=True)
+def nb_minnorm_normal(A, b, x):
+    """Minimum-norm solution of the underdetermined ``A x = b`` (m <= n) by the normal equations
+    ``A A^T y = b``, ``x = A^T y``, with one step of iterative refinement of ``y`` (the corrected
+    semi-normal equations: accurate to about ``cond(A) eps`` at the conditioning accepted here).
+    ``A A^T`` is summed column by column over each column's nonzero rows (a closure Jacobian's
+    limb columns touch only their limb's rows), and factored ``U^T U`` by a right-looking
+    Cholesky whose updates are contiguous row operations.  ``False`` (x untouched) when a pivot
+    ``U[j, j]`` is below 1e-4 times the largest, i.e. ``cond(A)`` may exceed about 1e4: the
+    squared conditioning would cost digits, and the QR or the SVD must decide."""
+    m, n = A.shape
+    rows = np.empty((n, m), dtype=np.int64)
+    cnt = np.zeros(n, dtype=np.int64)
+    for i in range(m):
+        for c in range(n):
+            if A[i, c] != 0.0:
+                rows[c, cnt[c]] = i
+                cnt[c] += 1
+    U = np.zeros((m, m))  # upper triangle: U[j, i] = (A A^T)[j, i], i >= j
+    for c in range(n):
+        for a in range(cnt[c]):
+            j = rows[c, a]
+            v = A[j, c]
+            for e in range(a, cnt[c]):
+                i = rows[c, e]
+                U[j, i] += v * A[i, c]
+    big = 0.0
+    for j in range(m):
+        big = max(big, U[j, j])
+    if not big > 0.0:
+        return False
+    for j in range(m):  # right-looking Cholesky A A^T = U^T U, in place
+        d = U[j, j]
+        if not d > 1e-8 * big:  # pivot^2 below (1e-4)^2 of the largest diagonal
+            return False
+        d = np.sqrt(d)
+        U[j, j] = d
+        for i in range(j + 1, m):
+            U[j, i] /= d
+        for k in range(j + 1, m):
+            u = U[j, k]
+            if u != 0.0:
+                for i in range(k, m):
+                    U[k, i] -= u * U[j, i]
+    y = np.zeros(m)
+    z = b.copy()
+    xs = np.zeros(n)
+    for sweep in range(2):
+        for k in range(m):  # U^T w = z (forward, in place)
+            z[k] /= U[k, k]
+            wk = z[k]
+            for i in range(k + 1, m):
+                z[i] -= U[k, i] * wk
+        for i in range(m - 1, -1, -1):  # U dy = w (backward, in place)
+            acc = z[i]
+            for k in range(i + 1, m):
+                acc -= U[i, k] * z[k]
+            z[i] = acc / U[i, i]
+        for i in range(m):
+            y[i] += z[i]
+        for c in range(n):
+            acc = 0.0
+            for a in range(cnt[c]):
+                i = rows[c, a]
+                acc += A[i, c] * y[i]
+            xs[c] = acc
+        if sweep == 0:  # the residual of A x = b, for the refinement
+            for i in range(m):
+                z[i] = b[i]
+            for c in range(n):
+                v = xs[c]
+                for a in range(cnt[c]):
+                    i = rows[c, a]
+                    z[i] -= A[i, c] * v
+    for c in range(n):
+        x[c] = xs[c]
+    return True
 
 
 @njit(cache=True)
@@ -403,7 +517,7 @@ def nb_lstsq(A, b):
     x = np.zeros(n)
     if m == 0 or n == 0:
         return x
-    if m <= n and nb_minnorm_qr(A, b, x):
+    if m <= n and (nb_minnorm_normal(A, b, x) or nb_minnorm_qr(A, b, x)):
         return x
     U, s, Vt = nb_svd(A)
     cut = EPS * max(m, n) * s[0]
@@ -449,15 +563,38 @@ def nb_det(M):
 
 @njit(cache=True)
 def nb_orthonormal(D):
-    """Keep the rotation of ``D`` orthonormal (``U Vt`` of its SVD: the nearest rotation), in place."""
+    """Keep the rotation of ``D`` orthonormal (the nearest rotation, ``U Vt`` of its SVD), in
+    place.  A product of rotations drifts from orthonormal only by rounding: then two steps of
+    the Bjorck iteration ``R <- R (3 I - R^T R) / 2`` give the same polar factor (the error is
+    squared each step) without the SVD; a drift above 1e-6 takes the SVD."""
     R = np.empty((3, 3))
+    G = np.empty((3, 3))
     for i in range(3):
         for j in range(3):
             R[i, j] = D[i, j]
-    U, _, Vt = nb_svd(R)
+    drift = 0.0
+    for sweep in range(2):
+        for i in range(3):
+            for j in range(3):
+                G[i, j] = R[0, i] * R[0, j] + R[1, i] * R[1, j] + R[2, i] * R[2, j]
+                if sweep == 0:
+                    drift = max(drift, abs(G[i, j] - (1.0 if i == j else 0.0)))
+        if sweep == 0 and not drift < 1e-6:
+            U, _, Vt = nb_svd(R)
+            for i in range(3):
+                for j in range(3):
+                    D[i, j] = U[i, 0] * Vt[0, j] + U[i, 1] * Vt[1, j] + U[i, 2] * Vt[2, j]
+            return
+        for i in range(3):
+            for j in range(3):
+                G[i, j] = (3.0 if i == j else 0.0) - G[i, j]
+        for i in range(3):
+            r0, r1, r2 = R[i, 0], R[i, 1], R[i, 2]
+            for j in range(3):
+                R[i, j] = 0.5 * (r0 * G[0, j] + r1 * G[1, j] + r2 * G[2, j])
     for i in range(3):
         for j in range(3):
-            D[i, j] = U[i, 0] * Vt[0, j] + U[i, 1] * Vt[1, j] + U[i, 2] * Vt[2, j]
+            D[i, j] = R[i, j]
 
 
 @njit(cache=True)
@@ -468,17 +605,17 @@ def nb_ball_product(A, u, v, invert_v, quat, out):
     (difference).  ``quat``: the matrix -> rotation vector conversion by quaternion (as
     :func:`scipy.spatial.transform.Rotation.as_rotvec`) rather than by the matrix logarithm; each
     caller keeps the conversion of the Python code it mirrors."""
-    a = np.empty(3)
-    b = np.empty(3)
-    Ra = np.empty((3, 3))
-    Rb = np.empty((3, 3))
-    Rn = np.empty((3, 3))
+    work = np.empty((3, 3, 3))
+    Ra = work[0]
+    Rb = work[1]
+    Rn = work[2]
     rv = np.empty(3)
-    for x in range(3):
-        a[x] = A[x, 0] * u[0] + A[x, 1] * u[1] + A[x, 2] * u[2]
-        b[x] = A[x, 0] * v[0] + A[x, 1] * v[1] + A[x, 2] * v[2]
-    nb_rotvec_matrix(a, Ra)
-    nb_rotvec_matrix(b, Rb)
+    nb_rotvec_matrix3(A[0, 0] * u[0] + A[0, 1] * u[1] + A[0, 2] * u[2],
+                      A[1, 0] * u[0] + A[1, 1] * u[1] + A[1, 2] * u[2],
+                      A[2, 0] * u[0] + A[2, 1] * u[1] + A[2, 2] * u[2], Ra)
+    nb_rotvec_matrix3(A[0, 0] * v[0] + A[0, 1] * v[1] + A[0, 2] * v[2],
+                      A[1, 0] * v[0] + A[1, 1] * v[1] + A[1, 2] * v[2],
+                      A[2, 0] * v[0] + A[2, 1] * v[1] + A[2, 2] * v[2], Rb)
     if invert_v:
         for x in range(3):
             for y in range(3):

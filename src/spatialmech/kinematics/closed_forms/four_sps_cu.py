@@ -63,7 +63,8 @@ from ...errors import InputError
 from ...geometry.rotations import euler_matrix, transform
 from ...geometry.validate import as_finite_array
 from .. import compiled
-from ..jit import njit, prange
+from ..jit import SAFE_FASTMATH, njit, prange
+from ..kernels_se3 import SINCOS_MAX, nb_sincos
 from . import sps
 
 __all__ = [
@@ -267,12 +268,11 @@ def _legs_sq_block(ph: np.ndarray, a: float, b: float, out: np.ndarray) -> None:
     np.subtract(c, m, out=out[:, 3])
 
 
-def _legs_pose(ph, i, k, ab2, a, squared, out):
-    """One pose of :func:`_legs_kernel` (the closed form of :func:`_legs_sq_block`)."""
+@njit(cache=True, fastmath=SAFE_FASTMATH, inline="always")
+def _legs_from(ph, i, sa, ca, sb, cb, sg, cg, k, ab2, a, squared, out):
+    """One pose of :func:`_legs_kernel` from its angles' sines and cosines (the closed form of
+    :func:`_legs_sq_block`)."""
     z = ph[i, 0]
-    sa, ca = np.sin(ph[i, 1]), np.cos(ph[i, 1])
-    sb, cb = np.sin(ph[i, 2]), np.cos(ph[i, 2])
-    sg, cg = np.sin(ph[i, 3]), np.cos(ph[i, 3])
     t = sa * sb
     P = ab2 * (cb * cg + ca * cg + t * sg)
     Q = ab2 * (t * cg + cb * sg - ca * sg)
@@ -292,27 +292,55 @@ def _legs_pose(ph, i, k, ab2, a, squared, out):
         out[i, 3] = np.sqrt(max(v3, 0.0))
 
 
-_legs_pose_nb = njit(cache=True, fastmath=True, inline="always")(_legs_pose)
+@njit(cache=True, fastmath=SAFE_FASTMATH, inline="always")
+def _legs_pose(ph, i, k, ab2, a, squared, out):
+    """One pose by :func:`.kernels_se3.nb_sincos` (vectorisable); returns its largest angle
+    (beyond ``SINCOS_MAX`` the pose is redone by :func:`_legs_pose_libm`)."""
+    sa, ca = nb_sincos(ph[i, 1])
+    sb, cb = nb_sincos(ph[i, 2])
+    sg, cg = nb_sincos(ph[i, 3])
+    _legs_from(ph, i, sa, ca, sb, cb, sg, cg, k, ab2, a, squared, out)
+    return max(abs(ph[i, 1]), abs(ph[i, 2]), abs(ph[i, 3]))
 
 
-@njit(cache=True, fastmath=True)
+@njit(cache=True, fastmath=SAFE_FASTMATH)
+def _legs_pose_libm(ph, i, k, ab2, a, squared, out):
+    """One pose with libm's sine and cosine (angles beyond :data:`.kernels_se3.SINCOS_MAX`)."""
+    _legs_from(ph, i, np.sin(ph[i, 1]), np.cos(ph[i, 1]), np.sin(ph[i, 2]), np.cos(ph[i, 2]), np.sin(ph[i, 3]),
+               np.cos(ph[i, 3]), k, ab2, a, squared, out)
+
+
+@njit(cache=True, fastmath=SAFE_FASTMATH)
+def _legs_redo_wide(ph, k, ab2, a, squared, out):
+    for i in range(ph.shape[0]):
+        if abs(ph[i, 1]) > SINCOS_MAX or abs(ph[i, 2]) > SINCOS_MAX or abs(ph[i, 3]) > SINCOS_MAX:
+            _legs_pose_libm(ph, i, k, ab2, a, squared, out)
+
+
+@njit(cache=True, fastmath=SAFE_FASTMATH)
 def _legs_kernel(ph, a, b, squared, out):
-    """:func:`_legs_sq_block` pose by pose (compiled, fastmath: last-bit differences from the
-    NumPy form), square roots unless ``squared``."""
+    """:func:`_legs_sq_block` pose by pose (compiled: last-bit differences from the NumPy form),
+    square roots unless ``squared``."""
     k = 2.0 * a * a + 2.0 * b * b
     ab2 = 2.0 * a * b
+    wide = 0.0
     for i in range(ph.shape[0]):
-        _legs_pose_nb(ph, i, k, ab2, a, squared, out)
+        wide = max(wide, _legs_pose(ph, i, k, ab2, a, squared, out))
+    if wide > SINCOS_MAX:
+        _legs_redo_wide(ph, k, ab2, a, squared, out)
 
 
-@njit(cache=True, fastmath=True, parallel=True)
+@njit(cache=True, fastmath=SAFE_FASTMATH, parallel=True)
 def _legs_kernel_parallel(ph, a, b, squared, out):
     """:func:`_legs_kernel` with the poses shared among the cores (numba's ``prange``): the same
     numbers, pose by pose."""
     k = 2.0 * a * a + 2.0 * b * b
     ab2 = 2.0 * a * b
+    wide = 0.0
     for i in prange(ph.shape[0]):
-        _legs_pose_nb(ph, i, k, ab2, a, squared, out)
+        wide = max(wide, _legs_pose(ph, i, k, ab2, a, squared, out))
+    if wide > SINCOS_MAX:
+        _legs_redo_wide(ph, k, ab2, a, squared, out)
 
 
 #: Poses from which :func:`leg_lengths` shares the work among the cores (below: one thread; the
