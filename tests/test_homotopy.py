@@ -361,3 +361,50 @@ def test_a_user_6_rss_with_driven_cranks_is_covered():
     ms = forward_position(mech, vals, all_solutions=True, method="multistart", n_seeds=10)
     for m in ms.solutions:
         assert min(_same_pose(m, h) for h in res.solutions) < 1e-6
+
+
+# ------------------------------------------------------------------ end game at singular end points
+def test_a_double_root_is_located_by_the_cauchy_end_game_and_proven_complete(general):
+    """At leg lengths of a forward-singular pose two assembly modes merge: two paths end at one
+    double root, where Newton cannot finish them. The Cauchy end game locates it (both loops
+    close after two turns: winding number 2), the local dimension test finds it isolated, and the
+    set is complete with the root counted twice; the pose comes back to rounding."""
+    from scipy.optimize import brentq
+
+    sysm = general[0]
+
+    def pose(s):
+        R = Rotation.from_rotvec(np.array([0.2, -0.1, 0.3]) * (1 + s)).as_matrix()
+        return R, np.array([0.1, -0.05, 0.2]) + s * np.array([0.3, 0.2, 0.4])
+
+    def det(s):  # the leg lines' determinant (forward singularity)
+        R, p = pose(s)
+        a = (R @ sysm.platform.T).T + p
+        u = (a - sysm.base) / np.linalg.norm(a - sysm.base, axis=1, keepdims=True)
+        return np.linalg.det(np.hstack([u, np.cross(a, u)]))
+
+    s0 = brentq(det, 2.3, 2.5, xtol=1e-16, rtol=8.9e-16)
+    R, p = pose(s0)
+    r = hc.homotopy_forward(sysm, _lengths(sysm, R, p))
+    sing = [s for s in r.solutions if s.status == "singular"]
+    assert r.complete and "Cauchy end game" in r.completeness and "isolated" in r.completeness
+    assert len(sing) == 2 and all(s.multiplicity == 2 and s.winding == 2 for s in sing)
+    assert r.count("real") + r.count("complex") + 2 == 40
+    for s in sing:
+        assert np.linalg.norm(s.R - R) + np.linalg.norm(s.p - p) < 1e-9
+        assert s.to_dict()["multiplicity"] == 2 and s.to_dict()["winding_number"] == 2
+
+
+def test_local_dimension_tells_a_multiple_root_from_a_continuum():
+    from spatialmech.kinematics.endgame import local_dimension
+
+    def ev(F):
+        def evaluate(Y):
+            return F(Y[0])[0][None], F(Y[0])[1][None]
+        return evaluate
+
+    double = ev(lambda v: (np.array([v[0] ** 2, v[1]]), np.array([[2 * v[0], 0], [0, 1]], dtype=complex)))
+    line = ev(lambda v: (np.array([(v[0] - v[1]) * v[0], (v[0] - v[1]) * v[1]]),
+                         np.array([[2 * v[0] - v[1], -v[0]], [v[1], v[0] - 2 * v[1]]], dtype=complex)))
+    assert local_dimension(double, np.array([0.0, 0.0], dtype=complex)) == 0
+    assert local_dimension(line, np.array([0.5, 0.5], dtype=complex)) == 1

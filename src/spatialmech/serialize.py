@@ -138,6 +138,8 @@ UNIT_FREE_KEYS: dict[str, str] = {
     "inverse_condition": "inverse condition number of the row-normalised Jacobian at a homotopy end point",
     "infinity_ratio": "|e.e| / |x|^2 at a homotopy end point (0 at infinity)",
     "imaginary_ratio": "|Im x| / |x| at a homotopy end point after removing the projective phase",
+    "multiplicity": "how many homotopy paths end at this point (a count)",
+    "winding_number": "loops of the Cauchy end game about t = 1 before the path closed (a count)",
     "singular_points": "singular points marked in a viewer",
     "starts_per_limb": "starts of the inverse-position search per limb",
     "sum_f": "sum of the joint freedoms (mobility formula)",

@@ -46,12 +46,18 @@ from ..errors import InputError
 
 __all__ = [
     "DEFAULT",
+    "ENDGAME_AGREE",
+    "ENDGAME_CLOSED",
+    "ENDGAME_LOOPS",
+    "ENDGAME_POINTS",
+    "ENDGAME_RADIUS",
     "HOMOTOPY_INFINITY",
     "HOMOTOPY_JUMP",
     "HOMOTOPY_NEAR_REAL",
     "HOMOTOPY_NEWTON",
     "HOMOTOPY_REAL",
     "HOMOTOPY_SINGULAR",
+    "LOCAL_DIMENSION_STEP",
     "NEAR_SINGULAR",
     "Tolerances",
     "characteristic_length",
@@ -254,3 +260,15 @@ HOMOTOPY_SINGULAR = 1e-7
 HOMOTOPY_INFINITY = 1e-7
 HOMOTOPY_REAL = 1e-7
 HOMOTOPY_NEAR_REAL = 1e-3
+
+#: Cauchy end game (:mod:`spatialmech.kinematics.endgame`), nondimensional: the first radius of
+#: the loops about ``t = 1`` (in the homotopy parameter), the points per loop, the most loops
+#: before a path must close (its winding number), the relative distance at which a loop has
+#: closed, the relative agreement of the estimates at two radii that accepts the end point, and
+#: the relative size of the perturbations of the local dimension test.
+ENDGAME_RADIUS = 0.05
+ENDGAME_POINTS = 24
+ENDGAME_LOOPS = 6
+ENDGAME_CLOSED = 1e-6
+ENDGAME_AGREE = 1e-8
+LOCAL_DIMENSION_STEP = 1e-4

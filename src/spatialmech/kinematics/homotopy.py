@@ -58,6 +58,7 @@ from ..geometry.tolerances import (
 )
 from ..model.mechanism import Mechanism
 from . import compiled
+from .endgame import cauchy_endgame, local_dimension
 from .homotopy_systems import (
     PoseSystem,
     StewartSystem,
@@ -353,19 +354,25 @@ def track_parameter(Q0: np.ndarray, Q1: np.ndarray, c: np.ndarray, X0: np.ndarra
 
 
 def _refine(Qc, c, X, iters: int = 4):
-    """Newton at ``t = 1`` (batched; a point whose step fails keeps its last value)."""
+    """Newton at ``t = 1`` (batched).  A point keeps its last value when its step fails or does not
+    lower the residual: at a singular root (located by the end game) the Jacobian is singular to
+    rounding, and a Newton step there would throw the point onto another root."""
     X = X.copy()
     with np.errstate(all="ignore"):
+        F, J, _ = _eval_quad(Qc, c, X)
         for _ in range(iters):
-            F, J, _ = _eval_quad(Qc, c, X)
             ok = np.all(np.isfinite(J), axis=(1, 2)) & np.all(np.isfinite(F), axis=1)
             ok &= np.abs(np.linalg.det(np.where(ok[:, None, None], J, np.eye(_N)))) > 0
             if not ok.any():
                 break
-            dx = np.linalg.solve(J[ok], F[ok][..., None])[..., 0]
-            Xn = X[ok] - dx
-            fin = np.all(np.isfinite(Xn), axis=1)
-            X[np.flatnonzero(ok)[fin]] = Xn[fin]
+            idx = np.flatnonzero(ok)
+            dx = np.linalg.solve(J[idx], F[idx][..., None])[..., 0]
+            Xn = X[idx] - dx
+            Fn, Jn, _ = _eval_quad(Qc, c, Xn)
+            better = np.all(np.isfinite(Xn), axis=1) & (np.linalg.norm(Fn, axis=1) < np.linalg.norm(F[idx], axis=1))
+            X[idx[better]], F[idx[better]], J[idx[better]] = Xn[better], Fn[better], Jn[better]
+            if not better.any():
+                break
         F, J, E = _eval_quad(Qc, c, X)
     return X, F, J, E
 
@@ -506,6 +513,20 @@ def _generic_solve(sysm: StewartSystem | PoseSystem, seed: int = 0, max_attempts
     return best, False
 
 
+def _groups(P: np.ndarray, tol: float = 1e-6) -> list[np.ndarray]:
+    """Indices of the points ``P`` (n, m) grouped by relative distance below ``tol``."""
+    groups: list[list[int]] = []
+    for i, x in enumerate(P):
+        for g in groups:
+            y = P[g[0]]
+            if np.linalg.norm(x - y) <= tol * max(float(np.linalg.norm(y)), 1e-300):
+                g.append(i)
+                break
+        else:
+            groups.append([i])
+    return [np.array(g, dtype=np.int64) for g in groups]
+
+
 def _distinct(P: np.ndarray) -> bool:
     if len(P) < 2:
         return True
@@ -530,11 +551,14 @@ class HomotopySolution:
     residual: float
     R: np.ndarray | None = None
     p: np.ndarray | None = None
+    multiplicity: int = 1  # paths ending at this point (singular end points)
+    winding: int = 0  # the Cauchy end game's winding number (singular end points; 0: not run or failed)
 
     def to_dict(self) -> dict:
         return {"status": self.status, "study_parameters_real": [float(v) for v in self.study.real],
                 "study_parameters_imag": [float(v) for v in self.study.imag], "inverse_condition": self.rcond,
-                "infinity_ratio": self.infinity_ratio, "imaginary_ratio": self.imag_ratio, "residual": self.residual}
+                "infinity_ratio": self.infinity_ratio, "imaginary_ratio": self.imag_ratio, "residual": self.residual,
+                "multiplicity": self.multiplicity, "winding_number": self.winding}
 
 
 @dataclass(frozen=True, eq=False)
@@ -564,25 +588,48 @@ def homotopy_forward(mech: Mechanism | StewartSystem | PoseSystem, actuator_valu
     gen, accounted = _generic_solve(sysm, seed=seed)
     Qt = sysm.coefficients(vals)
     c = gen.c
-    X = track_parameter(gen.Q, Qt, c, gen.X)[0] if len(gen.X) else gen.X
+    X, _, done = track_parameter(gen.Q, Qt, c, gen.X) if len(gen.X) else (gen.X, None, np.ones(0, dtype=bool))
+    cls = _classify(Qt, c, X)
+    # singular end points, and paths that stopped short of t = 1 without escaping to infinity
+    sing = np.array([i for i, r in enumerate(cls) if r[0] == "singular" or (not done[i] and r[0] != "at_infinity")],
+                    dtype=np.int64)
+    mult = np.ones(len(cls), dtype=np.int64)
+    wind = np.zeros(len(cls), dtype=np.int64)
+    isolated = True
+    if len(sing):  # the Cauchy end game locates them; then multiple roots or a continuum
+        eg = cauchy_endgame(track_parameter, gen.Q, Qt, c, gen.X[sing])
+        X = X.copy()
+        X[sing[eg.converged]] = eg.X[eg.converged]
+        wind[sing] = eg.winding
+        cls = _classify(Qt, c, X)
+        isolated = bool(eg.converged.all())
+        for grp in _groups(X[sing]):
+            mult[sing[grp]] = len(grp)
+            dim = local_dimension(lambda Y: _eval_quad(Qt, c, Y)[:2], X[sing[grp[0]]])
+            isolated &= dim == 0 and len(grp) > 1
     sols = []
-    for st, rc, ri, im, res, y, _ in _classify(Qt, c, X):
+    for i, (st, rc, ri, im, res, y, _) in enumerate(cls):
         R = p = None
         if (st == "real" or (st == "singular" and im < HOMOTOPY_NEAR_REAL)) and ri >= HOMOTOPY_INFINITY:
             R, p = study_to_pose(y / np.linalg.norm(y), sysm.L)
-        sols.append(HomotopySolution(st, y, rc, ri, im, res, R, p))
+        sols.append(HomotopySolution(st, y, rc, ri, im, res, R, p, int(mult[i]), int(wind[i])))
     n_par = len(sysm.affine_span()[1])
     how = (f"total-degree homotopy ({gen.n_paths} paths, gamma trick) to a generic complex instance: every path "
            f"accounted for ({len(gen.X)} finite nonsingular, {gen.n_at_infinity} at the exceptional generator e.e = 0); "
            f"parameter homotopy of those {len(gen.X)} paths to the requested actuator values (straight segment in the "
            f"{n_par}-dimensional affine span of the coefficients)")
     n_sing = sum(s.status == "singular" for s in sols)
-    if accounted and n_sing:
-        how += (f"; but {n_sing} end point(s) are singular (a continuum of solutions or a multiple root at these values, "
-                "located to a few digits only): not proven complete there; real points near them polished, the multi-start "
-                "roots added, and a continuum reported as one self-motion set")
+    if accounted and n_sing and isolated:
+        n_roots = len(_groups(X[sing]))
+        how += (f"; {n_sing} path(s) end at {n_roots} isolated multiple root(s) (multiplicities "
+                f"{sorted(int(m) for m in set(mult[sing].tolist()))}), located by a Cauchy end game (winding numbers "
+                f"{sorted(set(wind[sing].tolist()))}) and found isolated by a local dimension test")
+    elif accounted and n_sing:
+        how += (f"; but {n_sing} end point(s) are singular and not all isolated multiple roots (a continuum of "
+                "solutions, or an end game that did not converge): not proven complete there; real points near them "
+                "polished, the multi-start roots added, and a continuum reported as one self-motion set")
     if not accounted:
         how = (f"NOT complete: {gen.n_paths - len(gen.X) - gen.n_at_infinity} of the {gen.n_paths} total-degree paths "
                f"ended neither at a finite nonsingular point nor at infinity after {gen.attempts} attempts")
-    return HomotopyResult(tuple(sols), accounted and not n_sing, how, len(gen.X), gen.n_paths, gen.seconds,
+    return HomotopyResult(tuple(sols), accounted and (not n_sing or isolated), how, len(gen.X), gen.n_paths, gen.seconds,
                           time.perf_counter() - t0, cached)
