@@ -23,6 +23,34 @@ def _lengths(sysm, R, p):
     return np.linalg.norm((R @ sysm.platform.T).T + p - sysm.base, axis=1)
 
 
+@pytest.fixture(scope="module", autouse=True)
+def phc_runs(tmp_path_factory):
+    """PHCpack's blackbox solves for the two cross-checks below (10-25 s each), started when this
+    module starts, so that they run on the other core while the module's other tests compute."""
+    if shutil.which("phc") is None:
+        yield {}
+        return
+    d = tmp_path_factory.mktemp("phc")
+    cases = {"stewart-6sps": (hc.stewart_system(catalog.resolve("stewart-6sps")), [1.2] * 6),
+             "three-rps": (hc.pose_system(catalog.resolve("three-rps")), [0.34, 0.36, 0.32])}
+    jobs = {}
+    for name, (sysm, vals) in cases.items():
+        (d / f"{name}.in").write_text(hc.phc_input(sysm, vals, np.random.default_rng(3).normal(size=8)))
+        jobs[name] = (subprocess.Popen(["phc", "-b", str(d / f"{name}.in"), str(d / f"{name}.out")],
+                                       stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                                       stderr=subprocess.DEVNULL), d / f"{name}.out")
+    yield jobs
+    for proc, _ in jobs.values():
+        if proc.poll() is None:
+            proc.kill()
+
+
+def _phc_output(jobs, name: str) -> str:
+    proc, out = jobs[name]
+    assert proc.wait(timeout=300) == 0, f"phc -b failed on {name}"
+    return out.read_text()
+
+
 @pytest.fixture(scope="module")
 def general():
     """A general 6-6 geometry and a real pose of it (its leg lengths)."""
@@ -114,30 +142,6 @@ def test_uncovered_model_clear_message():
     assert "Traceback" not in out.output
     with pytest.raises(sm.InputError, match="method"):
         sm.fk("stewart-6sps", [1.2] * 6, all_solutions=True, method="newton")
-
-
-@pytest.mark.skipif(shutil.which("phc") is None, reason="PHCpack (Debian phcpack) not installed")
-def test_phcpack_agrees_on_the_stewart_model(stewart, tmp_path):
-    """Independent check: PHCpack's blackbox solver on the same system finds the same number of
-    regular solutions and the same real ones (about 13 s)."""
-    mech, res = stewart
-    sysm = hc.stewart_system(mech)
-    c = np.random.default_rng(3).normal(size=8)
-    (tmp_path / "in.txt").write_text(hc.phc_input(sysm, [1.2] * 6, c))
-    subprocess.run(["phc", "-b", str(tmp_path / "in.txt"), str(tmp_path / "out.txt")], check=True,
-                   capture_output=True, timeout=120)
-    out = (tmp_path / "out.txt").read_text()
-    n_regular = int(re.findall(r"Number of regular solutions\s*:\s*(\d+)", out)[-1])
-    assert n_regular == res.search["n_generic"] == res.search["n_real"] + res.search["n_complex"]
-    phc_real = []
-    for block in out[out.rfind("THE SOLUTIONS"):].split("solution ")[1:]:
-        vals = {k: complex(float(x), float(y)) for k, x, y in re.findall(r"\b([eg]\d) :\s+(\S+)\s+(\S+)", block)}
-        if len(vals) == 8 and "real regular" in block:
-            phc_real.append(hc.study_to_pose(np.array([vals[k] for k in sorted(vals)]).real, sysm.L)[1])
-    assert len(phc_real) == res.search["n_real"]
-    ours = [s.config.D[:3, 3] for s in res.solutions]
-    for p in phc_real:
-        assert min(np.linalg.norm(p - q) for q in ours) < 1e-6
 
 
 @pytest.mark.parametrize("phi", [[0.12, 0.2, -0.1, 0.6], [0.15, -0.3, 0.2, -0.4]])
@@ -295,30 +299,6 @@ def test_compiled_coefficient_tracker_equals_the_numpy_reference_on_the_delta():
 
 
 @pytest.mark.slow
-@pytest.mark.skipif(shutil.which("phc") is None, reason="PHCpack (Debian's phcpack) is not installed")
-def test_phcpack_agrees_on_the_three_rps(tmp_path):
-    """Second independent check (about 23 s of PHCpack's blackbox): the 3-RPS at legs (0.34,
-    0.36, 0.32) m, PHCpack and ours: 16 regular solutions, the same real ones."""
-    mech = catalog.resolve("three-rps")
-    legs = [0.34, 0.36, 0.32]
-    sysm = hc.pose_system(mech)
-    ours = hc.homotopy_forward(sysm, legs)
-    (tmp_path / "in.txt").write_text(hc.phc_input(sysm, legs, np.random.default_rng(3).normal(size=8)))
-    subprocess.run(["phc", "-b", str(tmp_path / "in.txt"), str(tmp_path / "out.txt")], check=True,
-                   capture_output=True, timeout=300)
-    out = (tmp_path / "out.txt").read_text()
-    assert int(re.findall(r"Number of regular solutions\s*:\s*(\d+)", out)[-1]) == ours.n_generic == 16
-    phc_real = []
-    for block in out[out.rfind("THE SOLUTIONS"):].split("solution ")[1:]:
-        vals = {k: complex(float(x), float(y)) for k, x, y in re.findall(r"\b([eg]\d) :\s+(\S+)\s+(\S+)", block)}
-        if len(vals) == 8 and "real regular" in block:
-            phc_real.append(hc.study_to_pose(np.array([vals[k] for k in sorted(vals)]).real, sysm.L)[1])
-    mine = [s.p for s in ours.solutions if s.status == "real"]
-    assert len(phc_real) == len(mine) > 0
-    for p in phc_real:
-        assert min(np.linalg.norm(p - q) for q in mine) < 1e-6
-
-
 def test_geometry_family_resolve_matches_a_fresh_solve():
     """The parameter homotopy in a 96-dimensional coefficient space (the 42 geometry numbers of
     a 6-6 platform, benchmarks/bench_all_real.py): moving to a new geometry gives the 40
@@ -408,3 +388,46 @@ def test_local_dimension_tells_a_multiple_root_from_a_continuum():
                          np.array([[2 * v[0] - v[1], -v[0]], [v[1], v[0] - 2 * v[1]]], dtype=complex)))
     assert local_dimension(double, np.array([0.0, 0.0], dtype=complex)) == 0
     assert local_dimension(line, np.array([0.5, 0.5], dtype=complex)) == 1
+
+
+# ------------------------------------------------------------------ PHCpack cross-checks (last: solves start with the module)
+@pytest.mark.skipif(shutil.which("phc") is None, reason="PHCpack (Debian phcpack) not installed")
+def test_phcpack_agrees_on_the_stewart_model(stewart, phc_runs):
+    """Independent check: PHCpack's blackbox solver on the same system finds the same number of
+    regular solutions and the same real ones (about 13 s, started with the module)."""
+    mech, res = stewart
+    sysm = hc.stewart_system(mech)
+    out = _phc_output(phc_runs, "stewart-6sps")
+    n_regular = int(re.findall(r"Number of regular solutions\s*:\s*(\d+)", out)[-1])
+    assert n_regular == res.search["n_generic"] == res.search["n_real"] + res.search["n_complex"]
+    phc_real = []
+    for block in out[out.rfind("THE SOLUTIONS"):].split("solution ")[1:]:
+        vals = {k: complex(float(x), float(y)) for k, x, y in re.findall(r"\b([eg]\d) :\s+(\S+)\s+(\S+)", block)}
+        if len(vals) == 8 and "real regular" in block:
+            phc_real.append(hc.study_to_pose(np.array([vals[k] for k in sorted(vals)]).real, sysm.L)[1])
+    assert len(phc_real) == res.search["n_real"]
+    ours = [s.config.D[:3, 3] for s in res.solutions]
+    for p in phc_real:
+        assert min(np.linalg.norm(p - q) for q in ours) < 1e-6
+
+
+@pytest.mark.skipif(shutil.which("phc") is None, reason="PHCpack (Debian's phcpack) is not installed")
+def test_phcpack_agrees_on_the_three_rps(phc_runs):
+    """Second independent check (about 23 s of PHCpack's blackbox, started with the module): the
+    3-RPS at legs (0.34, 0.36, 0.32) m, PHCpack and ours: 16 regular solutions, the same real
+    ones."""
+    mech = catalog.resolve("three-rps")
+    legs = [0.34, 0.36, 0.32]
+    sysm = hc.pose_system(mech)
+    ours = hc.homotopy_forward(sysm, legs)
+    out = _phc_output(phc_runs, "three-rps")
+    assert int(re.findall(r"Number of regular solutions\s*:\s*(\d+)", out)[-1]) == ours.n_generic == 16
+    phc_real = []
+    for block in out[out.rfind("THE SOLUTIONS"):].split("solution ")[1:]:
+        vals = {k: complex(float(x), float(y)) for k, x, y in re.findall(r"\b([eg]\d) :\s+(\S+)\s+(\S+)", block)}
+        if len(vals) == 8 and "real regular" in block:
+            phc_real.append(hc.study_to_pose(np.array([vals[k] for k in sorted(vals)]).real, sysm.L)[1])
+    mine = [s.p for s in ours.solutions if s.status == "real"]
+    assert len(phc_real) == len(mine) > 0
+    for p in phc_real:
+        assert min(np.linalg.norm(p - q) for q in mine) < 1e-6
