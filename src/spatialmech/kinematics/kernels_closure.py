@@ -16,6 +16,7 @@ from .kernels_se3 import (
     nb_lstsq,
     nb_mm4,
     nb_orthonormal,
+    nb_rodrigues,
 )
 from .jit import njit
 
@@ -31,28 +32,12 @@ __all__ = [
     "nb_max_limb",
     "nb_norm",
     "nb_retract",
-    "nb_rodrigues",
     "nb_scales",
     "nb_systems",
 ]
 
 
 # ---------------------------------------------------------------------------- chain and closure
-@njit(cache=True)
-def nb_rodrigues(w0, w1, w2, s, c, out):
-    """``I + s W + c W W`` with ``W = skew(w)`` (``W W = w w^T - |w|^2 I``)."""
-    n2 = w0 * w0 + w1 * w1 + w2 * w2
-    out[0, 0] = 1.0 + c * (w0 * w0 - n2)
-    out[1, 1] = 1.0 + c * (w1 * w1 - n2)
-    out[2, 2] = 1.0 + c * (w2 * w2 - n2)
-    out[0, 1] = -s * w2 + c * w0 * w1
-    out[1, 0] = s * w2 + c * w0 * w1
-    out[0, 2] = s * w1 + c * w0 * w2
-    out[2, 0] = -s * w1 + c * w0 * w2
-    out[1, 2] = -s * w0 + c * w1 * w2
-    out[2, 1] = s * w0 + c * w1 * w2
-
-
 @njit(cache=True)
 def nb_chain(S, ball_of, ball_axes, ball_centre, q, lo, hi, T, J):
     """:func:`.closure.chain_forward` (``local=True``) of the freedoms ``lo:hi``: ``T`` (4x4) and

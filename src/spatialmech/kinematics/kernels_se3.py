@@ -28,6 +28,7 @@ __all__ = [
     "nb_mv",
     "nb_orthonormal",
     "nb_quat_rotvec",
+    "nb_rodrigues",
     "nb_rotvec_matrix",
     "nb_rotvec_matrix3",
     "nb_sincos",
@@ -71,6 +72,21 @@ def nb_skew(w, out):
 
 
 @njit(cache=True)
+def nb_rodrigues(w0, w1, w2, s, c, out):
+    """``I + s W + c W W`` with ``W = skew(w)`` (``W W = w w^T - |w|^2 I``)."""
+    n2 = w0 * w0 + w1 * w1 + w2 * w2
+    out[0, 0] = 1.0 + c * (w0 * w0 - n2)
+    out[1, 1] = 1.0 + c * (w1 * w1 - n2)
+    out[2, 2] = 1.0 + c * (w2 * w2 - n2)
+    out[0, 1] = -s * w2 + c * w0 * w1
+    out[1, 0] = s * w2 + c * w0 * w1
+    out[0, 2] = s * w1 + c * w0 * w2
+    out[2, 0] = -s * w1 + c * w0 * w2
+    out[1, 2] = -s * w0 + c * w1 * w2
+    out[2, 1] = s * w0 + c * w1 * w2
+
+
+@njit(cache=True)
 def nb_rotvec_matrix3(p0, p1, p2, out):
     """:func:`..geometry.rotations.rotvec_matrix` of the rotation vector ``(p0, p1, p2)``:
     ``I + sin(th) K + (1 - cos(th)) K K`` with ``K = skew(phi / th)``, or ``I + skew(phi)``
@@ -80,17 +96,7 @@ def nb_rotvec_matrix3(p0, p1, p2, out):
         s, c, k0, k1, k2 = 1.0, 0.0, p0, p1, p2
     else:
         s, c, k0, k1, k2 = np.sin(th), 1.0 - np.cos(th), p0 / th, p1 / th, p2 / th
-    # K K = k k^T - |k|^2 I
-    n2 = k0 * k0 + k1 * k1 + k2 * k2
-    out[0, 0] = 1.0 + c * (k0 * k0 - n2)
-    out[1, 1] = 1.0 + c * (k1 * k1 - n2)
-    out[2, 2] = 1.0 + c * (k2 * k2 - n2)
-    out[0, 1] = -s * k2 + c * k0 * k1
-    out[1, 0] = s * k2 + c * k0 * k1
-    out[0, 2] = s * k1 + c * k0 * k2
-    out[2, 0] = -s * k1 + c * k0 * k2
-    out[1, 2] = -s * k0 + c * k1 * k2
-    out[2, 1] = s * k0 + c * k1 * k2
+    nb_rodrigues(k0, k1, k2, s, c, out)
 
 
 @njit(cache=True)
