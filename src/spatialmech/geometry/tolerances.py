@@ -52,6 +52,10 @@ __all__ = [
     "HOMOTOPY_NEWTON",
     "HOMOTOPY_REAL",
     "HOMOTOPY_SINGULAR",
+    "MONODROMY_MAX_LOOPS",
+    "MONODROMY_PARALLEL",
+    "MONODROMY_RESIDUAL",
+    "MONODROMY_STALE_LOOPS",
     "NEAR_SINGULAR",
     "Tolerances",
     "characteristic_length",
@@ -254,3 +258,10 @@ HOMOTOPY_SINGULAR = 1e-7
 HOMOTOPY_INFINITY = 1e-7
 HOMOTOPY_REAL = 1e-7
 HOMOTOPY_NEAR_REAL = 1e-3
+#: Monodromy (kinematics/homotopy_general.py): loops in a row without a new solution before the
+#: solve stops (saturation, not a proof), the most loops, and the relative residual of the full
+#: closure below which an end point of the square system is a solution (else spurious).
+MONODROMY_STALE_LOOPS = 8
+MONODROMY_MAX_LOOPS = 80
+MONODROMY_PARALLEL = 4  # loops tracked together in one batch
+MONODROMY_RESIDUAL = 1e-8

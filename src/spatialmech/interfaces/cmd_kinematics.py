@@ -255,12 +255,16 @@ def fk(model, values, all_solutions, method, seeds, as_json):
     if all_solutions and method != "multistart" and not closed:
         from ..kinematics import homotopy as hc
 
+        from ..kinematics import homotopy_general as hg
+
         why = hc.unsupported_reason(mech)
-        if why is None:
+        gwhy = hg.general_reason(mech) if why is not None else None
+        if why is None or gwhy is None:
             _fk_homotopy(mech, vals, as_json)
             return
         if method == "homotopy":
-            raise InputError(f"--method: homotopy does not cover {mech.name}: {why}; use --method multistart")
+            raise InputError(f"--method: homotopy does not cover {mech.name}: {why}; nor does the loop formulation: "
+                             f"{gwhy}; use --method multistart")
     geom = k4.geometry_of(mech) if all_solutions and method != "multistart" else None
     if geom is not None:  # the closed form of this limb layout: faster and more thorough
         fa = k4f.forward_all(np.asarray(vals), geometry=geom, **({} if seeds is None else {"n_seeds": seeds}))
@@ -330,8 +334,9 @@ def _fk_homotopy(mech: Mechanism, vals, as_json: bool) -> None:
     click.echo(f"{mech.name}: {len(sols)} real assembly mode{'s' if len(sols) != 1 else ''}"
                + (f" ({n_sm} of them self-motion sets)" if n_sm else "")
                + f"; end points: {sr['n_real']} real, {sr['n_complex']} complex, {sr['n_singular']} singular, "
-               f"{sr['n_at_infinity']} at infinity, of {sr['n_generic']} generic solutions "
-               f"(homotopy continuation, {sr['elapsed_s']:.2f} s)")
+               f"{sr['n_at_infinity']} at infinity, of {sr['n_generic']} generic solutions"
+               + (f" ({sr['n_spurious']} spurious end points of the square system discarded)" if "n_spurious" in sr else "")
+               + f" ({sr['method'].split(',')[0]}, {sr['elapsed_s']:.2f} s)")
     click.echo(("  complete (proven): " if sr["complete"] else "  NOT proven complete: ") + sr["completeness"])
     _fk_solution_lines(mech, sols)
 

@@ -1,0 +1,764 @@
+"""Every assembly mode of a model whose limbs do not reduce to quadrics in the Study parameters
+(:mod:`.homotopy_systems`): a polynomial formulation in the joint variables, generated from the
+model, solved by monodromy and a parameter homotopy.
+
+Formulation (limbs from the ground to the platform; joints R, P, C, U, S, Sm).  Every passive,
+unlocked revolute freedom is a pair ``(c, s)`` with ``c^2 + s^2 = 1`` and its displacement
+``exp(theta A) = I + s A + (1 - c) A^2`` (``A`` the 4x4 matrix of its unit twist, pitch 0:
+``A^3 = -A``), every passive slide a linear variable ``d`` (over the characteristic length
+``L``) with ``exp(d A) = I + d A``; an actuated freedom is the same with its ``(c, s)`` or ``d``
+as a *parameter*.  The product of a limb's displacements is then polynomial.  The platform
+displacement ``D`` is the product of the first limb without an S joint (the *reference
+limb*), or, when every limb has one, the Study parameters ``x = (e ; g)`` of :mod:`.homotopy`
+(``(e.e) D`` polynomial, with ``e.g = 0`` and a random complex patch).  Each other limb gives:
+
+* no S joint: ``FK = D`` (12 entries, 6 conditions);
+* one S joint at centre ``c``: ``before(c) = D after^-1(c)`` (3 entries): the S joint's rotation
+  is then whatever closes the limb, so it is not a variable;
+* two consecutive S joints (a rod, centres ``c1``, ``c2``): ``|before(c1) - D after^-1(c2)|^2 =
+  |c1 - c2|^2`` (1 entry): the rod's idle spin is not a variable either.
+
+The closure entries outnumber the unknowns they fix (12 entries for 6 conditions, and
+overconstrained linkages such as the Bennett have fewer conditions still): the system is made
+square by random complex combinations (each reference-free limb's 12 entries to 6 when the
+conditions count exactly, else all entries to the number needed), and every end point is
+checked against the full closure: points of the square system that do not close are
+*spurious* and discarded (their number is reported).
+
+Solver.  ``G(x; p) = b`` with the actuators' parameters ``p`` and an offset ``b``: for a random
+complex ``x0`` and ``p0``, ``b0 = G(x0; p0)`` makes ``x0`` a solution for free; the incidence
+variety ``{(x, b): G(x; p0) = b}`` is the graph of ``G``, irreducible, so monodromy loops
+``b0 -> b1 -> b2 -> b0`` through random complex offsets permute the solutions transitively:
+the solutions found grow until every solution of the generic instance is known (each loop
+also tracks one fresh random point ``x'`` from ``G(x'; p0)`` to ``b0``).  The loop
+stops after :data:`MONODROMY_STALE_LOOPS` loops in a row without a new solution; that is a
+*saturation*, not a proof (no trace test), and the result says so (``complete`` is false).
+A parameter homotopy along the straight segment ``(b, p) = ((1 - t) b0, (1 - t) p0 + t
+p_request)`` then tracks every known solution to the request (the NumPy tracker
+:func:`.homotopy.track`).  The generic solve is cached per geometry (in memory).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ..errors import InputError
+from ..geometry.rotations import matrix_rotvec, skew
+from ..geometry.tolerances import (
+    HOMOTOPY_INFINITY,
+    HOMOTOPY_REAL,
+    HOMOTOPY_SINGULAR,
+    MONODROMY_MAX_LOOPS,
+    MONODROMY_PARALLEL,
+    MONODROMY_RESIDUAL,
+    MONODROMY_STALE_LOOPS,
+)
+from ..model.mechanism import Mechanism
+from .closure import Configuration, limb_slices
+from .homotopy import study_to_pose, track
+
+__all__ = [
+    "GeneralResult",
+    "GeneralSolution",
+    "LoopSystem",
+    "clear_cache",
+    "configuration",
+    "general_forward",
+    "general_reason",
+    "loop_system",
+]
+
+_I4 = np.eye(4)
+
+
+@dataclass(frozen=True, eq=False)
+class _Factor:
+    kind: str  # "R" or "P"
+    A: np.ndarray  # 4x4 twist matrix (moments over L)
+    A2: np.ndarray
+    idx: tuple[int, ...]  # (c, s) or (d,) in the variable vector z = (x ; p)
+    inverse: bool = False
+
+    def inverted(self) -> _Factor:
+        return _Factor(self.kind, self.A, self.A2, self.idx, not self.inverse)
+
+
+@dataclass(frozen=True, eq=False)
+class _LimbEq:
+    kind: str  # "full", "point", "rod"
+    before: tuple[_Factor, ...]
+    after_inv: tuple[_Factor, ...]  # the factors after the S joint(s), inverted, in reverse order
+    c1: np.ndarray  # homogeneous centre(s) (over L)
+    c2: np.ndarray
+    length2: float  # rod length squared (over L^2)
+    limb: int
+    s_first: int  # index in the limb of the first S freedom (-1: none)
+
+
+@dataclass(frozen=True, eq=False)
+class LoopSystem:
+    """The polynomial closure of a model (module docstring): unknowns ``x`` (``nx``),
+    parameters ``p`` (the actuators, ``npar``), the square system ``G`` and the full closure."""
+
+    mech: Mechanism
+    L: float
+    nx: int
+    npar: int
+    circles: tuple[tuple[int, int], ...]  # (c, s) index pairs of the unknown revolutes
+    ref: tuple[_Factor, ...] | None  # the reference limb's factors (None: Study parameters)
+    ref_limb: int
+    study: int  # index of e0 in x when the platform is in Study parameters (-1 otherwise)
+    patch: np.ndarray | None
+    limbs: tuple[_LimbEq, ...]
+    compress: np.ndarray  # (m, r) complex: closure entries -> square rows
+    var_of: dict  # freedom index -> ("R", ic, is) / ("P", id) / ("A", ...) parameter / ("L",) locked / ("S",)
+    params: tuple[tuple[int, str, tuple[int, ...]], ...]  # (freedom index, kind, z indices)
+    n_conditions: int
+
+    @property
+    def n_rows(self) -> int:
+        return self.compress.shape[0]
+
+    def key(self) -> bytes:
+        parts = [np.array([self.nx, self.npar, self.ref_limb, self.study], float)]
+        for f in self.ref or ():
+            parts.append(f.A.ravel())
+        for le in self.limbs:
+            parts += [f.A.ravel() for f in le.before + le.after_inv] + [le.c1, le.c2, np.array([le.length2])]
+        return np.round(np.concatenate(parts), 12).tobytes()
+
+    # -------------------------------------------------------------------------- evaluation
+    def _chain(self, factors, Z):
+        n, nz = Z.shape
+        T = np.broadcast_to(_I4, (n, 4, 4)).astype(complex)
+        dT = np.zeros((n, nz, 4, 4), complex)
+        for f in factors:
+            sg = -1.0 if f.inverse else 1.0
+            if f.kind == "R":
+                c, s = Z[:, f.idx[0]], Z[:, f.idx[1]]
+                M = _I4 + sg * s[:, None, None] * f.A + (1 - c)[:, None, None] * f.A2
+                dT = dT @ M[:, None]
+                dT[:, f.idx[0]] += T @ (-f.A2)
+                dT[:, f.idx[1]] += T @ (sg * f.A)
+            else:
+                d = Z[:, f.idx[0]]
+                M = _I4 + sg * d[:, None, None] * f.A
+                dT = dT @ M[:, None]
+                dT[:, f.idx[0]] += T @ (sg * f.A)
+            T = T @ M
+        return T, dT
+
+    def _platform(self, Z):
+        """``D`` (or ``(e.e) D``), its derivative, and the scale ``n`` (1, or ``e.e``) with its derivative."""
+        n, nz = Z.shape
+        if self.ref is not None:
+            T, dT = self._chain(self.ref, Z)
+            return T, dT, np.ones(n, complex), np.zeros((n, nz), complex)
+        k = self.study
+        X = Z[:, k : k + 8]
+        Dn = np.einsum("ni,abij,nj->nab", X, _STUDY_Q, X)
+        dDn = np.zeros((n, nz, 4, 4), complex)
+        dDn[:, k : k + 8] = np.einsum("abij,nj->niab", _STUDY_Q + _STUDY_Q.transpose(0, 1, 3, 2), X)
+        E = np.einsum("ni,ni->n", X[:, :4], X[:, :4])
+        dE = np.zeros((n, nz), complex)
+        dE[:, k : k + 4] = 2 * X[:, :4]
+        return Dn, dDn, E, dE
+
+    def closure(self, Z):
+        """Every closure entry (n, r) and its derivative (n, r, nz) at points ``Z = (x ; p)``."""
+        D, dD, E, dE = self._platform(Z)
+        rows, jac = [], []
+        for le in self.limbs:
+            Tb, dTb = self._chain(le.before, Z)
+            if le.kind == "full":
+                r = E[:, None, None] * Tb - D
+                dr = E[:, None, None, None] * dTb + dE[:, :, None, None] * Tb[:, None] - dD
+                rows.append(r[:, :3].reshape(len(Z), 12))
+                jac.append(dr[:, :, :3].reshape(len(Z), -1, 12).transpose(0, 2, 1))
+                continue
+            Ta, dTa = self._chain(le.after_inv, Z)
+            u1 = Tb @ le.c1
+            du1 = dTb @ le.c1
+            v = Ta @ le.c2
+            dv = dTa @ le.c2
+            u2 = np.einsum("nab,nb->na", D, v)
+            du2 = np.einsum("nzab,nb->nza", dD, v) + np.einsum("nab,nzb->nza", D, dv)
+            w = E[:, None] * u1 - u2
+            dw = E[:, None, None] * du1 + dE[:, :, None] * u1[:, None] - du2
+            w, dw = w[:, :3], dw[:, :, :3]
+            if le.kind == "point":
+                rows.append(w)
+                jac.append(dw.transpose(0, 2, 1))
+            else:
+                rows.append((np.einsum("na,na->n", w, w) - E**2 * le.length2)[:, None])
+                jac.append((2 * np.einsum("na,nza->nz", w, dw) - 2 * (E * le.length2)[:, None] * dE)[:, None])
+        if not rows:
+            return np.zeros((len(Z), 0), complex), np.zeros((len(Z), 0, Z.shape[1]), complex)
+        return np.concatenate(rows, axis=1), np.concatenate(jac, axis=1)
+
+    def side(self, Z):
+        """The circles, the Study quadric and patch: entries (n, k) and derivative (n, k, nz)."""
+        n, nz = Z.shape
+        k = len(self.circles) + (2 if self.study >= 0 else 0)
+        F = np.zeros((n, k), complex)
+        J = np.zeros((n, k, nz), complex)
+        for i, (a, b) in enumerate(self.circles):
+            F[:, i] = Z[:, a] ** 2 + Z[:, b] ** 2 - 1
+            J[:, i, a] = 2 * Z[:, a]
+            J[:, i, b] = 2 * Z[:, b]
+        if self.study >= 0:
+            s, i = self.study, len(self.circles)
+            X = Z[:, s : s + 8]
+            F[:, i] = np.einsum("ni,ni->n", X[:, :4], X[:, 4:])
+            J[:, i, s : s + 4] = X[:, 4:]
+            J[:, i, s + 4 : s + 8] = X[:, :4]
+            assert self.patch is not None
+            F[:, i + 1] = X @ self.patch - 1
+            J[:, i + 1, s : s + 8] = self.patch
+        return F, J
+
+    def square(self, Z):
+        """The square system ``G`` (n, nx) and its derivative (n, nx, nz) in ``z = (x ; p)``."""
+        F1, J1 = self.side(Z)
+        F2, J2 = self.closure(Z)
+        F = np.concatenate([F1, np.einsum("mr,nr->nm", self.compress, F2)], axis=1)
+        J = np.concatenate([J1, np.einsum("mr,nrz->nmz", self.compress, J2)], axis=1)
+        return F, J
+
+    def residual(self, Z):
+        """Relative residual of the full closure (every entry) and the side equations per point."""
+        F1, _ = self.side(Z)
+        F2, _ = self.closure(Z)
+        scale = 1.0 + np.linalg.norm(Z[:, : self.nx], axis=1)
+        if self.study >= 0:
+            scale = np.maximum(scale, np.linalg.norm(Z[:, self.study : self.study + 8], axis=1) ** 4)
+        return np.concatenate([np.abs(F1), np.abs(F2)], axis=1).max(axis=1, initial=0.0) / scale
+
+    def parameters(self, targets: dict[int, float]) -> np.ndarray:
+        """The parameter vector of actuator values ``targets`` (joint variable by freedom index)."""
+        p = np.zeros(self.npar)
+        for fi, kind, idx in self.params:
+            v = targets[fi]
+            if kind == "R":
+                p[idx[0] - self.nx], p[idx[1] - self.nx] = np.cos(v), np.sin(v)
+            else:
+                p[idx[0] - self.nx] = v / self.L
+        return p
+
+
+def _study_forms() -> np.ndarray:
+    """``(e.e) D`` of the Study parameters as quadratic forms: (4, 4, 8, 8) symmetric."""
+    from .homotopy_systems import qmul
+
+    def nd(x):
+        e, g = x[:4], x[4:]
+        w, i, j, k = e
+        M = np.zeros((4, 4))
+        M[:3, :3] = [[w * w + i * i - j * j - k * k, 2 * (i * j - w * k), 2 * (i * k + w * j)],
+                     [2 * (i * j + w * k), w * w - i * i + j * j - k * k, 2 * (j * k - w * i)],
+                     [2 * (i * k - w * j), 2 * (j * k + w * i), w * w - i * i - j * j + k * k]]
+        M[:3, 3] = 2 * qmul(g, e * np.array([1, -1, -1, -1]))[1:]
+        M[3, 3] = e @ e
+        return M
+
+    Q = np.zeros((4, 4, 8, 8))
+    eye = np.eye(8)
+    for a in range(8):
+        Q[:, :, a, a] = nd(eye[a])
+    for a in range(8):
+        for b in range(a + 1, 8):
+            Q[:, :, a, b] = Q[:, :, b, a] = 0.5 * (nd(eye[a] + eye[b]) - nd(eye[a]) - nd(eye[b]))
+    return Q
+
+
+_STUDY_Q = _study_forms()
+
+
+def _twist_matrix(S: np.ndarray, L: float) -> np.ndarray:
+    A = np.zeros((4, 4))
+    A[:3, :3] = skew(S[:3])
+    A[:3, 3] = S[3:] / L
+    return A
+
+
+def general_reason(mech: Mechanism) -> str | None:
+    """``None`` when :func:`loop_system` formulates ``mech``, else why not (one sentence)."""
+    try:
+        loop_system(mech)
+    except InputError as exc:
+        return str(exc)
+    return None
+
+
+_SYSTEMS: dict[int, tuple[Mechanism, LoopSystem]] = {}
+
+
+def loop_system(mech: Mechanism, seed: int = 0) -> LoopSystem:
+    """The polynomial closure of ``mech`` (module docstring); ``InputError`` naming the limb or
+    joint when the formulation does not cover it."""
+    hit = _SYSTEMS.get(id(mech))
+    if hit is not None and hit[0] is mech:
+        return hit[1]
+    if mech.bodies:
+        raise InputError("a link-and-joint graph (internal bodies): the loop formulation covers limbs from the ground "
+                         "to the platform only")
+    L = mech.characteristic_length
+    refs = mech.freedom_refs
+    acts = set(mech.actuators)
+    slices = limb_slices(mech)
+    # the S joints of each limb, and which limbs can define the platform
+    s_of: list[list[tuple[int, np.ndarray]]] = []
+    for limb in mech.limbs:
+        if limb.base != "ground" or limb.tip is not None:
+            raise InputError(f"limb {limb.name} does not run from the ground to the platform")
+        k, ss = 0, []
+        for j in limb.joints:
+            if j.type == "S":
+                if any(f.actuated for f in j.freedoms):
+                    raise InputError(f"limb {limb.name}: S joint {j.name} is actuated")
+                ss.append((k, np.asarray(j.point, float)))
+            for f in j.freedoms:
+                if f.kind == "H" and f.pitch != 0:
+                    raise InputError(f"limb {limb.name}: helical joint {j.name} (its rotation angle enters both "
+                                     "as an angle and through its sine and cosine: not polynomial)")
+            k += len(j.freedoms)
+        if len(ss) > 2 or (len(ss) == 2 and ss[1][0] != ss[0][0] + 3):
+            raise InputError(f"limb {limb.name}: S joints other than one, or two adjacent (a rod)")
+        s_of.append(ss)
+    no_s = [li for li in range(len(mech.limbs)) if not s_of[li]]
+    n_unknown = [sum(1 for i in range(sl.start, sl.stop) if not refs[i].freedom.locked and refs[i].id not in acts)
+                 for sl in slices]
+    ref_limb = min(no_s, key=lambda li: n_unknown[li]) if no_s else -1
+
+    var_of: dict = {}
+    nx = 0
+    circles = []
+    for i, r in enumerate(refs):
+        li = r.limb
+        k = i - slices[li].start
+        if any(k0 <= k < k0 + 3 for k0, _ in s_of[li]):
+            var_of[i] = ("S",)
+        elif r.freedom.locked:
+            var_of[i] = ("L",)
+        elif r.id in acts:
+            var_of[i] = ("A",)
+        elif r.freedom.kind == "P":
+            var_of[i] = ("P", nx)
+            nx += 1
+        else:
+            var_of[i] = ("R", nx, nx + 1)
+            circles.append((nx, nx + 1))
+            nx += 2
+    study = -1
+    if ref_limb < 0:
+        study = nx
+        nx += 8
+    params = []
+    npar = 0
+    for i, r in enumerate(refs):
+        if var_of[i] == ("A",):
+            idx = (nx + npar, nx + npar + 1) if r.freedom.kind != "P" else (nx + npar,)
+            var_of[i] = ("A", *idx)
+            params.append((i, "P" if r.freedom.kind == "P" else "R", idx))
+            npar += len(idx)
+
+    def factors(li: int, lo: int, hi: int) -> list[_Factor]:
+        out = []
+        for i in range(slices[li].start + lo, slices[li].start + hi):
+            v = var_of[i]
+            if v[0] in ("L", "S"):
+                continue
+            A = _twist_matrix(refs[i].freedom.screw, L)
+            kind = "P" if refs[i].freedom.kind == "P" else "R"
+            out.append(_Factor(kind, A, A @ A, tuple(v[1:])))
+        return out
+
+    limbs: list[_LimbEq] = []
+    cond = 0
+    for li in range(len(mech.limbs)):
+        if li == ref_limb:
+            continue
+        m = slices[li].stop - slices[li].start
+        ss = s_of[li]
+        z4 = np.zeros(4)
+        if not ss:
+            limbs.append(_LimbEq("full", tuple(factors(li, 0, m)), (), z4, z4, 0.0, li, -1))
+            cond += 6
+            continue
+        k0 = ss[0][0]
+        k1 = ss[-1][0] + 3
+        c1 = np.append(ss[0][1] / L, 1.0)
+        c2 = np.append(ss[-1][1] / L, 1.0)
+        after = [f.inverted() for f in reversed(factors(li, k1, m))]
+        if len(ss) == 1:
+            limbs.append(_LimbEq("point", tuple(factors(li, 0, k0)), tuple(after), c1, c1, 0.0, li, k0))
+            cond += 3
+        else:
+            limbs.append(_LimbEq("rod", tuple(factors(li, 0, k0)), tuple(after), c1, c2,
+                                 float(np.sum((c1 - c2) ** 2)), li, k0))
+            cond += 1
+    m_needed = nx - len(circles) - (2 if study >= 0 else 0)
+    sizes = [12 if le.kind == "full" else 3 if le.kind == "point" else 1 for le in limbs]
+    rng = np.random.default_rng(seed + 7919)
+    patch = (rng.normal(size=8) + 1j * rng.normal(size=8)) if study >= 0 else None
+    ref = tuple(factors(ref_limb, 0, slices[ref_limb].stop - slices[ref_limb].start)) if ref_limb >= 0 else None
+    sysm = LoopSystem(mech, L, nx, npar, tuple(circles), ref, ref_limb, study, patch, tuple(limbs),
+                      np.eye(sum(sizes), dtype=complex), var_of, tuple(params), cond)
+    ranks = _limb_ranks(sysm, sizes, rng)
+    cond = sum(ranks)
+    if cond < m_needed:
+        raise InputError(f"the closure of {mech.name} leaves {m_needed - cond} freedom(s) undetermined with the actuators "
+                         "held (a mobility the loop formulation does not remove, e.g. an idle freedom other than an S-S "
+                         "rod's spin)")
+
+    def rnd(a, b):
+        M = rng.normal(size=(a, b)) + 1j * rng.normal(size=(a, b))
+        return M / np.linalg.norm(M, axis=1, keepdims=True)
+
+    if cond == m_needed:  # each limb's entries to its number of independent conditions
+        C = np.zeros((m_needed, sum(sizes)), complex)
+        i = j = 0
+        for rk, sz in zip(ranks, sizes, strict=True):
+            C[i : i + rk, j : j + sz] = rnd(rk, sz) if rk < sz else np.eye(sz)
+            i += rk
+            j += sz
+    else:  # overconstrained as a whole: every entry into the number of rows needed
+        C = rnd(m_needed, sum(sizes))
+    sysm = replace(sysm, compress=C, n_conditions=cond)
+    _SYSTEMS[id(mech)] = (mech, sysm)
+    return sysm
+
+
+def _point(sysm: LoopSystem, config: Configuration) -> np.ndarray:
+    """The variables ``z = (x ; p)`` of a real configuration (joint variables ``q``, platform ``D``)."""
+    z = np.zeros(sysm.nx + sysm.npar)
+    for i, v in sysm.var_of.items():
+        qi = config.q[i]
+        if v[0] in ("R", "A") and len(v) == 3:
+            z[v[1]], z[v[2]] = np.cos(qi), np.sin(qi)
+        elif v[0] in ("P", "A"):
+            z[v[1]] = qi / sysm.L
+    if sysm.study >= 0:
+        from scipy.spatial.transform import Rotation
+
+        x, y, zz, w = Rotation.from_matrix(config.D[:3, :3]).as_quat()
+        e = np.array([w, x, y, zz])
+        from .homotopy_systems import qmul
+
+        g = 0.5 * qmul(np.concatenate([[0.0], config.D[:3, 3] / sysm.L]), e)
+        xs = np.concatenate([e, g]).astype(complex)
+        assert sysm.patch is not None
+        z = z.astype(complex)
+        z[sysm.study : sysm.study + 8] = xs / (xs @ sysm.patch)
+    return np.asarray(z, complex)
+
+
+def _limb_ranks(sysm: LoopSystem, sizes: list[int], rng: np.random.Generator) -> list[int]:
+    """The number of independent conditions of each limb's closure entries on the unknowns: the
+    rank of their derivative along the side equations' solution set (circles, Study quadric),
+    the actuators held, at a generic
+    configuration of the mechanism (a random walk from the reference along its closure)."""
+    from .closure import generic_configuration
+
+    try:
+        config = generic_configuration(sysm.mech, seed=int(rng.integers(2**31)), step=0.5, steps=4)
+    except RuntimeError:
+        config = Configuration.reference(sysm.mech)
+    z = _point(sysm, config)[None]
+    _, Js = sysm.side(z)
+    _, Jc = sysm.closure(z)
+    Js, Jc = Js[:, :, : sysm.nx], Jc[:, :, : sysm.nx]  # the actuators held
+    _, sv, vt = np.linalg.svd(Js[0])
+    N = vt[int(np.sum(sv > 1e-9 * max(1.0, sv[0] if sv.size else 0.0))):].conj().T
+    out, j = [], 0
+    for sz in sizes:
+        M = Jc[0, j : j + sz] @ N
+        s = np.linalg.svd(M, compute_uv=False)
+        out.append(int(np.sum(s > 1e-8 * max(1.0, s[0] if s.size else 0.0))))
+        j += sz
+    return out
+
+
+# ------------------------------------------------------------------------------ solving
+def _segment(sysm: LoopSystem, X, b0, b1, p0, p1):
+    """Track the points ``X`` (n, nx) from ``(b0, p0)`` to ``(b1, p1)`` (straight segments; ``b0``
+    and ``b1`` one offset for all points, (m,), or one per point, (n, m))."""
+    nx = sysm.nx
+    if len(X) == 0:
+        return X, np.zeros(0), np.zeros(0, bool)
+    B0 = np.broadcast_to(b0, (len(X), nx))
+    dB = np.broadcast_to(b1, (len(X), nx)) - B0
+    dp = p1 - p0
+
+    def fun(Xc, t, idx):
+        p = p0[None] + t[:, None] * dp[None]
+        F, J = sysm.square(np.concatenate([Xc, p], axis=1))
+        b = B0[idx] + t[:, None] * dB[idx]
+        Ht = np.einsum("nkp,p->nk", J[:, :, nx:], dp) - dB[idx]
+        return F - b, J[:, :, :nx], Ht
+
+    Xe, t, done, _ = track(fun, X, max_steps=2000, indexed=True)
+    return Xe, t, done
+
+
+def _new_points(known: np.ndarray, cand: np.ndarray, tol: float = 1e-6) -> np.ndarray:
+    out = []
+    for x in cand:
+        ref = known if not out else np.vstack([known, out])
+        d = np.linalg.norm(ref - x, axis=1) / (1 + np.linalg.norm(x))
+        if np.all(d > tol):
+            out.append(x)
+    return np.array(out).reshape(-1, known.shape[1])
+
+
+@dataclass(frozen=True, eq=False)
+class _GenericLoop:
+    p0: np.ndarray
+    b0: np.ndarray
+    X: np.ndarray
+    loops: int
+    seconds: float
+    saturated: bool
+
+
+_CACHE: dict[bytes, _GenericLoop] = {}
+
+
+def _monodromy(sysm: LoopSystem, seed: int) -> _GenericLoop:
+    key = sysm.key() + bytes([seed % 256])
+    if key in _CACHE:
+        return _CACHE[key]
+    t0 = time.perf_counter()
+    rng = np.random.default_rng(seed)
+
+    def crand(*shape):
+        return rng.normal(size=shape) + 1j * rng.normal(size=shape)
+
+    p0 = crand(sysm.npar)
+    x0 = crand(sysm.nx)
+    b0 = sysm.square(np.concatenate([x0, p0])[None])[0][0]
+    scale = np.abs(b0) + 1.0
+    known = x0[None]
+    stale = loops = 0
+    k = MONODROMY_PARALLEL
+    while stale < MONODROMY_STALE_LOOPS and loops < MONODROMY_MAX_LOOPS:
+        loops += k  # k loops at once, each through its own two random offsets
+        B1 = np.repeat(scale * crand(k, len(b0)), len(known), axis=0)
+        B2 = np.repeat(scale * crand(k, len(b0)), len(known), axis=0)
+        X = np.tile(known, (k, 1))
+        for leg in range(3):
+            a, b = ((b0, B1), (B1, B2), (B2, b0))[leg]
+            X, _, done = _segment(sysm, X, a, b, p0, p0)
+            X, B1, B2 = X[done], B1[done], B2[done]  # a failed path is dropped
+        xr = crand(k, sysm.nx)  # and fresh random points, moved to the generic instance
+        br = sysm.square(np.concatenate([xr, np.tile(p0, (k, 1))], axis=1))[0]
+        Xr, _, done = _segment(sysm, xr, br, b0, p0, p0)
+        X = np.vstack([X, Xr[done]])
+        new = _new_points(known, X)
+        if len(new):
+            known = np.vstack([known, new])
+            stale = 0
+        else:
+            stale += k
+    g = _GenericLoop(p0, b0, known, loops, time.perf_counter() - t0, stale >= MONODROMY_STALE_LOOPS)
+    _CACHE[key] = g
+    return g
+
+
+def clear_cache() -> None:
+    """Forget the cached generic solves (benchmarks time the first solve)."""
+    _CACHE.clear()
+
+
+@dataclass(frozen=True, eq=False)
+class GeneralSolution:
+    """One end point at the request: ``status`` real / complex / singular / at_infinity, the
+    variables ``x`` and, for a real one, the joint variables ``q`` and platform ``D``."""
+
+    status: str
+    x: np.ndarray
+    rcond: float
+    imag_ratio: float
+    residual: float
+    q: np.ndarray | None = None
+    D: np.ndarray | None = None
+
+    def to_dict(self) -> dict:
+        return {"status": self.status, "variables_real": [float(v) for v in self.x.real],
+                "variables_imag": [float(v) for v in self.x.imag], "inverse_condition": self.rcond,
+                "imaginary_ratio": self.imag_ratio, "residual": self.residual}
+
+
+@dataclass(frozen=True, eq=False)
+class GeneralResult:
+    solutions: tuple[GeneralSolution, ...]
+    complete: bool
+    completeness: str
+    n_generic: int
+    n_spurious: int
+    loops: int
+    seconds_generic: float
+    seconds: float
+    cached: bool
+
+    def count(self, status: str) -> int:
+        return sum(s.status == status for s in self.solutions)
+
+
+def general_forward(mech: Mechanism, targets: dict[int, float], *, seed: int = 0) -> GeneralResult:
+    """Every solution found of the forward position of ``mech`` with the actuators at
+    ``targets`` (joint variables by freedom index, as ``forward._actuator_q`` gives them)."""
+    t0 = time.perf_counter()
+    sysm = loop_system(mech)
+    if set(targets) != {fi for fi, _, _ in sysm.params}:
+        raise InputError(f"actuators: expected values for {list(mech.actuators)}")
+    cached = sysm.key() + bytes([seed % 256]) in _CACHE
+    gen = _monodromy(sysm, seed)
+    p1 = sysm.parameters(targets).astype(complex)
+    X, _, done = _segment(sysm, gen.X, gen.b0, np.zeros_like(gen.b0), gen.p0, p1)
+    Z = np.concatenate([X, np.broadcast_to(p1, (len(X), sysm.npar))], axis=1)
+    Z = _refine(sysm, Z)
+    res = sysm.residual(Z)
+    sols: list[GeneralSolution] = []
+    spurious = lost = 0
+    kept = np.zeros((0, sysm.nx), complex)
+    for n in range(len(Z)):
+        z = Z[n]
+        x = z[: sysm.nx]
+        big = not np.all(np.isfinite(x)) or np.linalg.norm(x) > 1.0 / HOMOTOPY_INFINITY
+        if not big and sysm.study >= 0:
+            e = x[sysm.study : sysm.study + 4]
+            big = abs(e @ e) / max(np.linalg.norm(x[sysm.study : sysm.study + 8]) ** 2, 1e-300) < HOMOTOPY_INFINITY
+        if big:
+            sols.append(GeneralSolution("at_infinity", x, 0.0, 0.0, float(res[n])))
+            continue
+        if not res[n] < MONODROMY_RESIDUAL:
+            if done[n]:
+                spurious += 1
+            else:
+                lost += 1
+            continue
+        if len(kept) and np.min(np.linalg.norm(kept - x, axis=1) / (1 + np.linalg.norm(x))) < 1e-6:
+            continue  # two paths to one (singular) end point
+        kept = np.vstack([kept, x[None]])
+        _, J = sysm.square(z[None])
+        Jx = J[0, :, : sysm.nx]
+        rows = Jx / np.maximum(np.linalg.norm(Jx, axis=1, keepdims=True), 1e-300)
+        sv = np.linalg.svd(rows, compute_uv=False)
+        rcond = float(sv[-1] / sv[0]) if sv[0] > 0 else 0.0
+        y = x.copy()
+        if sysm.study >= 0:
+            s = slice(sysm.study, sysm.study + 8)
+            k = int(np.argmax(np.abs(y[s])))
+            y[s] = y[s] * (abs(y[s][k]) / y[s][k])
+        imag = float(np.max(np.abs(y.imag)) / (1 + np.max(np.abs(y.real))))
+        st = "singular" if rcond < HOMOTOPY_SINGULAR else "real" if imag < HOMOTOPY_REAL else "complex"
+        q = D = None
+        if st == "real":
+            q, D = _configuration(sysm, y.real, targets)
+        sols.append(GeneralSolution(st, y, rcond, imag, float(res[n]), q, D))
+    n_sing = sum(s.status == "singular" for s in sols)
+    how = (f"monodromy saturated after {gen.loops} loops ({MONODROMY_STALE_LOOPS} in a row without a new solution; "
+           f"{len(gen.X)} solutions of a generic complex instance of the square system) then a parameter homotopy to "
+           f"the requested actuator values; {spurious} end point(s) of the square system that do not satisfy the full "
+           "closure discarded: not a proof (no trace test)")
+    if not gen.saturated:
+        how = (f"monodromy NOT saturated after {gen.loops} loops ({len(gen.X)} solutions of the generic instance so far); "
+               f"{spurious} spurious end point(s) discarded: not a proof")
+    if n_sing:
+        how += f"; {n_sing} singular end point(s) (a continuum or a multiple root), located to a few digits only"
+    if lost:
+        how += f"; {lost} path(s) stopped short of the request away from any solution (lost)"
+    return GeneralResult(tuple(sols), False, how, len(gen.X), spurious, gen.loops, gen.seconds,
+                         time.perf_counter() - t0, cached)
+
+
+def _refine(sysm: LoopSystem, Z, iters: int = 3):
+    Z = Z.copy()
+    nx = sysm.nx
+    with np.errstate(all="ignore"):
+        for _ in range(iters):
+            F, J = sysm.square(Z)
+            for n in range(len(Z)):
+                if not (np.all(np.isfinite(F[n])) and np.all(np.isfinite(J[n]))):
+                    continue
+                try:
+                    dx = np.linalg.solve(J[n, :, :nx], F[n])
+                except np.linalg.LinAlgError:
+                    continue
+                if np.all(np.isfinite(dx)):
+                    Z[n, :nx] -= dx
+    return Z
+
+
+def _configuration(sysm: LoopSystem, x: np.ndarray, targets: dict[int, float]) -> tuple[np.ndarray, np.ndarray]:
+    """Joint variables ``q`` (every freedom) and platform displacement ``D`` (model units) of a
+    real solution ``x``; the S joints' rotation vectors are those that close their limbs (a rod
+    takes the smallest rotation at its first S joint)."""
+    mech, L = sysm.mech, sysm.L
+    refs = mech.freedom_refs
+    p = sysm.parameters(targets)
+    z = np.concatenate([x, p])[None].astype(complex)
+    q = np.zeros(len(refs))
+    for i, v in sysm.var_of.items():
+        if v[0] == "A":
+            q[i] = targets[i]
+        elif v[0] == "R":
+            q[i] = np.arctan2(x[v[2]], x[v[1]])
+        elif v[0] == "P":
+            q[i] = x[v[1]] * L
+    Dn, _, E, _ = sysm._platform(z)
+    D = (Dn[0] / E[0]).real
+    D[3] = [0, 0, 0, 1]
+    if sysm.study >= 0:
+        R, pp = study_to_pose(x[sysm.study : sysm.study + 8], 1.0)
+        D[:3, :3], D[:3, 3] = R, pp
+    slices = limb_slices(mech)
+    chains = {}
+    from .closure import limb_chains
+
+    for ch, sl in zip(limb_chains(mech), slices, strict=True):
+        for first, _, axes in ch.balls:
+            chains[sl.start + first] = axes
+    for le in sysm.limbs:
+        if le.kind == "full":
+            continue
+        Tb = sysm._chain(le.before, z)[0][0].real
+        Ta = sysm._chain(le.after_inv, z)[0][0].real
+        start = slices[le.limb].start + le.s_first
+        if le.kind == "point":
+            Rs = Tb[:3, :3].T @ D[:3, :3] @ Ta[:3, :3]
+            q[start : start + 3] = np.linalg.solve(chains[start], matrix_rotvec(Rs))
+            continue
+        a = le.c2[:3] - le.c1[:3]
+        bvec = Tb[:3, :3].T @ ((D @ Ta @ le.c2)[:3] - (Tb @ le.c1)[:3])
+        R1 = _min_rotation(a, bvec)
+        q[start : start + 3] = np.linalg.solve(chains[start], matrix_rotvec(R1))
+        Rs2 = R1.T @ Tb[:3, :3].T @ D[:3, :3] @ Ta[:3, :3]
+        q[start + 3 : start + 6] = np.linalg.solve(chains[start + 3], matrix_rotvec(Rs2))
+    D = D.copy()
+    D[:3, 3] *= L
+    return q, D
+
+
+def _min_rotation(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The smallest rotation taking the direction of ``a`` to that of ``b``."""
+    a = a / np.linalg.norm(a)
+    b = b / np.linalg.norm(b)
+    v = np.cross(a, b)
+    c = float(a @ b)
+    if c < -1 + 1e-12:
+        w = np.cross(a, [1.0, 0, 0]) if abs(a[0]) < 0.9 else np.cross(a, [0, 1.0, 0])
+        w /= np.linalg.norm(w)
+        return 2 * np.outer(w, w) - np.eye(3)
+    K = skew(v)
+    return np.eye(3) + K + K @ K / (1 + c)
+
+
+def configuration(sol: GeneralSolution) -> Configuration:
+    """The :class:`Configuration` of a real solution (a mechanism without internal bodies)."""
+    assert sol.q is not None and sol.D is not None
+    return Configuration(sol.q, sol.D)
