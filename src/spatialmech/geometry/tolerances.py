@@ -53,6 +53,7 @@ __all__ = [
     "HOMOTOPY_REAL",
     "HOMOTOPY_SINGULAR",
     "MONODROMY_MAX_LOOPS",
+    "MONODROMY_MAX_SOLUTIONS",
     "MONODROMY_PARALLEL",
     "MONODROMY_RESIDUAL",
     "MONODROMY_STALE_LOOPS",
@@ -263,5 +264,6 @@ HOMOTOPY_NEAR_REAL = 1e-3
 #: closure below which an end point of the square system is a solution (else spurious).
 MONODROMY_STALE_LOOPS = 8
 MONODROMY_MAX_LOOPS = 80
+MONODROMY_MAX_SOLUTIONS = 160  # beyond this the square system is too large for the NumPy tracker
 MONODROMY_PARALLEL = 4  # loops tracked together in one batch
 MONODROMY_RESIDUAL = 1e-8

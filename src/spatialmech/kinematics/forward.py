@@ -17,6 +17,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..errors import InputError
+from ..geometry.tolerances import MONODROMY_MAX_SOLUTIONS
 from ..geometry.tolerances import resolve as resolve_tolerances
 from ..geometry import screws as sc
 from ..model.mechanism import Mechanism, Pose
@@ -363,8 +364,12 @@ def forward_position(
 
         gwhy = hg.general_reason(mech)
         if gwhy is None:
-            return _forward_general(mech, targets, seed, max_iter, n_seeds)
-        if method == "homotopy":
+            gres = _forward_general(mech, targets, seed, max_iter, n_seeds, fallback=method == "auto")
+            if gres is not None:
+                return gres
+            gwhy = (f"its monodromy stopped unsaturated (more than {MONODROMY_MAX_SOLUTIONS} solutions of the square system "
+                    "or too many loops); use method='homotopy' to see that partial set")
+        elif method == "homotopy":
             raise InputError(f"method: homotopy forward position does not cover {mech.name}: {why}; nor does the loop "
                              f"formulation: {gwhy}; use method='multistart'")
     if all_solutions and (int(n_seeds) != n_seeds or n_seeds < 1):
@@ -574,7 +579,7 @@ def _group_runs(mech: Mechanism, runs: list) -> tuple[list, list]:
 
 
 def _forward_general(mech: Mechanism, targets: dict[int, float], seed: int, max_iter: int,
-                     n_seeds: int = 200) -> ForwardResult:
+                     n_seeds: int = 200, fallback: bool = False) -> ForwardResult | None:
     """``forward_position(..., method="homotopy")`` on a model whose limbs do not reduce to the
     Study-parameter quadrics: the loop formulation in joint variables solved by monodromy
     (:mod:`.homotopy_general`); each real end point is a configuration, polished by the same
@@ -582,6 +587,8 @@ def _forward_general(mech: Mechanism, targets: dict[int, float], seed: int, max_
     from . import homotopy_general as hg
 
     hr = hg.general_forward(mech, targets, seed=seed)
+    if fallback and not hr.saturated:  # method="auto": the multi-start instead
+        return None
     mask = active_mask(mech)
     for i in targets:
         mask[i] = False

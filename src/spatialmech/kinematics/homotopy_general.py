@@ -12,16 +12,20 @@ displacement ``D`` is the product of the first limb without an S joint (the *ref
 limb*), or, when every limb has one, the Study parameters ``x = (e ; g)`` of :mod:`.homotopy`
 (``(e.e) D`` polynomial, with ``e.g = 0`` and a random complex patch).  Each other limb gives:
 
-* no S joint: ``FK = D`` (12 entries, 6 conditions);
+* no S joint: ``FK = D``: the three off-diagonal entries of ``R_FK^T R_D`` and the
+  translation difference (6 equations; they also vanish where ``R_FK^T R_D`` is a half turn
+  about a coordinate axis: spurious points that the full closure, all 12 entries, rejects);
 * one S joint at centre ``c``: ``before(c) = D after^-1(c)`` (3 entries): the S joint's rotation
   is then whatever closes the limb, so it is not a variable;
 * two consecutive S joints (a rod, centres ``c1``, ``c2``): ``|before(c1) - D after^-1(c2)|^2 =
   |c1 - c2|^2`` (1 entry): the rod's idle spin is not a variable either.
 
-The closure entries outnumber the unknowns they fix (12 entries for 6 conditions, and
-overconstrained linkages such as the Bennett have fewer conditions still): the system is made
-square by random complex combinations (each reference-free limb's 12 entries to 6 when the
-conditions count exactly, else all entries to the number needed), and every end point is
+The equations can outnumber the conditions they impose (a spherical or planar limb has 3, an
+overconstrained linkage such as the Bennett fewer than its equations): the number of
+independent conditions of each limb is the rank of its equations at a generic configuration
+(a random walk from the reference along the closure, actuators held), and the system is made
+square by random complex combinations (each limb's equations to its rank when the ranks add
+up to the number of unknowns, else all equations to that number), and every end point is
 checked against the full closure: points of the square system that do not close are
 *spurious* and discarded (their number is reported).
 
@@ -41,6 +45,7 @@ p_request)`` then tracks every known solution to the request (the NumPy tracker
 from __future__ import annotations
 
 import time
+import weakref
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -52,6 +57,7 @@ from ..geometry.tolerances import (
     HOMOTOPY_REAL,
     HOMOTOPY_SINGULAR,
     MONODROMY_MAX_LOOPS,
+    MONODROMY_MAX_SOLUTIONS,
     MONODROMY_PARALLEL,
     MONODROMY_RESIDUAL,
     MONODROMY_STALE_LOOPS,
@@ -167,17 +173,31 @@ class LoopSystem:
         dE[:, k : k + 4] = 2 * X[:, :4]
         return Dn, dDn, E, dE
 
-    def closure(self, Z):
-        """Every closure entry (n, r) and its derivative (n, r, nz) at points ``Z = (x ; p)``."""
+    def closure(self, Z, full: bool = False):
+        """The closure equations (n, r) and their derivative (n, r, nz) at points ``Z = (x ; p)``:
+        a limb without S joint gives the off-diagonal entries of ``R_limb^T R_platform`` and the
+        translation difference (6; zero also at the three half-turns about the axes, spurious
+        points the full closure rejects), or with ``full`` every entry of ``T_limb - D`` (12)."""
         D, dD, E, dE = self._platform(Z)
         rows, jac = [], []
+        n = len(Z)
         for le in self.limbs:
             Tb, dTb = self._chain(le.before, Z)
-            if le.kind == "full":
+            if le.kind == "full" and full:
                 r = E[:, None, None] * Tb - D
                 dr = E[:, None, None, None] * dTb + dE[:, :, None, None] * Tb[:, None] - dD
-                rows.append(r[:, :3].reshape(len(Z), 12))
-                jac.append(dr[:, :, :3].reshape(len(Z), -1, 12).transpose(0, 2, 1))
+                rows.append(r[:, :3].reshape(n, 12))
+                jac.append(dr[:, :, :3].reshape(n, -1, 12).transpose(0, 2, 1))
+                continue
+            if le.kind == "full":
+                A, dA, B, dB = Tb[:, :3, :3], dTb[:, :, :3, :3], D[:, :3, :3], dD[:, :, :3, :3]
+                P = np.einsum("nai,naj->nij", A, B)
+                dP = np.einsum("nzai,naj->nzij", dA, B) + np.einsum("nai,nzaj->nzij", A, dB)
+                ii, jj = (0, 0, 1), (1, 2, 2)
+                t = E[:, None] * Tb[:, :3, 3] - D[:, :3, 3]
+                dt = E[:, None, None] * dTb[:, :, :3, 3] + dE[:, :, None] * Tb[:, None, :3, 3] - dD[:, :, :3, 3]
+                rows.append(np.concatenate([P[:, ii, jj], t], axis=1))
+                jac.append(np.concatenate([dP[:, :, ii, jj], dt], axis=2).transpose(0, 2, 1))
                 continue
             Ta, dTa = self._chain(le.after_inv, Z)
             u1 = Tb @ le.c1
@@ -231,7 +251,7 @@ class LoopSystem:
     def residual(self, Z):
         """Relative residual of the full closure (every entry) and the side equations per point."""
         F1, _ = self.side(Z)
-        F2, _ = self.closure(Z)
+        F2, _ = self.closure(Z, full=True)
         scale = 1.0 + np.linalg.norm(Z[:, : self.nx], axis=1)
         if self.study >= 0:
             scale = np.maximum(scale, np.linalg.norm(Z[:, self.study : self.study + 8], axis=1) ** 4)
@@ -293,15 +313,15 @@ def general_reason(mech: Mechanism) -> str | None:
     return None
 
 
-_SYSTEMS: dict[int, tuple[Mechanism, LoopSystem]] = {}
+_SYSTEMS: weakref.WeakKeyDictionary[Mechanism, LoopSystem] = weakref.WeakKeyDictionary()
 
 
 def loop_system(mech: Mechanism, seed: int = 0) -> LoopSystem:
     """The polynomial closure of ``mech`` (module docstring); ``InputError`` naming the limb or
     joint when the formulation does not cover it."""
-    hit = _SYSTEMS.get(id(mech))
-    if hit is not None and hit[0] is mech:
-        return hit[1]
+    hit = _SYSTEMS.get(mech)
+    if hit is not None:
+        return hit
     if mech.bodies:
         raise InputError("a link-and-joint graph (internal bodies): the loop formulation covers limbs from the ground "
                          "to the platform only")
@@ -401,7 +421,7 @@ def loop_system(mech: Mechanism, seed: int = 0) -> LoopSystem:
                                  float(np.sum((c1 - c2) ** 2)), li, k0))
             cond += 1
     m_needed = nx - len(circles) - (2 if study >= 0 else 0)
-    sizes = [12 if le.kind == "full" else 3 if le.kind == "point" else 1 for le in limbs]
+    sizes = [6 if le.kind == "full" else 3 if le.kind == "point" else 1 for le in limbs]
     rng = np.random.default_rng(seed + 7919)
     patch = (rng.normal(size=8) + 1j * rng.normal(size=8)) if study >= 0 else None
     ref = tuple(factors(ref_limb, 0, slices[ref_limb].stop - slices[ref_limb].start)) if ref_limb >= 0 else None
@@ -428,7 +448,7 @@ def loop_system(mech: Mechanism, seed: int = 0) -> LoopSystem:
     else:  # overconstrained as a whole: every entry into the number of rows needed
         C = rnd(m_needed, sum(sizes))
     sysm = replace(sysm, compress=C, n_conditions=cond)
-    _SYSTEMS[id(mech)] = (mech, sysm)
+    _SYSTEMS[mech] = sysm
     return sysm
 
 
@@ -544,7 +564,7 @@ def _monodromy(sysm: LoopSystem, seed: int) -> _GenericLoop:
     known = x0[None]
     stale = loops = 0
     k = MONODROMY_PARALLEL
-    while stale < MONODROMY_STALE_LOOPS and loops < MONODROMY_MAX_LOOPS:
+    while stale < MONODROMY_STALE_LOOPS and loops < MONODROMY_MAX_LOOPS and len(known) <= MONODROMY_MAX_SOLUTIONS:
         loops += k  # k loops at once, each through its own two random offsets
         B1 = np.repeat(scale * crand(k, len(b0)), len(known), axis=0)
         B2 = np.repeat(scale * crand(k, len(b0)), len(known), axis=0)
@@ -595,6 +615,7 @@ class GeneralSolution:
 @dataclass(frozen=True, eq=False)
 class GeneralResult:
     solutions: tuple[GeneralSolution, ...]
+    saturated: bool  # the monodromy stopped because loops found nothing new (not at a cap)
     complete: bool
     completeness: str
     n_generic: int
@@ -666,13 +687,15 @@ def general_forward(mech: Mechanism, targets: dict[int, float], *, seed: int = 0
            f"the requested actuator values; {spurious} end point(s) of the square system that do not satisfy the full "
            "closure discarded: not a proof (no trace test)")
     if not gen.saturated:
-        how = (f"monodromy NOT saturated after {gen.loops} loops ({len(gen.X)} solutions of the generic instance so far); "
-               f"{spurious} spurious end point(s) discarded: not a proof")
+        why = (f"more than {MONODROMY_MAX_SOLUTIONS} solutions of the square system" if len(gen.X) > MONODROMY_MAX_SOLUTIONS
+               else f"{MONODROMY_MAX_LOOPS} loops")
+        how = (f"monodromy NOT saturated: stopped at {why} ({len(gen.X)} solutions of the generic instance so far, "
+               f"{gen.loops} loops); {spurious} spurious end point(s) discarded: not a proof, solutions may be missing")
     if n_sing:
         how += f"; {n_sing} singular end point(s) (a continuum or a multiple root), located to a few digits only"
     if lost:
         how += f"; {lost} path(s) stopped short of the request away from any solution (lost)"
-    return GeneralResult(tuple(sols), False, how, len(gen.X), spurious, gen.loops, gen.seconds,
+    return GeneralResult(tuple(sols), gen.saturated, False, how, len(gen.X), spurious, gen.loops, gen.seconds,
                          time.perf_counter() - t0, cached)
 
 
