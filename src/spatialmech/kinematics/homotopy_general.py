@@ -75,6 +75,8 @@ __all__ = [
     "general_forward",
     "general_reason",
     "loop_system",
+    "rebuild",
+    "variables",
 ]
 
 _I4 = np.eye(4)
@@ -297,10 +299,12 @@ def _study_forms() -> np.ndarray:
 _STUDY_Q = _study_forms()
 
 
-def _twist_matrix(S: np.ndarray, L: float) -> np.ndarray:
+def _twist_matrix(S: np.ndarray, L: float, slide: bool) -> np.ndarray:
+    """The 4x4 matrix of a unit twist in units of ``L``: a rotation's moment over ``L``; a
+    slide's direction as it is (its variable is the slide over ``L``)."""
     A = np.zeros((4, 4))
     A[:3, :3] = skew(S[:3])
-    A[:3, 3] = S[3:] / L
+    A[:3, 3] = S[3:] if slide else S[3:] / L
     return A
 
 
@@ -391,8 +395,8 @@ def loop_system(mech: Mechanism, seed: int = 0) -> LoopSystem:
             v = var_of[i]
             if v[0] in ("L", "S"):
                 continue
-            A = _twist_matrix(refs[i].freedom.screw, L)
             kind = "P" if refs[i].freedom.kind == "P" else "R"
+            A = _twist_matrix(refs[i].freedom.screw, L, kind == "P")
             out.append(_Factor(kind, A, A @ A, tuple(v[1:])))
         return out
 
@@ -452,7 +456,7 @@ def loop_system(mech: Mechanism, seed: int = 0) -> LoopSystem:
     return sysm
 
 
-def _point(sysm: LoopSystem, config: Configuration) -> np.ndarray:
+def variables(sysm: LoopSystem, config: Configuration) -> np.ndarray:
     """The variables ``z = (x ; p)`` of a real configuration (joint variables ``q``, platform ``D``)."""
     z = np.zeros(sysm.nx + sysm.npar)
     for i, v in sysm.var_of.items():
@@ -487,7 +491,7 @@ def _limb_ranks(sysm: LoopSystem, sizes: list[int], rng: np.random.Generator) ->
         config = generic_configuration(sysm.mech, seed=int(rng.integers(2**31)), step=0.5, steps=4)
     except RuntimeError:
         config = Configuration.reference(sysm.mech)
-    z = _point(sysm, config)[None]
+    z = variables(sysm, config)[None]
     _, Js = sysm.side(z)
     _, Jc = sysm.closure(z)
     Js, Jc = Js[:, :, : sysm.nx], Jc[:, :, : sysm.nx]  # the actuators held
@@ -679,7 +683,7 @@ def general_forward(mech: Mechanism, targets: dict[int, float], *, seed: int = 0
         st = "singular" if rcond < HOMOTOPY_SINGULAR else "real" if imag < HOMOTOPY_REAL else "complex"
         q = D = None
         if st == "real":
-            q, D = _configuration(sysm, y.real, targets)
+            q, D = rebuild(sysm, y.real, targets)
         sols.append(GeneralSolution(st, y, rcond, imag, float(res[n]), q, D))
     n_sing = sum(s.status == "singular" for s in sols)
     how = (f"monodromy saturated after {gen.loops} loops ({MONODROMY_STALE_LOOPS} in a row without a new solution; "
@@ -717,7 +721,7 @@ def _refine(sysm: LoopSystem, Z, iters: int = 3):
     return Z
 
 
-def _configuration(sysm: LoopSystem, x: np.ndarray, targets: dict[int, float]) -> tuple[np.ndarray, np.ndarray]:
+def rebuild(sysm: LoopSystem, x: np.ndarray, targets: dict[int, float]) -> tuple[np.ndarray, np.ndarray]:
     """Joint variables ``q`` (every freedom) and platform displacement ``D`` (model units) of a
     real solution ``x``; the S joints' rotation vectors are those that close their limbs (a rod
     takes the smallest rotation at its first S joint)."""
