@@ -160,3 +160,16 @@ def test_configuration_of_a_point_limb_and_a_study_platform():
     q, D = hg.rebuild(sysm, z[: sysm.nx].real, targets)
     assert np.allclose(D, c.D, atol=1e-9)
     assert np.max(np.abs(closure_residual(m, Configuration(q, D)))) < 1e-9
+
+
+@pytest.mark.parametrize("name", ["bennett", "five-cs-3", "rssr"])
+def test_compiled_square_system_equals_the_numpy_reference(name):
+    """The numba evaluation (kernels_loops) and the NumPy reference of the square system and its
+    derivative agree at random complex points (full limbs, point limbs with a Study platform, rods)."""
+    sysm = hg.loop_system(sm.load_model(name))
+    rng = np.random.default_rng(4)
+    Z = rng.normal(size=(6, sysm.nx + sysm.npar)) + 1j * rng.normal(size=(6, sysm.nx + sysm.npar))
+    F0, J0 = sysm.square(Z, reference=True)
+    F1, J1 = sysm.square(Z)
+    assert np.max(np.abs(F0 - F1)) < 1e-12 * (1 + np.max(np.abs(F0)))
+    assert np.max(np.abs(J0 - J1)) < 1e-12 * (1 + np.max(np.abs(J0)))

@@ -264,6 +264,6 @@ HOMOTOPY_NEAR_REAL = 1e-3
 #: closure below which an end point of the square system is a solution (else spurious).
 MONODROMY_STALE_LOOPS = 8
 MONODROMY_MAX_LOOPS = 80
-MONODROMY_MAX_SOLUTIONS = 160  # beyond this the square system is too large for the NumPy tracker
+MONODROMY_MAX_SOLUTIONS = 256  # beyond this the square system is too large for this solver
 MONODROMY_PARALLEL = 4  # loops tracked together in one batch
 MONODROMY_RESIDUAL = 1e-8

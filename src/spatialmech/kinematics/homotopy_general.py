@@ -63,6 +63,7 @@ from ..geometry.tolerances import (
     MONODROMY_STALE_LOOPS,
 )
 from ..model.mechanism import Mechanism
+from . import compiled, kernels_loops
 from .closure import Configuration, limb_slices
 from .homotopy import study_to_pose, track
 
@@ -242,8 +243,14 @@ class LoopSystem:
             J[:, i + 1, s : s + 8] = self.patch
         return F, J
 
-    def square(self, Z):
-        """The square system ``G`` (n, nx) and its derivative (n, nx, nz) in ``z = (x ; p)``."""
+    def square(self, Z, *, reference: bool = False):
+        """The square system ``G`` (n, nx) and its derivative (n, nx, nz) in ``z = (x ; p)``:
+        compiled (:mod:`.kernels_loops`) when the compiled core is in use and not ``reference``."""
+        if not reference and compiled.enabled():
+            packed = _PACKED.get(self)
+            if packed is None:
+                packed = _PACKED[self] = kernels_loops.pack(self, _STUDY_Q)
+            return kernels_loops.square_batch(np.ascontiguousarray(Z, dtype=np.complex128), *packed)
         F1, J1 = self.side(Z)
         F2, J2 = self.closure(Z)
         F = np.concatenate([F1, np.einsum("mr,nr->nm", self.compress, F2)], axis=1)
@@ -297,6 +304,7 @@ def _study_forms() -> np.ndarray:
 
 
 _STUDY_Q = _study_forms()
+_PACKED: weakref.WeakKeyDictionary[LoopSystem, tuple] = weakref.WeakKeyDictionary()
 
 
 def _twist_matrix(S: np.ndarray, L: float, slide: bool) -> np.ndarray:
