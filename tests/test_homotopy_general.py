@@ -173,3 +173,17 @@ def test_compiled_square_system_equals_the_numpy_reference(name):
     F1, J1 = sysm.square(Z)
     assert np.max(np.abs(F0 - F1)) < 1e-12 * (1 + np.max(np.abs(F0)))
     assert np.max(np.abs(J0 - J1)) < 1e-12 * (1 + np.max(np.abs(J0)))
+
+
+def test_auto_gives_up_on_a_large_square_system_and_runs_the_multistart(monkeypatch):
+    """Under method="auto" the monodromy stops at its cap (here lowered to 4 generic solutions on
+    the Bennett's 40) and the multi-start runs instead, saying why; nothing unsaturated is cached."""
+    monkeypatch.setattr(hg, "MONODROMY_MAX_SOLUTIONS", 4)
+    hg.clear_cache()
+    m = sm.load_model("bennett")
+    r = forward_position(m, [0.3], all_solutions=True, n_seeds=4, method="auto")
+    d = r.to_dict(m)
+    assert d["complete"] is False and "multi-start" in d["completeness"] and "gave up" in d["completeness"]
+    assert "n_spurious" not in d["search"]
+    part = hg.general_forward(m, {0: 0.3}, capped=True)
+    assert not part.saturated and "NOT saturated" in part.completeness

@@ -52,7 +52,9 @@ __all__ = [
     "HOMOTOPY_NEWTON",
     "HOMOTOPY_REAL",
     "HOMOTOPY_SINGULAR",
+    "MONODROMY_DIVERGED",
     "MONODROMY_MAX_LOOPS",
+    "MONODROMY_MAX_SECONDS",
     "MONODROMY_MAX_SOLUTIONS",
     "MONODROMY_PARALLEL",
     "MONODROMY_RESIDUAL",
@@ -264,6 +266,8 @@ HOMOTOPY_NEAR_REAL = 1e-3
 #: closure below which an end point of the square system is a solution (else spurious).
 MONODROMY_STALE_LOOPS = 8
 MONODROMY_MAX_LOOPS = 80
-MONODROMY_MAX_SOLUTIONS = 256  # beyond this the square system is too large for this solver
+MONODROMY_MAX_SOLUTIONS = 128  # method="auto" gives up beyond this (the multi-start runs instead)
+MONODROMY_MAX_SECONDS = 20.0  # and beyond this time (method="homotopy" has neither cap)
+MONODROMY_DIVERGED = 1e4  # a path stopped short with |x| beyond this is at infinity (affine variables)
 MONODROMY_PARALLEL = 4  # loops tracked together in one batch
 MONODROMY_RESIDUAL = 1e-8

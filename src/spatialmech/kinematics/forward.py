@@ -17,7 +17,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..errors import InputError
-from ..geometry.tolerances import MONODROMY_MAX_SOLUTIONS
+from ..geometry.tolerances import MONODROMY_MAX_SECONDS, MONODROMY_MAX_SOLUTIONS
 from ..geometry.tolerances import resolve as resolve_tolerances
 from ..geometry import screws as sc
 from ..model.mechanism import Mechanism, Pose
@@ -367,8 +367,8 @@ def forward_position(
             gres = _forward_general(mech, targets, seed, max_iter, n_seeds, fallback=method == "auto")
             if gres is not None:
                 return gres
-            gwhy = (f"its monodromy stopped unsaturated (more than {MONODROMY_MAX_SOLUTIONS} solutions of the square system "
-                    "or too many loops); use method='homotopy' to see that partial set")
+            gwhy = (f"its monodromy gave up unsaturated (more than {MONODROMY_MAX_SOLUTIONS} solutions of the square system, "
+                    f"or {MONODROMY_MAX_SECONDS:g} s); method='homotopy' runs it without these caps")
         elif method == "homotopy":
             raise InputError(f"method: homotopy forward position does not cover {mech.name}: {why}; nor does the loop "
                              f"formulation: {gwhy}; use method='multistart'")
@@ -586,7 +586,7 @@ def _forward_general(mech: Mechanism, targets: dict[int, float], seed: int, max_
     Newton step and grouped as the multi-start roots.  Never a proof (``complete`` false)."""
     from . import homotopy_general as hg
 
-    hr = hg.general_forward(mech, targets, seed=seed)
+    hr = hg.general_forward(mech, targets, seed=seed, capped=fallback)
     if fallback and not hr.saturated:  # method="auto": the multi-start instead
         return None
     mask = active_mask(mech)

@@ -56,7 +56,9 @@ from ..geometry.tolerances import (
     HOMOTOPY_INFINITY,
     HOMOTOPY_REAL,
     HOMOTOPY_SINGULAR,
+    MONODROMY_DIVERGED,
     MONODROMY_MAX_LOOPS,
+    MONODROMY_MAX_SECONDS,
     MONODROMY_MAX_SOLUTIONS,
     MONODROMY_PARALLEL,
     MONODROMY_RESIDUAL,
@@ -452,11 +454,11 @@ def loop_system(mech: Mechanism, seed: int = 0) -> LoopSystem:
 
     if cond == m_needed:  # each limb's entries to its number of independent conditions
         C = np.zeros((m_needed, sum(sizes)), complex)
-        i = j = 0
+        row = col = 0
         for rk, sz in zip(ranks, sizes, strict=True):
-            C[i : i + rk, j : j + sz] = rnd(rk, sz) if rk < sz else np.eye(sz)
-            i += rk
-            j += sz
+            C[row : row + rk, col : col + sz] = rnd(rk, sz) if rk < sz else np.eye(sz)
+            row += rk
+            col += sz
     else:  # overconstrained as a whole: every entry into the number of rows needed
         C = rnd(m_needed, sum(sizes))
     sysm = replace(sysm, compress=C, n_conditions=cond)
@@ -537,9 +539,9 @@ def _segment(sysm: LoopSystem, X, b0, b1, p0, p1):
 
 
 def _new_points(known: np.ndarray, cand: np.ndarray, tol: float = 1e-6) -> np.ndarray:
-    out = []
+    out: list[np.ndarray] = []
     for x in cand:
-        ref = known if not out else np.vstack([known, out])
+        ref = known if not out else np.vstack([known, *[o[None] for o in out]])
         d = np.linalg.norm(ref - x, axis=1) / (1 + np.linalg.norm(x))
         if np.all(d > tol):
             out.append(x)
@@ -559,7 +561,9 @@ class _GenericLoop:
 _CACHE: dict[bytes, _GenericLoop] = {}
 
 
-def _monodromy(sysm: LoopSystem, seed: int) -> _GenericLoop:
+def _monodromy(sysm: LoopSystem, seed: int, capped: bool) -> _GenericLoop:
+    """The generic instance's solutions by monodromy; ``capped``: also stop at
+    :data:`MONODROMY_MAX_SOLUTIONS` solutions or :data:`MONODROMY_MAX_SECONDS` (unsaturated)."""
     key = sysm.key() + bytes([seed % 256])
     if key in _CACHE:
         return _CACHE[key]
@@ -576,7 +580,11 @@ def _monodromy(sysm: LoopSystem, seed: int) -> _GenericLoop:
     known = x0[None]
     stale = loops = 0
     k = MONODROMY_PARALLEL
-    while stale < MONODROMY_STALE_LOOPS and loops < MONODROMY_MAX_LOOPS and len(known) <= MONODROMY_MAX_SOLUTIONS:
+    capped_out = False
+    while stale < MONODROMY_STALE_LOOPS and loops < MONODROMY_MAX_LOOPS:
+        if capped and (len(known) > MONODROMY_MAX_SOLUTIONS or time.perf_counter() - t0 > MONODROMY_MAX_SECONDS):
+            capped_out = True
+            break
         loops += k  # k loops at once, each through its own two random offsets
         B1 = np.repeat(scale * crand(k, len(b0)), len(known), axis=0)
         B2 = np.repeat(scale * crand(k, len(b0)), len(known), axis=0)
@@ -596,7 +604,8 @@ def _monodromy(sysm: LoopSystem, seed: int) -> _GenericLoop:
         else:
             stale += k
     g = _GenericLoop(p0, b0, known, loops, time.perf_counter() - t0, stale >= MONODROMY_STALE_LOOPS)
-    _CACHE[key] = g
+    if not capped_out:  # a capped run is redone in full when asked without the caps
+        _CACHE[key] = g
     return g
 
 
@@ -641,15 +650,16 @@ class GeneralResult:
         return sum(s.status == status for s in self.solutions)
 
 
-def general_forward(mech: Mechanism, targets: dict[int, float], *, seed: int = 0) -> GeneralResult:
+def general_forward(mech: Mechanism, targets: dict[int, float], *, seed: int = 0, capped: bool = False) -> GeneralResult:
     """Every solution found of the forward position of ``mech`` with the actuators at
-    ``targets`` (joint variables by freedom index, as ``forward._actuator_q`` gives them)."""
+    ``targets`` (joint variables by freedom index, as ``forward._actuator_q`` gives them);
+    ``capped``: the monodromy gives up early on large systems (``saturated`` false)."""
     t0 = time.perf_counter()
     sysm = loop_system(mech)
     if set(targets) != {fi for fi, _, _ in sysm.params}:
         raise InputError(f"actuators: expected values for {list(mech.actuators)}")
     cached = sysm.key() + bytes([seed % 256]) in _CACHE
-    gen = _monodromy(sysm, seed)
+    gen = _monodromy(sysm, seed, capped)
     p1 = sysm.parameters(targets).astype(complex)
     X, _, done = _segment(sysm, gen.X, gen.b0, np.zeros_like(gen.b0), gen.p0, p1)
     Z = np.concatenate([X, np.broadcast_to(p1, (len(X), sysm.npar))], axis=1)
@@ -665,7 +675,7 @@ def general_forward(mech: Mechanism, targets: dict[int, float], *, seed: int = 0
         if not big and sysm.study >= 0:
             e = x[sysm.study : sysm.study + 4]
             big = abs(e @ e) / max(np.linalg.norm(x[sysm.study : sysm.study + 8]) ** 2, 1e-300) < HOMOTOPY_INFINITY
-        if big:
+        if big or (not done[n] and np.linalg.norm(x) > MONODROMY_DIVERGED):
             sols.append(GeneralSolution("at_infinity", x, 0.0, 0.0, float(res[n])))
             continue
         if not res[n] < MONODROMY_RESIDUAL:
@@ -700,7 +710,8 @@ def general_forward(mech: Mechanism, targets: dict[int, float], *, seed: int = 0
            "closure discarded: not a proof (no trace test)")
     if not gen.saturated:
         why = (f"more than {MONODROMY_MAX_SOLUTIONS} solutions of the square system" if len(gen.X) > MONODROMY_MAX_SOLUTIONS
-               else f"{MONODROMY_MAX_LOOPS} loops")
+               else f"{MONODROMY_MAX_LOOPS} loops" if gen.loops >= MONODROMY_MAX_LOOPS
+               else f"{MONODROMY_MAX_SECONDS:g} s")
         how = (f"monodromy NOT saturated: stopped at {why} ({len(gen.X)} solutions of the generic instance so far, "
                f"{gen.loops} loops); {spurious} spurious end point(s) discarded: not a proof, solutions may be missing")
     if n_sing:

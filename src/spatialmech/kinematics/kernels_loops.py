@@ -25,7 +25,14 @@ def pack(sysm, study_q: np.ndarray) -> tuple:
     for le in sysm.limbs:
         chains.append(le.before)
         chains.append(le.after_inv)
-    kind, sign, i0, i1, A, A2, lo, hi = [], [], [], [], [], [], [], []
+    kind: list[int] = []
+    sign: list[float] = []
+    i0: list[int] = []
+    i1: list[int] = []
+    A: list[np.ndarray] = []
+    A2: list[np.ndarray] = []
+    lo: list[int] = []
+    hi: list[int] = []
     for ch in chains:
         lo.append(len(kind))
         for f in ch:
