@@ -165,12 +165,15 @@ def test_configuration_of_a_point_limb_and_a_study_platform():
 @pytest.mark.parametrize("name", ["bennett", "five-cs-3", "rssr"])
 def test_compiled_square_system_equals_the_numpy_reference(name):
     """The numba evaluation (kernels_loops) and the NumPy reference of the square system and its
-    derivative agree at random complex points (full limbs, point limbs with a Study platform, rods)."""
+    derivative agree at random complex points and offsets (full limbs, point limbs with a Study
+    platform, rods)."""
     sysm = hg.loop_system(sm.load_model(name))
     rng = np.random.default_rng(4)
     Z = rng.normal(size=(6, sysm.nx + sysm.npar)) + 1j * rng.normal(size=(6, sysm.nx + sysm.npar))
-    F0, J0 = sysm.square(Z, reference=True)
-    F1, J1 = sysm.square(Z)
+    nw = sysm.w_offsets[-1]
+    W = rng.normal(size=(6, nw)) + 1j * rng.normal(size=(6, nw))  # the limbs' offsets of the monodromy family
+    F0, J0 = sysm.square(Z, W, reference=True)
+    F1, J1 = sysm.square(Z, W)
     assert np.max(np.abs(F0 - F1)) < 1e-12 * (1 + np.max(np.abs(F0)))
     assert np.max(np.abs(J0 - J1)) < 1e-12 * (1 + np.max(np.abs(J0)))
 

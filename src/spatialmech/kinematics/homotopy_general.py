@@ -128,6 +128,7 @@ class LoopSystem:
     var_of: dict  # freedom index -> ("R", ic, is) / ("P", id) / ("A", ...) parameter / ("L",) locked / ("S",)
     params: tuple[tuple[int, str, tuple[int, ...]], ...]  # (freedom index, kind, z indices)
     n_conditions: int
+    rigid_family: bool = False  # every limb's equations independent: monodromy over the limbs' offsets
 
     @property
     def n_rows(self) -> int:
@@ -178,7 +179,26 @@ class LoopSystem:
         dE[:, k : k + 4] = 2 * X[:, :4]
         return Dn, dDn, E, dE
 
-    def closure(self, Z, full: bool = False):
+    @property
+    def w_offsets(self) -> tuple[int, ...]:
+        """Start of each limb's offset parameters in ``W`` (a limb without S joint: a quaternion
+        and a translation, 7; one S joint: a translation, 3; a rod: a change of length squared, 1)
+        and, last, their number."""
+        out = [0]
+        for le in self.limbs:
+            out.append(out[-1] + (7 if le.kind == "full" else 3 if le.kind == "point" else 1))
+        return tuple(out)
+
+    def identity_offsets(self, n: int = 1) -> np.ndarray:
+        """The offset parameters of the mechanism itself (no offset): (n, nw)."""
+        off = self.w_offsets
+        W = np.zeros((n, off[-1]), complex)
+        for k, le in enumerate(self.limbs):
+            if le.kind == "full":
+                W[:, off[k]] = 1.0
+        return W
+
+    def closure(self, Z, full: bool = False, W=None):
         """The closure equations (n, r) and their derivative (n, r, nz) at points ``Z = (x ; p)``:
         a limb without S joint gives the off-diagonal entries of ``R_limb^T R_platform`` and the
         translation difference (6; zero also at the three half-turns about the axes, spurious
@@ -186,7 +206,11 @@ class LoopSystem:
         D, dD, E, dE = self._platform(Z)
         rows, jac = [], []
         n = len(Z)
-        for le in self.limbs:
+        off = self.w_offsets
+        if W is None:
+            W = self.identity_offsets(n)
+        for k, le in enumerate(self.limbs):
+            w_k = W[:, off[k] : off[k + 1]]
             Tb, dTb = self._chain(le.before, Z)
             if le.kind == "full" and full:
                 r = E[:, None, None] * Tb - D
@@ -194,13 +218,17 @@ class LoopSystem:
                 rows.append(r[:, :3].reshape(n, 12))
                 jac.append(dr[:, :, :3].reshape(n, -1, 12).transpose(0, 2, 1))
                 continue
-            if le.kind == "full":
-                A, dA, B, dB = Tb[:, :3, :3], dTb[:, :, :3, :3], D[:, :3, :3], dD[:, :, :3, :3]
+            if le.kind == "full":  # with the offset (q, t): R_D -> R_D E(q), p_D -> p_D + R_D t
+                Eq = _rotation_forms(w_k[:, :4])
+                A, dA = Tb[:, :3, :3], dTb[:, :, :3, :3]
+                B, dB = D[:, :3, :3] @ Eq, dD[:, :, :3, :3] @ Eq[:, None]
                 P = np.einsum("nai,naj->nij", A, B)
                 dP = np.einsum("nzai,naj->nzij", dA, B) + np.einsum("nai,nzaj->nzij", A, dB)
                 ii, jj = (0, 0, 1), (1, 2, 2)
-                t = E[:, None] * Tb[:, :3, 3] - D[:, :3, 3]
-                dt = E[:, None, None] * dTb[:, :, :3, 3] + dE[:, :, None] * Tb[:, None, :3, 3] - dD[:, :, :3, 3]
+                tk = w_k[:, 4:7]
+                t = E[:, None] * Tb[:, :3, 3] - D[:, :3, 3] - np.einsum("nab,nb->na", D[:, :3, :3], tk)
+                dt = (E[:, None, None] * dTb[:, :, :3, 3] + dE[:, :, None] * Tb[:, None, :3, 3] - dD[:, :, :3, 3]
+                      - np.einsum("nzab,nb->nza", dD[:, :, :3, :3], tk))
                 rows.append(np.concatenate([P[:, ii, jj], t], axis=1))
                 jac.append(np.concatenate([dP[:, :, ii, jj], dt], axis=2).transpose(0, 2, 1))
                 continue
@@ -214,12 +242,13 @@ class LoopSystem:
             w = E[:, None] * u1 - u2
             dw = E[:, None, None] * du1 + dE[:, :, None] * u1[:, None] - du2
             w, dw = w[:, :3], dw[:, :, :3]
-            if le.kind == "point":
-                rows.append(w)
-                jac.append(dw.transpose(0, 2, 1))
-            else:
-                rows.append((np.einsum("na,na->n", w, w) - E**2 * le.length2)[:, None])
-                jac.append((2 * np.einsum("na,nza->nz", w, dw) - 2 * (E * le.length2)[:, None] * dE)[:, None])
+            if le.kind == "point":  # with the offset o: before(c) = D after^-1(c) + o
+                rows.append(w - E[:, None] * w_k)
+                jac.append((dw - dE[:, :, None] * w_k[:, None]).transpose(0, 2, 1))
+            else:  # with the offset beta: length squared + beta
+                l2 = le.length2 + w_k[:, 0]
+                rows.append((np.einsum("na,na->n", w, w) - E**2 * l2)[:, None])
+                jac.append((2 * np.einsum("na,nza->nz", w, dw) - 2 * (E * l2)[:, None] * dE)[:, None])
         if not rows:
             return np.zeros((len(Z), 0), complex), np.zeros((len(Z), 0, Z.shape[1]), complex)
         return np.concatenate(rows, axis=1), np.concatenate(jac, axis=1)
@@ -245,16 +274,20 @@ class LoopSystem:
             J[:, i + 1, s : s + 8] = self.patch
         return F, J
 
-    def square(self, Z, *, reference: bool = False):
-        """The square system ``G`` (n, nx) and its derivative (n, nx, nz) in ``z = (x ; p)``:
-        compiled (:mod:`.kernels_loops`) when the compiled core is in use and not ``reference``."""
+    def square(self, Z, W=None, *, reference: bool = False, want_J: bool = True):
+        """The square system ``G`` (n, nx) and its derivative (n, nx, nz) in ``z = (x ; p)``,
+        with the offset parameters ``W`` (n, nw; default none): compiled (:mod:`.kernels_loops`)
+        when the compiled core is in use and not ``reference``."""
+        if W is None:
+            W = self.identity_offsets(len(Z))
         if not reference and compiled.enabled():
             packed = _PACKED.get(self)
             if packed is None:
                 packed = _PACKED[self] = kernels_loops.pack(self, _STUDY_Q)
-            return kernels_loops.square_batch(np.ascontiguousarray(Z, dtype=np.complex128), *packed)
+            return kernels_loops.square_batch(np.ascontiguousarray(Z, dtype=np.complex128),
+                                              np.ascontiguousarray(W, dtype=np.complex128), want_J, *packed)
         F1, J1 = self.side(Z)
-        F2, J2 = self.closure(Z)
+        F2, J2 = self.closure(Z, W=W)
         F = np.concatenate([F1, np.einsum("mr,nr->nm", self.compress, F2)], axis=1)
         J = np.concatenate([J1, np.einsum("mr,nrz->nmz", self.compress, J2)], axis=1)
         return F, J
@@ -278,6 +311,14 @@ class LoopSystem:
             else:
                 p[idx[0] - self.nx] = v / self.L
         return p
+
+
+def _rotation_forms(q: np.ndarray) -> np.ndarray:
+    """``E(q) = (q.q) R(q)`` (n, 3, 3) of quaternions ``q`` (n, 4), complex allowed."""
+    w, i, j, k = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
+    return np.stack([np.stack([w * w + i * i - j * j - k * k, 2 * (i * j - w * k), 2 * (i * k + w * j)], -1),
+                     np.stack([2 * (i * j + w * k), w * w - i * i + j * j - k * k, 2 * (j * k - w * i)], -1),
+                     np.stack([2 * (i * k - w * j), 2 * (j * k + w * i), w * w - i * i - j * j + k * k], -1)], 1)
 
 
 def _study_forms() -> np.ndarray:
@@ -461,7 +502,8 @@ def loop_system(mech: Mechanism, seed: int = 0) -> LoopSystem:
             col += sz
     else:  # overconstrained as a whole: every entry into the number of rows needed
         C = rnd(m_needed, sum(sizes))
-    sysm = replace(sysm, compress=C, n_conditions=cond)
+    sysm = replace(sysm, compress=C, n_conditions=cond,
+                   rigid_family=cond == m_needed and all(rk == sz for rk, sz in zip(ranks, sizes, strict=True)))
     _SYSTEMS[mech] = sysm
     return sysm
 
@@ -517,22 +559,37 @@ def _limb_ranks(sysm: LoopSystem, sizes: list[int], rng: np.random.Generator) ->
 
 
 # ------------------------------------------------------------------------------ solving
-def _segment(sysm: LoopSystem, X, b0, b1, p0, p1):
-    """Track the points ``X`` (n, nx) from ``(b0, p0)`` to ``(b1, p1)`` (straight segments; ``b0``
-    and ``b1`` one offset for all points, (m,), or one per point, (n, m))."""
-    nx = sysm.nx
+def _segment(sysm: LoopSystem, X, P0, P1):
+    """Track the points ``X`` (n, nx) from the parameters ``P0`` to ``P1`` (straight segments;
+    each (np + nw + nx,) for all points or (n, np + nw + nx) one per point: actuator parameters,
+    the limbs' offsets ``W``, then the offsets ``b`` of the square system ``G = b``).  ``H_t``:
+    exact in the actuators and ``b``; by central differences in ``W`` (exact up to rounding for
+    the parts of degree two or less, ample for the predictor elsewhere)."""
+    nx, npar, nw = sysm.nx, sysm.npar, sysm.w_offsets[-1]
     if len(X) == 0:
         return X, np.zeros(0), np.zeros(0, bool)
-    B0 = np.broadcast_to(b0, (len(X), nx))
-    dB = np.broadcast_to(b1, (len(X), nx)) - B0
-    dp = p1 - p0
+    A0 = np.broadcast_to(P0, (len(X), npar + nw + nx))
+    dA = np.broadcast_to(P1, A0.shape) - A0
+    h = 1e-5
+
+    def G(Xc, P, want_J):
+        F, J = sysm.square(np.concatenate([Xc, P[:, :npar]], axis=1), P[:, npar : npar + nw], want_J=want_J)
+        return F - P[:, npar + nw :], J
+
+    moves_w = bool(np.any(dA[:, npar : npar + nw]))
 
     def fun(Xc, t, idx):
-        p = p0[None] + t[:, None] * dp[None]
-        F, J = sysm.square(np.concatenate([Xc, p], axis=1))
-        b = B0[idx] + t[:, None] * dB[idx]
-        Ht = np.einsum("nkp,p->nk", J[:, :, nx:], dp) - dB[idx]
-        return F - b, J[:, :, :nx], Ht
+        P = A0[idx] + t[:, None] * dA[idx]
+        n = len(Xc)
+        F, J = G(Xc, P, True)
+        d = dA[idx]
+        Ht = np.einsum("nkp,np->nk", J[:, :, nx:], d[:, :npar]) - d[:, npar + nw :]
+        if moves_w:  # the limbs' offsets: central differences in W alone
+            dW = np.zeros_like(P)
+            dW[:, npar : npar + nw] = h * d[:, npar : npar + nw]
+            Fp, _ = G(np.tile(Xc, (2, 1)), np.concatenate([P + dW, P - dW]), False)
+            Ht = Ht + (Fp[:n] - Fp[n:]) / (2 * h)
+        return F, J[:, :, :nx], Ht
 
     Xe, t, done, _ = track(fun, X, max_steps=2000, indexed=True)
     return Xe, t, done
@@ -548,10 +605,64 @@ def _new_points(known: np.ndarray, cand: np.ndarray, tol: float = 1e-6) -> np.nd
     return np.array(out).reshape(-1, known.shape[1])
 
 
+def _random_point(sysm: LoopSystem, rng: np.random.Generator) -> np.ndarray:
+    """A random complex point ``x`` on the side equations (circles, Study quadric, patch)."""
+    x = rng.normal(size=sysm.nx) + 1j * rng.normal(size=sysm.nx)
+    for a, b in sysm.circles:
+        th = rng.uniform(-np.pi, np.pi) + 1j * rng.normal(scale=0.5)
+        x[a], x[b] = np.cos(th), np.sin(th)
+    if sysm.study >= 0:
+        s = sysm.study
+        e, g = x[s : s + 4], x[s + 4 : s + 8]
+        g = g - (e @ g) / (e @ e) * e
+        xs = np.concatenate([e, g])
+        assert sysm.patch is not None
+        x[s : s + 8] = xs / (xs @ sysm.patch)
+    return x
+
+
+def _random_parameters(sysm: LoopSystem, rng: np.random.Generator) -> np.ndarray:
+    """Random complex actuator parameters, a driven rotation's ``(c, s)`` on its circle (so that
+    every displacement of a start pair is a complex rigid motion)."""
+    p = rng.normal(size=sysm.npar) + 1j * rng.normal(size=sysm.npar)
+    for _, kind, idx in sysm.params:
+        if kind == "R":
+            th = rng.uniform(-np.pi, np.pi) + 1j * rng.normal(scale=0.5)
+            p[idx[0] - sysm.nx], p[idx[1] - sysm.nx] = np.cos(th), np.sin(th)
+    return p
+
+
+def _start_offsets(sysm: LoopSystem, x: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """The offset parameters for which ``x`` (on the side equations) with actuator parameters
+    ``p`` solves the closure: each limb's offset is what it misses by."""
+    z = np.concatenate([x, p])[None]
+    D, _, E, _ = sysm._platform(z)
+    D, E = D[0], E[0]
+    off = sysm.w_offsets
+    W = np.zeros(off[-1], complex)
+    for k, le in enumerate(sysm.limbs):
+        Tb = sysm._chain(le.before, z)[0][0]
+        if le.kind == "full":
+            M = np.linalg.solve(D[:3, :3], Tb[:3, :3])  # proportional to a complex rotation
+            sc = np.sqrt(np.trace(M.T @ M) / 3)
+            if abs(np.linalg.det(M) / sc**3 + 1) < 0.5:
+                sc = -sc
+            R = M / sc
+            W[off[k] : off[k] + 4] = [1 + np.trace(R), R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]]
+            W[off[k] + 4 : off[k] + 7] = np.linalg.solve(D[:3, :3], E * Tb[:3, 3] - D[:3, 3])
+            continue
+        Ta = sysm._chain(le.after_inv, z)[0][0]
+        w = (E * (Tb @ le.c1) - D @ (Ta @ le.c2))[:3]
+        if le.kind == "point":
+            W[off[k] : off[k] + 3] = w / E
+        else:
+            W[off[k]] = (w @ w) / E**2 - le.length2
+    return W
+
+
 @dataclass(frozen=True, eq=False)
 class _GenericLoop:
-    p0: np.ndarray
-    b0: np.ndarray
+    P0: np.ndarray  # the generic parameters: actuators, then offsets
     X: np.ndarray
     loops: int
     seconds: float
@@ -573,10 +684,33 @@ def _monodromy(sysm: LoopSystem, seed: int, capped: bool) -> _GenericLoop:
     def crand(*shape):
         return rng.normal(size=shape) + 1j * rng.normal(size=shape)
 
-    p0 = crand(sysm.npar)
-    x0 = crand(sysm.nx)
-    b0 = sysm.square(np.concatenate([x0, p0])[None])[0][0]
-    scale = np.abs(b0) + 1.0
+    rigid = sysm.rigid_family
+
+    def start(n):
+        xs, Ps = [], []
+        for _ in range(n):
+            p = _random_parameters(sysm, rng)
+            if rigid:  # a point on the side equations, the limbs' offsets that make it close
+                x = _random_point(sysm, rng)
+                Ps.append(np.concatenate([p, _start_offsets(sysm, x, p), np.zeros(sysm.nx)]))
+            else:  # any point, the offset b of the square system that makes it a solution
+                x = rng.normal(size=sysm.nx) + 1j * rng.normal(size=sysm.nx)
+                W = sysm.identity_offsets()[0]
+                b = sysm.square(np.concatenate([x, p])[None], W[None])[0][0]
+                Ps.append(np.concatenate([p, W, b]))
+            xs.append(x)
+        return np.array(xs), np.array(Ps)
+
+    X0, P0s = start(1)
+    x0, P0 = X0[0], P0s[0]
+    npar, nw = sysm.npar, sysm.w_offsets[-1]
+    free = np.zeros(len(P0), bool)  # the parameters the loops move: actuators, and W or b
+    free[:npar] = True
+    if rigid:
+        free[npar : npar + nw] = True
+    else:
+        free[npar + nw :] = True
+    scale = np.where(free, np.abs(P0) + 1.0, 0.0)
     known = x0[None]
     stale = loops = 0
     k = MONODROMY_PARALLEL
@@ -585,17 +719,16 @@ def _monodromy(sysm: LoopSystem, seed: int, capped: bool) -> _GenericLoop:
         if capped and (len(known) > MONODROMY_MAX_SOLUTIONS or time.perf_counter() - t0 > MONODROMY_MAX_SECONDS):
             capped_out = True
             break
-        loops += k  # k loops at once, each through its own two random offsets
-        B1 = np.repeat(scale * crand(k, len(b0)), len(known), axis=0)
-        B2 = np.repeat(scale * crand(k, len(b0)), len(known), axis=0)
+        loops += k  # k loops at once, each through its own two random parameter points
+        B1 = np.repeat(np.where(free, scale * crand(k, len(P0)), P0), len(known), axis=0)
+        B2 = np.repeat(np.where(free, scale * crand(k, len(P0)), P0), len(known), axis=0)
         X = np.tile(known, (k, 1))
         for leg in range(3):
-            a, b = ((b0, B1), (B1, B2), (B2, b0))[leg]
-            X, _, done = _segment(sysm, X, a, b, p0, p0)
+            a, b = ((P0, B1), (B1, B2), (B2, P0))[leg]
+            X, _, done = _segment(sysm, X, a, b)
             X, B1, B2 = X[done], B1[done], B2[done]  # a failed path is dropped
-        xr = crand(k, sysm.nx)  # and fresh random points, moved to the generic instance
-        br = sysm.square(np.concatenate([xr, np.tile(p0, (k, 1))], axis=1))[0]
-        Xr, _, done = _segment(sysm, xr, br, b0, p0, p0)
+        xr, Pr = start(k)  # and fresh start pairs, moved to P0
+        Xr, _, done = _segment(sysm, xr, Pr, P0)
         X = np.vstack([X, Xr[done]])
         new = _new_points(known, X)
         if len(new):
@@ -603,7 +736,7 @@ def _monodromy(sysm: LoopSystem, seed: int, capped: bool) -> _GenericLoop:
             stale = 0
         else:
             stale += k
-    g = _GenericLoop(p0, b0, known, loops, time.perf_counter() - t0, stale >= MONODROMY_STALE_LOOPS)
+    g = _GenericLoop(P0, known, loops, time.perf_counter() - t0, stale >= MONODROMY_STALE_LOOPS)
     if not capped_out:  # a capped run is redone in full when asked without the caps
         _CACHE[key] = g
     return g
@@ -661,7 +794,8 @@ def general_forward(mech: Mechanism, targets: dict[int, float], *, seed: int = 0
     cached = sysm.key() + bytes([seed % 256]) in _CACHE
     gen = _monodromy(sysm, seed, capped)
     p1 = sysm.parameters(targets).astype(complex)
-    X, _, done = _segment(sysm, gen.X, gen.b0, np.zeros_like(gen.b0), gen.p0, p1)
+    P1 = np.concatenate([p1, sysm.identity_offsets()[0], np.zeros(sysm.nx)])
+    X, _, done = _segment(sysm, gen.X, gen.P0, P1)
     Z = np.concatenate([X, np.broadcast_to(p1, (len(X), sysm.npar))], axis=1)
     Z = _refine(sysm, Z)
     res = sysm.residual(Z)

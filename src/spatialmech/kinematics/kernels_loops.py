@@ -54,12 +54,11 @@ def pack(sysm, study_q: np.ndarray) -> tuple:
             np.array(A, float).reshape(-1, 4, 4), np.array(A2, float).reshape(-1, 4, 4),
             np.array(lo, np.int64), np.array(hi, np.int64), off, 0 if sysm.ref is not None else -1, sysm.study,
             np.ascontiguousarray(study_q), lk, c1, c2, l2, circ, np.ascontiguousarray(patch, dtype=np.complex128),
-            np.ascontiguousarray(sysm.compress, dtype=np.complex128), sysm.nx)
+            np.ascontiguousarray(sysm.compress, dtype=np.complex128), sysm.nx, np.array(sysm.w_offsets, np.int64))
 
 
 @njit(cache=True)
-def _chain(kind, sign, i0, i1, A, A2, lo, hi, z, T, dT):
-    nz = z.shape[0]
+def _chain(kind, sign, i0, i1, A, A2, lo, hi, z, T, dT, nzd):
     for a in range(4):
         for b in range(4):
             T[a, b] = 1.0 if a == b else 0.0
@@ -79,7 +78,7 @@ def _chain(kind, sign, i0, i1, A, A2, lo, hi, z, T, dT):
             for a in range(4):
                 for b in range(4):
                     M[a, b] = (1.0 if a == b else 0.0) + sg * d * A[f, a, b]
-        for k in range(nz):  # dT <- dT M
+        for k in range(nzd):  # dT <- dT M
             for a in range(4):
                 for b in range(4):
                     acc = 0.0j
@@ -87,7 +86,7 @@ def _chain(kind, sign, i0, i1, A, A2, lo, hi, z, T, dT):
                         acc += dT[k, a, e] * M[e, b]
                     tmp[a, b] = acc
             dT[k] = tmp
-        for a in range(4):  # + T dM
+        for a in range(4 if nzd > 0 else 0):  # + T dM
             for b in range(4):
                 if kind[f] == 0:
                     acc_c = 0.0j
@@ -112,9 +111,12 @@ def _chain(kind, sign, i0, i1, A, A2, lo, hi, z, T, dT):
 
 
 @njit(cache=True)
-def square_batch(Z, kind, sign, i0, i1, A, A2, lo, hi, off, ref, study, Q, lk, c1, c2, l2, circ, patch, C, nx):
-    """The square system ``G`` (n, nx) and its derivative (n, nx, nz) at points ``Z`` (n, nz)."""
+def square_batch(Z, W, want_J, kind, sign, i0, i1, A, A2, lo, hi, off, ref, study, Q, lk, c1, c2, l2, circ, patch, C,
+                 nx, woff):
+    """The square system ``G`` (n, nx) and its derivative (n, nx, nz) at points ``Z`` (n, nz),
+    with the offset parameters ``W`` (n, nw); the derivative of the closure rows only with ``want_J`` (else left zero)."""
     n, nz = Z.shape
+    nzd = nz if want_J else 0
     r = C.shape[1]
     nside = circ.shape[0] + (2 if study >= 0 else 0)
     F = np.zeros((n, nx), np.complex128)
@@ -130,11 +132,14 @@ def square_batch(Z, kind, sign, i0, i1, A, A2, lo, hi, off, ref, study, Q, lk, c
     dE = np.empty(nz, np.complex128)
     w = np.empty(3, np.complex128)
     dw = np.empty((nz, 3), np.complex128)
+    Eq = np.empty((3, 3), np.complex128)
+    Bq = np.empty((3, 3), np.complex128)
+    dBq = np.empty((nz, 3, 3), np.complex128)
     for p in range(n):
         z = Z[p]
         dE[:] = 0.0
         if ref >= 0:
-            _chain(kind, sign, i0, i1, A, A2, lo[ref], hi[ref], z, D, dD)
+            _chain(kind, sign, i0, i1, A, A2, lo[ref], hi[ref], z, D, dD, nzd)
             E = 1.0 + 0.0j
         else:
             dD[:] = 0.0
@@ -157,27 +162,55 @@ def square_batch(Z, kind, sign, i0, i1, A, A2, lo, hi, off, ref, study, Q, lk, c
         row = 0
         for k in range(lk.shape[0]):
             cb = off + 2 * k
-            _chain(kind, sign, i0, i1, A, A2, lo[cb], hi[cb], z, Tb, dTb)
+            _chain(kind, sign, i0, i1, A, A2, lo[cb], hi[cb], z, Tb, dTb, nzd)
+            wk = W[p, woff[k] : woff[k + 1]]
             if lk[k] == 0:
+                qw, qi, qj, qk = wk[0], wk[1], wk[2], wk[3]
+                Eq[0, 0] = qw * qw + qi * qi - qj * qj - qk * qk
+                Eq[0, 1] = 2.0 * (qi * qj - qw * qk)
+                Eq[0, 2] = 2.0 * (qi * qk + qw * qj)
+                Eq[1, 0] = 2.0 * (qi * qj + qw * qk)
+                Eq[1, 1] = qw * qw - qi * qi + qj * qj - qk * qk
+                Eq[1, 2] = 2.0 * (qj * qk - qw * qi)
+                Eq[2, 0] = 2.0 * (qi * qk - qw * qj)
+                Eq[2, 1] = 2.0 * (qj * qk + qw * qi)
+                Eq[2, 2] = qw * qw - qi * qi - qj * qj + qk * qk
+                for a in range(3):  # B = R_D E(q), dB
+                    for b in range(3):
+                        acc = 0.0j
+                        for e in range(3):
+                            acc += D[a, e] * Eq[e, b]
+                        Bq[a, b] = acc
+                        for v in range(nzd):
+                            acc = 0.0j
+                            for e in range(3):
+                                acc += dD[v, a, e] * Eq[e, b]
+                            dBq[v, a, b] = acc
                 for m in range(3):
                     i = 0 if m < 2 else 1
                     j = 1 if m == 0 else 2
                     acc = 0.0j
                     for a in range(3):
-                        acc += Tb[a, i] * D[a, j]
+                        acc += Tb[a, i] * Bq[a, j]
                     rows[row + m] = acc
-                    for v in range(nz):
+                    for v in range(nzd):
                         acc = 0.0j
                         for a in range(3):
-                            acc += dTb[v, a, i] * D[a, j] + Tb[a, i] * dD[v, a, j]
+                            acc += dTb[v, a, i] * Bq[a, j] + Tb[a, i] * dBq[v, a, j]
                         drows[row + m, v] = acc
                 for a in range(3):
-                    rows[row + 3 + a] = E * Tb[a, 3] - D[a, 3]
-                    for v in range(nz):
-                        drows[row + 3 + a, v] = E * dTb[v, a, 3] + dE[v] * Tb[a, 3] - dD[v, a, 3]
+                    acc = E * Tb[a, 3] - D[a, 3]
+                    for e in range(3):
+                        acc -= D[a, e] * wk[4 + e]
+                    rows[row + 3 + a] = acc
+                    for v in range(nzd):
+                        acc = E * dTb[v, a, 3] + dE[v] * Tb[a, 3] - dD[v, a, 3]
+                        for e in range(3):
+                            acc -= dD[v, a, e] * wk[4 + e]
+                        drows[row + 3 + a, v] = acc
                 row += 6
                 continue
-            _chain(kind, sign, i0, i1, A, A2, lo[cb + 1], hi[cb + 1], z, Ta, dTa)
+            _chain(kind, sign, i0, i1, A, A2, lo[cb + 1], hi[cb + 1], z, Ta, dTa, nzd)
             vv = np.zeros(4, np.complex128)
             for a in range(4):
                 for b in range(4):
@@ -189,7 +222,7 @@ def square_batch(Z, kind, sign, i0, i1, A, A2, lo, hi, off, ref, study, Q, lk, c
                     u1 += Tb[a, b] * c1[k, b]
                     u2 += D[a, b] * vv[b]
                 w[a] = E * u1 - u2
-                for v in range(nz):
+                for v in range(nzd):
                     du1 = 0.0j
                     du2 = 0.0j
                     for b in range(4):
@@ -201,14 +234,15 @@ def square_batch(Z, kind, sign, i0, i1, A, A2, lo, hi, off, ref, study, Q, lk, c
                     dw[v, a] = E * du1 + dE[v] * u1 - du2
             if lk[k] == 1:
                 for a in range(3):
-                    rows[row + a] = w[a]
-                    for v in range(nz):
-                        drows[row + a, v] = dw[v, a]
+                    rows[row + a] = w[a] - E * wk[a]
+                    for v in range(nzd):
+                        drows[row + a, v] = dw[v, a] - dE[v] * wk[a]
                 row += 3
             else:
-                rows[row] = w[0] * w[0] + w[1] * w[1] + w[2] * w[2] - E * E * l2[k]
-                for v in range(nz):
-                    drows[row, v] = 2.0 * (w[0] * dw[v, 0] + w[1] * dw[v, 1] + w[2] * dw[v, 2]) - 2.0 * E * l2[k] * dE[v]
+                lsq = l2[k] + wk[0]
+                rows[row] = w[0] * w[0] + w[1] * w[1] + w[2] * w[2] - E * E * lsq
+                for v in range(nzd):
+                    drows[row, v] = 2.0 * (w[0] * dw[v, 0] + w[1] * dw[v, 1] + w[2] * dw[v, 2]) - 2.0 * E * lsq * dE[v]
                 row += 1
         for i in range(circ.shape[0]):
             a = circ[i, 0]
@@ -234,7 +268,7 @@ def square_batch(Z, kind, sign, i0, i1, A, A2, lo, hi, off, ref, study, Q, lk, c
             for j in range(r):
                 acc += C[m, j] * rows[j]
             F[p, nside + m] = acc
-            for v in range(nz):
+            for v in range(nzd):
                 acc = 0.0j
                 for j in range(r):
                     acc += C[m, j] * drows[j, v]
