@@ -29,17 +29,26 @@ up to the number of unknowns, else all equations to that number), and every end 
 checked against the full closure: points of the square system that do not close are
 *spurious* and discarded (their number is reported).
 
-Solver.  ``G(x; p) = b`` with the actuators' parameters ``p`` and an offset ``b``: for a random
-complex ``x0`` and ``p0``, ``b0 = G(x0; p0)`` makes ``x0`` a solution for free; the incidence
-variety ``{(x, b): G(x; p0) = b}`` is the graph of ``G``, irreducible, so monodromy loops
-``b0 -> b1 -> b2 -> b0`` through random complex offsets permute the solutions transitively:
-the solutions found grow until every solution of the generic instance is known (each loop
-also tracks one fresh random point ``x'`` from ``G(x'; p0)`` to ``b0``).  The loop
-stops after :data:`MONODROMY_STALE_LOOPS` loops in a row without a new solution; that is a
-*saturation*, not a proof (no trace test), and the result says so (``complete`` is false).
-A parameter homotopy along the straight segment ``(b, p) = ((1 - t) b0, (1 - t) p0 + t
-p_request)`` then tracks every known solution to the request (the NumPy tracker
-:func:`.homotopy.track`).  The generic solve is cached per geometry (in memory).
+Solver: monodromy on a family of square systems with a start pair built from a random complex
+point, then a parameter homotopy to the request.  When every limb's equations are independent
+(the ranks equal the numbers of equations: no random combination needed), the family moves the
+limbs themselves (:attr:`LoopSystem.rigid_family`): a complex rigid offset ``W_k`` (a
+quaternion and a translation) per limb without S joint, a point offset per single S joint and a
+change of length per rod; a random complex point ``x0`` on the circles (and the Study quadric)
+closes with the offsets it misses by, and the genuine solutions form an irreducible incidence
+variety (parametrised by ``x`` and the actuators), so the loops act transitively on the generic
+solutions and never leave them: no spurious points (the general 6R loop: the 16 solutions of
+the inverse kinematics, no more).  Otherwise (overconstrained or spherical limbs) the family is
+``G(x; p) = b`` with an offset ``b`` of the square system: for a random complex ``x0`` and
+``p0``, ``b0 = G(x0; p0)``; that incidence variety is the graph of ``G``, irreducible too, but
+its generic solutions include points of the square system that do not close.  Loops
+``P0 -> P1 -> P2 -> P0`` through random complex parameters (four per round, each round also
+moving fresh start pairs to ``P0``) stop after :data:`MONODROMY_STALE_LOOPS` loops in a row
+without a new solution: a *saturation*, not a proof (no trace test), and the result says so
+(``complete`` is false).  A parameter homotopy along the straight segment from ``P0`` to the
+request (actuators given, no offsets) then tracks every known solution, with the NumPy tracker
+:func:`.homotopy.track` and the compiled square system (:mod:`.kernels_loops`).  The generic
+solve is cached per geometry (in memory).
 """
 
 from __future__ import annotations
