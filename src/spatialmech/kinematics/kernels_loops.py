@@ -1,5 +1,5 @@
-"""The compiled evaluation of the loop formulation's square system (:mod:`.homotopy_general`):
-the same equations as :meth:`.homotopy_general.LoopSystem.square` (the NumPy reference, which
+"""The compiled evaluation of the loop formulation's square system (:mod:`.loop_system`):
+the same equations as :meth:`.loop_system.LoopSystem.square` (the NumPy reference, which
 runs under ``SPATIALMECH_PURE=1``), point by point in numba.
 
 The system is packed once into flat arrays (:func:`pack`): every chain of factors (the reference
