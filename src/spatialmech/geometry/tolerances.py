@@ -267,7 +267,7 @@ HOMOTOPY_NEAR_REAL = 1e-3
 MONODROMY_STALE_LOOPS = 8
 MONODROMY_MAX_LOOPS = 80
 MONODROMY_MAX_SOLUTIONS = 128  # method="auto" gives up beyond this (the multi-start runs instead)
-MONODROMY_MAX_SECONDS = 20.0  # and beyond this time (method="homotopy" has neither cap)
+MONODROMY_MAX_SECONDS = 8.0  # and beyond this time (method="homotopy" has neither cap)
 MONODROMY_DIVERGED = 1e4  # a path stopped short with |x| beyond this is at infinity (affine variables)
 MONODROMY_PARALLEL = 4  # loops tracked together in one batch
 MONODROMY_RESIDUAL = 1e-8

@@ -344,8 +344,10 @@ def general_forward(mech: Mechanism, targets: dict[int, float], *, seed: int = 0
             q, D = rebuild(sysm, y.real, targets)
         sols.append(GeneralSolution(st, y, rcond, imag, float(res[n]), q, D))
     n_sing = sum(s.status == "singular" for s in sols)
+    fam = ("the limbs offset by generic complex rigid motions" if sysm.rigid_family
+           else "the square system with a generic complex offset")
     how = (f"monodromy saturated after {gen.loops} loops ({MONODROMY_STALE_LOOPS} in a row without a new solution; "
-           f"{len(gen.X)} solutions of a generic complex instance of the square system) then a parameter homotopy to "
+           f"{len(gen.X)} solutions of a generic complex instance: {fam}) then a parameter homotopy to "
            f"the requested actuator values; {spurious} end point(s) of the square system that do not satisfy the full "
            "closure discarded: not a proof (no trace test)")
     if not gen.saturated:
