@@ -267,8 +267,9 @@ class GeneralSolution:
     D: np.ndarray | None = None
 
     def to_dict(self) -> dict:
-        return {"status": self.status, "variables_real": [float(v) for v in self.x.real],
-                "variables_imag": [float(v) for v in self.x.imag], "inverse_condition": self.rcond,
+        fin = bool(np.all(np.isfinite(self.x)))  # a path that diverged: no numbers to give
+        return {"status": self.status, "variables_real": [float(v) for v in self.x.real] if fin else [],
+                "variables_imag": [float(v) for v in self.x.imag] if fin else [], "inverse_condition": self.rcond,
                 "imaginary_ratio": self.imag_ratio, "residual": self.residual}
 
 
