@@ -269,8 +269,15 @@ class GeneralSolution:
     def to_dict(self) -> dict:
         fin = bool(np.all(np.isfinite(self.x)))  # a path that diverged: no numbers to give
         return {"status": self.status, "variables_real": [float(v) for v in self.x.real] if fin else [],
-                "variables_imag": [float(v) for v in self.x.imag] if fin else [], "inverse_condition": self.rcond,
-                "imaginary_ratio": self.imag_ratio, "residual": self.residual}
+                "variables_imag": [float(v) for v in self.x.imag] if fin else [],
+                "inverse_condition": _finite(self.rcond), "imaginary_ratio": _finite(self.imag_ratio),
+                "residual": _finite(self.residual)}
+
+
+def _finite(v: float) -> float:
+    """``v``, or the largest float for a quantity that overflowed on a diverged path (JSON has no
+    infinity)."""
+    return float(v) if np.isfinite(v) else float(np.finfo(float).max)
 
 
 @dataclass(frozen=True, eq=False)
