@@ -190,3 +190,18 @@ def test_auto_gives_up_on_a_large_square_system_and_runs_the_multistart(monkeypa
     assert "n_spurious" not in d["search"]
     part = hg.general_forward(m, {0: 0.3}, capped=True)
     assert not part.saturated and "NOT saturated" in part.completeness
+
+
+def test_the_cache_key_tells_which_joint_is_driven():
+    """Two RSSR with the same geometry, driven at the input or at the output crank, are other
+    systems: their generic solves are not shared."""
+    z, x = [0, 0, 1], [1, 0, 0]
+
+    def rssr(drive_input: bool):
+        return sm.Mechanism("k", limbs=[
+            sm.Limb("input", [sm.R("A0", [0, 0, 0], z, actuated=drive_input), sm.S("A1", [0.3, 0, 0]),
+                              sm.S("B1", [0, 1, -0.1])]),
+            sm.Limb("output", [sm.R("B0", [0, 1, 0.5], x, actuated=not drive_input)])], platform_point=[0, 1, -0.1])
+
+    a, b = hg.loop_system(rssr(True)), hg.loop_system(rssr(False))
+    assert a.key() != b.key() and a.key() == hg.loop_system(rssr(True)).key()

@@ -103,11 +103,21 @@ class LoopSystem:
         return self.compress.shape[0]
 
     def key(self) -> bytes:
-        parts = [np.array([self.nx, self.npar, self.ref_limb, self.study], float)]
+        """The geometry and structure of the system (which variable or parameter drives each
+        factor, the limbs' equation kinds): the cache key of its generic solve."""
+        parts = [np.array([self.nx, self.npar, self.ref_limb, self.study, float(self.rigid_family)], float)]
+
+        def factor(f):
+            return np.concatenate([f.A.ravel(), [float(f.kind == "R"), float(f.inverse)], np.asarray(f.idx, float)])
+
         for f in self.ref or ():
-            parts.append(f.A.ravel())
+            parts.append(factor(f))
         for le in self.limbs:
-            parts += [f.A.ravel() for f in le.before + le.after_inv] + [le.c1, le.c2, np.array([le.length2])]
+            parts += [np.array([{"full": 0.0, "point": 1.0, "rod": 2.0}[le.kind], -1.0])]
+            parts += [factor(f) for f in le.before] + [np.array([-2.0])] + [factor(f) for f in le.after_inv]
+            parts += [le.c1, le.c2, np.array([le.length2])]
+        parts.append(self.compress.real.ravel())
+        parts.append(self.compress.imag.ravel())
         return np.round(np.concatenate(parts), 12).tobytes()
 
     # -------------------------------------------------------------------------- evaluation
