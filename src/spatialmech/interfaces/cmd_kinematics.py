@@ -256,7 +256,6 @@ def fk(model, values, all_solutions, method, seeds, as_json):
     pre = None
     if all_solutions and method != "multistart" and not closed:
         from ..kinematics import homotopy as hc
-
         from ..kinematics import homotopy_general as hg
 
         why = hc.unsupported_reason(mech)

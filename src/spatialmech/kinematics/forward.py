@@ -510,7 +510,6 @@ def _forward_homotopy(mech: Mechanism, targets: dict[int, float], seed: int, max
     mask = active_mask(mech)
     for i in targets:
         mask[i] = False
-    L = mech.characteristic_length
     runs = []
     q0 = np.zeros(len(refs))
     for i, v in targets.items():  # the slides start at their values (not the leg reversed through its base)
@@ -526,21 +525,7 @@ def _forward_homotopy(mech: Mechanism, targets: dict[int, float], seed: int, max
         # multiple root) are located to a few digits only: the multi-start search adds its roots,
         # and a singular root is followed along its self-motion and reported as one continuum
         runs += _multistart_runs(mech, targets, mask, n_seeds, seed, max_iter)
-    conv = [r for r in runs if r.converged]
-    dedup, sdedup = dedup_tolerances()
-    locked = locked_actuators(mech)
-    keys = np.array([_pose_key(mech, r.config) for r in conv]).reshape(-1, 12)
-    conds = [forward_conditioning(mech, r.config) for r in conv]
-    groups = group_roots(keys, [c.singular for c in conds], [r.residual for r in conv],
-                         lambda i: _trace_self_motion(mech, locked, conv[i].config), dedup_tol=dedup,
-                         singular_dedup_tol=sdedup, prefer=[not within_limits(mech, r.config.q) for r in conv],
-                         free_dims=[c.free_dim for c in conds])
-    sols = []
-    for g in sorted(groups, key=lambda g: min(g.members)):
-        r = conv[g.rep]
-        sols.append(ForwardSolution(r.config, platform_pose(mech, r.config), True, r.residual, r.iterations,
-                                    tuple(within_limits(mech, r.config.q)), conds[g.rep], g.kind, len(g.members),
-                                    g.self_motion(keys, L)))
+    sols, conv = _group_runs(mech, runs)
     kinds = [s.kind for s in sols]
     extra = len(runs) - n_endpoint_runs
     search = {"method": "homotopy continuation (Study parameters), real end points polished by Newton"
