@@ -137,8 +137,8 @@ def test_cli_json_and_text(stewart):
 
 def test_uncovered_model_clear_message():
     runner = CliRunner()
-    out = runner.invoke(main, ["fk", "three-rrr-sm", "--actuators", "10,20,30", "--all", "--method", "homotopy"])
-    assert out.exit_code != 0 and "does not cover three-rrr-sm" in out.output and "R-R-R" in out.output
+    out = runner.invoke(main, ["fk", "spatial-six-bar", "--actuators", "10", "--all", "--method", "homotopy"])
+    assert out.exit_code != 0 and "does not cover spatial-six-bar" in out.output and "internal bodies" in out.output
     assert "Traceback" not in out.output
     with pytest.raises(sm.InputError, match="method"):
         sm.fk("stewart-6sps", [1.2] * 6, all_solutions=True, method="newton")

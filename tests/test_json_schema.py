@@ -74,6 +74,7 @@ CASES = [
     (["fk", "four-sps-cu", "--actuators", FK_ACTUATORS], "fk", "four-sps-cu"),  # general engine
     (["fk", "stewart-6sps", "--actuators", "1.2,1.2,1.2,1.2,1.2,1.2"], "fk", "stewart-6sps"),
     (["fk", "stewart-6sps", "--actuators", "1.2,1.2,1.2,1.2,1.2,1.2", "--all"], "fk", "stewart-6sps"),  # homotopy
+    (["fk", "rssr", "--actuators", "30", "--all"], "fk", "rssr"),  # loop formulation, monodromy
     (["jacobian", "four-sps-cu", *POSE], "jacobian", "four-sps-cu"),
     (["jacobian", "five-cs-1", "--position", "3", "--driver", "rot1"], "jacobian", "five-cs-1"),
     (["jacobian", "five-cs-3", "--dj-table"], "jacobian", "five-cs-3"),

@@ -132,7 +132,12 @@ UNIT_FREE_KEYS: dict[str, str] = {
     "n_at_infinity": "homotopy end points at infinity (the platform escapes: e.e = 0 in Study parameters)",
     "n_singular_roots": "isolated singular real roots found (homotopy search)",
     "n_generic": "isolated solutions of the generic instance (homotopy paths tracked)",
-    "n_paths": "paths of the total-degree homotopy",
+    "n_paths": "paths of the total-degree homotopy (loop formulation: of the final parameter homotopy)",
+    "n_spurious": "end points of the squared-up loop system that do not satisfy the full closure (discarded)",
+    "monodromy_loops": "monodromy loops run before the solution set stopped growing",
+    "variables_real": "real part of a loop-formulation end point: (cos, sin) of each passive rotation, slides / L, "
+                      "Study parameters when the platform is not fixed by a limb",
+    "variables_imag": "imaginary part of the same variables",
     "study_parameters_real": "real part of the Study parameters (e0..e3, g0..g3; g scaled by 1/L), projective",
     "study_parameters_imag": "imaginary part of the Study parameters, same scaling",
     "inverse_condition": "inverse condition number of the row-normalised Jacobian at a homotopy end point",

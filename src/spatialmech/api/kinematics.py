@@ -163,8 +163,10 @@ def fk(model: ModelLike, actuators, *, all_solutions: bool = False, seeds: int |
     From the reference configuration by Newton; ``all_solutions``: every assembly mode a
     multi-start search finds (``seeds`` starts: default 200, 512 on the 4-SPS/CU closed form).
     ``method`` (with ``all_solutions``): ``"auto"`` (default: homotopy continuation where it
-    covers the model (S-P-S and R-P-S legs, passive C-U limbs), proven complete; on the 4-SPS/CU its closed form; else the
-    multi-start), ``"homotopy"`` or ``"multistart"``; see docs/homotopy.md.  The result's
+    covers the model (S-P-S and R-P-S legs, passive C-U limbs), proven complete; on the 4-SPS/CU its closed form; else,
+    for limbs from the ground to the platform of R, P, C, U, Sm and S joints (at most one S, or an S-S rod, per limb), the
+    loop formulation solved by monodromy, *not* proven complete; else the multi-start), ``"homotopy"`` or
+    ``"multistart"``; see docs/homotopy.md.  The result's
     ``to_dict()`` says ``complete`` and ``completeness``.
     Nothing is raised when no assembly is found: see ``converged`` and ``to_dict()``.
 

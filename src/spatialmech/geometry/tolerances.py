@@ -58,6 +58,13 @@ __all__ = [
     "HOMOTOPY_REAL",
     "HOMOTOPY_SINGULAR",
     "LOCAL_DIMENSION_STEP",
+    "MONODROMY_DIVERGED",
+    "MONODROMY_MAX_LOOPS",
+    "MONODROMY_MAX_SECONDS",
+    "MONODROMY_MAX_SOLUTIONS",
+    "MONODROMY_PARALLEL",
+    "MONODROMY_RESIDUAL",
+    "MONODROMY_STALE_LOOPS",
     "NEAR_SINGULAR",
     "Tolerances",
     "characteristic_length",
@@ -272,3 +279,14 @@ ENDGAME_LOOPS = 6
 ENDGAME_CLOSED = 1e-6
 ENDGAME_AGREE = 1e-8
 LOCAL_DIMENSION_STEP = 1e-4
+
+#: Monodromy (kinematics/homotopy_general.py): loops in a row without a new solution before the
+#: solve stops (saturation, not a proof), the most loops, and the relative residual of the full
+#: closure below which an end point of the square system is a solution (else spurious).
+MONODROMY_STALE_LOOPS = 8
+MONODROMY_MAX_LOOPS = 80
+MONODROMY_MAX_SOLUTIONS = 128  # method="auto" gives up beyond this (the multi-start runs instead)
+MONODROMY_MAX_SECONDS = 8.0  # and beyond this time (method="homotopy" has neither cap)
+MONODROMY_DIVERGED = 1e4  # a path stopped short with |x| beyond this is at infinity (affine variables)
+MONODROMY_PARALLEL = 4  # loops tracked together in one batch
+MONODROMY_RESIDUAL = 1e-8

@@ -221,7 +221,8 @@ def ik(model, xyz, euler, position, all_solutions, free, as_json):
               help="All real assembly modes: homotopy continuation (proven complete) where it covers the model, "
                    "else multi-start.")
 @click.option("--method", type=click.Choice(["auto", "homotopy", "multistart"]), default="auto", show_default=True,
-              help="Method of --all (homotopy: S-P-S and R-P-S legs, passive C-U limbs; see docs/homotopy.md).")
+              help="Method of --all (homotopy: proven complete for S-P-S and R-P-S legs, passive C-U limbs, ...; "
+                   "by monodromy, not proven, for other limbs of R, P, C, U, S joints; see docs/homotopy.md).")
 @click.option("--seeds", type=click.IntRange(min=1, max=MAX_SEEDS), default=None,
               help=f"Number of starts for --all (default: 200; 512 on the 4-SPS/CU closed form; at most {MAX_SEEDS}).")
 @tol_option("newton")
@@ -252,15 +253,23 @@ def fk(model, values, all_solutions, method, seeds, as_json):
     from ..kinematics.closed_forms import four_sps_cu_forward as k4f
 
     closed = all_solutions and method == "auto" and k4.geometry_of(mech) is not None  # the 4-SPS/CU keeps its closed form
+    pre = None
     if all_solutions and method != "multistart" and not closed:
         from ..kinematics import homotopy as hc
+        from ..kinematics import homotopy_general as hg
 
         why = hc.unsupported_reason(mech)
-        if why is None:
-            _fk_homotopy(mech, vals, as_json)
-            return
-        if method == "homotopy":
-            raise InputError(f"--method: homotopy does not cover {mech.name}: {why}; use --method multistart")
+        gwhy = hg.general_reason(mech) if why is not None else None
+        if why is None or gwhy is None:
+            pre = forward_position(mech, vals, all_solutions=True, method="homotopy" if why is None else method,
+                                   n_seeds=200 if seeds is None else seeds)
+            if "n_generic" in pre.search:
+                _fk_homotopy(mech, pre, as_json)
+                return
+            # the loop formulation's monodromy stopped unsaturated: the multi-start ran instead (printed below)
+        elif method == "homotopy":
+            raise InputError(f"--method: homotopy does not cover {mech.name}: {why}; nor does the loop formulation: "
+                             f"{gwhy}; use --method multistart")
     geom = k4.geometry_of(mech) if all_solutions and method != "multistart" else None
     if geom is not None:  # the closed form of this limb layout: faster and more thorough
         fa = k4f.forward_all(np.asarray(vals), geometry=geom, **({} if seeds is None else {"n_seeds": seeds}))
@@ -281,7 +290,9 @@ def fk(model, values, all_solutions, method, seeds, as_json):
                                    mech.length_unit, None)
         return
     seeds = 200 if seeds is None else seeds
-    if all_solutions and not as_json:
+    if pre is not None:
+        res = pre
+    elif all_solutions and not as_json:
         import sys
 
         with click.progressbar(length=seeds, label="assembly modes", file=sys.stderr) as bar:
@@ -317,9 +328,8 @@ def _fk_solution_lines(mech: Mechanism, converged) -> None:
                                c.free_dim)
 
 
-def _fk_homotopy(mech: Mechanism, vals, as_json: bool) -> None:
+def _fk_homotopy(mech: Mechanism, res, as_json: bool) -> None:
     """``fk --all`` by homotopy continuation: counts, completeness, the real assembly modes."""
-    res = forward_position(mech, vals, all_solutions=True, method="homotopy")
     if as_json:
         emit_json("fk", mech, res.to_dict(mech))
         return
@@ -330,8 +340,10 @@ def _fk_homotopy(mech: Mechanism, vals, as_json: bool) -> None:
     click.echo(f"{mech.name}: {len(sols)} real assembly mode{'s' if len(sols) != 1 else ''}"
                + (f" ({n_sm} of them self-motion sets)" if n_sm else "")
                + f"; end points: {sr['n_real']} real, {sr['n_complex']} complex, {sr['n_singular']} singular, "
-               f"{sr['n_at_infinity']} at infinity, of {sr['n_generic']} generic solutions "
-               f"(homotopy continuation, {sr['elapsed_s']:.2f} s)")
+               f"{sr['n_at_infinity']} at infinity, of {sr['n_generic']} generic solutions"
+               + (f" ({sr['n_spurious']} spurious end points of the square system discarded)" if "n_spurious" in sr else "")
+               + f" ({'loop formulation by monodromy' if 'n_spurious' in sr else 'homotopy continuation'}, "
+               f"{sr['elapsed_s']:.2f} s)")
     click.echo(("  complete (proven): " if sr["complete"] else "  NOT proven complete: ") + sr["completeness"])
     _fk_solution_lines(mech, sols)
 

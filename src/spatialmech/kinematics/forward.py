@@ -17,6 +17,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..errors import InputError
+from ..geometry.tolerances import MONODROMY_MAX_SECONDS, MONODROMY_MAX_SOLUTIONS
 from ..geometry.tolerances import resolve as resolve_tolerances
 from ..geometry import screws as sc
 from ..model.mechanism import Mechanism, Pose
@@ -352,15 +353,25 @@ def forward_position(
     if method not in ("multistart", "homotopy", "auto"):
         raise InputError(f"method: expected 'multistart', 'homotopy' or 'auto', got {method!r}")
     targets = _actuator_q(mech, actuator_values)
+    gwhy: str | None = None  # why the loop formulation (homotopy_general) does not cover the model
     if all_solutions and method != "multistart":
         from . import homotopy as hc
 
         why = hc.unsupported_reason(mech)
         if why is None:
             return _forward_homotopy(mech, targets, seed, max_iter, n_seeds)
-        if method == "homotopy":
-            raise InputError(f"method: homotopy forward position does not cover {mech.name}: {why}; "
-                             "use method='multistart'")
+        from . import homotopy_general as hg
+
+        gwhy = hg.general_reason(mech)
+        if gwhy is None:
+            gres = _forward_general(mech, targets, seed, max_iter, n_seeds, fallback=method == "auto")
+            if gres is not None:
+                return gres
+            gwhy = (f"its monodromy gave up unsaturated (more than {MONODROMY_MAX_SOLUTIONS} solutions of the square system, "
+                    f"or {MONODROMY_MAX_SECONDS:g} s); method='homotopy' runs it without these caps")
+        elif method == "homotopy":
+            raise InputError(f"method: homotopy forward position does not cover {mech.name}: {why}; nor does the loop "
+                             f"formulation: {gwhy}; use method='multistart'")
     if all_solutions and (int(n_seeds) != n_seeds or n_seeds < 1):
         raise InputError(f"n_seeds: expected a positive number of starts, got {n_seeds}")
     mask = active_mask(mech)
@@ -419,7 +430,7 @@ def forward_position(
         search["complete"] = False
         search["completeness"] = ("multi-start search: not a proof; assembly modes may be missing" +
                                   ("" if method == "multistart" else f" (homotopy does not cover {mech.name}: "
-                                   f"{hc.unsupported_reason(mech)})"))
+                                   f"{hc.unsupported_reason(mech)}; nor does the loop formulation: {gwhy})"))
     return ForwardResult(tuple(sols), search)
 
 
@@ -499,7 +510,6 @@ def _forward_homotopy(mech: Mechanism, targets: dict[int, float], seed: int, max
     mask = active_mask(mech)
     for i in targets:
         mask[i] = False
-    L = mech.characteristic_length
     runs = []
     q0 = np.zeros(len(refs))
     for i, v in targets.items():  # the slides start at their values (not the leg reversed through its base)
@@ -515,21 +525,7 @@ def _forward_homotopy(mech: Mechanism, targets: dict[int, float], seed: int, max
         # multiple root) are located to a few digits only: the multi-start search adds its roots,
         # and a singular root is followed along its self-motion and reported as one continuum
         runs += _multistart_runs(mech, targets, mask, n_seeds, seed, max_iter)
-    conv = [r for r in runs if r.converged]
-    dedup, sdedup = dedup_tolerances()
-    locked = locked_actuators(mech)
-    keys = np.array([_pose_key(mech, r.config) for r in conv]).reshape(-1, 12)
-    conds = [forward_conditioning(mech, r.config) for r in conv]
-    groups = group_roots(keys, [c.singular for c in conds], [r.residual for r in conv],
-                         lambda i: _trace_self_motion(mech, locked, conv[i].config), dedup_tol=dedup,
-                         singular_dedup_tol=sdedup, prefer=[not within_limits(mech, r.config.q) for r in conv],
-                         free_dims=[c.free_dim for c in conds])
-    sols = []
-    for g in sorted(groups, key=lambda g: min(g.members)):
-        r = conv[g.rep]
-        sols.append(ForwardSolution(r.config, platform_pose(mech, r.config), True, r.residual, r.iterations,
-                                    tuple(within_limits(mech, r.config.q)), conds[g.rep], g.kind, len(g.members),
-                                    g.self_motion(keys, L)))
+    sols, conv = _group_runs(mech, runs)
     kinds = [s.kind for s in sols]
     extra = len(runs) - n_endpoint_runs
     search = {"method": "homotopy continuation (Study parameters), real end points polished by Newton"
@@ -543,4 +539,60 @@ def _forward_homotopy(mech: Mechanism, targets: dict[int, float], seed: int, max
               "n_paths": hr.n_paths_total_degree, "elapsed_s": hr.seconds, "generic_elapsed_s": hr.seconds_generic,
               "generic_cached": hr.cached, "endpoints": [e.to_dict() for e in hr.solutions],
               "singular_below": singular_threshold()}
+    return ForwardResult(tuple(sols), search)
+
+
+def _group_runs(mech: Mechanism, runs: list) -> tuple[list, list]:
+    """The converged runs grouped into results (distinct poses, self-motions), in the order found."""
+    conv = [r for r in runs if r.converged]
+    dedup, sdedup = dedup_tolerances()
+    locked = locked_actuators(mech)
+    L = mech.characteristic_length
+    keys = np.array([_pose_key(mech, r.config) for r in conv]).reshape(-1, 12)
+    conds = [forward_conditioning(mech, r.config) for r in conv]
+    groups = group_roots(keys, [c.singular for c in conds], [r.residual for r in conv],
+                         lambda i: _trace_self_motion(mech, locked, conv[i].config), dedup_tol=dedup,
+                         singular_dedup_tol=sdedup, prefer=[not within_limits(mech, r.config.q) for r in conv],
+                         free_dims=[c.free_dim for c in conds])
+    sols = []
+    for g in sorted(groups, key=lambda g: min(g.members)):
+        r = conv[g.rep]
+        sols.append(ForwardSolution(r.config, platform_pose(mech, r.config), True, r.residual, r.iterations,
+                                    tuple(within_limits(mech, r.config.q)), conds[g.rep], g.kind, len(g.members),
+                                    g.self_motion(keys, L)))
+    return sols, conv
+
+
+def _forward_general(mech: Mechanism, targets: dict[int, float], seed: int, max_iter: int,
+                     n_seeds: int = 200, fallback: bool = False) -> ForwardResult | None:
+    """``forward_position(..., method="homotopy")`` on a model whose limbs do not reduce to the
+    Study-parameter quadrics: the loop formulation in joint variables solved by monodromy
+    (:mod:`.homotopy_general`); each real end point is a configuration, polished by the same
+    Newton step and grouped as the multi-start roots.  Never a proof (``complete`` false)."""
+    from . import homotopy_general as hg
+
+    hr = hg.general_forward(mech, targets, seed=seed, capped=fallback)
+    if fallback and not hr.saturated:  # method="auto": the multi-start instead
+        return None
+    mask = active_mask(mech)
+    for i in targets:
+        mask[i] = False
+    runs = [_fk_from(mech, hg.configuration(e), targets, mask, max_iter) for e in hr.solutions if e.q is not None]
+    n_endpoint_runs = len(runs)
+    if hr.count("singular"):  # a continuum or a multiple root: the multi-start adds its roots (as _forward_homotopy)
+        runs += _multistart_runs(mech, targets, mask, n_seeds, seed, max_iter)
+    sols, conv = _group_runs(mech, runs)
+    kinds = [s.kind for s in sols]
+    extra = len(runs) - n_endpoint_runs
+    search = {"method": "homotopy continuation (loop closure in joint variables, monodromy), real end points polished "
+                        "by Newton" + (f"; singular end points: {extra} multi-start seeds added" if extra else ""),
+              "seeds": extra, "seed": seed, "converged_runs": len(conv), "distinct": len(kinds),
+              "n_regular": kinds.count(AssemblyKind.REGULAR), "n_singular_roots": kinds.count(AssemblyKind.SINGULAR),
+              "n_self_motion_sets": kinds.count(AssemblyKind.SELF_MOTION),
+              "complete": hr.complete, "completeness": hr.completeness,
+              "n_complex": hr.count("complex"), "n_real": hr.count("real"), "n_singular": hr.count("singular"),
+              "n_at_infinity": hr.count("at_infinity"), "n_generic": hr.n_generic, "n_spurious": hr.n_spurious,
+              "n_paths": hr.n_generic, "monodromy_loops": hr.loops, "elapsed_s": hr.seconds,
+              "generic_elapsed_s": hr.seconds_generic, "generic_cached": hr.cached,
+              "endpoints": [e.to_dict() for e in hr.solutions], "singular_below": singular_threshold()}
     return ForwardResult(tuple(sols), search)

@@ -107,10 +107,12 @@ def _eval_quad(Qc: np.ndarray, c: np.ndarray, X: np.ndarray):
     return F, J, E
 
 
-def track(fun, X0: np.ndarray, *, h0: float = 0.02, hmin: float = 1e-14, max_steps: int = 4000):
+def track(fun, X0: np.ndarray, *, h0: float = 0.02, hmin: float = 1e-14, max_steps: int = 4000,
+          indexed: bool = False):
     """Track the paths ``H(x, t) = 0`` from ``t = 0`` (points ``X0``, (n, m)) to ``t = 1``.
 
-    ``fun(X, t)`` (``t``: (n,)) returns ``H`` (n, m), ``H_x`` (n, m, m) and ``H_t`` (n, m).
+    ``fun(X, t)`` (``t``: (n,)) returns ``H`` (n, m), ``H_x`` (n, m, m) and ``H_t`` (n, m); with
+    ``indexed``, ``fun(X, t, idx)`` is also told which paths (rows of ``X0``) it is given.
     Returns ``(X, t, ok, steps)``: the end points, the ``t`` reached, whether ``t = 1`` was
     reached with a converged corrector, and the accepted steps per path."""
     X = np.array(X0, dtype=complex)
@@ -122,14 +124,18 @@ def track(fun, X0: np.ndarray, *, h0: float = 0.02, hmin: float = 1e-14, max_ste
     steps = np.zeros(n, int)
     good = np.zeros(n, int)
 
-    def vel(x, tt):
-        _, Hx, Ht = fun(x, tt)
-        return -np.linalg.solve(Hx, Ht[..., None])[..., 0]
-
     for _ in range(max_steps):
         idx = np.flatnonzero(~done & ~failed)
         if idx.size == 0:
             break
+
+        def fun_i(x, tt, idx=idx):
+            return fun(x, tt, idx) if indexed else fun(x, tt)
+
+        def vel(x, tt):
+            _, Hx, Ht = fun_i(x, tt)
+            return -np.linalg.solve(Hx, Ht[..., None])[..., 0]
+
         x, tt = X[idx], t[idx]
         hh = np.minimum(h[idx], 1.0 - tt)
         with np.errstate(all="ignore"):
@@ -141,11 +147,11 @@ def track(fun, X0: np.ndarray, *, h0: float = 0.02, hmin: float = 1e-14, max_ste
                 xc = x + hh[:, None] / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
                 tn = tt + hh
                 nx = 1 + np.linalg.norm(xc, axis=1)
-                H, Hx, _ = fun(xc, tn)
+                H, Hx, _ = fun_i(xc, tn)
                 dx = np.linalg.solve(Hx, H[..., None])[..., 0]
                 d0 = np.linalg.norm(dx, axis=1) / nx
                 xc = xc - dx
-                H, Hx, _ = fun(xc, tn)
+                H, Hx, _ = fun_i(xc, tn)
                 dx = np.linalg.solve(Hx, H[..., None])[..., 0]
                 d1 = np.linalg.norm(dx, axis=1) / nx
                 xc = xc - dx

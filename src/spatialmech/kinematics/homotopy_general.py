@@ -1,0 +1,460 @@
+"""Every assembly mode of a model whose limbs do not reduce to quadrics in the Study parameters
+(:mod:`.homotopy_systems`): the loop formulation of :mod:`.loop_system` (joint variables,
+generated from the model) solved by monodromy and a parameter homotopy.
+
+Solver: monodromy on a family of square systems with a start pair built from a random complex
+point, then a parameter homotopy to the request.  When every limb's equations are independent
+(the ranks equal the numbers of equations: no random combination needed), the family moves the
+limbs themselves (:attr:`LoopSystem.rigid_family`): a complex rigid offset ``W_k`` (a
+quaternion and a translation) per limb without S joint, a point offset per single S joint and a
+change of length per rod; a random complex point ``x0`` on the circles (and the Study quadric)
+closes with the offsets it misses by, and the genuine solutions form an irreducible incidence
+variety (parametrised by ``x`` and the actuators), so the loops act transitively on the generic
+solutions and never leave them: no spurious points (the general 6R loop: the 16 solutions of
+the inverse kinematics, no more).  Otherwise (overconstrained or spherical limbs) the family is
+``G(x; p) = b`` with an offset ``b`` of the square system: for a random complex ``x0`` and
+``p0``, ``b0 = G(x0; p0)``; that incidence variety is the graph of ``G``, irreducible too, but
+its generic solutions include points of the square system that do not close.  Loops
+``P0 -> P1 -> P2 -> P0`` through random complex parameters (four per round, each round also
+moving fresh start pairs to ``P0``) stop after :data:`MONODROMY_STALE_LOOPS` loops in a row
+without a new solution: a *saturation*, not a proof (no trace test), and the result says so
+(``complete`` is false).  A parameter homotopy along the straight segment from ``P0`` to the
+request (actuators given, no offsets) then tracks every known solution, with the NumPy tracker
+:func:`.homotopy.track` and the compiled square system (:mod:`.kernels_loops`).  The generic
+solve is cached per geometry (in memory).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import InputError
+from ..geometry.rotations import matrix_rotvec, skew
+from ..geometry.tolerances import (
+    HOMOTOPY_INFINITY,
+    HOMOTOPY_REAL,
+    HOMOTOPY_SINGULAR,
+    MONODROMY_DIVERGED,
+    MONODROMY_MAX_LOOPS,
+    MONODROMY_MAX_SECONDS,
+    MONODROMY_MAX_SOLUTIONS,
+    MONODROMY_PARALLEL,
+    MONODROMY_RESIDUAL,
+    MONODROMY_STALE_LOOPS,
+)
+from ..model.mechanism import Mechanism
+from .closure import Configuration, limb_slices
+from .homotopy import study_to_pose, track
+from .loop_system import LoopSystem, general_reason, loop_system, variables
+
+__all__ = [
+    "GeneralResult",
+    "GeneralSolution",
+    "LoopSystem",
+    "clear_cache",
+    "configuration",
+    "general_forward",
+    "general_reason",
+    "loop_system",
+    "rebuild",
+    "variables",
+]
+
+
+# ------------------------------------------------------------------------------ solving
+def _segment(sysm: LoopSystem, X, P0, P1):
+    """Track the points ``X`` (n, nx) from the parameters ``P0`` to ``P1`` (straight segments;
+    each (np + nw + nx,) for all points or (n, np + nw + nx) one per point: actuator parameters,
+    the limbs' offsets ``W``, then the offsets ``b`` of the square system ``G = b``).  ``H_t``:
+    exact in the actuators and ``b``; by central differences in ``W`` (exact up to rounding for
+    the parts of degree two or less, ample for the predictor elsewhere)."""
+    nx, npar, nw = sysm.nx, sysm.npar, sysm.w_offsets[-1]
+    if len(X) == 0:
+        return X, np.zeros(0), np.zeros(0, bool)
+    A0 = np.broadcast_to(P0, (len(X), npar + nw + nx))
+    dA = np.broadcast_to(P1, A0.shape) - A0
+    h = 1e-5
+
+    def G(Xc, P, want_J):
+        F, J = sysm.square(np.concatenate([Xc, P[:, :npar]], axis=1), P[:, npar : npar + nw], want_J=want_J)
+        return F - P[:, npar + nw :], J
+
+    moves_w = bool(np.any(dA[:, npar : npar + nw]))
+
+    def fun(Xc, t, idx):
+        P = A0[idx] + t[:, None] * dA[idx]
+        n = len(Xc)
+        F, J = G(Xc, P, True)
+        d = dA[idx]
+        Ht = np.einsum("nkp,np->nk", J[:, :, nx:], d[:, :npar]) - d[:, npar + nw :]
+        if moves_w:  # the limbs' offsets: central differences in W alone
+            dW = np.zeros_like(P)
+            dW[:, npar : npar + nw] = h * d[:, npar : npar + nw]
+            Fp, _ = G(np.tile(Xc, (2, 1)), np.concatenate([P + dW, P - dW]), False)
+            Ht = Ht + (Fp[:n] - Fp[n:]) / (2 * h)
+        return F, J[:, :, :nx], Ht
+
+    Xe, t, done, _ = track(fun, X, max_steps=2000, indexed=True)
+    return Xe, t, done
+
+
+def _new_points(known: np.ndarray, cand: np.ndarray, tol: float = 1e-6) -> np.ndarray:
+    out: list[np.ndarray] = []
+    for x in cand:
+        ref = known if not out else np.vstack([known, *[o[None] for o in out]])
+        d = np.linalg.norm(ref - x, axis=1) / (1 + np.linalg.norm(x))
+        if np.all(d > tol):
+            out.append(x)
+    return np.array(out).reshape(-1, known.shape[1])
+
+
+def _random_point(sysm: LoopSystem, rng: np.random.Generator) -> np.ndarray:
+    """A random complex point ``x`` on the side equations (circles, Study quadric, patch)."""
+    x = rng.normal(size=sysm.nx) + 1j * rng.normal(size=sysm.nx)
+    for a, b in sysm.circles:
+        th = rng.uniform(-np.pi, np.pi) + 1j * rng.normal(scale=0.5)
+        x[a], x[b] = np.cos(th), np.sin(th)
+    if sysm.study >= 0:
+        s = sysm.study
+        e, g = x[s : s + 4], x[s + 4 : s + 8]
+        g = g - (e @ g) / (e @ e) * e
+        xs = np.concatenate([e, g])
+        assert sysm.patch is not None
+        x[s : s + 8] = xs / (xs @ sysm.patch)
+    return x
+
+
+def _random_parameters(sysm: LoopSystem, rng: np.random.Generator) -> np.ndarray:
+    """Random complex actuator parameters, a driven rotation's ``(c, s)`` on its circle (so that
+    every displacement of a start pair is a complex rigid motion)."""
+    p = rng.normal(size=sysm.npar) + 1j * rng.normal(size=sysm.npar)
+    for _, kind, idx in sysm.params:
+        if kind == "R":
+            th = rng.uniform(-np.pi, np.pi) + 1j * rng.normal(scale=0.5)
+            p[idx[0] - sysm.nx], p[idx[1] - sysm.nx] = np.cos(th), np.sin(th)
+    return p
+
+
+def _start_offsets(sysm: LoopSystem, x: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """The offset parameters for which ``x`` (on the side equations) with actuator parameters
+    ``p`` solves the closure: each limb's offset is what it misses by."""
+    z = np.concatenate([x, p])[None]
+    D, _, E, _ = sysm._platform(z)
+    D, E = D[0], E[0]
+    off = sysm.w_offsets
+    W = np.zeros(off[-1], complex)
+    for k, le in enumerate(sysm.limbs):
+        Tb = sysm._chain(le.before, z)[0][0]
+        if le.kind == "full":
+            M = np.linalg.solve(D[:3, :3], Tb[:3, :3])  # proportional to a complex rotation
+            sc = np.sqrt(np.trace(M.T @ M) / 3)
+            if abs(np.linalg.det(M) / sc**3 + 1) < 0.5:
+                sc = -sc
+            R = M / sc
+            W[off[k] : off[k] + 4] = [1 + np.trace(R), R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]]
+            W[off[k] + 4 : off[k] + 7] = np.linalg.solve(D[:3, :3], E * Tb[:3, 3] - D[:3, 3])
+            continue
+        Ta = sysm._chain(le.after_inv, z)[0][0]
+        w = (E * (Tb @ le.c1) - D @ (Ta @ le.c2))[:3]
+        if le.kind == "point":
+            W[off[k] : off[k] + 3] = w / E
+        else:
+            W[off[k]] = (w @ w) / E**2 - le.length2
+    return W
+
+
+@dataclass(frozen=True, eq=False)
+class _GenericLoop:
+    P0: np.ndarray  # the generic parameters: actuators, then offsets
+    X: np.ndarray
+    loops: int
+    seconds: float
+    saturated: bool
+
+
+_CACHE: dict[bytes, _GenericLoop] = {}
+
+
+def _monodromy(sysm: LoopSystem, seed: int, capped: bool) -> _GenericLoop:
+    """The generic instance's solutions by monodromy; ``capped``: also stop at
+    :data:`MONODROMY_MAX_SOLUTIONS` solutions or :data:`MONODROMY_MAX_SECONDS` (unsaturated)."""
+    key = sysm.key() + bytes([seed % 256])
+    if key in _CACHE:
+        return _CACHE[key]
+    t0 = time.perf_counter()
+    rng = np.random.default_rng(seed)
+
+    def crand(*shape):
+        return rng.normal(size=shape) + 1j * rng.normal(size=shape)
+
+    rigid = sysm.rigid_family
+
+    def start(n):
+        xs, Ps = [], []
+        for _ in range(n):
+            p = _random_parameters(sysm, rng)
+            if rigid:  # a point on the side equations, the limbs' offsets that make it close
+                x = _random_point(sysm, rng)
+                Ps.append(np.concatenate([p, _start_offsets(sysm, x, p), np.zeros(sysm.nx)]))
+            else:  # any point, the offset b of the square system that makes it a solution
+                x = rng.normal(size=sysm.nx) + 1j * rng.normal(size=sysm.nx)
+                W = sysm.identity_offsets()[0]
+                b = sysm.square(np.concatenate([x, p])[None], W[None])[0][0]
+                Ps.append(np.concatenate([p, W, b]))
+            xs.append(x)
+        return np.array(xs), np.array(Ps)
+
+    X0, P0s = start(1)
+    x0, P0 = X0[0], P0s[0]
+    npar, nw = sysm.npar, sysm.w_offsets[-1]
+    free = np.zeros(len(P0), bool)  # the parameters the loops move: actuators, and W or b
+    free[:npar] = True
+    if rigid:
+        free[npar : npar + nw] = True
+    else:
+        free[npar + nw :] = True
+    scale = np.where(free, np.abs(P0) + 1.0, 0.0)
+    known = x0[None]
+    stale = loops = 0
+    k = MONODROMY_PARALLEL
+    capped_out = False
+    while stale < MONODROMY_STALE_LOOPS and loops < MONODROMY_MAX_LOOPS:
+        if capped and (len(known) > MONODROMY_MAX_SOLUTIONS or time.perf_counter() - t0 > MONODROMY_MAX_SECONDS):
+            capped_out = True
+            break
+        loops += k  # k loops at once, each through its own two random parameter points
+        B1 = np.repeat(np.where(free, scale * crand(k, len(P0)), P0), len(known), axis=0)
+        B2 = np.repeat(np.where(free, scale * crand(k, len(P0)), P0), len(known), axis=0)
+        X = np.tile(known, (k, 1))
+        for leg in range(3):
+            a, b = ((P0, B1), (B1, B2), (B2, P0))[leg]
+            X, _, done = _segment(sysm, X, a, b)
+            X, B1, B2 = X[done], B1[done], B2[done]  # a failed path is dropped
+        xr, Pr = start(k)  # and fresh start pairs, moved to P0
+        Xr, _, done = _segment(sysm, xr, Pr, P0)
+        X = np.vstack([X, Xr[done]])
+        new = _new_points(known, X)
+        if len(new):
+            known = np.vstack([known, new])
+            stale = 0
+        else:
+            stale += k
+    g = _GenericLoop(P0, known, loops, time.perf_counter() - t0, stale >= MONODROMY_STALE_LOOPS)
+    if not capped_out:  # a capped run is redone in full when asked without the caps
+        _CACHE[key] = g
+    return g
+
+
+def clear_cache() -> None:
+    """Forget the cached generic solves (benchmarks time the first solve)."""
+    _CACHE.clear()
+
+
+@dataclass(frozen=True, eq=False)
+class GeneralSolution:
+    """One end point at the request: ``status`` real / complex / singular / at_infinity, the
+    variables ``x`` and, for a real one, the joint variables ``q`` and platform ``D``."""
+
+    status: str
+    x: np.ndarray
+    rcond: float
+    imag_ratio: float
+    residual: float
+    q: np.ndarray | None = None
+    D: np.ndarray | None = None
+
+    def to_dict(self) -> dict:
+        fin = bool(np.all(np.isfinite(self.x)))  # a path that diverged: no numbers to give
+        return {"status": self.status, "variables_real": [float(v) for v in self.x.real] if fin else [],
+                "variables_imag": [float(v) for v in self.x.imag] if fin else [],
+                "inverse_condition": _finite(self.rcond), "imaginary_ratio": _finite(self.imag_ratio),
+                "residual": _finite(self.residual)}
+
+
+def _finite(v: float) -> float:
+    """``v``, or the largest float for a quantity that overflowed on a diverged path (JSON has no
+    infinity)."""
+    return float(v) if np.isfinite(v) else float(np.finfo(float).max)
+
+
+@dataclass(frozen=True, eq=False)
+class GeneralResult:
+    solutions: tuple[GeneralSolution, ...]
+    saturated: bool  # the monodromy stopped because loops found nothing new (not at a cap)
+    complete: bool
+    completeness: str
+    n_generic: int
+    n_spurious: int
+    loops: int
+    seconds_generic: float
+    seconds: float
+    cached: bool
+
+    def count(self, status: str) -> int:
+        return sum(s.status == status for s in self.solutions)
+
+
+def general_forward(mech: Mechanism, targets: dict[int, float], *, seed: int = 0, capped: bool = False) -> GeneralResult:
+    """Every solution found of the forward position of ``mech`` with the actuators at
+    ``targets`` (joint variables by freedom index, as ``forward._actuator_q`` gives them);
+    ``capped``: the monodromy gives up early on large systems (``saturated`` false)."""
+    t0 = time.perf_counter()
+    sysm = loop_system(mech)
+    if set(targets) != {fi for fi, _, _ in sysm.params}:
+        raise InputError(f"actuators: expected values for {list(mech.actuators)}")
+    cached = sysm.key() + bytes([seed % 256]) in _CACHE
+    gen = _monodromy(sysm, seed, capped)
+    p1 = sysm.parameters(targets).astype(complex)
+    P1 = np.concatenate([p1, sysm.identity_offsets()[0], np.zeros(sysm.nx)])
+    X, _, done = _segment(sysm, gen.X, gen.P0, P1)
+    Z = np.concatenate([X, np.broadcast_to(p1, (len(X), sysm.npar))], axis=1)
+    Z = _refine(sysm, Z)
+    res = sysm.residual(Z)
+    sols: list[GeneralSolution] = []
+    spurious = lost = 0
+    kept = np.zeros((0, sysm.nx), complex)
+    for n in range(len(Z)):
+        z = Z[n]
+        x = z[: sysm.nx]
+        big = not np.all(np.isfinite(x)) or np.linalg.norm(x) > 1.0 / HOMOTOPY_INFINITY
+        if not big and sysm.study >= 0:
+            e = x[sysm.study : sysm.study + 4]
+            big = abs(e @ e) / max(np.linalg.norm(x[sysm.study : sysm.study + 8]) ** 2, 1e-300) < HOMOTOPY_INFINITY
+        if big or (not done[n] and np.linalg.norm(x) > MONODROMY_DIVERGED):
+            sols.append(GeneralSolution("at_infinity", x, 0.0, 0.0, float(res[n])))
+            continue
+        if not res[n] < MONODROMY_RESIDUAL:
+            if done[n]:
+                spurious += 1
+            else:
+                lost += 1
+            continue
+        if len(kept) and np.min(np.linalg.norm(kept - x, axis=1) / (1 + np.linalg.norm(x))) < 1e-6:
+            continue  # two paths to one (singular) end point
+        kept = np.vstack([kept, x[None]])
+        _, J = sysm.square(z[None])
+        Jx = J[0, :, : sysm.nx]
+        rows = Jx / np.maximum(np.linalg.norm(Jx, axis=1, keepdims=True), 1e-300)
+        sv = np.linalg.svd(rows, compute_uv=False)
+        rcond = float(sv[-1] / sv[0]) if sv[0] > 0 else 0.0
+        y = x.copy()
+        if sysm.study >= 0:
+            s = slice(sysm.study, sysm.study + 8)
+            k = int(np.argmax(np.abs(y[s])))
+            y[s] = y[s] * (abs(y[s][k]) / y[s][k])
+        imag = float(np.max(np.abs(y.imag)) / (1 + np.max(np.abs(y.real))))
+        st = "singular" if rcond < HOMOTOPY_SINGULAR else "real" if imag < HOMOTOPY_REAL else "complex"
+        q = D = None
+        if st == "real":
+            q, D = rebuild(sysm, y.real, targets)
+        sols.append(GeneralSolution(st, y, rcond, imag, float(res[n]), q, D))
+    n_sing = sum(s.status == "singular" for s in sols)
+    fam = ("the limbs offset by generic complex rigid motions" if sysm.rigid_family
+           else "the square system with a generic complex offset")
+    how = (f"monodromy saturated after {gen.loops} loops ({MONODROMY_STALE_LOOPS} in a row without a new solution; "
+           f"{len(gen.X)} solutions of a generic complex instance: {fam}) then a parameter homotopy to "
+           f"the requested actuator values; {spurious} end point(s) of the square system that do not satisfy the full "
+           "closure discarded: not a proof (no trace test)")
+    if not gen.saturated:
+        why = (f"more than {MONODROMY_MAX_SOLUTIONS} solutions of the square system" if len(gen.X) > MONODROMY_MAX_SOLUTIONS
+               else f"{MONODROMY_MAX_LOOPS} loops" if gen.loops >= MONODROMY_MAX_LOOPS
+               else f"{MONODROMY_MAX_SECONDS:g} s")
+        how = (f"monodromy NOT saturated: stopped at {why} ({len(gen.X)} solutions of the generic instance so far, "
+               f"{gen.loops} loops); {spurious} spurious end point(s) discarded: not a proof, solutions may be missing")
+    if n_sing:
+        how += f"; {n_sing} singular end point(s) (a continuum or a multiple root), located to a few digits only"
+    if lost:
+        how += f"; {lost} path(s) stopped short of the request away from any solution (lost)"
+    return GeneralResult(tuple(sols), gen.saturated, False, how, len(gen.X), spurious, gen.loops, gen.seconds,
+                         time.perf_counter() - t0, cached)
+
+
+def _refine(sysm: LoopSystem, Z, iters: int = 3):
+    Z = Z.copy()
+    nx = sysm.nx
+    with np.errstate(all="ignore"):
+        for _ in range(iters):
+            F, J = sysm.square(Z)
+            for n in range(len(Z)):
+                if not (np.all(np.isfinite(F[n])) and np.all(np.isfinite(J[n]))):
+                    continue
+                try:
+                    dx = np.linalg.solve(J[n, :, :nx], F[n])
+                except np.linalg.LinAlgError:
+                    continue
+                if np.all(np.isfinite(dx)):
+                    Z[n, :nx] -= dx
+    return Z
+
+
+def rebuild(sysm: LoopSystem, x: np.ndarray, targets: dict[int, float]) -> tuple[np.ndarray, np.ndarray]:
+    """Joint variables ``q`` (every freedom) and platform displacement ``D`` (model units) of a
+    real solution ``x``; the S joints' rotation vectors are those that close their limbs (a rod
+    takes the smallest rotation at its first S joint)."""
+    mech, L = sysm.mech, sysm.L
+    refs = mech.freedom_refs
+    p = sysm.parameters(targets)
+    z = np.concatenate([x, p])[None].astype(complex)
+    q = np.zeros(len(refs))
+    for i, v in sysm.var_of.items():
+        if v[0] == "A":
+            q[i] = targets[i]
+        elif v[0] == "R":
+            q[i] = np.arctan2(x[v[2]], x[v[1]])
+        elif v[0] == "P":
+            q[i] = x[v[1]] * L
+    Dn, _, E, _ = sysm._platform(z)
+    D = (Dn[0] / E[0]).real
+    D[3] = [0, 0, 0, 1]
+    if sysm.study >= 0:
+        R, pp = study_to_pose(x[sysm.study : sysm.study + 8], 1.0)
+        D[:3, :3], D[:3, 3] = R, pp
+    slices = limb_slices(mech)
+    chains = {}
+    from .closure import limb_chains
+
+    for ch, sl in zip(limb_chains(mech), slices, strict=True):
+        for first, _, axes in ch.balls:
+            chains[sl.start + first] = axes
+    for le in sysm.limbs:
+        if le.kind == "full":
+            continue
+        Tb = sysm._chain(le.before, z)[0][0].real
+        Ta = sysm._chain(le.after_inv, z)[0][0].real
+        start = slices[le.limb].start + le.s_first
+        if le.kind == "point":
+            Rs = Tb[:3, :3].T @ D[:3, :3] @ Ta[:3, :3]
+            q[start : start + 3] = np.linalg.solve(chains[start], matrix_rotvec(Rs))
+            continue
+        a = le.c2[:3] - le.c1[:3]
+        bvec = Tb[:3, :3].T @ ((D @ Ta @ le.c2)[:3] - (Tb @ le.c1)[:3])
+        R1 = _min_rotation(a, bvec)
+        q[start : start + 3] = np.linalg.solve(chains[start], matrix_rotvec(R1))
+        Rs2 = R1.T @ Tb[:3, :3].T @ D[:3, :3] @ Ta[:3, :3]
+        q[start + 3 : start + 6] = np.linalg.solve(chains[start + 3], matrix_rotvec(Rs2))
+    D = D.copy()
+    D[:3, 3] *= L
+    return q, D
+
+
+def _min_rotation(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The smallest rotation taking the direction of ``a`` to that of ``b``."""
+    a = a / np.linalg.norm(a)
+    b = b / np.linalg.norm(b)
+    v = np.cross(a, b)
+    c = float(a @ b)
+    if c < -1 + 1e-12:
+        w = np.cross(a, [1.0, 0, 0]) if abs(a[0]) < 0.9 else np.cross(a, [0, 1.0, 0])
+        w /= np.linalg.norm(w)
+        return 2 * np.outer(w, w) - np.eye(3)
+    K = skew(v)
+    return np.eye(3) + K + K @ K / (1 + c)
+
+
+def configuration(sol: GeneralSolution) -> Configuration:
+    """The :class:`Configuration` of a real solution (a mechanism without internal bodies)."""
+    assert sol.q is not None and sol.D is not None
+    return Configuration(sol.q, sol.D)

@@ -1,0 +1,207 @@
+"""The loop formulation (kinematics/homotopy_general.py): models whose limbs do not reduce to
+quadrics in the Study parameters, solved by monodromy; checked against closed forms, the
+multi-start search and the full closure."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+import spatialmech as sm
+from spatialmech.interfaces.cli import cli as main
+from spatialmech.kinematics import homotopy_general as hg
+from spatialmech.kinematics.closure import Configuration, closure_residual
+from spatialmech.kinematics.forward import forward_position
+
+
+def _rotate(point, axis_point, axis, phi):
+    """``point`` turned by ``phi`` about the line through ``axis_point`` along unit ``axis``."""
+    u = np.asarray(point, float) - axis_point
+    n = np.asarray(axis, float)
+    return axis_point + u * np.cos(phi) + np.cross(n, u) * np.sin(phi) + n * (n @ u) * (1 - np.cos(phi))
+
+
+def _circle_roots(f):
+    """Roots in (-pi, pi] of ``f(phi) = k0 + kc cos(phi) + ks sin(phi)`` (sampled at three angles)."""
+    a = np.array([f(0.0), f(np.pi / 2), f(np.pi)])
+    k0, kc, ks = (a[0] + a[2]) / 2, (a[0] - a[2]) / 2, a[1] - (a[0] + a[2]) / 2
+    r = np.hypot(kc, ks)
+    if abs(k0) > r:
+        return []
+    base, w = np.arctan2(ks, kc), np.arccos(-k0 / r)
+    return [base + w, base - w]
+
+
+def _joint(mech, limb, k):
+    j = mech.limbs[limb].joints[k]
+    return np.asarray(j.freedoms[0].point, float), np.asarray(j.freedoms[0].direction, float)
+
+
+@pytest.fixture(scope="module")
+def rssr():
+    return sm.load_model("rssr")
+
+
+def test_rssr_two_assembly_modes_match_the_closed_form(rssr):
+    theta = np.radians(30.0)
+    r = forward_position(rssr, [theta], all_solutions=True, method="homotopy")
+    d = r.to_dict(rssr)
+    assert d["complete"] is False and "not a proof" in d["completeness"] and "monodromy" in d["completeness"]
+    assert d["n_real"] == 2 and d["search"]["n_generic"] == 2
+    # closed form: the crank point turned by theta, the rocker point on its circle, the rod's length kept
+    a0, az = _joint(rssr, 0, 0)
+    a1, _ = _joint(rssr, 0, 1)
+    b1, _ = _joint(rssr, 0, 2)
+    b0, bx = _joint(rssr, 1, 0)
+    A1 = _rotate(a1, a0, az, theta)
+    length2 = np.sum((a1 - b1) ** 2)
+    phis = _circle_roots(lambda phi: np.sum((A1 - _rotate(b1, b0, bx, phi)) ** 2) - length2)
+    assert len(phis) == 2
+    found = [s.pose for s in r.solutions]
+    assert len(found) == 2
+    for phi in phis:  # each closed-form rocker angle is one found pose of the output link
+        B1 = _rotate(b1, b0, bx, phi)
+        assert any(np.allclose(P.R @ (b1 - b0), B1 - b0, atol=1e-8) for P in found)
+    for s in r.solutions:
+        assert s.converged and s.kind == "regular"
+
+
+def test_planar_four_bar_both_modes_match_the_circle_intersection():
+    m = sm.load_model("planar-4r")
+    theta = np.radians(20.0)
+    r = forward_position(m, [theta], all_solutions=True, method="homotopy")
+    a0, az = _joint(m, 0, 0)
+    a1, _ = _joint(m, 0, 1)
+    b0, bz = _joint(m, 1, 0)
+    b1, _ = _joint(m, 1, 1)
+    A1 = _rotate(a1, a0, az, theta)
+    length2 = np.sum((a1 - b1) ** 2)
+    phis = _circle_roots(lambda phi: np.sum((A1 - _rotate(b1, b0, bz, phi)) ** 2) - length2)
+    assert len(phis) == 2 and len(r.solutions) == 2
+    for phi in phis:  # the coupler carries a1 to A1 and b1 to the rocker's point
+        B1 = _rotate(b1, b0, bz, phi)
+        assert any(np.allclose(D[:3, :3] @ a1 + D[:3, 3], A1, atol=1e-8) and
+                   np.allclose(D[:3, :3] @ b1 + D[:3, 3], B1, atol=1e-8) for D in (s.config.D for s in r.solutions))
+    d = r.to_dict(m)
+    assert d["search"]["n_spurious"] + d["n_real"] + d["n_complex"] + d["n_singular"] + d["n_at_infinity"] == \
+        d["search"]["n_generic"]
+
+
+def test_bennett_overconstrained_spurious_points_discarded_and_multistart_agrees():
+    m = sm.load_model("bennett")
+    theta = np.radians(40.0)
+    r = forward_position(m, [theta], all_solutions=True, method="homotopy")
+    d = r.to_dict(m)
+    # the square system (3 of the closure's equations in random combination) has points that do not close
+    assert d["search"]["n_spurious"] > 0 and "discarded" in d["completeness"]
+    assert d["n_real"] >= 1
+    for s in r.solutions:  # every reported mode closes the loop with the input held
+        assert np.max(np.abs(closure_residual(m, s.config))) < 1e-9
+        assert s.config.q[0] == pytest.approx(theta)
+    ms = forward_position(m, [theta], all_solutions=True, n_seeds=12, seed=3)
+    for s in ms.solutions:  # every multi-start mode is among the homotopy's
+        if s.converged:
+            assert any(np.allclose(s.pose.R, h.pose.R, atol=1e-7) and np.allclose(s.pose.p, h.pose.p, atol=1e-7)
+                       for h in r.solutions)
+
+
+def test_loop_equations_vanish_on_closed_configurations(rssr):
+    """The formulation's equations (square and full) are zero at closed configurations, and the
+    configuration rebuilt from a solution's variables closes the mechanism."""
+    from spatialmech.kinematics.closure import generic_configuration
+
+    for name in ("rssr", "bennett", "five-cs-3", "three-rrr-sm"):
+        m = sm.load_model(name)
+        sysm = hg.loop_system(m)
+        c = generic_configuration(m, seed=5, step=0.4, steps=3)
+        z = hg.variables(sysm, c)[None]
+        F, J = sysm.square(z)
+        assert np.max(np.abs(F)) < 1e-9, name
+        assert sysm.residual(z)[0] < 1e-9, name
+        # a finite-difference check of the derivative
+        dz = 1e-7 * (np.random.default_rng(1).normal(size=z.shape[1]))
+        F2, _ = sysm.square(z + dz)
+        assert np.allclose(F2[0] - F[0], J[0] @ dz, atol=1e-11), name
+
+
+def test_unsupported_models_say_why_and_auto_falls_back():
+    six = sm.load_model("spatial-six-bar")  # internal bodies
+    assert "internal bodies" in hg.general_reason(six)
+    runner = CliRunner()
+    out = runner.invoke(main, ["fk", "spatial-six-bar", "--actuators", "10", "--all", "--method", "homotopy"])
+    assert out.exit_code != 0 and "does not cover spatial-six-bar" in out.output and "loop formulation" in out.output
+    assert "Traceback" not in out.output
+
+
+def test_cli_text_and_json_say_not_proven():
+    runner = CliRunner()
+    out = runner.invoke(main, ["fk", "rssr", "--actuators", "30", "--all"])
+    assert out.exit_code == 0 and "NOT proven complete" in out.output and "monodromy" in out.output
+    assert "2 real assembly modes" in out.output
+    d = json.loads(runner.invoke(main, ["fk", "rssr", "--actuators", "30", "--all", "--json"]).output)
+    assert d["complete"] is False and d["n_real"] == 2 and len(d["endpoints"]) == 2
+    assert all(len(e["variables_real"]) == 2 for e in d["endpoints"])
+
+
+def test_configuration_of_a_point_limb_and_a_study_platform():
+    """A model whose limbs all carry an S joint (the platform in Study parameters): the
+    variables of a closed configuration map back to that configuration."""
+    m = sm.load_model("five-cs-3")
+    sysm = hg.loop_system(m)
+    assert sysm.study >= 0 and {le.kind for le in sysm.limbs} == {"point"}
+    from spatialmech.kinematics.closure import generic_configuration
+
+    c = generic_configuration(m, seed=2, step=0.3, steps=3)
+    z = hg.variables(sysm, c)
+    targets = {i: c.q[i] for i, v in sysm.var_of.items() if v[0] == "A"}
+    q, D = hg.rebuild(sysm, z[: sysm.nx].real, targets)
+    assert np.allclose(D, c.D, atol=1e-9)
+    assert np.max(np.abs(closure_residual(m, Configuration(q, D)))) < 1e-9
+
+
+@pytest.mark.parametrize("name", ["bennett", "five-cs-3", "rssr"])
+def test_compiled_square_system_equals_the_numpy_reference(name):
+    """The numba evaluation (kernels_loops) and the NumPy reference of the square system and its
+    derivative agree at random complex points and offsets (full limbs, point limbs with a Study
+    platform, rods)."""
+    sysm = hg.loop_system(sm.load_model(name))
+    rng = np.random.default_rng(4)
+    Z = rng.normal(size=(6, sysm.nx + sysm.npar)) + 1j * rng.normal(size=(6, sysm.nx + sysm.npar))
+    nw = sysm.w_offsets[-1]
+    W = rng.normal(size=(6, nw)) + 1j * rng.normal(size=(6, nw))  # the limbs' offsets of the monodromy family
+    F0, J0 = sysm.square(Z, W, reference=True)
+    F1, J1 = sysm.square(Z, W)
+    assert np.max(np.abs(F0 - F1)) < 1e-12 * (1 + np.max(np.abs(F0)))
+    assert np.max(np.abs(J0 - J1)) < 1e-12 * (1 + np.max(np.abs(J0)))
+
+
+def test_auto_gives_up_on_a_large_square_system_and_runs_the_multistart(monkeypatch):
+    """Under method="auto" the monodromy stops at its cap (here lowered to 4 generic solutions on
+    the Bennett's 40) and the multi-start runs instead, saying why; nothing unsaturated is cached."""
+    monkeypatch.setattr(hg, "MONODROMY_MAX_SOLUTIONS", 4)
+    hg.clear_cache()
+    m = sm.load_model("bennett")
+    r = forward_position(m, [0.3], all_solutions=True, n_seeds=4, method="auto")
+    d = r.to_dict(m)
+    assert d["complete"] is False and "multi-start" in d["completeness"] and "gave up" in d["completeness"]
+    assert "n_spurious" not in d["search"]
+    part = hg.general_forward(m, {0: 0.3}, capped=True)
+    assert not part.saturated and "NOT saturated" in part.completeness
+
+
+def test_the_cache_key_tells_which_joint_is_driven():
+    """Two RSSR with the same geometry, driven at the input or at the output crank, are other
+    systems: their generic solves are not shared."""
+    z, x = [0, 0, 1], [1, 0, 0]
+
+    def rssr(drive_input: bool):
+        return sm.Mechanism("k", limbs=[
+            sm.Limb("input", [sm.R("A0", [0, 0, 0], z, actuated=drive_input), sm.S("A1", [0.3, 0, 0]),
+                              sm.S("B1", [0, 1, -0.1])]),
+            sm.Limb("output", [sm.R("B0", [0, 1, 0.5], x, actuated=not drive_input)])], platform_point=[0, 1, -0.1])
+
+    a, b = hg.loop_system(rssr(True)), hg.loop_system(rssr(False))
+    assert a.key() != b.key() and a.key() == hg.loop_system(rssr(True)).key()
