@@ -17,7 +17,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..errors import InputError
-from ..geometry.tolerances import MONODROMY_MAX_SECONDS, MONODROMY_MAX_SOLUTIONS
+from ..geometry.tolerances import MONODROMY_MAX_SOLUTIONS, MONODROMY_MAX_WORK
 from ..geometry.tolerances import resolve as resolve_tolerances
 from ..geometry import screws as sc
 from ..model.mechanism import Mechanism, Pose
@@ -368,7 +368,8 @@ def forward_position(
             if gres is not None:
                 return gres
             gwhy = (f"its monodromy gave up unsaturated (more than {MONODROMY_MAX_SOLUTIONS} solutions of the square system, "
-                    f"or {MONODROMY_MAX_SECONDS:g} s); method='homotopy' runs it without these caps")
+                    f"or a work of {MONODROMY_MAX_WORK} paths tracked times unknowns); method='homotopy' runs it without "
+                    "these caps")
         elif method == "homotopy":
             raise InputError(f"method: homotopy forward position does not cover {mech.name}: {why}; nor does the loop "
                              f"formulation: {gwhy}; use method='multistart'")

@@ -39,8 +39,8 @@ from ..geometry.tolerances import (
     HOMOTOPY_SINGULAR,
     MONODROMY_DIVERGED,
     MONODROMY_MAX_LOOPS,
-    MONODROMY_MAX_SECONDS,
     MONODROMY_MAX_SOLUTIONS,
+    MONODROMY_MAX_WORK,
     MONODROMY_PARALLEL,
     MONODROMY_RESIDUAL,
     MONODROMY_STALE_LOOPS,
@@ -180,7 +180,8 @@ _CACHE: dict[bytes, _GenericLoop] = {}
 
 def _monodromy(sysm: LoopSystem, seed: int, capped: bool) -> _GenericLoop:
     """The generic instance's solutions by monodromy; ``capped``: also stop at
-    :data:`MONODROMY_MAX_SOLUTIONS` solutions or :data:`MONODROMY_MAX_SECONDS` (unsaturated)."""
+    :data:`MONODROMY_MAX_SOLUTIONS` solutions or :data:`MONODROMY_MAX_WORK` (paths tracked times
+    unknowns: a count, so that the choice does not depend on the machine's speed; unsaturated)."""
     key = sysm.key() + bytes([seed % 256])
     if key in _CACHE:
         return _CACHE[key]
@@ -221,14 +222,16 @@ def _monodromy(sysm: LoopSystem, seed: int, capped: bool) -> _GenericLoop:
     stale = loops = 0
     k = MONODROMY_PARALLEL
     capped_out = False
+    work = 0  # paths tracked times unknowns
     while stale < MONODROMY_STALE_LOOPS and loops < MONODROMY_MAX_LOOPS:
-        if capped and (len(known) > MONODROMY_MAX_SOLUTIONS or time.perf_counter() - t0 > MONODROMY_MAX_SECONDS):
+        if capped and (len(known) > MONODROMY_MAX_SOLUTIONS or work > MONODROMY_MAX_WORK):
             capped_out = True
             break
         loops += k  # k loops at once, each through its own two random parameter points
         B1 = np.repeat(np.where(free, scale * crand(k, len(P0)), P0), len(known), axis=0)
         B2 = np.repeat(np.where(free, scale * crand(k, len(P0)), P0), len(known), axis=0)
         X = np.tile(known, (k, 1))
+        work += (3 * len(X) + k) * sysm.nx
         for leg in range(3):
             a, b = ((P0, B1), (B1, B2), (B2, P0))[leg]
             X, _, done = _segment(sysm, X, a, b)
@@ -361,7 +364,7 @@ def general_forward(mech: Mechanism, targets: dict[int, float], *, seed: int = 0
     if not gen.saturated:
         why = (f"more than {MONODROMY_MAX_SOLUTIONS} solutions of the square system" if len(gen.X) > MONODROMY_MAX_SOLUTIONS
                else f"{MONODROMY_MAX_LOOPS} loops" if gen.loops >= MONODROMY_MAX_LOOPS
-               else f"{MONODROMY_MAX_SECONDS:g} s")
+               else f"a work of {MONODROMY_MAX_WORK} (paths tracked times unknowns)")
         how = (f"monodromy NOT saturated: stopped at {why} ({len(gen.X)} solutions of the generic instance so far, "
                f"{gen.loops} loops); {spurious} spurious end point(s) discarded: not a proof, solutions may be missing")
     if n_sing:
