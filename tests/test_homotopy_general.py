@@ -205,3 +205,21 @@ def test_the_cache_key_tells_which_joint_is_driven():
 
     a, b = hg.loop_system(rssr(True)), hg.loop_system(rssr(False))
     assert a.key() != b.key() and a.key() == hg.loop_system(rssr(True)).key()
+
+
+def test_a_dead_point_double_root_is_located_by_the_end_game():
+    """An RSSR driven at its output revolute, at the output's limit angle atan(0.6 / 0.84): the
+    two assembly modes merge into a double root (input crank at 90 deg). Newton cannot finish
+    those paths; the Cauchy end game locates the root to rounding (winding number 2) and the
+    statement says so."""
+    z, x = [0, 0, 1], [1, 0, 0]
+    m = sm.Mechanism("rssr-output-driven", limbs=[
+        sm.Limb("input", [sm.R("A0", [0, 0, 0], z), sm.S("A1", [0.3, 0, 0]), sm.S("B1", [0, 1, -0.1])]),
+        sm.Limb("output", [sm.R("B0", [0, 1, 0.5], x, actuated=True)]),
+    ], platform_point=[0, 1, -0.1])
+    phi = float(np.arctan2(0.6, 0.84))  # |sin(input)| = 1 there (the coupler-length equation)
+    g = hg.general_forward(m, {m.freedom_refs.index(m.freedom(m.actuators[0])): phi})
+    sing = [s for s in g.solutions if s.status == "singular"]
+    assert len(sing) == 1 and "Cauchy end game (winding numbers [2])" in g.completeness
+    c, s = sing[0].x[:2]  # the input crank's (cos, sin)
+    assert abs(c) < 1e-12 and abs(s - 1) < 1e-12

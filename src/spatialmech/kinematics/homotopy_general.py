@@ -47,6 +47,7 @@ from ..geometry.tolerances import (
 )
 from ..model.mechanism import Mechanism
 from .closure import Configuration, limb_slices
+from .endgame import cauchy_endgame
 from .homotopy import study_to_pose, track
 from .loop_system import LoopSystem, general_reason, loop_system, variables
 
@@ -315,6 +316,16 @@ def general_forward(mech: Mechanism, targets: dict[int, float], *, seed: int = 0
     X, _, done = _segment(sysm, gen.X, gen.P0, P1)
     Z = np.concatenate([X, np.broadcast_to(p1, (len(X), sysm.npar))], axis=1)
     Z = _refine(sysm, Z)
+    # singular end points and paths stopped short (not diverging): the Cauchy end game
+    cand = _endgame_candidates(sysm, Z, done)
+    winding: list[int] = []
+    if len(cand):
+        eg = cauchy_endgame(lambda PA, PB, c, Xs: _segment(sysm, Xs, PA, PB), gen.P0, P1, np.zeros(0), gen.X[cand])
+        Z[cand[eg.converged], : sysm.nx] = eg.X[eg.converged]
+        done = done.copy()
+        done[cand[eg.converged]] = True
+        winding = sorted(set(eg.winding[eg.converged].tolist()))
+        Z[cand] = _refine(sysm, Z[cand])
     res = sysm.residual(Z)
     sols: list[GeneralSolution] = []
     spurious = lost = 0
@@ -367,7 +378,10 @@ def general_forward(mech: Mechanism, targets: dict[int, float], *, seed: int = 0
                else f"a work of {MONODROMY_MAX_WORK} (paths tracked times unknowns)")
         how = (f"monodromy NOT saturated: stopped at {why} ({len(gen.X)} solutions of the generic instance so far, "
                f"{gen.loops} loops); {spurious} spurious end point(s) discarded: not a proof, solutions may be missing")
-    if n_sing:
+    if n_sing and winding:
+        how += (f"; {n_sing} singular end point(s) (a continuum or a multiple root), located by a Cauchy end game "
+                f"(winding numbers {winding})")
+    elif n_sing:
         how += f"; {n_sing} singular end point(s) (a continuum or a multiple root), located to a few digits only"
     if lost:
         how += f"; {lost} path(s) stopped short of the request away from any solution (lost)"
@@ -376,11 +390,14 @@ def general_forward(mech: Mechanism, targets: dict[int, float], *, seed: int = 0
 
 
 def _refine(sysm: LoopSystem, Z, iters: int = 3):
+    """Newton on the square system; a step is kept only when it lowers the residual (at a
+    singular root, located by the end game, a Newton step would throw the point elsewhere)."""
     Z = Z.copy()
     nx = sysm.nx
     with np.errstate(all="ignore"):
         for _ in range(iters):
             F, J = sysm.square(Z)
+            trial = Z.copy()
             for n in range(len(Z)):
                 if not (np.all(np.isfinite(F[n])) and np.all(np.isfinite(J[n]))):
                     continue
@@ -389,8 +406,29 @@ def _refine(sysm: LoopSystem, Z, iters: int = 3):
                 except np.linalg.LinAlgError:
                     continue
                 if np.all(np.isfinite(dx)):
-                    Z[n, :nx] -= dx
+                    trial[n, :nx] -= dx
+            Ft, _ = sysm.square(trial, want_J=False) if len(Z) else (F, J)
+            better = np.linalg.norm(Ft, axis=1) < np.linalg.norm(F, axis=1)
+            Z[better] = trial[better]
     return Z
+
+
+def _endgame_candidates(sysm: LoopSystem, Z, done) -> np.ndarray:
+    """End points for the end game: finite, not escaping, and singular or stopped short."""
+    if not len(Z):
+        return np.zeros(0, dtype=np.int64)
+    with np.errstate(all="ignore"):
+        _, J = sysm.square(Z)
+        out = []
+        for n in range(len(Z)):
+            x = Z[n, : sysm.nx]
+            if not (np.all(np.isfinite(x)) and np.all(np.isfinite(J[n]))) or np.linalg.norm(x) > MONODROMY_DIVERGED:
+                continue
+            Jx = J[n, :, : sysm.nx]
+            sv = np.linalg.svd(Jx / np.maximum(np.linalg.norm(Jx, axis=1, keepdims=True), 1e-300), compute_uv=False)
+            if not done[n] or not sv[-1] >= HOMOTOPY_SINGULAR * sv[0]:
+                out.append(n)
+    return np.array(out, dtype=np.int64)
 
 
 def rebuild(sysm: LoopSystem, x: np.ndarray, targets: dict[int, float]) -> tuple[np.ndarray, np.ndarray]:
