@@ -1,0 +1,46 @@
+"""Compile spatialmech's numba kernels into their on-disk cache before the tests, in two parts
+that `.ci/run` runs at once on the two cores (the tests would otherwise compile them one by one,
+on one core, as they first meet them: about two minutes of a cold run).
+
+    python .ci/warm_up.py 0    # the closure engine (compiled.warm_up), the tracker (a defect analysis)
+    python .ci/warm_up.py 1    # homotopy trackers, the loop formulation, 4-SPS/CU legs, CS dyads
+
+Only a cache warm-up: the tests do not depend on it (a kernel it misses compiles when first used).
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+
+import numpy as np
+
+
+def part0() -> None:
+    import spatialmech as sm
+    from spatialmech.kinematics import compiled
+
+    compiled.warm_up()
+    sm.defects("five-cs-3")
+
+
+def part1() -> None:
+    import spatialmech as sm
+    from spatialmech import catalog
+    from spatialmech.kinematics import homotopy as hc
+    from spatialmech.kinematics.closed_forms import four_sps_cu as k4
+    from spatialmech.synthesis import cs_dyads
+
+    hc.homotopy_forward(hc.pose_system(catalog.resolve("three-rps")), [0.34, 0.36, 0.32])
+    sm.fk("rssr", [30.0], degrees=True, all_solutions=True)
+    for n in (10, k4.PARALLEL_FROM):
+        k4.leg_lengths(np.zeros((n, 4)) + [0.2, 0.0, 0.0, 0.0])
+    x, D = np.linspace(0.1, 1.5, 15), np.tile(np.eye(4), (7, 1, 1))
+    cs_dyads.dyad_residual(x, D)
+    cs_dyads.dyad_jacobian(x, D)
+
+
+if __name__ == "__main__":
+    t = time.perf_counter()
+    (part0 if sys.argv[1:] == ["0"] else part1)()
+    print(f"warm-up part {sys.argv[1:]}: {time.perf_counter() - t:.1f} s")
