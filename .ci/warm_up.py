@@ -34,7 +34,7 @@ def part1() -> None:
     hc.homotopy_forward(hc.pose_system(catalog.resolve("three-rps")), [0.34, 0.36, 0.32])
     sm.fk("rssr", [30.0], degrees=True, all_solutions=True)
     for n in (10, k4.PARALLEL_FROM):
-        k4.leg_lengths(np.zeros((n, 4)) + [0.2, 0.0, 0.0, 0.0])
+        k4.leg_lengths(np.tile([0.2, 0.0, 0.0, 0.0], (n, 1)))
     x, D = np.linspace(0.1, 1.5, 15), np.tile(np.eye(4), (7, 1, 1))
     cs_dyads.dyad_residual(x, D)
     cs_dyads.dyad_jacobian(x, D)
