@@ -35,6 +35,18 @@ def _circle_roots(f):
     return [base + w, base - w]
 
 
+def _rocker_angles(mech, theta, b1):
+    """Closed form: the crank (limb 0, axis at its joint 0, coupler at its joint 1) turned by
+    ``theta``; the angles of the rocker (limb 1's joint 0) that carry the coupler's other end
+    ``b1`` to the coupler's length from the crank; with the rocker's axis point and direction."""
+    a0, az = _joint(mech, 0, 0)
+    a1, _ = _joint(mech, 0, 1)
+    b0, bx = _joint(mech, 1, 0)
+    A1 = _rotate(a1, a0, az, theta)
+    length2 = np.sum((a1 - b1) ** 2)
+    return _circle_roots(lambda phi: np.sum((A1 - _rotate(b1, b0, bx, phi)) ** 2) - length2), b0, bx
+
+
 def _joint(mech, limb, k):
     j = mech.limbs[limb].joints[k]
     return np.asarray(j.freedoms[0].point, float), np.asarray(j.freedoms[0].direction, float)
@@ -52,13 +64,8 @@ def test_rssr_two_assembly_modes_match_the_closed_form(rssr):
     assert d["complete"] is False and "not a proof" in d["completeness"] and "monodromy" in d["completeness"]
     assert d["n_real"] == 2 and d["search"]["n_generic"] == 2
     # closed form: the crank point turned by theta, the rocker point on its circle, the rod's length kept
-    a0, az = _joint(rssr, 0, 0)
-    a1, _ = _joint(rssr, 0, 1)
     b1, _ = _joint(rssr, 0, 2)
-    b0, bx = _joint(rssr, 1, 0)
-    A1 = _rotate(a1, a0, az, theta)
-    length2 = np.sum((a1 - b1) ** 2)
-    phis = _circle_roots(lambda phi: np.sum((A1 - _rotate(b1, b0, bx, phi)) ** 2) - length2)
+    phis, b0, bx = _rocker_angles(rssr, theta, b1)
     assert len(phis) == 2
     found = [s.pose for s in r.solutions]
     assert len(found) == 2
@@ -75,11 +82,9 @@ def test_planar_four_bar_both_modes_match_the_circle_intersection():
     r = forward_position(m, [theta], all_solutions=True, method="homotopy")
     a0, az = _joint(m, 0, 0)
     a1, _ = _joint(m, 0, 1)
-    b0, bz = _joint(m, 1, 0)
     b1, _ = _joint(m, 1, 1)
     A1 = _rotate(a1, a0, az, theta)
-    length2 = np.sum((a1 - b1) ** 2)
-    phis = _circle_roots(lambda phi: np.sum((A1 - _rotate(b1, b0, bz, phi)) ** 2) - length2)
+    phis, b0, bz = _rocker_angles(m, theta, b1)
     assert len(phis) == 2 and len(r.solutions) == 2
     for phi in phis:  # the coupler carries a1 to A1 and b1 to the rocker's point
         B1 = _rotate(b1, b0, bz, phi)
