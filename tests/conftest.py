@@ -29,6 +29,27 @@ def schema_validator():
     return lambda command: Draft202012Validator(load_schema(command), registry=registry)
 
 
+@pytest.fixture(scope="session")
+def studio_ok(schema_validator):
+    """``studio_ok(r)``: a studio answer (an HTTP response, or a ``studio --json`` document)
+    checked: status 200, the envelope, the studio schema and the unit rule; returns the document."""
+    from spatialmech.serialize import unit_rule_violations
+
+    validator = schema_validator("studio")
+
+    def check(r) -> dict:
+        if hasattr(r, "status_code"):
+            assert r.status_code == 200, r.text
+            r = r.json()
+        assert r["command"] == "studio" and r["schema_version"] == "2"
+        errors = [(list(e.absolute_path), e.message[:200]) for e in validator.iter_errors(r)]
+        assert not errors, errors[:3]
+        assert unit_rule_violations(r) == []
+        return r
+
+    return check
+
+
 @pytest.fixture
 def rng():
     return np.random.default_rng(12345)

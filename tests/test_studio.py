@@ -13,22 +13,6 @@ from spatialmech.interfaces.cli import cli
 from spatialmech.interfaces.studio.app import create_app
 from spatialmech.interfaces.studio.session import Session
 from spatialmech.kinematics.closure import closure_residual
-from spatialmech.serialize import unit_rule_violations
-
-
-@pytest.fixture(scope="module")
-def validator(schema_validator):
-    return schema_validator("studio")
-
-
-def ok(r, validator) -> dict:
-    assert r.status_code == 200, r.text
-    doc = r.json()
-    assert doc["command"] == "studio" and doc["schema_version"] == "2"
-    errors = [(list(e.absolute_path), e.message[:200]) for e in validator.iter_errors(doc)]
-    assert not errors, errors[:3]
-    assert unit_rule_violations(doc) == []
-    return doc
 
 
 @pytest.fixture(scope="module")
@@ -41,13 +25,13 @@ def table():
     return sm.dj_table("five-cs-3")
 
 
-def test_drive_linkage3_from_p1_to_p7_follows_the_circuit_and_reports_dj_events(five_cs, table, validator):
+def test_drive_linkage3_from_p1_to_p7_follows_the_circuit_and_reports_dj_events(five_cs, table, studio_ok):
     mech = catalog.build("five-cs-3")
     ids = [r.id for r in mech.freedom_refs]
     k_rot1 = ids.index("C1.rot")
     fits = [f.config for f in table.fits]
     rot1 = [float(np.degrees(sm.Configuration(c.q, c.D).q[k_rot1])) for c in fits]  # offsets are 0 here
-    start = ok(five_cs.get("/api/model"), validator)["state"]
+    start = studio_ok(five_cs.get("/api/model"))["state"]
     assert start["drivers"] == ["C1.rot"] and start["actuators_deg"]["C1.rot"] == pytest.approx(rot1[0], abs=1e-9)
     sc = start["scene"]  # the folded coupler is drawn as a solid: the hull of its 5 S centres and the platform point
     assert len(sc["platform_hull_len"]) == 6 and len(sc["hull_faces"]) == 8
@@ -56,7 +40,7 @@ def test_drive_linkage3_from_p1_to_p7_follows_the_circuit_and_reports_dj_events(
     for k in range(1, len(fits)):
         events: list[str] = []
         for target in np.linspace(rot1[k - 1], rot1[k], 3)[1:]:  # two drags per stretch
-            d = ok(five_cs.post("/api/drive", json={"actuators": [float(target)]}), validator)
+            d = studio_ok(five_cs.post("/api/drive", json={"actuators": [float(target)]}))
             assert d["status"] == "reached", d["message"]
             events += [e["driver"] for e in d["events"]]
             st = d["state"]
@@ -77,13 +61,13 @@ def test_drive_linkage3_from_p1_to_p7_follows_the_circuit_and_reports_dj_events(
     assert table.keeps_sign("rot1") and not any(e.startswith("C1.rot") for e in events)
 
 
-def test_drive_a_parallel_mechanism_checked_by_inverse_position(validator):
+def test_drive_a_parallel_mechanism_checked_by_inverse_position(studio_ok):
     c = TestClient(create_app(Session("stewart-6sps")))
-    st = ok(c.get("/api/state"), validator)["state"]
+    st = studio_ok(c.get("/api/state"))["state"]
     assert st["scene"]["hull_faces"] == [] and len(st["scene"]["platform_len"]) == 7  # a planar hexagon
     legs = np.array(list(st["actuators_len"].values()))
     target = legs + np.array([0.04, -0.02, 0.03, 0.0, 0.05, -0.01])
-    d = ok(c.post("/api/drive", json={"actuators": target.tolist()}), validator)
+    d = studio_ok(c.post("/api/drive", json={"actuators": target.tolist()}))
     assert d["status"] == "reached" and d["events"] == []
     s = d["state"]
     assert np.allclose(list(s["actuators_len"].values()), target, atol=1e-12)
@@ -92,22 +76,22 @@ def test_drive_a_parallel_mechanism_checked_by_inverse_position(validator):
     assert inv.reachable and np.allclose(list(inv.actuators.values()), target, atol=1e-8)
     # by name, in the model's units, with a map
     named = {k: v - 0.01 for k, v in s["actuators_len"].items()}
-    d2 = ok(c.post("/api/drive", json={"actuators": named}), validator)
+    d2 = studio_ok(c.post("/api/drive", json={"actuators": named}))
     assert d2["status"] == "reached" and d2["state"]["actuators_len"] == pytest.approx(named, abs=1e-12)
-    modes = ok(c.post("/api/fk_all", json={"seeds": 12}), validator)
+    modes = studio_ok(c.post("/api/fk_all", json={"seeds": 12}))
     assert modes["n_solutions"] >= 1 and modes["solutions"][0]["mode_number"] == 1
-    back = ok(c.post("/api/mode", json={"mode_number": 1}), validator)["state"]
+    back = studio_ok(c.post("/api/mode", json={"mode_number": 1}))["state"]
     assert np.allclose(back["pose"]["position_len"], modes["solutions"][0]["pose"]["position_len"], atol=1e-9)
 
 
-def test_a_rocker_driven_past_its_dead_point_stops_before_it(validator):
+def test_a_rocker_driven_past_its_dead_point_stops_before_it(studio_ok):
     session = Session("rssr")
     c = TestClient(create_app(session))
-    st = ok(c.post("/api/drivers", json={"drivers": ["B0.rot"]}), validator)["state"]
+    st = studio_ok(c.post("/api/drivers", json={"drivers": ["B0.rot"]}))["state"]
     assert st["drivers"] == ["B0.rot"] and set(st["candidate_drivers"]) == {"A0.rot", "B0.rot"}
     dj0 = st["dj"]
     a0 = st["actuators_deg"]["B0.rot"]
-    d = ok(c.post("/api/drive", json={"actuators": [a0 + 170.0]}), validator)
+    d = studio_ok(c.post("/api/drive", json={"actuators": [a0 + 170.0]}))
     assert d["status"] == "stopped_at_singularity", d["message"]
     # the dead point is located as an event (the rocker's own DJ does not vanish there: the
     # path turns back in its value) ...
@@ -123,7 +107,7 @@ def test_a_rocker_driven_past_its_dead_point_stops_before_it(validator):
     assert edge["state"]["task"]["values_deg"]["a3"] == pytest.approx(dead["actuators_deg"]["B0.rot"], abs=0.01)
     assert np.linalg.norm(closure_residual(session.mech, session.config)) < 1e-9
     # driving back works from there
-    back = ok(c.post("/api/drive", json={"actuators": [a0]}), validator)
+    back = studio_ok(c.post("/api/drive", json={"actuators": [a0]}))
     assert back["status"] == "reached"
 
 
@@ -167,7 +151,7 @@ def test_studio_command_errors_are_one_line():
     assert h.exit_code == 0 and "--no-browser" in h.output
 
 
-def test_studio_command_json_before_serving(monkeypatch, validator):
+def test_studio_command_json_before_serving(monkeypatch, studio_ok):
     """``studio --json`` prints the address and the start state, then serves (uvicorn.run is
     replaced here: the app it would serve is checked instead)."""
     import json
@@ -178,17 +162,15 @@ def test_studio_command_json_before_serving(monkeypatch, validator):
     monkeypatch.setattr(uvicorn, "run", lambda app, host, port, **kw: served.update(app=app, host=host, port=port))
     r = CliRunner().invoke(cli, ["studio", "rssr", "--port", "0", "--no-browser", "--json"])
     assert r.exit_code == 0, r.output
-    doc = json.loads(r.output)
-    errors = [e.message[:200] for e in validator.iter_errors(doc)]
-    assert not errors and unit_rule_violations(doc) == []
+    doc = studio_ok(json.loads(r.output))
     assert served["host"] == "127.0.0.1" and doc["url"] == f"http://127.0.0.1:{served['port']}/" == f"http://127.0.0.1:{doc['port']}/"
     assert TestClient(served["app"]).get("/api/state").json()["state"]["drivers"] == doc["state"]["drivers"] == ["A0.rot"]
 
 
-def test_the_traced_circuit_passes_through_the_current_configuration(validator):
+def test_the_traced_circuit_passes_through_the_current_configuration(studio_ok):
     session = Session("rssr")
     c = TestClient(create_app(session))
-    d = ok(c.get("/api/circuit"), validator)
+    d = studio_ok(c.get("/api/circuit"))
     pts = np.array(d["circuit_len"])
     here = np.array(session.state()["scene"]["platform_point_len"])
     assert len(pts) > 20 and np.min(np.linalg.norm(pts - here, axis=1)) < 1e-9

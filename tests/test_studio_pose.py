@@ -11,34 +11,19 @@ import spatialmech as sm
 from spatialmech.geometry.rotations import euler_matrix
 from spatialmech.interfaces.studio.app import create_app
 from spatialmech.interfaces.studio.session import Session
-from spatialmech.serialize import unit_rule_violations
-
-
-@pytest.fixture(scope="module")
-def validator(schema_validator):
-    return schema_validator("studio")
-
-
-def ok(r, validator) -> dict:
-    assert r.status_code == 200, r.text
-    doc = r.json()
-    errors = [(list(e.absolute_path), e.message[:200]) for e in validator.iter_errors(doc)]
-    assert not errors, errors[:3]
-    assert unit_rule_violations(doc) == []
-    return doc
 
 
 def pose_of(state) -> tuple[np.ndarray, np.ndarray]:
     return np.array(state["pose"]["position_len"]), np.array(state["pose"]["rotation_matrix"])
 
 
-def test_pose_drag_of_the_stewart_platform_gives_the_requested_pose_and_fk_agrees(validator):
+def test_pose_drag_of_the_stewart_platform_gives_the_requested_pose_and_fk_agrees(studio_ok):
     c = TestClient(create_app(Session("stewart-6sps")))
-    t = ok(c.get("/api/state"), validator)["state"]["task"]
+    t = studio_ok(c.get("/api/state"))["state"]["task"]
     assert t["given"] == ["x", "y", "z", "a1", "a2", "a3"] and t["solved"] == []
     req_len = {"x": 0.05, "y": -0.03, "z": t["values_len"]["z"] + 0.1}
     req_deg = {"a1": 8.0, "a2": -5.0, "a3": 4.0}
-    d = ok(c.post("/api/pose", json={"task_len": req_len, "task_deg": req_deg, "euler": "ZYX"}), validator)
+    d = studio_ok(c.post("/api/pose", json={"task_len": req_len, "task_deg": req_deg, "euler": "ZYX"}))
     assert d["status"] == "reached", d["message"]
     assert d["requested_task_len"] == pytest.approx(req_len) and d["requested_task_deg"] == pytest.approx(req_deg)
     st = d["state"]
@@ -50,7 +35,7 @@ def test_pose_drag_of_the_stewart_platform_gives_the_requested_pose_and_fk_agree
     fk = sm.fk("stewart-6sps", legs)  # the legs answered give the pose back
     assert fk.converged and np.allclose(fk.poses[0].p, p, atol=1e-8) and np.allclose(fk.poses[0].R, R, atol=1e-8)
     # increments, in another Euler sequence: the pose moves by them
-    d2 = ok(c.post("/api/pose", json={"task_deg": {"a1": 2.0}, "euler": "XYZ", "relative": True}), validator)
+    d2 = studio_ok(c.post("/api/pose", json={"task_deg": {"a1": 2.0}, "euler": "XYZ", "relative": True}))
     assert d2["status"] == "reached"
     p2, R2 = pose_of(d2["state"])
     from spatialmech.geometry.rotations import matrix_euler
@@ -58,9 +43,9 @@ def test_pose_drag_of_the_stewart_platform_gives_the_requested_pose_and_fk_agree
     assert np.allclose(p2, p, atol=1e-9)
 
 
-def test_a_lower_mobility_output_is_posed_by_the_coordinates_it_controls(validator):
+def test_a_lower_mobility_output_is_posed_by_the_coordinates_it_controls(studio_ok):
     c = TestClient(create_app(Session("four-sps-cu")))
-    st = ok(c.get("/api/state"), validator)["state"]
+    st = studio_ok(c.get("/api/state"))["state"]
     t = st["task"]
     assert t["given"] == ["z", "a1", "a2", "a3"] and t["solved"] == ["x", "y"]
     assert st["slider_ranges_len"] == {k: [0.1, 0.4] for k in st["drivers"]}  # the legs' joint limits
@@ -68,7 +53,7 @@ def test_a_lower_mobility_output_is_posed_by_the_coordinates_it_controls(validat
     assert r.status_code == 422 and r.json()["error"].startswith("task_len.x") and "solved" in r.json()["error"]
     z = t["values_len"]["z"] + 0.01
     a3 = t["values_deg"]["a3"] + 2.0
-    d = ok(c.post("/api/pose", json={"task_len": {"z": z}, "task_deg": {"a3": a3}}), validator)
+    d = studio_ok(c.post("/api/pose", json={"task_len": {"z": z}, "task_deg": {"a3": a3}}))
     assert d["status"] == "reached", d["message"]
     got = d["state"]["task"]
     assert got["values_len"]["z"] == pytest.approx(z, abs=1e-9) and got["values_deg"]["a3"] == pytest.approx(a3, abs=1e-9)
@@ -77,7 +62,7 @@ def test_a_lower_mobility_output_is_posed_by_the_coordinates_it_controls(validat
     fk = sm.fk("four-sps-cu", d["state"]["actuators_len"], all_solutions=True)  # closed form: every mode
     assert any(np.allclose(P.p, p, atol=1e-7) and np.allclose(P.R, R, atol=1e-7) for P in fk.poses)
     # far up: the legs reach their limits first; stopped inside them, with a clear status
-    up = ok(c.post("/api/pose", json={"task_len": {"z": 0.6}}), validator)
+    up = studio_ok(c.post("/api/pose", json={"task_len": {"z": 0.6}}))
     assert up["status"] == "stopped_at_limit" and "limits" in up["message"], up["message"]
     s = up["state"]
     assert s["outside_limits"] == [] and z < s["task"]["values_len"]["z"] < 0.6
@@ -87,28 +72,28 @@ def test_a_lower_mobility_output_is_posed_by_the_coordinates_it_controls(validat
     assert r.status_code == 422 and r.json()["error"].startswith("actuators:") and "L3" in r.json()["error"]
 
 
-def test_the_rssr_rocker_angle_stops_at_the_edge_of_its_range(validator):
+def test_the_rssr_rocker_angle_stops_at_the_edge_of_its_range(studio_ok):
     c = TestClient(create_app(Session("rssr")))
-    t = ok(c.get("/api/state"), validator)["state"]["task"]
+    t = studio_ok(c.get("/api/state"))["state"]["task"]
     assert t["given"] == ["a3"]
-    d = ok(c.post("/api/pose", json={"task_deg": {"a3": 20.0}}), validator)
+    d = studio_ok(c.post("/api/pose", json={"task_deg": {"a3": 20.0}}))
     assert d["status"] == "reached" and d["state"]["task"]["values_deg"]["a3"] == pytest.approx(20.0, abs=1e-9)
     crank = d["state"]["actuators_deg"]["A0.rot"]
     fk = sm.fk("rssr", [crank], degrees=True, all_solutions=True, seeds=8)
     assert any(np.allclose(P.R, pose_of(d["state"])[1], atol=1e-7) for P in fk.poses)
     # the rocker swings less than 90 deg: the crank's limb reaches an inverse singularity (dead centre)
-    far = ok(c.post("/api/pose", json={"task_deg": {"a3": 90.0}}), validator)
+    far = studio_ok(c.post("/api/pose", json={"task_deg": {"a3": 90.0}}))
     assert far["status"] == "limb_singular" and "A0.rot" in far["message"]
     a3 = far["state"]["task"]["values_deg"]["a3"]
     assert 20.0 < a3 < 90.0 and far["state"]["residual"] < 1e-9
-    again = ok(c.post("/api/pose", json={"task_deg": {"a3": 90.0}}), validator)  # nothing further, nothing jumps
+    again = studio_ok(c.post("/api/pose", json={"task_deg": {"a3": 90.0}}))  # nothing further, nothing jumps
     assert again["status"] == "limb_singular" and again["state"]["task"]["values_deg"]["a3"] == pytest.approx(a3, abs=1e-6)
 
 
-def test_a_direct_singularity_on_the_pose_path_is_located_and_stops_the_drag(validator):
+def test_a_direct_singularity_on_the_pose_path_is_located_and_stops_the_drag(studio_ok):
     c = TestClient(create_app(Session("four-sps-cu")))
-    st = ok(c.get("/api/state"), validator)["state"]
-    d = ok(c.post("/api/pose", json={"task_deg": {"a2": 60.0}}), validator)
+    st = studio_ok(c.get("/api/state"))["state"]
+    d = studio_ok(c.post("/api/pose", json={"task_deg": {"a2": 60.0}}))
     assert d["status"] == "stopped_at_singularity", d["message"]
     [ev] = d["events"]
     assert ev["name"] == "DJ (drivers)" and ev["kind"] == "zero"
