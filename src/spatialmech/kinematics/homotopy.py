@@ -602,6 +602,7 @@ def homotopy_forward(mech: Mechanism | StewartSystem | PoseSystem, actuator_valu
     mult = np.ones(len(cls), dtype=np.int64)
     wind = np.zeros(len(cls), dtype=np.int64)
     isolated = True
+    groups: list[np.ndarray] = []
     if len(sing):  # the Cauchy end game locates them; then multiple roots or a continuum
         eg = cauchy_endgame(track_parameter, gen.Q, Qt, c, gen.X[sing])
         X = X.copy()
@@ -609,7 +610,8 @@ def homotopy_forward(mech: Mechanism | StewartSystem | PoseSystem, actuator_valu
         wind[sing] = eg.winding
         cls = _classify(Qt, c, X)
         isolated = bool(eg.converged.all())
-        for grp in _groups(X[sing]):
+        groups = _groups(X[sing])
+        for grp in groups:
             mult[sing[grp]] = len(grp)
             dim = local_dimension(lambda Y: _eval_quad(Qt, c, Y)[:2], X[sing[grp[0]]])
             isolated &= dim == 0 and len(grp) > 1
@@ -626,8 +628,7 @@ def homotopy_forward(mech: Mechanism | StewartSystem | PoseSystem, actuator_valu
            f"{n_par}-dimensional affine span of the coefficients)")
     n_sing = sum(s.status == "singular" for s in sols)
     if accounted and n_sing and isolated:
-        n_roots = len(_groups(X[sing]))
-        how += (f"; {n_sing} path(s) end at {n_roots} isolated multiple root(s) (multiplicities "
+        how += (f"; {n_sing} path(s) end at {len(groups)} isolated multiple root(s) (multiplicities "
                 f"{sorted(int(m) for m in set(mult[sing].tolist()))}), located by a Cauchy end game (winding numbers "
                 f"{sorted(set(wind[sing].tolist()))}) and found isolated by a local dimension test")
     elif accounted and n_sing:
