@@ -61,7 +61,7 @@ def test_rssr_two_assembly_modes_match_the_closed_form(rssr):
     theta = np.radians(30.0)
     r = forward_position(rssr, [theta], all_solutions=True, method="homotopy")
     d = r.to_dict(rssr)
-    assert d["complete"] is False and "not a proof" in d["completeness"] and "monodromy" in d["completeness"]
+    assert d["complete"] is True and "trace test passed" in d["completeness"] and "monodromy" in d["completeness"]
     assert d["n_real"] == 2 and d["search"]["n_generic"] == 2
     # closed form: the crank point turned by theta, the rocker point on its circle, the rod's length kept
     b1, _ = _joint(rssr, 0, 2)
@@ -102,6 +102,8 @@ def test_bennett_overconstrained_spurious_points_discarded_and_multistart_agrees
     d = r.to_dict(m)
     # the square system (3 of the closure's equations in random combination) has points that do not close
     assert d["search"]["n_spurious"] > 0 and "discarded" in d["completeness"]
+    # the trace test covers the square system's 40 generic solutions, spurious ones included
+    assert d["complete"] is True and d["search"]["trace_test"] == "passed" and d["search"]["n_generic"] == 40
     assert d["n_real"] >= 1
     for s in r.solutions:  # every reported mode closes the loop with the input held
         assert np.max(np.abs(closure_residual(m, s.config))) < 1e-9
@@ -141,13 +143,13 @@ def test_unsupported_models_say_why_and_auto_falls_back():
     assert "Traceback" not in out.output
 
 
-def test_cli_text_and_json_say_not_proven():
+def test_cli_text_and_json_say_proven_by_the_trace_test():
     runner = CliRunner()
     out = runner.invoke(main, ["fk", "rssr", "--actuators", "30", "--all"])
-    assert out.exit_code == 0 and "NOT proven complete" in out.output and "monodromy" in out.output
+    assert out.exit_code == 0 and "complete (proven)" in out.output and "trace test passed" in out.output
     assert "2 real assembly modes" in out.output
     d = json.loads(runner.invoke(main, ["fk", "rssr", "--actuators", "30", "--all", "--json"]).output)
-    assert d["complete"] is False and d["n_real"] == 2 and len(d["endpoints"]) == 2
+    assert d["complete"] is True and d["n_real"] == 2 and len(d["endpoints"]) == 2
     assert all(len(e["variables_real"]) == 2 for e in d["endpoints"])
 
 
@@ -226,5 +228,6 @@ def test_a_dead_point_double_root_is_located_by_the_end_game():
     g = hg.general_forward(m, {m.freedom_refs.index(m.freedom(m.actuators[0])): phi})
     sing = [s for s in g.solutions if s.status == "singular"]
     assert len(sing) == 1 and "Cauchy end game (winding numbers [2])" in g.completeness
+    assert g.complete and g.trace is not None and g.trace.passed  # an isolated double root: still complete
     c, s = sing[0].x[:2]  # the input crank's (cos, sin)
     assert abs(c) < 1e-12 and abs(s - 1) < 1e-12

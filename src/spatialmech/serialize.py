@@ -135,6 +135,8 @@ UNIT_FREE_KEYS: dict[str, str] = {
     "n_paths": "paths of the total-degree homotopy (loop formulation: of the final parameter homotopy)",
     "n_spurious": "end points of the squared-up loop system that do not satisfy the full closure (discarded)",
     "monodromy_loops": "monodromy loops run before the solution set stopped growing",
+    "trace_deviation": "relative deviation of the trace test's traces from a line (a ratio)",
+    "n_witness": "witness points of the trace test's curve (a count)",
     "variables_real": "real part of a loop-formulation end point: (cos, sin) of each passive rotation, slides / L, "
                       "Study parameters when the platform is not fixed by a limb",
     "variables_imag": "imaginary part of the same variables",

@@ -66,6 +66,12 @@ __all__ = [
     "MONODROMY_RESIDUAL",
     "MONODROMY_STALE_LOOPS",
     "NEAR_SINGULAR",
+    "TRACE_MAX_LOOPS",
+    "TRACE_MAX_WORK",
+    "TRACE_MAX_WORK_FULL",
+    "TRACE_STALE_LOOPS",
+    "TRACE_STEP",
+    "TRACE_TOL",
     "Tolerances",
     "characteristic_length",
     "current",
@@ -293,3 +299,16 @@ MONODROMY_MAX_WORK = 10_000
 MONODROMY_DIVERGED = 1e4  # a path stopped short with |x| beyond this is at infinity (affine variables)
 MONODROMY_PARALLEL = 4  # loops tracked together in one batch
 MONODROMY_RESIDUAL = 1e-8
+
+#: Trace test (kinematics/trace_test.py), nondimensional: the largest relative deviation of the
+#: traces from a line that passes (a complete set gives 1e-11 or less, a missing solution of the
+#: order of 1e-2 to 1), the size of the two moves of the fibre, the loops in a row without a new
+#: witness point before a test, and the most loops over the hyperplanes; and the work (paths
+#: tracked times unknowns) after which ``method="auto"`` stops it (verdict "capped", not proven),
+#: and the work after which ``method="homotopy"`` stops it.
+TRACE_TOL = 1e-8
+TRACE_STEP = 0.3
+TRACE_STALE_LOOPS = 8
+TRACE_MAX_LOOPS = 200
+TRACE_MAX_WORK = 40_000
+TRACE_MAX_WORK_FULL = 2_000_000

@@ -564,12 +564,17 @@ def _group_runs(mech: Mechanism, runs: list) -> tuple[list, list]:
     return sols, conv
 
 
+def _json_float(v: float) -> float | None:
+    return float(v) if np.isfinite(v) else None
+
+
 def _forward_general(mech: Mechanism, targets: dict[int, float], seed: int, max_iter: int,
                      n_seeds: int = 200, fallback: bool = False) -> ForwardResult | None:
     """``forward_position(..., method="homotopy")`` on a model whose limbs do not reduce to the
     Study-parameter quadrics: the loop formulation in joint variables solved by monodromy
     (:mod:`.homotopy_general`); each real end point is a configuration, polished by the same
-    Newton step and grouped as the multi-start roots.  Never a proof (``complete`` false)."""
+    Newton step and grouped as the multi-start roots.  ``complete`` when the trace test of the
+    generic solutions passed and every path to the request is accounted for."""
     from . import homotopy_general as hg
 
     hr = hg.general_forward(mech, targets, seed=seed, capped=fallback)
@@ -580,20 +585,27 @@ def _forward_general(mech: Mechanism, targets: dict[int, float], seed: int, max_
         mask[i] = False
     runs = [_fk_from(mech, hg.configuration(e), targets, mask, max_iter) for e in hr.solutions if e.q is not None]
     n_endpoint_runs = len(runs)
-    if hr.count("singular"):  # a continuum or a multiple root: the multi-start adds its roots (as _forward_homotopy)
+    if hr.count("singular") or not hr.complete:  # a continuum, a multiple root, or no proof: the multi-start adds its roots
         runs += _multistart_runs(mech, targets, mask, n_seeds, seed, max_iter)
     sols, conv = _group_runs(mech, runs)
     kinds = [s.kind for s in sols]
     extra = len(runs) - n_endpoint_runs
+    why_more = "singular end points" if hr.count("singular") else "not proven complete"
     search = {"method": "homotopy continuation (loop closure in joint variables, monodromy), real end points polished "
-                        "by Newton" + (f"; singular end points: {extra} multi-start seeds added" if extra else ""),
+                        "by Newton" + (f"; {why_more}: {extra} multi-start seeds added" if extra else ""),
               "seeds": extra, "seed": seed, "converged_runs": len(conv), "distinct": len(kinds),
               "n_regular": kinds.count(AssemblyKind.REGULAR), "n_singular_roots": kinds.count(AssemblyKind.SINGULAR),
               "n_self_motion_sets": kinds.count(AssemblyKind.SELF_MOTION),
-              "complete": hr.complete, "completeness": hr.completeness,
+              "complete": hr.complete,
+              "completeness": hr.completeness + (f"; a {extra}-start multi-start search added its roots"
+                                                 if extra and not hr.complete else ""),
               "n_complex": hr.count("complex"), "n_real": hr.count("real"), "n_singular": hr.count("singular"),
               "n_at_infinity": hr.count("at_infinity"), "n_generic": hr.n_generic, "n_spurious": hr.n_spurious,
               "n_paths": hr.n_generic, "monodromy_loops": hr.loops, "elapsed_s": hr.seconds,
               "generic_elapsed_s": hr.seconds_generic, "generic_cached": hr.cached,
+              "trace_test": hr.trace.verdict if hr.trace else "not run",
+              "trace_deviation": _json_float(hr.trace.deviation) if hr.trace else None,
+              "n_witness": hr.trace.n_witness if hr.trace else 0,
+              "trace_elapsed_s": hr.trace.seconds if hr.trace else 0.0,
               "endpoints": [e.to_dict() for e in hr.solutions], "singular_below": singular_threshold()}
     return ForwardResult(tuple(sols), search)

@@ -17,9 +17,11 @@ the inverse kinematics, no more).  Otherwise (overconstrained or spherical limbs
 its generic solutions include points of the square system that do not close.  Loops
 ``P0 -> P1 -> P2 -> P0`` through random complex parameters (four per round, each round also
 moving fresh start pairs to ``P0``) stop after :data:`MONODROMY_STALE_LOOPS` loops in a row
-without a new solution: a *saturation*, not a proof (no trace test), and the result says so
-(``complete`` is false).  A parameter homotopy along the straight segment from ``P0`` to the
-request (actuators given, no offsets) then tracks every known solution, with the NumPy tracker
+without a new solution: a *saturation*, not a proof; the trace test (:mod:`.trace_test`, over
+the line from ``P0`` through a fresh start pair) then proves the generic solutions complete or
+says why not, and ``complete`` is true only when it passed.  A parameter homotopy along the
+straight segment from ``P0`` to the request (actuators given, no offsets) then tracks every
+known solution, with the NumPy tracker
 :func:`.homotopy.track` and the compiled square system (:mod:`.kernels_loops`).  The generic
 solve is cached per geometry (in memory).
 """
@@ -44,12 +46,16 @@ from ..geometry.tolerances import (
     MONODROMY_PARALLEL,
     MONODROMY_RESIDUAL,
     MONODROMY_STALE_LOOPS,
+    TRACE_MAX_WORK,
+    TRACE_MAX_WORK_FULL,
+    TRACE_TOL,
 )
 from ..model.mechanism import Mechanism
 from .closure import Configuration, limb_slices
 from .endgame import cauchy_endgame
 from .homotopy import study_to_pose, track
 from .loop_system import LoopSystem, general_reason, loop_system, variables
+from .trace_test import TraceResult, trace_test
 
 __all__ = [
     "GeneralResult",
@@ -59,6 +65,7 @@ __all__ = [
     "configuration",
     "general_forward",
     "general_reason",
+    "line_eval",
     "loop_system",
     "rebuild",
     "variables",
@@ -66,37 +73,41 @@ __all__ = [
 
 
 # ------------------------------------------------------------------------------ solving
+def line_eval(sysm: LoopSystem, X: np.ndarray, P: np.ndarray, dP: np.ndarray):
+    """The square system ``G(x; P) = square(x; p, W) - b`` at the points ``X`` (n, nx) with the
+    parameters ``P`` (n, np + nw + nx: actuator parameters, the limbs' offsets ``W``, the offsets
+    ``b``), its Jacobian in ``x`` and its derivative along ``dP`` (n, same): exact in the
+    actuators and ``b``; by central differences in ``W`` (exact up to rounding for the parts of
+    degree two or less, ample for a predictor)."""
+    nx, npar, nw = sysm.nx, sysm.npar, sysm.w_offsets[-1]
+    h = 1e-5
+
+    def G(Xc, Pc, want_J):
+        F, J = sysm.square(np.concatenate([Xc, Pc[:, :npar]], axis=1), Pc[:, npar : npar + nw], want_J=want_J)
+        return F - Pc[:, npar + nw :], J
+
+    n = len(X)
+    F, J = G(X, P, True)
+    Ft = np.einsum("nkp,np->nk", J[:, :, nx:], dP[:, :npar]) - dP[:, npar + nw :]
+    if np.any(dP[:, npar : npar + nw]):  # the limbs' offsets: central differences in W alone
+        dW = np.zeros_like(P)
+        dW[:, npar : npar + nw] = h * dP[:, npar : npar + nw]
+        Fp, _ = G(np.tile(X, (2, 1)), np.concatenate([P + dW, P - dW]), False)
+        Ft = Ft + (Fp[:n] - Fp[n:]) / (2 * h)
+    return F, J[:, :, :nx], Ft
+
+
 def _segment(sysm: LoopSystem, X, P0, P1):
     """Track the points ``X`` (n, nx) from the parameters ``P0`` to ``P1`` (straight segments;
-    each (np + nw + nx,) for all points or (n, np + nw + nx) one per point: actuator parameters,
-    the limbs' offsets ``W``, then the offsets ``b`` of the square system ``G = b``).  ``H_t``:
-    exact in the actuators and ``b``; by central differences in ``W`` (exact up to rounding for
-    the parts of degree two or less, ample for the predictor elsewhere)."""
+    each (np + nw + nx,) for all points or (n, np + nw + nx) one per point; :func:`line_eval`)."""
     nx, npar, nw = sysm.nx, sysm.npar, sysm.w_offsets[-1]
     if len(X) == 0:
         return X, np.zeros(0), np.zeros(0, bool)
     A0 = np.broadcast_to(P0, (len(X), npar + nw + nx))
     dA = np.broadcast_to(P1, A0.shape) - A0
-    h = 1e-5
-
-    def G(Xc, P, want_J):
-        F, J = sysm.square(np.concatenate([Xc, P[:, :npar]], axis=1), P[:, npar : npar + nw], want_J=want_J)
-        return F - P[:, npar + nw :], J
-
-    moves_w = bool(np.any(dA[:, npar : npar + nw]))
 
     def fun(Xc, t, idx):
-        P = A0[idx] + t[:, None] * dA[idx]
-        n = len(Xc)
-        F, J = G(Xc, P, True)
-        d = dA[idx]
-        Ht = np.einsum("nkp,np->nk", J[:, :, nx:], d[:, :npar]) - d[:, npar + nw :]
-        if moves_w:  # the limbs' offsets: central differences in W alone
-            dW = np.zeros_like(P)
-            dW[:, npar : npar + nw] = h * d[:, npar : npar + nw]
-            Fp, _ = G(np.tile(Xc, (2, 1)), np.concatenate([P + dW, P - dW]), False)
-            Ht = Ht + (Fp[:n] - Fp[n:]) / (2 * h)
-        return F, J[:, :, :nx], Ht
+        return line_eval(sysm, Xc, A0[idx] + t[:, None] * dA[idx], dA[idx])
 
     Xe, t, done, _ = track(fun, X, max_steps=2000, indexed=True)
     return Xe, t, done
@@ -167,6 +178,24 @@ def _start_offsets(sysm: LoopSystem, x: np.ndarray, p: np.ndarray) -> np.ndarray
     return W
 
 
+def _start_pairs(sysm: LoopSystem, rng: np.random.Generator, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """``n`` start pairs ``(x, P)``: with limb offsets, a point on the side equations and the
+    offsets that make it close; else any point and the offset ``b`` that makes it a solution."""
+    xs, Ps = [], []
+    for _ in range(n):
+        p = _random_parameters(sysm, rng)
+        if sysm.rigid_family:
+            x = _random_point(sysm, rng)
+            Ps.append(np.concatenate([p, _start_offsets(sysm, x, p), np.zeros(sysm.nx)]))
+        else:
+            x = rng.normal(size=sysm.nx) + 1j * rng.normal(size=sysm.nx)
+            W = sysm.identity_offsets()[0]
+            b = sysm.square(np.concatenate([x, p])[None], W[None])[0][0]
+            Ps.append(np.concatenate([p, W, b]))
+        xs.append(x)
+    return np.array(xs), np.array(Ps)
+
+
 @dataclass(frozen=True, eq=False)
 class _GenericLoop:
     P0: np.ndarray  # the generic parameters: actuators, then offsets
@@ -193,23 +222,7 @@ def _monodromy(sysm: LoopSystem, seed: int, capped: bool) -> _GenericLoop:
         return rng.normal(size=shape) + 1j * rng.normal(size=shape)
 
     rigid = sysm.rigid_family
-
-    def start(n):
-        xs, Ps = [], []
-        for _ in range(n):
-            p = _random_parameters(sysm, rng)
-            if rigid:  # a point on the side equations, the limbs' offsets that make it close
-                x = _random_point(sysm, rng)
-                Ps.append(np.concatenate([p, _start_offsets(sysm, x, p), np.zeros(sysm.nx)]))
-            else:  # any point, the offset b of the square system that makes it a solution
-                x = rng.normal(size=sysm.nx) + 1j * rng.normal(size=sysm.nx)
-                W = sysm.identity_offsets()[0]
-                b = sysm.square(np.concatenate([x, p])[None], W[None])[0][0]
-                Ps.append(np.concatenate([p, W, b]))
-            xs.append(x)
-        return np.array(xs), np.array(Ps)
-
-    X0, P0s = start(1)
+    X0, P0s = _start_pairs(sysm, rng, 1)
     x0, P0 = X0[0], P0s[0]
     npar, nw = sysm.npar, sysm.w_offsets[-1]
     free = np.zeros(len(P0), bool)  # the parameters the loops move: actuators, and W or b
@@ -237,7 +250,7 @@ def _monodromy(sysm: LoopSystem, seed: int, capped: bool) -> _GenericLoop:
             a, b = ((P0, B1), (B1, B2), (B2, P0))[leg]
             X, _, done = _segment(sysm, X, a, b)
             X, B1, B2 = X[done], B1[done], B2[done]  # a failed path is dropped
-        xr, Pr = start(k)  # and fresh start pairs, moved to P0
+        xr, Pr = _start_pairs(sysm, rng, k)  # and fresh start pairs, moved to P0
         Xr, _, done = _segment(sysm, xr, Pr, P0)
         X = np.vstack([X, Xr[done]])
         new = _new_points(known, X)
@@ -252,9 +265,35 @@ def _monodromy(sysm: LoopSystem, seed: int, capped: bool) -> _GenericLoop:
     return g
 
 
+_TRACES: dict[bytes, TraceResult] = {}
+
+
+def _trace(sysm: LoopSystem, gen: _GenericLoop, seed: int, capped: bool) -> TraceResult:
+    """The trace test of the generic solutions ``gen.X`` (:mod:`.trace_test`): the parameters
+    move along the line from ``gen.P0`` through a fresh start pair's parameters; ``capped``: stop
+    at :data:`TRACE_MAX_WORK`."""
+    key = sysm.key() + bytes([seed % 256])
+    if key in _TRACES:
+        return _TRACES[key]
+    rng = np.random.default_rng([seed, 7])
+    x1, P1 = _start_pairs(sysm, rng, 1)
+    V = P1[0] - gen.P0
+    nx = sysm.nx
+
+    def curve(Y):
+        P = gen.P0[None] + Y[:, nx : nx + 1] * V[None]
+        return line_eval(sysm, Y[:, :nx], P, np.broadcast_to(V, P.shape))
+
+    tr = trace_test(curve, gen.X, np.concatenate([x1[0], [1.0]]), rng, max_work=TRACE_MAX_WORK if capped else TRACE_MAX_WORK_FULL)
+    if tr.verdict != "capped":
+        _TRACES[key] = tr
+    return tr
+
+
 def clear_cache() -> None:
-    """Forget the cached generic solves (benchmarks time the first solve)."""
+    """Forget the cached generic solves and trace tests (benchmarks time the first solve)."""
     _CACHE.clear()
+    _TRACES.clear()
 
 
 @dataclass(frozen=True, eq=False)
@@ -296,6 +335,7 @@ class GeneralResult:
     seconds_generic: float
     seconds: float
     cached: bool
+    trace: TraceResult | None = None  # the trace test of the generic solutions (None: not run)
 
     def count(self, status: str) -> int:
         return sum(s.status == status for s in self.solutions)
@@ -311,6 +351,7 @@ def general_forward(mech: Mechanism, targets: dict[int, float], *, seed: int = 0
         raise InputError(f"actuators: expected values for {list(mech.actuators)}")
     cached = sysm.key() + bytes([seed % 256]) in _CACHE
     gen = _monodromy(sysm, seed, capped)
+    tr = _trace(sysm, gen, seed, capped) if gen.saturated else None
     p1 = sysm.parameters(targets).astype(complex)
     P1 = np.concatenate([p1, sysm.identity_offsets()[0], np.zeros(sysm.nx)])
     X, _, done = _segment(sysm, gen.X, gen.P0, P1)
@@ -368,10 +409,24 @@ def general_forward(mech: Mechanism, targets: dict[int, float], *, seed: int = 0
     n_sing = sum(s.status == "singular" for s in sols)
     fam = ("the limbs offset by generic complex rigid motions" if sysm.rigid_family
            else "the square system with a generic complex offset")
-    how = (f"monodromy saturated after {gen.loops} loops ({MONODROMY_STALE_LOOPS} in a row without a new solution; "
-           f"{len(gen.X)} solutions of a generic complex instance: {fam}) then a parameter homotopy to "
-           f"the requested actuator values; {spurious} end point(s) of the square system that do not satisfy the full "
-           "closure discarded: not a proof (no trace test)")
+    head = (f"monodromy saturated after {gen.loops} loops ({MONODROMY_STALE_LOOPS} in a row without a new solution; "
+            f"{len(gen.X)} solutions of a generic complex instance: {fam})")
+    tail = (f"then a parameter homotopy to the requested actuator values; {spurious} end point(s) of the square "
+            "system that do not satisfy the full closure discarded")
+    how = head
+    if tr is not None and tr.passed:
+        lead = "complete (trace test)" if lost == 0 else "NOT proven at the request"
+        how = (f"{lead}: {head}; trace test passed (the {len(gen.X)} solutions and {tr.n_witness} "
+               f"witness points of the curve through a second generic instance, traces on a line to "
+               f"{tr.deviation:.1e} <= {TRACE_TOL:g}); {tail}")
+    elif tr is not None:
+        why_not = {"failed": f"trace test FAILED (deviation {tr.deviation:.1e} > {TRACE_TOL:g} with {tr.n_witness} "
+                             "witness points that stopped growing): solutions of the generic instance are missing",
+                   "inconclusive": "trace test inconclusive (a path of its homotopies failed)",
+                   "capped": f"trace test stopped at its cap (a work of {tr.work} paths tracked times unknowns, "
+                             f"{tr.loops} loops; {tr.n_witness} witness points so far): not proven"
+                             + ("; method=\"homotopy\" runs it further" if capped else "")}
+        how = f"{head}; {why_not[tr.verdict]}; {tail}: not a proof"
     if not gen.saturated:
         why = (f"more than {MONODROMY_MAX_SOLUTIONS} solutions of the square system" if len(gen.X) > MONODROMY_MAX_SOLUTIONS
                else f"{MONODROMY_MAX_LOOPS} loops" if gen.loops >= MONODROMY_MAX_LOOPS
@@ -385,8 +440,9 @@ def general_forward(mech: Mechanism, targets: dict[int, float], *, seed: int = 0
         how += f"; {n_sing} singular end point(s) (a continuum or a multiple root), located to a few digits only"
     if lost:
         how += f"; {lost} path(s) stopped short of the request away from any solution (lost)"
-    return GeneralResult(tuple(sols), gen.saturated, False, how, len(gen.X), spurious, gen.loops, gen.seconds,
-                         time.perf_counter() - t0, cached)
+    complete = bool(tr is not None and tr.passed and lost == 0)
+    return GeneralResult(tuple(sols), gen.saturated, complete, how, len(gen.X), spurious, gen.loops, gen.seconds,
+                         time.perf_counter() - t0, cached, tr)
 
 
 def _refine(sysm: LoopSystem, Z, iters: int = 3):
