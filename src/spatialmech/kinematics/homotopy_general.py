@@ -178,12 +178,14 @@ def _start_offsets(sysm: LoopSystem, x: np.ndarray, p: np.ndarray) -> np.ndarray
     return W
 
 
-def _start_pairs(sysm: LoopSystem, rng: np.random.Generator, n: int) -> tuple[np.ndarray, np.ndarray]:
+def _start_pairs(sysm: LoopSystem, rng: np.random.Generator, n: int,
+                 p_fixed: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """``n`` start pairs ``(x, P)``: with limb offsets, a point on the side equations and the
-    offsets that make it close; else any point and the offset ``b`` that makes it a solution."""
+    offsets that make it close; else any point and the offset ``b`` that makes it a solution.
+    The actuator parameters are random (a driven rotation's on its circle), or ``p_fixed``."""
     xs, Ps = [], []
     for _ in range(n):
-        p = _random_parameters(sysm, rng)
+        p = _random_parameters(sysm, rng) if p_fixed is None else p_fixed
         if sysm.rigid_family:
             x = _random_point(sysm, rng)
             Ps.append(np.concatenate([p, _start_offsets(sysm, x, p), np.zeros(sysm.nx)]))
@@ -232,6 +234,15 @@ def _monodromy(sysm: LoopSystem, seed: int, capped: bool) -> _GenericLoop:
     else:
         free[npar + nw :] = True
     scale = np.where(free, np.abs(P0) + 1.0, 0.0)
+
+    def waypoints(n):
+        """Random parameters of the family: offsets at random, the actuators as a start pair's
+        (a driven rotation's ``(c, s)`` stays on its circle: off it, the instances with the
+        actuators on it, the request's included, are special and lose solutions to infinity)."""
+        B = np.where(free, scale * crand(n, len(P0)), P0)
+        B[:, :npar] = [_random_parameters(sysm, rng) for _ in range(n)]
+        return B
+
     known = x0[None]
     stale = loops = 0
     k = MONODROMY_PARALLEL
@@ -242,8 +253,8 @@ def _monodromy(sysm: LoopSystem, seed: int, capped: bool) -> _GenericLoop:
             capped_out = True
             break
         loops += k  # k loops at once, each through its own two random parameter points
-        B1 = np.repeat(np.where(free, scale * crand(k, len(P0)), P0), len(known), axis=0)
-        B2 = np.repeat(np.where(free, scale * crand(k, len(P0)), P0), len(known), axis=0)
+        B1 = np.repeat(waypoints(k), len(known), axis=0)
+        B2 = np.repeat(waypoints(k), len(known), axis=0)
         X = np.tile(known, (k, 1))
         work += (3 * len(X) + k) * sysm.nx
         for leg in range(3):
@@ -276,7 +287,7 @@ def _trace(sysm: LoopSystem, gen: _GenericLoop, seed: int, capped: bool) -> Trac
     if key in _TRACES:
         return _TRACES[key]
     rng = np.random.default_rng([seed, 7])
-    x1, P1 = _start_pairs(sysm, rng, 1)
+    x1, P1 = _start_pairs(sysm, rng, 1, p_fixed=gen.P0[: sysm.npar])  # the line moves the offsets alone
     V = P1[0] - gen.P0
     nx = sysm.nx
 

@@ -143,7 +143,7 @@ def trace_test(curve: Curve, X: np.ndarray, y1: np.ndarray, rng: np.random.Gener
     m = X.shape[1]
     a = _crand(rng, m)
     a = a / (a @ y1[:m])
-    scale = np.linalg.norm(a) / np.sqrt(2 * m)
+    base = np.linalg.norm(a) / np.sqrt(m)  # a typical entry of a
     W = np.asarray(y1, dtype=complex)[None]
     fibre = np.concatenate([X, np.zeros((len(X), 1))], axis=1)
     loops = stale = work = 0
@@ -153,8 +153,10 @@ def trace_test(curve: Curve, X: np.ndarray, y1: np.ndarray, rng: np.random.Gener
         if max_work is not None and work + (3 * k + 2) * len(W) * (m + 1) > max_work:  # the next round's
             return TraceResult("capped", dev, len(W), loops, work, time.perf_counter() - t0)
         loops += k  # k loops at once, each through its own two random hyperplanes
-        B1 = np.repeat(scale * _crand(rng, k, m), len(W), axis=0)
-        B2 = np.repeat(scale * _crand(rng, k, m), len(W), axis=0)
+        # random hyperplanes at random scales (0.5 to 8 times a's entries): small ones alone may
+        # never wind about the tangent hyperplanes (the RSSR's circle: no swap in 20 loops)
+        B1 = np.repeat(base * np.exp(rng.uniform(np.log(0.5), np.log(8.0), (k, 1))) * _crand(rng, k, m), len(W), axis=0)
+        B2 = np.repeat(base * np.exp(rng.uniform(np.log(0.5), np.log(8.0), (k, 1))) * _crand(rng, k, m), len(W), axis=0)
         A = np.broadcast_to(a, B1.shape)
         Y = np.tile(W, (k, 1))
         work += 3 * len(Y) * (m + 1)
