@@ -6,7 +6,8 @@ monodromy, on models the Study reductions do not cover.
 Cases: rssr, planar-4r and bennett at an input angle (first solve, including the monodromy), and
 (unless --quick) a general 6R loop: one limb of six R joints with seeded random axes, the
 platform held by a locked joint, no actuator -- the inverse kinematics of a general 6R arm, whose
-published count is 16 complex solutions.  Every real solution is checked against the closure.
+published count is 16 complex solutions.  Every real solution is checked against the closure;
+each case prints the trace test's verdict (kinematics/trace_test.py) and whether the set is proven.
 """
 
 from __future__ import annotations
@@ -47,7 +48,10 @@ def case(mech: sm.Mechanism, values) -> dict:
     return {"model": mech.name, "family": "limb offsets" if hg.loop_system(mech).rigid_family else "offset b",
             "n_generic": r.n_generic, "n_real": r.count("real"), "n_complex": r.count("complex"),
             "n_singular": r.count("singular"), "n_at_infinity": r.count("at_infinity"), "n_spurious": r.n_spurious,
-            "loops": r.loops, "seconds": round(sec, 3), "worst_real_closure_residual": worst}
+            "loops": r.loops, "seconds": round(sec, 3), "worst_real_closure_residual": worst,
+            "complete": r.complete, "trace_test": r.trace.verdict if r.trace else "not run",
+            "n_witness": r.trace.n_witness if r.trace else 0,
+            "trace_seconds": round(r.trace.seconds, 3) if r.trace else 0.0}
 
 
 def main() -> None:
@@ -65,7 +69,9 @@ def main() -> None:
     for r in rows:
         print(f"{r['model']:10s} {r['family']:12s} generic {r['n_generic']:4d}  real {r['n_real']:2d}  complex "
               f"{r['n_complex']:3d}  spurious {r['n_spurious']:4d}  at infinity {r['n_at_infinity']:4d}  "
-              f"{r['seconds']:.2f} s  (worst closure residual of a real one {r['worst_real_closure_residual']:.1e})")
+              f"{r['seconds']:.2f} s  (worst closure residual of a real one {r['worst_real_closure_residual']:.1e}); "
+              f"trace test {r['trace_test']} ({r['n_witness']} witness points, {r['trace_seconds']:.2f} s): "
+              f"{'complete' if r['complete'] else 'NOT proven'}")
     six = [r for r in rows if r["model"] == "six-r"]
     if six:
         n = six[0]["n_real"] + six[0]["n_complex"]

@@ -65,6 +65,7 @@ __all__ = [
     "configuration",
     "general_forward",
     "general_reason",
+    "angle_form",
     "line_eval",
     "loop_system",
     "rebuild",
@@ -73,14 +74,38 @@ __all__ = [
 
 
 # ------------------------------------------------------------------------------ solving
+def _rotations(sysm: LoopSystem) -> list[tuple[int, int]]:
+    """The ``(c, s)`` slots of the driven rotations in the actuator parameters."""
+    return [(idx[0] - sysm.nx, idx[1] - sysm.nx) for _, kind, idx in sysm.params if kind == "R"]
+
+
+def angle_form(sysm: LoopSystem, P: np.ndarray) -> np.ndarray:
+    """Parameters ``P`` (..., np + nw + nx) with each driven rotation's ``(c, s)`` (on its circle)
+    replaced by ``(theta, 0)``, ``c + i s = exp(i theta)`` (complex ``theta``): the form in
+    which the homotopies move them, so that every point of a straight segment keeps the
+    rotation on its circle (off it the family is larger, and its members with the actuators on
+    the circle, the request's included, are special ones that lose solutions to infinity)."""
+    P = np.array(P, dtype=complex)
+    for ic, js in _rotations(sysm):
+        P[..., ic], P[..., js] = -1j * np.log(P[..., ic] + 1j * P[..., js]), 0.0
+    return P
+
+
 def line_eval(sysm: LoopSystem, X: np.ndarray, P: np.ndarray, dP: np.ndarray):
     """The square system ``G(x; P) = square(x; p, W) - b`` at the points ``X`` (n, nx) with the
-    parameters ``P`` (n, np + nw + nx: actuator parameters, the limbs' offsets ``W``, the offsets
-    ``b``), its Jacobian in ``x`` and its derivative along ``dP`` (n, same): exact in the
-    actuators and ``b``; by central differences in ``W`` (exact up to rounding for the parts of
-    degree two or less, ample for a predictor)."""
+    parameters ``P`` (n, np + nw + nx, :func:`angle_form`: actuator parameters, the limbs' offsets
+    ``W``, the offsets ``b``), its Jacobian in ``x`` and its derivative along ``dP`` (n, same):
+    exact in the actuators and ``b``; by central differences in ``W`` (exact up to rounding for
+    the parts of degree two or less, ample for a predictor)."""
     nx, npar, nw = sysm.nx, sysm.npar, sysm.w_offsets[-1]
     h = 1e-5
+    rot = _rotations(sysm)
+    if rot:  # (theta, 0) -> (cos, sin), and the chain rule
+        P, dP = P.copy(), dP.copy()
+        for ic, js in rot:
+            th, dth = P[:, ic].copy(), dP[:, ic].copy()
+            P[:, ic], P[:, js] = np.cos(th), np.sin(th)
+            dP[:, ic], dP[:, js] = -np.sin(th) * dth, np.cos(th) * dth
 
     def G(Xc, Pc, want_J):
         F, J = sysm.square(np.concatenate([Xc, Pc[:, :npar]], axis=1), Pc[:, npar : npar + nw], want_J=want_J)
@@ -195,7 +220,7 @@ def _start_pairs(sysm: LoopSystem, rng: np.random.Generator, n: int,
             b = sysm.square(np.concatenate([x, p])[None], W[None])[0][0]
             Ps.append(np.concatenate([p, W, b]))
         xs.append(x)
-    return np.array(xs), np.array(Ps)
+    return np.array(xs), angle_form(sysm, np.array(Ps))
 
 
 @dataclass(frozen=True, eq=False)
@@ -240,7 +265,8 @@ def _monodromy(sysm: LoopSystem, seed: int, capped: bool) -> _GenericLoop:
         (a driven rotation's ``(c, s)`` stays on its circle: off it, the instances with the
         actuators on it, the request's included, are special and lose solutions to infinity)."""
         B = np.where(free, scale * crand(n, len(P0)), P0)
-        B[:, :npar] = [_random_parameters(sysm, rng) for _ in range(n)]
+        B[:, :npar] = angle_form(sysm, np.array([np.concatenate([_random_parameters(sysm, rng),
+                                                                 np.zeros(len(P0) - npar)]) for _ in range(n)]))[:, :npar]
         return B
 
     known = x0[None]
@@ -287,7 +313,10 @@ def _trace(sysm: LoopSystem, gen: _GenericLoop, seed: int, capped: bool) -> Trac
     if key in _TRACES:
         return _TRACES[key]
     rng = np.random.default_rng([seed, 7])
-    x1, P1 = _start_pairs(sysm, rng, 1, p_fixed=gen.P0[: sysm.npar])  # the line moves the offsets alone
+    p0 = gen.P0[: sysm.npar].copy()  # the line moves the offsets alone: the actuators as at P0
+    for ic, js in _rotations(sysm):
+        p0[ic], p0[js] = np.cos(gen.P0[ic]), np.sin(gen.P0[ic])
+    x1, P1 = _start_pairs(sysm, rng, 1, p_fixed=p0)
     V = P1[0] - gen.P0
     nx = sysm.nx
 
@@ -364,7 +393,7 @@ def general_forward(mech: Mechanism, targets: dict[int, float], *, seed: int = 0
     gen = _monodromy(sysm, seed, capped)
     tr = _trace(sysm, gen, seed, capped) if gen.saturated else None
     p1 = sysm.parameters(targets).astype(complex)
-    P1 = np.concatenate([p1, sysm.identity_offsets()[0], np.zeros(sysm.nx)])
+    P1 = angle_form(sysm, np.concatenate([p1, sysm.identity_offsets()[0], np.zeros(sysm.nx)]))
     X, _, done = _segment(sysm, gen.X, gen.P0, P1)
     Z = np.concatenate([X, np.broadcast_to(p1, (len(X), sysm.npar))], axis=1)
     Z = _refine(sysm, Z)
