@@ -292,10 +292,11 @@ LOCAL_DIMENSION_STEP = 1e-4
 MONODROMY_STALE_LOOPS = 8
 MONODROMY_MAX_LOOPS = 80
 MONODROMY_MAX_SOLUTIONS = 128  # method="auto" gives up beyond this (the multi-start runs instead)
-#: and beyond this work: paths tracked times unknowns, about 2 s here for the 21 unknowns of
-#: five-cs-3 (a count, not a time, so that every machine makes the same choice; method="homotopy"
-#: has neither cap)
-MONODROMY_MAX_WORK = 10_000
+#: and beyond this work: the tracker's steps times unknowns, the next round predicted from the
+#: last (a count, not a time, so that every machine makes the same choice; about 10-20 s here
+#: for five-cs-3, three-rrr-sm or delta-ruu; the Bennett's 40 generic solutions take 150,000;
+#: method="homotopy" has neither cap)
+MONODROMY_MAX_WORK = 250_000
 MONODROMY_DIVERGED = 1e4  # a path stopped short with |x| beyond this is at infinity (affine variables)
 MONODROMY_PARALLEL = 4  # loops tracked together in one batch
 MONODROMY_RESIDUAL = 1e-8

@@ -61,11 +61,11 @@ __all__ = [
     "GeneralResult",
     "GeneralSolution",
     "LoopSystem",
+    "angle_form",
     "clear_cache",
     "configuration",
     "general_forward",
     "general_reason",
-    "angle_form",
     "line_eval",
     "loop_system",
     "rebuild",
@@ -122,7 +122,7 @@ def line_eval(sysm: LoopSystem, X: np.ndarray, P: np.ndarray, dP: np.ndarray):
     return F, J[:, :, :nx], Ft
 
 
-def _segment(sysm: LoopSystem, X, P0, P1):
+def _segment(sysm: LoopSystem, X, P0, P1, steps: list[int] | None = None):
     """Track the points ``X`` (n, nx) from the parameters ``P0`` to ``P1`` (straight segments;
     each (np + nw + nx,) for all points or (n, np + nw + nx) one per point; :func:`line_eval`)."""
     nx, npar, nw = sysm.nx, sysm.npar, sysm.w_offsets[-1]
@@ -134,7 +134,9 @@ def _segment(sysm: LoopSystem, X, P0, P1):
     def fun(Xc, t, idx):
         return line_eval(sysm, Xc, A0[idx] + t[:, None] * dA[idx], dA[idx])
 
-    Xe, t, done, _ = track(fun, X, max_steps=2000, indexed=True)
+    Xe, t, done, n_steps = track(fun, X, max_steps=2000, indexed=True)
+    if steps is not None:  # the caller's count of the tracker's accepted steps
+        steps[0] += int(np.sum(n_steps))
     return Xe, t, done
 
 
@@ -230,6 +232,7 @@ class _GenericLoop:
     loops: int
     seconds: float
     saturated: bool
+    work: int = 0  # tracker steps times unknowns
 
 
 _CACHE: dict[bytes, _GenericLoop] = {}
@@ -237,7 +240,7 @@ _CACHE: dict[bytes, _GenericLoop] = {}
 
 def _monodromy(sysm: LoopSystem, seed: int, capped: bool) -> _GenericLoop:
     """The generic instance's solutions by monodromy; ``capped``: also stop at
-    :data:`MONODROMY_MAX_SOLUTIONS` solutions or :data:`MONODROMY_MAX_WORK` (paths tracked times
+    :data:`MONODROMY_MAX_SOLUTIONS` solutions or :data:`MONODROMY_MAX_WORK` (tracker steps times
     unknowns: a count, so that the choice does not depend on the machine's speed; unsaturated)."""
     key = sysm.key() + bytes([seed % 256])
     if key in _CACHE:
@@ -273,22 +276,25 @@ def _monodromy(sysm: LoopSystem, seed: int, capped: bool) -> _GenericLoop:
     stale = loops = 0
     k = MONODROMY_PARALLEL
     capped_out = False
-    work = 0  # paths tracked times unknowns
+    steps = [0]  # tracker steps; the work: steps times unknowns
+    per_path = 0.0  # the last round's steps per path: the next round's work is predicted from it
     while stale < MONODROMY_STALE_LOOPS and loops < MONODROMY_MAX_LOOPS:
-        if capped and (len(known) > MONODROMY_MAX_SOLUTIONS or work > MONODROMY_MAX_WORK):
+        next_work = per_path * (3 * k * len(known) + k) * sysm.nx
+        if capped and (len(known) > MONODROMY_MAX_SOLUTIONS or steps[0] * sysm.nx + next_work > MONODROMY_MAX_WORK):
             capped_out = True
             break
         loops += k  # k loops at once, each through its own two random parameter points
         B1 = np.repeat(waypoints(k), len(known), axis=0)
         B2 = np.repeat(waypoints(k), len(known), axis=0)
         X = np.tile(known, (k, 1))
-        work += (3 * len(X) + k) * sysm.nx
+        before, n_paths = steps[0], 3 * len(X) + k
         for leg in range(3):
             a, b = ((P0, B1), (B1, B2), (B2, P0))[leg]
-            X, _, done = _segment(sysm, X, a, b)
+            X, _, done = _segment(sysm, X, a, b, steps)
             X, B1, B2 = X[done], B1[done], B2[done]  # a failed path is dropped
         xr, Pr = _start_pairs(sysm, rng, k)  # and fresh start pairs, moved to P0
-        Xr, _, done = _segment(sysm, xr, Pr, P0)
+        Xr, _, done = _segment(sysm, xr, Pr, P0, steps)
+        per_path = (steps[0] - before) / n_paths
         X = np.vstack([X, Xr[done]])
         new = _new_points(known, X)
         if len(new):
@@ -296,7 +302,7 @@ def _monodromy(sysm: LoopSystem, seed: int, capped: bool) -> _GenericLoop:
             stale = 0
         else:
             stale += k
-    g = _GenericLoop(P0, known, loops, time.perf_counter() - t0, stale >= MONODROMY_STALE_LOOPS)
+    g = _GenericLoop(P0, known, loops, time.perf_counter() - t0, stale >= MONODROMY_STALE_LOOPS, steps[0] * sysm.nx)
     if not capped_out:  # a capped run is redone in full when asked without the caps
         _CACHE[key] = g
     return g
@@ -470,7 +476,7 @@ def general_forward(mech: Mechanism, targets: dict[int, float], *, seed: int = 0
     if not gen.saturated:
         why = (f"more than {MONODROMY_MAX_SOLUTIONS} solutions of the square system" if len(gen.X) > MONODROMY_MAX_SOLUTIONS
                else f"{MONODROMY_MAX_LOOPS} loops" if gen.loops >= MONODROMY_MAX_LOOPS
-               else f"a work of {MONODROMY_MAX_WORK} (paths tracked times unknowns)")
+               else f"a work of {MONODROMY_MAX_WORK} (tracker steps times unknowns)")
         how = (f"monodromy NOT saturated: stopped at {why} ({len(gen.X)} solutions of the generic instance so far, "
                f"{gen.loops} loops); {spurious} spurious end point(s) discarded: not a proof, solutions may be missing")
     if n_sing and winding:
