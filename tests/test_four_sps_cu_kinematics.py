@@ -16,6 +16,7 @@ from hypothesis import strategies as st
 from scipy.optimize import brentq
 
 from spatialmech import catalog
+from spatialmech.errors import InputError
 from spatialmech.geometry.rotations import euler_matrix, skew
 from spatialmech.kinematics.closed_forms import four_sps_cu as k
 from spatialmech.kinematics.closed_forms import four_sps_cu_forward as kf
@@ -531,3 +532,18 @@ def test_benchmark_runs_with_a_tiny_size():
     assert res["inverse"]["max_abs_diff_m"] < 1e-14
     assert res["inverse"]["vectorised_poses_per_s"] > 0 and res["inverse"]["loop_poses_per_s"] > 0
     assert res["forward"]["batched_converged"] == 3
+
+
+@pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
+def test_batched_legs_count_nan_and_infinity_in_the_kernel_and_name_phi(bad):
+    """The compiled legs kernels count the poses that hold a NaN or an infinity themselves (no
+    separate pass over the input); one such pose anywhere in a batch large enough for the
+    parallel kernel still raises the named error, and the clean part gives the same legs."""
+    n = k.PARALLEL_FROM + 3
+    phi = np.tile([0.2, 0.1, -0.2, 0.3], (n, 1))
+    good = k.leg_lengths(phi)
+    assert np.allclose(good, good[0]) and np.all(np.isfinite(good))
+    phi[n - 2, 1 + n % 3] = bad
+    with pytest.raises(InputError, match="phi"):
+        k.leg_lengths(phi)
+    assert np.array_equal(k.leg_lengths(phi[: n - 2]), good[: n - 2])

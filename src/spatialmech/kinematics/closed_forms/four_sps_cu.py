@@ -268,7 +268,12 @@ def _legs_sq_block(ph: np.ndarray, a: float, b: float, out: np.ndarray) -> None:
     np.subtract(c, m, out=out[:, 3])
 
 
-@njit(cache=True, fastmath=SAFE_FASTMATH, inline="always")
+#: The legs kernels' fastmath flags: :data:`.jit.SAFE_FASTMATH` without "no NaN / no infinity",
+#: so that the kernels themselves count the poses that hold one (and the caller names them).
+_LEGS_FASTMATH = SAFE_FASTMATH - {"nnan", "ninf"}
+
+
+@njit(cache=True, fastmath=_LEGS_FASTMATH, inline="always")
 def _legs_from(ph, i, sa, ca, sb, cb, sg, cg, k, ab2, a, squared, out):
     """One pose of :func:`_legs_kernel` from its angles' sines and cosines (the closed form of
     :func:`_legs_sq_block`)."""
@@ -292,7 +297,7 @@ def _legs_from(ph, i, sa, ca, sb, cb, sg, cg, k, ab2, a, squared, out):
         out[i, 3] = np.sqrt(max(v3, 0.0))
 
 
-@njit(cache=True, fastmath=SAFE_FASTMATH, inline="always")
+@njit(cache=True, fastmath=_LEGS_FASTMATH, inline="always")
 def _legs_pose(ph, i, k, ab2, a, squared, out):
     """One pose by :func:`.kernels_se3.nb_sincos` (vectorisable); returns its largest angle
     (beyond ``SINCOS_MAX`` the pose is redone by :func:`_legs_pose_libm`)."""
@@ -303,44 +308,53 @@ def _legs_pose(ph, i, k, ab2, a, squared, out):
     return max(abs(ph[i, 1]), abs(ph[i, 2]), abs(ph[i, 3]))
 
 
-@njit(cache=True, fastmath=SAFE_FASTMATH)
+@njit(cache=True, fastmath=_LEGS_FASTMATH)
 def _legs_pose_libm(ph, i, k, ab2, a, squared, out):
     """One pose with libm's sine and cosine (angles beyond :data:`.kernels_se3.SINCOS_MAX`)."""
     _legs_from(ph, i, np.sin(ph[i, 1]), np.cos(ph[i, 1]), np.sin(ph[i, 2]), np.cos(ph[i, 2]), np.sin(ph[i, 3]),
                np.cos(ph[i, 3]), k, ab2, a, squared, out)
 
 
-@njit(cache=True, fastmath=SAFE_FASTMATH)
+@njit(cache=True, fastmath=_LEGS_FASTMATH)
 def _legs_redo_wide(ph, k, ab2, a, squared, out):
     for i in range(ph.shape[0]):
         if abs(ph[i, 1]) > SINCOS_MAX or abs(ph[i, 2]) > SINCOS_MAX or abs(ph[i, 3]) > SINCOS_MAX:
             _legs_pose_libm(ph, i, k, ab2, a, squared, out)
 
 
-@njit(cache=True, fastmath=SAFE_FASTMATH)
+@njit(cache=True, fastmath=_LEGS_FASTMATH)
 def _legs_kernel(ph, a, b, squared, out):
     """:func:`_legs_sq_block` pose by pose (compiled: last-bit differences from the NumPy form),
-    square roots unless ``squared``."""
+    square roots unless ``squared``; returns the number of poses that hold a NaN or an infinity
+    (their legs are not meaningful: the caller raises)."""
     k = 2.0 * a * a + 2.0 * b * b
     ab2 = 2.0 * a * b
     wide = 0.0
+    bad = 0
     for i in range(ph.shape[0]):
         wide = max(wide, _legs_pose(ph, i, k, ab2, a, squared, out))
-    if wide > SINCOS_MAX:
+        t = ph[i, 0] + ph[i, 1] + ph[i, 2] + ph[i, 3]
+        bad += 0 if t - t == 0.0 else 1
+    if bad == 0 and wide > SINCOS_MAX:
         _legs_redo_wide(ph, k, ab2, a, squared, out)
+    return bad
 
 
-@njit(cache=True, fastmath=SAFE_FASTMATH, parallel=True)
+@njit(cache=True, fastmath=_LEGS_FASTMATH, parallel=True)
 def _legs_kernel_parallel(ph, a, b, squared, out):
     """:func:`_legs_kernel` with the poses shared among the cores (numba's ``prange``): the same
     numbers, pose by pose."""
     k = 2.0 * a * a + 2.0 * b * b
     ab2 = 2.0 * a * b
     wide = 0.0
+    bad = 0
     for i in prange(ph.shape[0]):
         wide = max(wide, _legs_pose(ph, i, k, ab2, a, squared, out))
-    if wide > SINCOS_MAX:
+        t = ph[i, 0] + ph[i, 1] + ph[i, 2] + ph[i, 3]
+        bad += 0 if t - t == 0.0 else 1
+    if bad == 0 and wide > SINCOS_MAX:
         _legs_redo_wide(ph, k, ab2, a, squared, out)
+    return bad
 
 
 #: Poses from which :func:`leg_lengths` shares the work among the cores (below: one thread; the
@@ -355,7 +369,13 @@ def leg_lengths(phi, geometry: FourSpsCuGeometry = PAPER_B, *, squared: bool = F
     ``squared=True`` returns ``l_i^2`` (m^2).  Example: ``leg_lengths([0.2, 0, 0, 0])`` gives
     ``sqrt(0.06) = 0.2449...`` for every leg (the catalog model's reference).
     """
-    phi = _phi(phi)
+    if compiled.enabled() and isinstance(phi, np.ndarray) and phi.dtype == np.float64 and phi.shape[-1:] == (4,):
+        flat = np.ascontiguousarray(phi.reshape(-1, 4))  # the kernel counts NaN and infinity itself
+        out = np.empty_like(flat)
+        kernel = _legs_kernel_parallel if flat.shape[0] >= PARALLEL_FROM else _legs_kernel
+        if kernel(flat, float(geometry.a), float(geometry.b), bool(squared), out) == 0:
+            return out.reshape(phi.shape)
+    phi = _phi(phi)  # names the bad field (or converts a list)
     flat = np.ascontiguousarray(phi.reshape(-1, 4))
     out = np.empty_like(flat)
     if compiled.enabled():
