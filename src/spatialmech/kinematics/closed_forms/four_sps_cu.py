@@ -322,6 +322,24 @@ def _legs_redo_wide(ph, k, ab2, a, squared, out):
             _legs_pose_libm(ph, i, k, ab2, a, squared, out)
 
 
+@njit(cache=True, fastmath=_LEGS_FASTMATH, inline="always")
+def _legs_step(ph, i, k, ab2, a, squared, out):
+    """:func:`_legs_pose`, and whether the pose may hold a NaN or an infinity: ``t - t`` is 0 for
+    the finite sum ``t`` of its four numbers (a sum that overflows is flagged too; the caller
+    then checks the input itself)."""
+    w = _legs_pose(ph, i, k, ab2, a, squared, out)
+    t = ph[i, 0] + ph[i, 1] + ph[i, 2] + ph[i, 3]
+    return w, 0 if t - t == 0.0 else 1
+
+
+@njit(cache=True, fastmath=_LEGS_FASTMATH)
+def _legs_finish(ph, k, ab2, a, squared, out, wide, bad):
+    """After the loop: the wide poses again with libm; returns ``bad``."""
+    if wide > SINCOS_MAX:
+        _legs_redo_wide(ph, k, ab2, a, squared, out)
+    return bad
+
+
 @njit(cache=True, fastmath=_LEGS_FASTMATH)
 def _legs_kernel(ph, a, b, squared, out):
     """:func:`_legs_sq_block` pose by pose (compiled: last-bit differences from the NumPy form),
@@ -332,12 +350,10 @@ def _legs_kernel(ph, a, b, squared, out):
     wide = 0.0
     bad = 0
     for i in range(ph.shape[0]):
-        wide = max(wide, _legs_pose(ph, i, k, ab2, a, squared, out))
-        t = ph[i, 0] + ph[i, 1] + ph[i, 2] + ph[i, 3]
-        bad += 0 if t - t == 0.0 else 1
-    if bad == 0 and wide > SINCOS_MAX:
-        _legs_redo_wide(ph, k, ab2, a, squared, out)
-    return bad
+        w, e = _legs_step(ph, i, k, ab2, a, squared, out)
+        wide = max(wide, w)
+        bad += e
+    return _legs_finish(ph, k, ab2, a, squared, out, wide, bad)
 
 
 @njit(cache=True, fastmath=_LEGS_FASTMATH, parallel=True)
@@ -349,12 +365,10 @@ def _legs_kernel_parallel(ph, a, b, squared, out):
     wide = 0.0
     bad = 0
     for i in prange(ph.shape[0]):
-        wide = max(wide, _legs_pose(ph, i, k, ab2, a, squared, out))
-        t = ph[i, 0] + ph[i, 1] + ph[i, 2] + ph[i, 3]
-        bad += 0 if t - t == 0.0 else 1
-    if bad == 0 and wide > SINCOS_MAX:
-        _legs_redo_wide(ph, k, ab2, a, squared, out)
-    return bad
+        w, e = _legs_step(ph, i, k, ab2, a, squared, out)
+        wide = max(wide, w)
+        bad += e
+    return _legs_finish(ph, k, ab2, a, squared, out, wide, bad)
 
 
 #: Poses from which :func:`leg_lengths` shares the work among the cores (below: one thread; the
@@ -369,18 +383,15 @@ def leg_lengths(phi, geometry: FourSpsCuGeometry = PAPER_B, *, squared: bool = F
     ``squared=True`` returns ``l_i^2`` (m^2).  Example: ``leg_lengths([0.2, 0, 0, 0])`` gives
     ``sqrt(0.06) = 0.2449...`` for every leg (the catalog model's reference).
     """
-    if compiled.enabled() and isinstance(phi, np.ndarray) and phi.dtype == np.float64 and phi.shape[-1:] == (4,):
-        flat = np.ascontiguousarray(phi.reshape(-1, 4))  # the kernel counts NaN and infinity itself
-        out = np.empty_like(flat)
-        kernel = _legs_kernel_parallel if flat.shape[0] >= PARALLEL_FROM else _legs_kernel
-        if kernel(flat, float(geometry.a), float(geometry.b), bool(squared), out) == 0:
-            return out.reshape(phi.shape)
-    phi = _phi(phi)  # names the bad field (or converts a list)
+    fast = compiled.enabled() and isinstance(phi, np.ndarray) and phi.dtype == np.float64 and phi.shape[-1:] == (4,)
+    if not fast:  # the compiled kernels flag NaN and infinity themselves: no separate pass
+        phi = _phi(phi)
     flat = np.ascontiguousarray(phi.reshape(-1, 4))
     out = np.empty_like(flat)
     if compiled.enabled():
         kernel = _legs_kernel_parallel if flat.shape[0] >= PARALLEL_FROM else _legs_kernel
-        kernel(flat, float(geometry.a), float(geometry.b), bool(squared), out)
+        if kernel(flat, float(geometry.a), float(geometry.b), bool(squared), out):
+            _phi(phi)  # the named error (a finite pose whose sum overflowed passes: its legs are right)
         return out.reshape(phi.shape)
     for s in range(0, flat.shape[0], _CHUNK):
         blk = out[s : s + _CHUNK]
