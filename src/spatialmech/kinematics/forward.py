@@ -368,7 +368,7 @@ def forward_position(
             if gres is not None:
                 return gres
             gwhy = (f"its monodromy gave up unsaturated (more than {MONODROMY_MAX_SOLUTIONS} solutions of the square system, "
-                    f"or a work of {MONODROMY_MAX_WORK} paths tracked times unknowns); method='homotopy' runs it without "
+                    f"or a work of {MONODROMY_MAX_WORK} tracker steps times unknowns); method='homotopy' runs it without "
                     "these caps")
         elif method == "homotopy":
             raise InputError(f"method: homotopy forward position does not cover {mech.name}: {why}; nor does the loop "

@@ -55,7 +55,7 @@ from .closure import Configuration, limb_slices
 from .endgame import cauchy_endgame
 from .homotopy import study_to_pose, track
 from .loop_system import LoopSystem, general_reason, loop_system, variables
-from .trace_test import TraceResult, trace_test
+from .trace_test import TraceResult, new_points, trace_test
 
 __all__ = [
     "GeneralResult",
@@ -80,7 +80,7 @@ def _rotations(sysm: LoopSystem) -> list[tuple[int, int]]:
 
 
 def angle_form(sysm: LoopSystem, P: np.ndarray) -> np.ndarray:
-    """Parameters ``P`` (..., np + nw + nx) with each driven rotation's ``(c, s)`` (on its circle)
+    """Parameters ``P`` (..., np + nw + nx, or the actuators alone) with each driven rotation's ``(c, s)`` (on its circle)
     replaced by ``(theta, 0)``, ``c + i s = exp(i theta)`` (complex ``theta``): the form in
     which the homotopies move them, so that every point of a straight segment keeps the
     rotation on its circle (off it the family is larger, and its members with the actuators on
@@ -138,16 +138,6 @@ def _segment(sysm: LoopSystem, X, P0, P1, steps: list[int] | None = None):
     if steps is not None:  # the caller's count of the tracker's accepted steps
         steps[0] += int(np.sum(n_steps))
     return Xe, t, done
-
-
-def _new_points(known: np.ndarray, cand: np.ndarray, tol: float = 1e-6) -> np.ndarray:
-    out: list[np.ndarray] = []
-    for x in cand:
-        ref = known if not out else np.vstack([known, *[o[None] for o in out]])
-        d = np.linalg.norm(ref - x, axis=1) / (1 + np.linalg.norm(x))
-        if np.all(d > tol):
-            out.append(x)
-    return np.array(out).reshape(-1, known.shape[1])
 
 
 def _random_point(sysm: LoopSystem, rng: np.random.Generator) -> np.ndarray:
@@ -232,7 +222,6 @@ class _GenericLoop:
     loops: int
     seconds: float
     saturated: bool
-    work: int = 0  # tracker steps times unknowns
 
 
 _CACHE: dict[bytes, _GenericLoop] = {}
@@ -268,8 +257,7 @@ def _monodromy(sysm: LoopSystem, seed: int, capped: bool) -> _GenericLoop:
         (a driven rotation's ``(c, s)`` stays on its circle: off it, the instances with the
         actuators on it, the request's included, are special and lose solutions to infinity)."""
         B = np.where(free, scale * crand(n, len(P0)), P0)
-        B[:, :npar] = angle_form(sysm, np.array([np.concatenate([_random_parameters(sysm, rng),
-                                                                 np.zeros(len(P0) - npar)]) for _ in range(n)]))[:, :npar]
+        B[:, :npar] = angle_form(sysm, np.array([_random_parameters(sysm, rng) for _ in range(n)]))
         return B
 
     known = x0[None]
@@ -296,13 +284,13 @@ def _monodromy(sysm: LoopSystem, seed: int, capped: bool) -> _GenericLoop:
         Xr, _, done = _segment(sysm, xr, Pr, P0, steps)
         per_path = (steps[0] - before) / n_paths
         X = np.vstack([X, Xr[done]])
-        new = _new_points(known, X)
+        new = new_points(known, X)
         if len(new):
             known = np.vstack([known, new])
             stale = 0
         else:
             stale += k
-    g = _GenericLoop(P0, known, loops, time.perf_counter() - t0, stale >= MONODROMY_STALE_LOOPS, steps[0] * sysm.nx)
+    g = _GenericLoop(P0, known, loops, time.perf_counter() - t0, stale >= MONODROMY_STALE_LOOPS)
     if not capped_out:  # a capped run is redone in full when asked without the caps
         _CACHE[key] = g
     return g

@@ -39,7 +39,7 @@ import numpy as np
 from ..geometry.tolerances import MONODROMY_PARALLEL, TRACE_MAX_LOOPS, TRACE_STALE_LOOPS, TRACE_STEP, TRACE_TOL
 from .homotopy import track
 
-__all__ = ["TraceResult", "trace_test"]
+__all__ = ["TraceResult", "new_points", "trace_test"]
 
 Curve = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]]
 
@@ -67,7 +67,9 @@ def _crand(rng: np.random.Generator, *shape: int) -> np.ndarray:
     return rng.normal(size=shape) + 1j * rng.normal(size=shape)
 
 
-def _new_points(known: np.ndarray, cand: np.ndarray, tol: float = 1e-6) -> np.ndarray:
+def new_points(known: np.ndarray, cand: np.ndarray, tol: float = 1e-6) -> np.ndarray:
+    """The rows of ``cand`` farther than ``tol`` (relative) from every row of ``known`` and from
+    each other (the first of a cluster kept)."""
     out: list[np.ndarray] = []
     for y in cand:
         ref = np.vstack([known, *[o[None] for o in out]])
@@ -149,21 +151,26 @@ def trace_test(curve: Curve, X: np.ndarray, y1: np.ndarray, rng: np.random.Gener
     loops = stale = work = 0
     dev, tested_at = np.inf, -1
     k = MONODROMY_PARALLEL
+
+    def hyperplanes():
+        """``k`` random hyperplanes at random scales (0.5 to 8 times a's entries; small ones alone
+        may never wind about the tangent hyperplanes: the RSSR's circle, no swap in 20 loops),
+        each repeated for every witness point."""
+        B = base * np.exp(rng.uniform(np.log(0.5), np.log(8.0), (k, 1))) * _crand(rng, k, m)
+        return np.repeat(B, len(W), axis=0)
+
     while loops < TRACE_MAX_LOOPS:
         if max_work is not None and work + (3 * k + 2) * len(W) * (m + 1) > max_work:  # the next round's
             return TraceResult("capped", dev, len(W), loops, work, time.perf_counter() - t0)
         loops += k  # k loops at once, each through its own two random hyperplanes
-        # random hyperplanes at random scales (0.5 to 8 times a's entries): small ones alone may
-        # never wind about the tangent hyperplanes (the RSSR's circle: no swap in 20 loops)
-        B1 = np.repeat(base * np.exp(rng.uniform(np.log(0.5), np.log(8.0), (k, 1))) * _crand(rng, k, m), len(W), axis=0)
-        B2 = np.repeat(base * np.exp(rng.uniform(np.log(0.5), np.log(8.0), (k, 1))) * _crand(rng, k, m), len(W), axis=0)
+        B1, B2 = hyperplanes(), hyperplanes()
         A = np.broadcast_to(a, B1.shape)
         Y = np.tile(W, (k, 1))
         work += 3 * len(Y) * (m + 1)
         for A0, A1 in ((A, B1), (B1, B2), (B2, A)):
             Y, ok = _move_slices(curve, Y, A0, A1)
             Y, A, B1, B2 = Y[ok], A[ok], B1[ok], B2[ok]
-        new = _new_points(W, Y)
+        new = new_points(W, Y)
         if len(new):
             W = np.vstack([W, new])
             stale = 0
