@@ -45,6 +45,8 @@ import numpy as np
 from ..errors import InputError
 
 __all__ = [
+    "BLOCK_MAX_COND",
+    "BLOCK_RANK_ZERO",
     "DEFAULT",
     "ENDGAME_AGREE",
     "ENDGAME_CLOSED",
@@ -313,3 +315,11 @@ TRACE_STALE_LOOPS = 8
 TRACE_MAX_LOOPS = 200
 TRACE_MAX_WORK = 40_000
 TRACE_MAX_WORK_FULL = 2_000_000
+
+#: Block elimination of the closure's Newton step (kinematics/kernels_blocks.py), relative to a
+#: block's largest column: remaining columns at or below ``BLOCK_RANK_ZERO`` are rank-deficient
+#: directions (an S-P-S leg's idle spin: about 1e-16), and a block whose rank lies between the
+#: two, or whose triangular factor is conditioned worse than ``BLOCK_MAX_COND``, goes to the
+#: general least-squares solver (the SVD decides there).
+BLOCK_RANK_ZERO = 1e-13
+BLOCK_MAX_COND = 1e8

@@ -52,8 +52,10 @@ from .closure import (
 )
 
 from .jit import AVAILABLE, UNAVAILABLE_REASON
+from .kernels_blocks import nb_minnorm_blocks
 from .kernels_closure import (
     nb_correct,
+    nb_correct_one,
     nb_correct_hyperplane,
     nb_limb_gn,
     nb_retract,
@@ -91,6 +93,7 @@ __all__ = [
     "limb_gn",
     "limb_inverse_many",
     "lstsq",
+    "minnorm_blocks",
     "python_reference",
     "retract",
     "sps_leg_lengths",
@@ -240,6 +243,8 @@ def _bools(x, shape) -> np.ndarray:
 def _mask(mech: Mechanism, cm: CompiledMechanism, active) -> np.ndarray:
     if active is None:
         return cm.active
+    if type(active) is np.ndarray and active.dtype == np.bool_ and active.shape == (cm.n,) and active.flags.c_contiguous:
+        return active
     a = np.require(active, np.bool_, ["C", "W"])
     if a.shape != (cm.n,):
         raise InputError(f"active: {mech.name} has {cm.n} joint variables, got a mask of shape {a.shape}")
@@ -383,7 +388,16 @@ def correct(mech: Mechanism, config: Configuration, *, active: np.ndarray | None
     """:func:`.closure.correct`, compiled (same steps, tolerances and statuses)."""
     cm = compile_mechanism(mech)
     _shapes(mech, cm, config)
-    return _run_correct(mech, cm, [config], active, fix_platform, tol, max_iter)[0]
+    act = _mask(mech, cm, active)
+    if tol is None:  # the newton tolerance in force (geometry/tolerances.py)
+        tol = current_tolerances().newton
+    q0, D0, B0 = _f64(config.q), _f64(config.D), _f64(config.B)
+    q, D, B = np.empty(cm.n), np.empty((4, 4)), np.empty(B0.shape)
+    info = np.empty(3)
+    nb_correct_one(*_correct_args(cm), q0, D0, B0, act, bool(fix_platform), float(tol), int(max_iter), q, D, B, info)
+    if info[0] < 0:  # NaN or infinity in the seed: the full check names it
+        check_configuration(mech, config)
+    return _result(config, q, D, B, int(info[0]), int(info[1]), float(info[2]))
 
 
 def correct_many(mech: Mechanism, seeds: Sequence[Configuration], *, active: np.ndarray | None = None,
@@ -493,6 +507,22 @@ def lstsq(A, b) -> np.ndarray:
     if A.ndim != 2 or b.shape != (A.shape[0],):
         raise InputError(f"A, b: expected shapes (m, n) and (m,), got {A.shape} and {b.shape}")
     return nb_lstsq(A, b)
+
+
+def minnorm_blocks(A, b, c_lo, c_hi, ns0: int) -> np.ndarray | None:
+    """The minimum-norm least-squares solution of a closure-shaped ``A x = b`` by block
+    elimination (:mod:`.kernels_blocks`): limb ``k``'s rows ``6k .. 6k+5`` and own columns
+    ``c_lo[k] .. c_hi[k]-1``, shared columns from ``ns0``; ``None`` where it declines (the
+    general solver, :func:`lstsq`, must decide)."""
+    A = _f64(A)
+    b = _f64(b)
+    lo = np.require(c_lo, np.int64, ["C"])
+    hi = np.require(c_hi, np.int64, ["C"])
+    if A.ndim != 2 or A.shape[0] % 6 or A.shape[0] != 6 * len(lo) or b.shape != (A.shape[0],) or lo.shape != hi.shape:
+        raise InputError(f"A, b, c_lo, c_hi: expected (6K, n), (6K,), (K,), (K,); got {A.shape}, {b.shape}, "
+                         f"{lo.shape}, {hi.shape}")
+    x = np.empty(A.shape[1])
+    return x if nb_minnorm_blocks(A, b, lo, hi, int(ns0), x) else None
 
 
 def limb_gn(chain: Chain, D, q, lin, L, tol=1e-12, max_iter=60, hold=None):
@@ -628,6 +658,8 @@ def warm_up() -> float:
     closure_residual(mech, c)
     closure_jacobian(mech, c)
     correct(mech, c)
+    correct_many(mech, [c, c])
+    minnorm_blocks(np.eye(6), np.ones(6), [0], [6], 6)
     driver_determinants(mech, c, ["A0.rot"])
     limb_gn(limb_chains(mech)[0], np.eye(4), np.zeros(7), np.zeros(7, bool), 1.0)
     limb_inverse_many(mech, np.eye(4)[None])

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .kernels_blocks import nb_minnorm_blocks
 from .kernels_se3 import (
     nb_lsq_qr,
     nb_ball_product,
@@ -27,7 +28,9 @@ __all__ = [
     "nb_colmap",
     "nb_correct",
     "nb_correct_hyperplane",
+    "nb_correct_one",
     "nb_hub",
+    "nb_limb_columns",
     "nb_limb_gn",
     "nb_max_limb",
     "nb_norm",
@@ -216,6 +219,23 @@ def nb_colmap(active):
 
 
 @njit(cache=True)
+def nb_limb_columns(limb_start, colmap):
+    """Each limb's active columns ``c_lo[k] .. c_hi[k]-1`` (contiguous: a limb's freedoms are
+    consecutive and :func:`nb_colmap` numbers the active ones in order)."""
+    K = len(limb_start) - 1
+    c_lo = np.empty(K, dtype=np.int64)
+    c_hi = np.empty(K, dtype=np.int64)
+    c = 0
+    for k in range(K):
+        c_lo[k] = c
+        for i in range(limb_start[k], limb_start[k + 1]):
+            if colmap[i] >= 0:
+                c += 1
+        c_hi[k] = c
+    return c_lo, c_hi
+
+
+@njit(cache=True)
 def nb_scales(linear, active, K, h, L):
     """:func:`.closure.closure_scales`."""
     row = np.empty(6 * K)
@@ -301,6 +321,8 @@ def nb_correct(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends,
     for i in range(nc):
         if keep[i]:
             nk += 1
+    c_lo, c_hi = nb_limb_columns(limb_start, colmap)
+    x = np.empty(nk)
     A = np.zeros((6 * K, nc))
     r = np.zeros(6 * K)
     As = np.empty((6 * K, nk))
@@ -349,12 +371,17 @@ def nb_correct(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends,
             if it == max_iter or not np.isfinite(rn):
                 break
             for i in range(6 * K):
-                j = 0
-                for c in range(nc):
-                    if keep[c]:
-                        As[i, j] = row[i] * A[i, c] * col[c]
-                        j += 1
-            x = nb_lstsq(As, rhs)
+                if nk == nc:
+                    for c in range(nc):
+                        As[i, c] = row[i] * A[i, c] * col[c]
+                else:
+                    j = 0
+                    for c in range(nc):
+                        if keep[c]:
+                            As[i, j] = row[i] * A[i, c] * col[c]
+                            j += 1
+            if not nb_minnorm_blocks(As, rhs, c_lo, c_hi, na, x):  # lstsq's step, by blocks
+                x = nb_lstsq(As, rhs)
             if nb_norm(x) < 1e-13 * max(1.0, rn):
                 st = 2
                 break
@@ -374,6 +401,23 @@ def nb_correct(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends,
         status[s] = st
         iters[s] = it
         resid[s] = rn
+
+
+@njit(cache=True)
+def nb_correct_one(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends, linear, L, q0, D0, B0, active,
+                   fix_platform, tol, max_iter, q, D, B, info):
+    """:func:`nb_correct` from one seed ``q0, D0, B0`` into ``q, D, B`` (no batch axis: one
+    forward-position solve or tracker step pays no reshaping in Python); ``info`` = (status,
+    iterations, residual)."""
+    status = np.empty(1, dtype=np.int64)
+    iters = np.empty(1, dtype=np.int64)
+    resid = np.empty(1)
+    nb_correct(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends, linear, L, q0.reshape((1, q0.shape[0])),
+               D0.reshape((1, 4, 4)), B0.reshape((1, B0.shape[0], 4, 4)), active, fix_platform, tol, max_iter,
+               q.reshape((1, q.shape[0])), D.reshape((1, 4, 4)), B.reshape((1, B.shape[0], 4, 4)), status, iters, resid)
+    info[0] = status[0]
+    info[1] = iters[0]
+    info[2] = resid[0]
 
 
 @njit(cache=True)
