@@ -135,12 +135,23 @@ def test_loop_equations_vanish_on_closed_configurations(rssr):
 
 
 def test_unsupported_models_say_why_and_auto_falls_back():
-    six = sm.load_model("spatial-six-bar")  # internal bodies
-    assert "internal bodies" in hg.general_reason(six)
+    """What the loop formulation still does not cover is named (limb and joints): S joints other
+    than one or an adjacent pair per limb (the 3-SPS/SmPU's S-P-S legs), helical joints."""
+    smpu = sm.load_model("three-sps-smpu")
+    why = hg.general_reason(smpu)
+    assert why is not None and "limb leg1" in why and "S joints B1, A1" in why
+    z, x = [0, 0, 1], [1, 0, 0]
+    helix = sm.Mechanism("rssh", limbs=[
+        sm.Limb("input", [sm.R("A0", [0, 0, 0], z, actuated=True), sm.S("A1", [0.3, 0, 0]), sm.S("B1", [0, 1, -0.1])]),
+        sm.Limb("output", [sm.H("B0", [0, 1, 0.5], x, pitch=0.01)])], platform_point=[0, 1, -0.1])
+    why = hg.general_reason(helix)
+    assert why is not None and "limb output" in why and "helical joint B0" in why
+    with pytest.raises(sm.InputError, match="nor does the loop formulation: limb output: helical joint B0"):
+        forward_position(helix, [0.3], all_solutions=True, method="homotopy")
     runner = CliRunner()
-    out = runner.invoke(main, ["fk", "spatial-six-bar", "--actuators", "10", "--all", "--method", "homotopy"])
-    assert out.exit_code != 0 and "does not cover spatial-six-bar" in out.output and "loop formulation" in out.output
-    assert "Traceback" not in out.output
+    out = runner.invoke(main, ["fk", "three-sps-smpu", "--actuators", "0.5,0.5,0.5", "--all", "--method", "homotopy"])
+    assert out.exit_code != 0 and "does not cover three-sps-smpu" in out.output and "loop formulation" in out.output
+    assert "S joints B1, A1" in out.output and "Traceback" not in out.output
 
 
 def test_cli_text_and_json_say_proven_by_the_trace_test():
