@@ -342,11 +342,10 @@ class LoopSystem:
     def square(self, Z, W=None, *, reference: bool = False, want_J: bool = True):
         """The square system ``G`` (n, nx) and its derivative (n, nx, nz) in ``z = (x ; p)``,
         with the offset parameters ``W`` (n, nw; default none): compiled (:mod:`.kernels_loops`)
-        when the compiled core is in use and not ``reference`` (models without internal bodies;
-        with bodies the NumPy code runs)."""
+        when the compiled core is in use and not ``reference``."""
         if W is None:
             W = self.identity_offsets(len(Z))
-        if not reference and compiled.enabled() and self.n_bodies == 0:
+        if not reference and compiled.enabled():
             packed = _PACKED.get(self)
             if packed is None:
                 packed = _PACKED[self] = kernels_loops.pack(self, _STUDY_Q)
