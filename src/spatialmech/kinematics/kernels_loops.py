@@ -22,7 +22,7 @@ __all__ = ["pack", "square_batch"]
 
 def pack(sysm, study_q: np.ndarray) -> tuple:
     """The arguments of :func:`square_batch` for a :class:`.homotopy_general.LoopSystem`."""
-    chains = []
+    chains: list[tuple] = []
     h_chain: list[int] = []
     for h in sysm.hubs:
         if h.study >= 0:

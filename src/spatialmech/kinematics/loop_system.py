@@ -2,23 +2,30 @@
 model whose limbs do not reduce to quadrics in the Study parameters, as a square polynomial
 system in the joint variables, generated from the model.
 
-Formulation (limbs from the ground to the platform; joints R, P, C, U, S, Sm).  Every passive,
+Formulation (joints R, P, C, U, S, Sm).  Every passive,
 unlocked revolute freedom is a pair ``(c, s)`` with ``c^2 + s^2 = 1`` and its displacement
 ``exp(theta A) = I + s A + (1 - c) A^2`` (``A`` the 4x4 matrix of its unit twist, pitch 0:
 ``A^3 = -A``), every passive slide a linear variable ``d`` (over the characteristic length
 ``L``) with ``exp(d A) = I + d A``; an actuated freedom is the same with its ``(c, s)`` or ``d``
-as a *parameter*.  The product of a limb's displacements is then polynomial.  The platform
-displacement ``D`` is the product of the first limb without an S joint (the *reference
-limb*), or, when every limb has one, the Study parameters ``x = (e ; g)`` of :mod:`.homotopy`
-(``(e.e) D`` polynomial, with ``e.g = 0`` and a random complex patch).  Each other limb gives:
+as a *parameter*.  The product of a limb's displacements is then polynomial.
 
-* no S joint: ``FK = D``: the three off-diagonal entries of ``R_FK^T R_D`` and the
-  translation difference (6 equations; they also vanish where ``R_FK^T R_D`` is a half turn
-  about a coordinate axis: spurious points that the full closure, all 12 entries, rejects);
-* one S joint at centre ``c``: ``before(c) = D after^-1(c)`` (3 entries): the S joint's rotation
-  is then whatever closes the limb, so it is not a variable;
-* two consecutive S joints (a rod, centres ``c1``, ``c2``): ``|before(c1) - D after^-1(c2)|^2 =
-  |c1 - c2|^2`` (1 entry): the rod's idle spin is not a variable either.
+Hubs (the ground, the platform or output link, the internal bodies of a link-and-joint graph):
+a limb runs from hub ``a`` to hub ``b`` and closes as ``H_a FK = H_b``.  Each moving hub's
+displacement is, in turn, the product of a limb without S joint (the one with the fewest
+unknowns) from a hub placed before it (a *reference limb*; its factors inverted in reverse order
+when the limb runs towards the placed hub), or, where no such limb reaches it, its own Study
+parameters ``x = (e ; g)`` of :mod:`.homotopy` (``(e.e) H`` polynomial, with ``e.g = 0`` and a
+random complex patch).  Without bodies this is the platform's reference limb, or the platform in
+Study parameters when every limb has an S joint.  Each other limb gives (``H_a`` multiplying
+the side before its S joints, ``H_b`` the side after, each side times the other's scale):
+
+* no S joint: ``H_a FK = H_b``: the three off-diagonal entries of ``(R_a R_FK)^T R_b`` and the
+  translation difference (6 equations; they also vanish where ``(R_a R_FK)^T R_b`` is a half
+  turn about a coordinate axis: spurious points that the full closure, all 12 entries, rejects);
+* one S joint at centre ``c``: ``H_a before(c) = H_b after^-1(c)`` (3 entries): the S joint's
+  rotation is then whatever closes the limb, so it is not a variable;
+* two consecutive S joints (a rod, centres ``c1``, ``c2``): ``|H_a before(c1) - H_b
+  after^-1(c2)|^2 = |c1 - c2|^2`` (1 entry): the rod's idle spin is not a variable either.
 
 The equations can outnumber the conditions they impose (a spherical or planar limb has 3, an
 overconstrained linkage such as the Bennett fewer than its equations): the number of
