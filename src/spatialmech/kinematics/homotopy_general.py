@@ -1,6 +1,9 @@
 """Every assembly mode of a model whose limbs do not reduce to quadrics in the Study parameters
 (:mod:`.homotopy_systems`): the loop formulation of :mod:`.loop_system` (joint variables,
-generated from the model) solved by monodromy and a parameter homotopy.
+generated from the model; link-and-joint graphs with internal bodies included, each body's
+displacement the product of a reference limb or its own Study parameters) solved by monodromy
+and a parameter homotopy.  A real solution becomes a :class:`Configuration` with its bodies
+(:func:`rebuild_configuration`).
 
 Solver: monodromy on a family of square systems with a start pair built from a random complex
 point, then a parameter homotopy to the request.  When every limb's equations are independent
@@ -176,7 +179,7 @@ def _start_offsets(sysm: LoopSystem, x: np.ndarray, p: np.ndarray) -> np.ndarray
     off = sysm.w_offsets
     W = np.zeros(off[-1], complex)
     for k, le in enumerate(sysm.limbs):
-        Tb3, _, D3, _, Ea3, _, E3, _ = sysm._ends(le, H, z)
+        Tb3, _, D3, _, Ea3, _, E3, _ = sysm.limb_sides(le, H, z)
         Tb, D, Ea, E = Tb3[0], D3[0], Ea3[0], E3[0]
         if le.kind == "full":
             M = np.linalg.solve(D[:3, :3], Tb[:3, :3])  # proportional to a complex rotation

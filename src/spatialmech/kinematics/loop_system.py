@@ -233,7 +233,7 @@ class LoopSystem:
         """``D`` (or ``(e.e) D``), its derivative, and the scale ``n`` (1, or ``e.e``) with its derivative."""
         return self.hub_values(Z)[0]
 
-    def _ends(self, le: _LimbEq, H: dict, Z):
+    def limb_sides(self, le: _LimbEq, H: dict, Z):
         """A limb's two sides: ``H_a before`` (scaled by ``E_a``) with its derivative, and ``H_b``
         (scaled by ``E_b``) with its derivative, and the two scales with theirs."""
         Ha, dHa, Ea, dEa = H[le.a]
@@ -276,7 +276,7 @@ class LoopSystem:
             W = self.identity_offsets(n)
         for k, le in enumerate(self.limbs):
             w_k = W[:, off[k] : off[k + 1]]
-            Tb, dTb, D, dD, Ea, dEa, E, dE = self._ends(le, H, Z)
+            Tb, dTb, D, dD, Ea, dEa, E, dE = self.limb_sides(le, H, Z)
             if le.kind == "full" and full:
                 r = E[:, None, None] * Tb - Ea[:, None, None] * D
                 dr = (E[:, None, None, None] * dTb + dE[:, :, None, None] * Tb[:, None]
