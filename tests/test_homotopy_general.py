@@ -135,12 +135,23 @@ def test_loop_equations_vanish_on_closed_configurations(rssr):
 
 
 def test_unsupported_models_say_why_and_auto_falls_back():
-    six = sm.load_model("spatial-six-bar")  # internal bodies
-    assert "internal bodies" in hg.general_reason(six)
+    """What the loop formulation still does not cover is named (limb and joints): S joints other
+    than one or an adjacent pair per limb (the 3-SPS/SmPU's S-P-S legs), helical joints."""
+    smpu = sm.load_model("three-sps-smpu")
+    why = hg.general_reason(smpu)
+    assert why is not None and "limb leg1" in why and "S joints B1, A1" in why
+    z, x = [0, 0, 1], [1, 0, 0]
+    helix = sm.Mechanism("rssh", limbs=[
+        sm.Limb("input", [sm.R("A0", [0, 0, 0], z, actuated=True), sm.S("A1", [0.3, 0, 0]), sm.S("B1", [0, 1, -0.1])]),
+        sm.Limb("output", [sm.H("B0", [0, 1, 0.5], x, pitch=0.01)])], platform_point=[0, 1, -0.1])
+    why = hg.general_reason(helix)
+    assert why is not None and "limb output" in why and "helical joint B0" in why
+    with pytest.raises(sm.InputError, match="nor does the loop formulation: limb output: helical joint B0"):
+        forward_position(helix, [0.3], all_solutions=True, method="homotopy")
     runner = CliRunner()
-    out = runner.invoke(main, ["fk", "spatial-six-bar", "--actuators", "10", "--all", "--method", "homotopy"])
-    assert out.exit_code != 0 and "does not cover spatial-six-bar" in out.output and "loop formulation" in out.output
-    assert "Traceback" not in out.output
+    out = runner.invoke(main, ["fk", "three-sps-smpu", "--actuators", "0.5,0.5,0.5", "--all", "--method", "homotopy"])
+    assert out.exit_code != 0 and "does not cover three-sps-smpu" in out.output and "loop formulation" in out.output
+    assert "S joints B1, A1" in out.output and "Traceback" not in out.output
 
 
 def test_cli_text_and_json_say_proven_by_the_trace_test():
@@ -231,3 +242,132 @@ def test_a_dead_point_double_root_is_located_by_the_end_game():
     assert g.complete and g.trace is not None and g.trace.passed  # an isolated double root: still complete
     c, s = sing[0].x[:2]  # the input crank's (cos, sin)
     assert abs(c) < 1e-12 and abs(s - 1) < 1e-12
+
+
+# ------------------------------------------------------------------ internal bodies (link-and-joint graphs)
+def _six_bar_closed_form(mech, theta):
+    """The spatial six-bar's assembly modes at crank angle ``theta``, loop by loop: the rocker
+    angles of the first RSSR (crank A0-A1, rod A1-B1, rocker about B0), then for each the
+    follower angles of the second (rod C1-D1 from the rocker, follower about D0): at most 2 x 2."""
+    b1, _ = _joint(mech, 0, 2)
+    phis, b0, bx = _rocker_angles(mech, theta, b1)
+    c1, _ = _joint(mech, 3, 0)
+    d1, _ = _joint(mech, 3, 1)
+    d0, dy = _joint(mech, 2, 0)
+    rod2 = np.sum((c1 - d1) ** 2)
+    out = []
+    for phi in phis:
+        C1 = _rotate(c1, b0, bx, phi)
+        out += [(phi, psi) for psi in _circle_roots(lambda psi, C1=C1: np.sum((C1 - _rotate(d1, d0, dy, psi)) ** 2) - rod2)]
+    return out
+
+
+@pytest.fixture(scope="module")
+def six_bar_30():
+    m = sm.load_model("spatial-six-bar")
+    theta = np.radians(30.0)
+    return m, theta, forward_position(m, [theta], all_solutions=True, method="auto")
+
+
+def test_six_bar_internal_body_every_mode_proven(six_bar_30):
+    """The spatial six-bar (two RSSR loops sharing the rocker, an internal body): the loop
+    formulation with the rocker and the follower each the product of their revolute from the
+    ground finds 4 generic solutions, all real at crank 30 deg, each closing the whole graph;
+    they are the closed form's 2 x 2 (each RSSR has two assembly modes), and the trace test proves
+    the set complete."""
+    m, theta, r = six_bar_30
+    d = r.to_dict(m)
+    assert d["complete"] is True and d["completeness"].startswith("complete (trace test)")
+    assert "loop closure" in d["search"]["method"] and d["search"]["trace_test"] == "passed"
+    assert d["search"]["n_generic"] == 4 and d["n_real"] == 4 and d["search"]["n_spurious"] == 0
+    i_b0, i_d0 = (m.freedom_refs.index(m.freedom(n)) for n in ("B0.rot", "D0.rot"))
+    modes = _six_bar_closed_form(m, theta)
+    assert len(modes) == 4 and len(r.solutions) == 4
+    c1, _ = _joint(m, 3, 0)
+    b0, bx = _joint(m, 1, 0)
+    for s in r.solutions:
+        assert s.converged and s.kind == "regular"
+        assert np.max(np.abs(closure_residual(m, s.config))) < 1e-9  # every limb, the rocker's B included
+        assert s.config.q[0] == pytest.approx(theta)
+        phi, psi = s.config.q[i_b0], s.config.q[i_d0]
+        assert sum(abs(np.angle(np.exp(1j * (phi - a)))) < 1e-8 and abs(np.angle(np.exp(1j * (psi - b)))) < 1e-8
+                   for a, b in modes) == 1
+        Bk = s.config.B[0]  # the rocker's displacement carries C1 where the rocker angle puts it
+        assert np.allclose(Bk[:3, :3] @ c1 + Bk[:3, 3], _rotate(c1, b0, bx, phi), atol=1e-9)
+
+
+def test_six_bar_multistart_modes_are_among_the_proven_set(six_bar_30):
+    m, theta, r = six_bar_30
+    ms = forward_position(m, [theta], all_solutions=True, method="multistart", n_seeds=40, seed=1)
+    assert ms.to_dict(m)["complete"] is False
+    found = [s for s in ms.solutions if s.converged]
+    assert found
+    for s in found:
+        assert any(np.allclose(s.pose.R, h.pose.R, atol=1e-7) and np.allclose(s.pose.p, h.pose.p, atol=1e-7)
+                   for h in r.solutions)
+
+
+def test_six_bar_described_backwards_gives_the_same_modes(six_bar_30):
+    """Limbs that end at the ground or run from the output link to the rocker: the reference
+    chains are inverted and the limbs' equations take their hubs the other way; same modes."""
+    from spatialmech.model.mechanism import Mechanism
+    from spatialmech.model.topology import link_graph
+
+    base, theta, r0 = six_bar_30
+    g = link_graph(base)
+    flip = [False, True, True, True, True, True, False]
+    edges = [(j.joint, j.b, j.a) if f else (j.joint, j.a, j.b) for j, f in zip(g.joints, flip, strict=True)]
+    m = Mechanism.from_graph("six-backwards", [k.name for k in g.links], edges, output="follower",
+                             platform_point=base.platform_point)
+    sysm = hg.loop_system(m)
+    assert any(h.chain and h.chain[0].inverse for h in sysm.hubs)  # a reference limb run backwards
+    r = forward_position(m, [theta], all_solutions=True, method="homotopy")
+    assert r.to_dict(m)["complete"] is True and len(r.solutions) == 4
+    for s in r.solutions:
+        assert np.max(np.abs(closure_residual(m, s.config))) < 1e-9
+        assert any(np.allclose(s.pose.p, h.pose.p, atol=1e-8) and np.allclose(s.pose.R, h.pose.R, atol=1e-8)
+                   for h in r0.solutions)
+
+
+def _cs_body():
+    """five-cs-3's five C-S limbs ending at an internal body ``mid`` (no limb without S joint
+    reaches it), the output link hinged to it and held by an S-S rod from the ground: one hub
+    in Study parameters, the other the product of the hinge from it."""
+    import dataclasses
+
+    f = sm.load_model("five-cs-3")
+    pp = np.asarray(f.platform_point, float)
+    limbs = [dataclasses.replace(limb, tip="mid") for limb in f.limbs]
+    limbs.append(sm.Limb("hinge", [sm.R("H", pp, [0, 0, 1])], base="mid"))
+    limbs.append(sm.Limb("rod", [sm.S("G", pp + np.array([0.5, 0.3, 0.2])), sm.S("K", pp + np.array([0.1, 0.4, 0.0]))]))
+    return sm.Mechanism("cs-body", limbs, platform_point=pp, bodies=("mid",))
+
+
+@pytest.mark.parametrize("name", ["spatial-six-bar", "delta", "cs-body"])
+def test_hub_equations_vanish_and_rebuild_the_bodies(name):
+    """With bodies (reference chains from the ground or from a hub in Study parameters, limbs
+    between any two hubs): the equations vanish at a closed configuration, their derivative
+    matches finite differences, the compiled system equals the NumPy reference, and the
+    variables rebuild the configuration, bodies included."""
+    from spatialmech.kinematics.closure import generic_configuration
+
+    m = _cs_body() if name == "cs-body" else sm.load_model(name)
+    sysm = hg.loop_system(m)
+    assert sysm.n_bodies == len(m.bodies) > 0
+    c = generic_configuration(m, seed=2, step=0.3, steps=3)
+    z = hg.variables(sysm, c)[None]
+    F, J = sysm.square(z)
+    assert np.max(np.abs(F)) < 1e-9 and sysm.residual(z)[0] < 1e-9
+    dz = 1e-7 * np.random.default_rng(1).normal(size=z.shape[1])
+    assert np.allclose(sysm.square(z + dz)[0][0] - F[0], J[0] @ dz, atol=1e-11)
+    rng = np.random.default_rng(4)
+    Z = rng.normal(size=(4, z.shape[1])) + 1j * rng.normal(size=(4, z.shape[1]))
+    W = rng.normal(size=(4, sysm.w_offsets[-1])) + 1j * rng.normal(size=(4, sysm.w_offsets[-1]))
+    F0, J0 = sysm.square(Z, W, reference=True)
+    F1, J1 = sysm.square(Z, W)
+    assert np.max(np.abs(F0 - F1)) < 1e-12 * (1 + np.max(np.abs(F0)))
+    assert np.max(np.abs(J0 - J1)) < 1e-12 * (1 + np.max(np.abs(J0)))
+    targets = {i: c.q[i] for i, v in sysm.var_of.items() if v[0] == "A"}
+    back = hg.rebuild_configuration(sysm, z[0, : sysm.nx].real, targets)
+    assert np.allclose(back.D, c.D, atol=1e-9) and np.allclose(back.B, c.B, atol=1e-9)
+    assert np.max(np.abs(closure_residual(m, back))) < 1e-9

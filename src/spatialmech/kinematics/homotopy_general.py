@@ -1,6 +1,9 @@
 """Every assembly mode of a model whose limbs do not reduce to quadrics in the Study parameters
 (:mod:`.homotopy_systems`): the loop formulation of :mod:`.loop_system` (joint variables,
-generated from the model) solved by monodromy and a parameter homotopy.
+generated from the model; link-and-joint graphs with internal bodies included, each body's
+displacement the product of a reference limb or its own Study parameters) solved by monodromy
+and a parameter homotopy.  A real solution becomes a :class:`Configuration` with its bodies
+(:func:`rebuild_configuration`).
 
 Solver: monodromy on a family of square systems with a start pair built from a random complex
 point, then a parameter homotopy to the request.  When every limb's equations are independent
@@ -69,6 +72,7 @@ __all__ = [
     "line_eval",
     "loop_system",
     "rebuild",
+    "rebuild_configuration",
     "variables",
 ]
 
@@ -146,13 +150,13 @@ def _random_point(sysm: LoopSystem, rng: np.random.Generator) -> np.ndarray:
     for a, b in sysm.circles:
         th = rng.uniform(-np.pi, np.pi) + 1j * rng.normal(scale=0.5)
         x[a], x[b] = np.cos(th), np.sin(th)
-    if sysm.study >= 0:
-        s = sysm.study
+    for h in sysm.studies:
+        s = h.study
         e, g = x[s : s + 4], x[s + 4 : s + 8]
         g = g - (e @ g) / (e @ e) * e
         xs = np.concatenate([e, g])
-        assert sysm.patch is not None
-        x[s : s + 8] = xs / (xs @ sysm.patch)
+        assert h.patch is not None
+        x[s : s + 8] = xs / (xs @ h.patch)
     return x
 
 
@@ -171,12 +175,12 @@ def _start_offsets(sysm: LoopSystem, x: np.ndarray, p: np.ndarray) -> np.ndarray
     """The offset parameters for which ``x`` (on the side equations) with actuator parameters
     ``p`` solves the closure: each limb's offset is what it misses by."""
     z = np.concatenate([x, p])[None]
-    D, _, E, _ = sysm._platform(z)
-    D, E = D[0], E[0]
+    H = sysm.hub_values(z)
     off = sysm.w_offsets
     W = np.zeros(off[-1], complex)
     for k, le in enumerate(sysm.limbs):
-        Tb = sysm._chain(le.before, z)[0][0]
+        Tb3, _, D3, _, Ea3, _, E3, _ = sysm.limb_sides(le, H, z)
+        Tb, D, Ea, E = Tb3[0], D3[0], Ea3[0], E3[0]
         if le.kind == "full":
             M = np.linalg.solve(D[:3, :3], Tb[:3, :3])  # proportional to a complex rotation
             sc = np.sqrt(np.trace(M.T @ M) / 3)
@@ -184,14 +188,14 @@ def _start_offsets(sysm: LoopSystem, x: np.ndarray, p: np.ndarray) -> np.ndarray
                 sc = -sc
             R = M / sc
             W[off[k] : off[k] + 4] = [1 + np.trace(R), R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]]
-            W[off[k] + 4 : off[k] + 7] = np.linalg.solve(D[:3, :3], E * Tb[:3, 3] - D[:3, 3])
+            W[off[k] + 4 : off[k] + 7] = np.linalg.solve(D[:3, :3], E * Tb[:3, 3] / Ea - D[:3, 3])
             continue
         Ta = sysm._chain(le.after_inv, z)[0][0]
-        w = (E * (Tb @ le.c1) - D @ (Ta @ le.c2))[:3]
+        w = (E * (Tb @ le.c1) - Ea * (D @ (Ta @ le.c2)))[:3]
         if le.kind == "point":
-            W[off[k] : off[k] + 3] = w / E
+            W[off[k] : off[k] + 3] = w / (Ea * E)
         else:
-            W[off[k]] = (w @ w) / E**2 - le.length2
+            W[off[k]] = (w @ w) / (Ea * E) ** 2 - le.length2
     return W
 
 
@@ -333,7 +337,8 @@ def clear_cache() -> None:
 @dataclass(frozen=True, eq=False)
 class GeneralSolution:
     """One end point at the request: ``status`` real / complex / singular / at_infinity, the
-    variables ``x`` and, for a real one, the joint variables ``q`` and platform ``D``."""
+    variables ``x`` and, for a real one, the joint variables ``q``, platform ``D`` and internal
+    bodies ``B``."""
 
     status: str
     x: np.ndarray
@@ -342,6 +347,7 @@ class GeneralSolution:
     residual: float
     q: np.ndarray | None = None
     D: np.ndarray | None = None
+    B: np.ndarray | None = None  # the internal bodies' displacements (k, 4, 4)
 
     def to_dict(self) -> dict:
         fin = bool(np.all(np.isfinite(self.x)))  # a path that diverged: no numbers to give
@@ -409,9 +415,9 @@ def general_forward(mech: Mechanism, targets: dict[int, float], *, seed: int = 0
         z = Z[n]
         x = z[: sysm.nx]
         big = not np.all(np.isfinite(x)) or np.linalg.norm(x) > 1.0 / HOMOTOPY_INFINITY
-        if not big and sysm.study >= 0:
-            e = x[sysm.study : sysm.study + 4]
-            big = abs(e @ e) / max(np.linalg.norm(x[sysm.study : sysm.study + 8]) ** 2, 1e-300) < HOMOTOPY_INFINITY
+        for h in sysm.studies:
+            e = x[h.study : h.study + 4]
+            big = big or abs(e @ e) / max(np.linalg.norm(x[h.study : h.study + 8]) ** 2, 1e-300) < HOMOTOPY_INFINITY
         if big or (not done[n] and np.linalg.norm(x) > MONODROMY_DIVERGED):
             sols.append(GeneralSolution("at_infinity", x, 0.0, 0.0, float(res[n])))
             continue
@@ -430,16 +436,17 @@ def general_forward(mech: Mechanism, targets: dict[int, float], *, seed: int = 0
         sv = np.linalg.svd(rows, compute_uv=False)
         rcond = float(sv[-1] / sv[0]) if sv[0] > 0 else 0.0
         y = x.copy()
-        if sysm.study >= 0:
-            s = slice(sysm.study, sysm.study + 8)
+        for h in sysm.studies:
+            s = slice(h.study, h.study + 8)
             k = int(np.argmax(np.abs(y[s])))
             y[s] = y[s] * (abs(y[s][k]) / y[s][k])
         imag = float(np.max(np.abs(y.imag)) / (1 + np.max(np.abs(y.real))))
         st = "singular" if rcond < HOMOTOPY_SINGULAR else "real" if imag < HOMOTOPY_REAL else "complex"
-        q = D = None
+        q = D = B = None
         if st == "real":
-            q, D = rebuild(sysm, y.real, targets)
-        sols.append(GeneralSolution(st, y, rcond, imag, float(res[n]), q, D))
+            c = rebuild_configuration(sysm, y.real, targets)
+            q, D, B = c.q, c.D, c.B
+        sols.append(GeneralSolution(st, y, rcond, imag, float(res[n]), q, D, B))
     n_sing = sum(s.status == "singular" for s in sols)
     fam = ("the limbs offset by generic complex rigid motions" if sysm.rigid_family
            else "the square system with a generic complex offset")
@@ -523,8 +530,15 @@ def _endgame_candidates(sysm: LoopSystem, Z, done) -> np.ndarray:
 
 def rebuild(sysm: LoopSystem, x: np.ndarray, targets: dict[int, float]) -> tuple[np.ndarray, np.ndarray]:
     """Joint variables ``q`` (every freedom) and platform displacement ``D`` (model units) of a
-    real solution ``x``; the S joints' rotation vectors are those that close their limbs (a rod
-    takes the smallest rotation at its first S joint)."""
+    real solution ``x`` (:func:`rebuild_configuration`, which also gives the internal bodies)."""
+    c = rebuild_configuration(sysm, x, targets)
+    return c.q, c.D
+
+
+def rebuild_configuration(sysm: LoopSystem, x: np.ndarray, targets: dict[int, float]) -> Configuration:
+    """The configuration (joint variables ``q``, platform ``D``, internal bodies ``B``; model
+    units) of a real solution ``x``; the S joints' rotation vectors are those that close their
+    limbs (a rod takes the smallest rotation at its first S joint)."""
     mech, L = sysm.mech, sysm.L
     refs = mech.freedom_refs
     p = sysm.parameters(targets)
@@ -537,12 +551,16 @@ def rebuild(sysm: LoopSystem, x: np.ndarray, targets: dict[int, float]) -> tuple
             q[i] = np.arctan2(x[v[2]], x[v[1]])
         elif v[0] == "P":
             q[i] = x[v[1]] * L
-    Dn, _, E, _ = sysm._platform(z)
-    D = (Dn[0] / E[0]).real
-    D[3] = [0, 0, 0, 1]
-    if sysm.study >= 0:
-        R, pp = study_to_pose(x[sysm.study : sysm.study + 8], 1.0)
-        D[:3, :3], D[:3, 3] = R, pp
+    Hv = sysm.hub_values(z)
+    hub: dict = {None: np.eye(4)}  # every hub's displacement, translations over L
+    for h in sysm.hubs:
+        if h.study >= 0:
+            M = np.eye(4)
+            M[:3, :3], M[:3, 3] = study_to_pose(x[h.study : h.study + 8], 1.0)
+        else:
+            M = (Hv[h.hub][0][0] / Hv[h.hub][2][0]).real
+            M[3] = [0, 0, 0, 1]
+        hub[h.hub] = M
     slices = limb_slices(mech)
     chains = {}
     from .closure import limb_chains
@@ -553,8 +571,9 @@ def rebuild(sysm: LoopSystem, x: np.ndarray, targets: dict[int, float]) -> tuple
     for le in sysm.limbs:
         if le.kind == "full":
             continue
-        Tb = sysm._chain(le.before, z)[0][0].real
+        Tb = hub[le.a] @ sysm._chain(le.before, z)[0][0].real
         Ta = sysm._chain(le.after_inv, z)[0][0].real
+        D = hub[le.b]
         start = slices[le.limb].start + le.s_first
         if le.kind == "point":
             Rs = Tb[:3, :3].T @ D[:3, :3] @ Ta[:3, :3]
@@ -566,9 +585,12 @@ def rebuild(sysm: LoopSystem, x: np.ndarray, targets: dict[int, float]) -> tuple
         q[start : start + 3] = np.linalg.solve(chains[start], matrix_rotvec(R1))
         Rs2 = R1.T @ Tb[:3, :3].T @ D[:3, :3] @ Ta[:3, :3]
         q[start + 3 : start + 6] = np.linalg.solve(chains[start + 3], matrix_rotvec(Rs2))
-    D = D.copy()
-    D[:3, 3] *= L
-    return q, D
+    out = {k: v.copy() for k, v in hub.items() if k is not None}
+    for v in out.values():
+        v[:3, 3] *= L
+    nb = sysm.n_bodies
+    B = np.array([out[1 + i] for i in range(nb)]).reshape(nb, 4, 4) if nb else Configuration.reference(mech).B
+    return Configuration(q, out[0], B)
 
 
 def _min_rotation(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -586,6 +608,8 @@ def _min_rotation(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def configuration(sol: GeneralSolution) -> Configuration:
-    """The :class:`Configuration` of a real solution (a mechanism without internal bodies)."""
+    """The :class:`Configuration` of a real solution (joint variables, platform, internal bodies)."""
     assert sol.q is not None and sol.D is not None
-    return Configuration(sol.q, sol.D)
+    if sol.B is None:
+        return Configuration(sol.q, sol.D)
+    return Configuration(sol.q, sol.D, sol.B)

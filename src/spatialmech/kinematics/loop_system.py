@@ -2,23 +2,30 @@
 model whose limbs do not reduce to quadrics in the Study parameters, as a square polynomial
 system in the joint variables, generated from the model.
 
-Formulation (limbs from the ground to the platform; joints R, P, C, U, S, Sm).  Every passive,
+Formulation (joints R, P, C, U, S, Sm).  Every passive,
 unlocked revolute freedom is a pair ``(c, s)`` with ``c^2 + s^2 = 1`` and its displacement
 ``exp(theta A) = I + s A + (1 - c) A^2`` (``A`` the 4x4 matrix of its unit twist, pitch 0:
 ``A^3 = -A``), every passive slide a linear variable ``d`` (over the characteristic length
 ``L``) with ``exp(d A) = I + d A``; an actuated freedom is the same with its ``(c, s)`` or ``d``
-as a *parameter*.  The product of a limb's displacements is then polynomial.  The platform
-displacement ``D`` is the product of the first limb without an S joint (the *reference
-limb*), or, when every limb has one, the Study parameters ``x = (e ; g)`` of :mod:`.homotopy`
-(``(e.e) D`` polynomial, with ``e.g = 0`` and a random complex patch).  Each other limb gives:
+as a *parameter*.  The product of a limb's displacements is then polynomial.
 
-* no S joint: ``FK = D``: the three off-diagonal entries of ``R_FK^T R_D`` and the
-  translation difference (6 equations; they also vanish where ``R_FK^T R_D`` is a half turn
-  about a coordinate axis: spurious points that the full closure, all 12 entries, rejects);
-* one S joint at centre ``c``: ``before(c) = D after^-1(c)`` (3 entries): the S joint's rotation
-  is then whatever closes the limb, so it is not a variable;
-* two consecutive S joints (a rod, centres ``c1``, ``c2``): ``|before(c1) - D after^-1(c2)|^2 =
-  |c1 - c2|^2`` (1 entry): the rod's idle spin is not a variable either.
+Hubs (the ground, the platform or output link, the internal bodies of a link-and-joint graph):
+a limb runs from hub ``a`` to hub ``b`` and closes as ``H_a FK = H_b``.  Each moving hub's
+displacement is, in turn, the product of a limb without S joint (the one with the fewest
+unknowns) from a hub placed before it (a *reference limb*; its factors inverted in reverse order
+when the limb runs towards the placed hub), or, where no such limb reaches it, its own Study
+parameters ``x = (e ; g)`` of :mod:`.homotopy` (``(e.e) H`` polynomial, with ``e.g = 0`` and a
+random complex patch).  Without bodies this is the platform's reference limb, or the platform in
+Study parameters when every limb has an S joint.  Each other limb gives (``H_a`` multiplying
+the side before its S joints, ``H_b`` the side after, each side times the other's scale):
+
+* no S joint: ``H_a FK = H_b``: the three off-diagonal entries of ``(R_a R_FK)^T R_b`` and the
+  translation difference (6 equations; they also vanish where ``(R_a R_FK)^T R_b`` is a half
+  turn about a coordinate axis: spurious points that the full closure, all 12 entries, rejects);
+* one S joint at centre ``c``: ``H_a before(c) = H_b after^-1(c)`` (3 entries): the S joint's
+  rotation is then whatever closes the limb, so it is not a variable;
+* two consecutive S joints (a rod, centres ``c1``, ``c2``): ``|H_a before(c1) - H_b
+  after^-1(c2)|^2 = |c1 - c2|^2`` (1 entry): the rod's idle spin is not a variable either.
 
 The equations can outnumber the conditions they impose (a spherical or planar limb has 3, an
 overconstrained linkage such as the Bennett fewer than its equations): the number of
@@ -75,6 +82,22 @@ class _LimbEq:
     length2: float  # rod length squared (over L^2)
     limb: int
     s_first: int  # index in the limb of the first S freedom (-1: none)
+    a: int | None = None  # the hub at the limb's base (None: the ground; 0: the platform; k: body k - 1)
+    b: int | None = 0  # the hub at its tip
+
+
+@dataclass(frozen=True, eq=False)
+class _Hub:
+    """How a moving hub's displacement is made: by a limb without S joint from a hub defined
+    before it (``chain``: the limb's factors, inverted and reversed when it runs the other way),
+    or by its own Study parameters (``study``: the index of ``e0`` in ``x``, with a patch)."""
+
+    hub: int  # 0: the platform (output link); k: body k - 1
+    frm: int | None  # the hub the chain starts from (None: the ground); unused for Study parameters
+    chain: tuple[_Factor, ...]
+    limb: int  # the limb of the chain (-1: Study parameters)
+    study: int = -1
+    patch: np.ndarray | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -87,10 +110,7 @@ class LoopSystem:
     nx: int
     npar: int
     circles: tuple[tuple[int, int], ...]  # (c, s) index pairs of the unknown revolutes
-    ref: tuple[_Factor, ...] | None  # the reference limb's factors (None: Study parameters)
-    ref_limb: int
-    study: int  # index of e0 in x when the platform is in Study parameters (-1 otherwise)
-    patch: np.ndarray | None
+    hubs: tuple[_Hub, ...]  # the moving hubs (platform, bodies), in the order they are defined
     limbs: tuple[_LimbEq, ...]
     compress: np.ndarray  # (m, r) complex: closure entries -> square rows
     var_of: dict  # freedom index -> ("R", ic, is) / ("P", id) / ("A", ...) parameter / ("L",) locked / ("S",)
@@ -102,6 +122,39 @@ class LoopSystem:
     def n_rows(self) -> int:
         return self.compress.shape[0]
 
+    @property
+    def studies(self) -> tuple[_Hub, ...]:
+        """The hubs in Study parameters (none when every hub is the product of a limb)."""
+        return tuple(h for h in self.hubs if h.study >= 0)
+
+    @property
+    def study(self) -> int:
+        """Index of ``e0`` in ``x`` of the first hub in Study parameters (-1: none)."""
+        st = self.studies
+        return st[0].study if st else -1
+
+    @property
+    def patch(self) -> np.ndarray | None:
+        st = self.studies
+        return st[0].patch if st else None
+
+    @property
+    def ref(self) -> tuple[_Factor, ...] | None:
+        """The platform's reference limb's factors (None: the platform in Study parameters)."""
+        h = self.hub_def(0)
+        return h.chain if h.study < 0 and h.frm is None else None
+
+    @property
+    def ref_limb(self) -> int:
+        return self.hub_def(0).limb
+
+    def hub_def(self, hub: int) -> _Hub:
+        return next(h for h in self.hubs if h.hub == hub)
+
+    @property
+    def n_bodies(self) -> int:
+        return len(self.hubs) - 1
+
     def key(self) -> bytes:
         """The geometry and structure of the system (which variable or parameter drives each
         factor, the limbs' equation kinds): the cache key of its generic solve."""
@@ -110,10 +163,14 @@ class LoopSystem:
         def factor(f):
             return np.concatenate([f.A.ravel(), [float(f.kind == "R"), float(f.inverse)], np.asarray(f.idx, float)])
 
-        for f in self.ref or ():
-            parts.append(factor(f))
+        def hub(h):
+            return -1.0 if h is None else float(h)
+
+        for h in self.hubs:
+            parts.append(np.array([-3.0, h.hub, hub(h.frm), h.limb, h.study]))
+            parts += [factor(f) for f in h.chain]
         for le in self.limbs:
-            parts += [np.array([{"full": 0.0, "point": 1.0, "rod": 2.0}[le.kind], -1.0])]
+            parts += [np.array([{"full": 0.0, "point": 1.0, "rod": 2.0}[le.kind], -1.0, hub(le.a), hub(le.b)])]
             parts += [factor(f) for f in le.before] + [np.array([-2.0])] + [factor(f) for f in le.after_inv]
             parts += [le.c1, le.c2, np.array([le.length2])]
         parts.append(self.compress.real.ravel())
@@ -141,13 +198,9 @@ class LoopSystem:
             T = T @ M
         return T, dT
 
-    def _platform(self, Z):
-        """``D`` (or ``(e.e) D``), its derivative, and the scale ``n`` (1, or ``e.e``) with its derivative."""
+    def _study_hub(self, Z, k):
+        """``(e.e) H`` of a hub in Study parameters (``e0`` at ``k``), its derivative, ``e.e`` and its derivative."""
         n, nz = Z.shape
-        if self.ref is not None:
-            T, dT = self._chain(self.ref, Z)
-            return T, dT, np.ones(n, complex), np.zeros((n, nz), complex)
-        k = self.study
         X = Z[:, k : k + 8]
         Dn = np.einsum("ni,abij,nj->nab", X, _STUDY_Q, X)
         dDn = np.zeros((n, nz, 4, 4), complex)
@@ -156,6 +209,39 @@ class LoopSystem:
         dE = np.zeros((n, nz), complex)
         dE[:, k : k + 4] = 2 * X[:, :4]
         return Dn, dDn, E, dE
+
+    def hub_values(self, Z) -> dict:
+        """Every hub's displacement times its scale, its derivative, the scale (1, or the product
+        of the ``e.e`` of the Study hubs it hangs from) and its derivative: ``{hub: (Hn, dHn, E,
+        dE)}``, the ground (``None``) included."""
+        n, nz = Z.shape
+        out: dict = {None: (np.broadcast_to(_I4, (n, 4, 4)).astype(complex), np.zeros((n, nz, 4, 4), complex),
+                            np.ones(n, complex), np.zeros((n, nz), complex))}
+        for h in self.hubs:
+            if h.study >= 0:
+                out[h.hub] = self._study_hub(Z, h.study)
+                continue
+            T, dT = self._chain(h.chain, Z)
+            if h.frm is None:
+                out[h.hub] = (T, dT, out[None][2], out[None][3])
+                continue
+            Hf, dHf, Ef, dEf = out[h.frm]
+            out[h.hub] = (Hf @ T, dHf @ T[:, None] + Hf[:, None] @ dT, Ef, dEf)
+        return out
+
+    def _platform(self, Z):
+        """``D`` (or ``(e.e) D``), its derivative, and the scale ``n`` (1, or ``e.e``) with its derivative."""
+        return self.hub_values(Z)[0]
+
+    def limb_sides(self, le: _LimbEq, H: dict, Z):
+        """A limb's two sides: ``H_a before`` (scaled by ``E_a``) with its derivative, and ``H_b``
+        (scaled by ``E_b``) with its derivative, and the two scales with theirs."""
+        Ha, dHa, Ea, dEa = H[le.a]
+        Tb, dTb = self._chain(le.before, Z)
+        if le.a is not None:
+            Tb, dTb = Ha @ Tb, dHa @ Tb[:, None] + Ha[:, None] @ dTb
+        Hb, dHb, Eb, dEb = H[le.b]
+        return Tb, dTb, Hb, dHb, Ea, dEa, Eb, dEb
 
     @property
     def w_offsets(self) -> tuple[int, ...]:
@@ -178,10 +264,11 @@ class LoopSystem:
 
     def closure(self, Z, full: bool = False, W=None):
         """The closure equations (n, r) and their derivative (n, r, nz) at points ``Z = (x ; p)``:
-        a limb without S joint gives the off-diagonal entries of ``R_limb^T R_platform`` and the
-        translation difference (6; zero also at the three half-turns about the axes, spurious
-        points the full closure rejects), or with ``full`` every entry of ``T_limb - D`` (12)."""
-        D, dD, E, dE = self._platform(Z)
+        a limb from hub ``a`` to hub ``b`` without S joint gives the off-diagonal entries of
+        ``(R_a R_limb)^T R_b`` and the translation difference (6; zero also at the three
+        half-turns about the axes, spurious points the full closure rejects), or with ``full``
+        every entry of ``H_a T_limb - H_b`` (12), each side times the other's scale."""
+        H = self.hub_values(Z)
         rows, jac = [], []
         n = len(Z)
         off = self.w_offsets
@@ -189,14 +276,15 @@ class LoopSystem:
             W = self.identity_offsets(n)
         for k, le in enumerate(self.limbs):
             w_k = W[:, off[k] : off[k + 1]]
-            Tb, dTb = self._chain(le.before, Z)
+            Tb, dTb, D, dD, Ea, dEa, E, dE = self.limb_sides(le, H, Z)
             if le.kind == "full" and full:
-                r = E[:, None, None] * Tb - D
-                dr = E[:, None, None, None] * dTb + dE[:, :, None, None] * Tb[:, None] - dD
+                r = E[:, None, None] * Tb - Ea[:, None, None] * D
+                dr = (E[:, None, None, None] * dTb + dE[:, :, None, None] * Tb[:, None]
+                      - Ea[:, None, None, None] * dD - dEa[:, :, None, None] * D[:, None])
                 rows.append(r[:, :3].reshape(n, 12))
                 jac.append(dr[:, :, :3].reshape(n, -1, 12).transpose(0, 2, 1))
                 continue
-            if le.kind == "full":  # with the offset (q, t): R_D -> R_D E(q), p_D -> p_D + R_D t
+            if le.kind == "full":  # with the offset (q, t): R_b -> R_b E(q), p_b -> p_b + R_b t
                 Eq = _rotation_forms(w_k[:, :4])
                 A, dA = Tb[:, :3, :3], dTb[:, :, :3, :3]
                 B, dB = D[:, :3, :3] @ Eq, dD[:, :, :3, :3] @ Eq[:, None]
@@ -204,9 +292,11 @@ class LoopSystem:
                 dP = np.einsum("nzai,naj->nzij", dA, B) + np.einsum("nai,nzaj->nzij", A, dB)
                 ii, jj = (0, 0, 1), (1, 2, 2)
                 tk = w_k[:, 4:7]
-                t = E[:, None] * Tb[:, :3, 3] - D[:, :3, 3] - np.einsum("nab,nb->na", D[:, :3, :3], tk)
-                dt = (E[:, None, None] * dTb[:, :, :3, 3] + dE[:, :, None] * Tb[:, None, :3, 3] - dD[:, :, :3, 3]
-                      - np.einsum("nzab,nb->nza", dD[:, :, :3, :3], tk))
+                s, Rt = D[:, :3, 3], np.einsum("nab,nb->na", D[:, :3, :3], tk)
+                ds, dRt = dD[:, :, :3, 3], np.einsum("nzab,nb->nza", dD[:, :, :3, :3], tk)
+                t = E[:, None] * Tb[:, :3, 3] - Ea[:, None] * s - Ea[:, None] * Rt
+                dt = (E[:, None, None] * dTb[:, :, :3, 3] + dE[:, :, None] * Tb[:, None, :3, 3]
+                      - Ea[:, None, None] * ds - Ea[:, None, None] * dRt - dEa[:, :, None] * (s + Rt)[:, None])
                 rows.append(np.concatenate([P[:, ii, jj], t], axis=1))
                 jac.append(np.concatenate([dP[:, :, ii, jj], dt], axis=2).transpose(0, 2, 1))
                 continue
@@ -217,39 +307,43 @@ class LoopSystem:
             dv = dTa @ le.c2
             u2 = np.einsum("nab,nb->na", D, v)
             du2 = np.einsum("nzab,nb->nza", dD, v) + np.einsum("nab,nzb->nza", D, dv)
-            w = E[:, None] * u1 - u2
-            dw = E[:, None, None] * du1 + dE[:, :, None] * u1[:, None] - du2
+            w = E[:, None] * u1 - Ea[:, None] * u2
+            dw = E[:, None, None] * du1 + dE[:, :, None] * u1[:, None] - Ea[:, None, None] * du2 - dEa[:, :, None] * u2[:, None]
             w, dw = w[:, :3], dw[:, :, :3]
-            if le.kind == "point":  # with the offset o: before(c) = D after^-1(c) + o
-                rows.append(w - E[:, None] * w_k)
-                jac.append((dw - dE[:, :, None] * w_k[:, None]).transpose(0, 2, 1))
+            EE, dEE = Ea * E, dEa * E[:, None] + Ea[:, None] * dE
+            if le.kind == "point":  # with the offset o: before(c) = H_b after^-1(c) + o
+                rows.append(w - EE[:, None] * w_k)
+                jac.append((dw - dEE[:, :, None] * w_k[:, None]).transpose(0, 2, 1))
             else:  # with the offset beta: length squared + beta
                 l2 = le.length2 + w_k[:, 0]
-                rows.append((np.einsum("na,na->n", w, w) - E**2 * l2)[:, None])
-                jac.append((2 * np.einsum("na,nza->nz", w, dw) - 2 * (E * l2)[:, None] * dE)[:, None])
+                rows.append((np.einsum("na,na->n", w, w) - EE**2 * l2)[:, None])
+                jac.append((2 * np.einsum("na,nza->nz", w, dw) - 2 * (EE * l2)[:, None] * dEE)[:, None])
         if not rows:
             return np.zeros((len(Z), 0), complex), np.zeros((len(Z), 0, Z.shape[1]), complex)
         return np.concatenate(rows, axis=1), np.concatenate(jac, axis=1)
 
     def side(self, Z):
-        """The circles, the Study quadric and patch: entries (n, k) and derivative (n, k, nz)."""
+        """The circles, the Study quadrics and patches: entries (n, k) and derivative (n, k, nz)."""
         n, nz = Z.shape
-        k = len(self.circles) + (2 if self.study >= 0 else 0)
+        st = self.studies
+        k = len(self.circles) + 2 * len(st)
         F = np.zeros((n, k), complex)
         J = np.zeros((n, k, nz), complex)
         for i, (a, b) in enumerate(self.circles):
             F[:, i] = Z[:, a] ** 2 + Z[:, b] ** 2 - 1
             J[:, i, a] = 2 * Z[:, a]
             J[:, i, b] = 2 * Z[:, b]
-        if self.study >= 0:
-            s, i = self.study, len(self.circles)
+        i = len(self.circles)
+        for h in st:
+            s = h.study
             X = Z[:, s : s + 8]
             F[:, i] = np.einsum("ni,ni->n", X[:, :4], X[:, 4:])
             J[:, i, s : s + 4] = X[:, 4:]
             J[:, i, s + 4 : s + 8] = X[:, :4]
-            assert self.patch is not None
-            F[:, i + 1] = X @ self.patch - 1
-            J[:, i + 1, s : s + 8] = self.patch
+            assert h.patch is not None
+            F[:, i + 1] = X @ h.patch - 1
+            J[:, i + 1, s : s + 8] = h.patch
+            i += 2
         return F, J
 
     def square(self, Z, W=None, *, reference: bool = False, want_J: bool = True):
@@ -275,8 +369,13 @@ class LoopSystem:
         F1, _ = self.side(Z)
         F2, _ = self.closure(Z, full=True)
         scale = 1.0 + np.linalg.norm(Z[:, : self.nx], axis=1)
-        if self.study >= 0:
+        if len(self.studies) == 1:
             scale = np.maximum(scale, np.linalg.norm(Z[:, self.study : self.study + 8], axis=1) ** 4)
+        elif self.studies:  # the equations' degree in the Study parameters: a product of their scales
+            big = np.ones(len(Z))
+            for h in self.studies:
+                big = big * np.maximum(1.0, np.linalg.norm(Z[:, h.study : h.study + 8], axis=1) ** 2)
+            scale = np.maximum(scale, big**2)
         return np.concatenate([np.abs(F1), np.abs(F2)], axis=1).max(axis=1, initial=0.0) / scale
 
     def parameters(self, targets: dict[int, float]) -> np.ndarray:
@@ -355,36 +454,49 @@ def loop_system(mech: Mechanism, seed: int = 0) -> LoopSystem:
     hit = _SYSTEMS.get(mech)
     if hit is not None:
         return hit
-    if mech.bodies:
-        raise InputError("a link-and-joint graph (internal bodies): the loop formulation covers limbs from the ground "
-                         "to the platform only")
     L = mech.characteristic_length
     refs = mech.freedom_refs
     acts = set(mech.actuators)
     slices = limb_slices(mech)
-    # the S joints of each limb, and which limbs can define the platform
+    ends = mech.limb_ends
+    # the S joints of each limb, and which limbs can define a hub
     s_of: list[list[tuple[int, np.ndarray]]] = []
     for limb in mech.limbs:
-        if limb.base != "ground" or limb.tip is not None:
-            raise InputError(f"limb {limb.name} does not run from the ground to the platform")
-        k, ss = 0, []
+        k, ss, names = 0, [], []
         for j in limb.joints:
             if j.type == "S":
                 if any(f.actuated for f in j.freedoms):
                     raise InputError(f"limb {limb.name}: S joint {j.name} is actuated")
                 ss.append((k, np.asarray(j.point, float)))
+                names.append(j.name)
             for f in j.freedoms:
                 if f.kind == "H" and f.pitch != 0:
                     raise InputError(f"limb {limb.name}: helical joint {j.name} (its rotation angle enters both "
                                      "as an angle and through its sine and cosine: not polynomial)")
             k += len(j.freedoms)
         if len(ss) > 2 or (len(ss) == 2 and ss[1][0] != ss[0][0] + 3):
-            raise InputError(f"limb {limb.name}: S joints other than one, or two adjacent (a rod)")
+            raise InputError(f"limb {limb.name}: S joints {', '.join(names)} (the loop formulation covers one S joint "
+                             "per limb, or two adjacent ones: a rod)")
         s_of.append(ss)
     no_s = [li for li in range(len(mech.limbs)) if not s_of[li]]
     n_unknown = [sum(1 for i in range(sl.start, sl.stop) if not refs[i].freedom.locked and refs[i].id not in acts)
                  for sl in slices]
-    ref_limb = min(no_s, key=lambda li: n_unknown[li]) if no_s else -1
+    # a spanning forest of reference limbs: every moving hub is the product of a limb without S
+    # joint from a hub defined before it (the fewest unknowns first), else in Study parameters
+    plan: list[tuple[int, int | None, int]] = []  # (hub, from hub, limb; -1: Study parameters)
+    defined: set[int | None] = {None}
+    while len(defined) < len(mech.bodies) + 2:
+        cands = [li for li in no_s if (ends[li][0] in defined) != (ends[li][1] in defined)]
+        if cands:
+            li = min(cands, key=lambda li: n_unknown[li])
+            a, b = ends[li]
+            hub, frm = (b, a) if a in defined else (a, b)
+        else:
+            hub, frm, li = next(h for h in range(len(mech.bodies) + 1) if h not in defined), None, -1
+        assert hub is not None
+        plan.append((hub, frm, li))
+        defined.add(hub)
+    ref_limbs = {li for _, _, li in plan if li >= 0}
 
     var_of: dict = {}
     nx = 0
@@ -405,10 +517,11 @@ def loop_system(mech: Mechanism, seed: int = 0) -> LoopSystem:
             var_of[i] = ("R", nx, nx + 1)
             circles.append((nx, nx + 1))
             nx += 2
-    study = -1
-    if ref_limb < 0:
-        study = nx
-        nx += 8
+    study_at = {}
+    for hub, _, li in plan:
+        if li < 0:
+            study_at[hub] = nx
+            nx += 8
     params = []
     npar = 0
     for i, r in enumerate(refs):
@@ -432,13 +545,14 @@ def loop_system(mech: Mechanism, seed: int = 0) -> LoopSystem:
     limbs: list[_LimbEq] = []
     cond = 0
     for li in range(len(mech.limbs)):
-        if li == ref_limb:
+        if li in ref_limbs:
             continue
+        a, b = ends[li]
         m = slices[li].stop - slices[li].start
         ss = s_of[li]
         z4 = np.zeros(4)
         if not ss:
-            limbs.append(_LimbEq("full", tuple(factors(li, 0, m)), (), z4, z4, 0.0, li, -1))
+            limbs.append(_LimbEq("full", tuple(factors(li, 0, m)), (), z4, z4, 0.0, li, -1, a, b))
             cond += 6
             continue
         k0 = ss[0][0]
@@ -447,18 +561,25 @@ def loop_system(mech: Mechanism, seed: int = 0) -> LoopSystem:
         c2 = np.append(ss[-1][1] / L, 1.0)
         after = [f.inverted() for f in reversed(factors(li, k1, m))]
         if len(ss) == 1:
-            limbs.append(_LimbEq("point", tuple(factors(li, 0, k0)), tuple(after), c1, c1, 0.0, li, k0))
+            limbs.append(_LimbEq("point", tuple(factors(li, 0, k0)), tuple(after), c1, c1, 0.0, li, k0, a, b))
             cond += 3
         else:
             limbs.append(_LimbEq("rod", tuple(factors(li, 0, k0)), tuple(after), c1, c2,
-                                 float(np.sum((c1 - c2) ** 2)), li, k0))
+                                 float(np.sum((c1 - c2) ** 2)), li, k0, a, b))
             cond += 1
-    m_needed = nx - len(circles) - (2 if study >= 0 else 0)
+    m_needed = nx - len(circles) - 2 * len(study_at)
     sizes = [6 if le.kind == "full" else 3 if le.kind == "point" else 1 for le in limbs]
     rng = np.random.default_rng(seed + 7919)
-    patch = (rng.normal(size=8) + 1j * rng.normal(size=8)) if study >= 0 else None
-    ref = tuple(factors(ref_limb, 0, slices[ref_limb].stop - slices[ref_limb].start)) if ref_limb >= 0 else None
-    sysm = LoopSystem(mech, L, nx, npar, tuple(circles), ref, ref_limb, study, patch, tuple(limbs),
+    hubs = []
+    for hub, frm, li in plan:
+        if li < 0:
+            hubs.append(_Hub(hub, None, (), -1, study_at[hub], rng.normal(size=8) + 1j * rng.normal(size=8)))
+            continue
+        ch = factors(li, 0, slices[li].stop - slices[li].start)
+        if ends[li][1] != hub:  # the limb runs from the hub to the one it hangs from: inverted
+            ch = [f.inverted() for f in reversed(ch)]
+        hubs.append(_Hub(hub, frm, tuple(ch), li))
+    sysm = LoopSystem(mech, L, nx, npar, tuple(circles), tuple(hubs), tuple(limbs),
                       np.eye(sum(sizes), dtype=complex), var_of, tuple(params), cond)
     ranks = _limb_ranks(sysm, sizes, rng)
     cond = sum(ranks)
@@ -487,7 +608,8 @@ def loop_system(mech: Mechanism, seed: int = 0) -> LoopSystem:
 
 
 def variables(sysm: LoopSystem, config: Configuration) -> np.ndarray:
-    """The variables ``z = (x ; p)`` of a real configuration (joint variables ``q``, platform ``D``)."""
+    """The variables ``z = (x ; p)`` of a real configuration (joint variables ``q``, the
+    platform ``D`` and bodies ``B`` where they are in Study parameters)."""
     z = np.zeros(sysm.nx + sysm.npar)
     for i, v in sysm.var_of.items():
         qi = config.q[i]
@@ -495,19 +617,20 @@ def variables(sysm: LoopSystem, config: Configuration) -> np.ndarray:
             z[v[1]], z[v[2]] = np.cos(qi), np.sin(qi)
         elif v[0] in ("P", "A"):
             z[v[1]] = qi / sysm.L
-    if sysm.study >= 0:
+    z = z.astype(complex)
+    for h in sysm.studies:
         from scipy.spatial.transform import Rotation
 
-        x, y, zz, w = Rotation.from_matrix(config.D[:3, :3]).as_quat()
-        e = np.array([w, x, y, zz])
         from .homotopy_systems import qmul
 
-        g = 0.5 * qmul(np.concatenate([[0.0], config.D[:3, 3] / sysm.L]), e)
+        H = config.hub(h.hub)
+        x, y, zz, w = Rotation.from_matrix(H[:3, :3]).as_quat()
+        e = np.array([w, x, y, zz])
+        g = 0.5 * qmul(np.concatenate([[0.0], H[:3, 3] / sysm.L]), e)
         xs = np.concatenate([e, g]).astype(complex)
-        assert sysm.patch is not None
-        z = z.astype(complex)
-        z[sysm.study : sysm.study + 8] = xs / (xs @ sysm.patch)
-    return np.asarray(z, complex)
+        assert h.patch is not None
+        z[h.study : h.study + 8] = xs / (xs @ h.patch)
+    return z
 
 
 def _limb_ranks(sysm: LoopSystem, sizes: list[int], rng: np.random.Generator) -> list[int]:
