@@ -137,8 +137,8 @@ def test_cli_json_and_text(stewart):
 
 def test_uncovered_model_clear_message():
     runner = CliRunner()
-    out = runner.invoke(main, ["fk", "spatial-six-bar", "--actuators", "10", "--all", "--method", "homotopy"])
-    assert out.exit_code != 0 and "does not cover spatial-six-bar" in out.output and "internal bodies" in out.output
+    out = runner.invoke(main, ["fk", "three-sps-smpu", "--actuators", "0.5,0.5,0.5", "--all", "--method", "homotopy"])
+    assert out.exit_code != 0 and "does not cover three-sps-smpu" in out.output and "S joints B1, A1" in out.output
     assert "Traceback" not in out.output
     with pytest.raises(sm.InputError, match="method"):
         sm.fk("stewart-6sps", [1.2] * 6, all_solutions=True, method="newton")
