@@ -344,7 +344,10 @@ def _fk_homotopy(mech: Mechanism, res, as_json: bool) -> None:
                + (f" ({sr['n_spurious']} spurious end points of the square system discarded)" if "n_spurious" in sr else "")
                + f" ({'loop formulation by monodromy' if 'n_spurious' in sr else 'homotopy continuation'}, "
                f"{sr['elapsed_s']:.2f} s)")
-    click.echo(("  complete (proven): " if sr["complete"] else "  NOT proven complete: ") + sr["completeness"])
+    how = sr["completeness"]
+    if sr["complete"] and how.startswith("complete (trace test): "):  # say "complete" once
+        how = "by the trace test: " + how[len("complete (trace test): "):]
+    click.echo(("  complete (proven): " if sr["complete"] else "  NOT proven complete: ") + how)
     _fk_solution_lines(mech, sols)
 
 
