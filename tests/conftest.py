@@ -1,4 +1,6 @@
+import json
 import os
+import shutil
 
 import numpy as np
 import pytest
@@ -13,6 +15,41 @@ from spatialmech.geometry.rotations import transform
 settings.register_profile("spatialmech", deadline=None)
 settings.register_profile("spatialmech-ci", deadline=None, derandomize=True)
 settings.load_profile("spatialmech-ci" if os.environ.get("CI") else "spatialmech")
+
+
+def _lock_numba_cache_saves() -> None:
+    """Make numba's on-disk cache safe for the two pytest-xdist workers (README: ``pytest -n 2``).
+
+    numba writes each file atomically, but ``IndexDataCacheFile.save`` reads the index, picks the
+    first free data-file number and writes both back without a lock: two processes saving new
+    signatures of one function at the same moment can both pick ``<fn>.1.nbc``, so one index entry
+    then names the other signature's machine code (numba issue #10128 discusses a file lock).
+    Here each save holds an exclusive ``flock`` on one lock file of that cache directory; loads
+    need none (a data file only ever holds the code of the key that names it)."""
+    try:
+        import fcntl
+
+        from numba.core import caching
+    except ImportError:  # no numba (pure-Python fallback of kinematics/jit.py) or no fcntl
+        return
+    save = caching.IndexDataCacheFile.save
+    if getattr(save, "spatialmech_locked", False):
+        return
+
+    def locked_save(self, key, data):
+        os.makedirs(self._cache_path, exist_ok=True)
+        with open(os.path.join(self._cache_path, "spatialmech-numba-save.lock"), "a") as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX)
+            try:
+                return save(self, key, data)
+            finally:
+                fcntl.flock(lock, fcntl.LOCK_UN)
+
+    locked_save.spatialmech_locked = True
+    caching.IndexDataCacheFile.save = locked_save
+
+
+_lock_numba_cache_saves()
 
 
 @pytest.fixture(scope="session")
@@ -68,10 +105,32 @@ def random_transform(seed: int) -> np.ndarray:
 
 @pytest.fixture(scope="session")
 def demo_report(tmp_path_factory):
-    """``spatialmech demo`` built once for the whole session (about 45 s): ``(out_dir, results)``.
+    """``spatialmech demo`` built once for the whole session (about 25 s): ``(out_dir, results)``.
     The report tests, the regression test of its rows and the JSON-schema test of the ``demo``
-    command all read this one run; nothing may modify ``results``."""
+    command all read this one run; nothing may modify ``results``.
+
+    Under pytest-xdist (``-n 2``) the workers share the run too: the first to need it builds it
+    into the session's common temporary directory under a file lock, the others wait for it and
+    read that directory's ``results.json`` (what :func:`build_demo` returns is exactly that file's
+    content)."""
     from spatialmech.present.report import build_demo
 
-    out = tmp_path_factory.mktemp("demo")
-    return out, build_demo(out, progress=False)
+    if not os.environ.get("PYTEST_XDIST_WORKER"):
+        out = tmp_path_factory.mktemp("demo")
+        return out, build_demo(out, progress=False)
+    import fcntl
+
+    shared = tmp_path_factory.getbasetemp().parent  # this session's directory, common to its workers
+    out, done = shared / "demo", shared / "demo.done"
+    with open(shared / "demo.lock", "a") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        try:
+            if not done.exists():
+                shutil.rmtree(out, ignore_errors=True)
+                out.mkdir()
+                results = build_demo(out, progress=False)
+                done.touch()
+                return out, results
+        finally:
+            fcntl.flock(lock, fcntl.LOCK_UN)
+    return out, json.loads((out / "results.json").read_text(encoding="utf-8"))
