@@ -103,34 +103,62 @@ def random_transform(seed: int) -> np.ndarray:
     return transform(Rotation.random(random_state=seed).as_matrix(), r.uniform(-5, 5, 3))
 
 
-@pytest.fixture(scope="session")
-def demo_report(tmp_path_factory):
-    """``spatialmech demo`` built once for the whole session (about 25 s): ``(out_dir, results)``.
-    The report tests, the regression test of its rows and the JSON-schema test of the ``demo``
-    command all read this one run; nothing may modify ``results``.
+def built_once(tmp_path_factory, name: str, build, load):
+    """``(directory, value)`` of an expensive build done once per test session.
 
-    Under pytest-xdist (``-n 2``) the workers share the run too: the first to need it builds it
-    into the session's common temporary directory under a file lock, the others wait for it and
-    read that directory's ``results.json`` (what :func:`build_demo` returns is exactly that file's
-    content)."""
-    from spatialmech.present.report import build_demo
-
+    ``build(directory)`` computes the value and writes into the (empty) ``directory`` whatever
+    ``load(directory)`` needs to give the same value back.  In one process this is just
+    ``build`` into a fresh temporary directory.  Under pytest-xdist (``-n 2``) the workers share
+    it: the first to ask builds it into the session's common temporary directory while holding a
+    file lock; the others wait for the lock and ``load`` the result."""
     if not os.environ.get("PYTEST_XDIST_WORKER"):
-        out = tmp_path_factory.mktemp("demo")
-        return out, build_demo(out, progress=False)
+        out = tmp_path_factory.mktemp(name)
+        return out, build(out)
     import fcntl
 
     shared = tmp_path_factory.getbasetemp().parent  # this session's directory, common to its workers
-    out, done = shared / "demo", shared / "demo.done"
-    with open(shared / "demo.lock", "a") as lock:
+    out, done = shared / name, shared / f"{name}.done"
+    with open(shared / f"{name}.lock", "a") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
         try:
             if not done.exists():
                 shutil.rmtree(out, ignore_errors=True)
                 out.mkdir()
-                results = build_demo(out, progress=False)
+                value = build(out)
                 done.touch()
-                return out, results
+                return out, value
         finally:
             fcntl.flock(lock, fcntl.LOCK_UN)
-    return out, json.loads((out / "results.json").read_text(encoding="utf-8"))
+    return out, load(out)
+
+
+@pytest.fixture(scope="session")
+def demo_report(tmp_path_factory):
+    """``spatialmech demo`` built once for the whole session (about 25 s): ``(out_dir, results)``.
+    The report tests, the regression test of its rows and the JSON-schema test of the ``demo``
+    command all read this one run; nothing may modify ``results``.  Shared by the xdist workers
+    (:func:`built_once`): what :func:`build_demo` returns is exactly its ``results.json``."""
+    from spatialmech.present.report import build_demo
+
+    return built_once(tmp_path_factory, "demo", lambda out: build_demo(out, progress=False),
+                      lambda out: json.loads((out / "results.json").read_text(encoding="utf-8")))
+
+
+@pytest.fixture(scope="session")
+def paper_a_cs_family(tmp_path_factory):
+    """Paper A's CS dyad family of the seven positions of table 9 (``synthesize_cs`` with 60
+    starts, seed 0, five picks; about 4 s), for every test that analyses that family
+    (tests/test_cs_dyads.py, test_regressions.py, test_screening.py); frozen, not modified.
+    Shared by the xdist workers as a pickle (:func:`built_once`)."""
+    import pickle
+
+    from spatialmech.catalog.papers import five_cs_positions
+    from spatialmech.synthesis.cs_dyads import synthesize_cs
+
+    def build(out):
+        family = synthesize_cs(five_cs_positions(), n_starts=60, seed=0, pick=5)
+        (out / "family.pickle").write_bytes(pickle.dumps(family))
+        return family
+
+    return built_once(tmp_path_factory, "paper-a-cs-family", build,
+                      lambda out: pickle.loads((out / "family.pickle").read_bytes()))[1]
