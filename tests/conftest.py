@@ -162,3 +162,16 @@ def paper_a_cs_family(tmp_path_factory):
 
     return built_once(tmp_path_factory, "paper-a-cs-family", build,
                       lambda out: pickle.loads((out / "family.pickle").read_bytes()))[1]
+
+
+def pytest_collection_modifyitems(config, items):
+    """Under pytest-xdist, the tests that read the session's demo run (``demo_report``) go last
+    in their module, their order otherwise kept: a worker reaches them after the rest of its file,
+    by which time the other worker has often built the demo already (without this, one worker sat
+    about 20 s waiting for the lock of :func:`built_once`).  A single process keeps the file order."""
+    if not os.environ.get("PYTEST_XDIST_WORKER"):
+        return
+    late = [item for item in items if "demo_report" in getattr(item, "fixturenames", ())]
+    if late:
+        ids = {id(item) for item in late}
+        items[:] = [item for item in items if id(item) not in ids] + late
