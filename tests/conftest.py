@@ -117,6 +117,8 @@ def built_once(tmp_path_factory, name: str, build, load):
     import fcntl
 
     shared = tmp_path_factory.getbasetemp().parent  # this session's directory, common to its workers
+    # named after the run too: with --basetemp that directory outlives the session
+    name = f"{name}-{os.environ.get('PYTEST_XDIST_TESTRUNUID', 'run')}"
     out, done = shared / name, shared / f"{name}.done"
     with open(shared / f"{name}.lock", "a") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
