@@ -167,10 +167,12 @@ def paper_a_cs_family(tmp_path_factory):
 
 
 def pytest_collection_modifyitems(config, items):
-    """Under pytest-xdist, the tests that read the session's demo run (``demo_report``) go last
-    in their module, their order otherwise kept: a worker reaches them after the rest of its file,
-    by which time the other worker has often built the demo already (without this, one worker sat
-    about 20 s waiting for the lock of :func:`built_once`).  A single process keeps the file order."""
+    """Under pytest-xdist, the tests that read the session's demo run (``demo_report``) go to the
+    end of the collection, the order otherwise kept.  With ``--dist loadfile`` (README) a file's
+    tests run in collection order, so they run last in their file: a worker reaches them after
+    the rest of it, by which time the other worker has often built the demo already (without
+    this, one worker sat about 20 s waiting for the lock of :func:`built_once`).  A single
+    process keeps the file order."""
     if not os.environ.get("PYTEST_XDIST_WORKER"):
         return
     late = [item for item in items if "demo_report" in getattr(item, "fixturenames", ())]
