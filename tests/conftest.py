@@ -1,4 +1,6 @@
+import json
 import os
+import shutil
 
 import numpy as np
 import pytest
@@ -13,6 +15,41 @@ from spatialmech.geometry.rotations import transform
 settings.register_profile("spatialmech", deadline=None)
 settings.register_profile("spatialmech-ci", deadline=None, derandomize=True)
 settings.load_profile("spatialmech-ci" if os.environ.get("CI") else "spatialmech")
+
+
+def _lock_numba_cache_saves() -> None:
+    """Make numba's on-disk cache safe for the two pytest-xdist workers (README: ``pytest -n 2``).
+
+    numba writes each file atomically, but ``IndexDataCacheFile.save`` reads the index, picks the
+    first free data-file number and writes both back without a lock: two processes saving new
+    signatures of one function at the same moment can both pick ``<fn>.1.nbc``, so one index entry
+    then names the other signature's machine code (numba issue #10128 discusses a file lock).
+    Here each save holds an exclusive ``flock`` on one lock file of that cache directory; loads
+    need none (a data file only ever holds the code of the key that names it)."""
+    try:
+        import fcntl
+
+        from numba.core import caching
+    except ImportError:  # no numba (pure-Python fallback of kinematics/jit.py) or no fcntl
+        return
+    save = caching.IndexDataCacheFile.save
+    if getattr(save, "spatialmech_locked", False):
+        return
+
+    def locked_save(self, key, data):
+        os.makedirs(self._cache_path, exist_ok=True)
+        with open(os.path.join(self._cache_path, "spatialmech-numba-save.lock"), "a") as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX)
+            try:
+                return save(self, key, data)
+            finally:
+                fcntl.flock(lock, fcntl.LOCK_UN)
+
+    locked_save.spatialmech_locked = True
+    caching.IndexDataCacheFile.save = locked_save
+
+
+_lock_numba_cache_saves()
 
 
 @pytest.fixture(scope="session")
@@ -66,12 +103,79 @@ def random_transform(seed: int) -> np.ndarray:
     return transform(Rotation.random(random_state=seed).as_matrix(), r.uniform(-5, 5, 3))
 
 
+def built_once(tmp_path_factory, name: str, build, load):
+    """``(directory, value)`` of an expensive build done once per test session.
+
+    ``build(directory)`` computes the value and writes into the (empty) ``directory`` whatever
+    ``load(directory)`` needs to give the same value back.  In one process this is just
+    ``build`` into a fresh temporary directory.  Under pytest-xdist (``-n 2``) the workers share
+    it: the first to ask builds it into the session's common temporary directory while holding a
+    file lock; the others wait for the lock and ``load`` the result."""
+    if not os.environ.get("PYTEST_XDIST_WORKER"):
+        out = tmp_path_factory.mktemp(name)
+        return out, build(out)
+    import fcntl
+
+    shared = tmp_path_factory.getbasetemp().parent  # this session's directory, common to its workers
+    # named after the run too: with --basetemp that directory outlives the session
+    name = f"{name}-{os.environ.get('PYTEST_XDIST_TESTRUNUID', 'run')}"
+    out, done = shared / name, shared / f"{name}.done"
+    with open(shared / f"{name}.lock", "a") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        try:
+            if not done.exists():
+                shutil.rmtree(out, ignore_errors=True)
+                out.mkdir()
+                value = build(out)
+                done.touch()
+                return out, value
+        finally:
+            fcntl.flock(lock, fcntl.LOCK_UN)
+    return out, load(out)
+
+
 @pytest.fixture(scope="session")
 def demo_report(tmp_path_factory):
-    """``spatialmech demo`` built once for the whole session (about 45 s): ``(out_dir, results)``.
+    """``spatialmech demo`` built once for the whole session (about 25 s): ``(out_dir, results)``.
     The report tests, the regression test of its rows and the JSON-schema test of the ``demo``
-    command all read this one run; nothing may modify ``results``."""
+    command all read this one run; nothing may modify ``results``.  Shared by the xdist workers
+    (:func:`built_once`): what :func:`build_demo` returns is exactly its ``results.json``."""
     from spatialmech.present.report import build_demo
 
-    out = tmp_path_factory.mktemp("demo")
-    return out, build_demo(out, progress=False)
+    return built_once(tmp_path_factory, "demo", lambda out: build_demo(out, progress=False),
+                      lambda out: json.loads((out / "results.json").read_text(encoding="utf-8")))
+
+
+@pytest.fixture(scope="session")
+def paper_a_cs_family(tmp_path_factory):
+    """Paper A's CS dyad family of the seven positions of table 9 (``synthesize_cs`` with 60
+    starts, seed 0, five picks; about 4 s), for every test that analyses that family
+    (tests/test_cs_dyads.py, test_regressions.py, test_screening.py); frozen, not modified.
+    Shared by the xdist workers as a pickle (:func:`built_once`)."""
+    import pickle
+
+    from spatialmech.catalog.papers import five_cs_positions
+    from spatialmech.synthesis.cs_dyads import synthesize_cs
+
+    def build(out):
+        family = synthesize_cs(five_cs_positions(), n_starts=60, seed=0, pick=5)
+        (out / "family.pickle").write_bytes(pickle.dumps(family))
+        return family
+
+    return built_once(tmp_path_factory, "paper-a-cs-family", build,
+                      lambda out: pickle.loads((out / "family.pickle").read_bytes()))[1]
+
+
+def pytest_collection_modifyitems(config, items):
+    """Under pytest-xdist, the tests that read the session's demo run (``demo_report``) go to the
+    end of the collection, the order otherwise kept.  With ``--dist loadfile`` (README) a file's
+    tests run in collection order, so they run last in their file: a worker reaches them after
+    the rest of it, by which time the other worker has often built the demo already (without
+    this, one worker sat about 20 s waiting for the lock of :func:`built_once`).  A single
+    process keeps the file order."""
+    if not os.environ.get("PYTEST_XDIST_WORKER"):
+        return
+    late = [item for item in items if "demo_report" in getattr(item, "fixturenames", ())]
+    if late:
+        ids = {id(item) for item in late}
+        items[:] = [item for item in items if id(item) not in ids] + late

@@ -11,7 +11,6 @@ Figures measured on table 9 (stated tolerances in each test):
   5-CS with pose errors < 1e-15 and 1 DOF.
 """
 
-from functools import lru_cache
 
 import numpy as np
 import pytest
@@ -42,15 +41,11 @@ from spatialmech.synthesis.five_cs import assemble_5cs, check_5cs, paper_a_check
 from .conftest import seeds
 
 
-# the paper-A family costs ~10 s: every test that uses it (or _claims) is marked slow
-@lru_cache(maxsize=1)
-def _family():
-    return synthesize_cs(five_cs_positions(), seed=0, pick=5)
-
-
-@lru_cache(maxsize=1)
-def _claims():
-    return paper_a_check(five_cs_positions(), five_cs_data()["linkages"], family=_family())
+# the paper-A family (tests/conftest.py: paper_a_cs_family, one for the session) costs ~4 s:
+# every test that uses it (or claims) is marked slow
+@pytest.fixture(scope="module")
+def claims(paper_a_cs_family):
+    return paper_a_check(five_cs_positions(), five_cs_data()["linkages"], family=paper_a_cs_family)
 
 
 def _printed_limbs():
@@ -131,12 +126,12 @@ def test_residual_invariants_flip_and_world_frame(seed):
 
 
 @pytest.mark.slow
-def test_dimension_count_is_one():
+def test_dimension_count_is_one(paper_a_cs_family):
     """15 unknowns, 14 equations, and no gauge freedom: the Jacobian has full rank 14 along the
     family (smallest of its 14 singular values, nondimensional, > 1e-4 at every 25th tracked
     point), so the solution set is a curve; eq 25 at j = 1 pins B1 to the foot of the
     perpendicular from M1 (|u.(M1 - B1)| < 1e-9)."""
-    fam = _family()
+    fam = paper_a_cs_family
     task = fam.task
     Dn = task.nondim_D()
     worst = np.inf
@@ -150,7 +145,7 @@ def test_dimension_count_is_one():
 
 
 @pytest.mark.slow
-def test_bad_input_raises_naming_the_argument():
+def test_bad_input_raises_naming_the_argument(paper_a_cs_family):
     poses = five_cs_positions()
     with pytest.raises(ValueError, match=r"^task_poses: .*exactly 7"):
         synthesize_cs(poses[:6])
@@ -165,7 +160,7 @@ def test_bad_input_raises_naming_the_argument():
     with pytest.raises(ValueError, match=r"^extent"):
         synthesize_cs(poses, extent=-1.0)
     with pytest.raises(ValueError, match=r"^dyads: .*exactly 5"):
-        assemble_5cs(poses, _family().picks[:4])
+        assemble_5cs(poses, paper_a_cs_family.picks[:4])
     with pytest.raises(ValueError, match=r"^slides"):
         dyad_from_limb(poses, [1, 0, 0], [0, 0, 0], [0, 1, 0], [1, 2, 3])
     with pytest.raises(ValueError, match=r"^u"):
@@ -214,14 +209,14 @@ def test_paper_a_printed_limbs_satisfy_eqs_24_25_to_the_printed_precision():
 
 
 @pytest.mark.slow
-def test_paper_a_printed_limbs_project_onto_the_synthesised_family():
+def test_paper_a_printed_limbs_project_onto_the_synthesised_family(paper_a_cs_family, claims):
     """Claim (b): the nearest dyad of the family to each printed limb (least squares over the 15
     printed numbers) is within 0.005 of it (measured 0.0042, consistent with 3-decimal rounding
     amplified by slides of 10-30), the printed slides s2..s7 are reproduced to 0.001 (measured
     0.0006), and that dyad lies on a branch found by the multi-start search (within 2e-3 task
     scales of a tracked polyline: the family found contains all 13 distinct printed limbs)."""
-    cl = _claims()
-    fam = _family()
+    cl = claims
+    fam = paper_a_cs_family
     Y = [cd._to_nondim(fam.task, b.points) for b in fam.branches]
     for k, projs in cl.projections.items():
         for i, p in enumerate(projs):
@@ -234,12 +229,12 @@ def test_paper_a_printed_limbs_project_onto_the_synthesised_family():
 
 
 @pytest.mark.slow
-def test_paper_a_refitted_linkages_pass_exactly_through_the_seven_positions():
+def test_paper_a_refitted_linkages_pass_exactly_through_the_seven_positions(claims):
     """The three paper linkages rebuilt from their projected limbs close exactly at the 7
     positions (pose error < 1e-9, 1 DOF), whereas the printed (rounded) linkages only come
     within 0.295 (linkage 3 at P4; the nearest closed configuration, measured 0.2948; tolerance
     0.28-0.31) - the reason a refit is needed before judging circuits on printed data."""
-    cl = _claims()
+    cl = claims
     for k, ch in cl.refitted.items():
         assert ch.ok and ch.max_pose_error < 1e-9 and np.max(np.abs(ch.slide_errors)) < 1e-9, k
     printed = check_5cs(five_cs(3))
@@ -248,12 +243,12 @@ def test_paper_a_refitted_linkages_pass_exactly_through_the_seven_positions():
 
 
 @pytest.mark.slow
-def test_paper_a_any_five_dyads_of_the_family_form_a_5cs():
+def test_paper_a_any_five_dyads_of_the_family_form_a_5cs(paper_a_cs_family, claims):
     """Claim (c) with the five small-slide picks: the 5-CS closes exactly at the 7 positions
     (pose error < 1e-9, IK residual < 1e-10), has 1 DOF (formula and numerical rank), and the
     C slides solved at each position equal the dyads' s_j (1e-9)."""
-    fam = _family()
-    ch = _claims().synthesised
+    fam = paper_a_cs_family
+    ch = claims.synthesised
     assert len(fam.picks) == 5
     assert ch.ok and ch.max_pose_error < 1e-9 and np.max(ch.ik_residuals) < 1e-10
     assert ch.dof == 1 and ch.dof_instantaneous == 1
@@ -263,10 +258,10 @@ def test_paper_a_any_five_dyads_of_the_family_form_a_5cs():
 @pytest.mark.slow
 @settings(max_examples=4)
 @given(st.integers(0, 10**6))
-def test_any_five_family_points_form_an_exact_5cs(seed):
+def test_any_five_family_points_form_an_exact_5cs(paper_a_cs_family, seed):
     """Claim (c) as a property: five random tracked dyads (distinct branches or far apart on
     one) give a 5-CS through the 7 positions (pose error < 1e-9) with 1 DOF."""
-    fam = _family()
+    fam = paper_a_cs_family
     r = np.random.default_rng(seed)
     P = fam.all_points()
     idx = []
@@ -281,13 +276,13 @@ def test_any_five_family_points_form_an_exact_5cs(seed):
 
 
 @pytest.mark.slow
-def test_paper_a_small_slide_picks():
+def test_paper_a_small_slide_picks(paper_a_cs_family):
     """'Choose dyads with small slides': the first pick is the smallest max |s_j| of the family
     (measured 5.3028 on table 9; tolerance 5.25-5.35), no tracked point is smaller by more than
     1e-9, moving along the curve from it increases max |s| (a refined minimum), the picks are
     sorted by max |s| within the local minima (measured 5.303, 9.762, 10.904, 11.185, 11.809)
     and pairwise at least one task scale apart."""
-    fam = _family()
+    fam = paper_a_cs_family
     picks = fam.picks
     g = [p.max_abs_slide for p in picks]
     assert 5.25 < g[0] < 5.35
@@ -308,20 +303,20 @@ def test_paper_a_small_slide_picks():
 
 
 @pytest.mark.slow
-def test_family_to_dict_is_json_serialisable():
+def test_family_to_dict_is_json_serialisable(paper_a_cs_family, claims):
     import json
 
-    d = _family().to_dict(samples=10)
+    d = paper_a_cs_family.to_dict(samples=10)
     s = json.dumps(d, allow_nan=False)
-    assert '"picks"' in s and d["n_branches"] == len(_family().branches)
+    assert '"picks"' in s and d["n_branches"] == len(paper_a_cs_family.branches)
     pts = sum(len(b["points"]) for b in d["branches"])
     assert 10 <= pts <= 10 + 2 * d["n_branches"]
-    json.dumps(_claims().to_dict(), allow_nan=False)
+    json.dumps(claims.to_dict(), allow_nan=False)
 
 
 @pytest.mark.slow
-def test_projection_of_an_exact_dyad_does_not_move_it():
-    p = project_dyad(five_cs_positions(), _family().picks[0])
+def test_projection_of_an_exact_dyad_does_not_move_it(paper_a_cs_family):
+    p = project_dyad(five_cs_positions(), paper_a_cs_family.picks[0])
     assert p.converged and p.distance < 1e-10
 
 

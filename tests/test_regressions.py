@@ -328,14 +328,12 @@ def test_synth_cs_success_needs_a_defect_free_driver():
 
 
 @pytest.mark.slow
-def test_synth_cs_of_paper_a_positions_reports_the_circuit_defect():
+def test_synth_cs_of_paper_a_positions_reports_the_circuit_defect(paper_a_cs_family):
     """The five small-slide dyads of table 9 close at every position (the old 'all exact: True')
     but the linkage has a circuit defect: the synthesis says FAILED and why."""
-    from spatialmech.catalog.papers import five_cs_positions
-    from spatialmech.synthesis.cs_dyads import synthesize_cs
     from spatialmech.synthesis.five_cs import assemble_5cs, check_5cs
 
-    fam = synthesize_cs(five_cs_positions(), seed=0, pick=5)
+    fam = paper_a_cs_family  # synthesize_cs(five_cs_positions(), seed=0, pick=5), tests/conftest.py
     check = check_5cs(assemble_5cs(fam.task, fam.picks), fam.picks, defects=True)
     assert check.ok and check.defects is not None
     assert check.defects.circuit_defect and not check.success

@@ -3,6 +3,7 @@ against the full defect analysis, the Parquet dataset, resuming after an interru
 Dask LocalCluster (2 workers on loopback) giving the serial result, and a usable linkage found
 by the screen confirmed by the single-linkage ``defects`` command on its saved file."""
 
+import dataclasses
 import json
 import math
 
@@ -18,7 +19,6 @@ from spatialmech.errors import InputError
 from spatialmech.interfaces.batch_screen import MANIFEST, read_rows, run_screen
 from spatialmech.interfaces.cli import cli
 from spatialmech.model.schema import load
-from spatialmech.synthesis.cs_dyads import synthesize_cs
 from spatialmech.synthesis.screening import (
     DyadPool,
     candidate_linkage,
@@ -37,8 +37,10 @@ USABLE = [26, 54, 59, 62, 114]
 
 
 @pytest.fixture(scope="module")
-def family():
-    return synthesize_cs(five_cs_positions(), n_starts=60, seed=0, pick=0)
+def family(paper_a_cs_family):
+    """``synthesize_cs(five_cs_positions(), n_starts=60, seed=0, pick=0)``: the session's family
+    (tests/conftest.py, the same call with pick=5) without its picks, exactly what pick=0 returns."""
+    return dataclasses.replace(paper_a_cs_family, picks=())
 
 
 @pytest.fixture(scope="module")
