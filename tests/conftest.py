@@ -32,8 +32,8 @@ def _lock_numba_cache_saves() -> None:
         from numba.core import caching
     except ImportError:  # no numba (pure-Python fallback of kinematics/jit.py) or no fcntl
         return
-    save = caching.IndexDataCacheFile.save
-    if getattr(save, "spatialmech_locked", False):
+    save = getattr(getattr(caching, "IndexDataCacheFile", None), "save", None)
+    if save is None or getattr(save, "spatialmech_locked", False):  # another numba layout: leave it alone
         return
 
     def locked_save(self, key, data):
