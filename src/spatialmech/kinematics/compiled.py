@@ -111,7 +111,8 @@ def enabled() -> bool:
     (or ``0``).  Read at every call, so a test or a benchmark can switch paths in one process.
     Without numba a one-time ``RuntimeWarning`` says that the Python path runs."""
     global _NOTED
-    if os.environ.get(PURE_ENV, "").strip() not in ("", "0"):
+    pure = os.environ.get(PURE_ENV)
+    if pure and pure.strip() not in ("", "0"):
         return False
     if not AVAILABLE:
         if not _NOTED:
@@ -228,6 +229,9 @@ def _chain_arrays(chain: Chain) -> _ChainArrays:
 
 
 # ---------------------------------------------------------------------------- Python entry points
+_NO_BODIES_W = np.empty((0, 4, 4))  # never written: it has no entries
+
+
 def _f64(x, shape=None) -> np.ndarray:
     """A C-contiguous, writable float64 array: one numba type per kernel argument (a read-only
     view, e.g. from ``np.broadcast_to``, would be a different type and compile again)."""
@@ -391,7 +395,9 @@ def correct(mech: Mechanism, config: Configuration, *, active: np.ndarray | None
     act = _mask(mech, cm, active)
     if tol is None:  # the newton tolerance in force (geometry/tolerances.py)
         tol = current_tolerances().newton
-    q0, D0, B0 = _f64(config.q), _f64(config.D), _f64(config.B)
+    # no bodies: a writable empty array, not a copy of the read-only shared one
+    B0 = _f64(config.B) if cm.n_bodies else _NO_BODIES_W
+    q0, D0 = _f64(config.q), _f64(config.D)
     q, D, B = np.empty(cm.n), np.empty((4, 4)), np.empty(B0.shape)
     info = np.empty(3)
     nb_correct_one(*_correct_args(cm), q0, D0, B0, act, bool(fix_platform), float(tol), int(max_iter), q, D, B, info)

@@ -35,7 +35,7 @@ __all__ = ["nb_minnorm_blocks", "nb_pivoted_qr", "nb_qt_apply", "nb_trapezoid_mi
 
 
 @njit(cache=True)
-def nb_pivoted_qr(ZT, nrows, m, ncols, piv, v0, vn2):
+def nb_pivoted_qr(ZT, nrows, m, ncols, piv, v0, vn2, e):
     """Householder QR with column pivoting of a block stored *transposed* (``ZT[c, i]`` is row
     ``i`` of column ``c``: every inner loop runs along a contiguous column) over its first
     ``nrows`` rows and ``m`` columns, the reflectors applied to every column up to ``ncols``
@@ -45,7 +45,8 @@ def nb_pivoted_qr(ZT, nrows, m, ncols, piv, v0, vn2):
     ``-1`` when a pivot lies between that and ``1 / BLOCK_MAX_COND`` of the largest (the rank is
     not clear) or ``R[:r, :r]`` is conditioned worse than ``BLOCK_MAX_COND`` (Frobenius norms of
     it and its inverse).  The reflectors stay below the diagonal (``ZT[j, j+1:nrows]``), with
-    their first entries in ``v0`` and squared norms in ``vn2`` (:func:`nb_qt_apply`)."""
+    their first entries in ``v0`` and squared norms in ``vn2`` (:func:`nb_qt_apply`); ``e``: scratch
+    of at least ``min(nrows, m)`` entries."""
     for j in range(m):
         piv[j] = j
     big = 0.0
@@ -101,7 +102,6 @@ def nb_pivoted_qr(ZT, nrows, m, ncols, piv, v0, vn2):
         for i in range(c + 1):
             fro += ZT[c, i] * ZT[c, i]
     inv = 0.0
-    e = np.empty(r)
     for c in range(r):
         for i in range(r - 1, -1, -1):
             acc = 1.0 if i == c else 0.0
@@ -115,10 +115,10 @@ def nb_pivoted_qr(ZT, nrows, m, ncols, piv, v0, vn2):
 
 
 @njit(cache=True)
-def nb_trapezoid_minnorm(ZT, r, m, d, y):
+def nb_trapezoid_minnorm(ZT, r, m, d, y, V, diag, vn):
     """The minimum-norm ``y`` (m,) of ``R y = d`` with ``R`` upper trapezoidal of full row rank
     ``r``, stored transposed (``R[i, c] = ZT[c, i]``): back substitution when ``r == m``, else by
-    a Householder QR of ``R^T``."""
+    a Householder QR of ``R^T`` (scratch: ``V`` at least (r, m), ``diag`` and ``vn`` at least r)."""
     if r == m:
         for i in range(r - 1, -1, -1):
             acc = d[i]
@@ -126,12 +126,9 @@ def nb_trapezoid_minnorm(ZT, r, m, d, y):
                 acc -= ZT[k, i] * y[k]
             y[i] = acc / ZT[i, i]
         return
-    V = np.zeros((r, m))  # row j: column j of R^T = row j of R, reduced in place to [L ; 0]
-    for i in range(r):
-        for c in range(i, m):
-            V[i, c] = ZT[c, i]
-    diag = np.empty(r)
-    vn = np.empty(r)
+    for i in range(r):  # row j of V: column j of R^T = row j of R, reduced in place to [L ; 0]
+        for c in range(m):
+            V[i, c] = ZT[c, i] if c >= i else 0.0
     for j in range(r):
         nrm = 0.0
         for c in range(j, m):
@@ -203,6 +200,7 @@ def nb_minnorm_blocks(A, b, c_lo, c_hi, ns0, x):
     v0s = np.empty((K, 6))
     vn2s = np.empty((K, 6))
     ranks = np.empty(K, dtype=np.int64)
+    scratch = np.empty(max(6, s))
     nred = 0
     for k in range(K):
         m = c_hi[k] - c_lo[k]
@@ -212,7 +210,7 @@ def nb_minnorm_blocks(A, b, c_lo, c_hi, ns0, x):
                 Z[c, i] = A[6 * k + i, c_lo[k] + c]
         for i in range(6):
             Z[m, i] = b[6 * k + i]
-        r = nb_pivoted_qr(Z, 6, m, m + 1, pivs[k], v0s[k], vn2s[k])
+        r = nb_pivoted_qr(Z, 6, m, m + 1, pivs[k], v0s[k], vn2s[k], scratch)
         if r < 0:
             return False
         ranks[k] = r
@@ -239,7 +237,7 @@ def nb_minnorm_blocks(A, b, c_lo, c_hi, ns0, x):
                 R[s, i0] = Zs[k, m, i]
                 i0 += 1
         pr = np.empty(s, dtype=np.int64)
-        if nb_pivoted_qr(R, s, s, s + 1, pr, np.empty(s), np.empty(s)) != s:
+        if nb_pivoted_qr(R, s, s, s + 1, pr, np.empty(s), np.empty(s), scratch) != s:
             return False
         for i in range(s - 1, -1, -1):
             acc = R[s, i]
@@ -247,6 +245,9 @@ def nb_minnorm_blocks(A, b, c_lo, c_hi, ns0, x):
                 acc -= R[c, i] * xi[pr[c]]
             xi[pr[i]] = acc / R[i, i]
     y = np.empty(max(mmax, 1))
+    V = np.empty((6, max(mmax, 1)))
+    diag = np.empty(6)
+    vn = np.empty(6)
     for k in range(K):
         m = c_hi[k] - c_lo[k]
         r = ranks[k]
@@ -262,7 +263,7 @@ def nb_minnorm_blocks(A, b, c_lo, c_hi, ns0, x):
             for a in range(6):
                 e[a] = Z[m, a]
         if r > 0:
-            nb_trapezoid_minnorm(Z, r, m, e, y)
+            nb_trapezoid_minnorm(Z, r, m, e, y, V, diag, vn)
         else:
             for j in range(m):
                 y[j] = 0.0

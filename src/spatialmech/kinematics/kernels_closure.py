@@ -10,6 +10,7 @@ from .kernels_blocks import nb_minnorm_blocks
 from .kernels_se3 import (
     nb_lsq_qr,
     nb_ball_product,
+    nb_ball_product_ws,
     nb_copy44,
     nb_exp_twist,
     nb_inverse_into,
@@ -24,6 +25,7 @@ from .jit import njit
 __all__ = [
     "nb_adjoint_columns",
     "nb_chain",
+    "nb_chain_ws",
     "nb_closure_system",
     "nb_colmap",
     "nb_correct",
@@ -48,14 +50,24 @@ def nb_chain(S, ball_of, ball_axes, ball_centre, q, lo, hi, T, J):
     the preceding freedoms).  Each joint (one freedom, or a ball's three) contributes columns
     ``(R a ; R m + p x R a)`` for its reference directions ``a`` and moments ``m``, then moves
     the chain's displacement ``(R, p)`` by its own ``(Rb, u)``: ``p += R u``, ``R = R Rb``."""
-    R = np.zeros((3, 3))
-    R[0, 0] = R[1, 1] = R[2, 2] = 1.0
-    p = np.zeros(3)
-    Rb = np.empty((3, 3))
-    Rn = np.empty((3, 3))
-    u = np.empty(3)
-    ax = np.empty((3, 3))
-    mo = np.empty((3, 3))
+    nb_chain_ws(S, ball_of, ball_axes, ball_centre, q, lo, hi, T, J, np.empty((6, 3, 3)))
+
+
+@njit(cache=True)
+def nb_chain_ws(S, ball_of, ball_axes, ball_centre, q, lo, hi, T, J, W):
+    """:func:`nb_chain` with its scratch matrices in ``W`` (6, 3, 3): a caller that runs many
+    chains allocates them once."""
+    R = W[0]
+    Rb = W[1]
+    Rn = W[2]
+    ax = W[3]
+    mo = W[4]
+    p = W[5, 0]
+    u = W[5, 1]
+    for a in range(3):
+        p[a] = 0.0
+        for b in range(3):
+            R[a, b] = 1.0 if a == b else 0.0
     i = lo
     while i < hi:
         g = ball_of[i]
@@ -167,6 +179,7 @@ def nb_closure_system(S, ball_of, ball_axes, ball_centre, limb_start, ends, q, D
     T2 = np.empty((4, 4))
     Hi = np.empty((4, 4))
     res = np.empty(6)
+    W = np.empty((6, 3, 3))
     if want_A:
         for i in range(A.shape[0]):
             for c in range(A.shape[1]):
@@ -174,7 +187,7 @@ def nb_closure_system(S, ball_of, ball_axes, ball_centre, limb_start, ends, q, D
     for k in range(K):
         lo = limb_start[k]
         hi = limb_start[k + 1]
-        nb_chain(S, ball_of, ball_axes, ball_centre, q, lo, hi, T, J)
+        nb_chain_ws(S, ball_of, ball_axes, ball_centre, q, lo, hi, T, J, W)
         a = ends[k, 0]
         b = ends[k, 1]
         r0 = 6 * k
@@ -272,9 +285,10 @@ def nb_retract(ball_first, ball_axes, q, D, B, active, step, na, fix_platform, q
             j += 1
     for i in range(n):
         q_out[i] = q[i] + dq[i]
+    work = np.empty((4, 3, 3))
     for g in range(len(ball_first)):
         i = ball_first[g]
-        nb_ball_product(ball_axes[g], dq[i : i + 3], q[i : i + 3], False, False, q_out[i : i + 3])
+        nb_ball_product_ws(ball_axes[g], dq[i : i + 3], q[i : i + 3], False, False, q_out[i : i + 3], work)
     nv = len(step) - na
     E = np.empty((4, 4))
     if fix_platform or nv < 6:

@@ -12,6 +12,7 @@ __all__ = [
     "EPS",
     "SINCOS_MAX",
     "nb_ball_product",
+    "nb_ball_product_ws",
     "nb_copy44",
     "nb_cross",
     "nb_det",
@@ -611,11 +612,17 @@ def nb_ball_product(A, u, v, invert_v, quat, out):
     (difference).  ``quat``: the matrix -> rotation vector conversion by quaternion (as
     :func:`scipy.spatial.transform.Rotation.as_rotvec`) rather than by the matrix logarithm; each
     caller keeps the conversion of the Python code it mirrors."""
-    work = np.empty((3, 3, 3))
+    nb_ball_product_ws(A, u, v, invert_v, quat, out, np.empty((4, 3, 3)))
+
+
+@njit(cache=True)
+def nb_ball_product_ws(A, u, v, invert_v, quat, out, work):
+    """:func:`nb_ball_product` with its scratch matrices in ``work`` (4, 3, 3): a caller that
+    composes many balls allocates them once."""
     Ra = work[0]
     Rb = work[1]
     Rn = work[2]
-    rv = np.empty(3)
+    rv = work[3, 0]
     nb_rotvec_matrix3(A[0, 0] * u[0] + A[0, 1] * u[1] + A[0, 2] * u[2],
                       A[1, 0] * u[0] + A[1, 1] * u[1] + A[1, 2] * u[2],
                       A[2, 0] * u[0] + A[2, 1] * u[1] + A[2, 2] * u[2], Ra)
