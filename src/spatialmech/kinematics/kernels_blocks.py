@@ -31,7 +31,32 @@ import numpy as np
 from ..geometry.tolerances import BLOCK_MAX_COND, BLOCK_RANK_ZERO
 from .jit import njit
 
-__all__ = ["nb_minnorm_blocks", "nb_pivoted_qr", "nb_qt_apply", "nb_trapezoid_minnorm"]
+__all__ = ["nb_minnorm_blocks", "nb_pivoted_qr", "nb_qt_apply", "nb_reflect", "nb_trapezoid_minnorm"]
+
+
+@njit(cache=True, inline="always")
+def nb_reflect(ZT, j, nrows, ncols, nrm, v0, vn2):
+    """One Householder step of a block stored transposed (``ZT[c, i]``: row ``i`` of column
+    ``c``): the reflector that maps column ``j`` (rows ``j ..``, norm ``nrm``) onto
+    ``R_jj e_j``, applied to the columns after it up to ``ncols``.  It stays below the diagonal
+    (``ZT[j, j+1:nrows]``) with its first entry in ``v0[j]`` and squared norm in ``vn2[j]``;
+    ``ZT[j, j]`` becomes ``R_jj``."""
+    alpha = -nrm if ZT[j, j] >= 0.0 else nrm
+    ZT[j, j] -= alpha  # the reflector v = (Z[j, j] - alpha, Z[j+1:, j]) in place
+    w = 0.0
+    for i in range(j, nrows):
+        w += ZT[j, i] * ZT[j, i]
+    if w > 0.0:
+        for c in range(j + 1, ncols):
+            dot = 0.0
+            for i in range(j, nrows):
+                dot += ZT[j, i] * ZT[c, i]
+            f = 2.0 * dot / w
+            for i in range(j, nrows):
+                ZT[c, i] -= f * ZT[j, i]
+    v0[j] = ZT[j, j]
+    vn2[j] = w
+    ZT[j, j] = alpha
 
 
 @njit(cache=True)
@@ -78,22 +103,7 @@ def nb_pivoted_qr(ZT, nrows, m, ncols, piv, v0, vn2, e):
             t2 = piv[j]
             piv[j] = piv[p]
             piv[p] = t2
-        alpha = -nrm if ZT[j, j] >= 0.0 else nrm
-        ZT[j, j] -= alpha  # the reflector v = (Z[j, j] - alpha, Z[j+1:, j]) in place
-        w = 0.0
-        for i in range(j, nrows):
-            w += ZT[j, i] * ZT[j, i]
-        if w > 0.0:
-            for c in range(j + 1, ncols):
-                dot = 0.0
-                for i in range(j, nrows):
-                    dot += ZT[j, i] * ZT[c, i]
-                f = 2.0 * dot / w
-                for i in range(j, nrows):
-                    ZT[c, i] -= f * ZT[j, i]
-        v0[j] = ZT[j, j]
-        vn2[j] = w
-        ZT[j, j] = alpha
+        nb_reflect(ZT, j, nrows, ncols, nrm, v0, vn2)
         r = j + 1
     # the conditioning of R[:r, :r]: |R|_F |R^-1|_F, the inverse column by column (r <= 6 here
     # for a limb; the reduced system's r is the number of shared columns)
@@ -115,10 +125,11 @@ def nb_pivoted_qr(ZT, nrows, m, ncols, piv, v0, vn2, e):
 
 
 @njit(cache=True)
-def nb_trapezoid_minnorm(ZT, r, m, d, y, V, diag, vn):
+def nb_trapezoid_minnorm(ZT, r, m, d, y, V, v0, vn2):
     """The minimum-norm ``y`` (m,) of ``R y = d`` with ``R`` upper trapezoidal of full row rank
-    ``r``, stored transposed (``R[i, c] = ZT[c, i]``): back substitution when ``r == m``, else by
-    a Householder QR of ``R^T`` (scratch: ``V`` at least (r, m), ``diag`` and ``vn`` at least r)."""
+    ``r``, stored transposed (``R[i, c] = ZT[c, i]``): back substitution when ``r == m``, else
+    ``R^T = Q [U ; 0]`` by Householder steps (:func:`nb_reflect`) and ``y = Q [z ; 0]`` with
+    ``U^T z = d`` (scratch: ``V`` at least (r, m), ``v0`` and ``vn2`` at least r)."""
     if r == m:
         for i in range(r - 1, -1, -1):
             acc = d[i]
@@ -126,45 +137,22 @@ def nb_trapezoid_minnorm(ZT, r, m, d, y, V, diag, vn):
                 acc -= ZT[k, i] * y[k]
             y[i] = acc / ZT[i, i]
         return
-    for i in range(r):  # row j of V: column j of R^T = row j of R, reduced in place to [L ; 0]
+    for i in range(r):  # V[i] = row i of R = column i of R^T: R^T stored transposed
         for c in range(m):
             V[i, c] = ZT[c, i] if c >= i else 0.0
     for j in range(r):
         nrm = 0.0
         for c in range(j, m):
             nrm += V[j, c] * V[j, c]
-        nrm = np.sqrt(nrm)
-        alpha = -nrm if V[j, j] >= 0.0 else nrm
-        V[j, j] -= alpha
-        s = 0.0
-        for c in range(j, m):
-            s += V[j, c] * V[j, c]
-        vn[j] = s
-        diag[j] = alpha
-        if s > 0.0:
-            for i in range(j + 1, r):
-                dot = 0.0
-                for c in range(j, m):
-                    dot += V[j, c] * V[i, c]
-                f = 2.0 * dot / s
-                for c in range(j, m):
-                    V[i, c] -= f * V[j, c]
-    # R = [L 0] Q2^T with L lower triangular: L[i, j] = V[i, j] (j < i), L[j, j] = diag[j]
-    for i in range(m):
-        y[i] = 0.0
-    for i in range(r):
-        acc = d[i]
-        for j in range(i):
-            acc -= V[i, j] * y[j]
-        y[i] = acc / diag[i]
-    for j in range(r - 1, -1, -1):  # y = Q2 [z ; 0] = H_0 ... H_{r-1} [z ; 0]
-        if vn[j] > 0.0:
-            dot = 0.0
-            for c in range(j, m):
-                dot += V[j, c] * y[c]
-            f = 2.0 * dot / vn[j]
-            for c in range(j, m):
-                y[c] -= f * V[j, c]
+        nb_reflect(V, j, m, r, np.sqrt(nrm), v0, vn2)
+    for j in range(r):  # U^T z = d, U[i, j] = V[j, i] (i <= j)
+        acc = d[j]
+        for i in range(j):
+            acc -= V[j, i] * y[i]
+        y[j] = acc / V[j, j]
+    for j in range(r, m):
+        y[j] = 0.0
+    nb_qt_apply(V, r, m, v0, vn2, y, False)
 
 
 @njit(cache=True)
@@ -246,8 +234,8 @@ def nb_minnorm_blocks(A, b, c_lo, c_hi, ns0, x):
             xi[pr[i]] = acc / R[i, i]
     y = np.empty(max(mmax, 1))
     V = np.empty((6, max(mmax, 1)))
-    diag = np.empty(6)
-    vn = np.empty(6)
+    tv0 = np.empty(6)
+    tvn2 = np.empty(6)
     for k in range(K):
         m = c_hi[k] - c_lo[k]
         r = ranks[k]
@@ -263,7 +251,7 @@ def nb_minnorm_blocks(A, b, c_lo, c_hi, ns0, x):
             for a in range(6):
                 e[a] = Z[m, a]
         if r > 0:
-            nb_trapezoid_minnorm(Z, r, m, e, y, V, diag, vn)
+            nb_trapezoid_minnorm(Z, r, m, e, y, V, tv0, tvn2)
         else:
             for j in range(m):
                 y[j] = 0.0
