@@ -357,14 +357,10 @@ def _run_correct(mech: Mechanism, cm: CompiledMechanism, seeds: Sequence[Configu
     act = _mask(mech, cm, active)
     if tol is None:  # the newton tolerance in force (geometry/tolerances.py)
         tol = current_tolerances().newton
-    N = len(seeds)
-    if N == 1:  # one seed (forward position, a tracker step): views, no copies
-        c = seeds[0]
-        qs, Ds, Bs = _f64(c.q, (1, cm.n)), _f64(c.D, (1, 4, 4)), _f64(c.B, (1, cm.n_bodies, 4, 4))
-    else:
-        qs = _f64([c.q for c in seeds], (N, cm.n))
-        Ds = _f64([c.D for c in seeds], (N, 4, 4))
-        Bs = _f64([c.B for c in seeds], (N, cm.n_bodies, 4, 4))
+    N = len(seeds)  # (one seed goes through correct's own entry, nb_correct_one)
+    qs = _f64([c.q for c in seeds], (N, cm.n))
+    Ds = _f64([c.D for c in seeds], (N, 4, 4))
+    Bs = _f64([c.B for c in seeds], (N, cm.n_bodies, 4, 4))
     q_out, D_out, B_out = np.empty_like(qs), np.empty_like(Ds), np.empty_like(Bs)
     status = np.empty(N, dtype=np.int64)
     iters = np.empty(N, dtype=np.int64)
