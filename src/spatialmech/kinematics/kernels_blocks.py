@@ -6,18 +6,23 @@ shared.  With ``J_k`` the limb's own block, ``H_k`` its shared block and ``b_k``
 side, the minimum-norm least-squares solution of the whole system (``np.linalg.lstsq``) is,
 whenever the shared twists ``xi`` are determined:
 
-1. a pivoted Householder QR of each ``J_k`` (``Q_k^T J_k P_k = [R_k ; 0]``, rank ``r_k``);
-2. the rows ``r_k .. 5`` of ``Q_k^T [H_k  b_k]`` stacked: the *reduced* system in ``xi``
-   (the constraints that the limb's own joints cannot absorb, e.g. the leg line of an S-P-S leg
-   with its slide held);
-3. ``xi`` from the reduced system, then each limb's minimum-norm least-squares ``dq_k`` from
-   ``R_k dq_k = (Q_k^T (b_k - H_k xi))_{0..r_k-1}``.
+1. a Householder QR of each ``J_k^T`` with its columns (the limb's six constraint rows)
+   pivoted: ``J_k^T P_k = Q_k R_k``, rank ``r_k``;
+2. the left null space of ``J_k`` -- the constraints that the limb's own joints cannot absorb,
+   e.g. the leg line of an S-P-S leg with its slide held -- is ``P_k u`` with ``R_k u = 0``: one
+   back substitution per missing rank, each vector normalised; these rows applied to
+   ``[H_k  b_k]``, stacked over the limbs, are the *reduced* system in ``xi``;
+3. ``xi`` from the reduced system, then each limb's minimum-norm ``dq_k = Q_k z`` of the now
+   consistent ``J_k dq_k = b_k - H_k xi`` from the triangular ``R_k[:, :r_k]^T z = (P_k^T (b_k -
+   H_k xi))_{0..r_k-1}``.
 
-When the reduced system is square and regular (a forward-position step of a non-redundant
-mechanism away from a singularity) every solution of the whole system has that ``xi``, so the
+One factorization per limb serves both the reduced system and the limb's step.  When the
+reduced system is square and regular (a forward-position step of a non-redundant mechanism away
+from a singularity) every solution of the whole system has that ``xi``, so the
 minimum-norm solution minimises each ``|dq_k|`` separately: this *is* ``lstsq``'s step, to
 rounding, at a few per cent of its cost.  When no column is shared (inverse position: the
-output held) the limbs decouple and the same holds for any rank.  Everything else -- a rank the
+output held) the limbs decouple: each limb's least-squares step, any rank, from a column-pivoted
+QR of ``[J_k  b_k]`` and :func:`nb_trapezoid_minnorm`.  Everything else -- a rank the
 factorization cannot tell (a pivot between ``BLOCK_RANK_ZERO`` and ``BLOCK_MAX_COND`` relative
 to the largest, or a triangular factor conditioned worse than ``BLOCK_MAX_COND``), a reduced
 system that is not square (overconstrained or redundant mechanisms), or an ill-conditioned one
@@ -31,7 +36,15 @@ import numpy as np
 from ..geometry.tolerances import BLOCK_MAX_COND, BLOCK_RANK_ZERO
 from .jit import njit
 
-__all__ = ["nb_minnorm_blocks", "nb_pivoted_qr", "nb_qt_apply", "nb_reflect", "nb_trapezoid_minnorm"]
+__all__ = [
+    "nb_blocks_workspace",
+    "nb_minnorm_blocks",
+    "nb_minnorm_blocks_ws",
+    "nb_pivoted_qr",
+    "nb_qt_apply",
+    "nb_reflect",
+    "nb_trapezoid_minnorm",
+]
 
 
 @njit(cache=True, inline="always")
@@ -172,91 +185,188 @@ def nb_qt_apply(ZT, r, nrows, v0, vn2, y, transpose):
 
 
 @njit(cache=True)
+def nb_blocks_workspace(c_lo, c_hi, ns0, n):
+    """Scratch of :func:`nb_minnorm_blocks_ws` for a system with these limb columns and ``n``
+    columns in all (allocated once per solve, not per Newton step): ``(floats, ints)``."""
+    K = len(c_lo)
+    mmax = 1
+    for k in range(K):
+        mmax = max(mmax, c_hi[k] - c_lo[k])
+    s = n - ns0
+    shared = K * 6 * mmax + 12 * K + (s + 1) * s + 3 * s + max(6, s) + 12 + mmax
+    decoupled = 13 * mmax + 36
+    return np.empty(max(shared, decoupled)), np.empty(7 * K + s + mmax, dtype=np.int64)
+
+
+@njit(cache=True)
 def nb_minnorm_blocks(A, b, c_lo, c_hi, ns0, x):
     """Minimum-norm least-squares solution of ``A x = b`` into ``x`` by block elimination (module
     docstring).  ``A`` is (6K, n): limb ``k``'s rows ``6k .. 6k+5``; its own columns
     ``c_lo[k] .. c_hi[k]-1`` (nonzero only in its rows), the shared columns ``ns0 .. n-1``.
-    Returns ``False`` (``x`` untouched) when the general solver must decide."""
+    Returns ``False`` (``x`` partly written) when the general solver must decide."""
+    fbuf, ibuf = nb_blocks_workspace(c_lo, c_hi, ns0, A.shape[1])
+    return nb_minnorm_blocks_ws(A, b, c_lo, c_hi, ns0, x, fbuf, ibuf)
+
+
+@njit(cache=True)
+def nb_minnorm_blocks_ws(A, b, c_lo, c_hi, ns0, x, fbuf, ibuf):
+    """:func:`nb_minnorm_blocks` with its scratch from :func:`nb_blocks_workspace`.  With shared
+    columns, one pivoted QR per limb of ``J_k^T`` (rows of ``J_k`` pivoted): ``J_k^T P_k = Q_k
+    R_k``.  Its left null space (the constraints the limb's joints cannot absorb) is ``P_k u``
+    with ``R_k u = 0``, by back substitution; once the shared twists ``xi`` are known, the
+    minimum-norm ``dq_k`` of the consistent ``J_k dq_k = b_k - H_k xi`` is ``Q_k z`` with
+    ``R_k[:, :r]^T z = (P_k^T (b_k - H_k xi))_{0..r-1}``."""
     K = len(c_lo)
     n = A.shape[1]
     s = n - ns0
-    mmax = 0
+    if s == 0:  # limbs decoupled: least squares of each limb, any rank
+        return _decoupled(A, b, c_lo, c_hi, x, fbuf, ibuf)
+    mmax = 1
     for k in range(K):
         mmax = max(mmax, c_hi[k] - c_lo[k])
-    Zs = np.empty((K, mmax + 1, 6))  # per limb [J_k b_k], transposed
-    pivs = np.empty((K, max(mmax, 1)), dtype=np.int64)
-    v0s = np.empty((K, 6))
-    vn2s = np.empty((K, 6))
-    ranks = np.empty(K, dtype=np.int64)
-    scratch = np.empty(max(6, s))
+    o = 0
+    Gs = fbuf[o : o + K * 6 * mmax].reshape((K, 6, mmax))  # per limb J_k row by row = J_k^T transposed
+    o += K * 6 * mmax
+    v0s = fbuf[o : o + 6 * K].reshape((K, 6))
+    o += 6 * K
+    vn2s = fbuf[o : o + 6 * K].reshape((K, 6))
+    o += 6 * K
+    R = fbuf[o : o + (s + 1) * s].reshape((s + 1, s))  # the reduced system [w^T H_k  w^T b_k], transposed
+    o += (s + 1) * s
+    rv0 = fbuf[o : o + s]
+    o += s
+    rvn2 = fbuf[o : o + s]
+    o += s
+    xi = fbuf[o : o + s]
+    o += s
+    e = fbuf[o : o + max(6, s)]
+    o += max(6, s)
+    w = fbuf[o : o + 6]
+    o += 6
+    c = fbuf[o : o + 6]
+    o += 6
+    y = fbuf[o : o + mmax]
+    pivs = ibuf[: 6 * K].reshape((K, 6))
+    ranks = ibuf[6 * K : 7 * K]
+    pr = ibuf[7 * K : 7 * K + s]
     nred = 0
     for k in range(K):
         m = c_hi[k] - c_lo[k]
-        Z = Zs[k]
-        for c in range(m):
-            for i in range(6):
-                Z[c, i] = A[6 * k + i, c_lo[k] + c]
+        G = Gs[k]
         for i in range(6):
-            Z[m, i] = b[6 * k + i]
-        r = nb_pivoted_qr(Z, 6, m, m + 1, pivs[k], v0s[k], vn2s[k], scratch)
+            for j in range(m):
+                G[i, j] = A[6 * k + i, c_lo[k] + j]
+        r = nb_pivoted_qr(G, m, 6, 6, pivs[k], v0s[k], vn2s[k], e)
         if r < 0:
             return False
         ranks[k] = r
         nred += 6 - r
-    xi = np.zeros(s)
-    e = np.empty(6)
-    if s > 0:
-        if nred != s:
-            return False
-        R = np.empty((s + 1, s))  # the reduced system [z_i^T H_k  z_i^T b_k], transposed
-        i0 = 0
-        for k in range(K):
-            m = c_hi[k] - c_lo[k]
-            for i in range(ranks[k], 6):
-                for a in range(6):  # z_i = Q e_i: the limb's constraint the joints cannot absorb
-                    e[a] = 0.0
-                e[i] = 1.0
-                nb_qt_apply(Zs[k], ranks[k], 6, v0s[k], vn2s[k], e, False)
-                for c in range(s):
-                    acc = 0.0
-                    for a in range(6):
-                        acc += e[a] * A[6 * k + a, ns0 + c]
-                    R[c, i0] = acc
-                R[s, i0] = Zs[k, m, i]
-                i0 += 1
-        pr = np.empty(s, dtype=np.int64)
-        if nb_pivoted_qr(R, s, s, s + 1, pr, np.empty(s), np.empty(s), scratch) != s:
-            return False
-        for i in range(s - 1, -1, -1):
-            acc = R[s, i]
-            for c in range(i + 1, s):
-                acc -= R[c, i] * xi[pr[c]]
-            xi[pr[i]] = acc / R[i, i]
-    y = np.empty(max(mmax, 1))
-    V = np.empty((6, max(mmax, 1)))
-    tv0 = np.empty(6)
-    tvn2 = np.empty(6)
+    if nred != s:
+        return False
+    i0 = 0
+    for k in range(K):
+        G = Gs[k]
+        r = ranks[k]
+        piv = pivs[k]
+        for t in range(r, 6):  # u: R u = 0 with u[t] = 1, u[r:] = 0 otherwise; w = P u, unit
+            for i in range(r, 6):
+                e[i] = 0.0
+            e[t] = 1.0
+            for i in range(r - 1, -1, -1):
+                acc = -G[t, i]
+                for j in range(i + 1, r):
+                    acc -= G[j, i] * e[j]
+                e[i] = acc / G[i, i]
+            nrm = 0.0
+            for i in range(6):
+                nrm += e[i] * e[i]
+            nrm = np.sqrt(nrm)
+            for i in range(6):
+                w[piv[i]] = e[i] / nrm
+            for cc in range(s):
+                acc = 0.0
+                for a in range(6):
+                    acc += w[a] * A[6 * k + a, ns0 + cc]
+                R[cc, i0] = acc
+            acc = 0.0
+            for a in range(6):
+                acc += w[a] * b[6 * k + a]
+            R[s, i0] = acc
+            i0 += 1
+    if nb_pivoted_qr(R, s, s, s + 1, pr, rv0, rvn2, e) != s:
+        return False
+    for i in range(s - 1, -1, -1):
+        acc = R[s, i]
+        for cc in range(i + 1, s):
+            acc -= R[cc, i] * xi[pr[cc]]
+        xi[pr[i]] = acc / R[i, i]
     for k in range(K):
         m = c_hi[k] - c_lo[k]
         r = ranks[k]
-        Z = Zs[k]
-        if s > 0:  # Q^T (b_k - H_k xi), the rows the limb's own joints take
-            for a in range(6):
-                acc = b[6 * k + a]
-                for c in range(s):
-                    acc -= A[6 * k + a, ns0 + c] * xi[c]
-                e[a] = acc
-            nb_qt_apply(Z, r, 6, v0s[k], vn2s[k], e, True)
-        else:
-            for a in range(6):
-                e[a] = Z[m, a]
+        G = Gs[k]
+        piv = pivs[k]
+        for a in range(6):  # b_k - H_k xi, consistent now
+            acc = b[6 * k + a]
+            for cc in range(s):
+                acc -= A[6 * k + a, ns0 + cc] * xi[cc]
+            c[a] = acc
+        for j in range(r):  # R[:, :r]^T z = (P^T c)[:r], lower triangular: R[i, j] = G[j, i]
+            acc = c[piv[j]]
+            for i in range(j):
+                acc -= G[j, i] * y[i]
+            y[j] = acc / G[j, j]
+        for j in range(r, m):
+            y[j] = 0.0
+        nb_qt_apply(G, r, m, v0s[k], vn2s[k], y, False)  # dq_k = Q [z ; 0]
+        for j in range(m):
+            x[c_lo[k] + j] = y[j]
+    for cc in range(s):
+        x[ns0 + cc] = xi[cc]
+    return True
+
+
+@njit(cache=True)
+def _decoupled(A, b, c_lo, c_hi, x, fbuf, ibuf):
+    """Each limb's minimum-norm least-squares step when no column is shared: a pivoted QR of
+    ``[J_k b_k]`` (columns pivoted), then :func:`nb_trapezoid_minnorm`."""
+    K = len(c_lo)
+    mmax = 1
+    for k in range(K):
+        mmax = max(mmax, c_hi[k] - c_lo[k])
+    o = 0
+    Z = fbuf[o : o + (mmax + 1) * 6].reshape((mmax + 1, 6))
+    o += (mmax + 1) * 6
+    v0 = fbuf[o : o + 6]
+    o += 6
+    vn2 = fbuf[o : o + 6]
+    o += 6
+    e = fbuf[o : o + 6]
+    o += 6
+    tv0 = fbuf[o : o + 6]
+    o += 6
+    tvn2 = fbuf[o : o + 6]
+    o += 6
+    y = fbuf[o : o + mmax]
+    o += mmax
+    V = fbuf[o : o + 6 * mmax].reshape((6, mmax))
+    piv = ibuf[:mmax]
+    for k in range(K):
+        m = c_hi[k] - c_lo[k]
+        for cc in range(m):
+            for i in range(6):
+                Z[cc, i] = A[6 * k + i, c_lo[k] + cc]
+        for i in range(6):
+            Z[m, i] = b[6 * k + i]
+        r = nb_pivoted_qr(Z, 6, m, m + 1, piv, v0, vn2, e)
+        if r < 0:
+            return False
+        for a in range(6):
+            e[a] = Z[m, a]
         if r > 0:
             nb_trapezoid_minnorm(Z, r, m, e, y, V, tv0, tvn2)
         else:
             for j in range(m):
                 y[j] = 0.0
         for j in range(m):
-            x[c_lo[k] + pivs[k, j]] = y[j]
-    for c in range(s):
-        x[ns0 + c] = xi[c]
+            x[c_lo[k] + piv[j]] = y[j]
     return True

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .kernels_blocks import nb_minnorm_blocks
+from .kernels_blocks import nb_blocks_workspace, nb_minnorm_blocks_ws
 from .kernels_se3 import (
     nb_lsq_qr,
     nb_ball_product,
@@ -345,6 +345,7 @@ def nb_correct(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends,
     q2 = np.empty(n)
     D2 = np.empty((4, 4))
     B2 = np.empty((h - 1, 4, 4))
+    fbuf, ibuf = nb_blocks_workspace(c_lo, c_hi, na, nk)
     for s in range(qs.shape[0]):
         q = q_out[s]
         D = D_out[s]
@@ -394,7 +395,7 @@ def nb_correct(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends,
                         if keep[c]:
                             As[i, j] = row[i] * A[i, c] * col[c]
                             j += 1
-            if not nb_minnorm_blocks(As, rhs, c_lo, c_hi, na, x):  # lstsq's step, by blocks
+            if not nb_minnorm_blocks_ws(As, rhs, c_lo, c_hi, na, x, fbuf, ibuf):  # lstsq's step, by blocks
                 x = nb_lstsq(As, rhs)
             if nb_norm(x) < 1e-13 * max(1.0, rn):
                 st = 2
