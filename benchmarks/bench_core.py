@@ -63,12 +63,20 @@ pure = compiled.python_reference
 
 def best_time(fn, repeat: int, number: int) -> float:
     """Best of ``repeat`` runs of ``number`` calls, seconds per call."""
-    best = math.inf
+    return best_times({"fn": (fn, number)}, repeat)["fn"]
+
+
+def best_times(fns: dict, repeat: int) -> dict:
+    """Best of ``repeat`` rounds, seconds per call, for each ``name: (fn, number)``.  Each round
+    runs every function once in turn, so that a slow spell of a shared machine falls on all of
+    them alike and the ratios stay fair."""
+    best = {k: math.inf for k in fns}
     for _ in range(repeat):
-        t = time.perf_counter()
-        for _ in range(number):
-            fn()
-        best = min(best, (time.perf_counter() - t) / number)
+        for k, (fn, number) in fns.items():
+            t = time.perf_counter()
+            for _ in range(number):
+                fn()
+            best[k] = min(best[k], (time.perf_counter() - t) / number)
     return best
 
 
@@ -142,8 +150,7 @@ def bench_fk(quick: bool) -> dict:
     assert res.converged, "the engine's forward solve did not converge"
     D = res.config.D
     err_engine = float(np.max(np.abs(D - goal.D)))
-    rep, num = (2, 3) if quick else (5, 40)
-    t_engine = best_time(lambda: correct(mech, seed, active=mask), rep, num)
+    rep, num = (2, 3) if quick else (25, 40)
     with pure():
         t_python = best_time(lambda: correct(mech, seed, active=mask), 2, 2 if quick else 5)
 
@@ -161,13 +168,18 @@ def bench_fk(quick: bool) -> dict:
 
     sol = root(F, np.zeros(6), method="hybr", tol=tol)
     assert sol.success, "scipy root did not converge"
-    t_scipy = best_time(lambda: root(F, np.zeros(6), method="hybr", tol=tol), rep, max(1, num // 4))
     # the hand-written numba Newton on the same residual
     R0, t0 = np.eye(3), np.zeros(3)
     Rh, th, it, ok = handwritten_stewart_newton(A, B, legs, R0, t0, tol, 50)
     assert ok, "the hand-written Newton did not converge"
     err_hand = float(max(np.max(np.abs(Rh - goal.D[:3, :3])), np.max(np.abs(th - goal.D[:3, 3]))))
-    t_hand = best_time(lambda: handwritten_stewart_newton(A, B, legs, R0, t0, tol, 50), rep, num * 20)
+    # the three timed in turn, round after round (best_times)
+    t = best_times({
+        "engine": (lambda: correct(mech, seed, active=mask), num),
+        "scipy": (lambda: root(F, np.zeros(6), method="hybr", tol=tol), max(1, num // 8)),
+        "hand": (lambda: handwritten_stewart_newton(A, B, legs, R0, t0, tol, 50), num * 4),
+    }, rep)
+    t_engine, t_scipy, t_hand = t["engine"], t["scipy"], t["hand"]
     return {
         "fk_solve_us": t_engine * 1e6,
         "fk_python_us": t_python * 1e6,

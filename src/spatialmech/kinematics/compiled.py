@@ -106,13 +106,25 @@ PURE_ENV = "SPATIALMECH_PURE"
 _NOTED = False
 
 
-def enabled() -> bool:
-    """True when the compiled kernels are used: numba imports and ``SPATIALMECH_PURE`` is unset
-    (or ``0``).  Read at every call, so a test or a benchmark can switch paths in one process.
-    Without numba a one-time ``RuntimeWarning`` says that the Python path runs."""
-    global _NOTED
+def _env_pure() -> bool:
     pure = os.environ.get(PURE_ENV)
-    if pure and pure.strip() not in ("", "0"):
+    return bool(pure and pure.strip() not in ("", "0"))
+
+
+#: ``SPATIALMECH_PURE`` as it was when this module was imported, and how many
+#: :func:`python_reference` blocks are open: :func:`enabled` reads these two (not the
+#: environment, whose lookup costs a microsecond on every solve).
+_ENV_PURE = _env_pure()
+_REFERENCE_DEPTH = 0
+
+
+def enabled() -> bool:
+    """True when the compiled kernels are used: numba imports, ``SPATIALMECH_PURE`` was unset
+    (or ``0``) when spatialmech was imported, and no :func:`python_reference` block is open (a
+    test or a benchmark switches paths in one process with that block).  Without numba a
+    one-time ``RuntimeWarning`` says that the Python path runs."""
+    global _NOTED
+    if _ENV_PURE or _REFERENCE_DEPTH:
         return False
     if not AVAILABLE:
         if not _NOTED:
@@ -125,13 +137,17 @@ def enabled() -> bool:
 
 @contextmanager
 def python_reference() -> Iterator[None]:
-    """Run the block on the pure-Python reference path (sets ``SPATIALMECH_PURE=1`` for its
-    duration, then restores the previous value): for comparisons and benchmarks."""
+    """Run the block on the pure-Python reference path, for comparisons and benchmarks.  It also
+    sets ``SPATIALMECH_PURE=1`` for its duration (then restores the previous value), so that a
+    subprocess started inside runs the reference too."""
+    global _REFERENCE_DEPTH
     old = os.environ.get(PURE_ENV)
     os.environ[PURE_ENV] = "1"
+    _REFERENCE_DEPTH += 1
     try:
         yield
     finally:
+        _REFERENCE_DEPTH -= 1
         if old is None:
             del os.environ[PURE_ENV]
         else:
@@ -394,12 +410,14 @@ def correct(mech: Mechanism, config: Configuration, *, active: np.ndarray | None
     # no bodies: a writable empty array, not a copy of the read-only shared one
     B0 = _f64(config.B) if cm.n_bodies else _NO_BODIES_W
     q0, D0 = _f64(config.q), _f64(config.D)
-    q, D, B = np.empty(cm.n), np.empty((4, 4)), np.empty(B0.shape)
+    q, D = np.empty(cm.n), np.empty((4, 4))
+    B = np.empty(B0.shape) if cm.n_bodies else _NO_BODIES_W  # (nothing is written into an empty array)
     info = np.empty(3)
     nb_correct_one(*_correct_args(cm), q0, D0, B0, act, bool(fix_platform), float(tol), int(max_iter), q, D, B, info)
-    if info[0] < 0:  # NaN or infinity in the seed: the full check names it
+    status, it, rn = info.tolist()
+    if status < 0:  # NaN or infinity in the seed: the full check names it
         check_configuration(mech, config)
-    return _result(config, q, D, B, int(info[0]), int(info[1]), float(info[2]))
+    return _result(config, q, D, B, int(status), int(it), rn)
 
 
 def correct_many(mech: Mechanism, seeds: Sequence[Configuration], *, active: np.ndarray | None = None,

@@ -17,7 +17,7 @@ from .kernels_se3 import (
     nb_log,
     nb_lstsq,
     nb_mm4,
-    nb_orthonormal,
+    nb_orthonormal_ws,
     nb_rodrigues,
 )
 from .jit import njit
@@ -27,6 +27,8 @@ __all__ = [
     "nb_chain",
     "nb_chain_ws",
     "nb_closure_system",
+    "nb_closure_system_ws",
+    "nb_closure_ws_size",
     "nb_colmap",
     "nb_correct",
     "nb_correct_hyperplane",
@@ -37,6 +39,7 @@ __all__ = [
     "nb_max_limb",
     "nb_norm",
     "nb_retract",
+    "nb_retract_ws",
     "nb_scales",
     "nb_systems",
 ]
@@ -146,19 +149,17 @@ def nb_hub(h, D, B):
 @njit(cache=True)
 def nb_adjoint_columns(H, J, m):
     """``J[:, :m] <- Ad(H) J[:, :m]`` in place."""
-    top = np.empty(3)
-    bot = np.empty(3)
-    x = np.empty(3)
     for c in range(m):
-        for a in range(3):
-            top[a] = H[a, 0] * J[0, c] + H[a, 1] * J[1, c] + H[a, 2] * J[2, c]
-            bot[a] = H[a, 0] * J[3, c] + H[a, 1] * J[4, c] + H[a, 2] * J[5, c]
-        x[0] = H[1, 3] * top[2] - H[2, 3] * top[1]
-        x[1] = H[2, 3] * top[0] - H[0, 3] * top[2]
-        x[2] = H[0, 3] * top[1] - H[1, 3] * top[0]
-        for a in range(3):
-            J[a, c] = top[a]
-            J[3 + a, c] = x[a] + bot[a]
+        t0 = H[0, 0] * J[0, c] + H[0, 1] * J[1, c] + H[0, 2] * J[2, c]
+        t1 = H[1, 0] * J[0, c] + H[1, 1] * J[1, c] + H[1, 2] * J[2, c]
+        t2 = H[2, 0] * J[0, c] + H[2, 1] * J[1, c] + H[2, 2] * J[2, c]
+        b0 = H[0, 0] * J[3, c] + H[0, 1] * J[4, c] + H[0, 2] * J[5, c]
+        b1 = H[1, 0] * J[3, c] + H[1, 1] * J[4, c] + H[1, 2] * J[5, c]
+        b2 = H[2, 0] * J[3, c] + H[2, 1] * J[4, c] + H[2, 2] * J[5, c]
+        J[0, c], J[1, c], J[2, c] = t0, t1, t2
+        J[3, c] = H[1, 3] * t2 - H[2, 3] * t1 + b0
+        J[4, c] = H[2, 3] * t0 - H[0, 3] * t2 + b1
+        J[5, c] = H[0, 3] * t1 - H[1, 3] * t0 + b2
 
 
 @njit(cache=True)
@@ -173,16 +174,38 @@ def nb_max_limb(limb_start):
 def nb_closure_system(S, ball_of, ball_axes, ball_centre, limb_start, ends, q, D, B, colmap, na, want_A, A, r):
     """Residual ``r`` (6K,) and, when ``want_A``, the closure Jacobian ``A`` (6K, na + 6h):
     active joint columns at ``colmap[i]`` (-1: not active), then a twist per moving hub."""
-    K = len(limb_start) - 1
-    J = np.empty((6, max(nb_max_limb(limb_start), 1)))
-    T = np.empty((4, 4))
-    T2 = np.empty((4, 4))
-    Hi = np.empty((4, 4))
-    res = np.empty(6)
-    W = np.empty((6, 3, 3))
     if want_A:
         for i in range(A.shape[0]):
             for c in range(A.shape[1]):
+                A[i, c] = 0.0
+    nb_closure_system_ws(S, ball_of, ball_axes, ball_centre, limb_start, ends, q, D, B, colmap, na, want_A, A, r,
+                         np.empty(nb_closure_ws_size(limb_start)))
+
+
+@njit(cache=True)
+def nb_closure_ws_size(limb_start):
+    """Length of the scratch of :func:`nb_closure_system_ws`."""
+    return 6 * max(nb_max_limb(limb_start), 1) + 3 * 16 + 6 + 54
+
+
+@njit(cache=True)
+def nb_closure_system_ws(S, ball_of, ball_axes, ball_centre, limb_start, ends, q, D, B, colmap, na, want_A, A, r, ws):
+    """:func:`nb_closure_system` with its scratch in ``ws`` (:func:`nb_closure_ws_size`): a
+    Newton loop allocates it once.  Only the hub columns of ``A`` are cleared: a limb's active
+    columns are written whole and nothing else is, so ``A`` must be zero there on the first call
+    (allocate it with ``np.zeros``)."""
+    K = len(limb_start) - 1
+    mj = max(nb_max_limb(limb_start), 1)
+    J = ws[: 6 * mj].reshape((6, mj))
+    o = 6 * mj
+    T = ws[o : o + 16].reshape((4, 4))
+    T2 = ws[o + 16 : o + 32].reshape((4, 4))
+    Hi = ws[o + 32 : o + 48].reshape((4, 4))
+    res = ws[o + 48 : o + 54]
+    W = ws[o + 54 : o + 108].reshape((6, 3, 3))
+    if want_A:
+        for i in range(A.shape[0]):
+            for c in range(na, A.shape[1]):
                 A[i, c] = 0.0
     for k in range(K):
         lo = limb_start[k]
@@ -276,32 +299,41 @@ def nb_scales(linear, active, K, h, L):
 @njit(cache=True)
 def nb_retract(ball_first, ball_axes, q, D, B, active, step, na, fix_platform, q_out, D_out, B_out):
     """:func:`.closure.retract` into ``q_out``, ``D_out``, ``B_out``."""
+    nb_retract_ws(ball_first, ball_axes, q, D, B, active, step, na, fix_platform, q_out, D_out, B_out,
+                  np.empty(len(q) + 70))
+
+
+@njit(cache=True)
+def nb_retract_ws(ball_first, ball_axes, q, D, B, active, step, na, fix_platform, q_out, D_out, B_out, ws):
+    """:func:`nb_retract` with its scratch in ``ws`` (``len(q) + 70``)."""
     n = len(q)
-    dq = np.zeros(n)
+    dq = ws[:n]
+    work = ws[n : n + 36].reshape((4, 3, 3))
+    E = ws[n + 36 : n + 52].reshape((4, 4))
+    orth = ws[n + 52 : n + 70].reshape((2, 3, 3))
     j = 0
     for i in range(n):
+        dq[i] = 0.0
         if active[i]:
             dq[i] = step[j]
             j += 1
     for i in range(n):
         q_out[i] = q[i] + dq[i]
-    work = np.empty((4, 3, 3))
     for g in range(len(ball_first)):
         i = ball_first[g]
         nb_ball_product_ws(ball_axes[g], dq[i : i + 3], q[i : i + 3], False, False, q_out[i : i + 3], work)
     nv = len(step) - na
-    E = np.empty((4, 4))
     if fix_platform or nv < 6:
         nb_copy44(D, D_out)
     else:
         nb_exp_twist(step[na : na + 6], E)
         nb_mm4(E, D, D_out)
-        nb_orthonormal(D_out)
+        nb_orthonormal_ws(D_out, orth)
     for bi in range(B.shape[0]):
         if nv >= 12 + 6 * bi:
             nb_exp_twist(step[na + 6 + 6 * bi : na + 12 + 6 * bi], E)
             nb_mm4(E, B[bi], B_out[bi])
-            nb_orthonormal(B_out[bi])
+            nb_orthonormal_ws(B_out[bi], orth)
         else:
             nb_copy44(B[bi], B_out[bi])
 
@@ -339,13 +371,15 @@ def nb_correct(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends,
     x = np.empty(nk)
     A = np.zeros((6 * K, nc))
     r = np.zeros(6 * K)
-    As = np.empty((6 * K, nk))
+    As = np.zeros((6 * K, nk))
     rhs = np.empty(6 * K)
     step = np.zeros(nc)
     q2 = np.empty(n)
     D2 = np.empty((4, 4))
     B2 = np.empty((h - 1, 4, 4))
     fbuf, ibuf = nb_blocks_workspace(c_lo, c_hi, na, nk)
+    cws = np.empty(nb_closure_ws_size(limb_start))
+    rws = np.empty(n + 70)
     for s in range(qs.shape[0]):
         q = q_out[s]
         D = D_out[s]
@@ -374,7 +408,8 @@ def nb_correct(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends,
             resid[s] = np.nan
             continue
         for it in range(max_iter + 1):
-            nb_closure_system(S, ball_of, ball_axes, ball_centre, limb_start, ends, q, D, B, colmap, na, True, A, r)
+            nb_closure_system_ws(S, ball_of, ball_axes, ball_centre, limb_start, ends, q, D, B, colmap, na, True, A, r,
+                                 cws)
             sq = 0.0
             for i in range(6 * K):
                 rhs[i] = -row[i] * r[i]
@@ -385,13 +420,12 @@ def nb_correct(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends,
                 break
             if it == max_iter or not np.isfinite(rn):
                 break
-            for i in range(6 * K):
-                if nk == nc:
-                    for c in range(nc):
+            for k in range(K):  # the scaled system: only a limb's own and the shared columns are nonzero
+                for i in range(6 * k, 6 * k + 6):
+                    for c in range(c_lo[k], c_hi[k]):
                         As[i, c] = row[i] * A[i, c] * col[c]
-                else:
-                    j = 0
-                    for c in range(nc):
+                    j = na
+                    for c in range(na, nc):
                         if keep[c]:
                             As[i, j] = row[i] * A[i, c] * col[c]
                             j += 1
@@ -407,7 +441,7 @@ def nb_correct(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends,
                     j += 1
                 else:
                     step[c] = 0.0
-            nb_retract(ball_first, ball_axes, q, D, B, active, step, na, fix_platform, q2, D2, B2)
+            nb_retract_ws(ball_first, ball_axes, q, D, B, active, step, na, fix_platform, q2, D2, B2, rws)
             for i in range(n):
                 q[i] = q2[i]
             nb_copy44(D2, D)

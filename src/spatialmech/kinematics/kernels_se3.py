@@ -28,6 +28,7 @@ __all__ = [
     "nb_mm4",
     "nb_mv",
     "nb_orthonormal",
+    "nb_orthonormal_ws",
     "nb_quat_rotvec",
     "nb_rodrigues",
     "nb_rotvec_matrix",
@@ -240,36 +241,29 @@ def nb_mm4(A, B, out):
 
 @njit(cache=True)
 def nb_exp_twist(V, out):
-    """:func:`..geometry.rotations.exp_twist` of one twist at ``theta = 1``."""
+    """:func:`..geometry.rotations.exp_twist` of one twist at ``theta = 1`` (no allocation:
+    ``W`` the skew matrix of the unit axis ``k``, ``W^2 = k k^T - I``)."""
     wn = np.sqrt(V[0] * V[0] + V[1] * V[1] + V[2] * V[2])
     for i in range(4):
         for j in range(4):
             out[i, j] = 0.0
     out[3, 3] = 1.0
     if wn > 0.0:
-        ws = np.empty(3)
-        vs = np.empty(3)
-        for i in range(3):
-            ws[i] = V[i] / wn
-            vs[i] = V[3 + i] / wn
-        W = np.empty((3, 3))
-        nb_skew(ws, W)
-        W2 = np.empty((3, 3))
-        nb_mm(W, W, W2)
+        k0, k1, k2 = V[0] / wn, V[1] / wn, V[2] / wn
+        u0, u1, u2 = V[3] / wn, V[4] / wn, V[5] / wn
         s = np.sin(wn)
         c = 1.0 - np.cos(wn)
-        for i in range(3):
-            for j in range(3):
-                out[i, j] = s * W[i, j] + c * W2[i, j]
-            out[i, i] += 1.0
-        for i in range(3):
-            acc = 0.0
-            for j in range(3):
-                G = c * W[i, j] + (wn - s) * W2[i, j]
-                if i == j:
-                    G += wn
-                acc += G * vs[j]
-            out[i, 3] = acc
+        nb_rodrigues(k0, k1, k2, s, c, out)  # out[:3, :3] = I + s W + c W^2
+        # G v = wn v + c (k x v) + (wn - s) (k x (k x v)), v = V[3:] / wn
+        x0 = k1 * u2 - k2 * u1
+        x1 = k2 * u0 - k0 * u2
+        x2 = k0 * u1 - k1 * u0
+        y0 = k1 * x2 - k2 * x1
+        y1 = k2 * x0 - k0 * x2
+        y2 = k0 * x1 - k1 * x0
+        out[0, 3] = wn * u0 + c * x0 + (wn - s) * y0
+        out[1, 3] = wn * u1 + c * x1 + (wn - s) * y1
+        out[2, 3] = wn * u2 + c * x2 + (wn - s) * y2
     else:
         for i in range(3):
             out[i, i] = 1.0
@@ -574,8 +568,14 @@ def nb_orthonormal(D):
     place.  A product of rotations drifts from orthonormal only by rounding: then two steps of
     the Bjorck iteration ``R <- R (3 I - R^T R) / 2`` give the same polar factor (the error is
     squared each step) without the SVD; a drift above 1e-6 takes the SVD."""
-    R = np.empty((3, 3))
-    G = np.empty((3, 3))
+    nb_orthonormal_ws(D, np.empty((2, 3, 3)))
+
+
+@njit(cache=True)
+def nb_orthonormal_ws(D, W):
+    """:func:`nb_orthonormal` with its scratch in ``W`` (2, 3, 3)."""
+    R = W[0]
+    G = W[1]
     for i in range(3):
         for j in range(3):
             R[i, j] = D[i, j]
