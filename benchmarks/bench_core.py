@@ -70,7 +70,7 @@ def best_times(fns: dict, repeat: int) -> dict:
     """Best of ``repeat`` rounds, seconds per call, for each ``name: (fn, number)``.  Each round
     runs every function once in turn, so that a slow spell of a shared machine falls on all of
     them alike and the ratios stay fair."""
-    best = {k: math.inf for k in fns}
+    best = dict.fromkeys(fns, math.inf)
     for _ in range(repeat):
         for k, (fn, number) in fns.items():
             t = time.perf_counter()
