@@ -9,7 +9,9 @@ Every target is printed with "met" or "NOT met" and the measured ratio or rate:
   held (the general engine: Newton on the whole closure, 42 joint variables and the platform
   twist), against ``fk_scipy_root_us`` (scipy ``root``, hybr, on the 6-equation leg-length residual
   of the same platform) and ``fk_handwritten_us`` (a minimal hand-written numba Newton on that
-  6x6 residual). Targets: >= 10x faster than scipy, within 5x of the hand-written Newton.
+  6x6 residual: no allocation in its loop, Gaussian elimination inline). The three are timed in
+  turn, round after round, each keeping its best. Targets: >= 10x faster than scipy, within 5x
+  of the hand-written Newton.
 - ``circuit_five_cs_3_s``: the whole circuit of 5-CS linkage 3 (paper A) with the ten driver
   determinants as monitors, compiled, and ``circuit_python_s`` the same on the Python reference
   (``SPATIALMECH_PURE=1``). Targets: < 1 s and >= 10x.
@@ -82,46 +84,72 @@ def best_times(fns: dict, repeat: int) -> dict:
 
 # ---------------------------------------------------------------------- Stewart forward position
 @njit(cache=False)  # not cached: a script and an imported module would share (and confuse) one cache
-def _rodrigues(w):
-    th = math.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
-    R = np.eye(3)
-    if th < 1e-300:
-        return R
-    k0, k1, k2 = w[0] / th, w[1] / th, w[2] / th
-    s, c = math.sin(th), math.cos(th)
-    K = np.array([[0.0, -k2, k1], [k2, 0.0, -k0], [-k1, k0, 0.0]])
-    return R + s * K + (1.0 - c) * (K @ K)
-
-
-@njit(cache=False)  # not cached: a script and an imported module would share (and confuse) one cache
-def handwritten_stewart_newton(A, B, target, R0, t0, tol, max_iter):
+def handwritten_stewart_newton(A, B, target, R0, t0, tol, max_iter, R, t):
     """Minimal Newton on the six leg lengths ``|R A_i + t - B_i| - target_i`` of a 6-6 Stewart
-    platform: rows ``[(x_i x u_i)^T, u_i^T]`` (spatial twist), update ``R <- exp(w) R``,
-    ``t <- exp(w) t + v``.  Returns ``R, t, iterations, converged``."""
-    R = R0.copy()
-    t = t0.copy()
-    J = np.empty((6, 6))
-    r = np.empty(6)
+    platform: rows ``[(x_i x u_i)^T, u_i^T]`` (spatial twist), Gaussian elimination with partial
+    pivoting on the 6x7 augmented matrix, update ``R <- exp(w) R``, ``t <- exp(w) t + v``; no
+    allocation in the loop.  ``R``, ``t``: the result (from ``R0``, ``t0``).  Returns the
+    iterations, or -1 when it did not converge."""
+    M = np.empty((6, 7))
+    for a in range(3):
+        t[a] = t0[a]
+        for b in range(3):
+            R[a, b] = R0[a, b]
     for it in range(max_iter):
         worst = 0.0
         for i in range(6):
-            x = R @ A[i] + t
-            d = x - B[i]
-            ln = math.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
-            u = d / ln
-            r[i] = ln - target[i]
-            worst = max(worst, abs(r[i]))
-            J[i, 0] = x[1] * u[2] - x[2] * u[1]
-            J[i, 1] = x[2] * u[0] - x[0] * u[2]
-            J[i, 2] = x[0] * u[1] - x[1] * u[0]
-            J[i, 3], J[i, 4], J[i, 5] = u[0], u[1], u[2]
+            x0 = R[0, 0] * A[i, 0] + R[0, 1] * A[i, 1] + R[0, 2] * A[i, 2] + t[0]
+            x1 = R[1, 0] * A[i, 0] + R[1, 1] * A[i, 1] + R[1, 2] * A[i, 2] + t[1]
+            x2 = R[2, 0] * A[i, 0] + R[2, 1] * A[i, 1] + R[2, 2] * A[i, 2] + t[2]
+            d0, d1, d2 = x0 - B[i, 0], x1 - B[i, 1], x2 - B[i, 2]
+            ln = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+            u0, u1, u2 = d0 / ln, d1 / ln, d2 / ln
+            ri = ln - target[i]
+            worst = max(worst, abs(ri))
+            M[i, 0] = x1 * u2 - x2 * u1
+            M[i, 1] = x2 * u0 - x0 * u2
+            M[i, 2] = x0 * u1 - x1 * u0
+            M[i, 3], M[i, 4], M[i, 5] = u0, u1, u2
+            M[i, 6] = -ri
         if worst < tol:
-            return R, t, it, True
-        dx = np.linalg.solve(J, -r)
-        Rw = _rodrigues(dx[:3])
-        R = Rw @ R
-        t = Rw @ t + dx[3:]
-    return R, t, max_iter, False
+            return it
+        for j in range(6):
+            p = j
+            for i in range(j + 1, 6):
+                if abs(M[i, j]) > abs(M[p, j]):
+                    p = i
+            if p != j:
+                for c in range(j, 7):
+                    M[j, c], M[p, c] = M[p, c], M[j, c]
+            for i in range(j + 1, 6):
+                f = M[i, j] / M[j, j]
+                for c in range(j, 7):
+                    M[i, c] -= f * M[j, c]
+        for j in range(5, -1, -1):
+            acc = M[j, 6]
+            for c in range(j + 1, 6):
+                acc -= M[j, c] * M[c, 6]
+            M[j, 6] = acc / M[j, j]
+        w0, w1, w2 = M[0, 6], M[1, 6], M[2, 6]
+        th = math.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
+        k0 = k1 = k2 = s = c = 0.0
+        if th > 0.0:
+            k0, k1, k2 = w0 / th, w1 / th, w2 / th
+            s, c = math.sin(th), 1.0 - math.cos(th)
+        W00, W11, W22 = 1.0 + c * (k0 * k0 - 1.0), 1.0 + c * (k1 * k1 - 1.0), 1.0 + c * (k2 * k2 - 1.0)
+        W01, W10 = -s * k2 + c * k0 * k1, s * k2 + c * k0 * k1
+        W02, W20 = s * k1 + c * k0 * k2, -s * k1 + c * k0 * k2
+        W12, W21 = -s * k0 + c * k1 * k2, s * k0 + c * k1 * k2
+        for b in range(3):
+            r0, r1, r2 = R[0, b], R[1, b], R[2, b]
+            R[0, b] = W00 * r0 + W01 * r1 + W02 * r2
+            R[1, b] = W10 * r0 + W11 * r1 + W12 * r2
+            R[2, b] = W20 * r0 + W21 * r1 + W22 * r2
+        r0, r1, r2 = t[0], t[1], t[2]
+        t[0] = W00 * r0 + W01 * r1 + W02 * r2 + M[3, 6]
+        t[1] = W10 * r0 + W11 * r1 + W12 * r2 + M[4, 6]
+        t[2] = W20 * r0 + W21 * r1 + W22 * r2 + M[5, 6]
+    return -1
 
 
 def stewart_case():
@@ -170,14 +198,16 @@ def bench_fk(quick: bool) -> dict:
     assert sol.success, "scipy root did not converge"
     # the hand-written numba Newton on the same residual
     R0, t0 = np.eye(3), np.zeros(3)
-    Rh, th, it, ok = handwritten_stewart_newton(A, B, legs, R0, t0, tol, 50)
-    assert ok, "the hand-written Newton did not converge"
+    Rh, th = np.empty((3, 3)), np.empty(3)
+    it = handwritten_stewart_newton(A, B, legs, R0, t0, tol, 50, Rh, th)
+    assert it >= 0, "the hand-written Newton did not converge"
     err_hand = float(max(np.max(np.abs(Rh - goal.D[:3, :3])), np.max(np.abs(th - goal.D[:3, 3]))))
     # the three timed in turn, round after round (best_times)
     t = best_times({
         "engine": (lambda: correct(mech, seed, active=mask), num),
         "scipy": (lambda: root(F, np.zeros(6), method="hybr", tol=tol), max(1, num // 8)),
-        "hand": (lambda: handwritten_stewart_newton(A, B, legs, R0, t0, tol, 50), num * 4),
+        "hand": (lambda: handwritten_stewart_newton(A, B, legs, R0, t0, tol, 50, np.empty((3, 3)), np.empty(3)),
+                 num * 4),
     }, rep)
     t_engine, t_scipy, t_hand = t["engine"], t["scipy"], t["hand"]
     return {
