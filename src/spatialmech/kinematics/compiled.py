@@ -52,10 +52,9 @@ from .closure import (
 )
 
 from .jit import AVAILABLE, UNAVAILABLE_REASON
-from .kernels_blocks import nb_minnorm_blocks
+from .kernels_blocks import nb_blocks_workspace, nb_minnorm_blocks
 from .kernels_closure import (
     nb_correct,
-    nb_correct_one,
     nb_correct_hyperplane,
     nb_limb_gn,
     nb_retract,
@@ -373,7 +372,7 @@ def _run_correct(mech: Mechanism, cm: CompiledMechanism, seeds: Sequence[Configu
     act = _mask(mech, cm, active)
     if tol is None:  # the newton tolerance in force (geometry/tolerances.py)
         tol = current_tolerances().newton
-    N = len(seeds)  # (one seed goes through correct's own entry, nb_correct_one)
+    N = len(seeds)
     qs = _f64([c.q for c in seeds], (N, cm.n))
     Ds = _f64([c.D for c in seeds], (N, 4, 4))
     Bs = _f64([c.B for c in seeds], (N, cm.n_bodies, 4, 4))
@@ -410,14 +409,18 @@ def correct(mech: Mechanism, config: Configuration, *, active: np.ndarray | None
     # no bodies: a writable empty array, not a copy of the read-only shared one
     B0 = _f64(config.B) if cm.n_bodies else _NO_BODIES_W
     q0, D0 = _f64(config.q), _f64(config.D)
-    q, D = np.empty(cm.n), np.empty((4, 4))
-    B = np.empty(B0.shape) if cm.n_bodies else _NO_BODIES_W  # (nothing is written into an empty array)
-    info = np.empty(3)
-    nb_correct_one(*_correct_args(cm), q0, D0, B0, act, bool(fix_platform), float(tol), int(max_iter), q, D, B, info)
-    status, it, rn = info.tolist()
+    nb = cm.n_bodies
+    q, D, B = np.empty((1, cm.n)), np.empty((1, 4, 4)), np.empty((1, nb, 4, 4))
+    info = np.empty(3, dtype=np.int64)  # status, iterations (the residual in its own array)
+    rn = np.empty(1)
+    # the batched kernel with a batch of one: a separate single-seed kernel would cost as much
+    # compilation again (numba re-optimises a kernel's callees inside each caller) for ~1 us
+    nb_correct(*_correct_args(cm), q0.reshape(1, cm.n), D0.reshape(1, 4, 4), B0.reshape(1, nb, 4, 4), act,
+               bool(fix_platform), float(tol), int(max_iter), q, D, B, info[0:1], info[1:2], rn)
+    status, it = info[0], info[1]
     if status < 0:  # NaN or infinity in the seed: the full check names it
         check_configuration(mech, config)
-    return _result(config, q, D, B, int(status), int(it), rn)
+    return _result(config, q[0], D[0], B[0], int(status), int(it), float(rn[0]))
 
 
 def correct_many(mech: Mechanism, seeds: Sequence[Configuration], *, active: np.ndarray | None = None,
@@ -440,7 +443,7 @@ def retract(mech: Mechanism, config: Configuration, active, step, fix_platform: 
     if len(st) < na:
         raise InputError(f"step: expected at least the {na} active joint steps, got {len(st)} values")
     q2, D2, B2 = np.empty_like(q), np.empty_like(D), np.empty_like(B)
-    nb_retract(cm.ball_first, cm.ball_axes, q, D, B, act, st, na, bool(fix_platform), q2, D2, B2)
+    nb_retract(cm.ball_first, cm.ball_axes, q, D, B, act, st, na, bool(fix_platform), q2, D2, B2, np.empty(cm.n + 70))
     return Configuration(q2, D2, B2)
 
 
@@ -542,7 +545,8 @@ def minnorm_blocks(A, b, c_lo, c_hi, ns0: int) -> np.ndarray | None:
         raise InputError(f"A, b, c_lo, c_hi: expected (6K, n), (6K,), (K,), (K,); got {A.shape}, {b.shape}, "
                          f"{lo.shape}, {hi.shape}")
     x = np.empty(A.shape[1])
-    return x if nb_minnorm_blocks(A, b, lo, hi, int(ns0), x) else None
+    fbuf, ibuf = nb_blocks_workspace(lo, hi, int(ns0), A.shape[1])
+    return x if nb_minnorm_blocks(A, b, lo, hi, int(ns0), x, fbuf, ibuf) else None
 
 
 def limb_gn(chain: Chain, D, q, lin, L, tol=1e-12, max_iter=60, hold=None):

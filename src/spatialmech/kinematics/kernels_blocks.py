@@ -39,7 +39,6 @@ from .jit import njit
 __all__ = [
     "nb_blocks_workspace",
     "nb_minnorm_blocks",
-    "nb_minnorm_blocks_ws",
     "nb_pivoted_qr",
     "nb_qt_apply",
     "nb_reflect",
@@ -186,7 +185,7 @@ def nb_qt_apply(ZT, r, nrows, v0, vn2, y, transpose):
 
 @njit(cache=True)
 def nb_blocks_workspace(c_lo, c_hi, ns0, n):
-    """Scratch of :func:`nb_minnorm_blocks_ws` for a system with these limb columns and ``n``
+    """Scratch of :func:`nb_minnorm_blocks` for a system with these limb columns and ``n``
     columns in all (allocated once per solve, not per Newton step): ``(floats, ints)``."""
     K = len(c_lo)
     mmax = 1
@@ -199,18 +198,12 @@ def nb_blocks_workspace(c_lo, c_hi, ns0, n):
 
 
 @njit(cache=True)
-def nb_minnorm_blocks(A, b, c_lo, c_hi, ns0, x):
+def nb_minnorm_blocks(A, b, c_lo, c_hi, ns0, x, fbuf, ibuf):
     """Minimum-norm least-squares solution of ``A x = b`` into ``x`` by block elimination (module
     docstring).  ``A`` is (6K, n): limb ``k``'s rows ``6k .. 6k+5``; its own columns
-    ``c_lo[k] .. c_hi[k]-1`` (nonzero only in its rows), the shared columns ``ns0 .. n-1``.
-    Returns ``False`` (``x`` partly written) when the general solver must decide."""
-    fbuf, ibuf = nb_blocks_workspace(c_lo, c_hi, ns0, A.shape[1])
-    return nb_minnorm_blocks_ws(A, b, c_lo, c_hi, ns0, x, fbuf, ibuf)
-
-
-@njit(cache=True)
-def nb_minnorm_blocks_ws(A, b, c_lo, c_hi, ns0, x, fbuf, ibuf):
-    """:func:`nb_minnorm_blocks` with its scratch from :func:`nb_blocks_workspace`.  With shared
+    ``c_lo[k] .. c_hi[k]-1`` (nonzero only in its rows), the shared columns ``ns0 .. n-1``;
+    scratch from :func:`nb_blocks_workspace`.  Returns ``False`` (``x`` partly written) when the
+    general solver must decide.  With shared
     columns, one pivoted QR per limb of ``J_k^T`` (rows of ``J_k`` pivoted): ``J_k^T P_k = Q_k
     R_k``.  Its left null space (the constraints the limb's joints cannot absorb) is ``P_k u``
     with ``R_k u = 0``, by back substitution; once the shared twists ``xi`` are known, the

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .kernels_blocks import nb_blocks_workspace, nb_minnorm_blocks_ws
+from .kernels_blocks import nb_blocks_workspace, nb_minnorm_blocks
 from .kernels_se3 import (
     nb_lsq_qr,
     nb_ball_product,
@@ -17,7 +17,7 @@ from .kernels_se3 import (
     nb_log,
     nb_lstsq,
     nb_mm4,
-    nb_orthonormal_ws,
+    nb_orthonormal,
     nb_rodrigues,
 )
 from .jit import njit
@@ -27,19 +27,16 @@ __all__ = [
     "nb_chain",
     "nb_chain_ws",
     "nb_closure_system",
-    "nb_closure_system_ws",
     "nb_closure_ws_size",
     "nb_colmap",
     "nb_correct",
     "nb_correct_hyperplane",
-    "nb_correct_one",
     "nb_hub",
     "nb_limb_columns",
     "nb_limb_gn",
     "nb_max_limb",
     "nb_norm",
     "nb_retract",
-    "nb_retract_ws",
     "nb_scales",
     "nb_systems",
 ]
@@ -171,29 +168,18 @@ def nb_max_limb(limb_start):
 
 
 @njit(cache=True)
-def nb_closure_system(S, ball_of, ball_axes, ball_centre, limb_start, ends, q, D, B, colmap, na, want_A, A, r):
-    """Residual ``r`` (6K,) and, when ``want_A``, the closure Jacobian ``A`` (6K, na + 6h):
-    active joint columns at ``colmap[i]`` (-1: not active), then a twist per moving hub."""
-    if want_A:
-        for i in range(A.shape[0]):
-            for c in range(A.shape[1]):
-                A[i, c] = 0.0
-    nb_closure_system_ws(S, ball_of, ball_axes, ball_centre, limb_start, ends, q, D, B, colmap, na, want_A, A, r,
-                         np.empty(nb_closure_ws_size(limb_start)))
-
-
-@njit(cache=True)
 def nb_closure_ws_size(limb_start):
-    """Length of the scratch of :func:`nb_closure_system_ws`."""
+    """Length of the scratch of :func:`nb_closure_system`."""
     return 6 * max(nb_max_limb(limb_start), 1) + 3 * 16 + 6 + 54
 
 
 @njit(cache=True)
-def nb_closure_system_ws(S, ball_of, ball_axes, ball_centre, limb_start, ends, q, D, B, colmap, na, want_A, A, r, ws):
-    """:func:`nb_closure_system` with its scratch in ``ws`` (:func:`nb_closure_ws_size`): a
-    Newton loop allocates it once.  Only the hub columns of ``A`` are cleared: a limb's active
-    columns are written whole and nothing else is, so ``A`` must be zero there on the first call
-    (allocate it with ``np.zeros``)."""
+def nb_closure_system(S, ball_of, ball_axes, ball_centre, limb_start, ends, q, D, B, colmap, na, want_A, A, r, ws):
+    """Residual ``r`` (6K,) and, when ``want_A``, the closure Jacobian ``A`` (6K, na + 6h):
+    active joint columns at ``colmap[i]`` (-1: not active), then a twist per moving hub.
+    Scratch in ``ws`` (:func:`nb_closure_ws_size`; a Newton loop allocates it once).  Only the
+    hub columns of ``A`` are cleared: a limb's active columns are written whole and nothing else
+    is, so the rest of ``A`` must be zero (allocate it with ``np.zeros``)."""
     K = len(limb_start) - 1
     mj = max(nb_max_limb(limb_start), 1)
     J = ws[: 6 * mj].reshape((6, mj))
@@ -297,15 +283,9 @@ def nb_scales(linear, active, K, h, L):
 
 
 @njit(cache=True)
-def nb_retract(ball_first, ball_axes, q, D, B, active, step, na, fix_platform, q_out, D_out, B_out):
-    """:func:`.closure.retract` into ``q_out``, ``D_out``, ``B_out``."""
-    nb_retract_ws(ball_first, ball_axes, q, D, B, active, step, na, fix_platform, q_out, D_out, B_out,
-                  np.empty(len(q) + 70))
-
-
-@njit(cache=True)
-def nb_retract_ws(ball_first, ball_axes, q, D, B, active, step, na, fix_platform, q_out, D_out, B_out, ws):
-    """:func:`nb_retract` with its scratch in ``ws`` (``len(q) + 70``)."""
+def nb_retract(ball_first, ball_axes, q, D, B, active, step, na, fix_platform, q_out, D_out, B_out, ws):
+    """:func:`.closure.retract` into ``q_out``, ``D_out``, ``B_out``; scratch in ``ws``
+    (``len(q) + 70`` entries)."""
     n = len(q)
     dq = ws[:n]
     work = ws[n : n + 36].reshape((4, 3, 3))
@@ -328,12 +308,12 @@ def nb_retract_ws(ball_first, ball_axes, q, D, B, active, step, na, fix_platform
     else:
         nb_exp_twist(step[na : na + 6], E)
         nb_mm4(E, D, D_out)
-        nb_orthonormal_ws(D_out, orth)
+        nb_orthonormal(D_out, orth)
     for bi in range(B.shape[0]):
         if nv >= 12 + 6 * bi:
             nb_exp_twist(step[na + 6 + 6 * bi : na + 12 + 6 * bi], E)
             nb_mm4(E, B[bi], B_out[bi])
-            nb_orthonormal_ws(B_out[bi], orth)
+            nb_orthonormal(B_out[bi], orth)
         else:
             nb_copy44(B[bi], B_out[bi])
 
@@ -408,7 +388,7 @@ def nb_correct(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends,
             resid[s] = np.nan
             continue
         for it in range(max_iter + 1):
-            nb_closure_system_ws(S, ball_of, ball_axes, ball_centre, limb_start, ends, q, D, B, colmap, na, True, A, r,
+            nb_closure_system(S, ball_of, ball_axes, ball_centre, limb_start, ends, q, D, B, colmap, na, True, A, r,
                                  cws)
             sq = 0.0
             for i in range(6 * K):
@@ -429,7 +409,7 @@ def nb_correct(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends,
                         if keep[c]:
                             As[i, j] = row[i] * A[i, c] * col[c]
                             j += 1
-            if not nb_minnorm_blocks_ws(As, rhs, c_lo, c_hi, na, x, fbuf, ibuf):  # lstsq's step, by blocks
+            if not nb_minnorm_blocks(As, rhs, c_lo, c_hi, na, x, fbuf, ibuf):  # lstsq's step, by blocks
                 x = nb_lstsq(As, rhs)
             if nb_norm(x) < 1e-13 * max(1.0, rn):
                 st = 2
@@ -441,7 +421,7 @@ def nb_correct(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends,
                     j += 1
                 else:
                     step[c] = 0.0
-            nb_retract_ws(ball_first, ball_axes, q, D, B, active, step, na, fix_platform, q2, D2, B2, rws)
+            nb_retract(ball_first, ball_axes, q, D, B, active, step, na, fix_platform, q2, D2, B2, rws)
             for i in range(n):
                 q[i] = q2[i]
             nb_copy44(D2, D)
@@ -450,23 +430,6 @@ def nb_correct(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends,
         status[s] = st
         iters[s] = it
         resid[s] = rn
-
-
-@njit(cache=True)
-def nb_correct_one(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends, linear, L, q0, D0, B0, active,
-                   fix_platform, tol, max_iter, q, D, B, info):
-    """:func:`nb_correct` from one seed ``q0, D0, B0`` into ``q, D, B`` (no batch axis: one
-    forward-position solve or tracker step pays no reshaping in Python); ``info`` = (status,
-    iterations, residual)."""
-    status = np.empty(1, dtype=np.int64)
-    iters = np.empty(1, dtype=np.int64)
-    resid = np.empty(1)
-    nb_correct(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends, linear, L, q0.reshape((1, q0.shape[0])),
-               D0.reshape((1, 4, 4)), B0.reshape((1, B0.shape[0], 4, 4)), active, fix_platform, tol, max_iter,
-               q.reshape((1, q.shape[0])), D.reshape((1, 4, 4)), B.reshape((1, B.shape[0], 4, 4)), status, iters, resid)
-    info[0] = status[0]
-    info[1] = iters[0]
-    info[2] = resid[0]
 
 
 @njit(cache=True)
@@ -490,10 +453,12 @@ def nb_correct_hyperplane(S, ball_of, ball_first, ball_axes, ball_centre, limb_s
     q2 = np.empty(n)
     D2 = np.empty((4, 4))
     B2 = np.empty(B0.shape)
+    cws = np.empty(nb_closure_ws_size(limb_start))
+    rws = np.empty(n + 70)
     if has_pred:
         for c in range(nc):
             step[c] = col[c] * pred[c]
-        nb_retract(ball_first, ball_axes, q0, D0, B0, active, step, na, False, q, D, B)
+        nb_retract(ball_first, ball_axes, q0, D0, B0, active, step, na, False, q, D, B, rws)
     else:
         for i in range(n):
             q[i] = q0[i]
@@ -503,7 +468,7 @@ def nb_correct_hyperplane(S, ball_of, ball_first, ball_axes, ball_centre, limb_s
     moved = 0.0
     prev = np.inf
     for it in range(max_iter):
-        nb_closure_system(S, ball_of, ball_axes, ball_centre, limb_start, ends, q, D, B, colmap, na, True, A, r)
+        nb_closure_system(S, ball_of, ball_axes, ball_centre, limb_start, ends, q, D, B, colmap, na, True, A, r, cws)
         sq = 0.0
         for i in range(m):
             v = row[i] * r[i]
@@ -531,13 +496,13 @@ def nb_correct_hyperplane(S, ball_of, ball_first, ball_axes, ball_centre, limb_s
         moved += dn
         for c in range(nc):
             step[c] = col[c] * d[c]
-        nb_retract(ball_first, ball_axes, q, D, B, active, step, na, False, q2, D2, B2)
+        nb_retract(ball_first, ball_axes, q, D, B, active, step, na, False, q2, D2, B2, rws)
         for i in range(n):
             q[i] = q2[i]
         nb_copy44(D2, D)
         for b in range(B0.shape[0]):
             nb_copy44(B2[b], B[b])
-    nb_closure_system(S, ball_of, ball_axes, ball_centre, limb_start, ends, q, D, B, colmap, na, False, A, r)
+    nb_closure_system(S, ball_of, ball_axes, ball_centre, limb_start, ends, q, D, B, colmap, na, False, A, r, cws)
     sq = 0.0
     for i in range(m):
         v = row[i] * r[i]
@@ -551,9 +516,14 @@ def nb_correct_hyperplane(S, ball_of, ball_first, ball_axes, ball_centre, limb_s
 def nb_systems(S, ball_of, ball_axes, ball_centre, limb_start, ends, qs, Ds, Bs, active, want_A, A_out, r_out):
     """Residuals ``r_out[s]`` and, when ``want_A``, closure Jacobians ``A_out[s]`` of many configurations."""
     colmap, na = nb_colmap(active)
+    ws = np.empty(nb_closure_ws_size(limb_start))
     for s in range(qs.shape[0]):
+        if want_A:
+            for i in range(A_out.shape[1]):
+                for c in range(A_out.shape[2]):
+                    A_out[s, i, c] = 0.0
         nb_closure_system(S, ball_of, ball_axes, ball_centre, limb_start, ends, qs[s], Ds[s], Bs[s], colmap, na, want_A,
-                        A_out[s] if want_A else A_out[0], r_out[s])
+                          A_out[s] if want_A else A_out[0], r_out[s], ws)
 
 
 # ---------------------------------------------------------------------------- limb inverse position

@@ -18,6 +18,7 @@ from .kernels_closure import (
     nb_adjoint_columns,
     nb_chain,
     nb_closure_system,
+    nb_closure_ws_size,
     nb_colmap,
     nb_hub,
     nb_max_limb,
@@ -297,9 +298,10 @@ def nb_closure_dets(S, ball_of, ball_axes, ball_centre, limb_start, ends, linear
     colmap, na = nb_colmap(active)
     row, col = nb_scales(linear, active, K, h, L)
     nc = na + 6 * h
-    A = np.empty((6 * K, nc))
+    A = np.zeros((6 * K, nc))
     r = np.empty(6 * K)
-    nb_closure_system(S, ball_of, ball_axes, ball_centre, limb_start, ends, q, D, B, colmap, na, True, A, r)
+    nb_closure_system(S, ball_of, ball_axes, ball_centre, limb_start, ends, q, D, B, colmap, na, True, A, r,
+                      np.empty(nb_closure_ws_size(limb_start)))
     for i in range(6 * K):
         for c in range(nc):
             A[i, c] *= row[i] * col[c]

@@ -28,7 +28,6 @@ __all__ = [
     "nb_mm4",
     "nb_mv",
     "nb_orthonormal",
-    "nb_orthonormal_ws",
     "nb_quat_rotvec",
     "nb_rodrigues",
     "nb_rotvec_matrix",
@@ -563,17 +562,12 @@ def nb_det(M):
 
 
 @njit(cache=True)
-def nb_orthonormal(D):
+def nb_orthonormal(D, W):
     """Keep the rotation of ``D`` orthonormal (the nearest rotation, ``U Vt`` of its SVD), in
-    place.  A product of rotations drifts from orthonormal only by rounding: then two steps of
-    the Bjorck iteration ``R <- R (3 I - R^T R) / 2`` give the same polar factor (the error is
-    squared each step) without the SVD; a drift above 1e-6 takes the SVD."""
-    nb_orthonormal_ws(D, np.empty((2, 3, 3)))
-
-
-@njit(cache=True)
-def nb_orthonormal_ws(D, W):
-    """:func:`nb_orthonormal` with its scratch in ``W`` (2, 3, 3)."""
+    place; scratch in ``W`` (2, 3, 3).  A product of rotations drifts from orthonormal only by
+    rounding: then two steps of the Bjorck iteration ``R <- R (3 I - R^T R) / 2`` give the same
+    polar factor (the error is squared each step) without the SVD; a drift above 1e-6 takes the
+    SVD."""
     R = W[0]
     G = W[1]
     for i in range(3):
