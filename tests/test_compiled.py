@@ -464,3 +464,35 @@ def test_joint_twists_match_the_reference(name):
     assert len(fast) == len(ref)
     for a, b in zip(fast, ref, strict=True):
         close(a, b, 1e-12)
+
+
+def test_a_kernel_compiled_on_first_use_is_announced_and_a_cached_one_is_not():
+    """The command line tells a person at a terminal when numba compiles a kernel (a cache miss:
+    the first use after installation), with its time; the outermost kernel only."""
+    import io
+
+    from numba import njit
+
+    from spatialmech.kinematics.jit import announce_compilation
+
+    @njit(cache=False)
+    def inner_kernel_for_the_notice(x):
+        return x + 1.0
+
+    @njit(cache=False)
+    def outer_kernel_for_the_notice(x):
+        return inner_kernel_for_the_notice(x) * 2.0
+
+    buf = io.StringIO()
+    assert announce_compilation(buf)
+    try:
+        assert outer_kernel_for_the_notice(1.0) == 4.0
+        assert outer_kernel_for_the_notice(2.0) == 6.0  # compiled already: nothing more said
+    finally:
+        announce_compilation(None)
+    text = buf.getvalue()
+    assert "outer_kernel_for_the_notice" in text and "inner_kernel_for_the_notice" not in text
+    assert text.count("compiling outer_kernel_for_the_notice ...") == 1
+    assert text.rstrip().endswith(" s")
+    outer_kernel_for_the_notice(3)  # an int signature compiles, but the listener is gone
+    assert buf.getvalue() == text

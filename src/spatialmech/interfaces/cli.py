@@ -18,6 +18,7 @@ import click
 from .. import __version__, catalog
 from ..analysis.mobility import mobility, mobility_modes
 from ..errors import ConvergenceError, SpatialmechError
+from ..kinematics.jit import announce_compilation
 from .common import UserError, check_output_dir, check_output_file, emit_json, json_option, tol_option
 
 
@@ -132,6 +133,8 @@ def cli(debug):
     Example:
       spatialmech mobility four-sps-cu
     """
+    if sys.stderr.isatty():  # a person waiting: say when a kernel compiles (first use only)
+        announce_compilation(sys.stderr)
 
 
 @cli.command()

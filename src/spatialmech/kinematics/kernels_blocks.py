@@ -249,7 +249,7 @@ def nb_minnorm_blocks(A, b, c_lo, c_hi, ns0, x, fbuf, ibuf):
         for i in range(6):
             for j in range(m):
                 G[i, j] = A[6 * k + i, c_lo[k] + j]
-        r = nb_pivoted_qr(G, m, 6, 6, pivs[k], v0s[k], vn2s[k], e)
+        r = nb_pivoted_qr(G, m, G.shape[0], G.shape[0], pivs[k], v0s[k], vn2s[k], e)  # (no literal 6: one compiled copy)
         if r < 0:
             return False
         ranks[k] = r
@@ -350,7 +350,7 @@ def _decoupled(A, b, c_lo, c_hi, x, fbuf, ibuf):
                 Z[cc, i] = A[6 * k + i, c_lo[k] + cc]
         for i in range(6):
             Z[m, i] = b[6 * k + i]
-        r = nb_pivoted_qr(Z, 6, m, m + 1, piv, v0, vn2, e)
+        r = nb_pivoted_qr(Z, Z.shape[1], m, m + 1, piv, v0, vn2, e)
         if r < 0:
             return False
         for a in range(6):

@@ -174,8 +174,9 @@ def nb_closure_ws_size(limb_start):
 
 
 @njit(cache=True)
-def nb_closure_system(S, ball_of, ball_axes, ball_centre, limb_start, ends, q, D, B, colmap, na, want_A, A, r, ws):
-    """Residual ``r`` (6K,) and, when ``want_A``, the closure Jacobian ``A`` (6K, na + 6h):
+def nb_closure_system(S, ball_of, ball_axes, ball_centre, limb_start, ends, q, D, B, colmap, na, A, r, ws):
+    """Residual ``r`` (6K,) and, unless ``A`` has no rows (shape (0, 0): the residual only), the
+    closure Jacobian ``A`` (6K, na + 6h):
     active joint columns at ``colmap[i]`` (-1: not active), then a twist per moving hub.
     Scratch in ``ws`` (:func:`nb_closure_ws_size`; a Newton loop allocates it once).  Only the
     hub columns of ``A`` are cleared: a limb's active columns are written whole and nothing else
@@ -189,6 +190,7 @@ def nb_closure_system(S, ball_of, ball_axes, ball_centre, limb_start, ends, q, D
     Hi = ws[o + 32 : o + 48].reshape((4, 4))
     res = ws[o + 48 : o + 54]
     W = ws[o + 54 : o + 108].reshape((6, 3, 3))
+    want_A = A.shape[0] > 0  # (no flag argument: a literal True or False would compile another copy)
     if want_A:
         for i in range(A.shape[0]):
             for c in range(na, A.shape[1]):
@@ -220,9 +222,9 @@ def nb_closure_system(S, ball_of, ball_axes, ball_centre, limb_start, ends, q, D
         if b >= 0:
             nb_inverse_into(nb_hub(b, D, B), Hi)
             nb_mm4(T, Hi, T2)
-            nb_log(T2, True, res)
+            nb_log(T2, np.bool_(True), res)
         else:
-            nb_log(T, True, res)
+            nb_log(T, np.bool_(True), res)
         for i in range(6):
             r[r0 + i] = res[i]
 
@@ -301,7 +303,7 @@ def nb_retract(ball_first, ball_axes, q, D, B, active, step, na, fix_platform, q
         q_out[i] = q[i] + dq[i]
     for g in range(len(ball_first)):
         i = ball_first[g]
-        nb_ball_product_ws(ball_axes[g], dq[i : i + 3], q[i : i + 3], False, False, q_out[i : i + 3], work)
+        nb_ball_product_ws(ball_axes[g], dq[i : i + 3], q[i : i + 3], np.bool_(False), np.bool_(False), q_out[i : i + 3], work)
     nv = len(step) - na
     if fix_platform or nv < 6:
         nb_copy44(D, D_out)
@@ -388,7 +390,7 @@ def nb_correct(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends,
             resid[s] = np.nan
             continue
         for it in range(max_iter + 1):
-            nb_closure_system(S, ball_of, ball_axes, ball_centre, limb_start, ends, q, D, B, colmap, na, True, A, r,
+            nb_closure_system(S, ball_of, ball_axes, ball_centre, limb_start, ends, q, D, B, colmap, na, A, r,
                                  cws)
             sq = 0.0
             for i in range(6 * K):
@@ -458,7 +460,7 @@ def nb_correct_hyperplane(S, ball_of, ball_first, ball_axes, ball_centre, limb_s
     if has_pred:
         for c in range(nc):
             step[c] = col[c] * pred[c]
-        nb_retract(ball_first, ball_axes, q0, D0, B0, active, step, na, False, q, D, B, rws)
+        nb_retract(ball_first, ball_axes, q0, D0, B0, active, step, na, np.bool_(False), q, D, B, rws)
     else:
         for i in range(n):
             q[i] = q0[i]
@@ -468,7 +470,7 @@ def nb_correct_hyperplane(S, ball_of, ball_first, ball_axes, ball_centre, limb_s
     moved = 0.0
     prev = np.inf
     for it in range(max_iter):
-        nb_closure_system(S, ball_of, ball_axes, ball_centre, limb_start, ends, q, D, B, colmap, na, True, A, r, cws)
+        nb_closure_system(S, ball_of, ball_axes, ball_centre, limb_start, ends, q, D, B, colmap, na, A, r, cws)
         sq = 0.0
         for i in range(m):
             v = row[i] * r[i]
@@ -496,13 +498,13 @@ def nb_correct_hyperplane(S, ball_of, ball_first, ball_axes, ball_centre, limb_s
         moved += dn
         for c in range(nc):
             step[c] = col[c] * d[c]
-        nb_retract(ball_first, ball_axes, q, D, B, active, step, na, False, q2, D2, B2, rws)
+        nb_retract(ball_first, ball_axes, q, D, B, active, step, na, np.bool_(False), q2, D2, B2, rws)
         for i in range(n):
             q[i] = q2[i]
         nb_copy44(D2, D)
         for b in range(B0.shape[0]):
             nb_copy44(B2[b], B[b])
-    nb_closure_system(S, ball_of, ball_axes, ball_centre, limb_start, ends, q, D, B, colmap, na, False, A, r, cws)
+    nb_closure_system(S, ball_of, ball_axes, ball_centre, limb_start, ends, q, D, B, colmap, na, A, r, cws)
     sq = 0.0
     for i in range(m):
         v = row[i] * r[i]
@@ -522,7 +524,7 @@ def nb_systems(S, ball_of, ball_axes, ball_centre, limb_start, ends, qs, Ds, Bs,
             for i in range(A_out.shape[1]):
                 for c in range(A_out.shape[2]):
                     A_out[s, i, c] = 0.0
-        nb_closure_system(S, ball_of, ball_axes, ball_centre, limb_start, ends, qs[s], Ds[s], Bs[s], colmap, na, want_A,
+        nb_closure_system(S, ball_of, ball_axes, ball_centre, limb_start, ends, qs[s], Ds[s], Bs[s], colmap, na,
                           A_out[s] if want_A else A_out[0], r_out[s], ws)
 
 
@@ -559,9 +561,9 @@ def nb_limb_gn(S, ball_of, ball_first, ball_axes, ball_centre, Ds, q0s, lin, L, 
             q[i] = q0s[s, i]
         rn = np.inf
         for _ in range(max_iter):
-            nb_chain(S, ball_of, ball_axes, ball_centre, q, 0, m, T, J)
+            nb_chain(S, ball_of, ball_axes, ball_centre, q, np.int64(0), m, T, J)
             nb_mm4(T, Dinv, T2)
-            nb_log(T2, False, r)
+            nb_log(T2, np.bool_(False), r)
             sq = 0.0
             for i in range(6):
                 rhs[i] = -row[i] * r[i]
@@ -586,7 +588,7 @@ def nb_limb_gn(S, ball_of, ball_first, ball_axes, ball_centre, Ds, q0s, lin, L, 
                 i = ball_first[g]
                 for t in range(3):
                     a[t] = colscale[i + t] * x[i + t]
-                nb_ball_product(ball_axes[g], a, q[i : i + 3], False, True, qn[i : i + 3])
+                nb_ball_product(ball_axes[g], a, q[i : i + 3], np.bool_(False), np.bool_(True), qn[i : i + 3])
             for j in range(m):
                 q[j] = qn[j]
         res_out[s] = rn

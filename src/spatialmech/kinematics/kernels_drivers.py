@@ -300,7 +300,7 @@ def nb_closure_dets(S, ball_of, ball_axes, ball_centre, limb_start, ends, linear
     nc = na + 6 * h
     A = np.zeros((6 * K, nc))
     r = np.empty(6 * K)
-    nb_closure_system(S, ball_of, ball_axes, ball_centre, limb_start, ends, q, D, B, colmap, na, True, A, r,
+    nb_closure_system(S, ball_of, ball_axes, ball_centre, limb_start, ends, q, D, B, colmap, na, A, r,
                       np.empty(nb_closure_ws_size(limb_start)))
     for i in range(6 * K):
         for c in range(nc):
@@ -346,7 +346,7 @@ def nb_difference(ball_first, ball_axes, qa, Da, Ba, qb, Db, Bb, active, wrap, c
         dq[i] = qb[i] - qa[i]
     for g in range(len(ball_first)):
         i = ball_first[g]
-        nb_ball_product(ball_axes[g], qb[i : i + 3], qa[i : i + 3], True, True, dq[i : i + 3])  # Rb Ra^T
+        nb_ball_product(ball_axes[g], qb[i : i + 3], qa[i : i + 3], np.bool_(True), np.bool_(True), dq[i : i + 3])  # Rb Ra^T
     j = 0
     for i in range(n):
         if active[i]:
@@ -361,7 +361,7 @@ def nb_difference(ball_first, ball_axes, qa, Da, Ba, qb, Db, Bb, active, wrap, c
     for h in range(1 + Ba.shape[0]):
         nb_inverse_into(nb_hub(h, Da, Ba), Hi)
         nb_mm4(nb_hub(h, Db, Bb), Hi, T)
-        nb_log(T, False, tw)
+        nb_log(T, np.bool_(False), tw)
         for x in range(6):
             out[j + x] = tw[x] / col[j + x]
         j += 6
