@@ -249,7 +249,9 @@ def nb_minnorm_blocks(A, b, c_lo, c_hi, ns0, x, fbuf, ibuf):
         for i in range(6):
             for j in range(m):
                 G[i, j] = A[6 * k + i, c_lo[k] + j]
-        r = nb_pivoted_qr(G, m, G.shape[0], G.shape[0], pivs[k], v0s[k], vn2s[k], e)  # (no literal 6: one compiled copy)
+        # literal 6s on purpose: the one specialised copy of the QR (its loops over the six rows of
+        # J_k unrolled) saves 4-5 us of a Stewart forward solve for about 1.5 s of compilation
+        r = nb_pivoted_qr(G, m, 6, 6, pivs[k], v0s[k], vn2s[k], e)
         if r < 0:
             return False
         ranks[k] = r
