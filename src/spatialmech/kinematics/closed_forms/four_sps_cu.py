@@ -348,7 +348,7 @@ def _legs_kernel(ph, a, b, squared, out):
     k = 2.0 * a * a + 2.0 * b * b
     ab2 = 2.0 * a * b
     wide = 0.0
-    bad = 0
+    bad = np.int64(0)
     for i in range(ph.shape[0]):
         w, e = _legs_step(ph, i, k, ab2, a, squared, out)
         wide = max(wide, w)
@@ -363,7 +363,7 @@ def _legs_kernel_parallel(ph, a, b, squared, out):
     k = 2.0 * a * a + 2.0 * b * b
     ab2 = 2.0 * a * b
     wide = 0.0
-    bad = 0
+    bad = np.int64(0)  # (a bare 0 reached _legs_finish as a literal: a second compiled copy)
     for i in prange(ph.shape[0]):
         w, e = _legs_step(ph, i, k, ab2, a, squared, out)
         wide = max(wide, w)
