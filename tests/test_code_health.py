@@ -94,7 +94,71 @@ def complexity_violations(paths: list[Path], limit: int) -> str:
     return p.stdout.strip() if p.returncode else ""
 
 
+def _is_njit(fn: ast.FunctionDef) -> bool:
+    for d in fn.decorator_list:
+        f = d.func if isinstance(d, ast.Call) else d
+        if isinstance(f, ast.Name) and f.id == "njit":
+            return True
+    return False
+
+
+#: The marker of a deliberate literal argument (a specialised copy that pays at run time); it
+#: must stand on the call's line or in the comment lines just above it.
+LITERAL_ON_PURPOSE = "literal"
+
+
+def kernel_names(sources: list[str]) -> set[str]:
+    """Names of the module-level ``@njit`` functions in ``sources``."""
+    names = set()
+    for src in sources:
+        for node in ast.parse(src).body:
+            if isinstance(node, ast.FunctionDef) and _is_njit(node):
+                names.add(node.name)
+    return names
+
+
+def literal_kernel_arguments(source: str, kernels: set[str]) -> list[str]:
+    """``line: call`` for each call, inside a kernel, of another kernel with a bare ``True``,
+    ``False`` or integer argument: numba types it as a literal and compiles a separate copy of the
+    callee (kinematics/jit.py).  A call marked as deliberate (``LITERAL_ON_PURPOSE`` in a comment
+    on its line or the lines above it) is allowed."""
+    lines = source.splitlines()
+    found = []
+    for fn in ast.parse(source).body:
+        if not (isinstance(fn, ast.FunctionDef) and _is_njit(fn)):
+            continue
+        for node in ast.walk(fn):
+            if not (isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id in kernels):
+                continue
+            args = list(node.args) + [k.value for k in node.keywords]
+            if not any(isinstance(a, ast.Constant) and type(a.value) in (bool, int) for a in args):
+                continue
+            above = lines[max(0, node.lineno - 3) : node.lineno]
+            if any("#" in ln and LITERAL_ON_PURPOSE in ln.split("#", 1)[1] for ln in above):
+                continue
+            found.append(f"{node.lineno}: {node.func.id}(...)")
+    return found
+
+
 # ------------------------------------------------------------------ the checks
+def test_no_kernel_passes_a_literal_constant_to_another_kernel():
+    """First-call compilation: a bare constant between kernels compiles the callee again."""
+    texts = {p: p.read_text(encoding="utf-8") for p in modules()}
+    kernels = kernel_names(list(texts.values()))
+    assert len(kernels) > 50
+    bad = [f"{p.relative_to(PKG)}:{hit}" for p, src in texts.items() for hit in literal_kernel_arguments(src, kernels)]
+    assert not bad, "kernels called with literal constants (pass np.bool_(...) / np.int64(...)):\n" + "\n".join(bad)
+
+
+def test_the_literal_argument_check_flags_a_violation_and_accepts_a_marked_one():
+    src = (
+        "@njit(cache=True)\ndef inner(a, flag):\n    return a\n\n"
+        "@njit(cache=True)\ndef outer(a):\n    x = inner(a, True)\n"
+        "    # a literal copy on purpose\n    y = inner(a, 6)\n    return inner(a, np.bool_(True))\n"
+    )
+    assert literal_kernel_arguments(src, kernel_names([src])) == ["7: inner(...)"]
+
+
 def test_the_checks_see_the_package():
     assert len(modules()) > 60
 

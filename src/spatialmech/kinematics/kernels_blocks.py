@@ -164,7 +164,7 @@ def nb_trapezoid_minnorm(ZT, r, m, d, y, V, v0, vn2):
         y[j] = acc / V[j, j]
     for j in range(r, m):
         y[j] = 0.0
-    nb_qt_apply(V, r, m, v0, vn2, y, False)
+    nb_qt_apply(V, r, m, v0, vn2, y, np.bool_(False))
 
 
 @njit(cache=True)
@@ -312,7 +312,7 @@ def nb_minnorm_blocks(A, b, c_lo, c_hi, ns0, x, fbuf, ibuf):
             y[j] = acc / G[j, j]
         for j in range(r, m):
             y[j] = 0.0
-        nb_qt_apply(G, r, m, v0s[k], vn2s[k], y, False)  # dq_k = Q [z ; 0]
+        nb_qt_apply(G, r, m, v0s[k], vn2s[k], y, np.bool_(False))  # dq_k = Q [z ; 0]
         for j in range(m):
             x[c_lo[k] + j] = y[j]
     for cc in range(s):
