@@ -54,6 +54,7 @@ from .closure import (
 from .jit import AVAILABLE, UNAVAILABLE_REASON
 from .kernels_blocks import nb_blocks_workspace, nb_minnorm_blocks
 from .kernels_closure import (
+    RETRACT_WS,
     nb_correct,
     nb_correct_hyperplane,
     nb_limb_gn,
@@ -411,7 +412,7 @@ def correct(mech: Mechanism, config: Configuration, *, active: np.ndarray | None
     q0, D0 = _f64(config.q), _f64(config.D)
     nb = cm.n_bodies
     q, D, B = np.empty((1, cm.n)), np.empty((1, 4, 4)), np.empty((1, nb, 4, 4))
-    info = np.empty(3, dtype=np.int64)  # status, iterations (the residual in its own array)
+    info = np.empty(2, dtype=np.int64)  # status, iterations (the residual in its own array)
     rn = np.empty(1)
     # the batched kernel with a batch of one: a separate single-seed kernel would cost as much
     # compilation again (numba re-optimises a kernel's callees inside each caller) for ~1 us
@@ -443,7 +444,8 @@ def retract(mech: Mechanism, config: Configuration, active, step, fix_platform: 
     if len(st) < na:
         raise InputError(f"step: expected at least the {na} active joint steps, got {len(st)} values")
     q2, D2, B2 = np.empty_like(q), np.empty_like(D), np.empty_like(B)
-    nb_retract(cm.ball_first, cm.ball_axes, q, D, B, act, st, na, bool(fix_platform), q2, D2, B2, np.empty(cm.n + 70))
+    nb_retract(cm.ball_first, cm.ball_axes, q, D, B, act, st, na, bool(fix_platform), q2, D2, B2,
+               np.empty(cm.n + RETRACT_WS))
     return Configuration(q2, D2, B2)
 
 

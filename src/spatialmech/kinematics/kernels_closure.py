@@ -19,10 +19,12 @@ from .kernels_se3 import (
     nb_mm4,
     nb_orthonormal,
     nb_rodrigues,
+    nb_screw_shift,
 )
 from .jit import njit
 
 __all__ = [
+    "RETRACT_WS",
     "nb_adjoint_columns",
     "nb_chain",
     "nb_chain_ws",
@@ -102,12 +104,7 @@ def nb_chain_ws(S, ball_of, ball_axes, ball_centre, q, lo, hi, T, J, W):
                 st = np.sin(t)
                 ct = 1.0 - np.cos(t)
                 nb_rodrigues(w0, w1, w2, st, ct, Rb)
-                x0 = w1 * v2 - w2 * v1  # w x v
-                x1 = w2 * v0 - w0 * v2
-                x2 = w0 * v1 - w1 * v0
-                u[0] = t * v0 + ct * x0 + (t - st) * (w1 * x2 - w2 * x1)
-                u[1] = t * v1 + ct * x1 + (t - st) * (w2 * x0 - w0 * x2)
-                u[2] = t * v2 + ct * x2 + (t - st) * (w0 * x1 - w1 * x0)
+                u[0], u[1], u[2] = nb_screw_shift(w0, w1, w2, v0, v1, v2, t, st, ct)
             else:
                 nb_rodrigues(0.0, 0.0, 0.0, 0.0, 0.0, Rb)
                 u[0], u[1], u[2] = t * v0, t * v1, t * v2
@@ -284,15 +281,19 @@ def nb_scales(linear, active, K, h, L):
     return row, col
 
 
+#: Scratch entries of :func:`nb_retract` beyond one per joint variable.
+RETRACT_WS = 70
+
+
 @njit(cache=True)
 def nb_retract(ball_first, ball_axes, q, D, B, active, step, na, fix_platform, q_out, D_out, B_out, ws):
     """:func:`.closure.retract` into ``q_out``, ``D_out``, ``B_out``; scratch in ``ws``
-    (``len(q) + 70`` entries)."""
+    (``len(q) + RETRACT_WS`` entries)."""
     n = len(q)
     dq = ws[:n]
     work = ws[n : n + 36].reshape((4, 3, 3))
     E = ws[n + 36 : n + 52].reshape((4, 4))
-    orth = ws[n + 52 : n + 70].reshape((2, 3, 3))
+    orth = ws[n + 52 : n + RETRACT_WS].reshape((2, 3, 3))
     j = 0
     for i in range(n):
         dq[i] = 0.0
@@ -361,7 +362,7 @@ def nb_correct(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends,
     B2 = np.empty((h - 1, 4, 4))
     fbuf, ibuf = nb_blocks_workspace(c_lo, c_hi, na, nk)
     cws = np.empty(nb_closure_ws_size(limb_start))
-    rws = np.empty(n + 70)
+    rws = np.empty(n + RETRACT_WS)
     for s in range(qs.shape[0]):
         q = q_out[s]
         D = D_out[s]
@@ -456,7 +457,7 @@ def nb_correct_hyperplane(S, ball_of, ball_first, ball_axes, ball_centre, limb_s
     D2 = np.empty((4, 4))
     B2 = np.empty(B0.shape)
     cws = np.empty(nb_closure_ws_size(limb_start))
-    rws = np.empty(n + 70)
+    rws = np.empty(n + RETRACT_WS)
     if has_pred:
         for c in range(nc):
             step[c] = col[c] * pred[c]
@@ -504,7 +505,8 @@ def nb_correct_hyperplane(S, ball_of, ball_first, ball_axes, ball_centre, limb_s
         nb_copy44(D2, D)
         for b in range(B0.shape[0]):
             nb_copy44(B2[b], B[b])
-    nb_closure_system(S, ball_of, ball_axes, ball_centre, limb_start, ends, q, D, B, colmap, na, A, r, cws)
+    nb_closure_system(S, ball_of, ball_axes, ball_centre, limb_start, ends, q, D, B, colmap, na, np.zeros((0, 0)), r,
+                      cws)  # the residual only
     sq = 0.0
     for i in range(m):
         v = row[i] * r[i]

@@ -32,6 +32,7 @@ __all__ = [
     "nb_rodrigues",
     "nb_rotvec_matrix",
     "nb_rotvec_matrix3",
+    "nb_screw_shift",
     "nb_sincos",
     "nb_skew",
     "nb_svd",
@@ -239,6 +240,19 @@ def nb_mm4(A, B, out):
 
 
 @njit(cache=True)
+def nb_screw_shift(w0, w1, w2, v0, v1, v2, t, st, ct):
+    """The translation of the screw motion ``exp(t (w ; v))`` for a unit ``w`` (its rotation is
+    ``nb_rodrigues(w, st, ct)``, ``st = sin t``, ``ct = 1 - cos t``):
+    ``t v + ct (w x v) + (t - st) w x (w x v)``."""
+    x0 = w1 * v2 - w2 * v1  # w x v
+    x1 = w2 * v0 - w0 * v2
+    x2 = w0 * v1 - w1 * v0
+    return (t * v0 + ct * x0 + (t - st) * (w1 * x2 - w2 * x1),
+            t * v1 + ct * x1 + (t - st) * (w2 * x0 - w0 * x2),
+            t * v2 + ct * x2 + (t - st) * (w0 * x1 - w1 * x0))
+
+
+@njit(cache=True)
 def nb_exp_twist(V, out):
     """:func:`..geometry.rotations.exp_twist` of one twist at ``theta = 1`` (no allocation:
     ``W`` the skew matrix of the unit axis ``k``, ``W^2 = k k^T - I``)."""
@@ -253,16 +267,7 @@ def nb_exp_twist(V, out):
         s = np.sin(wn)
         c = 1.0 - np.cos(wn)
         nb_rodrigues(k0, k1, k2, s, c, out)  # out[:3, :3] = I + s W + c W^2
-        # G v = wn v + c (k x v) + (wn - s) (k x (k x v)), v = V[3:] / wn
-        x0 = k1 * u2 - k2 * u1
-        x1 = k2 * u0 - k0 * u2
-        x2 = k0 * u1 - k1 * u0
-        y0 = k1 * x2 - k2 * x1
-        y1 = k2 * x0 - k0 * x2
-        y2 = k0 * x1 - k1 * x0
-        out[0, 3] = wn * u0 + c * x0 + (wn - s) * y0
-        out[1, 3] = wn * u1 + c * x1 + (wn - s) * y1
-        out[2, 3] = wn * u2 + c * x2 + (wn - s) * y2
+        out[0, 3], out[1, 3], out[2, 3] = nb_screw_shift(k0, k1, k2, u0, u1, u2, wn, s, c)
     else:
         for i in range(3):
             out[i, i] = 1.0
