@@ -6,7 +6,9 @@ run, with the targets of the compiled-core issue.
 Every target is printed with "met" or "NOT met" and the measured ratio or rate:
 
 - ``fk_solve_us``: one forward-position solve of stewart-6sps from the reference with the legs
-  held (the general engine: Newton on the whole closure, 42 joint variables and the platform
+  held, as ``correct`` runs it (a platform on six S-P-S legs: Newton on the pose, then the legs
+  placed and the closure checked, kinematics/leg_platform.py), and ``fk_joints_us`` the general
+  engine on the same solve (``method="joints"``: Newton on 42 joint variables and the platform
   twist), against ``fk_scipy_root_us`` (scipy ``root``, hybr, on the 6-equation leg-length residual
   of the same platform) and ``fk_handwritten_us`` (a minimal hand-written numba Newton on that
   6x6 residual: no allocation in its loop, Gaussian elimination inline). The three are timed in
@@ -205,13 +207,20 @@ def bench_fk(quick: bool) -> dict:
     # the three timed in turn, round after round (best_times)
     t = best_times({
         "engine": (lambda: correct(mech, seed, active=mask), num),
+        "joints": (lambda: correct(mech, seed, active=mask, method="joints"), max(1, num // 4)),
         "scipy": (lambda: root(F, np.zeros(6), method="hybr", tol=tol), max(1, num // 8)),
         "hand": (lambda: handwritten_stewart_newton(A, B, legs, R0, t0, tol, 50, np.empty((3, 3)), np.empty(3)),
                  num * 4),
     }, rep)
-    t_engine, t_scipy, t_hand = t["engine"], t["scipy"], t["hand"]
+    t_engine, t_joints, t_scipy, t_hand = t["engine"], t["joints"], t["scipy"], t["hand"]
+    joints = correct(mech, seed, active=mask, method="joints")
+    assert joints.converged, "the general engine's forward solve did not converge"
     return {
         "fk_solve_us": t_engine * 1e6,
+        "fk_joints_us": t_joints * 1e6,
+        "fk_joints_iterations": int(joints.iterations),
+        "fk_joints_vs_scipy_root": t_scipy / t_joints,
+        "fk_joints_max_pose_difference": float(np.max(np.abs(joints.config.D - D))),
         "fk_python_us": t_python * 1e6,
         "fk_scipy_root_us": t_scipy * 1e6,
         "fk_handwritten_us": t_hand * 1e6,
@@ -370,6 +379,8 @@ def main(argv=None) -> dict:
     word = {True: "met", False: "NOT met"}
     print(f"FK solve, stewart-6sps      engine {out['fk_solve_us']:.1f} us, scipy root {out['fk_scipy_root_us']:.1f} us, "
           f"hand-written numba {out['fk_handwritten_us']:.2f} us, Python path {out['fk_python_us']:.0f} us")
+    print(f"  general engine (method='joints') {out['fk_joints_us']:.1f} us, {out['fk_joints_vs_scipy_root']:.1f}x "
+          f"faster than scipy root; same pose to {out['fk_joints_max_pose_difference']:.1e}")
     print(f"  vs scipy root             {out['fk_vs_scipy_root']:.1f}x faster (target >= 10x): {word[met['fk_vs_scipy_root']]}")
     print(f"  vs hand-written Newton    {out['fk_vs_handwritten']:.1f}x slower (target <= 5x): {word[met['fk_vs_handwritten']]}")
     print(f"circuit of five-cs-3        {out['circuit_five_cs_3_s']:.2f} s, {out['circuit_points']} points, "

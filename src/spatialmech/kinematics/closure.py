@@ -393,6 +393,19 @@ def _compiled():
 _COMPILED_MODULE: ModuleType | None = None
 
 
+def _leg_platform() -> ModuleType:
+    """:mod:`.leg_platform` (imported on first use: it builds on this module)."""
+    global _LEG_MODULE
+    if _LEG_MODULE is None:
+        from . import leg_platform
+
+        _LEG_MODULE = leg_platform
+    return _LEG_MODULE
+
+
+_LEG_MODULE: ModuleType | None = None
+
+
 def closure_residual(mech: Mechanism, config: Configuration) -> np.ndarray:
     """Stacked limb residuals ``log(D_a FK_k D_b^-1)`` (6 K,), SI units."""
     if (fast := _compiled()) is not None:
@@ -518,6 +531,7 @@ def correct(
     fix_platform: bool = False,
     tol: float | None = None,
     max_iter: int = 50,
+    method: str = "auto",
 ) -> CorrectionResult:
     """Gauss-Newton (minimum-norm) correction of ``config`` onto the closure manifold.
 
@@ -526,7 +540,21 @@ def correct(
     platform displacement (inverse position); internal bodies always move.  Returns the corrected configuration with
     ``converged`` and the final nondimensional residual norm; never raises on
     non-convergence (the caller decides).
+
+    ``method``: ``"joints"`` runs the general Newton on the joint variables; ``"auto"`` (the
+    default) does too, except for forward position of a platform on six S-P-S legs (``active``
+    frees every ball and holds every slide), which is solved in pose coordinates
+    (:mod:`.leg_platform`: the same pose; each leg's idle spin by the shortest-turn rule).
     """
+    if method != "joints":
+        if method != "auto":
+            raise InputError(f"method: expected 'auto' or 'joints', got {method!r}")
+        if active is not None and not fix_platform:
+            legs = _leg_platform()
+            lp = legs.leg_platform(mech)
+            if lp is not None and lp.applies(active):
+                return legs.correct(mech, lp, config, tol=tol, max_iter=max_iter, general=lambda c: correct(
+                    mech, c, active=active, tol=tol, max_iter=max_iter, method="joints"))
     if (fast := _compiled()) is not None:
         return fast.correct(mech, config, active=active, fix_platform=fix_platform, tol=tol, max_iter=max_iter)
     if active is None:

@@ -67,6 +67,7 @@ from .kernels_drivers import (
     nb_differences,
     nb_sps_legs,
 )
+from .kernels_legs import nb_leg_platform
 from .kernels_se3 import (
     nb_lstsq,
 )
@@ -85,6 +86,7 @@ __all__ = [
     "config_difference",
     "config_differences",
     "correct",
+    "correct_leg_platform",
     "correct_many",
     "correct_on_hyperplane",
     "driver_determinants",
@@ -424,6 +426,19 @@ def correct(mech: Mechanism, config: Configuration, *, active: np.ndarray | None
     return _result(config, q[0], D[0], B[0], int(status), int(it), float(rn[0]))
 
 
+def correct_leg_platform(mech: Mechanism, lp, config: Configuration, tol: float, max_iter: int):
+    """:func:`.leg_platform.correct`'s solve, compiled: (status, iterations, q, D, residual), with
+    ``q`` and ``D`` ``None`` when the seed itself is the result."""
+    cm = compile_mechanism(mech)
+    _shapes(mech, cm, config)
+    q, D = np.empty(cm.n), np.empty((4, 4))
+    status, it, rn, seed = nb_leg_platform(cm.ball_of, cm.ball_axes, lp.index, lp.geometry, cm.length, _f64(config.q),
+                                           _f64(config.D), float(tol), int(max_iter), q, D)
+    if status == -1:  # NaN or infinity in the seed: the full check names it
+        check_configuration(mech, config)
+    return (status, it, None, None, rn) if seed else (status, it, q, D, rn)
+
+
 def correct_many(mech: Mechanism, seeds: Sequence[Configuration], *, active: np.ndarray | None = None,
                  fix_platform: bool = False, tol: float | None = None, max_iter: int = 50) -> list[CorrectionResult]:
     """:func:`correct` from many seeds in one compiled loop (multi-start forward position: pass
@@ -671,8 +686,9 @@ def warm_up() -> float:
     seconds it took (the first-call cost a user pays once per process)."""
     import time
 
-    from ..model.joints import R, S
+    from ..model.joints import P, R, S
     from ..model.mechanism import Limb  # here, not at the top: only the warm-up builds a model
+    from .closure import correct as closure_correct  # the dispatching entry: it takes the legs' path
 
     t0 = time.perf_counter()
     z = [0.0, 0.0, 1.0]
@@ -690,4 +706,15 @@ def warm_up() -> float:
     limb_gn(limb_chains(mech)[0], np.eye(4), np.zeros(7), np.zeros(7, bool), 1.0)
     limb_inverse_many(mech, np.eye(4)[None])
     sps_leg_lengths(np.zeros((1, 6)), np.zeros((1, 3)), np.ones((1, 3)))
+    # six S-P-S legs: the pose-coordinate forward solve (leg_platform.py)
+    ang = np.arange(6) * np.pi / 3.0
+    a, b = np.c_[np.cos(ang), np.sin(ang), np.zeros(6)], np.c_[0.5 * np.cos(ang + 0.4), 0.5 * np.sin(ang + 0.4), np.ones(6)]
+    stewart = Mechanism("warm-up legs", limbs=tuple(
+        Limb(f"l{i}", (S(f"a{i}", a[i]), P(f"p{i}", a[i], (b[i] - a[i]) / np.linalg.norm(b[i] - a[i]), actuated=True),
+                       S(f"b{i}", b[i]))) for i in range(6)), platform_point=np.zeros(3))
+    held = active_mask(stewart)
+    held[[7 * i + 3 for i in range(6)]] = False
+    q = np.zeros(42)
+    q[~held] = 0.01
+    closure_correct(stewart, Configuration(q, np.eye(4)), active=held)
     return time.perf_counter() - t0
