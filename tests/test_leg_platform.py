@@ -24,7 +24,7 @@ from spatialmech.kinematics.closure import (
     correct,
     generic_configuration,
 )
-from spatialmech.kinematics.kernels_legs import nb_shortest_rotvec
+from spatialmech.kinematics.kernels_legs import nb_shortest_rotation, nb_shortest_rotvec
 
 ROOT = Path(__file__).resolve().parents[1]
 pure = compiled.python_reference
@@ -135,6 +135,11 @@ def test_shortest_rotation_takes_a_to_b_about_their_normal(a, b, opposite):
     out = np.empty(3)
     nb_shortest_rotvec(*a, *b, out)
     np.testing.assert_allclose(out, v, atol=1e-15)
+    M = leg_platform.shortest_rotation(a, b)  # the same rotation, without trigonometry unless > 120 deg
+    np.testing.assert_allclose(M, rotvec_matrix(v), atol=1e-14)
+    Mc = np.empty((3, 3))
+    nb_shortest_rotation(*a, *b, Mc, np.empty(3))
+    np.testing.assert_allclose(Mc, M, atol=1e-15)
 
 
 @pytest.mark.parametrize("model", ["stewart-6sps", "dietmaier"])

@@ -67,7 +67,6 @@ from .kernels_drivers import (
     nb_differences,
     nb_sps_legs,
 )
-from .kernels_legs import nb_leg_platform
 from .kernels_se3 import (
     nb_lstsq,
 )
@@ -86,7 +85,6 @@ __all__ = [
     "config_difference",
     "config_differences",
     "correct",
-    "correct_leg_platform",
     "correct_many",
     "correct_on_hyperplane",
     "driver_determinants",
@@ -424,19 +422,6 @@ def correct(mech: Mechanism, config: Configuration, *, active: np.ndarray | None
     if status < 0:  # NaN or infinity in the seed: the full check names it
         check_configuration(mech, config)
     return _result(config, q[0], D[0], B[0], int(status), int(it), float(rn[0]))
-
-
-def correct_leg_platform(mech: Mechanism, lp, config: Configuration, tol: float, max_iter: int):
-    """:func:`.leg_platform.correct`'s solve, compiled: (status, iterations, q, D, residual), with
-    ``q`` and ``D`` ``None`` when the seed itself is the result."""
-    cm = compile_mechanism(mech)
-    _shapes(mech, cm, config)
-    q, D = np.empty(cm.n), np.empty((4, 4))
-    status, it, rn, seed = nb_leg_platform(cm.ball_of, cm.ball_axes, lp.index, lp.geometry, cm.length, _f64(config.q),
-                                           _f64(config.D), float(tol), int(max_iter), q, D)
-    if status == -1:  # NaN or infinity in the seed: the full check names it
-        check_configuration(mech, config)
-    return (status, it, None, None, rn) if seed else (status, it, q, D, rn)
 
 
 def correct_many(mech: Mechanism, seeds: Sequence[Configuration], *, active: np.ndarray | None = None,

@@ -7,9 +7,9 @@ from __future__ import annotations
 import numpy as np
 
 from .jit import njit
-from .kernels_se3 import nb_log, nb_matrix_rotvec, nb_rotvec_matrix3
+from .kernels_se3 import nb_log, nb_matrix_rotvec, nb_rodrigues, nb_rotvec_matrix3
 
-__all__ = ["nb_leg_closure", "nb_leg_platform", "nb_shortest_rotvec"]
+__all__ = ["nb_leg_closure", "nb_leg_platform", "nb_shortest_rotation", "nb_shortest_rotvec"]
 
 
 @njit(cache=True)
@@ -45,9 +45,25 @@ def nb_shortest_rotvec(a0, a1, a2, b0, b1, b2, out):
 
 
 @njit(cache=True)
-def nb_leg_platform(ball_of, ball_axes, index, geom, L, q0, D0, tol, max_iter, q, D):
+def nb_shortest_rotation(a0, a1, a2, b0, b1, b2, out, v):
+    """:func:`.leg_platform.shortest_rotation` of the unit vectors ``a`` and ``b`` into ``out``
+    (3x3); ``v`` (3,) scratch."""
+    x0 = a1 * b2 - a2 * b1
+    x1 = a2 * b0 - a0 * b2
+    x2 = a0 * b1 - a1 * b0
+    c = a0 * b0 + a1 * b1 + a2 * b2
+    if c > -0.5:
+        nb_rodrigues(x0, x1, x2, 1.0, 1.0 / (1.0 + c), out)
+    else:
+        nb_shortest_rotvec(a0, a1, a2, b0, b1, b2, v)
+        nb_rotvec_matrix3(v[0], v[1], v[2], out)
+
+
+@njit(cache=True)
+def nb_leg_platform(index, geom, L, q0, D0, tol, max_iter, q, D):
     """:func:`.leg_platform.correct` before its fallback: the legs ``index`` (6, 3) (base ball,
-    slide, platform ball) with ``geom`` (6, 9) (base centre, platform centre, slide direction) from
+    slide, platform ball) with ``geom`` (6, 27) (:attr:`.leg_platform.LegPlatform.data`: base
+    centre, platform centre, slide direction, the two balls' axes) from
     the seed ``q0``, ``D0``.  The result in ``q``, ``D``; returns the status (1 converged, 0 not,
     -2 a singular or non-finite step, -1 NaN or infinity in the seed), the iterations, the
     nondimensional closure residual (:func:`nb_leg_closure`), and whether the seed itself is the
@@ -144,7 +160,7 @@ def nb_leg_platform(ball_of, ball_axes, index, geom, L, q0, D0, tol, max_iter, q
         return status, it, np.inf, False
     W3 = np.empty((4, 3, 3))
     if it == 0:  # the seed's pose already closes the legs: the seed itself when it closes
-        rn = nb_leg_closure(ball_of, ball_axes, index, geom, L, q0, D0, W3)
+        rn = nb_leg_closure(index, geom, L, q0, D0, W3)
         if rn < tol:
             return 1, it, rn, True
     for i in range(n):
@@ -155,11 +171,11 @@ def nb_leg_platform(ball_of, ball_axes, index, geom, L, q0, D0, tol, max_iter, q
     v = np.empty(3)
     for k in range(m):
         i1, i_s, i2 = index[k, 0], index[k, 1], index[k, 2]
-        A1 = ball_axes[ball_of[i1]]
-        A2 = ball_axes[ball_of[i2]]
-        x0 = A1[0, 0] * q0[i1] + A1[0, 1] * q0[i1 + 1] + A1[0, 2] * q0[i1 + 2]
-        x1 = A1[1, 0] * q0[i1] + A1[1, 1] * q0[i1 + 1] + A1[1, 2] * q0[i1 + 2]
-        x2 = A1[2, 0] * q0[i1] + A1[2, 1] * q0[i1 + 1] + A1[2, 2] * q0[i1 + 2]
+        A1 = geom[k, 9:18]  # row by row: A1[3 r + c]
+        A2 = geom[k, 18:27]
+        x0 = A1[0] * q0[i1] + A1[1] * q0[i1 + 1] + A1[2] * q0[i1 + 2]
+        x1 = A1[3] * q0[i1] + A1[4] * q0[i1 + 1] + A1[5] * q0[i1 + 2]
+        x2 = A1[6] * q0[i1] + A1[7] * q0[i1 + 1] + A1[8] * q0[i1 + 2]
         nb_rotvec_matrix3(x0, x1, x2, R1s)
         s = q0[i_s]
         w0 = geom[k, 3] - geom[k, 0] + s * geom[k, 6]
@@ -174,8 +190,7 @@ def nb_leg_platform(ball_of, ball_axes, index, geom, L, q0, D0, tol, max_iter, q
         d1 = R[1, 0] * geom[k, 3] + R[1, 1] * geom[k, 4] + R[1, 2] * geom[k, 5] + t[1] - geom[k, 1]
         d2 = R[2, 0] * geom[k, 3] + R[2, 1] * geom[k, 4] + R[2, 2] * geom[k, 5] + t[2] - geom[k, 2]
         dn = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
-        nb_shortest_rotvec(us0, us1, us2, d0 / dn, d1 / dn, d2 / dn, v)
-        nb_rotvec_matrix3(v[0], v[1], v[2], W)
+        nb_shortest_rotation(us0, us1, us2, d0 / dn, d1 / dn, d2 / dn, W, v)
         for a in range(3):
             for b in range(3):
                 R1[a, b] = W[a, 0] * R1s[0, b] + W[a, 1] * R1s[1, b] + W[a, 2] * R1s[2, b]
@@ -184,22 +199,22 @@ def nb_leg_platform(ball_of, ball_axes, index, geom, L, q0, D0, tol, max_iter, q
                 R2[a, b] = R1[0, a] * R[0, b] + R1[1, a] * R[1, b] + R1[2, a] * R[2, b]
         nb_matrix_rotvec(R1, v)
         for j in range(3):
-            q[i1 + j] = A1[0, j] * v[0] + A1[1, j] * v[1] + A1[2, j] * v[2]
+            q[i1 + j] = A1[j] * v[0] + A1[3 + j] * v[1] + A1[6 + j] * v[2]
         nb_matrix_rotvec(R2, v)
         for j in range(3):
-            q[i2 + j] = A2[0, j] * v[0] + A2[1, j] * v[1] + A2[2, j] * v[2]
+            q[i2 + j] = A2[j] * v[0] + A2[3 + j] * v[1] + A2[6 + j] * v[2]
     for a in range(3):
         D[a, 3] = t[a]
         D[3, a] = 0.0
         for b in range(3):
             D[a, b] = R[a, b]
     D[3, 3] = 1.0
-    rn = nb_leg_closure(ball_of, ball_axes, index, geom, L, q, D, W3)
+    rn = nb_leg_closure(index, geom, L, q, D, W3)
     return (1 if rn < tol else 0), it, rn, False
 
 
 @njit(cache=True)
-def nb_leg_closure(ball_of, ball_axes, index, geom, L, q, D, W):
+def nb_leg_closure(index, geom, L, q, D, W):
     """The nondimensional norm of the closure residual of S-P-S legs (6 per leg: rotation, then
     moment / ``L``), as :func:`.kernels_closure.nb_closure_system` computes it for any limb, with
     each leg's chain written out: ``T = [R1, a - R1 a] [I, s e] [R2, b - R2 b]`` and the residual
@@ -214,11 +229,11 @@ def nb_leg_closure(ball_of, ball_axes, index, geom, L, q, D, W):
     sq = 0.0
     for k in range(index.shape[0]):
         i1, i_s, i2 = index[k, 0], index[k, 1], index[k, 2]
-        for g, i, Rb in ((ball_of[i1], i1, R1), (ball_of[i2], i2, R2)):
-            A = ball_axes[g]
-            nb_rotvec_matrix3(A[0, 0] * q[i] + A[0, 1] * q[i + 1] + A[0, 2] * q[i + 2],
-                              A[1, 0] * q[i] + A[1, 1] * q[i + 1] + A[1, 2] * q[i + 2],
-                              A[2, 0] * q[i] + A[2, 1] * q[i + 1] + A[2, 2] * q[i + 2], Rb)
+        for o, i, Rb in ((9, i1, R1), (18, i2, R2)):
+            A = geom[k, o:o + 9]  # the ball's axes, row by row
+            nb_rotvec_matrix3(A[0] * q[i] + A[1] * q[i + 1] + A[2] * q[i + 2],
+                              A[3] * q[i] + A[4] * q[i + 1] + A[5] * q[i + 2],
+                              A[6] * q[i] + A[7] * q[i + 1] + A[8] * q[i + 2], Rb)
         s = q[i_s]
         for a in range(3):  # x = s e + b - R2 b;  p = a - R1 a + R1 x
             x[a] = s * geom[k, 6 + a] + geom[k, 3 + a] - (R2[a, 0] * geom[k, 3] + R2[a, 1] * geom[k, 4]

@@ -24,8 +24,8 @@ including ``stationary``; the iterations of both are counted).
 
 :func:`.closure.correct` takes this path by itself (``method="auto"``) when it applies:
 :func:`leg_platform` finds the legs, and the active mask must free every ball and hold every
-slide.  The Python code here is the reference; :func:`.compiled.correct_leg_platform` runs the
-same steps compiled.
+slide.  The Python code here is the reference; :func:`.kernels_legs.nb_leg_platform` runs the
+same steps compiled (when :func:`.compiled.enabled`).
 """
 
 from __future__ import annotations
@@ -35,20 +35,22 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..geometry.rotations import matrix_rotvec, rotvec_matrix
+from ..geometry.rotations import matrix_rotvec, rotvec_matrix, skew
 from ..geometry.tolerances import current as current_tolerances
 from ..model.mechanism import Mechanism
 from . import compiled
+from .kernels_legs import nb_leg_platform
 from .closure import (
     Configuration,
     CorrectionResult,
     check_configuration,
     closure_residual,
+    correct as closure_correct,
     limb_chains,
     limb_slices,
 )
 
-__all__ = ["LegPlatform", "closure_norm", "correct", "leg_platform", "place_legs", "shortest_rotvec"]
+__all__ = ["LegPlatform", "closure_norm", "correct", "leg_platform", "place_legs", "shortest_rotation", "shortest_rotvec"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -56,30 +58,40 @@ class LegPlatform:
     """The six S-P-S legs of a mechanism, as arrays (:func:`leg_platform`)."""
 
     index: np.ndarray  # (6, 3) int64: first freedom of the base ball, the slide, first freedom of the platform ball
-    geometry: np.ndarray  # (6, 9): base ball centre a_i, platform ball centre b_i (reference), slide direction e_i
-    axes: np.ndarray  # (6, 2, 3, 3) the two balls' axes (columns)
+    #: (6, 27) per leg: base ball centre a_i, platform ball centre b_i (reference), slide direction
+    #: e_i, then the base ball's and the platform ball's axes (3x3, columns, row by row)
+    data: np.ndarray
     held: bytes  # the active mask this path applies to (every freedom but the slides), as bytes
+    n: int  # joint variables of the mechanism
     length: float  # characteristic length L
 
     def applies(self, active) -> bool:
         """Whether ``active`` frees every ball and holds every slide."""
-        return (type(active) is np.ndarray and active.dtype == np.bool_ and active.ndim == 1
-                and active.tobytes() == self.held)
+        return type(active) is np.ndarray and active.dtype is _BOOL and active.tobytes() == self.held
+
+    @property
+    def axes(self) -> np.ndarray:
+        """(6, 2, 3, 3): the two balls' axes (columns)."""
+        return self.data[:, 9:].reshape(6, 2, 3, 3)
 
     @property
     def base(self) -> np.ndarray:
-        return self.geometry[:, 0:3]
+        return self.data[:, 0:3]
 
     @property
     def tip(self) -> np.ndarray:
-        return self.geometry[:, 3:6]
+        return self.data[:, 3:6]
 
     @property
     def direction(self) -> np.ndarray:
-        return self.geometry[:, 6:9]
+        return self.data[:, 6:9]
 
 
-_LEGS: weakref.WeakKeyDictionary[Mechanism, LegPlatform | None] = weakref.WeakKeyDictionary()
+_BOOL = np.dtype(np.bool_)
+_F64 = np.dtype(np.float64)
+#: per mechanism (by ``id``; an entry leaves with its mechanism): a plain dict, as the lookup is
+#: on every forward solve and a ``WeakKeyDictionary``'s costs a fifth of a microsecond
+_LEGS: dict[int, LegPlatform | None] = {}
 
 
 def leg_platform(mech: Mechanism) -> LegPlatform | None:
@@ -87,10 +99,11 @@ def leg_platform(mech: Mechanism) -> LegPlatform | None:
     bodies, no locked freedom; a leg's slide may be off the line of its balls), else ``None``
     (cached per mechanism)."""
     try:
-        return _LEGS[mech]
+        return _LEGS[id(mech)]
     except KeyError:
         pass
-    _LEGS[mech] = out = _find_legs(mech)
+    _LEGS[id(mech)] = out = _find_legs(mech)
+    weakref.finalize(mech, _LEGS.pop, id(mech), None)
     return out
 
 
@@ -112,9 +125,9 @@ def _find_legs(mech: Mechanism) -> LegPlatform | None:
         axes.append([balls[0][1], balls[4][1]])
     held = np.ones(len(refs), dtype=np.bool_)
     held[[i[1] for i in index]] = False
-    geometry = np.ascontiguousarray(np.hstack([base, tip, direction]), dtype=float)
-    return LegPlatform(np.array(index, dtype=np.int64), geometry, np.array(axes, dtype=float), held.tobytes(),
-                       float(mech.characteristic_length))
+    data = np.hstack([base, tip, direction, np.array(axes, dtype=float).reshape(6, 18)])
+    return LegPlatform(np.array(index, dtype=np.int64), np.ascontiguousarray(data, dtype=float), held.tobytes(),
+                       len(refs), float(mech.characteristic_length))
 
 
 def shortest_rotvec(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -132,6 +145,16 @@ def shortest_rotvec(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     p = -a[k] * a
     p[k] += 1.0
     return p * (np.pi / float(np.sqrt(p @ p)))
+
+
+def shortest_rotation(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The matrix of :func:`shortest_rotvec`: ``I + [x] + [x]^2 / (1 + c)`` with ``x = a x b``,
+    ``c = a . b`` (no trigonometry) unless ``a`` and ``b`` are more than 120 degrees apart."""
+    c = float(a @ b)
+    if c > -0.5:
+        K = skew(np.cross(a, b))
+        return np.eye(3) + K + (K @ K) / (1.0 + c)
+    return rotvec_matrix(shortest_rotvec(a, b))
 
 
 def _pose_newton(lp: LegPlatform, q0: np.ndarray, D0: np.ndarray, tol: float, max_iter: int):
@@ -176,7 +199,7 @@ def place_legs(lp: LegPlatform, q0: np.ndarray, R: np.ndarray, t: np.ndarray) ->
         w = lp.tip[k] - lp.base[k] + q0[i_s] * lp.direction[k]
         us = R1s @ (w / np.sqrt(w @ w))
         d = R @ lp.tip[k] + t - lp.base[k]
-        R1 = rotvec_matrix(shortest_rotvec(us, d / np.sqrt(d @ d))) @ R1s
+        R1 = shortest_rotation(us, d / np.sqrt(d @ d)) @ R1s
         q[i1 : i1 + 3] = A1.T @ matrix_rotvec(R1)
         q[i2 : i2 + 3] = A2.T @ matrix_rotvec(R1.T @ R)
     return q
@@ -190,22 +213,41 @@ def closure_norm(mech: Mechanism, config: Configuration, length: float) -> float
     return float(np.sqrt(np.sum(r * r)))
 
 
-def correct(mech: Mechanism, lp: LegPlatform, config: Configuration, *, tol: float | None = None,
-            max_iter: int = 50, general=None) -> CorrectionResult:
+def correct(mech: Mechanism, lp: LegPlatform, config: Configuration, tol: float | None = None, max_iter: int = 50,
+            active: np.ndarray | None = None) -> CorrectionResult:
     """Forward position of the platform from ``config`` with the slides held (see the module
-    docstring); ``general(config)`` is the general engine's correction, the fallback."""
+    docstring); the general engine (:func:`.closure.correct` with ``method="joints"`` and
+    ``active``, by default every freedom but the slides) is the fallback."""
     if tol is None:  # the newton tolerance in force (geometry/tolerances.py)
         tol = current_tolerances().newton
     if compiled.enabled():
-        status, it, q, D, rn = compiled.correct_leg_platform(mech, lp, config, tol, max_iter)
+        q0, D0 = config.q, config.D
+        if not (_plain(q0, (lp.n,)) and _plain(D0, (4, 4)) and type(config.B) is np.ndarray
+                and config.B.shape == (0, 4, 4)):  # else the full check, and one numba type per argument
+            check_configuration(mech, config)
+            q0, D0 = np.require(q0, np.float64, ["C", "W"]), np.require(D0, np.float64, ["C", "W"])
+        qn, Dn = np.empty(lp.n), np.empty((4, 4))
+        status, it, rn, same = nb_leg_platform(lp.index, lp.data, lp.length, q0, D0, float(tol), int(max_iter), qn, Dn)
+        if status == -1:  # NaN or infinity in the seed: the full check names it
+            check_configuration(mech, config)
+        q, D = (None, None) if same else (qn, Dn)
     else:
         check_configuration(mech, config)
         status, it, q, D, rn = _correct_python(mech, lp, config, tol, max_iter)
     if status == 1:
-        c = config if it == 0 and q is None else Configuration(q, D)
-        return CorrectionResult(c, True, it, rn)
-    res = general(config)
+        return CorrectionResult.of(config if q is None or D is None else Configuration.of(q, D), True, it, rn)
+    if active is None:
+        active = np.frombuffer(lp.held, dtype=np.bool_).copy()
+    res = closure_correct(mech, config, active=active, tol=tol, max_iter=max_iter, method="joints")
     return CorrectionResult(res.config, res.converged, it + res.iterations, res.residual, res.stationary)
+
+
+def _plain(x, shape) -> bool:
+    """A C-contiguous, writable float64 array of ``shape`` (what the kernel takes as it is)."""
+    if type(x) is not np.ndarray or x.dtype is not _F64 or x.shape != shape:
+        return False
+    f = x.flags
+    return f.c_contiguous and f.writeable
 
 
 def _correct_python(mech: Mechanism, lp: LegPlatform, config: Configuration, tol: float, max_iter: int):
