@@ -218,3 +218,43 @@ def test_the_closure_of_placed_legs_is_the_leg_length_mismatch():
     mismatch = np.linalg.norm(p, axis=1) - np.linalg.norm(w, axis=1)
     assert np.abs(mismatch).max() > 1e-5
     np.testing.assert_allclose(np.linalg.norm(r[:, 3:], axis=1), np.abs(mismatch), rtol=1e-6, atol=1e-15)
+
+
+def _random_platform(seed: int, skewed: bool):
+    """Six S-P-S legs of a random platform; ``skewed``: each slide off the line of its balls."""
+    from spatialmech.model.joints import P, S
+    from spatialmech.model.mechanism import Limb, Mechanism
+
+    rng = np.random.default_rng(seed)
+    ang = np.arange(6) * np.pi / 3.0 + rng.uniform(-0.2, 0.2, 6)
+    a = np.c_[np.cos(ang), np.sin(ang), rng.uniform(-0.1, 0.1, 6)]
+    b = np.c_[0.5 * np.cos(ang + 0.5), 0.5 * np.sin(ang + 0.5), 1.0 + rng.uniform(-0.1, 0.1, 6)]
+    limbs = []
+    for i in range(6):
+        e = _unit(b[i] - a[i])
+        if skewed:
+            e = _unit(e + 0.3 * rng.standard_normal(3))
+        limbs.append(Limb(f"l{i}", (S(f"a{i}", a[i]), P(f"p{i}", a[i], e, actuated=True), S(f"b{i}", b[i]))))
+    return Mechanism(f"random-{seed}", limbs=tuple(limbs), platform_point=np.zeros(3))
+
+
+@pytest.mark.parametrize("seed,skewed", [(1, False), (2, True), (3, True)])
+def test_a_users_platform_with_slides_off_the_leg_line_gets_the_same_pose(seed, skewed):
+    """A platform built in a few lines of Python (the slides need not lie on the line of their
+    balls): the pose path finds the general engine's pose, on both paths alike."""
+    mech = _random_platform(seed, skewed)
+    lp = leg_platform.leg_platform(mech)
+    assert lp is not None
+    held = active_mask(mech)
+    held[lp.index[:, 1]] = False
+    target = generic_configuration(mech, seed=seed, step=0.2)
+    start = _seed(mech, lp, target, Configuration.reference(mech))
+    auto = correct(mech, start, active=held)
+    joints = correct(mech, start, active=held, method="joints")
+    with pure():
+        ref = correct(mech, start, active=held)
+    assert auto.converged and joints.converged and ref.converged
+    np.testing.assert_allclose(auto.config.D, joints.config.D, atol=1e-11)
+    np.testing.assert_allclose(auto.config.q, ref.config.q, atol=1e-10)
+    assert auto.iterations == ref.iterations
+    assert np.abs(closure_residual(mech, auto.config)).max() < 1e-12
