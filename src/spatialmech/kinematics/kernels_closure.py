@@ -33,6 +33,7 @@ __all__ = [
     "nb_colmap",
     "nb_correct",
     "nb_correct_hyperplane",
+    "nb_finite_config",
     "nb_hub",
     "nb_limb_columns",
     "nb_limb_gn",
@@ -330,6 +331,23 @@ def nb_norm(x):
 
 
 @njit(cache=True)
+def nb_finite_config(q, D, B):
+    """Whether a configuration's ``q``, ``D`` and ``B`` hold no NaN or infinity (one sum: either
+    propagates into it)."""
+    tot = 0.0
+    for i in range(q.shape[0]):
+        tot += q[i]
+    for i in range(4):
+        for j in range(4):
+            tot += D[i, j]
+    for b in range(B.shape[0]):
+        for i in range(4):
+            for j in range(4):
+                tot += B[b, i, j]
+    return np.isfinite(tot)
+
+
+@njit(cache=True)
 def nb_correct(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends, linear, L, qs, Ds, Bs, active,
              fix_platform, tol, max_iter, q_out, D_out, B_out, status, iters, resid):
     """:func:`.closure.correct` from each seed ``qs[s], Ds[s], Bs[s]``: the result in ``q_out[s]``,
@@ -375,17 +393,7 @@ def nb_correct(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends,
         st = 0
         rn = np.inf
         it = 0
-        tot = 0.0
-        for i in range(n):
-            tot += q[i]
-        for i in range(4):
-            for j in range(4):
-                tot += D[i, j]
-        for b in range(h - 1):
-            for i in range(4):
-                for j in range(4):
-                    tot += B[b, i, j]
-        if not np.isfinite(tot):
+        if not nb_finite_config(q, D, B):
             status[s] = -1
             iters[s] = 0
             resid[s] = np.nan

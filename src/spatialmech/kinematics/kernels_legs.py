@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from .jit import njit
+from .kernels_closure import nb_finite_config
 from .kernels_se3 import nb_log, nb_matrix_rotvec, nb_rodrigues, nb_rotvec_matrix3
 
 __all__ = ["nb_leg_closure", "nb_leg_platform", "nb_shortest_rotation", "nb_shortest_rotvec"]
@@ -70,21 +71,17 @@ def nb_leg_platform(index, geom, L, q0, D0, tol, max_iter, q, D):
     result (already closed)."""
     m = index.shape[0]
     n = q0.shape[0]
-    tot = 0.0
-    for i in range(n):
-        tot += q0[i]
-    for i in range(4):
-        for j in range(4):
-            tot += D0[i, j]
-    if not np.isfinite(tot):
+    if not nb_finite_config(q0, D0, np.empty((0, 4, 4))):
         return -1, 0, np.nan, False
     Lk = np.empty(m)
+    wu = np.empty((m, 3))  # each leg's direction in its base ball's frame (b - a + s e, unit)
     for k in range(m):
         s = q0[index[k, 1]]
         w0 = geom[k, 3] - geom[k, 0] + s * geom[k, 6]
         w1 = geom[k, 4] - geom[k, 1] + s * geom[k, 7]
         w2 = geom[k, 5] - geom[k, 2] + s * geom[k, 8]
         Lk[k] = np.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
+        wu[k, 0], wu[k, 1], wu[k, 2] = w0 / Lk[k], w1 / Lk[k], w2 / Lk[k]
     R = np.empty((3, 3))
     t = np.empty(3)
     for a in range(3):
@@ -170,27 +167,18 @@ def nb_leg_platform(index, geom, L, q0, D0, tol, max_iter, q, D):
     R2 = np.empty((3, 3))
     v = np.empty(3)
     for k in range(m):
-        i1, i_s, i2 = index[k, 0], index[k, 1], index[k, 2]
+        i1, i2 = index[k, 0], index[k, 2]
         A1 = geom[k, 9:18]  # row by row: A1[3 r + c]
         A2 = geom[k, 18:27]
         x0 = A1[0] * q0[i1] + A1[1] * q0[i1 + 1] + A1[2] * q0[i1 + 2]
         x1 = A1[3] * q0[i1] + A1[4] * q0[i1 + 1] + A1[5] * q0[i1 + 2]
         x2 = A1[6] * q0[i1] + A1[7] * q0[i1 + 1] + A1[8] * q0[i1 + 2]
         nb_rotvec_matrix3(x0, x1, x2, R1s)
-        s = q0[i_s]
-        w0 = geom[k, 3] - geom[k, 0] + s * geom[k, 6]
-        w1 = geom[k, 4] - geom[k, 1] + s * geom[k, 7]
-        w2 = geom[k, 5] - geom[k, 2] + s * geom[k, 8]
-        wn = np.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
-        w0, w1, w2 = w0 / wn, w1 / wn, w2 / wn
-        us0 = R1s[0, 0] * w0 + R1s[0, 1] * w1 + R1s[0, 2] * w2
-        us1 = R1s[1, 0] * w0 + R1s[1, 1] * w1 + R1s[1, 2] * w2
-        us2 = R1s[2, 0] * w0 + R1s[2, 1] * w1 + R1s[2, 2] * w2
-        d0 = R[0, 0] * geom[k, 3] + R[0, 1] * geom[k, 4] + R[0, 2] * geom[k, 5] + t[0] - geom[k, 0]
-        d1 = R[1, 0] * geom[k, 3] + R[1, 1] * geom[k, 4] + R[1, 2] * geom[k, 5] + t[1] - geom[k, 1]
-        d2 = R[2, 0] * geom[k, 3] + R[2, 1] * geom[k, 4] + R[2, 2] * geom[k, 5] + t[2] - geom[k, 2]
-        dn = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
-        nb_shortest_rotation(us0, us1, us2, d0 / dn, d1 / dn, d2 / dn, W, v)
+        us0 = R1s[0, 0] * wu[k, 0] + R1s[0, 1] * wu[k, 1] + R1s[0, 2] * wu[k, 2]
+        us1 = R1s[1, 0] * wu[k, 0] + R1s[1, 1] * wu[k, 1] + R1s[1, 2] * wu[k, 2]
+        us2 = R1s[2, 0] * wu[k, 0] + R1s[2, 1] * wu[k, 1] + R1s[2, 2] * wu[k, 2]
+        # the leg's new direction: the last residual's, at this pose (M[k, 3:6])
+        nb_shortest_rotation(us0, us1, us2, M[k, 3], M[k, 4], M[k, 5], W, v)
         for a in range(3):
             for b in range(3):
                 R1[a, b] = W[a, 0] * R1s[0, b] + W[a, 1] * R1s[1, b] + W[a, 2] * R1s[2, b]

@@ -43,14 +43,16 @@ from .kernels_legs import nb_leg_platform
 from .closure import (
     Configuration,
     CorrectionResult,
+    active_mask,
     check_configuration,
     closure_residual,
+    closure_scales,
     correct as closure_correct,
     limb_chains,
     limb_slices,
 )
 
-__all__ = ["LegPlatform", "closure_norm", "correct", "leg_platform", "place_legs", "shortest_rotation", "shortest_rotvec"]
+__all__ = ["LegPlatform", "correct", "leg_platform", "place_legs", "shortest_rotation", "shortest_rotvec"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -205,12 +207,11 @@ def place_legs(lp: LegPlatform, q0: np.ndarray, R: np.ndarray, t: np.ndarray) ->
     return q
 
 
-def closure_norm(mech: Mechanism, config: Configuration, length: float) -> float:
-    """The nondimensional norm of the closure residual (moments divided by ``length``), the
-    general engine's convergence measure."""
-    r = closure_residual(mech, config).reshape(-1, 2, 3)
-    r[:, 1] /= length
-    return float(np.sqrt(np.sum(r * r)))
+def _closure_norm(mech: Mechanism, config: Configuration) -> float:
+    """The general engine's convergence measure: the closure residual scaled by
+    :func:`.closure.closure_scales`' rows (moments divided by the characteristic length)."""
+    row, _ = closure_scales(mech, active_mask(mech))
+    return float(np.linalg.norm(row * closure_residual(mech, config)))
 
 
 def correct(mech: Mechanism, lp: LegPlatform, config: Configuration, tol: float | None = None, max_iter: int = 50,
@@ -257,12 +258,12 @@ def _correct_python(mech: Mechanism, lp: LegPlatform, config: Configuration, tol
     if status != 1:
         return status, it, None, None, np.inf
     if it == 0:  # the seed's pose already closes the legs: the seed itself when it closes
-        rn = closure_norm(mech, config, lp.length)
+        rn = _closure_norm(mech, config)
         if rn < tol:
             return 1, 0, None, None, rn
     q = place_legs(lp, q0, R, t)
     D = np.eye(4)
     D[:3, :3] = R
     D[:3, 3] = t
-    rn = closure_norm(mech, Configuration(q, D), lp.length)
+    rn = _closure_norm(mech, Configuration(q, D))
     return (1 if rn < tol else 0), it, q, D, rn
