@@ -33,11 +33,15 @@ from enum import StrEnum
 
 __all__ = [
     "BranchEnd",
+    "DriveStatus",
+    "EndPointStatus",
     "EventKind",
     "Progress",
+    "ScreenStage",
     "SingularityKind",
     "SolveStatus",
     "Steps",
+    "TraceVerdict",
     "TrackStatus",
     "Verdict",
     "check_progress",
@@ -135,3 +139,45 @@ class Verdict(StrEnum):
     REPRODUCED = "reproduced"
     CORRECTED = "reproduced after correction"
     NOT_REPRODUCED = "not reproduced"
+
+
+class EndPointStatus(StrEnum):
+    """The kind of one end point of a homotopy path (:mod:`spatialmech.kinematics.homotopy`,
+    :mod:`~spatialmech.kinematics.homotopy_general`)."""
+
+    REAL = "real"  #: a finite, nonsingular, real solution
+    COMPLEX = "complex"  #: a finite, nonsingular solution that is not real
+    SINGULAR = "singular"  #: the Jacobian is singular there (a multiple root or a continuum)
+    AT_INFINITY = "at_infinity"  #: the path diverged (the platform escapes: e.e = 0)
+
+
+class TraceVerdict(StrEnum):
+    """The verdict of a trace test (:func:`spatialmech.kinematics.trace_test.trace_test`)."""
+
+    PASSED = "passed"  #: the known solutions are complete
+    FAILED = "failed"  #: some are missing (the traces are not on a line)
+    INCONCLUSIVE = "inconclusive"  #: a path of the test's homotopies failed
+    CAPPED = "capped"  #: the work cap ran out first
+
+
+class DriveStatus(StrEnum):
+    """How one studio drive or pose request ended (the ``status`` of ``POST /api/drive`` and
+    ``POST /api/pose``)."""
+
+    REACHED = "reached"  #: the requested values, on the same branch
+    STOPPED_SINGULAR = "stopped_at_singularity"  #: the drivers lost control: DJ zero / dead point ahead
+    STOPPED_TRACKER = "stopped"  #: the tracker could not step on (bifurcation, branch crossing, no closure)
+    UNCHANGED = "unchanged"  #: nothing to do (the values are the current ones)
+    STOPPED_LIMIT = "stopped_at_limit"  #: pose: an actuator would leave its joint limits
+    LIMB_SINGULAR = "limb_singular"  #: pose: a limb reaches an inverse singularity (workspace edge)
+    UNREACHABLE = "unreachable"  #: pose: no closed configuration further along the path
+
+
+class ScreenStage(StrEnum):
+    """The stage of the 5-CS screen that rejected a candidate (``rejected_by`` of
+    :class:`spatialmech.synthesis.screening.CandidateVerdict`)."""
+
+    ASSEMBLY = "assembly"  #: the candidate does not close (or is singular) at the task positions
+    DJ_SIGNS = "dj_signs"  #: no single driver keeps the sign of DJ over the positions
+    CIRCUITS = "circuits"  #: the full defect analysis found no usable driver
+    ERROR = "error"  #: a numerical routine failed (``error`` says how)

@@ -21,7 +21,7 @@ from ..geometry.tolerances import MONODROMY_MAX_SOLUTIONS, MONODROMY_MAX_WORK
 from ..geometry.tolerances import resolve as resolve_tolerances
 from ..geometry import screws as sc
 from ..model.mechanism import Mechanism, Pose
-from ..results import Progress
+from ..results import EndPointStatus, Progress
 from ..serialize import freedom_values_dict, pose_dict
 from .closure import (
     Configuration,
@@ -521,7 +521,7 @@ def _forward_homotopy(mech: Mechanism, targets: dict[int, float], seed: int, max
         D = transform(e.R, e.p)
         runs.append(_fk_from(mech, _limbs_at(mech, D, q0, targets, seed), targets, mask, max_iter))
     n_endpoint_runs = len(runs)
-    if hr.count("singular"):
+    if hr.count(EndPointStatus.SINGULAR):
         # singular end points (a continuum, as the 4-SPS/CU's self-motion at its home legs, or a
         # multiple root) are located to a few digits only: the multi-start search adds its roots,
         # and a singular root is followed along its self-motion and reported as one continuum
@@ -535,8 +535,9 @@ def _forward_homotopy(mech: Mechanism, targets: dict[int, float], seed: int, max
               "n_regular": kinds.count(AssemblyKind.REGULAR), "n_singular_roots": kinds.count(AssemblyKind.SINGULAR),
               "n_self_motion_sets": kinds.count(AssemblyKind.SELF_MOTION),
               "complete": hr.complete, "completeness": hr.completeness,
-              "n_complex": hr.count("complex"), "n_real": hr.count("real"), "n_singular": hr.count("singular"),
-              "n_at_infinity": hr.count("at_infinity"), "n_generic": hr.n_generic,
+              "n_complex": hr.count(EndPointStatus.COMPLEX), "n_real": hr.count(EndPointStatus.REAL),
+              "n_singular": hr.count(EndPointStatus.SINGULAR),
+              "n_at_infinity": hr.count(EndPointStatus.AT_INFINITY), "n_generic": hr.n_generic,
               "n_paths": hr.n_paths_total_degree, "elapsed_s": hr.seconds, "generic_elapsed_s": hr.seconds_generic,
               "generic_cached": hr.cached, "endpoints": [e.to_dict() for e in hr.solutions],
               "singular_below": singular_threshold()}
@@ -585,12 +586,13 @@ def _forward_general(mech: Mechanism, targets: dict[int, float], seed: int, max_
         mask[i] = False
     runs = [_fk_from(mech, hg.configuration(e), targets, mask, max_iter) for e in hr.solutions if e.q is not None]
     n_endpoint_runs = len(runs)
-    if hr.count("singular") or not hr.complete:  # a continuum, a multiple root, or no proof: the multi-start adds its roots
+    # a continuum, a multiple root, or no proof: the multi-start adds its roots
+    if hr.count(EndPointStatus.SINGULAR) or not hr.complete:
         runs += _multistart_runs(mech, targets, mask, n_seeds, seed, max_iter)
     sols, conv = _group_runs(mech, runs)
     kinds = [s.kind for s in sols]
     extra = len(runs) - n_endpoint_runs
-    why_more = "singular end points" if hr.count("singular") else "not proven complete"
+    why_more = "singular end points" if hr.count(EndPointStatus.SINGULAR) else "not proven complete"
     search = {"method": "homotopy continuation (loop closure in joint variables, monodromy), real end points polished "
                         "by Newton" + (f"; {why_more}: {extra} multi-start seeds added" if extra else ""),
               "seeds": extra, "seed": seed, "converged_runs": len(conv), "distinct": len(kinds),
@@ -599,8 +601,9 @@ def _forward_general(mech: Mechanism, targets: dict[int, float], seed: int, max_
               "complete": hr.complete,
               "completeness": hr.completeness + (f"; a {extra}-start multi-start search added its roots"
                                                  if extra and not hr.complete else ""),
-              "n_complex": hr.count("complex"), "n_real": hr.count("real"), "n_singular": hr.count("singular"),
-              "n_at_infinity": hr.count("at_infinity"), "n_generic": hr.n_generic, "n_spurious": hr.n_spurious,
+              "n_complex": hr.count(EndPointStatus.COMPLEX), "n_real": hr.count(EndPointStatus.REAL),
+              "n_singular": hr.count(EndPointStatus.SINGULAR),
+              "n_at_infinity": hr.count(EndPointStatus.AT_INFINITY), "n_generic": hr.n_generic, "n_spurious": hr.n_spurious,
               "n_paths": hr.n_generic, "monodromy_loops": hr.loops, "elapsed_s": hr.seconds,
               "generic_elapsed_s": hr.seconds_generic, "generic_cached": hr.cached,
               "trace_test": hr.trace.verdict if hr.trace else "not run",

@@ -57,6 +57,7 @@ from ..geometry.tolerances import (
     HOMOTOPY_SINGULAR,
 )
 from ..model.mechanism import Mechanism
+from ..results import EndPointStatus
 from . import compiled
 from .endgame import cauchy_endgame, local_dimension
 from .homotopy_systems import (
@@ -404,13 +405,13 @@ def _classify(Qc, c, X):
         imag = float(np.linalg.norm(y.imag) / max(float(np.linalg.norm(y)), 1e-300))
         res = float(np.linalg.norm(F[n, :7]) / max(nx[n] ** 2, 1e-300))
         if not np.isfinite(nx[n]) or rel_inf < HOMOTOPY_INFINITY:
-            st = "at_infinity"
+            st = EndPointStatus.AT_INFINITY
         elif rcond < HOMOTOPY_SINGULAR:
-            st = "singular"
+            st = EndPointStatus.SINGULAR
         elif imag < HOMOTOPY_REAL:
-            st = "real"
+            st = EndPointStatus.REAL
         else:
-            st = "complex"
+            st = EndPointStatus.COMPLEX
         out.append((st, rcond, rel_inf, imag, res, y, x))
     return out
 
@@ -504,8 +505,8 @@ def _generic_solve(sysm: StewartSystem | PoseSystem, seed: int = 0, max_attempts
 
         X, _, _, _ = track(fun, X0)
         cls = _classify(Qg, c, X)
-        fin = [i for i, r in enumerate(cls) if r[0] in ("real", "complex")]
-        inf = [i for i, r in enumerate(cls) if r[0] == "at_infinity"]
+        fin = [i for i, r in enumerate(cls) if r[0] in (EndPointStatus.REAL, EndPointStatus.COMPLEX)]
+        inf = [i for i, r in enumerate(cls) if r[0] == EndPointStatus.AT_INFINITY]
         pts = np.array([cls[i][6] for i in fin]).reshape(-1, _N)
         distinct = _distinct(pts)
         accounted = len(fin) + len(inf) == len(X) and distinct
@@ -549,7 +550,7 @@ class HomotopySolution:
     (projective, phase removed), the inverse condition number of the row-normalised Jacobian,
     ``|e.e| / |x|^2``, the relative residual and, for a real end point, the displacement."""
 
-    status: str
+    status: EndPointStatus
     study: np.ndarray
     rcond: float
     infinity_ratio: float
@@ -578,7 +579,7 @@ class HomotopyResult:
     seconds: float
     cached: bool
 
-    def count(self, status: str) -> int:
+    def count(self, status: EndPointStatus | str) -> int:
         return sum(s.status == status for s in self.solutions)
 
 
@@ -597,7 +598,8 @@ def homotopy_forward(mech: Mechanism | StewartSystem | PoseSystem, actuator_valu
     X, _, done = track_parameter(gen.Q, Qt, c, gen.X) if len(gen.X) else (gen.X, None, np.ones(0, dtype=bool))
     cls = _classify(Qt, c, X)
     # singular end points, and paths that stopped short of t = 1 without escaping to infinity
-    sing = np.array([i for i, r in enumerate(cls) if r[0] == "singular" or (not done[i] and r[0] != "at_infinity")],
+    sing = np.array([i for i, r in enumerate(cls)
+                     if r[0] == EndPointStatus.SINGULAR or (not done[i] and r[0] != EndPointStatus.AT_INFINITY)],
                     dtype=np.int64)
     mult = np.ones(len(cls), dtype=np.int64)
     wind = np.zeros(len(cls), dtype=np.int64)
@@ -618,7 +620,7 @@ def homotopy_forward(mech: Mechanism | StewartSystem | PoseSystem, actuator_valu
     sols = []
     for i, (st, rc, ri, im, res, y, _) in enumerate(cls):
         R = p = None
-        if (st == "real" or (st == "singular" and im < HOMOTOPY_NEAR_REAL)) and ri >= HOMOTOPY_INFINITY:
+        if (st == EndPointStatus.REAL or (st == EndPointStatus.SINGULAR and im < HOMOTOPY_NEAR_REAL)) and ri >= HOMOTOPY_INFINITY:
             R, p = study_to_pose(y / np.linalg.norm(y), sysm.L)
         sols.append(HomotopySolution(st, y, rc, ri, im, res, R, p, int(mult[i]), int(wind[i])))
     n_par = len(sysm.affine_span()[1])
@@ -626,7 +628,7 @@ def homotopy_forward(mech: Mechanism | StewartSystem | PoseSystem, actuator_valu
            f"accounted for ({len(gen.X)} finite nonsingular, {gen.n_at_infinity} at the exceptional generator e.e = 0); "
            f"parameter homotopy of those {len(gen.X)} paths to the requested actuator values (straight segment in the "
            f"{n_par}-dimensional affine span of the coefficients)")
-    n_sing = sum(s.status == "singular" for s in sols)
+    n_sing = sum(s.status == EndPointStatus.SINGULAR for s in sols)
     if accounted and n_sing and isolated:
         how += (f"; {n_sing} path(s) end at {len(groups)} isolated multiple root(s) (multiplicities "
                 f"{sorted(int(m) for m in set(mult[sing].tolist()))}), located by a Cauchy end game (winding numbers "

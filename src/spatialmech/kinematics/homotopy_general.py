@@ -54,6 +54,7 @@ from ..geometry.tolerances import (
     TRACE_TOL,
 )
 from ..model.mechanism import Mechanism
+from ..results import EndPointStatus, TraceVerdict
 from .closure import Configuration, limb_slices
 from .endgame import cauchy_endgame
 from .homotopy import study_to_pose, track
@@ -340,7 +341,7 @@ class GeneralSolution:
     variables ``x`` and, for a real one, the joint variables ``q``, platform ``D`` and internal
     bodies ``B``."""
 
-    status: str
+    status: EndPointStatus
     x: np.ndarray
     rcond: float
     imag_ratio: float
@@ -377,7 +378,7 @@ class GeneralResult:
     cached: bool
     trace: TraceResult | None = None  # the trace test of the generic solutions (None: not run)
 
-    def count(self, status: str) -> int:
+    def count(self, status: EndPointStatus | str) -> int:
         return sum(s.status == status for s in self.solutions)
 
 
@@ -419,7 +420,7 @@ def general_forward(mech: Mechanism, targets: dict[int, float], *, seed: int = 0
             e = x[h.study : h.study + 4]
             big = big or abs(e @ e) / max(np.linalg.norm(x[h.study : h.study + 8]) ** 2, 1e-300) < HOMOTOPY_INFINITY
         if big or (not done[n] and np.linalg.norm(x) > MONODROMY_DIVERGED):
-            sols.append(GeneralSolution("at_infinity", x, 0.0, 0.0, float(res[n])))
+            sols.append(GeneralSolution(EndPointStatus.AT_INFINITY, x, 0.0, 0.0, float(res[n])))
             continue
         if not res[n] < MONODROMY_RESIDUAL:
             if done[n]:
@@ -441,13 +442,14 @@ def general_forward(mech: Mechanism, targets: dict[int, float], *, seed: int = 0
             k = int(np.argmax(np.abs(y[s])))
             y[s] = y[s] * (abs(y[s][k]) / y[s][k])
         imag = float(np.max(np.abs(y.imag)) / (1 + np.max(np.abs(y.real))))
-        st = "singular" if rcond < HOMOTOPY_SINGULAR else "real" if imag < HOMOTOPY_REAL else "complex"
+        st = (EndPointStatus.SINGULAR if rcond < HOMOTOPY_SINGULAR else EndPointStatus.REAL if imag < HOMOTOPY_REAL
+              else EndPointStatus.COMPLEX)
         q = D = B = None
-        if st == "real":
+        if st == EndPointStatus.REAL:
             c = rebuild_configuration(sysm, y.real, targets)
             q, D, B = c.q, c.D, c.B
         sols.append(GeneralSolution(st, y, rcond, imag, float(res[n]), q, D, B))
-    n_sing = sum(s.status == "singular" for s in sols)
+    n_sing = sum(s.status == EndPointStatus.SINGULAR for s in sols)
     fam = ("the limbs offset by generic complex rigid motions" if sysm.rigid_family
            else "the square system with a generic complex offset")
     head = (f"monodromy saturated after {gen.loops} loops ({MONODROMY_STALE_LOOPS} in a row without a new solution; "
@@ -461,10 +463,10 @@ def general_forward(mech: Mechanism, targets: dict[int, float], *, seed: int = 0
                f"witness points of the curve through a second generic instance, traces on a line to "
                f"{tr.deviation:.1e} <= {TRACE_TOL:g}); {tail}")
     elif tr is not None:
-        why_not = {"failed": f"trace test FAILED (deviation {tr.deviation:.1e} > {TRACE_TOL:g} with {tr.n_witness} "
+        why_not = {TraceVerdict.FAILED: f"trace test FAILED (deviation {tr.deviation:.1e} > {TRACE_TOL:g} with {tr.n_witness} "
                              "witness points that stopped growing): solutions of the generic instance are missing",
-                   "inconclusive": "trace test inconclusive (a path of its homotopies failed)",
-                   "capped": f"trace test stopped at its cap (a work of {tr.work} paths tracked times unknowns, "
+                   TraceVerdict.INCONCLUSIVE: "trace test inconclusive (a path of its homotopies failed)",
+                   TraceVerdict.CAPPED: f"trace test stopped at its cap (a work of {tr.work} paths tracked times unknowns, "
                              f"{tr.loops} loops; {tr.n_witness} witness points so far): not proven"
                              + ("; method=\"homotopy\" runs it further" if capped else "")}
         how = f"{head}; {why_not[tr.verdict]}; {tail}: not a proof"

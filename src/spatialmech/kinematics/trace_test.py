@@ -37,6 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..geometry.tolerances import MONODROMY_PARALLEL, TRACE_MAX_LOOPS, TRACE_STALE_LOOPS, TRACE_STEP, TRACE_TOL
+from ..results import TraceVerdict
 from .homotopy import track
 
 __all__ = ["TraceResult", "new_points", "trace_test"]
@@ -51,7 +52,7 @@ class TraceResult:
     trace path failed) or "capped" (the work cap ran out first).  ``deviation``: the last
     relative deviation of the traces from a line (infinity before any test)."""
 
-    verdict: str
+    verdict: TraceVerdict
     deviation: float
     n_witness: int
     loops: int
@@ -60,7 +61,7 @@ class TraceResult:
 
     @property
     def passed(self) -> bool:
-        return self.verdict == "passed"
+        return self.verdict is TraceVerdict.PASSED
 
 
 def _crand(rng: np.random.Generator, *shape: int) -> np.ndarray:
@@ -161,7 +162,7 @@ def trace_test(curve: Curve, X: np.ndarray, y1: np.ndarray, rng: np.random.Gener
 
     while loops < TRACE_MAX_LOOPS:
         if max_work is not None and work + (3 * k + 2) * len(W) * (m + 1) > max_work:  # the next round's
-            return TraceResult("capped", dev, len(W), loops, work, time.perf_counter() - t0)
+            return TraceResult(TraceVerdict.CAPPED, dev, len(W), loops, work, time.perf_counter() - t0)
         loops += k  # k loops at once, each through its own two random hyperplanes
         B1, B2 = hyperplanes(), hyperplanes()
         A = np.broadcast_to(a, B1.shape)
@@ -183,10 +184,10 @@ def trace_test(curve: Curve, X: np.ndarray, y1: np.ndarray, rng: np.random.Gener
                 dev, ok_all, w = _deviation(curve, np.vstack([fibre, W]), a, rng)  # one more direction
                 work += w * (m + 1)
                 if not ok_all:
-                    return TraceResult("inconclusive", dev, len(W), loops, work, time.perf_counter() - t0)
+                    return TraceResult(TraceVerdict.INCONCLUSIVE, dev, len(W), loops, work, time.perf_counter() - t0)
             if dev < TRACE_TOL:
-                return TraceResult("passed", dev, len(W), loops, work, time.perf_counter() - t0)
+                return TraceResult(TraceVerdict.PASSED, dev, len(W), loops, work, time.perf_counter() - t0)
             tested_at = len(W)
         elif stale >= TRACE_STALE_LOOPS:  # failed, and nothing new since: solutions are missing
-            return TraceResult("failed", dev, len(W), loops, work, time.perf_counter() - t0)
-    return TraceResult("capped", dev, len(W), loops, work, time.perf_counter() - t0)
+            return TraceResult(TraceVerdict.FAILED, dev, len(W), loops, work, time.perf_counter() - t0)
+    return TraceResult(TraceVerdict.CAPPED, dev, len(W), loops, work, time.perf_counter() - t0)

@@ -40,6 +40,7 @@ import numpy as np
 from ..errors import InputError
 from ..geometry.tolerances import current as current_tolerances
 from ..model.mechanism import Mechanism
+from ..results import ScreenStage
 from .cs_dyads import CSDyad, CSFamily, CSTask, cs_task, dyad_from_vector
 from .five_cs import assemble_5cs, cs_configuration
 
@@ -59,7 +60,7 @@ __all__ = [
 ]
 
 #: The stages of the judgement, in order; a rejected candidate names the stage that rejected it.
-STAGES = ("assembly", "dj_signs", "circuits")
+STAGES = (ScreenStage.ASSEMBLY, ScreenStage.DJ_SIGNS, ScreenStage.CIRCUITS)
 
 
 # ------------------------------------------------------------------------------ coordinates
@@ -164,7 +165,7 @@ def candidate_sets(pool: DyadPool, n: int, *, seed: int = 0, separation: float =
         raise InputError(f"density: only {m} dyads sampled from the family; a 5-CS needs 5 (raise the density)")
     Y = nondimensional(pool.task, pool.vectors)
     if math.comb(m, 5) <= n:
-        out = [c for c in itertools.combinations(range(m), 5) if _separated(Y, c, separation)]
+        out: list[tuple[int, ...]] = [c for c in itertools.combinations(range(m), 5) if _separated(Y, c, separation)]
         return np.array(out, dtype=np.int64).reshape(-1, 5), "all"
     s = pool.max_abs_slide
     w = (np.min(s) / np.maximum(s, 1e-300)) ** 2
@@ -203,7 +204,7 @@ class CandidateVerdict:
 
     candidate: int
     dyads: tuple[int, ...]
-    rejected_by: str | None
+    rejected_by: ScreenStage | None
     keeps_sign: tuple[str, ...] = ()
     usable_drivers: tuple[str, ...] = ()
     branch_defect_drivers: tuple[str, ...] = ()
@@ -294,11 +295,11 @@ def judge_candidate(pool: DyadPool, idx: Sequence[int], *, candidate: int = 0, h
     idx = tuple(int(i) for i in idx)
     V = pool.vectors[list(idx)]
     slides = np.concatenate([np.zeros((5, 1)), V[:, 9:15]], axis=1)
-    base = dict(candidate=int(candidate), dyads=idx, stroke=float(np.sum(np.ptp(slides, axis=1))),
-                max_abs_slide=float(np.max(np.abs(slides))))
+    stroke, max_abs_slide = float(np.sum(np.ptp(slides, axis=1))), float(np.max(np.abs(slides)))
 
     def done(**kw) -> CandidateVerdict:
-        return CandidateVerdict(**base, **kw, seconds=time.perf_counter() - t0)
+        return CandidateVerdict(candidate=int(candidate), dyads=idx, stroke=stroke, max_abs_slide=max_abs_slide, **kw,
+                                seconds=time.perf_counter() - t0)
 
     tol = current_tolerances()
     try:
@@ -308,22 +309,22 @@ def judge_candidate(pool: DyadPool, idx: Sequence[int], *, candidate: int = 0, h
             raise InputError("dyads: a candidate limb is not a C-S chain")
         res, sig = _closure_at_positions(mech, configs)
         if not (res <= tol.reachability and sig > tol.rank):
-            return done(rejected_by="assembly", min_closure_sigma_positions=sig)
+            return done(rejected_by=ScreenStage.ASSEMBLY, min_closure_sigma_positions=sig)
         drivers = candidate_drivers(mech)
         djf, _ = dj_function(mech, drivers, configs[0])
         dj = np.array([djf(c) for c in configs])
         s = np.sign(dj)
         keeps = tuple(d for k, d in enumerate(drivers) if np.all(s[:, k] == s[0, k]) and s[0, k] != 0)
         if not keeps:
-            return done(rejected_by="dj_signs", min_closure_sigma_positions=sig)
+            return done(rejected_by=ScreenStage.DJ_SIGNS, min_closure_sigma_positions=sig)
         r = defect_analysis(mech, drivers=list(keeps), h0=h0, max_arc=max_arc)
     except (InputError, ValueError, RuntimeError, np.linalg.LinAlgError) as e:
-        return done(rejected_by="error", error=f"{type(e).__name__}: {e}")
+        return done(rejected_by=ScreenStage.ERROR, error=f"{type(e).__name__}: {e}")
     usable = tuple(r.usable_drivers)
     sig_d = {v.driver: v.min_sigma_on_path for v in r.drivers if v.usable and v.min_sigma_on_path is not None}
     best = max(sig_d, key=lambda d: sig_d[d]) if sig_d else None
     return done(
-        rejected_by=None if usable else "circuits", keeps_sign=keeps, usable_drivers=usable,
+        rejected_by=None if usable else ScreenStage.CIRCUITS, keeps_sign=keeps, usable_drivers=usable,
         branch_defect_drivers=tuple(v.driver for v in r.drivers if v.branch_defect),
         circuit_defect=bool(r.circuit_defect), order_defect=bool(r.order_defect), n_circuits=len(r.circuits),
         min_closure_sigma_positions=sig, min_closure_sigma_path=r.min_closure_sigma,

@@ -35,6 +35,7 @@ from ...kinematics.position import within_limits
 from ...kinematics.task import solve_task, task_values
 from ...model.mechanism import Mechanism
 from ...model.task import TASK_NAMES, TaskCoordinates
+from ...results import DriveStatus
 
 __all__ = ["MAX_JOINT_STEP", "MIN_STEP", "PosePath", "pose_path"]
 
@@ -56,7 +57,7 @@ class PosePath:
     (on the branch), the configurations passed, the DJ event (if any: path parameter and the six
     task values there) and the number of steps."""
 
-    status: str
+    status: DriveStatus
     message: str
     config: Configuration
     passed: list = field(default_factory=list)
@@ -102,8 +103,8 @@ def pose_path(mech: Mechanism, start: Configuration, task: TaskCoordinates, targ
     steps = 0
     while lam < ell:
         if steps >= MAX_STEPS:
-            return PosePath("stopped", f"moved part of the way ({steps} steps); request again to go on", cur, passed,
-                            steps=steps)
+            return PosePath(DriveStatus.STOPPED_TRACKER, f"moved part of the way ({steps} steps); request again to go on", cur,
+                            passed, steps=steps)
         nxt_lam = min(ell, lam + h)
         nxt = at(nxt_lam, cur)
         if nxt is None:
@@ -115,7 +116,7 @@ def pose_path(mech: Mechanism, start: Configuration, task: TaskCoordinates, targ
         bad = [b for b in within_limits(mech, nxt.q) if b not in outside0]
         if bad:
             lims = ", ".join(f"{b} {_show_limits(mech, b)}" for b in bad)
-            return PosePath("stopped_at_limit", f"joints leave their limits ({lims}) before the requested pose; stopped "
+            return PosePath(DriveStatus.STOPPED_LIMIT, f"joints leave their limits ({lims}) before the requested pose; stopped "
                             "just before", cur, passed, steps=steps)
         d1 = dj(nxt)
         if own0 is not None and d1 is not None and d1 != 0 and np.sign(d1) != np.sign(own0):
@@ -130,13 +131,13 @@ def pose_path(mech: Mechanism, start: Configuration, task: TaskCoordinates, targ
                     hi = mid
                 else:
                     lo, c_lo = mid, c_mid
-            return PosePath("stopped_at_singularity", "the chosen drivers lose control before the requested pose (DJ of "
+            return PosePath(DriveStatus.STOPPED_SINGULAR, "the chosen drivers lose control before the requested pose (DJ of "
                             "the drivers changes sign: a direct singularity); stopped just before it (move back, or "
                             "switch drivers)", cur, passed, event=task_at(0.5 * (lo + hi), c_lo), steps=steps)
         cur, lam = nxt, nxt_lam
         passed.append(cur)
         h = min(MAX_STEP, 1.5 * h)
-    return PosePath("reached", "reached the requested pose along the current branch", cur, passed, steps=steps)
+    return PosePath(DriveStatus.REACHED, "reached the requested pose along the current branch", cur, passed, steps=steps)
 
 
 def _show_limits(mech: Mechanism, fid: str) -> str:
@@ -159,7 +160,7 @@ def _edge(mech: Mechanism, cur: Configuration, passed: list, steps: int) -> Pose
     if weak:
         t, a = weak[0]
         limb = mech.limbs[mech.freedom(a).limb].name
-        return PosePath("limb_singular", f"limb {limb} reaches an inverse singularity (actuator {a}, transmission "
+        return PosePath(DriveStatus.LIMB_SINGULAR, f"limb {limb} reaches an inverse singularity (actuator {a}, transmission "
                         f"{t:.2g}): the edge of the workspace of this branch; stopped there", cur, passed, steps=steps)
-    return PosePath("unreachable", "the requested pose is not reachable along this branch (no closed configuration "
+    return PosePath(DriveStatus.UNREACHABLE, "the requested pose is not reachable along this branch (no closed configuration "
                     "beyond this one); stopped at the last reachable pose", cur, passed, steps=steps)

@@ -49,22 +49,23 @@ from ...model.mechanism import Mechanism
 from ...model.task import TASK_NAMES, TaskCoordinates
 from ...present.shapes import joint_list, joint_meshes, mesh_json, platform_solid
 from ...present.viewer import LIMB_COLOURS, drawing
+from ...results import DriveStatus, TrackStatus
 from ...serialize import freedom_values_dict, pose_dict
 from .posing import pose_path
 
 __all__ = ["DriveResult", "Session"]
 
-#: Drive statuses (the ``status`` field of ``POST /api/drive``).
-REACHED = "reached"  # the requested actuator values, on the same branch
-STOPPED_SINGULAR = "stopped_at_singularity"  # the drivers lost control: DJ zero / dead point ahead
-STOPPED_TRACKER = "stopped"  # the tracker could not step on (bifurcation, branch crossing, no closure)
-UNCHANGED = "unchanged"  # nothing to do (the values are the current ones)
-STOPPED_LIMIT = "stopped_at_limit"  # POST /api/pose: an actuator would leave its joint limits
-LIMB_SINGULAR = "limb_singular"  # POST /api/pose: a limb reaches an inverse singularity (workspace edge)
-UNREACHABLE = "unreachable"  # POST /api/pose: no closed configuration further along the path
+#: Drive statuses (the ``status`` field of ``POST /api/drive``): :class:`~spatialmech.results.DriveStatus`.
+REACHED = DriveStatus.REACHED
+STOPPED_SINGULAR = DriveStatus.STOPPED_SINGULAR
+STOPPED_TRACKER = DriveStatus.STOPPED_TRACKER
+UNCHANGED = DriveStatus.UNCHANGED
+STOPPED_LIMIT = DriveStatus.STOPPED_LIMIT
+LIMB_SINGULAR = DriveStatus.LIMB_SINGULAR
+UNREACHABLE = DriveStatus.UNREACHABLE
 #: The name of the event where a single driver's path turns back (a dead point).
 DEAD_POINT = "dead point (drivers)"
-DRIVE_STATUSES = (REACHED, STOPPED_SINGULAR, STOPPED_TRACKER, UNCHANGED, STOPPED_LIMIT, LIMB_SINGULAR, UNREACHABLE)
+DRIVE_STATUSES = tuple(DriveStatus)
 
 #: Half-width of the slider ranges around the start values (where a freedom has no joint
 #: limits; the limits are the range otherwise): rotations (degrees) and slides (in
@@ -82,7 +83,7 @@ class DriveResult:
     """What one drive did: ``status`` (one of :data:`DRIVE_STATUSES`), a sentence, the events
     met (DJ sign changes, in the order met), the tracker steps and the time taken."""
 
-    status: str
+    status: DriveStatus
     message: str
     events: tuple[dict, ...] = ()
     steps: int = 0
@@ -567,7 +568,7 @@ class Session:
                 msg = ("the path turns back in the actuator values (a dead point / direct singularity) before the "
                        "requested values; stopped just before it (drive back, or switch drivers)")
             return self._stop_before(r, STOPPED_SINGULAR, msg, events, steps, elapsed, requested, with_actuators)
-        if r.status == "max_arc" or steps >= MAX_STEPS:
+        if r.status == TrackStatus.MAX_ARC or steps >= MAX_STEPS:
             msg = (f"moved part of the way ({steps} steps): the mechanism moves fast for these actuator values (near a "
                    "singularity); drive again to go on")
         else:
