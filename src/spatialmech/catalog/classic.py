@@ -36,7 +36,7 @@ def stewart_6sps(rb: float = 1.0, rp: float = 0.6, h: float = 1.0) -> Mechanism:
             )
         )
     return Mechanism(
-        "stewart-6sps", tuple(limbs), platform_point=[0, 0, h],
+        "stewart-6sps", tuple(limbs), platform_point=np.array([0.0, 0.0, h]),
         description="Gough-Stewart platform (6-SPS), 6 DOF",
     )
 
@@ -58,7 +58,7 @@ def three_rps(rb: float = 0.3, rp: float = 0.15, h: float = 0.3) -> Mechanism:
             )
         )
     return Mechanism(
-        "three-rps", tuple(limbs), platform_point=[0, 0, h],
+        "three-rps", tuple(limbs), platform_point=np.array([0.0, 0.0, h]),
         description="3-RPS parallel mechanism, 3 DOF (2 rotations + 1 translation, with parasitic motion)",
     )
 
@@ -82,7 +82,7 @@ def three_prs(rb: float = 0.3, rp: float = 0.15, h: float = 0.3) -> Mechanism:
             )
         )
     return Mechanism(
-        "three-prs", tuple(limbs), platform_point=[0, 0, h],
+        "three-prs", tuple(limbs), platform_point=np.array([0.0, 0.0, h]),
         description="3-PRS parallel mechanism (vertical rails), 3 DOF (2 rotations + 1 translation, with parasitic motion)",
     )
 
@@ -110,7 +110,7 @@ def three_upu(rb: float = 0.3, rp: float = 0.1, h: float = 0.3) -> Mechanism:
             )
         )
     return Mechanism(
-        "three-upu", tuple(limbs), platform_point=[0, 0, h],
+        "three-upu", tuple(limbs), platform_point=np.array([0.0, 0.0, h]),
         description="Translational 3-UPU parallel mechanism (Tsai), 3 translations",
     )
 
@@ -136,7 +136,7 @@ def delta(rb: float = 0.2, arm: float = 0.2, rp: float = 0.05, h: float = -0.35,
             joints.append((S(f"E{k}{side}", E + off), f"arm{k}", f"rod{k}{side}"))
             joints.append((S(f"W{k}{side}", W[i] + off), f"rod{k}{side}", "platform"))
     return Mechanism.from_graph(
-        "delta", links, joints, platform_point=[0, 0, h],
+        "delta", links, joints, platform_point=np.array([0.0, 0.0, h]),
         description="Clavel Delta robot (3 R + 12 S, parallelograms of two SS rods), 3 translations",
     )
 
@@ -161,7 +161,7 @@ def delta_ruu(rb: float = 0.2, arm: float = 0.2, rp: float = 0.05, h: float = -0
             )
         )
     return Mechanism(
-        "delta-ruu", tuple(limbs), platform_point=[0, 0, h],
+        "delta-ruu", tuple(limbs), platform_point=np.array([0.0, 0.0, h]),
         description="Delta robot (parallelograms as equivalent U-U pairs, 3-RUU), 3 translations",
     )
 
@@ -272,7 +272,7 @@ def spatial_six_bar() -> Mechanism:
         (R("D0", [0.6, 2.0, 0.5], Y), "ground", "follower"),
     ]
     return Mechanism.from_graph(
-        "spatial-six-bar", links, joints, output="follower", platform_point=[0.6, 2.0, 0.5],
+        "spatial-six-bar", links, joints, output="follower", platform_point=np.array([0.6, 2.0, 0.5]),
         description="Spatial six-bar: two RSSR loops sharing the rocker; 1 DOF (+2 passive rod spins)",
     )
 

@@ -49,6 +49,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
 from itertools import pairwise
+from typing import Any
 
 import numpy as np
 
@@ -525,8 +526,9 @@ def mechanism_from_tree(bt: BodyTree) -> Mechanism:
         axes = e.axes if (a, b) == (e.a, e.b) else _reverse(e.axes)
         joints[e.name] = (_joint_from_axes(e.name, axes, bt.characteristic_length, bt.joint_types.get(e.name), helical,
                                            frozenset(bt.lockable), f"joint {e.name!r}"), a, b)
-    kw = {"platform_point": bt.platform_point, "description": bt.description, "modes": bt.modes,
-          "aliases": bt.aliases, "length_unit": bt.length_unit}
+    # Mechanism's keywords, of their several types
+    kw: dict[str, Any] = {"platform_point": bt.platform_point, "description": bt.description, "modes": bt.modes,
+                          "aliases": bt.aliases, "length_unit": bt.length_unit}
     if walks is not None:
         limbs = []
         for w in walks:

@@ -12,13 +12,15 @@ Units: the model's length unit; angles in degrees in tables and plots (labelled)
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
+
 import numpy as np
 
 from .. import catalog
 from ..analysis.mobility import mobility_modes
 from ..kinematics.closure import Configuration
-from ..kinematics.jacobian import complete_jacobian
-from ..kinematics.position import configuration_at_pose, freedom_values
+from ..kinematics.jacobian import CompleteJacobian, complete_jacobian
+from ..kinematics.position import PoseFit, configuration_at_pose, freedom_values
 from ..kinematics.tracking import trace_motion
 from ..model.mechanism import Mechanism
 from ..results import Progress, Steps
@@ -44,8 +46,8 @@ def _mob_row(name, r):
 
 def section(progress: Progress | None = None) -> Section:
     """The mobility of every ready-made model (modified Kutzbach-Grübler, checked numerically)."""
-    progress = Steps(progress, STEPS)
-    progress("mobility of every ready-made model")
+    say = Steps(progress, STEPS)
+    say("mobility of every ready-made model")
     rows, data = [], {}
     for name in catalog.names():
         res = mobility_modes(catalog.build(name))
@@ -67,20 +69,21 @@ def _jacobian_row(label, J):
 
 def model_section(mech: Mechanism, progress: Progress | None = None, *, trace: bool = True) -> Section:
     """Every analysis that applies to ``mech`` (see the module docstring)."""
-    progress = Steps(progress, MODEL_STEPS)
+    say = Steps(progress, MODEL_STEPS)
     from ..analysis.defects import dj_table
     from ..kinematics.motion import sample_motion
 
-    tables, figs, viewers, data, notes = [], [], [], {}, []
+    tables, figs, viewers, notes = [], [], [], []
+    data: dict[str, object] = {}  # JSON of each analysis, by name
     unit = mech.length_unit
-    progress(f"{mech.name}: mobility")
+    say(f"{mech.name}: mobility")
     mob = mobility_modes(mech)
     data["mobility"] = [r.to_dict() for r in mob]
     tables.append(Table("Mobility (modified Kutzbach-Grübler, checked numerically)", _MOB_COLS,
                         tuple(_mob_row(mech.name, r) for r in mob), "; ".join(dict.fromkeys(r.explanation for r in mob))))
     dof = mob[0].dof if len(mob) == 1 else None
 
-    progress(f"{mech.name}: complete Jacobian at the reference configuration")
+    say(f"{mech.name}: complete Jacobian at the reference configuration")
     ref = Configuration.reference(mech)
     jrows = []
     if mech.actuators:
@@ -93,7 +96,7 @@ def model_section(mech: Mechanism, progress: Progress | None = None, *, trace: b
     else:
         notes.append("no actuated freedom: no complete Jacobian (mark freedoms 'actuated' in the model file)")
 
-    progress(f"{mech.name}: task positions")
+    say(f"{mech.name}: task positions")
     if mech.positions:
         if dof == 1:
             try:
@@ -102,21 +105,23 @@ def model_section(mech: Mechanism, progress: Progress | None = None, *, trace: b
                 tables.append(Table("DJ at the task positions per base-joint driver (only signs along a row are comparable)",
                                     ("driver", *t.positions, "keeps sign"),
                                     tuple((d, *[float(x) for x in t.dj[i]], t.keeps_sign(d)) for i, d in enumerate(t.drivers))))
-                fits = t.fits
+                fits: Sequence[PoseFit] = t.fits
             except ValueError as e:
                 notes.append(str(e))
                 fits = ()
         else:
-            fits, prev = [], None
+            fitted: list[PoseFit] = []
+            prev = None
             for P in mech.positions:
                 fit = configuration_at_pose(mech, P, start=prev)
-                fits.append(fit)
+                fitted.append(fit)
                 prev = fit.config if fit.converged else prev
                 if fit.converged and mech.actuators:
                     try:
                         jrows.append(_jacobian_row(P.name, complete_jacobian(mech, fit.config)))
                     except ValueError as e:
                         notes.append(f"{P.name}: {e}")
+            fits = fitted
         tables.append(Table("Task positions fitted onto the closure", ("position", "converged", "exact",
                             f"platform-point error [{unit}]", "orientation error [deg]"),
                             tuple((P.name, f.converged, f.exact, f.position_error, float(np.degrees(f.angle_error)))
@@ -126,8 +131,10 @@ def model_section(mech: Mechanism, progress: Progress | None = None, *, trace: b
                                ("configuration", "actuators", "det J", "sigma_min (scale-free)", "1/condition",
                                 "inverse-singular actuators"), tuple(jrows)))
 
-    progress(f"{mech.name}: motion")
-    configs, sing, title, vnote = None, (), "", ""
+    say(f"{mech.name}: motion")
+    configs: tuple[Configuration, ...] | None = None
+    sing: tuple[object, ...] = ()  # the tracker's states at the zeros of DJ
+    title = vnote = ""
     if dof == 1 and trace:
         square = False
         if mech.actuators:
@@ -135,9 +142,9 @@ def model_section(mech: Mechanism, progress: Progress | None = None, *, trace: b
                 square = complete_jacobian(mech, ref).is_square
             except ValueError:
                 square = False
-        last = {"J": None}
+        last: dict[str, CompleteJacobian | None] = {"J": None}
 
-        def dj(c) -> float:
+        def dj(c: Configuration) -> float:
             """DJ with the constraint bases kept continuous along the path (``reference``: the
             previous Jacobian); where a limb loses rank the matrix is not square: DJ = 0 there."""
             J = complete_jacobian(mech, c, reference=last["J"])
@@ -145,7 +152,7 @@ def model_section(mech: Mechanism, progress: Progress | None = None, *, trace: b
                 last["J"] = J
             return 0.0 if J.det is None else J.det
 
-        mons = {"DJ": dj} if square else None
+        mons: dict[str, Callable[[Configuration], float]] | None = {"DJ": dj} if square else None
         tr = trace_motion(mech, ref, increasing=mech.actuators[0] if mech.actuators else None, monitors=mons,
                           max_arc=200, max_steps=TRACE_MAX_STEPS)
         q = np.array([freedom_values(mech, c.q) for c in tr.points])
@@ -164,8 +171,8 @@ def model_section(mech: Mechanism, progress: Progress | None = None, *, trace: b
                      ylabel="scale-free sigma_min of J", title="distance to singularity", logy=bool(np.all(sig > 0)))
             data["trace_sigma_min"] = {"min": float(sig.min()), "max": float(sig.max())}
         kinds = [{"driver": e.name, "s": float(e.s), "kind": e.kind} for e in tr.events]
-        for k in kinds:
-            ax.axvline(k["s"], color="#b3261e" if k["kind"] == "zero" else "#555555", linestyle="--", linewidth=0.8)
+        for ev in tr.events:
+            ax.axvline(float(ev.s), color="#b3261e" if ev.kind == "zero" else "#555555", linestyle="--", linewidth=0.8)
         nz = sum(k["kind"] == "zero" for k in kinds)
         figs.append(F.to_png(fig, "motion.png", f"{mech.name}: the one-degree-of-freedom motion traced by continuation",
                              f"Pseudo-arclength continuation from the reference configuration until the motion closes "

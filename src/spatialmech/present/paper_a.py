@@ -23,9 +23,9 @@ import tempfile
 import numpy as np
 
 from .. import catalog
-from ..analysis.defects import DJTable, defect_analysis
+from ..analysis.defects import DefectResult, DJTable, defect_analysis
 from ..analysis.mobility import mobility
-from ..results import Progress, Steps
+from ..results import Progress, Steps, Verdict
 from . import figures as F
 from .defect_figures import write_defect_figures
 from .report import Claim, Section, Table, Viewer
@@ -46,23 +46,27 @@ def _sign_text(t: DJTable, d: str) -> str:
 
 def section(progress: Progress | None = None) -> Section:
     """Paper A's section of the demo report (see the module docstring)."""
-    progress = Steps(progress, STEPS)
+    say = Steps(progress, STEPS)
     claims, tables, figs, viewers, data = [], [], [], [], {}
-    tabs, res = {}, {}
+    tabs: dict[int, DJTable] = {}
+    res: dict[int, DefectResult] = {}
     for k in (1, 2, 3):
         name = f"five-cs-{k}"
-        progress(f"paper A: mobility and DJ at the 7 positions of {name}")
+        say(f"paper A: mobility and DJ at the 7 positions of {name}")
         mech = catalog.build(name)
         m = mobility(mech)
         claims.append(Claim(
             "A", f"5-CS linkage {k} is a one-degree-of-freedom linkage (section 1)", "1",
             f"{m.formula()} (instantaneous {m.dof_instantaneous})",
-            "reproduced" if m.dof == 1 == m.dof_instantaneous else "not reproduced",
+            Verdict.REPRODUCED if m.dof == 1 == m.dof_instantaneous else Verdict.NOT_REPRODUCED,
             evidence={"dof": m.dof, "dof_instantaneous": m.dof_instantaneous, "gk_classic": m.gk_classic},
             test="tests/test_mobility.py"))
-        progress(f"paper A: defect analysis of {name} (DJ at the positions, circuits, branch points)")
+        say(f"paper A: defect analysis of {name} (DJ at the positions, circuits, branch points)")
         res[k] = defect_analysis(mech, drivers=list(DRIVERS))
-        tabs[k] = res[k].table
+        table = res[k].table
+        if table is None:  # the paper's linkages have task positions: the analysis tabulates DJ at them
+            raise RuntimeError(f"{name}: defect analysis without a DJ table")
+        tabs[k] = table
         data[name] = {"dj_table": tabs[k].to_dict(), "defects": res[k].to_dict()}
 
     t1, t2, t3 = tabs[1], tabs[2], tabs[3]
@@ -71,7 +75,7 @@ def section(progress: Progress | None = None) -> Section:
         "A", "Linkage 1: DJ changes sign over the 7 positions for every one of the 10 drivers (figs 6-7)",
         "all 10 drivers change sign", f"{len(changing)} of 10 change sign: "
         + ", ".join(f"{d} {_sign_text(t1, d)}" for d in DRIVERS),
-        "reproduced" if len(changing) == 10 else "not reproduced",
+        Verdict.REPRODUCED if len(changing) == 10 else Verdict.NOT_REPRODUCED,
         "signs at P1..P7; each printed pose fitted onto the closure first",
         {"signs": {d: t1.signs[i].tolist() for i, d in enumerate(DRIVERS)}},
         "tests/test_jacobian.py::test_paper_A_linkage1_every_driver_changes_sign_figs_6_7"))
@@ -82,7 +86,7 @@ def section(progress: Progress | None = None) -> Section:
         "K2 in P6-P7 (rot1), K1 in P3-P4 (rot5)",
         f"rot1 changes sign only between {', '.join(f'P{i + 1}-P{i + 2}' for i in c1)}; rot5 only between "
         f"{', '.join(f'P{i + 1}-P{i + 2}' for i in c5)}",
-        "reproduced" if (c1, c5) == ([5], [2]) else "not reproduced",
+        Verdict.REPRODUCED if (c1, c5) == ([5], [2]) else Verdict.NOT_REPRODUCED,
         "located by the sign change between consecutive positions; the dual-drive plan itself is the defect analysis",
         {"sign_changes_after": {"rot1": c1, "rot5": c5}},
         "tests/test_jacobian.py::test_paper_A_linkage1_every_driver_changes_sign_figs_6_7"))
@@ -90,7 +94,7 @@ def section(progress: Progress | None = None) -> Section:
     claims.append(Claim(
         "A", "Linkage 2: with the slide of C3, C4 or C5 as driver DJ keeps its sign at the 7 positions (figs 8-9)",
         "slide3, slide4, slide5 keep their sign", f"drivers keeping their sign: {', '.join(keep2) or 'none'}",
-        "reproduced" if set(keep2) == {"slide3", "slide4", "slide5"} else "not reproduced",
+        Verdict.REPRODUCED if set(keep2) == {"slide3", "slide4", "slide5"} else Verdict.NOT_REPRODUCED,
         "the other 7 drivers change sign", {"keeps_sign": keep2},
         "tests/test_jacobian.py::test_paper_A_linkage2_slides_3_4_5_keep_sign_figs_8_9"))
     keep3 = [d for d in DRIVERS if t3.keeps_sign(d)]
@@ -98,12 +102,12 @@ def section(progress: Progress | None = None) -> Section:
         "A", "Linkage 3: with the rotation of C1 or C2 as driver DJ keeps its sign at the 7 positions; every other "
         "driver changes sign (figs 15-16)",
         "rot1, rot2 keep their sign; the other 8 change", f"drivers keeping their sign: {', '.join(keep3) or 'none'}",
-        "reproduced" if set(keep3) == {"rot1", "rot2"} else "not reproduced", "",
+        Verdict.REPRODUCED if set(keep3) == {"rot1", "rot2"} else Verdict.NOT_REPRODUCED, "",
         {"keeps_sign": keep3},
         "tests/test_jacobian.py::test_paper_A_linkage3_rot1_rot2_keep_sign_others_change_figs_15_16"))
 
-    progress("paper A: DJ sign tables and pose fits")
-    rows = []
+    say("paper A: DJ sign tables and pose fits")
+    rows: list[tuple] = []  # table cells: text and numbers
     for k, t in tabs.items():
         for P, f in zip(t.positions, t.fits, strict=True):
             rows.append((f"five-cs-{k}", P, f.position_error, float(np.degrees(f.angle_error)), f.exact))
@@ -127,7 +131,7 @@ def section(progress: Progress | None = None) -> Section:
                          "fitted onto the closure. A row of one colour: the driver has no branch defect at the positions."))
 
     claims.extend(_defect_claims(res))
-    progress("paper A: seven-position synthesis of CS dyads (section 3)")
+    say("paper A: seven-position synthesis of CS dyads (section 3)")
     cs_claims, cs_data = _cs_dyad_claims()
     claims.extend(cs_claims)
     data["cs_dyads"] = cs_data
@@ -143,16 +147,16 @@ def section(progress: Progress | None = None) -> Section:
         tuple(rows),
         "Linkage 2 has a circuit defect, so no path joins its positions: its branch points are not defined (-)."))
     mech_by = {k: catalog.build(f"five-cs-{k}") for k in res}
-    progress("paper A: the linkages driven by rot1 from P1 to P7 in MuJoCo")
+    say("paper A: the linkages driven by rot1 from P1 to P7 in MuJoCo")
     tables.append(_mujoco_table(mech_by, res))
     for k, r in res.items():
-        progress(f"paper A: figures of five-cs-{k}")
+        say(f"paper A: figures of five-cs-{k}")
         with tempfile.TemporaryDirectory(prefix="spatialmech-paper-a-") as tmp:  # read back at once, then removed
             for path in write_defect_figures(mech_by[k], r, tmp):
                 cap = _caption(path.name, k, r)
                 figs.append(F.figure_from_file(path, f"paper_a_{path.name}",
                                                cap.split(":")[0] + ": " + cap.split(":")[1].split("(")[0].strip(), cap))
-    progress("paper A: 3-D viewer of linkage 1 along its circuit")
+    say("paper A: 3-D viewer of linkage 1 along its circuit")
     tr = res[1].traces[0]
     idx = np.unique(np.linspace(0, len(tr.points) - 1, min(VIEWER_FRAMES, len(tr.points))).round().astype(int))
     bps = [np.array(b.point) for v in res[1].drivers if v.driver in ("rot1", "rot5") for b in v.circuit_branch_points]
@@ -180,7 +184,7 @@ def _mujoco_table(mechs: dict, res: dict) -> Table:
     along the library's path from P1 to P7; the largest differences from the library's poses."""
     from ..analysis.validation import validate
 
-    rows = []
+    rows: list[tuple] = []  # table cells: text and numbers
     for k, mech in mechs.items():
         if not any(1 in c and 7 in c for c in res[k].circuits):
             rows.append((f"five-cs-{k}", 0, "-", "-", "no: P1 and P7 are on different circuits (circuit defect)", ""))
@@ -219,7 +223,7 @@ def _defect_claims(res) -> list:
     out.append(Claim(
         "A", "Linkage 1 has no circuit and no order defect (fig 11)", "one circuit, positions in order",
         f"{len(r1.circuits)} circuit(s); order {', '.join(f'P{j}' for j in r1.order)}",
-        "reproduced" if len(r1.circuits) == 1 and not r1.order_defect else "not reproduced",
+        Verdict.REPRODUCED if len(r1.circuits) == 1 and not r1.order_defect else Verdict.NOT_REPRODUCED,
         f"membership within {r1.tolerances['pose']:.3g} units / {r1.tolerances['angle_deg']:g} deg of the traced circuit",
         {"circuits": [list(c) for c in r1.circuits]},
         "tests/test_defects.py::test_paper_A_linkage1_one_circuit_no_order_defect_fig_11"))
@@ -229,7 +233,7 @@ def _defect_claims(res) -> list:
         "A", "Linkage 1 along the path: the DJ zero K2 of rot1 lies between P6 and P7, K1 of rot5 between P3 and P4 (fig 14)",
         "K2 in P6-P7, K1 in P3-P4",
         f"rot1 zeros between {k2}, rot5 zeros between {k1} (tracked, located to 1e-9 in arc)",
-        "reproduced" if k2 == [(6, 7)] and k1 == [(3, 4)] else "not reproduced", "",
+        Verdict.REPRODUCED if k2 == [(6, 7)] and k1 == [(3, 4)] else Verdict.NOT_REPRODUCED, "",
         {"branch_point_arcs": {"K2": [b.arc for b in d1["rot1"].branch_points],
                                "K1": [b.arc for b in d1["rot5"].branch_points]}},
         "tests/test_defects.py::test_paper_A_linkage1_K2_of_rot1_between_P6_P7_and_K1_of_rot5_between_P3_P4"))
@@ -241,13 +245,14 @@ def _defect_claims(res) -> list:
         "; ".join(f"{p.driver} arc {p.start_arc:.3f}..{p.end_arc:.3f}"
                   + (f" (switch window {p.switch_window[0]:.3f}..{p.switch_window[1]:.3f})" if p.switch_window else "")
                   for p in plan) or "no plan",
-        "reproduced" if ok else "not reproduced", "the plan is searched over all ten drivers; the switch window is (K1, K2)",
+        Verdict.REPRODUCED if ok else Verdict.NOT_REPRODUCED,
+        "the plan is searched over all ten drivers; the switch window is (K1, K2)",
         {"plan": [p.to_dict() for p in plan]},
         "tests/test_defects.py::test_paper_A_linkage1_dual_drive_rot1_then_rot5_switching_between_K1_and_K2_fig_14"))
     out.append(Claim(
         "A", "Linkage 2: the positions lie on different circuits: circuit defect (fig 10)", "circuit defect",
         "circuits " + "; ".join("{" + ", ".join(f"P{j}" for j in c) + "}" for c in r2.circuits),
-        "reproduced" if r2.circuit_defect and r2.circuits == ((1,), (2, 3), (4, 5, 6, 7)) else "not reproduced",
+        Verdict.REPRODUCED if r2.circuit_defect and r2.circuits == ((1,), (2, 3), (4, 5, 6, 7)) else Verdict.NOT_REPRODUCED,
         "conventions.md: {P1}, {P2, P3}, {P4..P7}; P5 is within 0.006 of P4's circuit and also near a fourth circuit "
         "(rounded data near a near-bifurcation): the fewest circuits holding every position are kept",
         {"membership": r2.to_dict()["membership"]},
@@ -258,15 +263,15 @@ def _defect_claims(res) -> list:
         "order on one circuit: usable (figs 17-19)", "no defect with rot1, rot2",
         f"usable drivers {', '.join(r3.usable_drivers) or 'none'}; {len(r3.circuits)} circuit(s); order "
         f"{', '.join(f'P{j}' for j in r3.order)}",
-        "reproduced" if set(r3.usable_drivers) == {"rot1", "rot2"} and len(r3.circuits) == 1 and not r3.order_defect
-        else "not reproduced", "", {"usable": list(r3.usable_drivers)},
+        Verdict.REPRODUCED if set(r3.usable_drivers) == {"rot1", "rot2"} and len(r3.circuits) == 1 and not r3.order_defect
+        else Verdict.NOT_REPRODUCED, "", {"usable": list(r3.usable_drivers)},
         "tests/test_defects.py::test_paper_A_linkage3_usable_one_circuit_in_order_no_dj_zero_figs_17_19"))
     b = r3.min_closure_sigma_between
     out.append(Claim(
         "A", "Linkage 3 passes close to a singularity between P3 and P4 (conventions.md)", "(not quantified by the paper)",
         f"smallest scale-free sigma of the closure Jacobian on the path {r3.min_closure_sigma:.2e}"
         + (f" between P{b[0]} and P{b[1]}" if b else "") + f"; rot1's own {d3['rot1'].min_sigma_on_path:.2e}",
-        "reproduced" if b == (3, 4) else "not reproduced",
+        Verdict.REPRODUCED if b == (3, 4) else Verdict.NOT_REPRODUCED,
         "reported as a robustness measure; the verdict is sensitive to the rounding of the data there",
         {"min_closure_sigma_on_path": r3.min_closure_sigma},
         "tests/test_defects.py::test_paper_A_linkage3_passes_close_to_a_singularity_between_P3_and_P4"))
@@ -292,24 +297,26 @@ def _cs_dyad_claims():
         Claim("A", "The limbs of linkages 1-3 are CS dyads for the 7 positions (section 3, eqs 22-26)",
               "each limb satisfies the dyad equations",
               f"largest residual of the 14 equations over the 15 printed limbs {res:.4f}",
-              "reproduced" if res < 0.02 else "not reproduced",
+              Verdict.REPRODUCED if res < 0.02 else Verdict.NOT_REPRODUCED,
               "the tables are printed to 3 decimals (conventions.md: link lengths vary by up to 0.01)",
               {"printed_residuals_len": d["printed_residuals_len"]}, "tests/test_cs_dyads.py"),
         Claim("A", "The CS dyads for 7 positions form a one-parameter family (15 unknowns, 14 equations; section 3)",
               "a one-parameter infinity of dyads",
               f"a curve of dyads traced by continuation ({len(c.family.branches)} pieces); every printed limb lies "
               f"within {dist:.4f} of it and its slides are reproduced to {slide:.4f}",
-              "reproduced" if dist < 0.01 else "not reproduced", "the Jacobian of the 14 equations has rank 14 along the family",
+              Verdict.REPRODUCED if dist < 0.01 else Verdict.NOT_REPRODUCED,
+              "the Jacobian of the 14 equations has rank 14 along the family",
               {"max_distance_len": dist, "max_slide_change_len": slide}, "tests/test_cs_dyads.py"),
         Claim("A", "Any five dyads of the family form a 5-CS linkage guiding the body through the 7 positions (section 3)",
               "a 1-DOF 5-CS through P1..P7",
               f"five small-slide dyads assembled: pose errors <= {syn.max_pose_error:.1e}, mobility {syn.dof}",
-              "reproduced" if syn.ok else "not reproduced", "checked by solving the assembled linkage's closure at the 7 poses",
+              Verdict.REPRODUCED if syn.ok else Verdict.NOT_REPRODUCED,
+              "checked by solving the assembled linkage's closure at the 7 poses",
               {"position_errors_len": list(map(float, syn.position_errors)), "dof": syn.dof}, "tests/test_cs_dyads.py"),
         Claim("A", "Dyads with small slides can be chosen from the family (section 3)", "choose small slides",
               f"the five picks have max |slide| {', '.join(f'{x:.2f}' for x in picks)}; the printed limbs "
               f"{min(printed_max):.2f}..{max(printed_max):.2f}",
-              "reproduced", "smallest max |slide| over the traced family, picks kept apart along it",
+              Verdict.REPRODUCED, "smallest max |slide| over the traced family, picks kept apart along it",
               {"picks_max_abs_slide_len": picks}, "tests/test_cs_dyads.py"),
     ]
     return out, d

@@ -33,7 +33,7 @@ from ..kinematics.closure import Configuration
 from ..kinematics.jacobian import complete_jacobian
 from ..kinematics.position import inverse_position
 from ..model.mechanism import Pose
-from ..results import Progress, Steps
+from ..results import Progress, Steps, Verdict
 from . import figures as F
 from .report import Claim, Section, Table, Viewer, join_names
 
@@ -101,10 +101,10 @@ def _engine_legs(mech, phi) -> np.ndarray:
 
 def section(progress: Progress | None = None) -> Section:
     """Paper B's section of the demo report (see the module docstring)."""
-    progress = Steps(progress, STEPS)
+    say = Steps(progress, STEPS)
     g = k.PAPER_B
     claims, tables, figs, data = [], [], [], {}
-    progress("paper B: mobility and inverse position (eq 8)")
+    say("paper B: mobility and inverse position (eq 8)")
     mech = catalog.build("four-sps-cu")
     m = mobility(mech)
     motions = sorted(m.motion[i:i + 2] for i in range(0, len(m.motion), 2))
@@ -112,7 +112,7 @@ def section(progress: Progress | None = None) -> Section:
     claims.append(Claim("B", "Mobility by the modified Kutzbach-Grübler formula (eq 4, section 3)",
                         "n=11, g=14, sum f=32, lambda=0, v=0, xi=4, M=4 (3R + Tz)",
                         f"{m.formula()}; lambda={m.lam}, t={m.t}, k={m.k}, v={m.v}, xi={m.xi}; {m.motion}; "
-                        f"instantaneous {m.dof_instantaneous}", "reproduced" if ok else "not reproduced",
+                        f"instantaneous {m.dof_instantaneous}", Verdict.REPRODUCED if ok else Verdict.NOT_REPRODUCED,
                         "v = t - k (paper C prints k - t; equal here since t = k)", m.to_dict(),
                         "tests/test_mobility.py"))
 
@@ -127,7 +127,7 @@ def section(progress: Progress | None = None) -> Section:
                         "eq 8 (printed)",
                         f"legs 1..4 off by up to {', '.join(f'{e:.3g}' for e in err_printed)} m over {SAMPLE_SIZE} poses "
                         f"(z in CU range, angles within +-30 deg); at the home pose legs 3, 4 off by {err_home[2]:.4f}, "
-                        f"{err_home[3]:.4f} m", "not reproduced",
+                        f"{err_home[3]:.4f} m", Verdict.NOT_REPRODUCED,
                         "typos in the Y terms of legs 1, 3, 4; leg 2 is right (error < 1e-15 m). Computed instead: "
                         "l_i = |T A_i - B_i|", {"max_error_per_leg_len": err_printed, "home_error_per_leg_len": err_home},
                         "tests/test_four_sps_cu_kinematics.py::test_printed_eq8_is_wrong_for_legs_1_3_4"))
@@ -136,12 +136,12 @@ def section(progress: Progress | None = None) -> Section:
     claims.append(Claim("B", "Inverse position, eq 8 with the three corrections of conventions.md",
                         "eq 8", f"corrected eq 8 = |T A_i - B_i| to {err_corr:.1e} m over {SAMPLE_SIZE} poses; the "
                         f"general closure engine gives the same legs to {err_engine:.1e} m",
-                        "reproduced after correction",
+                        Verdict.CORRECTED,
                         "l1 Y term: ca sb sg -> sa sb sg; l3 Y term: a sa sg -> a ca cg; l4 Y term: -b -> +b",
                         {"max_error_len": err_corr, "engine_vs_closed_form_len": err_engine},
                         "tests/test_four_sps_cu_kinematics.py::test_conventions_corrections_repair_eq8"))
 
-    progress("paper B: velocity and acceleration along a trajectory (eqs 9-13)")
+    say("paper B: velocity and acceleration along a trajectory (eqs 9-13)")
     t = np.linspace(0.0, 2.0, 201)
     P, dP, ddP = trajectory(t)
     l = k.leg_lengths(P)
@@ -158,7 +158,7 @@ def section(progress: Progress | None = None) -> Section:
                         "phi'' = Jx^-1 (l'' - Jx' phi')", "eqs 9-13 (symbols garbled in eqs 10-13)",
                         f"along a 2 s trajectory (201 samples): l' vs central differences of l {v_err:.1e} m/s, "
                         f"l'' vs differences of l' {a_err:.1e} m/s^2; forward velocity / acceleration recover phi', "
-                        f"phi'' to {back_v:.1e}, {back_a:.1e}", "reproduced after correction",
+                        f"phi'' to {back_v:.1e}, {back_a:.1e}", Verdict.CORRECTED,
                         "eqs 10-13 garble the symbols; the relations used are those of conventions.md (Jx = L^-1 J)",
                         {"velocity_fd_error_len_per_s": v_err, "acceleration_fd_error_len_per_s2": a_err,
                          "forward_velocity_error": back_v, "forward_acceleration_error": back_a},
@@ -176,10 +176,10 @@ def section(progress: Progress | None = None) -> Section:
                           "beta_deg": np.degrees(P[::10, 2]), "gamma_deg": np.degrees(P[::10, 3]), "legs_len": l[::10],
                           "leg_rates_len_per_s": ld[::10]}
 
-    progress("paper B: the trajectory driven by its leg lengths in MuJoCo")
+    say("paper B: the trajectory driven by its leg lengths in MuJoCo")
     tables.append(_mujoco_table(mech))
 
-    progress("paper B: singularities (alpha = beta = 0, det J sign map)")
+    say("paper B: singularities (alpha = beta = 0, det J sign map)")
     zg, gg = np.meshgrid(np.linspace(*g.z_limits, 23), np.linspace(-np.pi, np.pi, 73))
     flat = np.stack([zg.ravel(), 0 * zg.ravel(), 0 * zg.ravel(), gg.ravel()], axis=-1)
     sig_flat = float(k.conditioning(flat)[0].max())
@@ -204,7 +204,7 @@ def section(progress: Progress | None = None) -> Section:
                         f"the legs locked at l = {l0:.4f} m the platform keeps the self-motion "
                         f"z^2 = l^2 - 2a^2 - 2b^2 + 4ab cos(gamma) (legs constant to {self_err:.1e} m, gamma from "
                         f"{g_span[0]:.1f} to {g_span[1]:.1f} deg within the CU limits); det J takes both signs in the "
-                        f"sampled workspace ({100 * frac_neg:.1f}% negative)", "not reproduced",
+                        f"sampled workspace ({100 * frac_neg:.1f}% negative)", Verdict.NOT_REPRODUCED,
                         "for this symmetric geometry the four leg lines meet on the Z axis whenever alpha = beta = 0, "
                         "and surfaces det J = 0 cross the workspace (figure); forward position must not start there",
                         {"max_sigma_min_on_singular_set": sig_flat, "engine_sigma_min_home": J0.sigma_min,
@@ -224,7 +224,7 @@ def section(progress: Progress | None = None) -> Section:
                          "Jx = dl/dphi (eq 9, corrected), R = Rz(gamma) Ry(beta) Rx(alpha). The red curves are "
                          "singularity loci crossing the workspace; alpha = beta = 0 is always on them."))
 
-    progress("paper B: forward position (all assembly modes of an example)")
+    say("paper B: forward position (all assembly modes of an example)")
     lx = k.leg_lengths(EXAMPLE_POSE)
     res = kf.forward_all(lx)
     ph = res.phis
@@ -235,7 +235,7 @@ def section(progress: Progress | None = None) -> Section:
                         f"{found}; largest residual {max(s.residual for s in res.solutions):.1e} m; kinds: "
                         f"{join_names(sorted({str(s.kind) for s in res.solutions}))} (smallest scale-free sigma_min "
                         f"{min(s.sigma_min for s in res.solutions):.1e})",
-                        "reproduced" if found and all(s.converged for s in res.solutions) else "not reproduced",
+                        Verdict.REPRODUCED if found and all(s.converged for s in res.solutions) else Verdict.NOT_REPRODUCED,
                         "multi-seed Levenberg-Marquardt (512 Halton seeds); every mode has a mirror image below the base",
                         res.to_dict(), "tests/test_four_sps_cu_kinematics.py::test_multiple_assembly_modes_claim"))
     tables.append(Table("Assembly modes of the example legs (forward_all)",
@@ -245,17 +245,17 @@ def section(progress: Progress | None = None) -> Section:
                         "Limits checked: leg lengths 0.1-0.4 m and CU length 0.08-0.3 m (joint angles of eqs 18-21: "
                         "workspace analysis)."))
 
-    progress("paper B: singular cases by line geometry (section 5)")
+    say("paper B: singular cases by line geometry (section 5)")
     c2, t2 = _singular_case_claims()
     claims.extend(c2)
     tables.append(t2)
-    progress("paper B: orientation workspace at z = 0.1 m (section 6)")
+    say("paper B: orientation workspace at z = 0.1 m (section 6)")
     c3, ws = workspace_claim()
     claims.append(c3)
     figs.append(_workspace_figure(ws))
     data["workspace"] = ws.to_dict()
 
-    progress("paper B: 3-D viewer")
+    say("paper B: 3-D viewer")
     from ..kinematics.motion import sample_motion
 
     viewers = (Viewer("Paper B, 4-SPS/CU: a demonstration loop from the home pose", mech,
@@ -276,6 +276,13 @@ def _case_c_lines(P14, P23):
     return kp.wrench_lines([P14, P23, P23, P14], k.PAPER_B, cu_point=(0.0, 0.0, 0.2))
 
 
+def _lines(r) -> dict:
+    """The line geometry of a singularity result of the 4-SPS/CU (its legs are lines: always there)."""
+    if r.line_geometry is None:
+        raise RuntimeError("singularity of the 4-SPS/CU without a line geometry of its legs")
+    return r.line_geometry
+
+
 def _singular_case_claims():
     """Paper B's singular cases (a), (b), (c), found by the singularity analysis at the poses."""
     from ..analysis.singularity import singularity, singularity_at_pose
@@ -284,32 +291,36 @@ def _singular_case_claims():
     from ..kinematics.closure import Configuration
     from ..model.mechanism import Pose
 
-    out, rows = [], []
+    out: list[Claim] = []
+    rows: list[tuple] = []  # table cells: text and numbers
     ma = four_sps_cu(a=0.15, b=0.15, z0=0.2)
     ra = singularity(ma, Configuration.reference(ma), self_motion_arc=0.05)
-    par = [c for c in ra.line_geometry["circuits"] if c["case"] == "parallel"]
+    par = [c for c in _lines(ra)["circuits"] if c["case"] == "parallel"]
     out.append(Claim("B", "Singular case (a): the four leg lines parallel (section 5, fig 3a)", "singular",
                      f"with a = b = 0.15 m at alpha = beta = gamma = 0: {ra.kind} singularity, rank {ra.rank}; the legs "
-                     f"form a '{par[0]['case'] if par else '?'}' set; the 6 lines are a '{ra.line_geometry['case']}'",
-                     "reproduced" if ra.rank == 5 and par else "not reproduced",
+                     f"form a '{par[0]['case'] if par else '?'}' set; the 6 lines are a '{_lines(ra)['case']}'",
+                     Verdict.REPRODUCED if ra.rank == 5 and par else Verdict.NOT_REPRODUCED,
                      "needs a = b (paper B's a = 0.1, b = 0.2 cannot have parallel legs)",
-                     {"rank": ra.rank, "kind": ra.kind, "line_geometry": ra.line_geometry["case"]},
+                     {"rank": ra.rank, "kind": ra.kind, "line_geometry": _lines(ra)["case"]},
                      "tests/test_singularity.py::test_paper_B_case_a_parallel_legs_needs_a_equal_b"))
-    rows.append(("(a) a = b, home", ra.kind, ra.rank, ra.line_geometry["case"], par[0]["case"] if par else "-"))
+    rows.append(("(a) a = b, home", ra.kind, ra.rank, _lines(ra)["case"], par[0]["case"] if par else "-"))
     mb = catalog.build("four-sps-cu")
     rb = singularity(mb, Configuration.reference(mb), self_motion_arc=0.3)
-    conc = [c for c in rb.line_geometry["circuits"] if c["case"] == "concurrent"]
+    conc = [c for c in _lines(rb)["circuits"] if c["case"] == "concurrent"]
     pt = conc[0]["witnesses"]["point"] if conc else None
+    if rb.self_motion is None:  # singular at the home pose: its self-motion is traced
+        raise RuntimeError("4-SPS/CU at its home pose: no self-motion analysed")
     out.append(Claim("B", "Singular case (b): the four leg lines through one point (section 5, fig 3b)", "singular",
                      f"at the home pose (z = 0.2 m, alpha = beta = gamma = 0): {rb.kind}, rank {rb.rank}; legs concurrent at "
                      f"{np.round(pt, 6).tolist() if pt is not None else '?'} = (0, 0, z b / (b - a)); finite self-motion: "
-                     f"{rb.self_motion['finite']}", "reproduced" if conc and rb.rank == 5 else "not reproduced",
+                     f"{rb.self_motion['finite']}", Verdict.REPRODUCED if conc and rb.rank == 5 else Verdict.NOT_REPRODUCED,
                      "found by the analysis itself, with the uncontrolled twist (rotation about Z)",
                      {"point_len": pt, "twist": [list(t) for t in rb.twist], "self_motion": rb.to_dict()["self_motion"]},
                      "tests/test_singularity.py::test_paper_B_case_b_leg_lines_concurrent_on_the_z_axis"))
-    rows.append(("(b) home pose", rb.kind, rb.rank, rb.line_geometry["case"], "concurrent at " + str(np.round(pt, 4).tolist())))
+    rows.append(("(b) home pose", rb.kind, rb.rank, _lines(rb)["case"],
+                 "concurrent at " + str(np.round(pt, 4).tolist()) if pt is not None else "-"))
     rg = singularity_at_pose(mb, Pose.from_euler("ZYX", [0.5, 0, 0], [0, 0, 0.2]), self_motion_arc=0.05)
-    rows.append(("alpha = beta = 0, gamma = 28.6 deg", rg.kind, rg.rank, rg.line_geometry["case"],
+    rows.append(("alpha = beta = 0, gamma = 28.6 deg", rg.kind, rg.rank, _lines(rg)["case"],
                  "legs on a regulus (not concurrent)"))
     worded = classify_lines(_case_c_lines(np.array([0.03, 0.05, 0.45]), np.array([0.03, -0.12, 0.45])), length_scale=0.2)
     true_c = classify_lines(_case_c_lines(np.array([0.05, 0.03, 0.45]), np.array([-0.12, 0.03, 0.45])), length_scale=0.2)
@@ -318,7 +329,7 @@ def _singular_case_claims():
                      "A1A2B2B1 and A4A3B3B4 (section 5, fig 3c)", "singular",
                      f"as worded the six lines keep rank {worded.rank} ({worded.case}): not singular; with the meeting "
                      f"points in the planes of the two pencils (A1A4B4B1, A2A3B3B2) the rank is {true_c.rank}: legs "
-                     f"'{tc.case if tc else '?'}'", "reproduced after correction",
+                     f"'{tc.case if tc else '?'}'", Verdict.CORRECTED,
                      "the planes are swapped in the paper; with its square platform no pose realises either case "
                      "(platform points chosen on the constructed lines)",
                      {"worded_rank": worded.rank, "corrected_rank": true_c.rank},
@@ -366,7 +377,7 @@ def workspace_claim(step_deg: float = 4.0, *, polish: bool = True):
                   f"(each alone; the whole set has {'the same' if set_same else 'other'} extents); limits at the ends: "
                   + "; ".join(f"{c}: {join_names(v)}" for c, v in limits_at.items())
                   + f"; active on the boundary of the set: {join_names(list(res.active_limits))}",
-                  "not reproduced",
+                  Verdict.NOT_REPRODUCED,
                   f"the stated model gives alpha, beta = +-atan(z/b) = +-{ca:.2f} deg (platform-side spherical-joint "
                   f"cone of eq 18) and gamma = +-arccos((2a^2 + 2b^2 + z^2 - l_max^2) / (4ab)) = +-{cg:.2f} deg "
                   "(maximum leg length 0.4 m); no reading of eqs 18-22 tried gives 48/48/65 (docs/workspace.md)",

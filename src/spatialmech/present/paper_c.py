@@ -16,7 +16,7 @@ import numpy as np
 from .. import catalog
 from ..analysis.mobility import mobility_modes
 from ..catalog.papers import THREE_RRR_TABLE2, THREE_SPS_SMPU_MODES
-from ..results import Progress, Steps
+from ..results import Progress, Steps, Verdict
 from . import figures as F
 from .report import Claim, Section, Table, Viewer
 
@@ -40,8 +40,8 @@ def _mobility_table(title: str, results) -> Table:
 
 def section(progress: Progress | None = None) -> Section:
     """Paper C's section of the demo report (see the module docstring)."""
-    progress = Steps(progress, STEPS)
-    progress("paper C: mobility of the 3-RRR metamorphic joint (table 2)")
+    say = Steps(progress, STEPS)
+    say("paper C: mobility of the 3-RRR metamorphic joint (table 2)")
     rrr = catalog.build("three-rrr-sm")
     res = mobility_modes(rrr)
     by_mode = {x.mode: x for x in res}
@@ -54,11 +54,11 @@ def section(progress: Progress | None = None) -> Section:
             "C", f"3-RRR metamorphic joint, drive {', '.join(driven)} (table 2, eqs 10/13/16)",
             f"M = {len(driven)}, {printed}", f"M = {x.dof} = {x.d}({x.n} - {x.g} - 1) + {x.sum_f} + {x.v} - {x.xi}, "
             f"{x.motion} (instantaneous {x.dof_instantaneous})",
-            ("reproduced after correction" if driven == ("R7",) else "reproduced") if ok else "not reproduced",
+            (Verdict.CORRECTED if driven == ("R7",) else Verdict.REPRODUCED) if ok else Verdict.NOT_REPRODUCED,
             ("table 2 prints R7 -> Rx; R7 is the base joint about Z and drives Rz" if driven == ("R7",) else "")
             + ("; " if driven == ("R7",) else "") + "locked joints removed and their links merged (lambda = 3, d = 3)",
             x.to_dict(), "tests/test_mobility.py"))
-    progress("paper C: mobility of the 3-SPS/SmPU (section 5)")
+    say("paper C: mobility of the 3-SPS/SmPU (section 5)")
     smpu = catalog.build("three-sps-smpu")
     res2 = mobility_modes(smpu)
     by_mode2 = {x.mode: x for x in res2}
@@ -68,9 +68,9 @@ def section(progress: Progress | None = None) -> Section:
         claims.append(Claim(
             "C", f"3-SPS/SmPU, Sm rotations driven: {', '.join(driven) or 'none'} (section 5)",
             f"{3 + len(driven)} DOF, {motion}", f"{x.dof} DOF, {x.motion} (instantaneous {x.dof_instantaneous})",
-            "reproduced" if ok else "not reproduced", "generic dimensions (the paper gives none)", x.to_dict(),
+            Verdict.REPRODUCED if ok else Verdict.NOT_REPRODUCED, "generic dimensions (the paper gives none)", x.to_dict(),
             "tests/test_mobility.py"))
-    progress("paper C: closed-form inverse kinematics and the section 4.2 motion")
+    say("paper C: closed-form inverse kinematics and the section 4.2 motion")
     c42, fig42, data42 = _closed_form_claims()
     claims.extend(c42)
     from ..kinematics.motion import sample_motion
@@ -118,7 +118,7 @@ def _closed_form_claims():
     err21 = float(np.max(np.abs(np.array(eng) - closed)))  # closed: (poses, 3)
     out = [Claim("C", "Eq 21: closed-form actuator angles from (alpha, beta, gamma)", "arctan form",
                  f"equals the general inverse continued along the section 4.2 path to {err21:.1e} rad (73 poses)",
-                 "reproduced after correction", "R = Ry(beta) Rx(alpha) Rz(gamma) ('YXZ'); atan2 with the branch "
+                 Verdict.CORRECTED, "R = Ry(beta) Rx(alpha) Rz(gamma) ('YXZ'); atan2 with the branch "
                  "continuous from home (the printed arctan jumps to the theta + pi assembly when cos(alpha) cos(gamma) < 0)",
                  {"max_error_deg": float(np.degrees(err21))},
                  "tests/test_spherical_rrr.py::test_eq21_matches_general_inverse_along_the_section_42_path")]
@@ -129,7 +129,7 @@ def _closed_form_claims():
                   axis=-1)
     err22 = float(np.max(np.abs(J - fd)))
     out.append(Claim("C", "Eq 22: the Jacobian of the inverse kinematics", "theta' = J Q'",
-                     f"matches finite differences to {err22:.1e}", "reproduced",
+                     f"matches finite differences to {err22:.1e}", Verdict.REPRODUCED,
                      "eq 22 maps Euler-angle rates (alpha', beta', gamma'), not angular velocity; the angular-velocity "
                      "Jacobian is given separately", {"max_fd_error": err22},
                      "tests/test_spherical_rrr.py"))
@@ -153,7 +153,8 @@ def _closed_form_claims():
     out.append(Claim("C", "Section 4.2 motion alpha = beta = gamma = (pi/6) sin(pi t/180): actuator ranges (fig 3a)",
                      "theta1 +-30, theta2 +39.81/-11.94, theta3 +26.33/-34.72 deg",
                      ", ".join(f"theta{k + 1} {found[k][0]:+.3f}/{found[k][1]:+.3f}" for k in found) + " deg",
-                     "reproduced" if ok else "not reproduced", "extremes located by a bounded search; tolerance 0.01 deg",
+                     Verdict.REPRODUCED if ok else Verdict.NOT_REPRODUCED,
+                     "extremes located by a bounded search; tolerance 0.01 deg",
                      {"extremes_deg": found}, "tests/test_spherical_rrr.py::test_section_42_extremes_of_the_actuator_angles"))
     fig = F.new_figure((8.0, 3.6))
     ax = fig.add_subplot()

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..results import Progress, Steps
+from ..results import Progress, Steps, Verdict
 from ..synthesis.burmester import burmester_det, poles
 from ..synthesis.dyads import direction_residuals, rc_dyad_three_positions
 from .synthesis_figures import write_all
@@ -59,8 +59,8 @@ _FIGURES = {  # write_all's file -> (report file, title, caption)
 
 def section(progress: Progress | None = None) -> Section:
     """Paper D's section of the demo report (see the module docstring)."""
-    progress = Steps(progress, STEPS)
-    progress("paper D: Burmester curves, regions, RCCC synthesis")
+    say = Steps(progress, STEPS)
+    say("paper D: Burmester curves, regions, RCCC synthesis")
     task = get_task("rccc-four-positions")
     res = synthesize_rccc(task)
     cur = res.curves
@@ -75,7 +75,7 @@ def section(progress: Progress | None = None) -> Section:
         "poles lie on them", "cubic cones (figure)",
         f"branches: {', '.join(f'{k} ({l:.3f} rad)' for k, l in zip(cur.kinds, cur.lengths, strict=True))}; "
         f"|det| on the samples <= {max(det_u, det_v):.1e}; the 6 poles and 6 image poles: |det| <= {pole_res:.1e}",
-        "reproduced", "det B(u0) = 0 (circle points), det A(v) = 0 (center points), each sample Newton-projected",
+        Verdict.REPRODUCED, "det B(u0) = 0 (circle points), det A(v) = 0 (center points), each sample Newton-projected",
         {"kinds": list(cur.kinds), "lengths_deg": [float(np.degrees(x)) for x in cur.lengths],
          "max_det_samples": max(det_u, det_v),
          "max_det_poles": pole_res}, "tests/test_synthesis_burmester.py")]
@@ -94,7 +94,7 @@ def section(progress: Progress | None = None) -> Section:
             "direction-equation residuals u0^T(C_j^T - I)v: "
             + "; ".join(f"({k}): {', '.join(f'{x:+.3f}' for x in r)}" for k, r in resid.items())
             + f"; the printed circle points are {off[0]:.1f} and {off[1]:.1f} deg off the computed curve{extra}",
-            "not reproduced",
+            Verdict.NOT_REPRODUCED,
             f"residuals up to {worst:.2f}, far above the ~1e-3 that 3-decimal rounding explains; no convention tried "
             "(4,608) does better than 0.07. The method is reproduced on its own points instead",
             {"residuals": resid, "off_circle_curve_deg": off},
@@ -106,7 +106,7 @@ def section(progress: Progress | None = None) -> Section:
         "approximate for four positions",
         f"the three slide conditions have no common zero on any solution line: smallest max |slide| over the "
         f"Burmester curve and line (defect-free crank-rocker) {res.max_abs_slide:.3f} {unit} "
-        f"(slides {', '.join(f'{s:+.3f}' for s in res.slides)} {unit})", "reproduced",
+        f"(slides {', '.join(f'{s:+.3f}' for s in res.slides)} {unit})", Verdict.REPRODUCED,
         "slides are affine along a solution line: 3 conditions, 1 parameter",
         {"max_abs_slide_len": res.max_abs_slide, "slides_len": res.slides.tolist()},
         "tests/test_synthesis_rccc.py"))
@@ -118,7 +118,7 @@ def section(progress: Progress | None = None) -> Section:
     claims.append(Claim(
         "D", "... and exact for three positions", "exact for three positions",
         f"positions 1, 2, 4 with a sampled u0: fixed slides {slide3:.1e} {unit}, direction residuals {dres3:.1e}",
-        "reproduced", "six linear equations for a chosen u0", {"max_slide_len": slide3, "max_direction_residual": dres3},
+        Verdict.REPRODUCED, "six linear equations for a chosen u0", {"max_slide_len": slide3, "max_direction_residual": dres3},
         "tests/test_synthesis_dyads.py::test_rc_dyad_is_exact_for_three_positions"))
     claims.append(Claim(
         "D", "The synthesised RCCC guides the coupler through the four positions (approximately: RCCC)",
@@ -126,12 +126,12 @@ def section(progress: Progress | None = None) -> Section:
         f"{res.linkage_type}, defects: {res.defects}; closure solved at positions 2-4 with the input held: position "
         f"errors {', '.join(f'{e:.3f}' for e in ch.position_errors)} {unit}, orientation errors "
         f"<= {np.degrees(ch.orientation_errors).max():.1e} deg",
-        "reproduced" if bool(np.all(ch.converged)) else "not reproduced",
+        Verdict.REPRODUCED if bool(np.all(ch.converged)) else Verdict.NOT_REPRODUCED,
         "orientation exact by construction; the position errors are the price of the R joint",
         {"position_errors_len": ch.position_errors.tolist(), "orientation_errors_deg": np.degrees(ch.orientation_errors).tolist(),
          "type": res.linkage_type, "defects": res.defects}, "tests/test_synthesis_rccc.py"))
 
-    progress("paper D: figures (curves, regions 1 and 2, solution lines, linkage)")
+    say("paper D: figures (curves, regions 1 and 2, solution lines, linkage)")
     figs = []
     with tempfile.TemporaryDirectory() as tmp:
         for path in write_all(res, tmp):
@@ -148,7 +148,7 @@ def section(progress: Progress | None = None) -> Section:
                     for name, d in (("input (R-C)", res.input_dyad), ("output (C-C)", res.output_dyad)))),
     )
 
-    progress("paper D: 3-D viewer of the RCCC")
+    say("paper D: 3-D viewer of the RCCC")
     from ..kinematics.motion import sample_motion
 
     mech = res.linkage

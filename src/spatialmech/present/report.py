@@ -39,6 +39,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
+from ..model.mechanism import Mechanism
 from ..results import Progress as ProgressCallback
 from ..results import Verdict, check_progress
 from ..serialize import json_default
@@ -123,7 +124,7 @@ class Claim:
     @property
     def reproduced(self) -> bool:
         """True unless the verdict is ``not reproduced``."""
-        return self.verdict != "not reproduced"
+        return self.verdict is not Verdict.NOT_REPRODUCED
 
     def to_dict(self) -> dict:
         return {
@@ -165,7 +166,7 @@ class Viewer:
     (see :func:`.viewer.viewer_figure` for ``task_positions`` and ``singular_points``)."""
 
     title: str
-    mech: object = field(repr=False)
+    mech: Mechanism = field(repr=False)
     configs: tuple = field(repr=False)
     task_positions: tuple = field(default=(), repr=False)
     singular_points: tuple = field(default=(), repr=False)
@@ -334,16 +335,17 @@ def _viewer_html(v: Viewer, div_id: str) -> str:
 
 def summary(sections: Sequence[Section]) -> dict:
     """Counts of the verdicts, overall and per section."""
-    out = {"claims": 0, **dict.fromkeys(VERDICTS, 0), "inconsistent": 0, "by_section": {}}
+    out: dict[str, int] = {"claims": 0, **dict.fromkeys(VERDICTS, 0), "inconsistent": 0}
+    by_section: dict[str, dict[str, int]] = {}
     for s in sections:
         per = {v: sum(c.verdict == v for c in s.claims) for v in VERDICTS}
         bad = sum(c.consistent is False for c in s.claims)
-        out["by_section"][s.key] = {"claims": len(s.claims), **per, "inconsistent": bad}
+        by_section[s.key] = {"claims": len(s.claims), **per, "inconsistent": bad}
         out["claims"] += len(s.claims)
         out["inconsistent"] += bad
         for v in VERDICTS:
             out[v] += per[v]
-    return out
+    return {**out, "by_section": by_section}
 
 
 def render_html(title: str, sections: Sequence[Section], data: dict) -> str:

@@ -155,11 +155,11 @@ def _outline_order(points: np.ndarray, scale: float) -> np.ndarray:
     if n == 0:
         return np.zeros(0, int)
     # drop coincident points (keep the first of each)
-    keep = []
+    picked: list[int] = []
     for i in range(n):
-        if all(np.linalg.norm(points[i] - points[j]) > COINCIDENT * scale for j in keep):
-            keep.append(i)
-    keep = np.array(keep)
+        if all(np.linalg.norm(points[i] - points[j]) > COINCIDENT * scale for j in picked):
+            picked.append(i)
+    keep = np.array(picked)
     if len(keep) == 1:
         return keep
     P = points[keep] - points[keep].mean(axis=0)
@@ -245,7 +245,7 @@ def drawing(mech: Mechanism, config: Configuration) -> Drawing:
             centres.append(P[j])
             names.append(joint.name)
             if joint.type in AXIS_JOINTS:
-                seen = []
+                seen: list[np.ndarray] = []
                 for kind, twist in by_joint[j]:
                     d = _freedom_direction(kind, twist)
                     if any(abs(d @ e) > 1 - 1e-9 for e in seen):
@@ -272,8 +272,8 @@ def drawing(mech: Mechanism, config: Configuration) -> Drawing:
     last = _attachments(mech, pts, mech.output)
     order = _platform_order(mech)  # from the reference: the same corners at every configuration
     segs = []
-    for b in mech.bodies:
-        at = _attachments(mech, pts, b)
+    for body in mech.bodies:
+        at = _attachments(mech, pts, body)
         c = at.mean(axis=0)
         segs += [[c, a] for a in at]
     return Drawing(
@@ -324,7 +324,7 @@ def _mesh3d(mesh: dict | None, faces: bool) -> go.Mesh3d:
     if mesh is None:
         return go.Mesh3d(x=[], y=[], z=[])
     V = np.asarray(mesh["vertices"], np.float32)
-    kw = {"x": V[:, 0], "y": V[:, 1], "z": V[:, 2]}
+    kw: dict[str, np.ndarray] = {"x": V[:, 0], "y": V[:, 1], "z": V[:, 2]}
     if faces:
         T = np.asarray(mesh["triangles"], np.int32)
         kw.update(i=T[:, 0], j=T[:, 1], k=T[:, 2])
@@ -442,10 +442,10 @@ def viewer_figure(
         static.append(go.Scatter3d(**_xyz(P), mode="markers+text", name="task positions",
                                    text=[pz.name or f"#{k + 1}" for k, pz in enumerate(poses)],
                                    marker=dict(size=5, color="#000000", symbol="diamond"), legendgroup="task"))
-        for k, c in enumerate(_FRAME_COLOURS):
+        for k, colour in enumerate(_FRAME_COLOURS):
             segs = np.concatenate([_frame_segments(pz.p, pz.R, 0.6 * FRAME_LEN * s, k) for pz in poses])
             x, y, z = _segments(segs)
-            static.append(go.Scatter3d(x=x, y=y, z=z, mode="lines", line=dict(color=c, width=3), legendgroup="task",
+            static.append(go.Scatter3d(x=x, y=y, z=z, mode="lines", line=dict(color=colour, width=3), legendgroup="task",
                                        name="task frames", showlegend=False, hoverinfo="skip"))
             extra.append(segs.reshape(-1, 3))
     if len(sing):
@@ -465,7 +465,7 @@ def viewer_figure(
     lo, hi = allp.min(axis=0), allp.max(axis=0)
     centre, half = (lo + hi) / 2, max(float(np.max(hi - lo)) / 2 * 1.08, 1e-9 * s, 1e-12)
     unit = mech.length_unit
-    scene = dict(aspectmode="cube")
+    scene: dict[str, object] = dict(aspectmode="cube")
     for ax, c in zip("xyz", centre, strict=True):
         scene[f"{ax}axis"] = dict(range=[c - half, c + half], title=f"{ax} [{unit}]", autorange=False)
 

@@ -263,7 +263,7 @@ def _trace(K: np.ndarray, x0: np.ndarray, h: float, max_steps: int = 20000):
         while True:
             y = x + step * t
             y = project_to_curve(K, y / np.linalg.norm(y))
-            dist = np.linalg.norm(y - x)
+            dist = float(np.linalg.norm(y - x))
             _, gy = _det_grad(K, y)
             ty = np.cross(y, gy)
             ty /= np.linalg.norm(ty)

@@ -227,12 +227,12 @@ def check_5cs(mech: Mechanism, dyads: Sequence[CSDyad] | None = None, *, defects
         ex.append(fit.exact)
         cv.append(fit.converged)
         sl.append(freedom_values(mech, fit.config.q)[sl_idx])
-    sl = np.array(sl)
+    slides = np.array(sl)
     errs = None
     if dyads is not None:
-        errs = sl - np.array([d.slides for d in dyads]).T
+        errs = slides - np.array([d.slides for d in dyads]).T
     mob = mobility(mech)
-    out = FiveCSCheck(np.array(pe), np.array(ae), np.array(ik), np.array(ex), np.array(cv), sl, errs, int(mob.dof),
+    out = FiveCSCheck(np.array(pe), np.array(ae), np.array(ik), np.array(ex), np.array(cv), slides, errs, int(mob.dof),
                       int(mob.dof_instantaneous))
     if defects and out.ok:
         from ..analysis.defects import defect_analysis

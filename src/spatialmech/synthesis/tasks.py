@@ -294,7 +294,8 @@ def task_from_dict(data: dict[str, Any], *, source: str = "<dict>", min_position
         err = e.errors()[0]
         msg = {"extra_forbidden": "unknown field", "missing": "required field is missing"}.get(err["type"], err["msg"])
         raise InputError(f"{_loc(err['loc'])}: {msg}") from None
-    Rs, ps, names, convs, angs = [], [], [], [], []
+    Rs, ps, names, convs = [], [], [], []
+    angs: list[list[float] | None] = []  # the angles as given (None: a matrix)
     for i, ps_ in enumerate(spec.positions):
         where = f"positions[{i}]"
         given = [k for k in ("mccarthy_deg", "euler", "matrix") if getattr(ps_, k) is not None]

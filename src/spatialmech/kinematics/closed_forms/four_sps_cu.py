@@ -56,6 +56,7 @@ Worked example (the pose of the multi-assembly check)::
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TypedDict
 
 import numpy as np
 
@@ -162,11 +163,23 @@ class FourSpsCuGeometry:
 
 #: Paper B, section 6: a = 0.1 m, b = 0.2 m, legs 0.1..0.4 m, CU 0.08..0.3 m.
 PAPER_B = FourSpsCuGeometry()
+
+
+class PaperBDimensions(TypedDict):
+    """Paper B's linkage as the catalogue builds it: half-sizes, home height, leg and CU-slide limits."""
+
+    a: float
+    b: float
+    z0: float
+    leg_limits: tuple[float, float]
+    cu_limits: tuple[float, float]
+
+
 #: Paper B, section 6 (m): half-sides ``a`` (platform) and ``b`` (base), the leg-length and CU-length
 #: limits, and ``z0``, the reference height of the ready-made model (``catalog.papers.four_sps_cu``
 #: builds it from these: the catalogue depends on the closed form, not the reverse).
-PAPER_B_DIMENSIONS = {"a": PAPER_B.a, "b": PAPER_B.b, "z0": 0.2, "leg_limits": PAPER_B.leg_limits,
-                      "cu_limits": PAPER_B.z_limits}
+PAPER_B_DIMENSIONS: PaperBDimensions = {"a": PAPER_B.a, "b": PAPER_B.b, "z0": 0.2, "leg_limits": PAPER_B.leg_limits,
+                                        "cu_limits": PAPER_B.z_limits}
 
 
 # ------------------------------------------------------------------ pose and inverse position
