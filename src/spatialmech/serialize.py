@@ -27,8 +27,10 @@ numbers) or screws (:data:`SCREW_KEYS`: ``(direction ; moment)`` 6-vectors, the 
 
 from __future__ import annotations
 
+import dataclasses
 import re
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
+from typing import Any
 
 import numpy as np
 
@@ -41,8 +43,10 @@ __all__ = [
     "UNIT_FREE_MAPS",
     "UNIT_SUFFIXES",
     "envelope",
+    "fields_dict",
     "freedom_values_dict",
     "json_default",
+    "json_value",
     "pose_dict",
     "unit_rule_violations",
 ]
@@ -350,6 +354,61 @@ def freedom_values_dict(mech, values: Mapping[str, float], prefix: str) -> dict:
 
 #: Keys naming an angle: they must carry a degree suffix wherever they hold numbers.
 _ANGLE_WORD = re.compile(r"(^|_)(angle|angles|alpha|beta|gamma|theta|phi|psi|euler|rotation|rotated|twist_angle)(_|$)")
+
+
+def json_value(v: Any, *, degrees: bool = False) -> Any:
+    """``v`` as plain JSON values: NumPy arrays and tuples to lists, NumPy scalars to Python ones,
+    mappings' values and lists' items converted in turn, results to their ``to_dict()``;
+    ``degrees``: numbers (radians) to degrees.  Strings (str enums too), bools, ``None`` as they are."""
+    if v is None or isinstance(v, (str, bool, np.bool_)):
+        return v.item() if isinstance(v, np.bool_) else v
+    if isinstance(v, np.ndarray):
+        return (np.degrees(v) if degrees else v).tolist()
+    if isinstance(v, (np.floating, np.integer)):
+        return float(np.degrees(v)) if degrees else v.item()
+    if isinstance(v, (int, float)):
+        return float(np.degrees(v)) if degrees else v
+    if isinstance(v, Mapping):
+        return {k: json_value(w, degrees=degrees) for k, w in v.items()}
+    if isinstance(v, (list, tuple)):
+        return [json_value(w, degrees=degrees) for w in v]
+    if callable(getattr(v, "to_dict", None)):
+        return v.to_dict()
+    raise TypeError(f"not JSON serialisable: {type(v).__name__}")
+
+
+def _converts_to_degrees(name: str, key: str) -> bool:
+    return key.endswith("_deg") and not name.endswith("_deg")
+
+
+def fields_dict(obj, keys: Mapping[str, str] | None = None, *, names: Iterable[str] | None = None) -> dict:
+    """The JSON payload of a dataclass result, derived from its fields (docs/json.md).
+
+    ``names``: the attributes to write, in order (default: every dataclass field, in declaration
+    order; a property may be named too).  ``keys``: the one table of renames and units, attribute
+    -> JSON key, for the attributes whose key is not their own name.  The key's unit suffix is the
+    unit rule: a key that ends with ``_deg`` for an attribute that does not holds radians
+    converted to degrees; the other suffixes (``_len``, ``_s`` ...) only name the unit the value
+    is already in (the model's length unit, seconds).  Values go through :func:`json_value`.
+
+        >>> from dataclasses import dataclass
+        >>> @dataclass
+        ... class Fit:
+        ...     converged: bool
+        ...     position_error: float
+        ...     angle_error: float
+        >>> fields_dict(Fit(True, 0.25, np.pi / 2), {"position_error": "position_error_len",
+        ...                                          "angle_error": "angle_error_deg"})
+        {'converged': True, 'position_error_len': 0.25, 'angle_error_deg': 90.0}
+    """
+    keys = keys or {}
+    if names is None:
+        names = [f.name for f in dataclasses.fields(obj)]
+    out = {}
+    for name in names:
+        key = keys.get(name, name)
+        out[key] = json_value(getattr(obj, name), degrees=_converts_to_degrees(name, key))
+    return out
 
 
 def _unit_of(key: str) -> str | None:

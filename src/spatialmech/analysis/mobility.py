@@ -52,6 +52,7 @@ from ..kinematics.closure import (
     limb_slices,
 )
 from ..model.mechanism import Mechanism, Mode
+from ..serialize import fields_dict
 
 __all__ = ["ELEMENTARY_MOTIONS", "SCAN_RANGE", "MobilityResult", "ToleranceStep", "mobility", "mobility_modes", "motion_type"]
 
@@ -115,7 +116,7 @@ class ToleranceStep:
     source: str = ""
 
     def to_dict(self) -> dict:
-        return {"from": self.lower, "to": self.upper, "dof": self.dof, "source": self.source}
+        return fields_dict(self, {"lower": "from", "upper": "to"})
 
 
 @dataclass(frozen=True)

@@ -43,6 +43,7 @@ from dataclasses import dataclass, fields, replace
 import numpy as np
 
 from ..errors import InputError
+from ..serialize import fields_dict
 
 __all__ = [
     "BLOCK_MAX_COND",
@@ -145,7 +146,7 @@ class Tolerances:
         return replace(self, **changes)
 
     def to_dict(self) -> dict:
-        return {f.name: getattr(self, f.name) for f in fields(self)}
+        return fields_dict(self)
 
     @classmethod
     def parse(cls, text: str, *, primary: str = "rank", base: Tolerances | None = None) -> Tolerances:

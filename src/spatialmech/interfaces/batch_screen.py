@@ -39,6 +39,7 @@ from ..synthesis.cs_dyads import CSFamily, cs_task, synthesize_cs
 from ..synthesis.screening import (
     RANKINGS,
     STAGES,
+    VERDICT_COLUMNS,
     DyadPool,
     candidate_linkage,
     candidate_sets,
@@ -59,19 +60,16 @@ _FORMAT = "spatialmech-screen/1"
 
 
 def row_schema():
-    """The pyarrow schema of one verdict row (docs/screening.md describes the columns)."""
+    """The pyarrow schema of one verdict row (docs/screening.md describes the columns): the
+    verdict's columns (:data:`~spatialmech.synthesis.screening.VERDICT_COLUMNS`), with the
+    ``chunk`` after the candidate number and the ``worker`` last."""
     import pyarrow as pa
 
-    strings = pa.list_(pa.string())
-    return pa.schema([
-        ("candidate", pa.int64()), ("chunk", pa.int32()), ("dyads", pa.list_(pa.int32())),
-        ("rejected_by", pa.string()), ("usable", pa.bool_()), ("keeps_sign", strings), ("usable_drivers", strings),
-        ("branch_defect_drivers", strings), ("circuit_defect", pa.bool_()), ("order_defect", pa.bool_()),
-        ("n_circuits", pa.int32()), ("min_closure_sigma_at_positions", pa.float64()),
-        ("min_closure_sigma_on_path", pa.float64()), ("min_sigma_on_path", pa.float64()),
-        ("best_driver", pa.string()), ("stroke_len", pa.float64()), ("max_abs_slide_len", pa.float64()),
-        ("seconds", pa.float64()), ("error", pa.string()), ("worker", pa.string()),
-    ])
+    def arrow(t: str):
+        return pa.list_(pa.type_for_alias(t[5:-1])) if t.startswith("list<") else pa.type_for_alias(t)
+
+    cols = [(c, arrow(t)) for _, c, t in VERDICT_COLUMNS]
+    return pa.schema([cols[0], ("chunk", pa.int32()), *cols[1:], ("worker", pa.string())])
 
 
 def judge_chunk(pool: DyadPool, sets: np.ndarray, first: int, chunk: int) -> list[dict]:

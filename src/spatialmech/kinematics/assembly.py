@@ -36,6 +36,7 @@ import numpy as np
 
 from ..geometry.tolerances import Tolerances, current
 from ..results import TrackStatus
+from ..serialize import fields_dict
 from .tracking import correct_on_hyperplane, track
 
 __all__ = [
@@ -125,14 +126,8 @@ class Conditioning:
         return cls(float(sv[-1]), float(sv[-1] / sv[0]), measure, thr, free)
 
     def to_dict(self) -> dict:
-        return {
-            "sigma_min": self.sigma_min,
-            "condition": self.condition,
-            "singular": self.singular,
-            "singular_below": self.threshold,
-            "measure": self.measure,
-            "free_dim": self.free_dim,
-        }
+        return fields_dict(self, {"threshold": "singular_below"},
+                           names=("sigma_min", "condition", "singular", "threshold", "measure", "free_dim"))
 
 
 def pose_keys(R, p, length_scale: float) -> np.ndarray:

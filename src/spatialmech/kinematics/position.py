@@ -22,7 +22,7 @@ from ..geometry.rotations import inverse_transform, log_transform, rotation_angl
 from ..geometry.tolerances import Tolerances
 from ..geometry.tolerances import resolve as resolve_tolerances
 from ..model.mechanism import Mechanism, Pose
-from ..serialize import freedom_values_dict, pose_dict
+from ..serialize import fields_dict, freedom_values_dict, pose_dict
 from . import compiled
 from .closure import (
     Configuration,
@@ -110,14 +110,9 @@ class PoseFit:
 
     def to_dict(self) -> dict:
         """JSON (docs/json.md): ``position_error_len`` in the model's length unit, degrees."""
-        return {
-            "converged": bool(self.converged),
-            "exact": bool(self.exact),
-            "position_error_len": float(self.position_error),
-            "angle_error_deg": float(np.degrees(self.angle_error)),
-            "ik_residual": float(self.ik_residual),
-            "pose_error": self.error,
-        }
+        return fields_dict(self, {"position_error": "position_error_len", "angle_error": "angle_error_deg",
+                                  "error": "pose_error"},
+                           names=("converged", "exact", "position_error", "angle_error", "ik_residual", "error"))
 
 
 def configuration_at_pose(

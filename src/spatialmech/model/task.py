@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 from ..errors import InputError
 from ..geometry.rotations import check_sequence
+from ..serialize import fields_dict
 
 __all__ = ["TASK_NAMES", "TaskCoordinates"]
 
@@ -61,4 +62,4 @@ class TaskCoordinates:
         return tuple(n for n in TASK_NAMES if n not in self.given)
 
     def to_dict(self) -> dict:
-        return {"given": list(self.given), "solved": list(self.solved), "euler": self.euler}
+        return fields_dict(self, names=("given", "solved", "euler"))

@@ -42,7 +42,7 @@ from ..errors import InputError
 from ..model.mechanism import Mechanism
 from ..results import Progress as ProgressCallback
 from ..results import Verdict, check_progress
-from ..serialize import json_default
+from ..serialize import fields_dict, json_default
 from .figures import ReportFigure
 
 __all__ = [
@@ -127,19 +127,8 @@ class Claim:
         return self.verdict is not Verdict.NOT_REPRODUCED
 
     def to_dict(self) -> dict:
-        return {
-            "paper": self.paper,
-            "claim": self.claim,
-            "paper_value": self.paper_value,
-            "ours": self.ours,
-            "verdict": self.verdict,
-            "reproduced": self.reproduced,
-            "note": self.note,
-            "evidence": self.evidence,
-            "test": self.test,
-            "consistent": self.consistent,
-            "consistency": self.consistency,
-        }
+        return fields_dict(self, names=("paper", "claim", "paper_value", "ours", "verdict", "reproduced", "note",
+                                        "evidence", "test", "consistent", "consistency"))
 
 
 @dataclass(frozen=True)
@@ -157,7 +146,7 @@ class Table:
                 raise InputError(f"rows[{k}]: expected {len(self.columns)} values ({', '.join(self.columns)}), got {len(r)}")
 
     def to_dict(self) -> dict:
-        return {"title": self.title, "columns": list(self.columns), "rows": [list(r) for r in self.rows], "note": self.note}
+        return fields_dict(self)
 
 
 @dataclass(frozen=True, eq=False)
@@ -196,18 +185,8 @@ class Section:
     def to_dict(self) -> dict:
         """JSON (docs/json.md): the section's ``length_unit`` declares the unit of the ``*_len``
         fields of its claims and data (a report spans models in different units)."""
-        return {
-            "key": self.key,
-            "title": self.title,
-            "length_unit": self.length_unit,
-            "intro": self.intro,
-            "claims": [c.to_dict() for c in self.claims],
-            "tables": [t.to_dict() for t in self.tables],
-            "figures": [f.to_dict() for f in self.figures],
-            "viewers": [v.to_dict() for v in self.viewers],
-            "pending": list(self.pending),
-            "data": self.data,
-        }
+        return fields_dict(self, names=("key", "title", "length_unit", "intro", "claims", "tables", "figures", "viewers",
+                                        "pending", "data"))
 
 
 # ------------------------------------------------------------------------------ progress

@@ -55,6 +55,7 @@ from ..errors import InputError
 from ..geometry.validate import as_finite_array
 from ..kinematics.closure import Configuration, joint_points, joint_twists
 from ..model.mechanism import GROUND, Mechanism, Pose
+from ..serialize import fields_dict
 from .shapes import joint_list, joint_meshes, platform_solid
 
 __all__ = ["DIV_ID", "LIMB_COLOURS", "PLOTLY_MODES", "SINGULAR_SYMBOL", "Drawing", "ViewerFile", "drawing", "viewer_figure",
@@ -113,18 +114,8 @@ class Drawing:
     def to_dict(self) -> dict:
         """JSON (docs/json.md): points in the model's length unit (``*_len``); the platform
         frame's columns are unit vectors."""
-        return {
-            "limbs_len": [l.tolist() for l in self.limbs],
-            "base_len": self.base.tolist(),
-            "platform_len": self.platform.tolist(),
-            "axes_len": self.axes.tolist(),
-            "joints_len": self.joints.tolist(),
-            "joint_names": list(self.joint_names),
-            "platform_point_len": self.platform_point.tolist(),
-            "platform_frame": self.platform_frame.tolist(),
-            "scale_len": float(self.scale),
-            "bodies_len": self.bodies.tolist(),
-        }
+        return fields_dict(self, {n: f"{n}_len" for n in ("limbs", "base", "platform", "axes", "joints", "platform_point",
+                                                          "scale", "bodies")})
 
 
 #: How a written page gets plotly.js: ``inline`` (in the page: one self-contained file that opens
@@ -144,7 +135,7 @@ class ViewerFile:
     plotly: str = "inline"
 
     def to_dict(self) -> dict:
-        return {"out": self.out, "frames": self.frames, "bytes": self.bytes, "plotly": self.plotly}
+        return fields_dict(self)
 
 
 # ---------------------------------------------------------------------------- geometry

@@ -67,6 +67,7 @@ from ..kinematics.jit import njit
 from ..kinematics.tracking import EuclideanProblem, correct_on_hyperplane, track
 from ..model.mechanism import Pose
 from ..results import BranchEnd
+from ..serialize import fields_dict
 
 __all__ = [
     "N_POSITIONS",
@@ -332,15 +333,8 @@ class CSDyad:
     def to_dict(self) -> dict:
         """JSON (docs/json.md): ``u`` unit direction; ``B1_len``, ``M1_len``, the link length,
         slides and ``residual_len`` (largest error of eqs 24-25, a length) in the task unit."""
-        return {
-            "u": self.u.tolist(),
-            "B1_len": self.B1.tolist(),
-            "M1_len": self.M1.tolist(),
-            "link_length_len": float(self.link_length),
-            "slides_len": self.slides.tolist(),
-            "max_abs_slide_len": self.max_abs_slide,
-            "residual_len": float(self.residual),
-        }
+        lengths = ("B1", "M1", "link_length", "slides", "max_abs_slide", "residual")
+        return fields_dict(self, {n: f"{n}_len" for n in lengths}, names=("u", *lengths))
 
 
 def _dyad_errors(x_phys: np.ndarray, task: CSTask) -> float:
@@ -750,17 +744,8 @@ class Projection:
     converged: bool
 
     def to_dict(self) -> dict:
-        return {
-            "printed": self.printed.to_dict(),
-            "fitted": self.fitted.to_dict(),
-            "distance_len": self.distance,
-            "B1_change_len": self.B1_change,
-            "M1_change_len": self.M1_change,
-            "axis_change_deg": self.axis_change_deg,
-            "slide_change_len": self.slide_change,
-            "link_length_change_len": self.link_length_change,
-            "converged": self.converged,
-        }
+        return fields_dict(self, {n: f"{n}_len" for n in ("distance", "B1_change", "M1_change", "slide_change",
+                                                          "link_length_change")})
 
 
 def project_dyad(task_poses, dyad: CSDyad, *, max_iter: int = 100) -> Projection:

@@ -41,12 +41,14 @@ from ..errors import InputError
 from ..geometry.tolerances import current as current_tolerances
 from ..model.mechanism import Mechanism
 from ..results import ScreenStage
+from ..serialize import fields_dict
 from .cs_dyads import CSDyad, CSFamily, CSTask, cs_task, dyad_from_vector
 from .five_cs import assemble_5cs, cs_configuration
 
 __all__ = [
     "RANKINGS",
     "STAGES",
+    "VERDICT_COLUMNS",
     "CandidateVerdict",
     "DyadPool",
     "candidate_linkage",
@@ -226,27 +228,32 @@ class CandidateVerdict:
 
     def row(self) -> dict:
         """One row of the screening dataset (docs/screening.md names the columns)."""
-        return {
-            "candidate": self.candidate,
-            "dyads": list(self.dyads),
-            "rejected_by": self.rejected_by,
-            "usable": self.usable,
-            "keeps_sign": list(self.keeps_sign),
-            "usable_drivers": list(self.usable_drivers),
-            "branch_defect_drivers": list(self.branch_defect_drivers),
-            "circuit_defect": self.circuit_defect,
-            "order_defect": self.order_defect,
-            "n_circuits": self.n_circuits,
-            "min_closure_sigma_at_positions": self.min_closure_sigma_positions,
-            "min_closure_sigma_on_path": self.min_closure_sigma_path,
-            "min_sigma_on_path": self.min_driver_sigma_path,
-            "best_driver": self.best_driver,
-            "stroke_len": self.stroke,
-            "max_abs_slide_len": self.max_abs_slide,
-            "seconds": self.seconds,
-            "error": self.error,
-        }
+        return fields_dict(self, {a: c for a, c, _ in VERDICT_COLUMNS if a != c}, names=[a for a, _, _ in VERDICT_COLUMNS])
 
+
+#: The columns of a verdict row, in order (docs/screening.md): (attribute of
+#: :class:`CandidateVerdict`, column, Parquet type).  The one spelling of each column: :meth:`CandidateVerdict.row`
+#: and the dataset's Parquet schema (``row_schema`` of the batch screen, which adds ``chunk`` and ``worker``) read it.
+VERDICT_COLUMNS: tuple[tuple[str, str, str], ...] = (
+    ("candidate", "candidate", "int64"),
+    ("dyads", "dyads", "list<int32>"),
+    ("rejected_by", "rejected_by", "string"),
+    ("usable", "usable", "bool"),
+    ("keeps_sign", "keeps_sign", "list<string>"),
+    ("usable_drivers", "usable_drivers", "list<string>"),
+    ("branch_defect_drivers", "branch_defect_drivers", "list<string>"),
+    ("circuit_defect", "circuit_defect", "bool"),
+    ("order_defect", "order_defect", "bool"),
+    ("n_circuits", "n_circuits", "int32"),
+    ("min_closure_sigma_positions", "min_closure_sigma_at_positions", "float64"),
+    ("min_closure_sigma_path", "min_closure_sigma_on_path", "float64"),
+    ("min_driver_sigma_path", "min_sigma_on_path", "float64"),
+    ("best_driver", "best_driver", "string"),
+    ("stroke", "stroke_len", "float64"),
+    ("max_abs_slide", "max_abs_slide_len", "float64"),
+    ("seconds", "seconds", "float64"),
+    ("error", "error", "string"),
+)
 
 #: The rankings of usable candidates (:func:`rank_key`), the default first.
 RANKINGS = ("singularity", "slide")

@@ -10,6 +10,7 @@ import numpy as np
 from ...errors import InputError
 from ...geometry.validate import as_finite_array, as_unit_vector
 from ...model.mechanism import Mechanism
+from ...serialize import fields_dict
 
 #: ``R = Rz(gamma) Ry(beta) Rx(alpha)``: intrinsic "ZYX" with the angles ``(gamma, beta, alpha)``.
 ORIENTATION_SEQUENCE = "ZYX"
@@ -61,8 +62,7 @@ class ConeLimit:
         return f"{self.joint} cone"
 
     def to_dict(self) -> dict:
-        return {"joint": self.joint, "axis": list(self.axis), "frame": self.frame,
-                "max_angle_deg": float(np.degrees(self.max_angle))}
+        return fields_dict(self, {"max_angle": "max_angle_deg"})
 
 
 @dataclass(frozen=True)

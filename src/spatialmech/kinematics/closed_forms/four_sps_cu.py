@@ -63,6 +63,7 @@ import numpy as np
 from ...errors import InputError
 from ...geometry.rotations import euler_matrix, transform
 from ...geometry.validate import as_finite_array
+from ...serialize import fields_dict
 from .. import compiled
 from ..jit import SAFE_FASTMATH, njit, prange
 from ..kernels_se3 import SINCOS_MAX, nb_sincos
@@ -158,7 +159,7 @@ class FourSpsCuGeometry:
 
     def to_dict(self) -> dict:
         """JSON (docs/json.md): lengths in the model's unit (``*_len``; paper B: metres)."""
-        return {"a_len": self.a, "b_len": self.b, "leg_limits_len": list(self.leg_limits), "z_limits_len": list(self.z_limits)}
+        return fields_dict(self, {n: f"{n}_len" for n in ("a", "b", "leg_limits", "z_limits")})
 
 
 #: Paper B, section 6: a = 0.1 m, b = 0.2 m, legs 0.1..0.4 m, CU 0.08..0.3 m.
