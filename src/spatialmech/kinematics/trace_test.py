@@ -61,7 +61,7 @@ class TraceResult:
 
     @property
     def passed(self) -> bool:
-        return self.verdict is TraceVerdict.PASSED
+        return self.verdict == TraceVerdict.PASSED  # a plain "passed" too
 
 
 def _crand(rng: np.random.Generator, *shape: int) -> np.ndarray:
