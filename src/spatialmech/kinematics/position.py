@@ -544,8 +544,9 @@ def _inverse(mech: Mechanism, pose: Pose, all_solutions: bool, n_seeds: int, see
                 all_ok &= ls.reachable
     config = Configuration(recentre_balls(mech, q_all), D, B_all) if all_ok else None
     search = {"method": "Gauss-Newton per limb", "starts_per_limb": 1 + (n_seeds if all_solutions else 0), "seed": seed,
-              "tolerance": t.closure, "dedup_tol": t.dedup, "distinct_by": ("joint values: angles modulo 2 pi (2 sin(d / 2)), slides / L, S joints by their rotation; "
-                            "solutions joined by a continuum (a passive spin) count once")}
+              "tolerance": t.closure, "dedup_tol": t.dedup,
+              "distinct_by": ("joint values: angles modulo 2 pi (2 sin(d / 2)), slides / L, S joints by their rotation; "
+                              "solutions joined by a continuum (a passive spin) count once")}
     if clusters:
         search["clusters"] = clusters
         search["coupled"] = ("limbs that share an internal body are solved together with the body (Gauss-Newton on their "
