@@ -51,7 +51,13 @@ def test_delta_inverse_finds_both_elbows_of_every_arm():
 def test_passive_spin_is_reported_as_a_continuum():
     pose = platform_pose(STEWART, generic_configuration(STEWART, seed=1))
     inv = inverse_position(STEWART, pose, all_solutions=True, n_seeds=8)
-    assert all(l.passive_dim == 1 and len(l.solutions) == 1 for l in inv.limbs)
+    # every leg spins freely about its line (one continuum, listed once whatever the seeds land
+    # on) and closes with its length or with minus its length (the leg through its base joint: a
+    # configuration of its own, which the old axis-line signature merged with the first)
+    assert all(l.passive_dim == 1 and len(l.solutions) == 2 for l in inv.limbs)
+    for k, l in enumerate(inv.limbs):
+        lengths = sorted(STEWART.freedom_refs[7 * k + 3].freedom.offset + q[3] for q in l.solutions)
+        assert lengths[0] == pytest.approx(-lengths[1], rel=1e-9) and lengths[1] > 0
 
 
 def test_unreachable_pose_is_reported_not_hidden():

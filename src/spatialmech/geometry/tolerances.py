@@ -104,8 +104,10 @@ class Tolerances:
     #: and the nearest closed configuration for which ``ik`` fits the pose (and says by how
     #: much) instead of calling it unreachable: covers poses printed with 6 significant digits.
     reachability: float = 1e-5
-    #: Nondimensional distance between two solutions' signatures below which they are the same
-    #: solution (inverse position: joint lines and ball centres / L).
+    #: Nondimensional distance between two solutions below which they are the same solution
+    #: (inverse position: in configuration space, every angle as 2 sin(d / 2), slides / L, an S
+    #: joint's rotation as 2 sin(d / 2) of the angle between the two; forward position: the pose
+    #: distance of kinematics/assembly.py).
     dedup: float = 1e-6
     #: Pivot threshold of the readable (row-echelon) basis of a screw system, relative to the
     #: largest remaining entry: smaller pivots are rounding noise of typed data, not structure.

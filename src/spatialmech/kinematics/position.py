@@ -1,8 +1,8 @@
 """Position analysis on the general closure engine: inverse position and poses onto the manifold.
 
 - :func:`inverse_position`: platform pose -> every limb's joint values; all real solutions
-  (multi-start Gauss-Newton per limb, deduplicated by the limb's joint geometry), with joint
-  limits checked and positive-dimensional (passive) solution sets reported.
+  (multi-start Gauss-Newton per limb, told apart in configuration space: :func:`solution_key`),
+  with joint limits checked and positive-dimensional (passive) solution sets reported.
 - forward position (actuator values -> platform pose) is in :mod:`.forward`.
 - :func:`configuration_at_pose`: the closed configuration nearest to a given (possibly
   inexact, e.g. printed and rounded) platform pose, with the pose error it implies.
@@ -25,6 +25,7 @@ from ..model.mechanism import Mechanism, Pose
 from ..serialize import fields_dict, freedom_values_dict, pose_dict
 from . import compiled
 from .closure import (
+    Chain,
     Configuration,
     active_mask,
     chain_forward,
@@ -42,6 +43,7 @@ __all__ = [
     "InverseResult",
     "LimbSolutions",
     "PoseFit",
+    "SolutionForm",
     "cluster_newton",
     "cluster_system",
     "configuration_at_pose",
@@ -51,6 +53,9 @@ __all__ = [
     "limb_gauss_newton",
     "platform_pose",
     "random_joint_values",
+    "same_solution",
+    "solution_form",
+    "solution_key",
     "within_limits",
     "wrap_rotations",
 ]
@@ -286,26 +291,142 @@ def limb_gauss_newton(chain, D, q, lin, L, tol=1e-12, max_iter=60, hold=None):
     return q, rn, rn < tol
 
 
-def _signature(chain, q, L) -> np.ndarray:
-    """Geometry of a limb's solution, nondimensional: every one-freedom joint's line (its twist
-    up to sign, so a universal joint's flipped cross (t1 + pi, pi - t2) counts once) and every
-    S joint's centre (its axes are a parametrisation, not geometry)."""
-    _, J, pre = chain_forward(chain, q, prefixes=True, local=True)
-    scale = np.r_[np.ones(3), np.full(3, 1.0 / L)]
-    ball = {k: c for k, c, _ in chain.balls}
-    parts = []
-    i = 0
-    while i < J.shape[1]:
-        if i in ball:
-            c = ball[i]
-            parts.append((pre[i, :3, :3] @ c + pre[i, :3, 3]) / L)
-            i += 3
+@dataclass(frozen=True, eq=False)
+class SolutionForm:
+    """How the solutions of one limb are told apart (:func:`solution_key`): which freedoms are
+    angles (compared modulo 2 pi), which are numbers (slides, divided by ``L``, and helical
+    values), and which triples are the rotation of one spherical joint (compared by its matrix:
+    an ``S`` joint's rotation vector, an ``Sm`` joint's three serial rotations)."""
+
+    chain: Chain
+    angles: np.ndarray  # (m,) bool: an angle of its own (R, U, C rotations; H of pitch 0)
+    wrap: np.ndarray  # (m,) bool: a rotation whose difference is wrapped (the angles and the Sm rotations)
+    lin: np.ndarray  # (m,) bool: a slide
+    exact: np.ndarray  # indices compared as numbers
+    exact_scale: np.ndarray  # 1 / L for a slide, 1 for a helical value
+    balls: tuple[tuple[int, np.ndarray], ...]  # (first index, axes as columns) of S joints (rotation vectors)
+    serial_balls: tuple[tuple[int, np.ndarray], ...]  # (first index, axes as columns) of Sm joints
+    L: float
+
+
+def solution_form(mech: Mechanism, li: int) -> SolutionForm:
+    """The :class:`SolutionForm` of limb ``li``."""
+    ch, sl = limb_chains(mech)[li], limb_slices(mech)[li]
+    refs = mech.freedom_refs[sl]
+    L = mech.characteristic_length
+    joints = mech.limbs[li].joints
+    angles = np.zeros(len(refs), dtype=bool)
+    wrap = np.zeros(len(refs), dtype=bool)
+    exact: list[int] = []
+    scale: list[float] = []
+    serial = []
+    k = 0
+    while k < len(refs):
+        jt = joints[refs[k].joint].type
+        if jt in ("S", "Sm"):
+            if jt == "Sm":  # three serial rotations about the reference directions of its axes
+                serial.append((k, ch.screws[k : k + 3, :3].T.copy()))
+                wrap[k : k + 3] = True
+            k += 3
             continue
-        col = J[:, i] * scale
-        lead = int(np.argmax(np.abs(col) > 1e-9))
-        parts.append(col * (np.sign(col[lead]) or 1.0))
-        i += 1
+        f = refs[k].freedom
+        if f.kind == "R" or (f.kind == "H" and f.pitch == 0.0):
+            angles[k] = wrap[k] = True
+        else:  # a slide, or a helical value (a turn more is a pitch further)
+            exact.append(k)
+            scale.append(1.0 / L if f.kind == "P" else 1.0)
+        k += 1
+    lin = np.array([r.freedom.kind == "P" for r in refs], dtype=bool)
+    return SolutionForm(ch, angles, wrap, lin, np.array(exact, dtype=int), np.array(scale, dtype=float),
+                        tuple((k, A) for k, _, A in ch.balls), tuple(serial), L)
+
+
+def _serial_rotation(A: np.ndarray, q: np.ndarray) -> np.ndarray:
+    Rm = np.eye(3)
+    for j in range(3):
+        Rm = Rm @ Rotation.from_rotvec(A[:, j] * q[j]).as_matrix()
+    return Rm
+
+
+def solution_key(form: SolutionForm, q) -> np.ndarray:
+    """A limb's solution as a point whose distances tell solutions apart in configuration
+    space, nondimensional: every angle ``t`` as ``(cos t, sin t)`` (a distance of
+    ``2 |sin(dt / 2)|``: ``t`` and ``t + 2 pi`` are one value, a half turn is 2 away), slides
+    divided by ``L``, helical values as they are, and every spherical joint's rotation matrix
+    divided by ``sqrt(2)`` (again ``2 |sin(dt / 2)|``, ``dt`` the angle between the two
+    rotations: its three variables are a redundant parametrisation, the rotation is not).
+
+    A universal joint's two angles are compared as angles: its flipped cross ``(t1 + pi,
+    pi - t2)`` is not the same joint displacement (the next link is turned by a half turn about
+    the normal of the two axes), so it is another configuration, like any R joint's half turn."""
+    q = np.asarray(q, dtype=float)
+    a = q[form.angles]
+    parts = [np.cos(a), np.sin(a), q[form.exact] * form.exact_scale]
+    for k, A in form.balls:
+        parts.append(Rotation.from_rotvec(A @ q[k : k + 3]).as_matrix().ravel() / np.sqrt(2.0))
+    for k, A in form.serial_balls:
+        parts.append(_serial_rotation(A, q[k : k + 3]).ravel() / np.sqrt(2.0))
     return np.concatenate(parts)
+
+
+def _difference(form: SolutionForm, q: np.ndarray, q_to: np.ndarray) -> np.ndarray:
+    """The step from ``q`` to ``q_to`` in the local coordinates of :func:`limb_gauss_newton`
+    (angles the short way round; an S joint's rotation composed on the left)."""
+    d = q_to - q
+    d[form.wrap] = (d[form.wrap] + np.pi) % (2 * np.pi) - np.pi
+    for k, A in form.balls:
+        rel = Rotation.from_rotvec(A @ q_to[k : k + 3]) * Rotation.from_rotvec(A @ q[k : k + 3]).inv()
+        d[k : k + 3] = A.T @ rel.as_rotvec()
+    return d
+
+
+def _joins(form: SolutionForm, q_from: np.ndarray, q_to: np.ndarray, t: Tolerances, max_iter: int = 40) -> bool:
+    """Whether ``q_from`` reaches ``q_to`` along the limb's solution set with its tip held (a
+    passive spin, a continuum of solutions): steps along the null space of the limb's Jacobian
+    towards ``q_to`` (at most 0.5 nondimensional each), each corrected back onto the set, until
+    the two are one solution (:func:`solution_key` within the ``dedup`` tolerance).  ``False``
+    when the set does not lead there (a distinct solution, or a continuum of its own)."""
+    ch, L = form.chain, form.L
+    T = chain_forward(ch, q_to)[0]
+    key_to = solution_key(form, q_to)
+    colscale = np.where(form.lin, L, 1.0)
+    row = np.r_[np.ones(3), np.full(3, 1.0 / L)]
+    q = q_from.copy()
+    kicked = False
+    for _ in range(max_iter):
+        if np.linalg.norm(solution_key(form, q) - key_to) < t.dedup:
+            return True
+        _, J = chain_forward(ch, q, local=True)
+        _, sv, Vt = np.linalg.svd(row[:, None] * J * colscale[None, :])
+        rank = int(np.sum(sv > t.rank * max(1.0, sv[0] if sv.size else 0.0)))
+        N = Vt[rank:].T  # the tangent of the solution set (nondimensional)
+        if N.shape[1] == 0:
+            return False
+        x = N @ (N.T @ (_difference(form, q, q_to) / colscale))
+        nx = float(np.linalg.norm(x))
+        if nx < 1e-9:  # the far side of a closed continuum (a spin by half a turn): go round one way
+            if kicked:
+                return False
+            x, nx, kicked = N[:, 0].copy(), 1.0, True
+        dq = colscale * (x if nx <= 0.5 else x * (0.5 / nx))
+        q_new = q + dq
+        for k, A in form.balls:
+            sl = slice(k, k + 3)
+            q_new[sl] = A.T @ (Rotation.from_rotvec(A @ dq[sl]) * Rotation.from_rotvec(A @ q[sl])).as_rotvec()
+        q, _, ok = limb_gauss_newton(ch, T, q_new, form.lin, L, tol=t.closure)
+        if not ok:
+            return False
+    return False
+
+
+def same_solution(form: SolutionForm, q: np.ndarray, key: np.ndarray, q2: np.ndarray, key2: np.ndarray,
+                  t: Tolerances, passive: int) -> bool:
+    """Whether two closed solutions of one limb (its tip at the same place) are one: their
+    :func:`solution_key` within the ``dedup`` tolerance, or, when the first lies on a continuum
+    (``passive > 0`` free directions), the continuum leads to the second (:func:`_joins`)."""
+    if np.linalg.norm(key - key2) < t.dedup:
+        return True
+    return passive > 0 and _joins(form, q, q2, t)
 
 
 def wrap_rotations(mech: Mechanism, q, indices=None) -> np.ndarray:
@@ -338,9 +459,10 @@ def inverse_position(
     """Joint values of every limb for a platform pose.
 
     Single solution: Gauss-Newton from ``start`` (default: the reference).  ``all_solutions``:
-    also ``n_seeds`` random starts per limb; solutions are distinct when the limb's joint
-    twists differ (so passive spins, which leave the geometry unchanged up to that freedom,
-    are not counted twice); ``passive_dim > 0`` says the solution set is a continuum.
+    also ``n_seeds`` random starts per limb; two solutions are one when every freedom agrees
+    within the ``dedup`` tolerance (:func:`solution_key`: angles modulo 2 pi, slides, S joints
+    by their rotation), so a half turn of any joint is another solution; solutions joined by
+    a continuum (a passive spin) count once, and ``passive_dim > 0`` says the set is one.
 
     ``tol``: a :class:`~spatialmech.geometry.tolerances.Tolerances` or a number (the ``closure``
     residual at which a limb counts as solved); default: the tolerances in force.
@@ -417,7 +539,9 @@ def _inverse(mech: Mechanism, pose: Pose, all_solutions: bool, n_seeds: int, see
                 all_ok &= ls.reachable
     config = Configuration(recentre_balls(mech, q_all), D, B_all) if all_ok else None
     search = {"method": "Gauss-Newton per limb", "starts_per_limb": 1 + (n_seeds if all_solutions else 0), "seed": seed,
-              "tolerance": t.closure, "dedup_tol": t.dedup, "distinct_by": "joint twists (axis placement) of the limb"}
+              "tolerance": t.closure, "dedup_tol": t.dedup,
+              "distinct_by": ("joint values: angles modulo 2 pi (2 sin(d / 2)), slides / L, S joints by their rotation; "
+                              "solutions joined by a continuum (a passive spin) count once")}
     if clusters:
         search["clusters"] = clusters
         search["coupled"] = ("limbs that share an internal body are solved together with the body (Gauss-Newton on their "
@@ -455,9 +579,10 @@ def _inverse_limb(mech: Mechanism, li: int, D: np.ndarray, q_start: np.ndarray, 
     starts = [q_start[sl].copy()]
     if all_solutions:
         starts += [random_joint_values(mech, rng, sl, q_start[sl], locked) for _ in range(n_seeds)]
+    form = solution_form(mech, li)
     sols: list[np.ndarray] = []
     res: list[float] = []
-    sigs: list[np.ndarray] = []
+    keys: list[np.ndarray] = []
     best = (None, np.inf)
     for q0 in starts:
         q, rn, ok = limb_gauss_newton(ch, D, q0.astype(float), lin, L, tol=tol)
@@ -466,10 +591,13 @@ def _inverse_limb(mech: Mechanism, li: int, D: np.ndarray, q_start: np.ndarray, 
                 best = (q, rn)
             continue
         q = wrap_rotations(mech, q, range(sl.start, sl.stop))
-        sig_n = _signature(ch, q, L)
-        if any(np.linalg.norm(sig_n - s2) < t.dedup for s2 in sigs):
+        key = solution_key(form, q)
+        if any(np.linalg.norm(key - k2) < t.dedup for k2 in keys):
             continue
-        sigs.append(sig_n)
+        passive = _limb_passive(ch, q, L, t.rank)
+        if passive and any(same_solution(form, q, key, q2, k2, t, passive) for q2, k2 in zip(sols, keys, strict=True)):
+            continue
+        keys.append(key)
         sols.append(q)
         res.append(rn)
     idx_l = set(range(sl.start, sl.stop))
@@ -544,6 +672,23 @@ def cluster_system(mech: Mechanism, cl: list[int], held=()) -> tuple[np.ndarray,
     return idx, bodies, rows, np.array(qcols + bcols, dtype=int)
 
 
+def _same_cluster_solution(forms: dict[int, SolutionForm], cl: list[int], sls: list[slice], q: np.ndarray,
+                           kb: np.ndarray, kl: list[np.ndarray], q2: np.ndarray,
+                           k2: tuple[np.ndarray, list[np.ndarray]], t: Tolerances) -> bool:
+    """Two solutions of a group of limbs are one when the shared bodies' poses agree and every
+    limb's solutions are one (:func:`same_solution`: passive spins of a rod count once)."""
+    if np.linalg.norm(kb - k2[0]) >= t.dedup:
+        return False
+    for i, ka, kb2 in zip(cl, kl, k2[1], strict=True):
+        if np.linalg.norm(ka - kb2) < t.dedup:
+            continue
+        f = forms[i]
+        passive = _limb_passive(f.chain, q[sls[i]], f.L, t.rank)
+        if not same_solution(f, q[sls[i]], ka, q2[sls[i]], kb2, t, passive):
+            return False
+    return True
+
+
 def _inverse_cluster(mech: Mechanism, cl: list[int], D: np.ndarray, q_start: np.ndarray, q_all: np.ndarray,
                      B_all: np.ndarray, all_solutions: bool, n_seeds: int, rng: np.random.Generator,
                      t: Tolerances) -> tuple[list[LimbSolutions], np.ndarray]:
@@ -557,7 +702,8 @@ def _inverse_cluster(mech: Mechanism, cl: list[int], D: np.ndarray, q_start: np.
     locked = ~active_mask(mech)
     idx, bodies, rows, cols = cluster_system(mech, cl)
     found: list[tuple[np.ndarray, np.ndarray, float]] = []  # (q, B, residual)
-    keys: list[np.ndarray] = []
+    keys: list[tuple[np.ndarray, list[np.ndarray]]] = []  # (the bodies' poses, each limb's solution_key)
+    forms = {i: solution_form(mech, i) for i in cl}
     best: tuple[np.ndarray | None, np.ndarray | None, float] = (None, None, np.inf)
     n_starts = 1 + n_seeds
     for s in range(n_starts):
@@ -577,10 +723,11 @@ def _inverse_cluster(mech: Mechanism, cl: list[int], D: np.ndarray, q_start: np.
         else:
             q = c.q.copy()
             q[idx] = wrap_rotations(mech, q[idx], idx)
-            key = np.concatenate([np.r_[c.B[h - 1][:3, :3].ravel(), c.B[h - 1][:3, 3] / L] for h in bodies]
-                                 + [_signature(limb_chains(mech)[i], q[sls[i]], L) for i in cl])
-            if not any(np.linalg.norm(key - k2) < t.dedup for k2 in keys):
-                keys.append(key)
+            kb = np.concatenate([np.r_[c.B[h - 1][:3, :3].ravel(), c.B[h - 1][:3, 3] / L] for h in bodies])
+            kl = [solution_key(forms[i], q[sls[i]]) for i in cl]
+            if not any(_same_cluster_solution(forms, cl, sls, q, kb, kl, f[0], k2, t)
+                       for f, k2 in zip(found, keys, strict=True)):
+                keys.append((kb, kl))
                 found.append((q, c.B, rn))
         if found and not all_solutions:
             break
