@@ -19,7 +19,7 @@ import time
 import numpy as np
 
 import spatialmech as sm
-from spatialmech.kinematics import homotopy_general as hg
+from spatialmech.kinematics.homotopy import general as hg
 from spatialmech.kinematics.closure import Configuration, closure_residual
 
 

@@ -22,7 +22,7 @@ from spatialmech.analysis.defects import candidate_drivers
 from spatialmech.errors import InputError
 from spatialmech.geometry.rotations import exp_twist
 from spatialmech.kinematics import compiled
-from spatialmech.kinematics import kernels_se3
+from spatialmech.kinematics.compiled import kernels_se3
 from spatialmech.kinematics.closed_forms import four_sps_cu
 from spatialmech.kinematics.closure import (
     Configuration,
@@ -370,7 +370,7 @@ def test_nearest_rotation_without_the_svd_equals_the_svd():
     rounding, by the SVD otherwise: both give the polar factor ``U Vt``."""
     from scipy.spatial.transform import Rotation
 
-    from spatialmech.kinematics.kernels_se3 import nb_orthonormal
+    from spatialmech.kinematics.compiled.kernels_se3 import nb_orthonormal
 
     rng = np.random.default_rng(5)
     for _ in range(200):
@@ -473,7 +473,7 @@ def test_a_kernel_compiled_on_first_use_is_announced_and_a_cached_one_is_not():
 
     from numba import njit
 
-    from spatialmech.kinematics.jit import announce_compilation
+    from spatialmech.kinematics.compiled.jit import announce_compilation
 
     @njit(cache=False)
     def inner_kernel_for_the_notice(x):

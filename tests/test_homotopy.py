@@ -15,7 +15,7 @@ from scipy.spatial.transform import Rotation
 import spatialmech as sm
 from spatialmech import catalog
 from spatialmech.interfaces.cli import cli as main
-from spatialmech.kinematics import homotopy as hc
+from spatialmech.kinematics.homotopy import study as hc
 from spatialmech.kinematics.forward import forward_position
 
 
@@ -401,7 +401,7 @@ def test_a_double_root_is_located_by_the_cauchy_end_game_and_proven_complete(gen
 
 
 def test_local_dimension_tells_a_multiple_root_from_a_continuum():
-    from spatialmech.kinematics.endgame import local_dimension
+    from spatialmech.kinematics.homotopy.endgame import local_dimension
 
     def ev(F):
         def evaluate(Y):

@@ -12,7 +12,7 @@ from click.testing import CliRunner
 
 import spatialmech as sm
 from spatialmech.interfaces.cli import cli as main
-from spatialmech.kinematics import homotopy_general as hg
+from spatialmech.kinematics.homotopy import general as hg
 from spatialmech.kinematics.closure import Configuration, closure_residual
 from spatialmech.kinematics.forward import forward_position
 

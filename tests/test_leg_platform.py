@@ -24,7 +24,7 @@ from spatialmech.kinematics.closure import (
     correct,
     generic_configuration,
 )
-from spatialmech.kinematics.kernels_legs import nb_shortest_rotation, nb_shortest_rotvec
+from spatialmech.kinematics.compiled.kernels_legs import nb_shortest_rotation, nb_shortest_rotvec
 
 ROOT = Path(__file__).resolve().parents[1]
 pure = compiled.python_reference

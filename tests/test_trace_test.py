@@ -8,7 +8,7 @@ import pytest
 
 import spatialmech as sm
 from spatialmech.geometry.tolerances import TRACE_TOL
-from spatialmech.kinematics.trace_test import trace_test
+from spatialmech.kinematics.homotopy.trace_test import trace_test
 
 
 def _conics(P0, V):

@@ -355,12 +355,12 @@ def forward_position(
     targets = _actuator_q(mech, actuator_values)
     gwhy: str | None = None  # why the loop formulation (homotopy_general) does not cover the model
     if all_solutions and method != "multistart":
-        from . import homotopy as hc
+        from .homotopy import study as hc
 
         why = hc.unsupported_reason(mech)
         if why is None:
             return _forward_homotopy(mech, targets, seed, max_iter, n_seeds)
-        from . import homotopy_general as hg
+        from .homotopy import general as hg
 
         gwhy = hg.general_reason(mech)
         if gwhy is None:
@@ -503,7 +503,7 @@ def _forward_homotopy(mech: Mechanism, targets: dict[int, float], seed: int, max
     """``forward_position(..., method="homotopy")``: the real end points polished with the
     actuators held, grouped and classified as the multi-start roots."""
     from ..geometry.rotations import transform
-    from . import homotopy as hc
+    from .homotopy import study as hc
 
     refs = mech.freedom_refs
     vals = [targets[refs.index(mech.freedom(a))] + mech.freedom(a).freedom.offset for a in mech.actuators]
@@ -575,7 +575,7 @@ def _forward_general(mech: Mechanism, targets: dict[int, float], seed: int, max_
     (:mod:`.homotopy_general`); each real end point is a configuration, polished by the same
     Newton step and grouped as the multi-start roots.  ``complete`` when the trace test of the
     generic solutions passed and every path to the request is accounted for."""
-    from . import homotopy_general as hg
+    from .homotopy import general as hg
 
     hr = hg.general_forward(mech, targets, seed=seed, capped=fallback)
     if fallback and not hr.saturated:  # method="auto": the multi-start instead

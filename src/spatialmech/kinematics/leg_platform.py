@@ -39,7 +39,7 @@ from ..geometry.rotations import matrix_rotvec, rotvec_matrix, skew
 from ..geometry.tolerances import current as current_tolerances
 from ..model.mechanism import Mechanism
 from . import compiled
-from .kernels_legs import nb_leg_platform
+from .compiled.kernels_legs import nb_leg_platform
 from .closure import (
     Configuration,
     CorrectionResult,

@@ -63,7 +63,7 @@ from ..errors import InputError
 from ..geometry.rotations import inverse_transform, rotation_angle, transform
 from ..geometry.validate import as_finite_array, as_unit_vector
 from ..kinematics import compiled
-from ..kinematics.jit import njit
+from ..kinematics.compiled.jit import njit
 from ..kinematics.tracking import EuclideanProblem, correct_on_hyperplane, track
 from ..model.mechanism import Pose
 from ..results import BranchEnd

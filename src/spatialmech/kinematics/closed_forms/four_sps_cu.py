@@ -63,8 +63,8 @@ from ...errors import InputError
 from ...geometry.rotations import euler_matrix, transform
 from ...geometry.validate import as_finite_array
 from .. import compiled
-from ..jit import SAFE_FASTMATH, njit, prange
-from ..kernels_se3 import SINCOS_MAX, nb_sincos
+from ..compiled.jit import SAFE_FASTMATH, njit, prange
+from ..compiled.kernels_se3 import SINCOS_MAX, nb_sincos
 from . import sps
 
 __all__ = [

@@ -6,14 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .kernels_se3 import (
-    nb_ball_product,
-    nb_det,
-    nb_inverse_into,
-    nb_log,
-    nb_mm4,
-    nb_svd,
-)
+from .kernels_se3 import nb_ball_product, nb_det, nb_inverse_into, nb_log, nb_mm4, nb_svd
 from .kernels_closure import (
     nb_adjoint_columns,
     nb_chain,

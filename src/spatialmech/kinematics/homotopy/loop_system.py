@@ -44,11 +44,12 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..errors import InputError
-from ..geometry.rotations import skew
-from ..model.mechanism import Mechanism
-from . import compiled, kernels_loops
-from .closure import Configuration, limb_slices
+from ...errors import InputError
+from ...geometry.rotations import skew
+from ...model.mechanism import Mechanism
+from .. import compiled
+from ..compiled import kernels_loops
+from ..closure import Configuration, limb_slices
 
 __all__ = [
     "LoopSystem",
@@ -400,7 +401,7 @@ def _rotation_forms(q: np.ndarray) -> np.ndarray:
 
 def _study_forms() -> np.ndarray:
     """``(e.e) D`` of the Study parameters as quadratic forms: (4, 4, 8, 8) symmetric."""
-    from .homotopy_systems import qmul
+    from .systems import qmul
 
     def nd(x):
         e, g = x[:4], x[4:]
@@ -621,7 +622,7 @@ def variables(sysm: LoopSystem, config: Configuration) -> np.ndarray:
     for h in sysm.studies:
         from scipy.spatial.transform import Rotation
 
-        from .homotopy_systems import qmul
+        from .systems import qmul
 
         H = config.hub(h.hub)
         x, y, zz, w = Rotation.from_matrix(H[:3, :3]).as_quat()
@@ -638,7 +639,7 @@ def _limb_ranks(sysm: LoopSystem, sizes: list[int], rng: np.random.Generator) ->
     rank of their derivative along the side equations' solution set (circles, Study quadric),
     the actuators held, at a generic
     configuration of the mechanism (a random walk from the reference along its closure)."""
-    from .closure import generic_configuration
+    from ..closure import generic_configuration
 
     try:
         config = generic_configuration(sysm.mech, seed=int(rng.integers(2**31)), step=0.5, steps=4)

@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..geometry.tolerances import BLOCK_MAX_COND, BLOCK_RANK_ZERO
+from ...geometry.tolerances import BLOCK_MAX_COND, BLOCK_RANK_ZERO
 from .jit import njit
 
 __all__ = [

@@ -37,10 +37,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError
-from ..geometry.tolerances import current as current_tolerances
-from ..model.mechanism import Mechanism
-from .closure import (
+from ...errors import InputError
+from ...geometry.tolerances import current as current_tolerances
+from ...model.mechanism import Mechanism
+from ..closure import (
     Chain,
     Configuration,
     CorrectionResult,
@@ -53,23 +53,9 @@ from .closure import (
 
 from .jit import AVAILABLE, UNAVAILABLE_REASON
 from .kernels_blocks import nb_blocks_workspace, nb_minnorm_blocks
-from .kernels_closure import (
-    RETRACT_WS,
-    nb_correct,
-    nb_correct_hyperplane,
-    nb_limb_gn,
-    nb_retract,
-    nb_systems,
-)
-from .kernels_drivers import (
-    nb_dets_many,
-    nb_difference,
-    nb_differences,
-    nb_sps_legs,
-)
-from .kernels_se3 import (
-    nb_lstsq,
-)
+from .kernels_closure import RETRACT_WS, nb_correct, nb_correct_hyperplane, nb_limb_gn, nb_retract, nb_systems
+from .kernels_drivers import nb_dets_many, nb_difference, nb_differences, nb_sps_legs
+from .kernels_se3 import nb_lstsq
 
 
 
@@ -671,9 +657,9 @@ def warm_up() -> float:
     seconds it took (the first-call cost a user pays once per process)."""
     import time
 
-    from ..model.joints import P, R, S
-    from ..model.mechanism import Limb  # here, not at the top: only the warm-up builds a model
-    from .closure import correct as closure_correct  # the dispatching entry: it takes the legs' path
+    from ...model.joints import P, R, S
+    from ...model.mechanism import Limb  # here, not at the top: only the warm-up builds a model
+    from ..closure import correct as closure_correct  # the dispatching entry: it takes the legs' path
 
     t0 = time.perf_counter()
     z = [0.0, 0.0, 1.0]

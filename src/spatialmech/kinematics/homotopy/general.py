@@ -36,9 +36,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError
-from ..geometry.rotations import matrix_rotvec, skew
-from ..geometry.tolerances import (
+from ...errors import InputError
+from ...geometry.rotations import matrix_rotvec, skew
+from ...geometry.tolerances import (
     HOMOTOPY_INFINITY,
     HOMOTOPY_REAL,
     HOMOTOPY_SINGULAR,
@@ -53,10 +53,10 @@ from ..geometry.tolerances import (
     TRACE_MAX_WORK_FULL,
     TRACE_TOL,
 )
-from ..model.mechanism import Mechanism
-from .closure import Configuration, limb_slices
+from ...model.mechanism import Mechanism
+from ..closure import Configuration, limb_slices
 from .endgame import cauchy_endgame
-from .homotopy import study_to_pose, track
+from .study import study_to_pose, track
 from .loop_system import LoopSystem, general_reason, loop_system, variables
 from .trace_test import TraceResult, new_points, trace_test
 
@@ -563,7 +563,7 @@ def rebuild_configuration(sysm: LoopSystem, x: np.ndarray, targets: dict[int, fl
         hub[h.hub] = M
     slices = limb_slices(mech)
     chains = {}
-    from .closure import limb_chains
+    from ..closure import limb_chains
 
     for ch, sl in zip(limb_chains(mech), slices, strict=True):
         for first, _, axes in ch.balls:

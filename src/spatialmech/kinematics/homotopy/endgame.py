@@ -30,7 +30,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ..geometry.tolerances import (
+from ...geometry.tolerances import (
     ENDGAME_AGREE,
     ENDGAME_CLOSED,
     ENDGAME_LOOPS,

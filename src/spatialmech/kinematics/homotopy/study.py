@@ -47,8 +47,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError
-from ..geometry.tolerances import (
+from ...errors import InputError
+from ...geometry.tolerances import (
     HOMOTOPY_INFINITY,
     HOMOTOPY_JUMP,
     HOMOTOPY_NEAR_REAL,
@@ -56,10 +56,10 @@ from ..geometry.tolerances import (
     HOMOTOPY_REAL,
     HOMOTOPY_SINGULAR,
 )
-from ..model.mechanism import Mechanism
-from . import compiled
+from ...model.mechanism import Mechanism
+from .. import compiled
 from .endgame import cauchy_endgame, local_dimension
-from .homotopy_systems import (
+from .systems import (
     PoseSystem,
     StewartSystem,
     geometry_family,
@@ -69,7 +69,7 @@ from .homotopy_systems import (
     system_from_points,
     unsupported_reason,
 )
-from .jit import njit
+from ..compiled.jit import njit
 
 __all__ = [
     "HomotopyResult",

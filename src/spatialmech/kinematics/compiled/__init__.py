@@ -1,0 +1,70 @@
+"""The compiled engine (numba).
+
+:mod:`.engine` holds the compiled model and the Python entry points (the same computations as
+the Python reference in :mod:`spatialmech.kinematics.closure` and the modules that use it);
+the kernels are plain-array ``@njit(cache=True)`` functions in :mod:`.kernels_se3`,
+:mod:`.kernels_closure`, :mod:`.kernels_blocks`, :mod:`.kernels_drivers`, :mod:`.kernels_legs`
+and :mod:`.kernels_loops`; :mod:`.jit` is numba's ``njit`` or its stand-in.
+
+Callers do not choose between this package and the Python reference themselves:
+:mod:`spatialmech.kinematics.backend` does (``backend.engine()`` is this package when it is in
+use, else ``None``).  This package imports the Python reference (its data types, chains and
+checks); the reference never imports this package.
+"""
+
+from __future__ import annotations
+
+from .engine import (
+    CompiledMechanism,
+    closure_jacobian,
+    closure_jacobians,
+    closure_residual,
+    closure_residuals,
+    compile_mechanism,
+    config_difference,
+    config_differences,
+    correct,
+    correct_many,
+    correct_on_hyperplane,
+    driver_determinants,
+    driver_determinants_many,
+    limb_gn,
+    limb_inverse_many,
+    enabled,
+    lstsq,
+    minnorm_blocks,
+    python_reference,
+    PURE_ENV,
+    retract,
+    sps_leg_lengths,
+    warm_up,
+)
+from .jit import AVAILABLE, UNAVAILABLE_REASON
+
+__all__ = [
+    "AVAILABLE",
+    "UNAVAILABLE_REASON",
+    "CompiledMechanism",
+    "closure_jacobian",
+    "closure_jacobians",
+    "closure_residual",
+    "closure_residuals",
+    "compile_mechanism",
+    "config_difference",
+    "config_differences",
+    "correct",
+    "correct_many",
+    "correct_on_hyperplane",
+    "driver_determinants",
+    "driver_determinants_many",
+    "limb_gn",
+    "limb_inverse_many",
+    "enabled",
+    "lstsq",
+    "minnorm_blocks",
+    "python_reference",
+    "PURE_ENV",
+    "retract",
+    "sps_leg_lengths",
+    "warm_up",
+]
