@@ -20,7 +20,8 @@ import numpy as np
 
 import spatialmech as sm
 from spatialmech.kinematics.homotopy import general as hg
-from spatialmech.kinematics.closure import Configuration, closure_residual
+from spatialmech.kinematics.closure import Configuration
+from spatialmech.kinematics.backend import closure_residual
 
 
 def six_r() -> sm.Mechanism:

@@ -26,16 +26,14 @@ from ..serialize import freedom_values_dict, pose_dict
 from .closure import (
     Configuration,
     active_mask,
-    closure_jacobian,
     closure_scales,
-    correct,
-    generic_configuration,
     hub_displacements,
-    joint_twists,
     limb_chains,
     limb_slices,
     placed_configuration,
 )
+from .backend import closure_jacobian, correct, joint_twists
+from .motion import generic_configuration
 from .assembly import (
     AssemblyKind,
     Conditioning,

@@ -34,7 +34,8 @@ from scipy.optimize import minimize_scalar
 
 from ..errors import InputError
 from ..geometry.rotations import rotation_angle
-from ..kinematics.closure import Configuration, correct
+from ..kinematics.closure import Configuration
+from ..kinematics.backend import correct
 from ..model.joints import C as Cjoint
 from ..model.joints import R as Rjoint
 from ..model.mechanism import Limb, Mechanism, Pose

@@ -47,8 +47,7 @@ import numpy as np
 from ...errors import InputError
 from ...geometry.rotations import skew
 from ...model.mechanism import Mechanism
-from .. import compiled
-from ..compiled import kernels_loops
+from .. import backend
 from ..closure import Configuration, limb_slices
 
 __all__ = [
@@ -353,12 +352,12 @@ class LoopSystem:
         when the compiled core is in use and not ``reference``."""
         if W is None:
             W = self.identity_offsets(len(Z))
-        if not reference and compiled.enabled():
+        if not reference and (fast := backend.engine()) is not None:
             packed = _PACKED.get(self)
             if packed is None:
-                packed = _PACKED[self] = kernels_loops.pack(self, _STUDY_Q)
-            return kernels_loops.square_batch(np.ascontiguousarray(Z, dtype=np.complex128),
-                                              np.ascontiguousarray(W, dtype=np.complex128), want_J, *packed)
+                packed = _PACKED[self] = fast.pack_loop_system(self, _STUDY_Q)
+            return fast.loop_square_batch(np.ascontiguousarray(Z, dtype=np.complex128),
+                                          np.ascontiguousarray(W, dtype=np.complex128), want_J, *packed)
         F1, J1 = self.side(Z)
         F2, J2 = self.closure(Z, W=W)
         F = np.concatenate([F1, np.einsum("mr,nr->nm", self.compress, F2)], axis=1)
@@ -639,7 +638,7 @@ def _limb_ranks(sysm: LoopSystem, sizes: list[int], rng: np.random.Generator) ->
     rank of their derivative along the side equations' solution set (circles, Study quadric),
     the actuators held, at a generic
     configuration of the mechanism (a random walk from the reference along its closure)."""
-    from ..closure import generic_configuration
+    from ..motion import generic_configuration
 
     try:
         config = generic_configuration(sysm.mech, seed=int(rng.integers(2**31)), step=0.5, steps=4)
