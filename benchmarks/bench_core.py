@@ -1,4 +1,4 @@
-"""Benchmark: the compiled core (kinematics/compiled.py) against baselines measured in the same
+"""Benchmark: the compiled core (kinematics/compiled/, switched by kinematics/backend.py) against baselines measured in the same
 run, with the targets of the compiled-core issue.
 
     python benchmarks/bench_core.py [--json] [--quick]

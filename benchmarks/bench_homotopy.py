@@ -1,4 +1,4 @@
-"""Benchmark: forward position by homotopy continuation (kinematics/homotopy.py) against
+"""Benchmark: forward position by homotopy continuation (kinematics/homotopy/study.py) against
 PHCpack's blackbox solver on the same polynomial system, measured in the same run.
 
     python benchmarks/bench_homotopy.py [--json] [--quick]

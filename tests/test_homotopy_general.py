@@ -1,4 +1,4 @@
-"""The loop formulation (kinematics/homotopy_general.py): models whose limbs do not reduce to
+"""The loop formulation (kinematics/homotopy/general.py): models whose limbs do not reduce to
 quadrics in the Study parameters, solved by monodromy; checked against closed forms, the
 multi-start search and the full closure."""
 

@@ -1,4 +1,4 @@
-"""The block-elimination Newton step (kinematics/kernels_blocks.py) is lstsq's minimum-norm step,
+"""The block-elimination Newton step (kinematics/compiled/kernels_blocks.py) is lstsq's minimum-norm step,
 or declines; and the compiled forward solve that uses it still equals the Python reference."""
 
 from __future__ import annotations

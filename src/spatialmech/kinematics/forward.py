@@ -351,7 +351,7 @@ def forward_position(
     if method not in ("multistart", "homotopy", "auto"):
         raise InputError(f"method: expected 'multistart', 'homotopy' or 'auto', got {method!r}")
     targets = _actuator_q(mech, actuator_values)
-    gwhy: str | None = None  # why the loop formulation (homotopy_general) does not cover the model
+    gwhy: str | None = None  # why the loop formulation (homotopy/general.py) does not cover the model
     if all_solutions and method != "multistart":
         from .homotopy import study as hc
 
@@ -570,7 +570,7 @@ def _forward_general(mech: Mechanism, targets: dict[int, float], seed: int, max_
                      n_seeds: int = 200, fallback: bool = False) -> ForwardResult | None:
     """``forward_position(..., method="homotopy")`` on a model whose limbs do not reduce to the
     Study-parameter quadrics: the loop formulation in joint variables solved by monodromy
-    (:mod:`.homotopy_general`); each real end point is a configuration, polished by the same
+    (:mod:`.homotopy.general`); each real end point is a configuration, polished by the same
     Newton step and grouped as the multi-start roots.  ``complete`` when the trace test of the
     generic solutions passed and every path to the request is accounted for."""
     from .homotopy import general as hg

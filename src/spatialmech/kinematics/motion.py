@@ -5,7 +5,7 @@ This is **not** the continuation tracker (:mod:`.tracking`): it does no driver-c
 tracking, no branch or singularity handling and no step-size control beyond halving a failed
 step.  It exists so that the viewer (:mod:`spatialmech.present.viewer`, which only draws) has
 something honest to animate for any model: every configuration it returns satisfies the closure
-equations of :mod:`.closure` (checked by :func:`.closure.correct`), and the viewer accepts any
+equations of :mod:`.closure` (checked by :func:`.backend.correct`), and the viewer accepts any
 list of :class:`~.closure.Configuration` so that tracked paths can be shown the same way (the
 circuit of a one-degree-of-freedom linkage: :func:`spatialmech.analysis.traced_motion.traced_motion`).
 
@@ -24,7 +24,7 @@ flips), scaled so that its platform part ``(w ; v / L)`` has unit norm: the walk
 Frame ``i`` of ``n`` sits at ``s_i = amplitude * sin(2 pi i / n)``: from the start out to
 ``+amplitude``, back through the start to ``-amplitude`` and back.  Configurations are computed
 once per distinct ``s`` by predictor (``x + ds t``) and Newton corrector
-(:func:`~.closure.correct`), walking outwards from the start on each side, so the
+(:func:`~.backend.correct`), walking outwards from the start on each side, so the
 loop closes exactly (frame ``i`` and frame ``n/2 - i`` are the same configuration).
 """
 
@@ -56,7 +56,7 @@ def tangent_space(mech: Mechanism, config: Configuration, *, active: np.ndarray 
     Returns ``N`` (k, n_active + 6): rows span the null space of the nondimensional closure
     Jacobian, in nondimensional coordinates (joint rotations in rad, slides / L, platform twist
     ``(w ; v / L)``, the last six columns).  Multiply by the column scaling of
-    :func:`.closure.correct` to get SI steps.
+    :func:`.backend.correct` to get SI steps.
     """
     if active is None:
         active = active_mask(mech)

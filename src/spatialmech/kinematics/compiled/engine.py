@@ -325,7 +325,7 @@ def _shapes(mech: Mechanism, cm: CompiledMechanism, config: Configuration) -> No
 
 def correct(mech: Mechanism, config: Configuration, *, active: np.ndarray | None = None, fix_platform: bool = False,
             tol: float | None = None, max_iter: int = 50) -> CorrectionResult:
-    """:func:`.closure.correct`, compiled (same steps, tolerances and statuses)."""
+    """:func:`..closure.correct`, compiled (same steps, tolerances and statuses)."""
     cm = compile_mechanism(mech)
     _shapes(mech, cm, config)
     act = _mask(mech, cm, active)

@@ -1,6 +1,6 @@
 """Compiled kernels of the driver determinants (:func:`.jacobian.driver_determinants`,
 :func:`.jacobian.closure_determinant`), the tracker's configuration difference and the S-P-S
-leg lengths (:mod:`.compiled`)."""
+leg lengths (:mod:`.engine`)."""
 
 from __future__ import annotations
 

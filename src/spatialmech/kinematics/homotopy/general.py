@@ -1,5 +1,5 @@
 """Every assembly mode of a model whose limbs do not reduce to quadrics in the Study parameters
-(:mod:`.homotopy_systems`): the loop formulation of :mod:`.loop_system` (joint variables,
+(:mod:`.systems`): the loop formulation of :mod:`.loop_system` (joint variables,
 generated from the model; link-and-joint graphs with internal bodies included, each body's
 displacement the product of a reference limb or its own Study parameters) solved by monodromy
 and a parameter homotopy.  A real solution becomes a :class:`Configuration` with its bodies
@@ -25,7 +25,7 @@ the line from ``P0`` through a fresh start pair) then proves the generic solutio
 says why not, and ``complete`` is true only when it passed.  A parameter homotopy along the
 straight segment from ``P0`` to the request (actuators given, no offsets) then tracks every
 known solution, with the NumPy tracker
-:func:`.homotopy.track` and the compiled square system (:mod:`.kernels_loops`).  The generic
+:func:`.study.track` and the compiled square system (``compiled/kernels_loops.py``).  The generic
 solve is cached per geometry (in memory).
 """
 

@@ -1,4 +1,4 @@
-"""The loop formulation of the forward position (:mod:`.homotopy_general`): the closure of a
+"""The loop formulation of the forward position (:mod:`.general`): the closure of a
 model whose limbs do not reduce to quadrics in the Study parameters, as a square polynomial
 system in the joint variables, generated from the model.
 
@@ -14,7 +14,7 @@ a limb runs from hub ``a`` to hub ``b`` and closes as ``H_a FK = H_b``.  Each mo
 displacement is, in turn, the product of a limb without S joint (the one with the fewest
 unknowns) from a hub placed before it (a *reference limb*; its factors inverted in reverse order
 when the limb runs towards the placed hub), or, where no such limb reaches it, its own Study
-parameters ``x = (e ; g)`` of :mod:`.homotopy` (``(e.e) H`` polynomial, with ``e.g = 0`` and a
+parameters ``x = (e ; g)`` of :mod:`.study` (``(e.e) H`` polynomial, with ``e.g = 0`` and a
 random complex patch).  Without bodies this is the platform's reference limb, or the platform in
 Study parameters when every limb has an S joint.  Each other limb gives (``H_a`` multiplying
 the side before its S joints, ``H_b`` the side after, each side times the other's scale):
@@ -348,7 +348,7 @@ class LoopSystem:
 
     def square(self, Z, W=None, *, reference: bool = False, want_J: bool = True):
         """The square system ``G`` (n, nx) and its derivative (n, nx, nz) in ``z = (x ; p)``,
-        with the offset parameters ``W`` (n, nw; default none): compiled (:mod:`.kernels_loops`)
+        with the offset parameters ``W`` (n, nw; default none): compiled (``compiled/kernels_loops.py``)
         when the compiled core is in use and not ``reference``."""
         if W is None:
             W = self.identity_offsets(len(Z))

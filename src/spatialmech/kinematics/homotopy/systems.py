@@ -1,4 +1,4 @@
-"""The polynomial systems of the homotopy forward position (:mod:`.homotopy`): each limb of a
+"""The polynomial systems of the homotopy forward position (:mod:`.study`): each limb of a
 platform, with the actuator values given, as quadrics in the Study parameters ``x = (e ; g)``
 of the platform displacement.
 
