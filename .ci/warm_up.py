@@ -27,7 +27,7 @@ def part0() -> None:
 def part1() -> None:
     import spatialmech as sm
     from spatialmech import catalog
-    from spatialmech.kinematics import homotopy as hc
+    from spatialmech.kinematics.homotopy import study as hc
     from spatialmech.kinematics.closed_forms import four_sps_cu as k4
     from spatialmech.synthesis import cs_dyads
 

@@ -25,7 +25,7 @@ import time
 
 import numpy as np
 
-from spatialmech.kinematics import homotopy as hc
+from spatialmech.kinematics.homotopy import study as hc
 
 
 def score(sysm, v) -> tuple[float, int]:

@@ -1,4 +1,4 @@
-"""Benchmark: the compiled core (kinematics/compiled.py) against baselines measured in the same
+"""Benchmark: the compiled core (kinematics/compiled/, switched by kinematics/backend.py) against baselines measured in the same
 run, with the targets of the compiled-core issue.
 
     python benchmarks/bench_core.py [--json] [--quick]
@@ -45,8 +45,10 @@ from scipy.optimize import root
 from spatialmech import catalog
 from spatialmech.analysis.defects import candidate_drivers
 from spatialmech.analysis.workspace.checker import pose_checker
-from spatialmech.kinematics import compiled
-from spatialmech.kinematics.closure import Configuration, active_mask, correct, generic_configuration
+from spatialmech.kinematics import backend, compiled
+from spatialmech.kinematics.closure import Configuration, active_mask
+from spatialmech.kinematics.backend import correct
+from spatialmech.kinematics.motion import generic_configuration
 from spatialmech.kinematics.jacobian import driver_determinants
 from spatialmech.kinematics.position import configuration_at_pose, platform_pose
 from spatialmech.kinematics.tracking import trace_motion
@@ -62,7 +64,7 @@ TARGETS = {
 }
 
 
-pure = compiled.python_reference
+pure = backend.python_reference
 
 
 def best_time(fn, repeat: int, number: int) -> float:
@@ -361,7 +363,7 @@ def main(argv=None) -> dict:
     ap.add_argument("--json", action="store_true", help="print the results as JSON")
     ap.add_argument("--quick", action="store_true", help="tiny sizes (a smoke test; the targets mean nothing then)")
     args = ap.parse_args(argv)
-    if not compiled.enabled():
+    if not backend.enabled():
         raise SystemExit("the compiled core is not in use (numba missing or SPATIALMECH_PURE set)")
     out: dict = {"quick": bool(args.quick)}
     out.update(bench_fk(args.quick))

@@ -1,4 +1,4 @@
-"""Benchmark: forward position by homotopy continuation (kinematics/homotopy.py) against
+"""Benchmark: forward position by homotopy continuation (kinematics/homotopy/study.py) against
 PHCpack's blackbox solver on the same polynomial system, measured in the same run.
 
     python benchmarks/bench_homotopy.py [--json] [--quick]
@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from spatialmech import catalog
-from spatialmech.kinematics import homotopy as hc
+from spatialmech.kinematics.homotopy import study as hc
 
 TARGET_FIRST_S = 2.0
 TARGET_RESOLVE_MS = 50.0

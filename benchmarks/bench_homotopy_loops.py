@@ -1,4 +1,4 @@
-"""Benchmark: the loop formulation of the forward position (kinematics/homotopy_general.py) by
+"""Benchmark: the loop formulation of the forward position (kinematics/homotopy/general.py) by
 monodromy, on models the Study reductions do not cover.
 
     python benchmarks/bench_homotopy_loops.py [--json] [--quick]
@@ -7,7 +7,7 @@ Cases: rssr, planar-4r and bennett at an input angle (first solve, including the
 (unless --quick) a general 6R loop: one limb of six R joints with seeded random axes, the
 platform held by a locked joint, no actuator -- the inverse kinematics of a general 6R arm, whose
 published count is 16 complex solutions.  Every real solution is checked against the closure;
-each case prints the trace test's verdict (kinematics/trace_test.py) and whether the set is proven.
+each case prints the trace test's verdict (kinematics/homotopy/trace_test.py) and whether the set is proven.
 """
 
 from __future__ import annotations
@@ -19,8 +19,9 @@ import time
 import numpy as np
 
 import spatialmech as sm
-from spatialmech.kinematics import homotopy_general as hg
-from spatialmech.kinematics.closure import Configuration, closure_residual
+from spatialmech.kinematics.homotopy import general as hg
+from spatialmech.kinematics.closure import Configuration
+from spatialmech.kinematics.backend import closure_residual
 
 
 def six_r() -> sm.Mechanism:

@@ -21,7 +21,8 @@ from scipy.optimize import root
 from spatialmech import catalog
 from spatialmech.analysis.defects import candidate_drivers
 from spatialmech.geometry.rotations import exp_twist
-from spatialmech.kinematics.closure import Configuration, active_mask, closure_residual
+from spatialmech.kinematics.closure import Configuration, active_mask
+from spatialmech.kinematics.backend import closure_residual
 from spatialmech.kinematics.jacobian import driver_determinants
 from spatialmech.kinematics.position import configuration_at_pose
 from spatialmech.kinematics.tracking import trace_motion

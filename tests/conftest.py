@@ -30,7 +30,7 @@ def _lock_numba_cache_saves() -> None:
         import fcntl
 
         from numba.core import caching
-    except ImportError:  # no numba (pure-Python fallback of kinematics/jit.py) or no fcntl
+    except ImportError:  # no numba (pure-Python fallback of kinematics/compiled/jit.py) or no fcntl
         return
     save = getattr(getattr(caching, "IndexDataCacheFile", None), "save", None)
     if save is None or getattr(save, "spatialmech_locked", False):  # another numba layout: leave it alone

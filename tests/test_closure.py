@@ -5,15 +5,9 @@ import pytest
 
 from spatialmech import catalog
 from spatialmech.geometry.rotations import exp_twist, inverse_transform, log_transform
-from spatialmech.kinematics.closure import (
-    Configuration,
-    closure_residual,
-    correct,
-    generic_configuration,
-    limb_forward,
-    limb_slices,
-    reference_screws,
-)
+from spatialmech.kinematics.closure import Configuration, limb_forward, limb_slices, reference_screws
+from spatialmech.kinematics.backend import closure_residual, correct
+from spatialmech.kinematics.motion import generic_configuration
 
 
 @pytest.mark.parametrize("name", ["stewart-6sps", "five-cs-1", "bennett", "three-upu"])

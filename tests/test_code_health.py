@@ -120,7 +120,7 @@ def kernel_names(sources: list[str]) -> set[str]:
 def literal_kernel_arguments(source: str, kernels: set[str]) -> list[str]:
     """``line: call`` for each call, inside a kernel, of another kernel with a bare ``True``,
     ``False`` or integer argument: numba types it as a literal and compiles a separate copy of the
-    callee (kinematics/jit.py).  A call marked as deliberate (``LITERAL_ON_PURPOSE`` in a comment
+    callee (kinematics/compiled/jit.py).  A call marked as deliberate (``LITERAL_ON_PURPOSE`` in a comment
     on its line or the lines above it) is allowed."""
     lines = source.splitlines()
     found = []

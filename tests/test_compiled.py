@@ -21,19 +21,12 @@ from spatialmech import catalog
 from spatialmech.analysis.defects import candidate_drivers
 from spatialmech.errors import InputError
 from spatialmech.geometry.rotations import exp_twist
-from spatialmech.kinematics import compiled
-from spatialmech.kinematics import kernels_se3
+from spatialmech.kinematics import backend, compiled
+from spatialmech.kinematics.compiled import kernels_se3
 from spatialmech.kinematics.closed_forms import four_sps_cu
-from spatialmech.kinematics.closure import (
-    Configuration,
-    active_mask,
-    closure_jacobian,
-    closure_residual,
-    correct,
-    generic_configuration,
-    hub_count,
-    retract,
-)
+from spatialmech.kinematics.closure import Configuration, active_mask, hub_count
+from spatialmech.kinematics.backend import closure_jacobian, closure_residual, correct, retract
+from spatialmech.kinematics.motion import generic_configuration
 from spatialmech.kinematics.jacobian import driver_determinants
 from spatialmech.kinematics.position import inverse_position, platform_pose
 from spatialmech.kinematics.tracking import MotionProblem, trace_motion
@@ -42,7 +35,7 @@ NAMES = catalog.names()
 ONE_DOF = ["five-cs-1", "five-cs-2", "five-cs-3", "planar-4r", "bennett", "rssr", "spatial-six-bar"]
 
 
-pure = compiled.python_reference
+pure = backend.python_reference
 
 
 _GENERIC: dict[str, Configuration] = {}
@@ -70,10 +63,10 @@ def close(a, b, tol):
 
 
 def test_the_compiled_path_is_on_by_default_and_pure_switches_it_off():
-    assert compiled.enabled()
+    assert backend.enabled()
     with pure():
-        assert not compiled.enabled()
-    assert compiled.enabled()
+        assert not backend.enabled()
+    assert backend.enabled()
 
 
 @pytest.mark.parametrize("name", NAMES)
@@ -289,13 +282,13 @@ def test_batched_4sps_cu_legs_on_all_cores_equal_the_reference():
     big = four_sps_cu.leg_lengths(phi)
     one = np.concatenate([four_sps_cu.leg_lengths(phi[i:i + 1000]) for i in range(0, n, 1000)])
     assert np.array_equal(big, one)
-    with compiled.python_reference():
+    with backend.python_reference():
         ref = four_sps_cu.leg_lengths(phi)
     close(big, ref, 1e-14)
     # angles beyond the polynomial sine's range are redone with libm's, on both kernels
     phi[::97, 2] += 3e6
     for part in (phi, phi[:500]):
-        with compiled.python_reference():
+        with backend.python_reference():
             ref = four_sps_cu.leg_lengths(part)
         close(four_sps_cu.leg_lengths(part), ref, 1e-14)
 
@@ -314,7 +307,7 @@ def test_vectorisable_sine_cosine_equals_libm(x, k, eps):
 def test_without_numba_the_python_path_runs_with_a_note(monkeypatch):
     monkeypatch.setattr(compiled, "AVAILABLE", False)
     with pytest.warns(RuntimeWarning, match="numba"):
-        assert not compiled.enabled()
+        assert not backend.enabled()
     mech = catalog.build("rssr")
     assert np.allclose(closure_residual(mech, Configuration.reference(mech)), 0, atol=1e-12)
 
@@ -370,7 +363,7 @@ def test_nearest_rotation_without_the_svd_equals_the_svd():
     rounding, by the SVD otherwise: both give the polar factor ``U Vt``."""
     from scipy.spatial.transform import Rotation
 
-    from spatialmech.kinematics.kernels_se3 import nb_orthonormal
+    from spatialmech.kinematics.compiled.kernels_se3 import nb_orthonormal
 
     rng = np.random.default_rng(5)
     for _ in range(200):
@@ -454,7 +447,7 @@ def test_core_benchmark_runs_and_reports_every_target(capsys):
 def test_joint_twists_match_the_reference(name):
     """Joint twists (the complete Jacobian's and the viewer's input) from the compiled closure
     Jacobian equal the Python chains', locked freedoms included."""
-    from spatialmech.kinematics.closure import joint_twists
+    from spatialmech.kinematics.backend import joint_twists
 
     mech = catalog.build(name)
     config = generic(name)
@@ -473,7 +466,7 @@ def test_a_kernel_compiled_on_first_use_is_announced_and_a_cached_one_is_not():
 
     from numba import njit
 
-    from spatialmech.kinematics.jit import announce_compilation
+    from spatialmech.kinematics.compiled.jit import announce_compilation
 
     @njit(cache=False)
     def inner_kernel_for_the_notice(x):

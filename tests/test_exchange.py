@@ -23,7 +23,8 @@ from spatialmech.exchange import body_tree, export_model, format_of, from_mjcf, 
 from spatialmech.exchange.urdf import DRAKE_NS, SPATIALMECH_NS
 from spatialmech.geometry.rotations import rotation_angle
 from spatialmech.interfaces.cli import cli
-from spatialmech.kinematics.closure import closure_residual, generic_configuration
+from spatialmech.kinematics.backend import closure_residual
+from spatialmech.kinematics.motion import generic_configuration
 from spatialmech.kinematics.position import platform_pose
 from spatialmech.model import C, H, Limb, Mechanism, P, R, S, U
 from spatialmech.model.topology import link_graph, spanning_tree

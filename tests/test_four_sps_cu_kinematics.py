@@ -21,7 +21,8 @@ from spatialmech.geometry.rotations import euler_matrix, skew
 from spatialmech.kinematics.closed_forms import four_sps_cu as k
 from spatialmech.kinematics.closed_forms import four_sps_cu_forward as kf
 from spatialmech.kinematics.closed_forms import sps
-from spatialmech.kinematics.closure import Configuration, correct
+from spatialmech.kinematics.closure import Configuration
+from spatialmech.kinematics.backend import correct
 from spatialmech.model.mechanism import Pose
 
 A, B = k.PAPER_B.a, k.PAPER_B.b

@@ -12,14 +12,9 @@ from hypothesis import strategies as st
 import spatialmech as sm
 from spatialmech import catalog
 from spatialmech.errors import InputError
-from spatialmech.kinematics.closure import (
-    Configuration,
-    closure_jacobian,
-    closure_residual,
-    generic_configuration,
-    placed_configuration,
-    retract,
-)
+from spatialmech.kinematics.closure import Configuration, placed_configuration
+from spatialmech.kinematics.backend import closure_jacobian, closure_residual, retract
+from spatialmech.kinematics.motion import generic_configuration
 from spatialmech.kinematics.jacobian import complete_jacobian
 from spatialmech.kinematics.position import inverse_position, platform_pose
 from spatialmech.kinematics.forward import forward_position

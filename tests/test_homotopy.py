@@ -15,7 +15,7 @@ from scipy.spatial.transform import Rotation
 import spatialmech as sm
 from spatialmech import catalog
 from spatialmech.interfaces.cli import cli as main
-from spatialmech.kinematics import homotopy as hc
+from spatialmech.kinematics.homotopy import study as hc
 from spatialmech.kinematics.forward import forward_position
 
 
@@ -189,13 +189,13 @@ def test_homotopy_benchmark_runs_and_reports_its_targets():
 def test_compiled_parameter_tracker_equals_the_numpy_reference(name):
     """The compiled path-by-path parameter homotopy ends where the batched NumPy tracker does:
     the same end points (every complex one, to 1e-8) and the same statuses."""
-    from spatialmech.kinematics import compiled
+    from spatialmech.kinematics import backend
 
     mech = catalog.resolve(name)
     sysm = hc.stewart_system(mech)
     vals = [1.21, 1.19, 1.2, 1.22, 1.18, 1.2] if name == "stewart-6sps" else [0.25, 0.24, 0.26, 0.245]
     fast = hc.homotopy_forward(sysm, vals)
-    with compiled.python_reference():
+    with backend.python_reference():
         ref = hc.homotopy_forward(sysm, vals)
     assert [s.status for s in fast.solutions] == [s.status for s in ref.solutions]
     for a, b in zip(fast.solutions, ref.solutions, strict=True):
@@ -266,7 +266,7 @@ def test_delta_two_translational_modes_among_the_40():
 def test_reduced_quadrics_vanish_on_closed_configurations():
     """Each limb's quadrics hold at assembled configurations away from the reference (random
     walks along the closure manifold), with the actuator values read from them."""
-    from spatialmech.kinematics.closure import generic_configuration
+    from spatialmech.kinematics.motion import generic_configuration
 
     for name in ("three-prs", "three-upu", "delta"):
         mech = catalog.resolve(name)
@@ -285,11 +285,11 @@ def test_reduced_quadrics_vanish_on_closed_configurations():
 
 
 def test_compiled_coefficient_tracker_equals_the_numpy_reference_on_the_delta():
-    from spatialmech.kinematics import compiled
+    from spatialmech.kinematics import backend
 
     sysm = hc.pose_system(catalog.resolve("delta"))
     fast = hc.homotopy_forward(sysm, [0.3, -0.2, 0.5])
-    with compiled.python_reference():
+    with backend.python_reference():
         ref = hc.homotopy_forward(sysm, [0.3, -0.2, 0.5])
     assert [s.status for s in fast.solutions] == [s.status for s in ref.solutions]
     for a, b in zip(fast.solutions, ref.solutions, strict=True):
@@ -401,7 +401,7 @@ def test_a_double_root_is_located_by_the_cauchy_end_game_and_proven_complete(gen
 
 
 def test_local_dimension_tells_a_multiple_root_from_a_continuum():
-    from spatialmech.kinematics.endgame import local_dimension
+    from spatialmech.kinematics.homotopy.endgame import local_dimension
 
     def ev(F):
         def evaluate(Y):

@@ -1,4 +1,4 @@
-"""The loop formulation (kinematics/homotopy_general.py): models whose limbs do not reduce to
+"""The loop formulation (kinematics/homotopy/general.py): models whose limbs do not reduce to
 quadrics in the Study parameters, solved by monodromy; checked against closed forms, the
 multi-start search and the full closure."""
 
@@ -12,8 +12,9 @@ from click.testing import CliRunner
 
 import spatialmech as sm
 from spatialmech.interfaces.cli import cli as main
-from spatialmech.kinematics import homotopy_general as hg
-from spatialmech.kinematics.closure import Configuration, closure_residual
+from spatialmech.kinematics.homotopy import general as hg
+from spatialmech.kinematics.closure import Configuration
+from spatialmech.kinematics.backend import closure_residual
 from spatialmech.kinematics.forward import forward_position
 
 
@@ -118,7 +119,7 @@ def test_bennett_overconstrained_spurious_points_discarded_and_multistart_agrees
 def test_loop_equations_vanish_on_closed_configurations(rssr):
     """The formulation's equations (square and full) are zero at closed configurations, and the
     configuration rebuilt from a solution's variables closes the mechanism."""
-    from spatialmech.kinematics.closure import generic_configuration
+    from spatialmech.kinematics.motion import generic_configuration
 
     for name in ("rssr", "bennett", "five-cs-3", "three-rrr-sm"):
         m = sm.load_model(name)
@@ -170,7 +171,7 @@ def test_configuration_of_a_point_limb_and_a_study_platform():
     m = sm.load_model("five-cs-3")
     sysm = hg.loop_system(m)
     assert sysm.study >= 0 and {le.kind for le in sysm.limbs} == {"point"}
-    from spatialmech.kinematics.closure import generic_configuration
+    from spatialmech.kinematics.motion import generic_configuration
 
     c = generic_configuration(m, seed=2, step=0.3, steps=3)
     z = hg.variables(sysm, c)
@@ -349,7 +350,7 @@ def test_hub_equations_vanish_and_rebuild_the_bodies(name):
     between any two hubs): the equations vanish at a closed configuration, their derivative
     matches finite differences, the compiled system equals the NumPy reference, and the
     variables rebuild the configuration, bodies included."""
-    from spatialmech.kinematics.closure import generic_configuration
+    from spatialmech.kinematics.motion import generic_configuration
 
     m = _cs_body() if name == "cs-body" else sm.load_model(name)
     sysm = hg.loop_system(m)

@@ -5,7 +5,9 @@ import pytest
 
 from spatialmech import catalog
 from spatialmech.geometry.rotations import inverse_transform, log_transform
-from spatialmech.kinematics.closure import Configuration, active_mask, closure_jacobian, correct, generic_configuration
+from spatialmech.kinematics.closure import Configuration, active_mask
+from spatialmech.kinematics.backend import closure_jacobian, correct
+from spatialmech.kinematics.motion import generic_configuration
 from spatialmech.kinematics.jacobian import complete_jacobian
 from spatialmech.kinematics.position import configuration_at_pose
 
@@ -35,7 +37,7 @@ def test_complete_jacobian_against_finite_motion():
     c0 = generic_configuration(mech, seed=1)
     t = _tangent(mech, c0)
     h = 1e-6
-    from spatialmech.kinematics.closure import retract
+    from spatialmech.kinematics.backend import retract
     c1 = correct(mech, retract(mech, c0, active_mask(mech), h * t)).config
     V = log_transform(c1.D @ inverse_transform(c0.D)) / h
     dq = (c1.q - c0.q) / h

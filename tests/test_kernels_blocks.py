@@ -1,4 +1,4 @@
-"""The block-elimination Newton step (kinematics/kernels_blocks.py) is lstsq's minimum-norm step,
+"""The block-elimination Newton step (kinematics/compiled/kernels_blocks.py) is lstsq's minimum-norm step,
 or declines; and the compiled forward solve that uses it still equals the Python reference."""
 
 from __future__ import annotations
@@ -9,8 +9,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from spatialmech import catalog
-from spatialmech.kinematics import compiled
-from spatialmech.kinematics.closure import Configuration, active_mask, correct, generic_configuration
+from spatialmech.kinematics import backend, compiled
+from spatialmech.kinematics.closure import Configuration, active_mask
+from spatialmech.kinematics.backend import correct
+from spatialmech.kinematics.motion import generic_configuration
 
 pytestmark = pytest.mark.skipif(not compiled.AVAILABLE, reason="numba is not available")
 
@@ -95,7 +97,7 @@ def test_compiled_forward_solve_equals_the_python_reference(name):
     q0[act] = goal.q[act]
     seed = start.with_q(q0)
     fast = correct(mech, seed, active=mask)
-    with compiled.python_reference():
+    with backend.python_reference():
         ref = correct(mech, seed, active=mask)
     assert fast.converged == ref.converged and fast.iterations == ref.iterations
     assert np.abs(fast.config.q - ref.config.q).max() < 1e-10

@@ -172,3 +172,120 @@ def test_the_runtime_check_flags_a_module_that_loads_plotting():
     found = runtime_violations(["spatialmech.geometry.screws", "spatialmech.present.viewer"])
     assert "spatialmech.geometry.screws" not in found
     assert "plotly" in {m.split(".")[0] for m in found["spatialmech.present.viewer"]}, found
+
+
+# ------------------------------------------------------------------ the engine's two backends (issue 26)
+# The Python reference (everything under kinematics/ but the compiled package and the front that
+# picks a backend) never imports the compiled package; so the compiled package may import the
+# reference (its data types, chains, checks) without an import circle.
+KIN = PKG / "kinematics"
+COMPILED = "spatialmech.kinematics.compiled"
+FRONT = "spatialmech.kinematics.backend"
+#: Reference modules that host numba kernels of their own and so import the compiled package's
+#: leaf modules (``jit``, ``kernels_se3``), never its engine; each with its reason.
+KERNEL_HOSTS = {
+    "spatialmech.kinematics.closed_forms.four_sps_cu": "its closed-form leg-length kernels (numba) live with the "
+                                                       "closed form; it imports compiled.jit and compiled.kernels_se3",
+}
+KERNEL_LEAVES = (f"{COMPILED}.jit", f"{COMPILED}.kernels_se3")
+
+
+def reference_files() -> list[Path]:
+    return sorted(p for p in KIN.rglob("*.py") if "__pycache__" not in p.parts and not p.is_relative_to(KIN / "compiled")
+                  and module_name(p) != FRONT)
+
+
+def compiled_imports(path: Path, source: str | None = None) -> list[str]:
+    """Messages ``file:line: imports NAME`` for every import of the compiled package (or a module
+    of it) in one reference file (a kernel host: of anything but the leaf modules)."""
+    source = path.read_text(encoding="utf-8") if source is None else source
+    mod = module_name(path)
+    allowed = KERNEL_LEAVES if mod in KERNEL_HOSTS else ()
+    first: dict[int, str] = {}
+    for line, name in imported_names(source, mod, path.name == "__init__.py"):
+        if (name == COMPILED or name.startswith(COMPILED + ".")) and not any(
+                name == a or name.startswith(a + ".") for a in allowed):
+            first.setdefault(line, name)
+    rel = path.relative_to(ROOT) if path.is_relative_to(ROOT) else path
+    return [f"{rel}:{line}: imports {name}" for line, name in sorted(first.items())]
+
+
+def import_graph(files: list[Path]) -> dict[str, set[str]]:
+    """``module -> the spatialmech modules it imports`` (every import, lazy ones included; a
+    ``from P import m`` counts as importing ``P.m`` when that is a module of ``files``; importing
+    ``a.b.c`` also runs the packages ``a.b`` -- not the root package, whose ``__init__`` is the
+    API facade and imports everything)."""
+    known = {module_name(p) for p in files}
+    graph: dict[str, set[str]] = {}
+    for p in files:
+        mod = module_name(p)
+        out = set()
+        for _, name in imported_names(p.read_text(encoding="utf-8"), mod, p.name == "__init__.py"):
+            while name and name not in known:
+                name = name.rpartition(".")[0]
+            while name.count("."):  # the module and the packages that hold it
+                if name != mod and not mod.startswith(name + "."):
+                    out.add(name)
+                name = name.rpartition(".")[0]
+        graph[mod] = out
+    return graph
+
+
+def reaches(graph: dict[str, set[str]], start: str, goal: str) -> list[str] | None:
+    """An import path from ``start`` to ``goal`` (a module or a package: any module in it), or ``None``."""
+    seen, todo = {start}, [[start]]
+    while todo:
+        path = todo.pop()
+        for nxt in sorted(graph.get(path[-1], ())):
+            if nxt == goal or nxt.startswith(goal + "."):
+                return [*path, nxt]
+            if nxt not in seen:
+                seen.add(nxt)
+                todo.append([*path, nxt])
+    return None
+
+
+def test_the_python_reference_never_imports_the_compiled_package():
+    files = reference_files()
+    assert len(files) > 20 and KIN / "closure.py" in files and KIN / "tracking.py" in files, files
+    problems = [m for f in files for m in compiled_imports(f)]
+    assert not problems, ("the Python reference must not import the compiled package (ask kinematics/backend.py "
+                          "for the engine):\n" + "\n".join(problems))
+    assert set(KERNEL_HOSTS) <= {module_name(f) for f in files}, "a kernel host moved: update KERNEL_HOSTS"
+
+
+def test_no_import_cycle_between_closure_and_compiled():
+    files = sorted(p for p in PKG.rglob("*.py") if "__pycache__" not in p.parts)
+    graph = import_graph(files)
+    closure = "spatialmech.kinematics.closure"
+    assert reaches(graph, COMPILED, closure) is not None  # the graph sees the compiled package use the reference
+    path = reaches(graph, closure, COMPILED)
+    assert path is None, "closure.py reaches the compiled package: " + " -> ".join(path or [])
+    assert reaches(graph, closure, FRONT) is None, "closure.py must not import the front (backend.py)"
+
+
+def test_the_compiled_import_check_flags_a_violation():
+    for where, source in [
+        ("kinematics/closure.py", "def f():\n    from . import compiled\n"),
+        ("kinematics/tracking.py", "from .compiled.engine import lstsq\n"),
+        ("kinematics/homotopy/study.py", "from ..compiled.jit import njit\n"),
+        ("kinematics/closed_forms/four_sps_cu.py", "from .. import compiled\n"),
+        ("kinematics/closed_forms/sps.py", "from ..compiled.kernels_se3 import nb_sincos\n"),
+        ("kinematics/position.py", "import importlib\nm = importlib.import_module('spatialmech.kinematics.compiled')\n"),
+    ]:
+        found = compiled_imports(PKG / where, source)
+        assert len(found) == 1 and COMPILED in found[0], (where, found)
+    ok = "from . import backend\nfrom .closure import correct\nfrom ..geometry.tolerances import current\n"
+    assert compiled_imports(PKG / "kinematics" / "tracking.py", ok) == []
+    host = "from ..compiled.jit import njit\nfrom ..compiled.kernels_se3 import nb_sincos\n"
+    assert compiled_imports(PKG / "kinematics" / "closed_forms" / "four_sps_cu.py", host) == []
+
+
+def test_the_cycle_check_finds_a_cycle():
+    graph = {"spatialmech.kinematics.closure": {"spatialmech.kinematics.leg_platform"},
+             "spatialmech.kinematics.leg_platform": {"spatialmech.kinematics.compiled.legs"},
+             "spatialmech.kinematics.compiled.legs": {"spatialmech.kinematics.closure"}}
+    assert reaches(graph, "spatialmech.kinematics.closure", COMPILED) == [
+        "spatialmech.kinematics.closure", "spatialmech.kinematics.leg_platform", "spatialmech.kinematics.compiled.legs"]
+    graph["spatialmech.kinematics.leg_platform"] = set()
+    assert reaches(graph, "spatialmech.kinematics.closure", COMPILED) is None

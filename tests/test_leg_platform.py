@@ -16,18 +16,14 @@ import spatialmech as sm
 from spatialmech import catalog
 from spatialmech.errors import InputError
 from spatialmech.geometry.rotations import exp_twist, matrix_rotvec, rotvec_matrix
-from spatialmech.kinematics import compiled, leg_platform
-from spatialmech.kinematics.closure import (
-    Configuration,
-    active_mask,
-    closure_residual,
-    correct,
-    generic_configuration,
-)
-from spatialmech.kinematics.kernels_legs import nb_shortest_rotation, nb_shortest_rotvec
+from spatialmech.kinematics import backend, leg_platform
+from spatialmech.kinematics.closure import Configuration, active_mask
+from spatialmech.kinematics.backend import closure_residual, correct
+from spatialmech.kinematics.motion import generic_configuration
+from spatialmech.kinematics.compiled.kernels_legs import nb_shortest_rotation, nb_shortest_rotvec
 
 ROOT = Path(__file__).resolve().parents[1]
-pure = compiled.python_reference
+pure = backend.python_reference
 
 
 def _stewart():

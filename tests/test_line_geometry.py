@@ -12,7 +12,8 @@ from spatialmech.catalog.papers import four_sps_cu, four_sps_cu_points
 from spatialmech.geometry import screws as sc
 from spatialmech.geometry.line_geometry import classify_lines, pair_relation
 from spatialmech.geometry.rotations import euler_matrix
-from spatialmech.kinematics.closure import Configuration, correct, joint_points
+from spatialmech.kinematics.closure import Configuration, joint_points
+from spatialmech.kinematics.backend import correct
 from spatialmech.model.mechanism import Pose
 
 from .conftest import random_transform

@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 import spatialmech as sm
 from spatialmech import catalog
 from spatialmech.interfaces.cli import cli
-from spatialmech.kinematics.closure import generic_configuration
+from spatialmech.kinematics.motion import generic_configuration
 from spatialmech.kinematics.position import freedom_values, inverse_position, platform_pose
 from spatialmech.kinematics.forward import forward_position
 

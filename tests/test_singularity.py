@@ -11,7 +11,8 @@ from spatialmech import catalog
 from spatialmech.analysis.singularity import singularity, singularity_at_pose, singularity_slice
 from spatialmech.catalog.papers import four_sps_cu
 from spatialmech.interfaces.cli import cli
-from spatialmech.kinematics.closure import Configuration, generic_configuration
+from spatialmech.kinematics.closure import Configuration
+from spatialmech.kinematics.motion import generic_configuration
 
 M = catalog.build("four-sps-cu")  # a = 0.1, b = 0.2, reference z0 = 0.2
 

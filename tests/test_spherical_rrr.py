@@ -18,7 +18,8 @@ from scipy.spatial.transform import Rotation
 from spatialmech import catalog
 from spatialmech.geometry.rotations import skew, transform
 from spatialmech.kinematics.closed_forms import spherical_rrr as srrr
-from spatialmech.kinematics.closure import Configuration, closure_residual, correct
+from spatialmech.kinematics.closure import Configuration
+from spatialmech.kinematics.backend import closure_residual, correct
 
 ACTUATORS = [0, 3, 6]  # R1.rot, R4.rot, R7.rot in the freedom order of three-rrr-sm
 angle = st.floats(-3.0, 3.0, allow_nan=False)

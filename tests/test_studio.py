@@ -12,7 +12,7 @@ from spatialmech import catalog
 from spatialmech.interfaces.cli import cli
 from spatialmech.interfaces.studio.app import create_app
 from spatialmech.interfaces.studio.session import Session
-from spatialmech.kinematics.closure import closure_residual
+from spatialmech.kinematics.backend import closure_residual
 
 
 @pytest.fixture(scope="module")

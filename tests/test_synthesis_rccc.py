@@ -9,7 +9,7 @@ import pytest
 from click.testing import CliRunner
 
 import spatialmech as sm
-from spatialmech.kinematics.closure import closure_residual
+from spatialmech.kinematics.backend import closure_residual
 from spatialmech.synthesis.rccc import assemble, check_linkage, synthesize_rccc
 from spatialmech.synthesis.tasks import get_task
 

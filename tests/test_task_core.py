@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 
 from spatialmech import catalog
 from spatialmech.errors import InputError
-from spatialmech.kinematics.closure import closure_residual
+from spatialmech.kinematics.backend import closure_residual
 from spatialmech.kinematics.task import coordinate_map, default_task, pose_from_task, solve_task, task_values
 from spatialmech.model import schema
 from spatialmech.model.task import TaskCoordinates

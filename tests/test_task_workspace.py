@@ -29,7 +29,8 @@ from spatialmech.errors import InputError
 from spatialmech.geometry.rotations import euler_matrix
 from spatialmech.interfaces.cli import cli
 from spatialmech.interfaces.task_args import parse_axes
-from spatialmech.kinematics.closure import Configuration, closure_residual, closure_scales, active_mask
+from spatialmech.kinematics.closure import Configuration, closure_scales, active_mask
+from spatialmech.kinematics.backend import closure_residual
 from spatialmech.kinematics.jacobian import complete_jacobian
 from spatialmech.kinematics.task import default_task, solve_task, task_values
 from spatialmech.kinematics.task_grid import TASK_NAMES

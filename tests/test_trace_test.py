@@ -1,4 +1,4 @@
-"""The trace test (kinematics/trace_test.py): a complete set of solutions passes, a set with one
+"""The trace test (kinematics/homotopy/trace_test.py): a complete set of solutions passes, a set with one
 solution left out fails; on toy families with known counts, and on the loop formulation's RSSR."""
 
 from __future__ import annotations
@@ -8,7 +8,7 @@ import pytest
 
 import spatialmech as sm
 from spatialmech.geometry.tolerances import TRACE_TOL
-from spatialmech.kinematics.trace_test import trace_test
+from spatialmech.kinematics.homotopy.trace_test import trace_test
 
 
 def _conics(P0, V):

@@ -4,7 +4,9 @@ import numpy as np
 import pytest
 
 from spatialmech import catalog
-from spatialmech.kinematics.closure import Configuration, closure_residual, generic_configuration
+from spatialmech.kinematics.closure import Configuration
+from spatialmech.kinematics.backend import closure_residual
+from spatialmech.kinematics.motion import generic_configuration
 from spatialmech.kinematics.jacobian import complete_jacobian
 from spatialmech.kinematics.position import freedom_values
 from spatialmech.kinematics.forward import forward_position

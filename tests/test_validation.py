@@ -21,7 +21,7 @@ from spatialmech.interfaces.cli import cli
 from spatialmech.interfaces.common import load_schema
 from spatialmech.kinematics.closed_forms import four_sps_cu as k4
 from spatialmech.kinematics.closed_forms.four_sps_cu_paper import cone_trajectory
-from spatialmech.kinematics.closure import generic_configuration
+from spatialmech.kinematics.motion import generic_configuration
 from spatialmech.kinematics.position import configuration_at_pose
 from spatialmech.model.mechanism import Pose
 from spatialmech.serialize import unit_rule_violations

@@ -7,7 +7,9 @@ from hypothesis import strategies as st
 
 from spatialmech import catalog
 from spatialmech.geometry.rotations import euler_matrix, exp_twist, inverse_transform, log_transform
-from spatialmech.kinematics.closure import Configuration, retract, active_mask, correct, generic_configuration
+from spatialmech.kinematics.closure import Configuration, active_mask
+from spatialmech.kinematics.backend import retract, correct
+from spatialmech.kinematics.motion import generic_configuration
 from spatialmech.kinematics.velocity import (
     euler_rate_matrix,
     forward_acceleration,

@@ -12,13 +12,9 @@ from click.testing import CliRunner
 from hypothesis import given, settings
 
 from spatialmech import catalog
-from spatialmech.kinematics.closure import (
-    Configuration,
-    CorrectionResult,
-    closure_residual,
-    generic_configuration,
-    joint_points,
-)
+from spatialmech.kinematics.closure import Configuration, CorrectionResult, joint_points
+from spatialmech.kinematics.backend import closure_residual
+from spatialmech.kinematics.motion import generic_configuration
 from spatialmech.model.joints import R
 from spatialmech.model.mechanism import Limb, Mechanism
 from spatialmech.kinematics.motion import sample_motion

@@ -35,7 +35,8 @@ from typing import cast
 import numpy as np
 
 from ..errors import InputError
-from ..kinematics.closure import Configuration, active_mask, closure_jacobian, closure_scales
+from ..kinematics.closure import Configuration, active_mask, closure_scales
+from ..kinematics.backend import closure_jacobian
 from ..kinematics.jacobian import complete_jacobian, driver_determinants
 from ..geometry.tolerances import current as current_tolerances
 from ..kinematics.position import PoseFit, configuration_at_pose, freedom_values

@@ -41,16 +41,9 @@ import numpy as np
 from ..errors import ConvergenceError, InputError
 from ..geometry import screws as sc
 from ..geometry.tolerances import Tolerances, current, resolve, use
-from ..kinematics.closure import (
-    Configuration,
-    active_mask,
-    closure_jacobian,
-    closure_scales,
-    generic_configuration,
-    hub_count,
-    joint_twists,
-    limb_slices,
-)
+from ..kinematics.closure import Configuration, active_mask, closure_scales, hub_count, limb_slices
+from ..kinematics.backend import closure_jacobian, joint_twists
+from ..kinematics.motion import generic_configuration
 from ..model.mechanism import Mechanism, Mode
 from ..serialize import fields_dict
 

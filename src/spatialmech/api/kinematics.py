@@ -211,7 +211,7 @@ def fk(model: ModelLike, actuators, *, all_solutions: bool = False, seeds: int |
     if method not in ("auto", "homotopy", "multistart"):
         raise InputError(f"method: expected 'auto', 'homotopy' or 'multistart', got {method!r}")
     if all_solutions and method != "multistart":
-        from ..kinematics import homotopy as hc
+        from ..kinematics.homotopy import study as hc
         from ..kinematics.closed_forms import four_sps_cu as k4c
 
         closed = method == "auto" and k4c.geometry_of(mech) is not None  # the 4-SPS/CU keeps its closed form

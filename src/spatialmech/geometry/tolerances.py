@@ -279,7 +279,7 @@ HOMOTOPY_INFINITY = 1e-7
 HOMOTOPY_REAL = 1e-7
 HOMOTOPY_NEAR_REAL = 1e-3
 
-#: Cauchy end game (:mod:`spatialmech.kinematics.endgame`), nondimensional: the first radius of
+#: Cauchy end game (:mod:`spatialmech.kinematics.homotopy.endgame`), nondimensional: the first radius of
 #: the loops about ``t = 1`` (in the homotopy parameter), the points per loop, the most loops
 #: before a path must close (its winding number), the relative distance at which a loop has
 #: closed, the relative agreement of the estimates at two radii that accepts the end point, and
@@ -291,7 +291,7 @@ ENDGAME_CLOSED = 1e-6
 ENDGAME_AGREE = 1e-8
 LOCAL_DIMENSION_STEP = 1e-4
 
-#: Monodromy (kinematics/homotopy_general.py): loops in a row without a new solution before the
+#: Monodromy (kinematics/homotopy/general.py): loops in a row without a new solution before the
 #: solve stops (saturation, not a proof), the most loops, and the relative residual of the full
 #: closure below which an end point of the square system is a solution (else spurious).
 MONODROMY_STALE_LOOPS = 8
@@ -306,7 +306,7 @@ MONODROMY_DIVERGED = 1e4  # a path stopped short with |x| beyond this is at infi
 MONODROMY_PARALLEL = 4  # loops tracked together in one batch
 MONODROMY_RESIDUAL = 1e-8
 
-#: Trace test (kinematics/trace_test.py), nondimensional: the largest relative deviation of the
+#: Trace test (kinematics/homotopy/trace_test.py), nondimensional: the largest relative deviation of the
 #: traces from a line that passes (a complete set gives 1e-11 or less, a missing solution of the
 #: order of 1e-2 to 1), the size of the two moves of the fibre, the loops in a row without a new
 #: witness point before a test, and the most loops over the hyperplanes; and the work (paths
@@ -319,7 +319,7 @@ TRACE_MAX_LOOPS = 200
 TRACE_MAX_WORK = 40_000
 TRACE_MAX_WORK_FULL = 2_000_000
 
-#: Block elimination of the closure's Newton step (kinematics/kernels_blocks.py), relative to a
+#: Block elimination of the closure's Newton step (kinematics/compiled/kernels_blocks.py), relative to a
 #: block's largest column: remaining columns at or below ``BLOCK_RANK_ZERO`` are rank-deficient
 #: directions (an S-P-S leg's idle spin: about 1e-16), and a block whose rank lies between the
 #: two, or whose triangular factor is conditioned worse than ``BLOCK_MAX_COND``, goes to the

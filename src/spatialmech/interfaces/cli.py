@@ -18,7 +18,7 @@ import click
 from .. import __version__, catalog
 from ..analysis.mobility import mobility, mobility_modes
 from ..errors import ConvergenceError, SpatialmechError
-from ..kinematics.jit import announce_compilation
+from ..kinematics.compiled.jit import announce_compilation
 from .common import UserError, check_output_dir, check_output_file, emit_json, json_option, tol_option
 
 

@@ -255,8 +255,8 @@ def fk(model, values, all_solutions, method, seeds, as_json):
     closed = all_solutions and method == "auto" and k4.geometry_of(mech) is not None  # the 4-SPS/CU keeps its closed form
     pre = None
     if all_solutions and method != "multistart" and not closed:
-        from ..kinematics import homotopy as hc
-        from ..kinematics import homotopy_general as hg
+        from ..kinematics.homotopy import study as hc
+        from ..kinematics.homotopy import general as hg
 
         why = hc.unsupported_reason(mech)
         gwhy = hg.general_reason(mech) if why is not None else None

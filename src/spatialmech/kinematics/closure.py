@@ -21,14 +21,12 @@ divided by ``L``) are used for rank decisions and convergence tests.
 
 from __future__ import annotations
 
-from types import ModuleType
-
 import weakref
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import ConvergenceError, InputError
+from ..errors import InputError
 from ..geometry.rotations import (
     exp_twist,
     inverse_transform,
@@ -54,7 +52,6 @@ __all__ = [
     "closure_residual",
     "closure_scales",
     "correct",
-    "generic_configuration",
     "hub_count",
     "hub_displacements",
     "joint_points",
@@ -324,9 +321,6 @@ def recentre_balls(mech: Mechanism, q: np.ndarray) -> np.ndarray:
 
 def joint_twists(mech: Mechanism, config: Configuration) -> list[np.ndarray]:
     """Per limb, the (6, m_k) spatial twists of all its freedoms at ``config``."""
-    if (fast := _compiled()) is not None:  # the joint columns of the closure Jacobian, every freedom active
-        A, _ = fast.closure_jacobian(mech, config, active=np.ones(len(mech.freedom_refs), dtype=bool))
-        return [A[6 * k : 6 * k + 6, sl].copy() for k, sl in enumerate(limb_slices(mech))]
     check_configuration(mech, config)
     out = []
     for (a, _), ch, sl in zip(mech.limb_ends, limb_chains(mech), limb_slices(mech), strict=True):
@@ -388,37 +382,8 @@ def placed_configuration(mech: Mechanism, q) -> Configuration:
     return Configuration(q, known.get(0, np.eye(4)), B)
 
 
-def _compiled():
-    """The compiled kernels (:mod:`.compiled`) when they are in use, else ``None``: the Python
-    code below runs (``SPATIALMECH_PURE=1``, or numba missing) and is the reference."""
-    global _COMPILED_MODULE
-    if _COMPILED_MODULE is None:
-        from . import compiled  # imported here: it builds on this module
-
-        _COMPILED_MODULE = compiled
-    return _COMPILED_MODULE if _COMPILED_MODULE.enabled() else None
-
-
-_COMPILED_MODULE: ModuleType | None = None
-
-
-def _leg_platform() -> ModuleType:
-    """:mod:`.leg_platform` (imported on first use: it builds on this module)."""
-    global _LEG_MODULE
-    if _LEG_MODULE is None:
-        from . import leg_platform
-
-        _LEG_MODULE = leg_platform
-    return _LEG_MODULE
-
-
-_LEG_MODULE: ModuleType | None = None
-
-
 def closure_residual(mech: Mechanism, config: Configuration) -> np.ndarray:
     """Stacked limb residuals ``log(D_a FK_k D_b^-1)`` (6 K,), SI units."""
-    if (fast := _compiled()) is not None:
-        return fast.closure_residual(mech, config)
     check_configuration(mech, config)
     res = []
     for (a, b), ch, sl in zip(mech.limb_ends, limb_chains(mech), limb_slices(mech), strict=True):
@@ -434,8 +399,6 @@ def closure_jacobian(mech: Mechanism, config: Configuration, *, active: np.ndarr
 
     Columns: the active joint variables, then the spatial twist of the output link (6), then
     those of the internal bodies (6 each; ``h`` = :func:`hub_count`)."""
-    if (fast := _compiled()) is not None:
-        return fast.closure_jacobian(mech, config, active=active)
     check_configuration(mech, config)
     if active is None:
         active = active_mask(mech)
@@ -519,8 +482,6 @@ def retract(mech, config, active, step, fix_platform=False):
     ``step``: the active joint steps, then a twist (6) per moving hub (:func:`hub_count`: the
     output link, then the internal bodies); a shorter step leaves the remaining hubs where they
     are.  ``fix_platform`` holds the output link (its twist in ``step`` is ignored)."""
-    if (fast := _compiled()) is not None:
-        return fast.retract(mech, config, active, step, fix_platform)
     dq = np.zeros_like(config.q)
     na = int(active.sum())
     dq[active] = step[:na]
@@ -549,31 +510,17 @@ def correct(
     fix_platform: bool = False,
     tol: float | None = None,
     max_iter: int = 50,
-    method: str = "auto",
 ) -> CorrectionResult:
-    """Gauss-Newton (minimum-norm) correction of ``config`` onto the closure manifold.
+    """Gauss-Newton (minimum-norm) correction of ``config`` onto the closure manifold, on the joint
+    variables: the Python reference of :func:`.backend.correct` (which callers use: it runs the
+    compiled engine when it is in use, and the pose-coordinate path of six S-P-S legs).
 
     ``active`` selects the joint variables that may move (default: every unlocked freedom;
     pass a mask without the actuators for forward position).  ``fix_platform`` holds the
     platform displacement (inverse position); internal bodies always move.  Returns the corrected configuration with
     ``converged`` and the final nondimensional residual norm; never raises on
     non-convergence (the caller decides).
-
-    ``method``: ``"joints"`` runs the general Newton on the joint variables; ``"auto"`` (the
-    default) does too, except for forward position of a platform on six S-P-S legs (``active``
-    frees every ball and holds every slide), which is solved in pose coordinates
-    (:mod:`.leg_platform`: the same pose; each leg's idle spin by the shortest-turn rule).
     """
-    if method != "joints":
-        if method != "auto":
-            raise InputError(f"method: expected 'auto' or 'joints', got {method!r}")
-        if active is not None and not fix_platform:
-            legs = _leg_platform()
-            lp = legs.leg_platform(mech)
-            if lp is not None and lp.applies(active):
-                return legs.correct(mech, lp, config, tol, max_iter, active)
-    if (fast := _compiled()) is not None:
-        return fast.correct(mech, config, active=active, fix_platform=fix_platform, tol=tol, max_iter=max_iter)
     if active is None:
         active = active_mask(mech)
     if tol is None:  # the newton tolerance in force (geometry/tolerances.py)
@@ -624,45 +571,3 @@ def joint_points(mech: Mechanism, config: Configuration) -> list[np.ndarray]:
                 pts.append(pre[k, :3, :3] @ p + pre[k, :3, 3])
         out.append(np.array(pts))
     return out
-
-
-def generic_configuration(
-    mech: Mechanism,
-    *,
-    active: np.ndarray | None = None,
-    seed: int = 0,
-    step: float = 0.1,
-    steps: int = 3,
-    start: Configuration | None = None,
-) -> Configuration:
-    """A configuration on the closure manifold near ``start`` (default: the reference),
-    reached by random steps along the manifold's tangent space, each corrected by Newton.
-
-    Random directions avoid the special (often singular) symmetric reference poses of
-    ready-made models.  ``step`` is nondimensional (radians, or lengths / L).  Raises
-    ``RuntimeError`` if a correction does not converge.
-    """
-    rng = np.random.default_rng(seed)
-    if active is None:
-        active = active_mask(mech)
-    config = start if start is not None else Configuration.reference(mech)
-    row, col = closure_scales(mech, active)
-    for _ in range(steps):
-        A, _ = closure_jacobian(mech, config, active=active)
-        As = row[:, None] * A * col[None, :]
-        _, sv, vt = np.linalg.svd(As)
-        r = int(np.sum(sv > current_tolerances().rank * max(1.0, sv[0])))
-        N = vt[r:]
-        if N.shape[0] == 0:
-            break
-        c = rng.standard_normal(N.shape[0])
-        t = N.T @ c
-        t *= step / max(float(np.linalg.norm(t)), 1e-300)
-        trial = retract(mech, config, active, col * t)
-        res = correct(mech, trial, active=active)
-        if not res.converged:
-            raise ConvergenceError(
-                f"generic configuration: Newton correction did not converge (residual {res.residual:.2e})"
-            )
-        config = res.config
-    return config

@@ -26,16 +26,14 @@ from ..serialize import freedom_values_dict, pose_dict
 from .closure import (
     Configuration,
     active_mask,
-    closure_jacobian,
     closure_scales,
-    correct,
-    generic_configuration,
     hub_displacements,
-    joint_twists,
     limb_chains,
     limb_slices,
     placed_configuration,
 )
+from .backend import closure_jacobian, correct, joint_twists
+from .motion import generic_configuration
 from .assembly import (
     AssemblyKind,
     Conditioning,
@@ -353,14 +351,14 @@ def forward_position(
     if method not in ("multistart", "homotopy", "auto"):
         raise InputError(f"method: expected 'multistart', 'homotopy' or 'auto', got {method!r}")
     targets = _actuator_q(mech, actuator_values)
-    gwhy: str | None = None  # why the loop formulation (homotopy_general) does not cover the model
+    gwhy: str | None = None  # why the loop formulation (homotopy/general.py) does not cover the model
     if all_solutions and method != "multistart":
-        from . import homotopy as hc
+        from .homotopy import study as hc
 
         why = hc.unsupported_reason(mech)
         if why is None:
             return _forward_homotopy(mech, targets, seed, max_iter, n_seeds)
-        from . import homotopy_general as hg
+        from .homotopy import general as hg
 
         gwhy = hg.general_reason(mech)
         if gwhy is None:
@@ -503,7 +501,7 @@ def _forward_homotopy(mech: Mechanism, targets: dict[int, float], seed: int, max
     """``forward_position(..., method="homotopy")``: the real end points polished with the
     actuators held, grouped and classified as the multi-start roots."""
     from ..geometry.rotations import transform
-    from . import homotopy as hc
+    from .homotopy import study as hc
 
     refs = mech.freedom_refs
     vals = [targets[refs.index(mech.freedom(a))] + mech.freedom(a).freedom.offset for a in mech.actuators]
@@ -573,10 +571,10 @@ def _forward_general(mech: Mechanism, targets: dict[int, float], seed: int, max_
                      n_seeds: int = 200, fallback: bool = False) -> ForwardResult | None:
     """``forward_position(..., method="homotopy")`` on a model whose limbs do not reduce to the
     Study-parameter quadrics: the loop formulation in joint variables solved by monodromy
-    (:mod:`.homotopy_general`); each real end point is a configuration, polished by the same
+    (:mod:`.homotopy.general`); each real end point is a configuration, polished by the same
     Newton step and grouped as the multi-start roots.  ``complete`` when the trace test of the
     generic solutions passed and every path to the request is accounted for."""
-    from . import homotopy_general as hg
+    from .homotopy import general as hg
 
     hr = hg.general_forward(mech, targets, seed=seed, capped=fallback)
     if fallback and not hr.saturated:  # method="auto": the multi-start instead

@@ -32,8 +32,9 @@ from ..errors import InputError
 from ..geometry import screws as sc
 from ..geometry.tolerances import DEFAULT, current
 from ..model.mechanism import Mechanism
-from . import compiled
-from .closure import Configuration, active_mask, closure_jacobian, closure_scales, joint_twists, limb_slices
+from . import backend
+from .closure import Configuration, active_mask, closure_scales, limb_slices
+from .backend import closure_jacobian, joint_twists
 
 __all__ = ["SINGULAR_SIGMA", "CompleteJacobian", "actuation_wrench", "closure_determinant", "complete_jacobian",
            "limb_constraint_wrenches"]
@@ -353,7 +354,7 @@ def driver_determinants(mech: Mechanism, config: Configuration, drivers) -> np.n
     A mechanism with internal bodies (a link-and-joint graph) gets :func:`closure_determinant`
     per driver instead: the same zeros where a driver loses control of the motion, a different
     magnitude and no poles."""
-    if compiled.enabled() and (fast := compiled.driver_determinants(mech, config, drivers)) is not None:
+    if (engine := backend.engine()) is not None and (fast := engine.driver_determinants(mech, config, drivers)) is not None:
         return fast
     if mech.bodies:
         return np.array([closure_determinant(mech, config, d) for d in drivers])

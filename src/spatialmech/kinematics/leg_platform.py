@@ -22,15 +22,17 @@ equations cannot be solved (a singular step, NaN, no convergence within ``max_it
 general engine starts again from the seed, and the result is its result (its statuses,
 including ``stationary``; the iterations of both are counted).
 
-:func:`.closure.correct` takes this path by itself (``method="auto"``) when it applies:
+:func:`.backend.correct` takes this path by itself (``method="auto"``) when it applies:
 :func:`leg_platform` finds the legs, and the active mask must free every ball and hold every
-slide.  The Python code here is the reference; :func:`.kernels_legs.nb_leg_platform` runs the
-same steps compiled (when :func:`.compiled.enabled`).
+slide.  The Python code here is the reference (it never imports the compiled package);
+``compiled.correct_legs`` (:mod:`spatialmech.kinematics.compiled.legs`, the kernel
+``kernels_legs.nb_leg_platform``) runs the same steps compiled, when :func:`.backend.enabled`.
 """
 
 from __future__ import annotations
 
 import weakref
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -38,8 +40,6 @@ import numpy as np
 from ..geometry.rotations import matrix_rotvec, rotvec_matrix, skew
 from ..geometry.tolerances import current as current_tolerances
 from ..model.mechanism import Mechanism
-from . import compiled
-from .kernels_legs import nb_leg_platform
 from .closure import (
     Configuration,
     CorrectionResult,
@@ -52,7 +52,7 @@ from .closure import (
     limb_slices,
 )
 
-__all__ = ["LegPlatform", "correct", "leg_platform", "place_legs", "shortest_rotation", "shortest_rotvec"]
+__all__ = ["LegPlatform", "correct", "leg_platform", "place_legs", "result_or_general", "shortest_rotation", "shortest_rotvec"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -90,7 +90,6 @@ class LegPlatform:
 
 
 _BOOL = np.dtype(np.bool_)
-_F64 = np.dtype(np.float64)
 #: per mechanism (by ``id``; an entry leaves with its mechanism): a plain dict, as the lookup is
 #: on every forward solve and a ``WeakKeyDictionary``'s costs a fifth of a microsecond
 _LEGS: dict[int, LegPlatform | None] = {}
@@ -217,38 +216,28 @@ def _closure_norm(mech: Mechanism, config: Configuration) -> float:
 def correct(mech: Mechanism, lp: LegPlatform, config: Configuration, tol: float | None = None, max_iter: int = 50,
             active: np.ndarray | None = None) -> CorrectionResult:
     """Forward position of the platform from ``config`` with the slides held (see the module
-    docstring); the general engine (:func:`.closure.correct` with ``method="joints"`` and
-    ``active``, by default every freedom but the slides) is the fallback."""
+    docstring); the general engine (:func:`.closure.correct` with ``active``, by default every
+    freedom but the slides) is the fallback.  The Python reference of the compiled
+    ``compiled.correct_legs``; callers use :func:`.backend.correct`, which picks one."""
     if tol is None:  # the newton tolerance in force (geometry/tolerances.py)
         tol = current_tolerances().newton
-    if compiled.enabled():
-        q0, D0 = config.q, config.D
-        if not (_plain(q0, (lp.n,)) and _plain(D0, (4, 4)) and type(config.B) is np.ndarray
-                and config.B.shape == (0, 4, 4)):  # else the full check, and one numba type per argument
-            check_configuration(mech, config)
-            q0, D0 = np.require(q0, np.float64, ["C", "W"]), np.require(D0, np.float64, ["C", "W"])
-        qn, Dn = np.empty(lp.n), np.empty((4, 4))
-        status, it, rn, same = nb_leg_platform(lp.index, lp.data, lp.length, q0, D0, float(tol), int(max_iter), qn, Dn)
-        if status == -1:  # NaN or infinity in the seed: the full check names it
-            check_configuration(mech, config)
-        q, D = (None, None) if same else (qn, Dn)
-    else:
-        check_configuration(mech, config)
-        status, it, q, D, rn = _correct_python(mech, lp, config, tol, max_iter)
+    check_configuration(mech, config)
+    status, it, q, D, rn = _correct_python(mech, lp, config, tol, max_iter)
+    return result_or_general(mech, lp, config, status, it, q, D, rn, tol, max_iter, active, closure_correct)
+
+
+def result_or_general(mech: Mechanism, lp: LegPlatform, config: Configuration, status: int, it: int,
+                      q: np.ndarray | None, D: np.ndarray | None, rn: float, tol: float, max_iter: int,
+                      active: np.ndarray | None, general: Callable[..., CorrectionResult]) -> CorrectionResult:
+    """The result of the pose-coordinate solve (``status`` 1: converged to ``q``, ``D``, or to
+    ``config`` itself when they are ``None``), or else ``general`` (the general engine's
+    ``correct`` of the backend in use) from the seed, the iterations of both counted."""
     if status == 1:
         return CorrectionResult.of(config if q is None or D is None else Configuration.of(q, D), True, it, rn)
     if active is None:
         active = np.frombuffer(lp.held, dtype=np.bool_).copy()
-    res = closure_correct(mech, config, active=active, tol=tol, max_iter=max_iter, method="joints")
+    res = general(mech, config, active=active, tol=tol, max_iter=max_iter)
     return CorrectionResult(res.config, res.converged, it + res.iterations, res.residual, res.stationary)
-
-
-def _plain(x, shape) -> bool:
-    """A C-contiguous, writable float64 array of ``shape`` (what the kernel takes as it is)."""
-    if type(x) is not np.ndarray or x.dtype is not _F64 or x.shape != shape:
-        return False
-    f = x.flags
-    return f.c_contiguous and f.writeable
 
 
 def _correct_python(mech: Mechanism, lp: LegPlatform, config: Configuration, tol: float, max_iter: int):

@@ -5,7 +5,7 @@ This is **not** the continuation tracker (:mod:`.tracking`): it does no driver-c
 tracking, no branch or singularity handling and no step-size control beyond halving a failed
 step.  It exists so that the viewer (:mod:`spatialmech.present.viewer`, which only draws) has
 something honest to animate for any model: every configuration it returns satisfies the closure
-equations of :mod:`.closure` (checked by :func:`.closure.correct`), and the viewer accepts any
+equations of :mod:`.closure` (checked by :func:`.backend.correct`), and the viewer accepts any
 list of :class:`~.closure.Configuration` so that tracked paths can be shown the same way (the
 circuit of a one-degree-of-freedom linkage: :func:`spatialmech.analysis.traced_motion.traced_motion`).
 
@@ -24,7 +24,7 @@ flips), scaled so that its platform part ``(w ; v / L)`` has unit norm: the walk
 Frame ``i`` of ``n`` sits at ``s_i = amplitude * sin(2 pi i / n)``: from the start out to
 ``+amplitude``, back through the start to ``-amplitude`` and back.  Configurations are computed
 once per distinct ``s`` by predictor (``x + ds t``) and Newton corrector
-(:func:`~.closure.correct`), walking outwards from the start on each side, so the
+(:func:`~.backend.correct`), walking outwards from the start on each side, so the
 loop closes exactly (frame ``i`` and frame ``n/2 - i`` are the same configuration).
 """
 
@@ -33,21 +33,16 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ConvergenceError, InputError
+from ..geometry.tolerances import current as current_tolerances
 from ..geometry.validate import as_finite_array
-from .closure import (
-    Configuration,
-    active_mask,
-    closure_jacobian,
-    closure_scales,
-    correct,
-    retract,
-)
+from .closure import Configuration, active_mask, closure_scales
+from .backend import closure_jacobian, correct, retract
 from ..model.mechanism import Mechanism
 
-__all__ = ["sample_motion", "tangent_space"]
+__all__ = ["generic_configuration", "sample_motion", "tangent_space"]
 
 #: Relative singular-value threshold for the rank of the nondimensional closure Jacobian
-#: (the same as :func:`.closure.generic_configuration`).
+#: (the same as :func:`generic_configuration`).
 RANK_RTOL = 1e-9
 #: Largest predictor step (nondimensional platform motion) before a Newton correction.
 MAX_STEP = 0.05
@@ -61,7 +56,7 @@ def tangent_space(mech: Mechanism, config: Configuration, *, active: np.ndarray 
     Returns ``N`` (k, n_active + 6): rows span the null space of the nondimensional closure
     Jacobian, in nondimensional coordinates (joint rotations in rad, slides / L, platform twist
     ``(w ; v / L)``, the last six columns).  Multiply by the column scaling of
-    :func:`.closure.correct` to get SI steps.
+    :func:`.backend.correct` to get SI steps.
     """
     if active is None:
         active = active_mask(mech)
@@ -177,3 +172,45 @@ def sample_motion(
     at.update(zip(pos.tolist(), _walk(mech, x0, t0, amplitude * pos, active, col), strict=True))
     at.update(zip(neg.tolist(), _walk(mech, x0, t0, amplitude * neg, active, col), strict=True))
     return [at[float(k)] for k in keys]
+
+
+def generic_configuration(
+    mech: Mechanism,
+    *,
+    active: np.ndarray | None = None,
+    seed: int = 0,
+    step: float = 0.1,
+    steps: int = 3,
+    start: Configuration | None = None,
+) -> Configuration:
+    """A configuration on the closure manifold near ``start`` (default: the reference),
+    reached by random steps along the manifold's tangent space, each corrected by Newton.
+
+    Random directions avoid the special (often singular) symmetric reference poses of
+    ready-made models.  ``step`` is nondimensional (radians, or lengths / L).  Raises
+    ``RuntimeError`` if a correction does not converge.
+    """
+    rng = np.random.default_rng(seed)
+    if active is None:
+        active = active_mask(mech)
+    config = start if start is not None else Configuration.reference(mech)
+    row, col = closure_scales(mech, active)
+    for _ in range(steps):
+        A, _ = closure_jacobian(mech, config, active=active)
+        As = row[:, None] * A * col[None, :]
+        _, sv, vt = np.linalg.svd(As)
+        r = int(np.sum(sv > current_tolerances().rank * max(1.0, sv[0])))
+        N = vt[r:]
+        if N.shape[0] == 0:
+            break
+        c = rng.standard_normal(N.shape[0])
+        t = N.T @ c
+        t *= step / max(float(np.linalg.norm(t)), 1e-300)
+        trial = retract(mech, config, active, col * t)
+        res = correct(mech, trial, active=active)
+        if not res.converged:
+            raise ConvergenceError(
+                f"generic configuration: Newton correction did not converge (residual {res.residual:.2e})"
+            )
+        config = res.config
+    return config

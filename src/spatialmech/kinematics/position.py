@@ -23,21 +23,19 @@ from ..geometry.tolerances import Tolerances
 from ..geometry.tolerances import resolve as resolve_tolerances
 from ..model.mechanism import Mechanism, Pose
 from ..serialize import fields_dict, freedom_values_dict, pose_dict
-from . import compiled
+from . import backend
 from .closure import (
     Chain,
     Configuration,
     active_mask,
     chain_forward,
-    closure_jacobian,
     closure_scales,
-    correct,
     hub_displacements,
     limb_chains,
     limb_slices,
     recentre_balls,
-    retract,
 )
+from .backend import closure_jacobian, correct, retract
 
 __all__ = [
     "InverseResult",
@@ -265,8 +263,8 @@ def _violation(mech: Mechanism, sl: slice, q_limb) -> float:
 def limb_gauss_newton(chain, D, q, lin, L, tol=1e-12, max_iter=60, hold=None):
     """Gauss-Newton for one limb with the platform held at ``D``, in local coordinates (S
     joints updated by composing rotations); freedoms in the ``hold`` mask keep their value."""
-    if compiled.enabled():
-        return compiled.limb_gn(chain, D, q, lin, L, tol=tol, max_iter=max_iter, hold=hold)
+    if (fast := backend.engine()) is not None:
+        return fast.limb_gn(chain, D, q, lin, L, tol=tol, max_iter=max_iter, hold=hold)
     Dinv = inverse_transform(D)
     colscale = np.where(lin, L, 1.0)
     if hold is not None:

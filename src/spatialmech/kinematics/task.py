@@ -35,7 +35,8 @@ from ..geometry.tolerances import current as current_tolerances
 from ..model.mechanism import Mechanism
 from ..model.task import TASK_NAMES, TaskCoordinates
 from ..results import SolveStatus
-from .closure import Configuration, active_mask, closure_jacobian, closure_scales, retract
+from .closure import Configuration, active_mask, closure_scales
+from .backend import closure_jacobian, retract
 from .velocity import euler_rate_matrix
 
 __all__ = [

@@ -33,8 +33,9 @@ from ..geometry.rotations import inverse_transform, log_transform
 from ..geometry.tolerances import current as current_tolerances
 from ..model.mechanism import Mechanism
 from ..results import EventKind, Progress, TrackStatus
-from . import compiled
-from .closure import Configuration, active_mask, ball_groups, closure_jacobian, closure_scales, hub_count, retract
+from . import backend
+from .closure import Configuration, active_mask, ball_groups, closure_scales, hub_count
+from .backend import closure_jacobian, retract
 
 __all__ = [
     "ActuatorPathProblem",
@@ -211,7 +212,7 @@ def correct_on_hyperplane(problem, xp, t, tol, max_iter, contraction=0.6):
     ``(x, converged, iterations, total correction length)``; it stops early when the corrections
     stop contracting."""
     fast = getattr(problem, "compiled_correct", None)
-    if fast is not None and compiled.enabled():
+    if fast is not None and backend.enabled():
         return fast(xp, t, tol, max_iter, contraction)
     moved = 0.0
     prev = np.inf
@@ -224,7 +225,7 @@ def correct_on_hyperplane(problem, xp, t, tol, max_iter, contraction=0.6):
         M = np.vstack([A, t[None, :]])
         rhs = np.r_[-r, 0.0]
         # minimum-norm least squares: the compiled solver when in use (the same solution to rounding)
-        d = compiled.lstsq(M, rhs) if compiled.enabled() else np.linalg.lstsq(M, rhs, rcond=None)[0]
+        d = engine.lstsq(M, rhs) if (engine := backend.engine()) is not None else np.linalg.lstsq(M, rhs, rcond=None)[0]
         dn = float(np.linalg.norm(d))
         if it > 0 and dn > contraction * prev:
             return xp, False, it, moved
@@ -238,7 +239,7 @@ def predict_correct(problem, x, step, t, tol, max_iter, contraction=0.6):
     """``correct_on_hyperplane(problem, problem.retract(x, step), t, ...)``: the predictor step
     and the corrector, in one compiled call for a mechanism's motion."""
     fast = getattr(problem, "compiled_correct", None)
-    if fast is not None and compiled.enabled():
+    if fast is not None and backend.enabled():
         return fast(x, t, tol, max_iter, contraction, predictor=step)
     return correct_on_hyperplane(problem, problem.retract(x, step), t, tol, max_iter, contraction)
 
@@ -451,8 +452,8 @@ class _MechanismBase:
         return retract(self.mech, config, self.active, self.col * dx)
 
     def _config_diff(self, a: Configuration, b: Configuration) -> np.ndarray:
-        if compiled.enabled():
-            return compiled.config_difference(self.mech, a, b, self.active, self.kinds != "P", self.col)
+        if (fast := backend.engine()) is not None:
+            return fast.config_difference(self.mech, a, b, self.active, self.kinds != "P", self.col)
         dq_all = b.q - a.q
         for i, A in ball_groups(self.mech):  # relative rotation of each S joint
             sl = slice(i, i + 3)
@@ -489,13 +490,15 @@ class MotionProblem(_MechanismBase):
     def compiled_correct(self, xp, t, tol, max_iter, contraction, predictor=None):
         """:func:`correct_on_hyperplane` with the whole Newton loop compiled (same steps); with
         ``predictor``, from ``retract(xp, predictor)`` (:func:`predict_correct`)."""
-        return compiled.correct_on_hyperplane(self.mech, xp, self.active, self.row, self.col, t, tol, max_iter,
-                                              contraction, predictor)
+        fast = backend.engine()
+        assert fast is not None, "compiled_correct runs only when the compiled engine is in use"
+        return fast.correct_on_hyperplane(self.mech, xp, self.active, self.row, self.col, t, tol, max_iter, contraction,
+                                          predictor)
 
     def differences(self, xs, y) -> np.ndarray:
         """:meth:`difference` of ``y`` relative to each of ``xs`` (rows), compiled in one loop."""
-        if compiled.enabled() and len(xs):
-            return compiled.config_differences(self.mech, xs, y, self.active, self.kinds != "P", self.col)
+        if (fast := backend.engine()) is not None and len(xs):
+            return fast.config_differences(self.mech, xs, y, self.active, self.kinds != "P", self.col)
         return np.array([self._config_diff(x, y) for x in xs])
 
     def tangent(self, x):

@@ -23,15 +23,8 @@ from ..errors import InputError
 from ..geometry.rotations import check_sequence
 from ..geometry.tolerances import current as current_tolerances
 from ..model.mechanism import Mechanism
-from .closure import (
-    Configuration,
-    active_mask,
-    chain_forward,
-    closure_jacobian,
-    closure_scales,
-    limb_chains,
-    limb_slices,
-)
+from .closure import Configuration, active_mask, chain_forward, closure_scales, limb_chains, limb_slices
+from .backend import closure_jacobian
 
 __all__ = [
     "ad",

@@ -102,7 +102,8 @@ def _closed_form_claims():
 
     from ..geometry.rotations import transform
     from ..kinematics.closed_forms import spherical_rrr as srrr
-    from ..kinematics.closure import Configuration, correct
+    from ..kinematics.closure import Configuration
+    from ..kinematics.backend import correct
 
     mech = catalog.build("three-rrr-sm").in_mode("R1+R4+R7")
     t = np.arange(0.0, 361.0, 5.0)

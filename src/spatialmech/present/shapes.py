@@ -19,7 +19,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..kinematics.closure import Configuration, joint_points, joint_twists
+from ..kinematics.closure import Configuration, joint_points
+from ..kinematics.backend import joint_twists
 from ..model.mechanism import Mechanism
 
 __all__ = ["JOINT_SIZES", "joint_list", "joint_meshes", "mesh_json", "platform_solid", "plotly_mesh"]

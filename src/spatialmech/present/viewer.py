@@ -53,7 +53,8 @@ from scipy.spatial import ConvexHull
 
 from ..errors import InputError
 from ..geometry.validate import as_finite_array
-from ..kinematics.closure import Configuration, joint_points, joint_twists
+from ..kinematics.closure import Configuration, joint_points
+from ..kinematics.backend import joint_twists
 from ..model.mechanism import GROUND, Mechanism, Pose
 from ..serialize import fields_dict
 from .shapes import joint_list, joint_meshes, platform_solid

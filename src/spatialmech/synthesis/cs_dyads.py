@@ -62,8 +62,8 @@ from scipy.optimize import least_squares, minimize_scalar
 from ..errors import InputError
 from ..geometry.rotations import inverse_transform, rotation_angle, transform
 from ..geometry.validate import as_finite_array, as_unit_vector
-from ..kinematics import compiled
-from ..kinematics.jit import njit
+from ..kinematics import backend
+from ..kinematics.compiled.jit import njit
 from ..kinematics.tracking import EuclideanProblem, correct_on_hyperplane, track
 from ..model.mechanism import Pose
 from ..results import BranchEnd
@@ -243,7 +243,7 @@ def _dyad_system(x, D, want_J, r, J):
 
 def _one_dyad(x, D) -> bool:
     """True when the compiled single-dyad kernel serves this call."""
-    return compiled.enabled() and x.shape == (_NX,) and D.shape == (N_POSITIONS, 4, 4)
+    return backend.enabled() and x.shape == (_NX,) and D.shape == (N_POSITIONS, 4, 4)
 
 
 def dyad_residual(x, D) -> np.ndarray:

@@ -16,7 +16,7 @@ Steps (paper D section 2.1):
    coupler (``u_in`` through ``P1_in``)], limb ``output`` = [C ``B0`` on the base, C ``B1`` on the
    coupler]; ``platform_point`` = the task point of position 1, reference configuration =
    position 1;
-5. it is checked by solving its closure (:func:`spatialmech.kinematics.closure.correct`) at
+5. it is checked by solving its closure (:func:`spatialmech.kinematics.backend.correct`) at
    each task position with the input R angle held at the spherical 4R's input angle.  The
    orientation is exact by construction (the spherical image of the RCCC is the spherical 4R);
    the position errors are the price of replacing the input C by an R joint.
@@ -34,7 +34,8 @@ from scipy.optimize import minimize_scalar
 
 from ..errors import InputError
 from ..geometry.rotations import rotation_angle
-from ..kinematics.closure import Configuration, correct
+from ..kinematics.closure import Configuration
+from ..kinematics.backend import correct
 from ..model.joints import C as Cjoint
 from ..model.joints import R as Rjoint
 from ..model.mechanism import Limb, Mechanism, Pose
@@ -111,7 +112,7 @@ def check_linkage(mech: Mechanism, task: TaskPositions, input_dyad: Dyad, output
 
     The input rotation ``A0.rot`` (and, for a 4C, the slide ``A0.slide``) is held at the value
     the dyad needs for that position; every other joint and the platform move
-    (:func:`~spatialmech.kinematics.closure.correct` with an ``active`` mask without them),
+    (:func:`~spatialmech.kinematics.backend.correct` with an ``active`` mask without them),
     starting from the exact 4C joint values.
     """
     ids = [r.id for r in mech.freedom_refs]

@@ -275,7 +275,8 @@ def rank_key(row, by: str = "singularity") -> tuple[float, float]:
 
 def _closure_at_positions(mech: Mechanism, configs) -> tuple[float, float]:
     """Largest nondimensional closure residual and smallest scale-free closure sigma over ``configs``."""
-    from ..kinematics.closure import active_mask, closure_jacobian, closure_residual, closure_scales
+    from ..kinematics.closure import active_mask, closure_scales
+    from ..kinematics.backend import closure_jacobian, closure_residual
 
     L = mech.characteristic_length
     active = active_mask(mech)

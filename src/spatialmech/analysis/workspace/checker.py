@@ -345,7 +345,7 @@ def pose_checker(mech: Mechanism, limits: WorkspaceLimits | None = None, *, meth
         cols.append(np.array([[1e-9 * L]]))  # reachable: the same closure margin as the closed form
         return np.concatenate(cols, axis=1)[0]
 
-    from ...kinematics import compiled
+    from ...kinematics import backend, compiled
     from ...kinematics.closure import recentre_balls
 
     batchable = all(ends == (None, 0) for ends in mech.limb_ends)
@@ -381,7 +381,7 @@ def pose_checker(mech: Mechanism, limits: WorkspaceLimits | None = None, *, meth
 
     def fn_general(R, p):
         n = R.shape[0]
-        if batchable and n > 1 and compiled.enabled():
+        if batchable and n > 1 and backend.enabled():
             out, done = fn_batch(R, p)
         else:
             out, done = np.empty((n, len(names))), np.zeros(n, dtype=bool)

@@ -32,13 +32,9 @@ import numpy as np
 from ... import catalog
 from ...errors import ConvergenceError, InputError
 from ...geometry.tolerances import NEAR_SINGULAR, current
-from ...kinematics.closure import (
-    Configuration,
-    active_mask,
-    closure_residual,
-    correct,
-    generic_configuration,
-)
+from ...kinematics.closure import Configuration, active_mask
+from ...kinematics.backend import closure_residual, correct
+from ...kinematics.motion import generic_configuration
 from ...kinematics.jacobian import complete_jacobian, driver_determinants
 from ...kinematics.forward import forward_position
 from ...geometry.rotations import check_sequence

@@ -64,9 +64,9 @@ from ...errors import InputError
 from ...geometry.rotations import euler_matrix, transform
 from ...geometry.validate import as_finite_array
 from ...serialize import fields_dict
-from .. import compiled
-from ..jit import SAFE_FASTMATH, njit, prange
-from ..kernels_se3 import SINCOS_MAX, nb_sincos
+from .. import backend
+from ..compiled.jit import SAFE_FASTMATH, njit, prange
+from ..compiled.kernels_se3 import SINCOS_MAX, nb_sincos
 from . import sps
 
 __all__ = [
@@ -397,12 +397,12 @@ def leg_lengths(phi, geometry: FourSpsCuGeometry = PAPER_B, *, squared: bool = F
     ``squared=True`` returns ``l_i^2`` (m^2).  Example: ``leg_lengths([0.2, 0, 0, 0])`` gives
     ``sqrt(0.06) = 0.2449...`` for every leg (the catalog model's reference).
     """
-    fast = compiled.enabled() and isinstance(phi, np.ndarray) and phi.dtype == np.float64 and phi.shape[-1:] == (4,)
+    fast = backend.enabled() and isinstance(phi, np.ndarray) and phi.dtype == np.float64 and phi.shape[-1:] == (4,)
     if not fast:  # the compiled kernels flag NaN and infinity themselves: no separate pass
         phi = _phi(phi)
     flat = np.ascontiguousarray(phi.reshape(-1, 4))
     out = np.empty_like(flat)
-    if compiled.enabled():
+    if backend.enabled():
         kernel = _legs_kernel_parallel if flat.shape[0] >= PARALLEL_FROM else _legs_kernel
         if kernel(flat, float(geometry.a), float(geometry.b), bool(squared), out):
             _phi(phi)  # the named error (a finite pose whose sum overflowed passes: its legs are right)

@@ -47,8 +47,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError
-from ..geometry.tolerances import (
+from ...errors import InputError
+from ...geometry.tolerances import (
     HOMOTOPY_INFINITY,
     HOMOTOPY_JUMP,
     HOMOTOPY_NEAR_REAL,
@@ -56,11 +56,11 @@ from ..geometry.tolerances import (
     HOMOTOPY_REAL,
     HOMOTOPY_SINGULAR,
 )
-from ..model.mechanism import Mechanism
-from ..results import EndPointStatus
-from . import compiled
+from ...model.mechanism import Mechanism
+from ...results import EndPointStatus
+from .. import backend
 from .endgame import cauchy_endgame, local_dimension
-from .homotopy_systems import (
+from .systems import (
     PoseSystem,
     StewartSystem,
     geometry_family,
@@ -70,7 +70,6 @@ from .homotopy_systems import (
     system_from_points,
     unsupported_reason,
 )
-from .jit import njit
 
 __all__ = [
     "HomotopyResult",
@@ -177,160 +176,6 @@ def track(fun, X0: np.ndarray, *, h0: float = 0.02, hmin: float = 1e-14, max_ste
     return X, t, done, steps
 
 
-# ------------------------------------------------------------------------------ compiled parameter homotopy
-@njit(cache=True)
-def _lu_solve(A, b, out):
-    """``A x = b`` (complex, small) by LU with partial pivoting into ``out``; False when a pivot
-    is zero or not finite (the batched NumPy tracker's LinAlgError)."""
-    n = A.shape[0]
-    M = A.copy()
-    y = b.copy()
-    for k in range(n):
-        p = k
-        big = abs(M[k, k])
-        for i in range(k + 1, n):
-            if abs(M[i, k]) > big:
-                big = abs(M[i, k])
-                p = i
-        if not big > 0.0 or not np.isfinite(big):
-            return False
-        if p != k:
-            for j in range(n):
-                M[k, j], M[p, j] = M[p, j], M[k, j]
-            y[k], y[p] = y[p], y[k]
-        for i in range(k + 1, n):
-            f = M[i, k] / M[k, k]
-            for j in range(k, n):
-                M[i, j] -= f * M[k, j]
-            y[i] -= f * y[k]
-    for i in range(n - 1, -1, -1):
-        acc = y[i]
-        for j in range(i + 1, n):
-            acc -= M[i, j] * out[j]
-        out[i] = acc / M[i, i]
-    return True
-
-
-@njit(cache=True)
-def _param_system(Q0, dQ, c, x, t, F, J, Ht):
-    """:func:`_eval_quad` of one point on the straight coefficient path ``Q0 + t dQ`` and ``H_t``."""
-    n = x.shape[0]
-    for k in range(7):
-        acc = 0.0j
-        acct = 0.0j
-        for i in range(n):
-            qx = 0.0j
-            dx = 0.0j
-            for j in range(n):
-                qx += (Q0[k, i, j] + t * dQ[k, i, j]) * x[j]
-                dx += dQ[k, i, j] * x[j]
-            J[k, i] = 2.0 * qx
-            acc += qx * x[i]
-            acct += dx * x[i]
-        F[k] = acc
-        Ht[k] = acct
-    acc = -1.0 + 0.0j
-    for i in range(n):
-        acc += x[i] * c[i]
-        J[7, i] = c[i]
-    F[7] = acc
-    Ht[7] = 0.0
-
-
-@njit(cache=True)
-def _param_vel(Q0, dQ, c, x, t, F, J, Ht, out):
-    ok = True
-    _param_system(Q0, dQ, c, x, t, F, J, Ht)
-    for i in range(Ht.shape[0]):
-        Ht[i] = -Ht[i]
-    ok = _lu_solve(J, Ht, out)
-    return ok
-
-
-@njit(cache=True)
-def _track_param(Q0, dQ, c, X0, h0, hmin, max_steps, jump, newton, X, T, done):
-    """:func:`track` of the parameter homotopy, path by path (compiled): the same RK4 predictor,
-    two Newton corrections, acceptance test and step control."""
-    n = X0.shape[1]
-    F = np.empty(n, dtype=np.complex128)
-    J = np.empty((n, n), dtype=np.complex128)
-    Ht = np.empty(n, dtype=np.complex128)
-    k1 = np.empty(n, dtype=np.complex128)
-    k2 = np.empty(n, dtype=np.complex128)
-    k3 = np.empty(n, dtype=np.complex128)
-    k4 = np.empty(n, dtype=np.complex128)
-    xs = np.empty(n, dtype=np.complex128)
-    xc = np.empty(n, dtype=np.complex128)
-    dx = np.empty(n, dtype=np.complex128)
-    for p in range(X0.shape[0]):
-        x = X[p]
-        for i in range(n):
-            x[i] = X0[p, i]
-        t = 0.0
-        h = h0
-        good = 0
-        fin = False
-        for _ in range(max_steps):
-            hh = min(h, 1.0 - t)
-            ok = _param_vel(Q0, dQ, c, x, t, F, J, Ht, k1)
-            if ok:
-                for i in range(n):
-                    xs[i] = x[i] + 0.5 * hh * k1[i]
-                ok = _param_vel(Q0, dQ, c, xs, t + 0.5 * hh, F, J, Ht, k2)
-            if ok:
-                for i in range(n):
-                    xs[i] = x[i] + 0.5 * hh * k2[i]
-                ok = _param_vel(Q0, dQ, c, xs, t + 0.5 * hh, F, J, Ht, k3)
-            if ok:
-                for i in range(n):
-                    xs[i] = x[i] + hh * k3[i]
-                ok = _param_vel(Q0, dQ, c, xs, t + hh, F, J, Ht, k4)
-            d0 = np.inf
-            d1 = np.inf
-            tn = t + hh
-            if ok:
-                nx = 0.0
-                for i in range(n):
-                    xc[i] = x[i] + hh / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
-                    nx += abs(xc[i]) ** 2
-                nx = 1.0 + np.sqrt(nx)
-                _param_system(Q0, dQ, c, xc, tn, F, J, Ht)
-                ok = _lu_solve(J, F, dx)
-                if ok:
-                    s0 = 0.0
-                    for i in range(n):
-                        s0 += abs(dx[i]) ** 2
-                        xc[i] -= dx[i]
-                    d0 = np.sqrt(s0) / nx
-                    _param_system(Q0, dQ, c, xc, tn, F, J, Ht)
-                    ok = _lu_solve(J, F, dx)
-                if ok:
-                    s1 = 0.0
-                    for i in range(n):
-                        s1 += abs(dx[i]) ** 2
-                        xc[i] -= dx[i]
-                    d1 = np.sqrt(s1) / nx
-            acc = ok and np.isfinite(d0) and np.isfinite(d1) and d0 < jump and (d1 < 0.1 * d0 or d1 < newton)
-            if acc:
-                for i in range(n):
-                    x[i] = xc[i]
-                t = tn
-                good += 1
-                if good >= 2:
-                    h *= 2.0
-                    good = 0
-                if t >= 1.0:
-                    fin = True
-                    break
-            else:
-                h *= 0.5
-                good = 0
-                if h < hmin:
-                    break
-        T[p] = t
-        done[p] = fin
-
-
 def track_parameter(Q0: np.ndarray, Q1: np.ndarray, c: np.ndarray, X0: np.ndarray, *,
                     h0: float = 0.02, hmin: float = 1e-14, max_steps: int = 4000):
     """The parameter homotopy from the quadrics ``Q0`` (7, 8, 8; points ``X0``) to ``Q1`` along
@@ -340,15 +185,8 @@ def track_parameter(Q0: np.ndarray, Q1: np.ndarray, c: np.ndarray, X0: np.ndarra
     X0 = np.ascontiguousarray(X0, dtype=complex)
     Q0 = np.ascontiguousarray(Q0, dtype=complex)
     dQ = np.ascontiguousarray(np.asarray(Q1, dtype=complex) - Q0)
-    if compiled.enabled():
-        X = np.empty_like(X0)
-        T = np.zeros(len(X0))
-        done = np.zeros(len(X0), dtype=np.bool_)
-        if len(X0):
-            _track_param(Q0, dQ, np.ascontiguousarray(c, dtype=complex), X0,
-                         float(h0), float(hmin), int(max_steps), float(HOMOTOPY_JUMP), float(HOMOTOPY_NEWTON),
-                         X, T, done)
-        return X, T, done
+    if (fast := backend.engine()) is not None:
+        return fast.track_parameter(Q0, dQ, c, X0, h0=h0, hmin=hmin, max_steps=max_steps)
 
     def fun(X, t):
         F, J, _ = _eval_quad(Q0[None] + t[:, None, None, None] * dQ[None], c, X)

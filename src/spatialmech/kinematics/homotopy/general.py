@@ -1,5 +1,5 @@
 """Every assembly mode of a model whose limbs do not reduce to quadrics in the Study parameters
-(:mod:`.homotopy_systems`): the loop formulation of :mod:`.loop_system` (joint variables,
+(:mod:`.systems`): the loop formulation of :mod:`.loop_system` (joint variables,
 generated from the model; link-and-joint graphs with internal bodies included, each body's
 displacement the product of a reference limb or its own Study parameters) solved by monodromy
 and a parameter homotopy.  A real solution becomes a :class:`Configuration` with its bodies
@@ -25,7 +25,7 @@ the line from ``P0`` through a fresh start pair) then proves the generic solutio
 says why not, and ``complete`` is true only when it passed.  A parameter homotopy along the
 straight segment from ``P0`` to the request (actuators given, no offsets) then tracks every
 known solution, with the NumPy tracker
-:func:`.homotopy.track` and the compiled square system (:mod:`.kernels_loops`).  The generic
+:func:`.study.track` and the compiled square system (``compiled/kernels_loops.py``).  The generic
 solve is cached per geometry (in memory).
 """
 
@@ -36,9 +36,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError
-from ..geometry.rotations import matrix_rotvec, skew
-from ..geometry.tolerances import (
+from ...errors import InputError
+from ...geometry.rotations import matrix_rotvec, skew
+from ...geometry.tolerances import (
     HOMOTOPY_INFINITY,
     HOMOTOPY_REAL,
     HOMOTOPY_SINGULAR,
@@ -53,11 +53,11 @@ from ..geometry.tolerances import (
     TRACE_MAX_WORK_FULL,
     TRACE_TOL,
 )
-from ..model.mechanism import Mechanism
-from ..results import EndPointStatus, TraceVerdict
-from .closure import Configuration, limb_slices
+from ...model.mechanism import Mechanism
+from ...results import EndPointStatus, TraceVerdict
+from ..closure import Configuration, limb_slices
 from .endgame import cauchy_endgame
-from .homotopy import study_to_pose, track
+from .study import study_to_pose, track
 from .loop_system import LoopSystem, general_reason, loop_system, variables
 from .trace_test import TraceResult, new_points, trace_test
 
@@ -565,7 +565,7 @@ def rebuild_configuration(sysm: LoopSystem, x: np.ndarray, targets: dict[int, fl
         hub[h.hub] = M
     slices = limb_slices(mech)
     chains = {}
-    from .closure import limb_chains
+    from ..closure import limb_chains
 
     for ch, sl in zip(limb_chains(mech), slices, strict=True):
         for first, _, axes in ch.balls:

@@ -1,4 +1,4 @@
-"""Compiled kernels of the closure engine (:mod:`.compiled`): limb chains by products of
+"""Compiled kernels of the closure engine (:mod:`spatialmech.kinematics.compiled`): limb chains by products of
 exponentials, the closure residual and Jacobian, Newton correction with retraction, and the
 per-limb Gauss-Newton of inverse position; the same steps as :mod:`.closure` and :mod:`.position`."""
 
@@ -350,7 +350,7 @@ def nb_finite_config(q, D, B):
 @njit(cache=True)
 def nb_correct(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends, linear, L, qs, Ds, Bs, active,
              fix_platform, tol, max_iter, q_out, D_out, B_out, status, iters, resid):
-    """:func:`.closure.correct` from each seed ``qs[s], Ds[s], Bs[s]``: the result in ``q_out[s]``,
+    """:func:`..closure.correct` from each seed ``qs[s], Ds[s], Bs[s]``: the result in ``q_out[s]``,
     ``D_out[s]``, ``B_out[s]``, with ``status[s]`` 1 converged, 2 stationary (steps vanished
     without closure), 0 not converged, -1 a seed holding NaN or infinity (left unsolved: the
     caller names the problem), the iterations and the residual."""

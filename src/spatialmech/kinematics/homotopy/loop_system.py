@@ -1,4 +1,4 @@
-"""The loop formulation of the forward position (:mod:`.homotopy_general`): the closure of a
+"""The loop formulation of the forward position (:mod:`.general`): the closure of a
 model whose limbs do not reduce to quadrics in the Study parameters, as a square polynomial
 system in the joint variables, generated from the model.
 
@@ -14,7 +14,7 @@ a limb runs from hub ``a`` to hub ``b`` and closes as ``H_a FK = H_b``.  Each mo
 displacement is, in turn, the product of a limb without S joint (the one with the fewest
 unknowns) from a hub placed before it (a *reference limb*; its factors inverted in reverse order
 when the limb runs towards the placed hub), or, where no such limb reaches it, its own Study
-parameters ``x = (e ; g)`` of :mod:`.homotopy` (``(e.e) H`` polynomial, with ``e.g = 0`` and a
+parameters ``x = (e ; g)`` of :mod:`.study` (``(e.e) H`` polynomial, with ``e.g = 0`` and a
 random complex patch).  Without bodies this is the platform's reference limb, or the platform in
 Study parameters when every limb has an S joint.  Each other limb gives (``H_a`` multiplying
 the side before its S joints, ``H_b`` the side after, each side times the other's scale):
@@ -44,11 +44,11 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..errors import InputError
-from ..geometry.rotations import skew
-from ..model.mechanism import Mechanism
-from . import compiled, kernels_loops
-from .closure import Configuration, limb_slices
+from ...errors import InputError
+from ...geometry.rotations import skew
+from ...model.mechanism import Mechanism
+from .. import backend
+from ..closure import Configuration, limb_slices
 
 __all__ = [
     "LoopSystem",
@@ -348,16 +348,16 @@ class LoopSystem:
 
     def square(self, Z, W=None, *, reference: bool = False, want_J: bool = True):
         """The square system ``G`` (n, nx) and its derivative (n, nx, nz) in ``z = (x ; p)``,
-        with the offset parameters ``W`` (n, nw; default none): compiled (:mod:`.kernels_loops`)
+        with the offset parameters ``W`` (n, nw; default none): compiled (``compiled/kernels_loops.py``)
         when the compiled core is in use and not ``reference``."""
         if W is None:
             W = self.identity_offsets(len(Z))
-        if not reference and compiled.enabled():
+        if not reference and (fast := backend.engine()) is not None:
             packed = _PACKED.get(self)
             if packed is None:
-                packed = _PACKED[self] = kernels_loops.pack(self, _STUDY_Q)
-            return kernels_loops.square_batch(np.ascontiguousarray(Z, dtype=np.complex128),
-                                              np.ascontiguousarray(W, dtype=np.complex128), want_J, *packed)
+                packed = _PACKED[self] = fast.pack_loop_system(self, _STUDY_Q)
+            return fast.loop_square_batch(np.ascontiguousarray(Z, dtype=np.complex128),
+                                          np.ascontiguousarray(W, dtype=np.complex128), want_J, *packed)
         F1, J1 = self.side(Z)
         F2, J2 = self.closure(Z, W=W)
         F = np.concatenate([F1, np.einsum("mr,nr->nm", self.compress, F2)], axis=1)
@@ -400,7 +400,7 @@ def _rotation_forms(q: np.ndarray) -> np.ndarray:
 
 def _study_forms() -> np.ndarray:
     """``(e.e) D`` of the Study parameters as quadratic forms: (4, 4, 8, 8) symmetric."""
-    from .homotopy_systems import qmul
+    from .systems import qmul
 
     def nd(x):
         e, g = x[:4], x[4:]
@@ -621,7 +621,7 @@ def variables(sysm: LoopSystem, config: Configuration) -> np.ndarray:
     for h in sysm.studies:
         from scipy.spatial.transform import Rotation
 
-        from .homotopy_systems import qmul
+        from .systems import qmul
 
         H = config.hub(h.hub)
         x, y, zz, w = Rotation.from_matrix(H[:3, :3]).as_quat()
@@ -638,7 +638,7 @@ def _limb_ranks(sysm: LoopSystem, sizes: list[int], rng: np.random.Generator) ->
     rank of their derivative along the side equations' solution set (circles, Study quadric),
     the actuators held, at a generic
     configuration of the mechanism (a random walk from the reference along its closure)."""
-    from .closure import generic_configuration
+    from ..motion import generic_configuration
 
     try:
         config = generic_configuration(sysm.mech, seed=int(rng.integers(2**31)), step=0.5, steps=4)

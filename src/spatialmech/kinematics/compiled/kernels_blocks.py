@@ -1,4 +1,4 @@
-"""Minimum-norm Newton steps of the closure by block elimination (compiled, :mod:`.compiled`).
+"""Minimum-norm Newton steps of the closure by block elimination (compiled, :mod:`.engine`).
 
 The closure Jacobian of a mechanism has one block of six rows per limb.  A limb's own joint
 columns touch only its rows; the hubs' twist columns (the output link, the internal bodies) are
@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..geometry.tolerances import BLOCK_MAX_COND, BLOCK_RANK_ZERO
+from ...geometry.tolerances import BLOCK_MAX_COND, BLOCK_RANK_ZERO
 from .jit import njit
 
 __all__ = [

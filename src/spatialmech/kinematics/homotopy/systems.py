@@ -1,4 +1,4 @@
-"""The polynomial systems of the homotopy forward position (:mod:`.homotopy`): each limb of a
+"""The polynomial systems of the homotopy forward position (:mod:`.study`): each limb of a
 platform, with the actuator values given, as quadrics in the Study parameters ``x = (e ; g)``
 of the platform displacement.
 
@@ -17,8 +17,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import InputError
-from ..model.mechanism import Mechanism
+from ...errors import InputError
+from ...model.mechanism import Mechanism
 
 __all__ = [
     "PoseSystem",
@@ -384,7 +384,7 @@ def _reduce_limb(limb, L: float, act_index: dict, hubs: dict) -> tuple[str | Non
         return None, [rod], f"{limb.name} ({'-'.join(types)} rod from driven {limb.base}): sphere about a moving centre"
     prefix = [f for j in limb.joints[:-2] for f in j.freedoms]
     if len(types) > 2 and _is_rod(limb.joints[-2:], L) and all(f.actuated and id(f) in act_index for f in prefix):
-        from .closure import limb_forward
+        from ..closure import limb_forward
 
         S = np.array([f.screw for f in prefix])
         ks = [act_index[id(f)] for f in prefix]
@@ -484,7 +484,7 @@ def _reduce_limb(limb, L: float, act_index: dict, hubs: dict) -> tuple[str | Non
 
 def _general(mech: Mechanism) -> tuple[str | None, PoseSystem | None]:
     """(why not, system) of the general reduction (see :func:`pose_system`)."""
-    from .closure import limb_forward, limb_slices, reference_screws
+    from ..closure import limb_forward, limb_slices, reference_screws
 
     L = float(mech.characteristic_length)
     acts = [mech.freedom(a) for a in mech.actuators]

@@ -36,9 +36,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..geometry.tolerances import MONODROMY_PARALLEL, TRACE_MAX_LOOPS, TRACE_STALE_LOOPS, TRACE_STEP, TRACE_TOL
-from ..results import TraceVerdict
-from .homotopy import track
+from ...geometry.tolerances import MONODROMY_PARALLEL, TRACE_MAX_LOOPS, TRACE_STALE_LOOPS, TRACE_STEP, TRACE_TOL
+from ...results import TraceVerdict
+from .study import track
 
 __all__ = ["TraceResult", "new_points", "trace_test"]
 

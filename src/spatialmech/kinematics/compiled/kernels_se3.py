@@ -1,4 +1,4 @@
-"""Small compiled kernels of the closure engine (:mod:`.compiled`): 3-vector and matrix products,
+"""Small compiled kernels of the closure engine (:mod:`.engine`): 3-vector and matrix products,
 rotation vectors, SE(3) exponential and logarithm, least squares and determinants, on plain
 float64 arrays, writing into ``out`` arguments (no allocation in the inner loops)."""
 

@@ -19,7 +19,7 @@ root), and stop on other solutions, as far away as the perturbation, when the po
 continuum.
 
 Both functions take the tracker and the system as functions (``track(QA, QB, c, X)`` as
-:func:`.homotopy.track_parameter`, ``evaluate(X) -> (F, J)``), so that they serve any square
+:func:`.study.track_parameter`, ``evaluate(X) -> (F, J)``), so that they serve any square
 polynomial system on an affine patch.
 """
 
@@ -30,7 +30,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ..geometry.tolerances import (
+from ...geometry.tolerances import (
     ENDGAME_AGREE,
     ENDGAME_CLOSED,
     ENDGAME_LOOPS,

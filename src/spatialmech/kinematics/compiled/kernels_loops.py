@@ -1,4 +1,4 @@
-"""The compiled evaluation of the loop formulation's square system (:mod:`.loop_system`):
+"""The compiled evaluation of the loop formulation's square system (:mod:`..homotopy.loop_system`):
 the same equations as :meth:`.loop_system.LoopSystem.square` (the NumPy reference, which
 runs under ``SPATIALMECH_PURE=1``), point by point in numba.
 
@@ -21,7 +21,7 @@ __all__ = ["pack", "square_batch"]
 
 
 def pack(sysm, study_q: np.ndarray) -> tuple:
-    """The arguments of :func:`square_batch` for a :class:`.homotopy_general.LoopSystem`."""
+    """The arguments of :func:`square_batch` for a :class:`..homotopy.loop_system.LoopSystem`."""
     chains: list[tuple] = []
     h_chain: list[int] = []
     for h in sysm.hubs:

@@ -1,10 +1,10 @@
-"""The general closure engine compiled (numba): the same computations as :mod:`.closure`,
-:func:`.jacobian.driver_determinants` and the per-limb inverse position, on plain arrays.
+"""The general closure engine compiled (numba): the same computations as :mod:`..closure`,
+:func:`..jacobian.driver_determinants` and the per-limb inverse position, on plain arrays.
 
 The kernels themselves are plain-array numba functions in :mod:`.kernels_se3` (small linear
 algebra, SE(3)), :mod:`.kernels_closure` (chains, closure system, Newton, limb Gauss-Newton) and
 :mod:`.kernels_drivers` (driver determinants, configuration difference, S-P-S legs); this module
-holds the switch, the compiled model and the Python entry points.
+holds the compiled model and the Python entry points.
 
 A mechanism is compiled once into arrays (:class:`CompiledMechanism`, cached per mechanism):
 the reference screws of its freedoms, its ball (S) joints (first freedom, axes, centre), the
@@ -14,12 +14,12 @@ functions of those arrays: compiled on first use and cached on disk next to this
 numba's user-wide cache when this directory is not writable), so later processes only load
 them.
 
-The Python path stays the reference: :func:`.closure.correct`, :func:`.closure.closure_jacobian`,
-:func:`.closure.closure_residual`, :func:`.jacobian.driver_determinants` and the per-limb
-Gauss-Newton of :mod:`.position` call these kernels when :func:`enabled` (numba importable and
-the environment variable ``SPATIALMECH_PURE`` unset or ``0``) and run their own Python code
-otherwise.  Same steps, tolerances and statuses; the results agree to rounding (the test suite
-compares both paths on every ready-made model).
+The Python path stays the reference: :func:`..closure.correct`, :func:`..closure.closure_jacobian`,
+:func:`..closure.closure_residual`, :func:`..jacobian.driver_determinants` and the per-limb
+Gauss-Newton of :mod:`..position`.  :mod:`..backend` picks this engine or the reference
+(:func:`..backend.enabled`: numba importable, ``SPATIALMECH_PURE`` unset or ``0`` at import, no
+``python_reference()`` block open).  Same steps, tolerances and statuses; the results agree to
+rounding (the test suite compares both paths on every ready-made model).
 
 Batched entry points for many configurations, seeds or poses: :func:`closure_residuals`,
 :func:`closure_jacobians`, :func:`correct_many`, :func:`limb_inverse_many`,
@@ -28,19 +28,16 @@ Batched entry points for many configurations, seeds or poses: :func:`closure_res
 
 from __future__ import annotations
 
-import os
-import warnings
 import weakref
-from collections.abc import Iterator, Sequence
-from contextlib import contextmanager
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError
-from ..geometry.tolerances import current as current_tolerances
-from ..model.mechanism import Mechanism
-from .closure import (
+from ...errors import InputError
+from ...geometry.tolerances import current as current_tolerances
+from ...model.mechanism import Mechanism
+from ..closure import (
     Chain,
     Configuration,
     CorrectionResult,
@@ -51,31 +48,14 @@ from .closure import (
     reference_screws,
 )
 
-from .jit import AVAILABLE, UNAVAILABLE_REASON
 from .kernels_blocks import nb_blocks_workspace, nb_minnorm_blocks
-from .kernels_closure import (
-    RETRACT_WS,
-    nb_correct,
-    nb_correct_hyperplane,
-    nb_limb_gn,
-    nb_retract,
-    nb_systems,
-)
-from .kernels_drivers import (
-    nb_dets_many,
-    nb_difference,
-    nb_differences,
-    nb_sps_legs,
-)
-from .kernels_se3 import (
-    nb_lstsq,
-)
+from .kernels_closure import RETRACT_WS, nb_correct, nb_correct_hyperplane, nb_limb_gn, nb_retract, nb_systems
+from .kernels_drivers import nb_dets_many, nb_difference, nb_differences, nb_sps_legs
+from .kernels_se3 import nb_lstsq
 
 
 
 __all__ = [
-    "AVAILABLE",
-    "PURE_ENV",
     "CompiledMechanism",
     "closure_jacobian",
     "closure_jacobians",
@@ -89,70 +69,14 @@ __all__ = [
     "correct_on_hyperplane",
     "driver_determinants",
     "driver_determinants_many",
-    "enabled",
     "limb_gn",
     "limb_inverse_many",
     "lstsq",
     "minnorm_blocks",
-    "python_reference",
     "retract",
     "sps_leg_lengths",
     "warm_up",
 ]
-
-#: Set this environment variable to ``1`` to run the pure-Python engine (the reference).
-PURE_ENV = "SPATIALMECH_PURE"
-
-_NOTED = False
-
-
-def _env_pure() -> bool:
-    pure = os.environ.get(PURE_ENV)
-    return bool(pure and pure.strip() not in ("", "0"))
-
-
-#: ``SPATIALMECH_PURE`` as it was when this module was imported, and how many
-#: :func:`python_reference` blocks are open: :func:`enabled` reads these two (not the
-#: environment, whose lookup costs a microsecond on every solve).
-_ENV_PURE = _env_pure()
-_REFERENCE_DEPTH = 0
-
-
-def enabled() -> bool:
-    """True when the compiled kernels are used: numba imports, ``SPATIALMECH_PURE`` was unset
-    (or ``0``) when spatialmech was imported, and no :func:`python_reference` block is open (a
-    test or a benchmark switches paths in one process with that block).  Without numba a
-    one-time ``RuntimeWarning`` says that the Python path runs."""
-    global _NOTED
-    if _ENV_PURE or _REFERENCE_DEPTH:
-        return False
-    if not AVAILABLE:
-        if not _NOTED:
-            _NOTED = True
-            warnings.warn(f"spatialmech: {UNAVAILABLE_REASON or 'numba is not available'}; the pure-Python engine "
-                          "runs instead (slower, same results)", RuntimeWarning, stacklevel=3)
-        return False
-    return True
-
-
-@contextmanager
-def python_reference() -> Iterator[None]:
-    """Run the block on the pure-Python reference path, for comparisons and benchmarks.  It also
-    sets ``SPATIALMECH_PURE=1`` for its duration (then restores the previous value), so that a
-    subprocess started inside runs the reference too."""
-    global _REFERENCE_DEPTH
-    old = os.environ.get(PURE_ENV)
-    os.environ[PURE_ENV] = "1"
-    _REFERENCE_DEPTH += 1
-    try:
-        yield
-    finally:
-        _REFERENCE_DEPTH -= 1
-        if old is None:
-            del os.environ[PURE_ENV]
-        else:
-            os.environ[PURE_ENV] = old
-
 
 # ---------------------------------------------------------------------------- compiled model
 @dataclass(frozen=True, eq=False)
@@ -401,7 +325,7 @@ def _shapes(mech: Mechanism, cm: CompiledMechanism, config: Configuration) -> No
 
 def correct(mech: Mechanism, config: Configuration, *, active: np.ndarray | None = None, fix_platform: bool = False,
             tol: float | None = None, max_iter: int = 50) -> CorrectionResult:
-    """:func:`.closure.correct`, compiled (same steps, tolerances and statuses)."""
+    """:func:`..closure.correct`, compiled (same steps, tolerances and statuses)."""
     cm = compile_mechanism(mech)
     _shapes(mech, cm, config)
     act = _mask(mech, cm, active)
@@ -671,9 +595,10 @@ def warm_up() -> float:
     seconds it took (the first-call cost a user pays once per process)."""
     import time
 
-    from ..model.joints import P, R, S
-    from ..model.mechanism import Limb  # here, not at the top: only the warm-up builds a model
-    from .closure import correct as closure_correct  # the dispatching entry: it takes the legs' path
+    from ...model.joints import P, R, S
+    from ...model.mechanism import Limb  # here, not at the top: only the warm-up builds a model
+    from ..leg_platform import leg_platform
+    from .legs import correct_legs  # here, not at the top: legs.py builds on this module
 
     t0 = time.perf_counter()
     z = [0.0, 0.0, 1.0]
@@ -701,5 +626,7 @@ def warm_up() -> float:
     held[[7 * i + 3 for i in range(6)]] = False
     q = np.zeros(42)
     q[~held] = 0.01
-    closure_correct(stewart, Configuration(q, np.eye(4)), active=held)
+    lp = leg_platform(stewart)
+    assert lp is not None and lp.applies(held)
+    correct_legs(stewart, lp, Configuration(q, np.eye(4)), active=held)
     return time.perf_counter() - t0

@@ -1,19 +1,12 @@
 """Compiled kernels of the driver determinants (:func:`.jacobian.driver_determinants`,
 :func:`.jacobian.closure_determinant`), the tracker's configuration difference and the S-P-S
-leg lengths (:mod:`.compiled`)."""
+leg lengths (:mod:`.engine`)."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from .kernels_se3 import (
-    nb_ball_product,
-    nb_det,
-    nb_inverse_into,
-    nb_log,
-    nb_mm4,
-    nb_svd,
-)
+from .kernels_se3 import nb_ball_product, nb_det, nb_inverse_into, nb_log, nb_mm4, nb_svd
 from .kernels_closure import (
     nb_adjoint_columns,
     nb_chain,

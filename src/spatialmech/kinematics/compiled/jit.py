@@ -1,6 +1,6 @@
-"""The numba entry point of the compiled kernels (:mod:`.compiled`): ``njit``, or, where numba
+"""The numba entry point of the compiled kernels (:mod:`spatialmech.kinematics.compiled`): ``njit``, or, where numba
 cannot be imported, a stand-in that leaves functions as plain Python (the kernels then never
-run: :func:`.compiled.enabled` is false and the Python reference path runs).
+run: :func:`..backend.enabled` is false and the Python reference path runs).
 
 First-call compilation is what a new user waits for, so two rules for the kernels:
 

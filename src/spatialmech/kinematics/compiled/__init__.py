@@ -1,0 +1,74 @@
+"""The compiled engine (numba).
+
+:mod:`.engine` holds the compiled model and the Python entry points (the same computations as
+the Python reference in :mod:`spatialmech.kinematics.closure` and the modules that use it);
+the kernels are plain-array ``@njit(cache=True)`` functions in :mod:`.kernels_se3`,
+:mod:`.kernels_closure`, :mod:`.kernels_blocks`, :mod:`.kernels_drivers`, :mod:`.kernels_legs`
+(with its entry :mod:`.legs`: six S-P-S legs in pose coordinates), :mod:`.kernels_homotopy` (the
+Study formulation's parameter homotopy) and :mod:`.kernels_loops` (the loop formulation's square
+system); :mod:`.jit` is numba's ``njit`` or its stand-in.
+
+Callers do not choose between this package and the Python reference themselves:
+:mod:`spatialmech.kinematics.backend` does (``backend.engine()`` is this package when it is in
+use, else ``None``).  This package imports the Python reference (its data types, chains and
+checks); the reference never imports this package.
+"""
+
+from __future__ import annotations
+
+from .engine import (
+    CompiledMechanism,
+    closure_jacobian,
+    closure_jacobians,
+    closure_residual,
+    closure_residuals,
+    compile_mechanism,
+    config_difference,
+    config_differences,
+    correct,
+    correct_many,
+    correct_on_hyperplane,
+    driver_determinants,
+    driver_determinants_many,
+    limb_gn,
+    limb_inverse_many,
+    lstsq,
+    minnorm_blocks,
+    retract,
+    sps_leg_lengths,
+    warm_up,
+)
+from .jit import AVAILABLE, UNAVAILABLE_REASON
+from .kernels_homotopy import track_parameter
+from .kernels_loops import pack as pack_loop_system
+from .kernels_loops import square_batch as loop_square_batch
+from .legs import correct_legs
+
+__all__ = [
+    "AVAILABLE",
+    "UNAVAILABLE_REASON",
+    "CompiledMechanism",
+    "closure_jacobian",
+    "closure_jacobians",
+    "closure_residual",
+    "closure_residuals",
+    "compile_mechanism",
+    "config_difference",
+    "config_differences",
+    "correct",
+    "correct_legs",
+    "correct_many",
+    "correct_on_hyperplane",
+    "driver_determinants",
+    "driver_determinants_many",
+    "limb_gn",
+    "limb_inverse_many",
+    "loop_square_batch",
+    "lstsq",
+    "minnorm_blocks",
+    "pack_loop_system",
+    "retract",
+    "sps_leg_lengths",
+    "track_parameter",
+    "warm_up",
+]
