@@ -177,6 +177,14 @@ def link_graph(mech: Mechanism) -> LinkGraph:
     return LinkGraph(mech.name, tuple(links), tuple(joints), output=mech.output)
 
 
+#: An edge of a graph being read (:func:`mechanism_from_graph`): the joint moves link ``b``
+#: relative to link ``a``.
+_Edge = tuple[Joint, str, str]
+#: A chain between two hub links: its base, its edges each with whether it is traversed from
+#: ``a`` to ``b``, its intermediate links and its tip.
+_Chain = tuple[str, list[tuple[int, bool]], list[str], str]
+
+
 def mechanism_from_graph(name: str, links, joints, *, output: str | None = None, **kwargs) -> Mechanism:
     """A :class:`Mechanism` from its link-and-joint graph.
 
@@ -193,8 +201,24 @@ def mechanism_from_graph(name: str, links, joints, *, output: str | None = None,
     Errors name the field: unknown or duplicate links, a joint from a link to itself, links
     not connected to the ground, a link held by one joint only (it would move freely).
     """
-    from .joints import Joint as _JointType
+    names = _link_names(links)
+    output = _output_link(names, output)
+    edges = _graph_edges(joints, names)
+    degree = _check_held(names, edges, output)
+    hubs = [GROUND, output] + [ln for ln in names if ln not in (GROUND, output) and degree[ln] >= 3]
+    depth = _depths(edges)
+    limbs = []
+    taken: set[str] = set()
+    for chain in _chains(hubs, edges):
+        limb = _limb(edges, *_oriented(*chain, depth), output=output, taken=taken)
+        taken.add(limb.name)
+        limbs.append(limb)
+    bodies = tuple(ln for ln in hubs[2:])
+    return Mechanism(name=name, limbs=tuple(limbs), output=output, bodies=bodies, **kwargs)
 
+
+def _link_names(links) -> list[str]:
+    """The link names of :func:`mechanism_from_graph`, checked: strings, distinct, the ground among them."""
     if isinstance(links, (str, bytes)) or not hasattr(links, "__iter__"):
         raise TypeError(f"links: expected a sequence of link names, got {type(links).__name__}")
     names = list(links)
@@ -206,6 +230,11 @@ def mechanism_from_graph(name: str, links, joints, *, output: str | None = None,
         raise InputError(f"links: duplicate link names {dup}")
     if GROUND not in names:
         raise InputError(f"links: one link must be named {GROUND!r} (the fixed link); got {names}")
+    return names
+
+
+def _output_link(names: list[str], output: str | None) -> str:
+    """The output link: ``output``, by default the link named ``"platform"``; never the ground."""
     if output is None:
         if OUTPUT not in names:
             raise InputError(f"output: name the output link (the link whose pose is the task); links: {', '.join(names)}")
@@ -214,13 +243,19 @@ def mechanism_from_graph(name: str, links, joints, *, output: str | None = None,
         raise UnknownNameError(f"output: unknown link {output!r}; links: {', '.join(names)}")
     if output == GROUND:
         raise InputError("output: the output link cannot be the ground")
-    edges: list[tuple[Joint, str, str]] = []
+    return output
+
+
+def _graph_edges(joints, names: list[str]) -> list[_Edge]:
+    """The ``(joint, a, b)`` items of :func:`mechanism_from_graph`, checked: joints with
+    distinct names between two different known links, at least one of them."""
+    edges: list[_Edge] = []
     seen: set[str] = set()
     for k, item in enumerate(joints):
         if not (isinstance(item, (tuple, list)) and len(item) == 3):
             raise TypeError(f"joints[{k}]: expected (joint, link a, link b), got {item!r}")
         j, a, b = item
-        if not isinstance(j, _JointType):
+        if not isinstance(j, Joint):
             raise TypeError(f"joints[{k}]: expected a Joint (R, P, C, U, S, Sm, H), got {type(j).__name__}")
         for end in (a, b):
             if end not in names:
@@ -233,6 +268,12 @@ def mechanism_from_graph(name: str, links, joints, *, output: str | None = None,
         edges.append((j, a, b))
     if not edges:
         raise InputError("joints: a mechanism needs at least one joint")
+    return edges
+
+
+def _check_held(names: list[str], edges: list[_Edge], output: str) -> dict[str, int]:
+    """The number of joints at each link, after checking that every link is connected to the
+    ground and held by two joints or more (the ground and the output link by one or more)."""
     degree = dict.fromkeys(names, 0)
     for _, a, b in edges:
         degree[a] += 1
@@ -252,8 +293,12 @@ def mechanism_from_graph(name: str, links, joints, *, output: str | None = None,
         if ln not in (GROUND, output) and degree[ln] == 1:
             raise InputError(f"links: link {ln!r} is held by one joint only; it would move freely "
                              "(connect it or remove it)")
-    hubs = [GROUND, output] + [ln for ln in names if ln not in (GROUND, output) and degree[ln] >= 3]
-    # hub depth from the ground, to orient chains with no preferred direction
+    return degree
+
+
+def _depths(edges: list[_Edge]) -> dict[str, int]:
+    """Each link's depth from the ground (joints on a shortest path), to orient chains with no
+    preferred direction."""
     depth = {GROUND: 0}
     frontier = [GROUND]
     while frontier:
@@ -265,8 +310,14 @@ def mechanism_from_graph(name: str, links, joints, *, output: str | None = None,
                         depth[v] = depth[x] + 1
                         nxt.append(v)
         frontier = nxt
+    return depth
+
+
+def _chains(hubs: list[str], edges: list[_Edge]) -> list[_Chain]:
+    """The serial chains between hub links, each followed from the first hub (in ``hubs``
+    order) that has one of its end joints."""
     used: set[int] = set()
-    chains: list[tuple[str, list[tuple[int, bool]], list[str], str]] = []  # base, (edge, forward), inner, tip
+    chains: list[_Chain] = []
     hub_set = set(hubs)
     for h in hubs:
         for e0, (_, a0, b0) in enumerate(edges):
@@ -284,23 +335,27 @@ def mechanism_from_graph(name: str, links, joints, *, output: str | None = None,
                 inner.append(at)
                 e = next(i for i, (_, x, y) in enumerate(edges) if i not in used and at in (x, y))
             chains.append((h, steps, inner, at))
-    limbs = []
-    taken: set[str] = set()
-    for base, steps, inner, tip in chains:
-        n_back = sum(not f for _, f in steps)
-        flip = 2 * n_back > len(steps) or (2 * n_back == len(steps) and depth[tip] < depth[base])
-        if flip:
-            base, tip = tip, base
-            steps = [(e, not f) for e, f in steps[::-1]]
-            inner = inner[::-1]
-        js = [edges[e][0] if f else edges[e][0].flipped() for e, f in steps]
-        lname = js[0].name if len(js) == 1 else f"{js[0].name}-{js[-1].name}"
-        while lname in taken:
-            lname += "'"
-        taken.add(lname)
-        limbs.append(Limb(lname, tuple(js), base=base, tip=None if tip == output else tip, links=tuple(inner)))
-    bodies = tuple(ln for ln in hubs[2:])
-    return Mechanism(name=name, limbs=tuple(limbs), output=output, bodies=bodies, **kwargs)
+    return chains
+
+
+def _oriented(base: str, steps: list[tuple[int, bool]], inner: list[str], tip: str, depth: dict[str, int]) -> _Chain:
+    """The chain traversed in the direction most of its joints were described in (on a tie:
+    from the end nearer the ground)."""
+    n_back = sum(not f for _, f in steps)
+    if 2 * n_back > len(steps) or (2 * n_back == len(steps) and depth[tip] < depth[base]):
+        return tip, [(e, not f) for e, f in steps[::-1]], inner[::-1], base
+    return base, steps, inner, tip
+
+
+def _limb(edges: list[_Edge], base: str, steps: list[tuple[int, bool]], inner: list[str], tip: str, *,
+          output: str, taken: set[str]) -> Limb:
+    """The limb of an oriented chain, named after its end joints (primed until the name is not
+    in ``taken``); a joint traversed backwards is flipped."""
+    js = [edges[e][0] if f else edges[e][0].flipped() for e, f in steps]
+    lname = js[0].name if len(js) == 1 else f"{js[0].name}-{js[-1].name}"
+    while lname in taken:
+        lname += "'"
+    return Limb(lname, tuple(js), base=base, tip=None if tip == output else tip, links=tuple(inner))
 
 
 def _reach(g: LinkGraph, start: str) -> set[str]:

@@ -260,104 +260,153 @@ def pose_checker(mech: Mechanism, limits: WorkspaceLimits | None = None, *, meth
     if isinstance(plan, str) and method == "closed-form":
         raise InputError(f"method: no closed form for {mech.name}: {plan}")
     refs = mech.freedom_refs
-    los = np.array([refs[k].freedom.limits[0] for k in fl])
-    his = np.array([refs[k].freedom.limits[1] for k in fl])
-    rot = np.array([refs[k].freedom.kind != "P" for k in fl], dtype=bool)
-    offs = np.array([r.freedom.offset for r in refs])
     L = mech.characteristic_length
-    n_links = len(links)
-    names = [*names, CLOSURE]
-    scale = np.array([*scale, L])
-
+    kern = _Kernel(
+        mech=mech, links=links, cones=cones, pairs=pairs, fl=fl,
+        los=np.array([refs[k].freedom.limits[0] for k in fl]),
+        his=np.array([refs[k].freedom.limits[1] for k in fl]),
+        rot=np.array([refs[k].freedom.kind != "P" for k in fl], dtype=bool),
+        offs=np.array([r.freedom.offset for r in refs]),
+        L=L, names=[*names, CLOSURE], scale=np.array([*scale, L]),
+    )
     if not isinstance(plan, str):
-        slot = {k: i for i, k in enumerate(fl)}
-        link_of_limb = {lk.limb: k for k, lk in enumerate(links)}
+        cf = _ClosedFormKernel(kern, plan)
+        return PoseChecker(mech, limits, "closed-form", tuple(kern.names), kern.scale, cf.margins, "", _pinned(plan, L),
+                           cf.feasible)
+    general = _GeneralKernel(kern, general_seeds)
+    return PoseChecker(mech, limits, "general", tuple(kern.names), kern.scale, general.margins, plan, {})
 
-        def fn_pre(R, p):
-            n = R.shape[0]
-            seg_a = np.empty((n, n_links, 3))
-            seg_b = np.empty((n, n_links, 3))
-            vals = np.zeros((n, len(fl)))
-            closure = np.full(n, 1e-9 * L)
-            for li, item in enumerate(plan):
-                if item[0] == "leg":
-                    _, Bp, Aloc, lref, fi = item
-                    A = np.einsum("nij,j->ni", R, Aloc) + p
-                    length = np.linalg.norm(A - Bp, axis=-1)
-                    a_end, b_end = np.broadcast_to(Bp, A.shape), A
-                    if fi in slot:
-                        vals[:, slot[fi]] = offs[fi] + length - lref
-                else:
-                    _, c, k, uloc, sref, fi = item
-                    u = np.einsum("nij,j->ni", R, uloc) + p
-                    rel = u - c
-                    s = rel @ k
-                    closure -= np.linalg.norm(rel - s[:, None] * k, axis=-1)
-                    a_end, b_end = np.broadcast_to(c, u.shape), u
-                    if fi in slot:
-                        vals[:, slot[fi]] = offs[fi] + s - sref
-                if li in link_of_limb:
-                    seg_a[:, link_of_limb[li]] = a_end
-                    seg_b[:, link_of_limb[li]] = b_end
-            cols = [_freedom_margins(vals, los, his, rot)] if fl else []
-            cols += [c[:, None] for c in _cone_margins(seg_a, seg_b, R, cones)]
-            return np.concatenate([*cols, closure[:, None]], axis=1), seg_a, seg_b
 
-        n_pre = len(names) - 1 - len(pairs)
+@dataclass(frozen=True, eq=False)
+class _Kernel:
+    """What both pose-check kernels use: the links, cone (limit, link) pairs and capsule pairs
+    of :func:`_common`, the limited freedoms ``fl`` with their ranges (``los``, ``his``; ``rot``:
+    a rotation) and every freedom's offset, the characteristic length, the margin names and
+    scales (``"closure"`` last)."""
 
-        def fn(R, p):
-            pre, seg_a, seg_b = fn_pre(R, p)
-            out = np.empty((R.shape[0], len(names)))
-            out[:, :n_pre] = pre[:, :-1]
-            out[:, -1] = pre[:, -1]
-            for k, col in enumerate(_pair_margins(seg_a, seg_b, pairs)):
-                out[:, n_pre + k] = col
-            return out
+    mech: Mechanism
+    links: list[_Link]
+    cones: list
+    pairs: list
+    fl: list[int]
+    los: np.ndarray
+    his: np.ndarray
+    rot: np.ndarray
+    offs: np.ndarray
+    L: float
+    names: list[str]
+    scale: np.ndarray
 
-        def fn_feasible(R, p):
-            pre, seg_a, seg_b = fn_pre(R, p)
-            ok = np.all(pre >= 0.0, axis=1)
-            live = np.flatnonzero(ok)  # interference (the costly part) only where the rest holds
-            if live.size and pairs:
-                for col in _pair_margins(seg_a[live], seg_b[live], pairs):
-                    ok[live[col < 0.0]] = False
-            return ok
 
-        pinned = {}
-        for item in plan:
-            if item[0] == "cu" and np.linalg.norm(item[3]) < 1e-12 * L:
-                axis_k = np.flatnonzero(np.abs(np.abs(item[2]) - 1.0) < 1e-12)
-                if axis_k.size == 1:
-                    pinned.update({POSITION_COORDINATES[i]: float(item[1][i]) for i in range(3) if i != axis_k[0]})
-        return PoseChecker(mech, limits, "closed-form", tuple(names), scale, fn, "", pinned, fn_feasible)
+class _ClosedFormKernel:
+    """Margins of stacks of poses from the closed-form plan (:func:`_closed_form_plan`)."""
 
-    from ...kinematics.closure import hub_displacements, limb_slices
-    from ...kinematics.position import inverse_position, limb_clusters
+    def __init__(self, k: _Kernel, plan: list):
+        self.k, self.plan = k, plan
+        self.slot = {f: i for i, f in enumerate(k.fl)}
+        self.link_of_limb = {lk.limb: i for i, lk in enumerate(k.links)}
+        self.n_pre = len(k.names) - 1 - len(k.pairs)
 
-    def _general_row(config, R1):
-        vals = offs + config.q
-        pts = joint_points(mech, config)
-        seg_a = np.array([[pts[lk.limb][lk.ends[0]] for lk in links]]).reshape(1, n_links, 3)
-        seg_b = np.array([[pts[lk.limb][lk.ends[1]] for lk in links]]).reshape(1, n_links, 3)
-        cols = [_freedom_margins(vals[fl][None], los, his, rot)] if fl else []
-        cols += [c[:, None] for c in _cone_margins(seg_a, seg_b, R1, cones)]
-        cols += [c[:, None] for c in _pair_margins(seg_a, seg_b, pairs)]
-        cols.append(np.array([[1e-9 * L]]))  # reachable: the same closure margin as the closed form
+    def pre(self, R, p):
+        """``(margins but interference, closure last; link starts; link ends)``."""
+        k = self.k
+        n = R.shape[0]
+        seg_a = np.empty((n, len(k.links), 3))
+        seg_b = np.empty((n, len(k.links), 3))
+        vals = np.zeros((n, len(k.fl)))
+        closure = np.full(n, 1e-9 * k.L)
+        for li, item in enumerate(self.plan):
+            if item[0] == "leg":
+                _, Bp, Aloc, lref, fi = item
+                A = np.einsum("nij,j->ni", R, Aloc) + p
+                length = np.linalg.norm(A - Bp, axis=-1)
+                a_end, b_end = np.broadcast_to(Bp, A.shape), A
+                if fi in self.slot:
+                    vals[:, self.slot[fi]] = k.offs[fi] + length - lref
+            else:
+                _, c, ax, uloc, sref, fi = item
+                u = np.einsum("nij,j->ni", R, uloc) + p
+                rel = u - c
+                s = rel @ ax
+                closure -= np.linalg.norm(rel - s[:, None] * ax, axis=-1)
+                a_end, b_end = np.broadcast_to(c, u.shape), u
+                if fi in self.slot:
+                    vals[:, self.slot[fi]] = k.offs[fi] + s - sref
+            if li in self.link_of_limb:
+                seg_a[:, self.link_of_limb[li]] = a_end
+                seg_b[:, self.link_of_limb[li]] = b_end
+        cols = [_freedom_margins(vals, k.los, k.his, k.rot)] if k.fl else []
+        cols += [c[:, None] for c in _cone_margins(seg_a, seg_b, R, k.cones)]
+        return np.concatenate([*cols, closure[:, None]], axis=1), seg_a, seg_b
+
+    def margins(self, R, p):
+        pre, seg_a, seg_b = self.pre(R, p)
+        out = np.empty((R.shape[0], len(self.k.names)))
+        out[:, : self.n_pre] = pre[:, :-1]
+        out[:, -1] = pre[:, -1]
+        for i, col in enumerate(_pair_margins(seg_a, seg_b, self.k.pairs)):
+            out[:, self.n_pre + i] = col
+        return out
+
+    def feasible(self, R, p):
+        pre, seg_a, seg_b = self.pre(R, p)
+        ok = np.all(pre >= 0.0, axis=1)
+        live = np.flatnonzero(ok)  # interference (the costly part) only where the rest holds
+        if live.size and self.k.pairs:
+            for col in _pair_margins(seg_a[live], seg_b[live], self.k.pairs):
+                ok[live[col < 0.0]] = False
+        return ok
+
+
+def _pinned(plan: list, L: float) -> dict[str, float]:
+    """Position coordinates a C-U limb through the platform point fixes (its column's axis is a
+    coordinate axis): ``{"x": ..., "y": ...}``."""
+    pinned = {}
+    for item in plan:
+        if item[0] == "cu" and np.linalg.norm(item[3]) < 1e-12 * L:
+            axis_k = np.flatnonzero(np.abs(np.abs(item[2]) - 1.0) < 1e-12)
+            if axis_k.size == 1:
+                pinned.update({POSITION_COORDINATES[i]: float(item[1][i]) for i in range(3) if i != axis_k[0]})
+    return pinned
+
+
+class _GeneralKernel:
+    """Margins of stacks of poses by inverse position (see :func:`pose_checker`)."""
+
+    def __init__(self, k: _Kernel, general_seeds: int):
+        mech = k.mech
+        refs = mech.freedom_refs
+        self.k, self.general_seeds = k, general_seeds
+        self.batchable = all(ends == (None, 0) for ends in mech.limb_ends)
+        self.s_limits = any(mech.limbs[refs[f].limb].joints[refs[f].joint].type == "S" for f in k.fl)
+        self.simple = not k.cones and not k.pairs
+
+    def row(self, config, R1):
+        """The margins at a closed configuration (platform orientation ``R1``, (1, 3, 3))."""
+        from ...kinematics.closure import joint_points
+
+        k = self.k
+        n_links = len(k.links)
+        vals = k.offs + config.q
+        pts = joint_points(k.mech, config)
+        seg_a = np.array([[pts[lk.limb][lk.ends[0]] for lk in k.links]]).reshape(1, n_links, 3)
+        seg_b = np.array([[pts[lk.limb][lk.ends[1]] for lk in k.links]]).reshape(1, n_links, 3)
+        cols = [_freedom_margins(vals[k.fl][None], k.los, k.his, k.rot)] if k.fl else []
+        cols += [c[:, None] for c in _cone_margins(seg_a, seg_b, R1, k.cones)]
+        cols += [c[:, None] for c in _pair_margins(seg_a, seg_b, k.pairs)]
+        cols.append(np.array([[1e-9 * k.L]]))  # reachable: the same closure margin as the closed form
         return np.concatenate(cols, axis=1)[0]
 
-    from ...kinematics import backend, compiled
-    from ...kinematics.closure import recentre_balls
-
-    batchable = all(ends == (None, 0) for ends in mech.limb_ends)
-    s_limits = any(mech.limbs[refs[k].limb].joints[refs[k].joint].type == "S" for k in fl)
-    simple = not cones and not pairs
-
-    def fn_batch(R, p) -> tuple[np.ndarray, np.ndarray]:
+    def batch(self, R, p) -> tuple[np.ndarray, np.ndarray]:
         """Rows of the poses whose every limb closes from the reference (compiled, batched) and
         which violate no limit: exactly the rows the per-pose path gives them (its first attempt
         is this one); ``done`` marks them, the rest go through the per-pose path."""
+        from ...kinematics import compiled
+        from ...kinematics.closure import Configuration, hub_displacements, recentre_balls
+
+        k, mech = self.k, self.k.mech
         n = R.shape[0]
-        out = np.empty((n, len(names)))
+        out = np.empty((n, len(k.names)))
         D = np.zeros((n, 4, 4))
         D[:, :3, :3] = R
         D[:, :3, 3] = p - np.einsum("nij,j->ni", R, mech.platform_point)
@@ -365,59 +414,72 @@ def pose_checker(mech: Mechanism, limits: WorkspaceLimits | None = None, *, meth
         q, _res, ok = compiled.limb_inverse_many(mech, D)
         done = np.all(ok, axis=1)
         idx = np.flatnonzero(done)
-        if simple:
+        if self.simple:
             qq = q[idx]
-            if s_limits:
+            if self.s_limits:
                 qq = np.array([recentre_balls(mech, row) for row in qq]).reshape(qq.shape)
-            cols = [_freedom_margins(offs[fl] + qq[:, fl], los, his, rot)] if fl else []
-            cols.append(np.full((idx.size, 1), 1e-9 * L))
+            cols = [_freedom_margins(k.offs[k.fl] + qq[:, k.fl], k.los, k.his, k.rot)] if k.fl else []
+            cols.append(np.full((idx.size, 1), 1e-9 * k.L))
             out[idx] = np.concatenate(cols, axis=1)
         else:
             for i in idx:
                 qi = recentre_balls(mech, q[i])
-                out[i] = _general_row(Configuration(qi, D[i], hub_displacements(mech, qi, D[i])), R[i : i + 1])
+                out[i] = self.row(Configuration(qi, D[i], hub_displacements(mech, qi, D[i])), R[i : i + 1])
         done[idx] = np.all(out[idx] >= 0.0, axis=1)
         return out, done
 
-    def fn_general(R, p):
+    def margins(self, R, p):
+        from ...kinematics import backend
+        from ...kinematics.position import inverse_position
+
+        k = self.k
         n = R.shape[0]
-        if batchable and n > 1 and backend.enabled():
-            out, done = fn_batch(R, p)
+        if self.batchable and n > 1 and backend.enabled():
+            out, done = self.batch(R, p)
         else:
-            out, done = np.empty((n, len(names))), np.zeros(n, dtype=bool)
+            out, done = np.empty((n, len(k.names))), np.zeros(n, dtype=bool)
         for i in np.flatnonzero(~done):
             pose = Pose(R[i], p[i])
-            res = inverse_position(mech, pose)
+            res = inverse_position(k.mech, pose)
             best = None
             if res.reachable and res.config is not None:
-                best = _general_row(res.config, R[i : i + 1])
+                best = self.row(res.config, R[i : i + 1])
                 if np.all(best >= 0.0):
                     out[i] = best
                     continue
-            # another assembly of some limb (e.g. a leg flipped through its base joint, with a
-            # negative slide) may satisfy the limits: search every limb's solutions
-            alt = inverse_position(mech, pose, all_solutions=True, n_seeds=general_seeds)
-            if alt.reachable:
-                q = np.zeros(len(refs))
-                sls = limb_slices(mech)
-                # limbs that share a body have corresponding solutions: one choice per group
-                for group in limb_clusters(mech):
-                    viol = [sum(len(alt.limbs[g].violations[j]) for g in group)
-                            for j in range(len(alt.limbs[group[0]].solutions))]
-                    k = int(np.argmin(viol))
-                    for g in group:
-                        q[sls[g]] = alt.limbs[g].solutions[k]
-                D = pose.displacement(mech.platform_point)
-                row = _general_row(Configuration(q, D, hub_displacements(mech, q, D)), R[i : i + 1])
-                if best is None or np.min(row / scale) > np.min(best / scale):
-                    best = row
+            best = self.other_assemblies(pose, R[i : i + 1], best)
             if best is None:
-                best = np.ones(len(names))  # only the closure margin decides
-                best[-1] = -L
+                best = np.ones(len(k.names))  # only the closure margin decides
+                best[-1] = -k.L
             out[i] = best
         return out
 
-    return PoseChecker(mech, limits, "general", tuple(names), scale, fn_general, plan, {})
+    def other_assemblies(self, pose: Pose, R1, best):
+        """``best`` (the margins of the reference assembly, ``None`` where it does not close) or,
+        when larger in its smallest scaled margin, the margins of another assembly of some limb
+        (e.g. a leg flipped through its base joint, with a negative slide): per group of limbs
+        that share a body, the solution that violates the fewest freedom limits."""
+        from ...kinematics.closure import Configuration, hub_displacements, limb_slices
+        from ...kinematics.position import inverse_position, limb_clusters
+
+        k, mech = self.k, self.k.mech
+        alt = inverse_position(mech, pose, all_solutions=True, n_seeds=self.general_seeds)
+        if not alt.reachable:
+            return best
+        q = np.zeros(len(mech.freedom_refs))
+        sls = limb_slices(mech)
+        # limbs that share a body have corresponding solutions: one choice per group
+        for group in limb_clusters(mech):
+            viol = [sum(len(alt.limbs[g].violations[j]) for g in group)
+                    for j in range(len(alt.limbs[group[0]].solutions))]
+            j = int(np.argmin(viol))
+            for g in group:
+                q[sls[g]] = alt.limbs[g].solutions[j]
+        D = pose.displacement(mech.platform_point)
+        row = self.row(Configuration(q, D, hub_displacements(mech, q, D)), R1)
+        if best is None or np.min(row / k.scale) > np.min(best / k.scale):
+            return row
+        return best
 
 
 # ------------------------------------------------------------------------------ configuration checker

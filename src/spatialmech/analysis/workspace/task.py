@@ -40,7 +40,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import cast
 
 import numpy as np
@@ -343,106 +343,25 @@ def task_workspace(
     progress = check_progress(progress)
     g = solve_task_grid(mech, cast(Mapping[str, Sequence[float]], axes), at=at, task=task, seed=seed,
                         max_cells=max_cells, progress=progress)
-    names, grid, shape, d = g.over, g.axes, g.shape, len(g.over)
+    names, grid, d = g.over, g.axes, len(g.over)
     stepv = np.array([float(np.diff(a).mean()) if a.size > 1 else 1.0 for a in grid])
-    if tol is None:
-        tolv = 1e-3 * stepv
-    elif isinstance(tol, Mapping):
-        for c in tol:
-            if c not in names:
-                raise InputError(f"tol.{c}: {c} is not a grid coordinate ({', '.join(names)})")
-        tolv = np.array([float(as_finite_array(tol.get(c, 1e-3 * s), f"tol.{c}", shape=()))
-                         for c, s in zip(names, stepv, strict=True)])
-    else:
-        tolv = np.full(d, float(as_finite_array(tol, "tol", shape=())))
-    if np.any(tolv <= 0):
-        raise InputError(f"tol: must be positive, got {tol!r}")
+    tolv = _tolerances(tol, names, stepv)
 
-    # ---- limits at every closed cell
     probe = _Probe(mech, g, checker)
-    cell_limits = np.full(shape, CLOSURE, dtype=object)
-    cell_margins: dict[tuple, np.ndarray] = {}
-    for idx in zip(*np.nonzero(g.converged), strict=True):
-        cell_margins[idx] = probe.margins(g.configs[idx])
-        cell_limits[idx] = probe.limit(cell_margins[idx])
+    cell_limits, cell_margins = _cell_limits(probe, g)
     feasible = g.converged & (cell_limits == "")
-
-    # ---- boundary refinement between reachable and unreachable neighbours
-    pairs: list[tuple[int, tuple[int, ...], tuple[int, ...]]] = []
-    for k in range(d):
-        a = [slice(None)] * d
-        b = [slice(None)] * d
-        a[k], b[k] = slice(0, -1), slice(1, None)
-        change = feasible[tuple(a)] != feasible[tuple(b)]
-        for idx in zip(*np.nonzero(change), strict=True):
-            i0 = tuple(int(i) for i in idx)
-            i1 = tuple(i + 1 if j == k else i for j, i in enumerate(i0))
-            pairs.append((k, i0, i1))
-    n_iter = int(np.ceil(np.log2(max(float(np.max(stepv / tolv)), 2.0))))
-    total = g.n_solves + len(pairs) * n_iter
-    bpts, bvals, blims, bconfs, baxes, bouts = [], [], [], [], [], []
-    refined_axis0: dict[tuple, float] = {}  # (line, cell index of the inside end) -> refined coordinate
-    for n, (k, i0, i1) in enumerate(pairs):
-        inside, outside = (i0, i1) if feasible[i0] else (i1, i0)
-        c0: Configuration = g.configs[inside]
-        x_in, c_in, v_in, x_out, lim = _bracket(probe, k, g.point(inside), c0, g.values[inside],
-                                                cell_margins[inside], g.point(outside), cell_margins.get(outside),
-                                                str(cell_limits[outside]), float(tolv[k]))
-        bpts.append(x_in)
-        bvals.append(v_in)
-        blims.append(lim)
-        bconfs.append(c_in)
-        baxes.append(k)
-        bouts.append(x_out)
-        if k == 0:
-            refined_axis0[(inside, outside[0] - inside[0])] = float(x_in[0])
-        progress(g.n_solves + (n + 1) * n_iter, total, "refining the boundary")
+    b = _refine_boundary(probe, g, feasible, cell_limits, cell_margins, stepv, tolv, progress)
 
     # ---- extents of the grid coordinates, ranges of every coordinate
-    bp = np.array(bpts).reshape(-1, d)
-    bv = np.array(bvals).reshape(-1, 6)
-    ba = np.array(baxes, dtype=int)
-    cells = np.array([g.point(idx) for idx in zip(*np.nonzero(feasible), strict=True)]).reshape(-1, d)
-    cell_idx = np.argwhere(feasible)
-    extents: dict[str, Extent | None] = {}
-    for k, c in enumerate(names):
-        if cells.shape[0] == 0:
-            extents[c] = None
-            continue
-        ends = []
-        for sign in (-1.0, 1.0):
-            best_cell = cells[:, k].min() if sign < 0 else cells[:, k].max()
-            best, lim = float(best_cell), BOX
-            along = np.flatnonzero(ba == k)  # boundary points refined along this coordinate
-            if along.size:
-                j = int(along[np.argmin(bp[along, k])]) if sign < 0 else int(along[np.argmax(bp[along, k])])
-                if sign * (bp[j, k] - best) >= 0:
-                    best, lim = float(bp[j, k]), blims[j]
-            if lim == BOX:
-                edge = 0 if sign < 0 else shape[k] - 1
-                on_edge = np.any(cell_idx[:, k] == edge) and abs(best - grid[k][edge]) == 0.0
-                lim = BOX if on_edge else "?"
-            ends.append((best, lim))
-        extents[c] = Extent(ends[0][0], ends[1][0], ends[0][1], ends[1][1])
+    bp = np.array(b.points).reshape(-1, d)
+    bv = np.array(b.values).reshape(-1, 6)
+    ba = np.array(b.axes, dtype=int)
+    extents = _extents(g, feasible, bp, ba, b.limits)
     reach_vals = np.concatenate([g.values[feasible].reshape(-1, 6), bv])
     ranges = {c: (None if reach_vals.shape[0] == 0 else (float(np.min(reach_vals[:, i])), float(np.max(reach_vals[:, i]))))
               for i, c in enumerate(TASK_NAMES)}
 
-    # ---- measure: refined run lengths along the first grid coordinate, trapezoid over the others
-    volume = 0.0
-    w_other = [trapezoid_weights(a) for a in grid[1:]]
-    for row in cell_idx:
-        idx = tuple(int(i) for i in row)
-        lo = refined_axis0.get((idx, -1))
-        hi = refined_axis0.get((idx, 1))
-        x = grid[0]
-        i = idx[0]
-        left = lo if lo is not None else (x[i - 1] + x[i]) / 2 if i > 0 and feasible[(i - 1, *idx[1:])] else x[i]
-        right = hi if hi is not None else (x[i] + x[i + 1]) / 2 if i + 1 < shape[0] and feasible[(i + 1, *idx[1:])] else x[i]
-        w = 1.0
-        for j, wk in enumerate(w_other):
-            w *= wk[idx[j + 1]]
-        volume += w * (right - left)
+    volume = _measure(g, feasible, b.refined_axis0)
     units = {task_unit(c) for c in names}
     if len(units) == 1:
         u = "rad" if units.pop() == "deg" else mech.length_unit
@@ -454,10 +373,156 @@ def task_workspace(
         mechanism=mech.name, euler=g.task.euler, given=g.given, solved=g.solved, over=names, fixed=dict(g.fixed),
         grid=grid, converged=g.converged, feasible=feasible, cell_limits=cell_limits, values=g.values,
         extents=extents, ranges=ranges, volume=vol, volume_unit=volume_unit, boundary_points=bp,
-        boundary_values=bv, boundary_limits=tuple(blims), boundary_configs=tuple(bconfs), boundary_axes=ba,
-        boundary_outside=np.array(bouts).reshape(-1, d),
+        boundary_values=bv, boundary_limits=tuple(b.limits), boundary_configs=tuple(b.configs), boundary_axes=ba,
+        boundary_outside=np.array(b.outside).reshape(-1, d),
         step={c: float(s) for c, s in zip(names, stepv, strict=True)},
         tol={c: float(t) for c, t in zip(names, tolv, strict=True)}, n_solves=g.n_solves + probe.n,
         seconds=time.perf_counter() - t0, limits=checker.limits, limit_names=checker.names, configs=g.configs,
         length_unit=mech.length_unit,
     )
+
+
+def _tolerances(tol, names: tuple[str, ...], stepv: np.ndarray) -> np.ndarray:
+    """The boundary tolerance of each grid coordinate from :func:`task_workspace`'s ``tol``."""
+    if tol is None:
+        tolv = 1e-3 * stepv
+    elif isinstance(tol, Mapping):
+        for c in tol:
+            if c not in names:
+                raise InputError(f"tol.{c}: {c} is not a grid coordinate ({', '.join(names)})")
+        tolv = np.array([float(as_finite_array(tol.get(c, 1e-3 * s), f"tol.{c}", shape=()))
+                         for c, s in zip(names, stepv, strict=True)])
+    else:
+        tolv = np.full(len(names), float(as_finite_array(tol, "tol", shape=())))
+    if np.any(tolv <= 0):
+        raise InputError(f"tol: must be positive, got {tol!r}")
+    return tolv
+
+
+def _cell_limits(probe: _Probe, g: TaskGrid) -> tuple[np.ndarray, dict[tuple, np.ndarray]]:
+    """The most violated limit of every grid cell (``"closure"`` where it does not close) and
+    the scaled margins of every closed cell."""
+    cell_limits = np.full(g.shape, CLOSURE, dtype=object)
+    cell_margins: dict[tuple, np.ndarray] = {}
+    for idx in zip(*np.nonzero(g.converged), strict=True):
+        cell_margins[idx] = probe.margins(g.configs[idx])
+        cell_limits[idx] = probe.limit(cell_margins[idx])
+    return cell_limits, cell_margins
+
+
+def _boundary_pairs(feasible: np.ndarray) -> list[tuple[int, tuple[int, ...], tuple[int, ...]]]:
+    """``(k, i0, i1)`` for every pair of neighbours along grid coordinate ``k`` with one
+    reachable cell and one unreachable."""
+    d = feasible.ndim
+    pairs: list[tuple[int, tuple[int, ...], tuple[int, ...]]] = []
+    for k in range(d):
+        a = [slice(None)] * d
+        b = [slice(None)] * d
+        a[k], b[k] = slice(0, -1), slice(1, None)
+        change = feasible[tuple(a)] != feasible[tuple(b)]
+        for idx in zip(*np.nonzero(change), strict=True):
+            i0 = tuple(int(i) for i in idx)
+            i1 = tuple(i + 1 if j == k else i for j, i in enumerate(i0))
+            pairs.append((k, i0, i1))
+    return pairs
+
+
+@dataclass
+class _Boundary:
+    """The refined boundary points (:func:`_refine_boundary`), one entry each: the last inside
+    point (grid coordinates), its six coordinates, the limit broken just outside, its closed
+    configuration, the grid coordinate it was refined along and the last outside point.
+    ``refined_axis0``: ``(cell index of the inside end, +-1 towards the outside) -> refined
+    first grid coordinate``, for the pairs along the first grid coordinate."""
+
+    points: list[np.ndarray] = field(default_factory=list)
+    values: list[np.ndarray] = field(default_factory=list)
+    limits: list[str] = field(default_factory=list)
+    configs: list[Configuration] = field(default_factory=list)
+    axes: list[int] = field(default_factory=list)
+    outside: list[np.ndarray] = field(default_factory=list)
+    refined_axis0: dict[tuple, float] = field(default_factory=dict)
+
+
+def _refine_boundary(probe: _Probe, g: TaskGrid, feasible: np.ndarray, cell_limits: np.ndarray,
+                     cell_margins: dict[tuple, np.ndarray], stepv: np.ndarray, tolv: np.ndarray,
+                     progress: Progress) -> _Boundary:
+    """Every reachable / unreachable pair of grid neighbours bracketed to ``tolv`` (:func:`_bracket`)."""
+    pairs = _boundary_pairs(feasible)
+    n_iter = int(np.ceil(np.log2(max(float(np.max(stepv / tolv)), 2.0))))
+    total = g.n_solves + len(pairs) * n_iter
+    out = _Boundary()
+    for n, (k, i0, i1) in enumerate(pairs):
+        inside, outside = (i0, i1) if feasible[i0] else (i1, i0)
+        c0: Configuration = g.configs[inside]
+        x_in, c_in, v_in, x_out, lim = _bracket(probe, k, g.point(inside), c0, g.values[inside],
+                                                cell_margins[inside], g.point(outside), cell_margins.get(outside),
+                                                str(cell_limits[outside]), float(tolv[k]))
+        out.points.append(x_in)
+        out.values.append(v_in)
+        out.limits.append(lim)
+        out.configs.append(c_in)
+        out.axes.append(k)
+        out.outside.append(x_out)
+        if k == 0:
+            out.refined_axis0[(inside, outside[0] - inside[0])] = float(x_in[0])
+        progress(g.n_solves + (n + 1) * n_iter, total, "refining the boundary")
+    return out
+
+
+def _extents(g: TaskGrid, feasible: np.ndarray, bp: np.ndarray, ba: np.ndarray,
+             blims: list[str]) -> dict[str, Extent | None]:
+    """``[lo, hi]`` of each grid coordinate over the reachable cells and the refined boundary
+    points ``bp`` (refined along grid coordinate ``ba``, limits ``blims``), with the limit met at
+    each end; ``None`` when no cell is reachable."""
+    cells = np.array([g.point(idx) for idx in zip(*np.nonzero(feasible), strict=True)]).reshape(-1, len(g.over))
+    cell_idx = np.argwhere(feasible)
+    extents: dict[str, Extent | None] = {}
+    for k, c in enumerate(g.over):
+        if cells.shape[0] == 0:
+            extents[c] = None
+            continue
+        lo, lo_limit = _extent_end(g, k, -1.0, cells, cell_idx, bp, ba, blims)
+        hi, hi_limit = _extent_end(g, k, 1.0, cells, cell_idx, bp, ba, blims)
+        extents[c] = Extent(lo, hi, lo_limit, hi_limit)
+    return extents
+
+
+def _extent_end(g: TaskGrid, k: int, sign: float, cells: np.ndarray, cell_idx: np.ndarray, bp: np.ndarray,
+                ba: np.ndarray, blims: list[str]) -> tuple[float, str]:
+    """The lower (``sign < 0``) or upper end of grid coordinate ``k`` over the reachable set and
+    the limit met there: a refined boundary point's, ``"box"`` at the grid's own bound, ``"?"``
+    when neither explains it."""
+    best_cell = cells[:, k].min() if sign < 0 else cells[:, k].max()
+    best, lim = float(best_cell), BOX
+    along = np.flatnonzero(ba == k)  # boundary points refined along this coordinate
+    if along.size:
+        j = int(along[np.argmin(bp[along, k])]) if sign < 0 else int(along[np.argmax(bp[along, k])])
+        if sign * (bp[j, k] - best) >= 0:
+            best, lim = float(bp[j, k]), blims[j]
+    if lim == BOX:
+        edge = 0 if sign < 0 else g.shape[k] - 1
+        on_edge = np.any(cell_idx[:, k] == edge) and abs(best - g.axes[k][edge]) == 0.0
+        lim = BOX if on_edge else "?"
+    return best, lim
+
+
+def _measure(g: TaskGrid, feasible: np.ndarray, refined_axis0: dict[tuple, float]) -> float:
+    """The measure of the reachable set in the grid coordinates: refined run lengths along the
+    first grid coordinate, trapezoid rule over the others."""
+    grid, shape = g.axes, g.shape
+    volume = 0.0
+    w_other = [trapezoid_weights(a) for a in grid[1:]]
+    for row in np.argwhere(feasible):
+        idx = tuple(int(i) for i in row)
+        lo = refined_axis0.get((idx, -1))
+        hi = refined_axis0.get((idx, 1))
+        x = grid[0]
+        i = idx[0]
+        left = lo if lo is not None else (x[i - 1] + x[i]) / 2 if i > 0 and feasible[(i - 1, *idx[1:])] else x[i]
+        right = hi if hi is not None else (x[i] + x[i + 1]) / 2 if i + 1 < shape[0] and feasible[(i + 1, *idx[1:])] else x[i]
+        w = 1.0
+        for j, wk in enumerate(w_other):
+            w *= wk[idx[j + 1]]
+        volume += w * (right - left)
+    return volume
