@@ -140,7 +140,47 @@ def literal_kernel_arguments(source: str, kernels: set[str]) -> list[str]:
     return found
 
 
+TESTS = ROOT / "tests"
+
+
+def suite_files() -> list[Path]:
+    return sorted(TESTS.glob("*.py"))
+
+
+def _decorator_name(d: ast.expr) -> str:
+    return ast.unparse(d.func if isinstance(d, ast.Call) else d)
+
+
+def _own_nodes(fn: ast.FunctionDef):
+    """The nodes of ``fn``'s body, not those of functions, lambdas or classes defined inside it."""
+    stack = list(fn.body)
+    while stack:
+        node = stack.pop()
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda, ast.ClassDef)):
+            continue
+        yield node
+        stack.extend(ast.iter_child_nodes(node))
+
+
+def given_test_returns(source: str) -> list[str]:
+    """``line: test`` for each ``return`` in a hypothesis test (a function decorated with
+    ``@given``): a return skips the rest of the example but hypothesis counts the example as
+    tested; ``hypothesis.assume(...)`` (or ``reject()``) says it does not apply, so hypothesis
+    draws another and reports when too few apply."""
+    found = []
+    for fn in ast.walk(ast.parse(source)):
+        if isinstance(fn, (ast.FunctionDef, ast.AsyncFunctionDef)) and any(
+                _decorator_name(d).split(".")[-1] == "given" for d in fn.decorator_list):
+            found += [f"{n.lineno}: {fn.name}" for n in _own_nodes(fn) if isinstance(n, ast.Return)]
+    return sorted(found, key=lambda x: int(x.split(":")[0]))
+
+
 # ------------------------------------------------------------------ the checks
+def test_no_hypothesis_test_returns_early():
+    bad = [f"{p.name}:{hit}" for p in suite_files() for hit in given_test_returns(p.read_text(encoding="utf-8"))]
+    assert not bad, "@given tests that return to skip an example (use hypothesis.assume):\n" + "\n".join(bad)
+
+
 def test_no_kernel_passes_a_literal_constant_to_another_kernel():
     """First-call compilation: a bare constant between kernels compiles the callee again."""
     texts = {p: p.read_text(encoding="utf-8") for p in modules()}
@@ -215,3 +255,15 @@ def test_the_complexity_check_flags_a_complex_function(tmp_path):
     bad = tmp_path / "bad.py"
     bad.write_text(f"def f(x):\n{branches}    return None\n", encoding="utf-8")
     assert "C901" in complexity_violations([bad], MAX_DEFECT_COMPLEXITY)
+
+
+def test_the_hypothesis_return_check_flags_a_return_and_accepts_assume():
+    src = (
+        "from hypothesis import assume, given\nimport hypothesis\n\n"
+        "@given(x)\ndef test_a(x):\n    if x < 0:\n        return\n    assert x >= 0\n\n"
+        "@hypothesis.given(x)\ndef test_b(x):\n    for y in x:\n        if y:\n            return None\n\n"
+        "@given(x)\ndef test_c(x):\n    assume(x >= 0)\n    def f():\n        return x\n    g = lambda: x\n"
+        "    assert f() == g()\n\n"
+        "def test_d():\n    return\n"
+    )
+    assert given_test_returns(src) == ["7: test_a", "14: test_b"]
