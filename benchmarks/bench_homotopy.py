@@ -6,8 +6,9 @@ PHCpack's blackbox solver on the same polynomial system, measured in the same ru
 Targets of the homotopy issue: every solution of the Stewart platform faster than PHCpack's
 blackbox solver (goal: under 2 s), and a parameter-homotopy re-solve for new leg lengths under
 50 ms (it reuses the cached generic solve, ``resolve_cached``), reported with
-``resolve_speedup``, the first solve's time over the re-solve's median in the same run.  Cases: the ready-made stewart-6sps (a symmetric geometry: 28 generic solutions) and a
-random general 6-6 platform (40).  ``phc`` is Debian's phcpack; without it that baseline is
+``resolve_speedup``, the first solve's time over the re-solve's median in the same run.
+Cases: the ready-made stewart-6sps (a symmetric geometry: 28 generic solutions) and a random
+general 6-6 platform (40).  ``phc`` is Debian's phcpack; without it that baseline is
 skipped and said so.
 """
 
