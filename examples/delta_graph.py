@@ -35,6 +35,12 @@ angles = ik.actuators
 print("actuator angles [deg]:", {k: round(float(np.degrees(v)), 4) for k, v in angles.items()})
 fk = sm.fk(delta, list(angles.values()))
 print("forward position:", np.round(fk.poses[0].p, 9))
+clusters = ik.result.search["clusters"]                 # limbs sharing a body, solved together
+print("inverse:", ik.result.search["method"], "| arm clusters:", [c["limbs"] for c in clusters],
+      "| forward:", fk.to_dict()["method"])
 
 assert (m.dof, m.loops, m.motion, m.xi) == (3, 5, "TxTyTz", 6)
+assert ik.result.search["method"] == "Gauss-Newton per limb"
+assert sorted(len(c["limbs"]) for c in clusters) == [3, 3, 3]          # each arm with its two rods
+assert fk.to_dict()["method"].startswith("Gauss-Newton with the actuators held")
 assert np.allclose(fk.poses[0].p, pose[0], atol=1e-9)

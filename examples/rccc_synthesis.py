@@ -13,11 +13,12 @@ import spatialmech as sm
 res = sm.synth_rccc("rccc-four-positions")
 task = res.task
 u = task.length_unit
-print(f"spherical 4R: {res.linkage_type}, defects: {res.defects}")
+print(f"spherical 4R: {res.linkage_type}, defects: {res.defects}; pick {res.pick}, input dyad {res.input_dyad.kind}")
 print(f"input slides replaced by the R joint: {np.round(res.slides, 3)} {u}")
 print(f"position errors at positions 2-4: {np.round(res.check.position_errors, 3)} {u}")
 print(f"orientation errors: {np.degrees(res.check.orientation_errors).max():.1e} deg")
 
+assert res.pick == "best-rc" and res.input_dyad.kind == "RC"     # the C joint replaced by an R joint
 assert res.linkage_type == "crank-rocker" and res.defects == 0
 assert np.all(res.check.converged)
 assert np.degrees(res.check.orientation_errors).max() < 1e-9       # orientations exact

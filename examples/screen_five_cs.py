@@ -13,7 +13,9 @@ import spatialmech as sm
 
 out = Path(tempfile.mkdtemp()) / "screen.parquet"
 s = sm.screen("five-cs-positions", out, candidates=30, workers=0, top=3, seed=0)
-print(f"{s.judged} candidates judged in {s.seconds:.1f} s: rejected {s.rejected_by_stage}, usable {s.usable}")
+print(f"{s.judged} candidates judged in {s.seconds:.1f} s ({s.scheduler}): rejected {s.rejected_by_stage}, "
+      f"usable {s.usable}")
+assert s.workers == 0 and s.scheduler.startswith("serial")  # workers=0: in this process, no Dask
 assert s.judged == 30 and sum(s.rejected_by_stage.values()) + s.usable == 30
 assert s.rejected_by_stage["dj_signs"] > s.rejected_by_stage["circuits"]  # the cheap stage rejects the most
 

@@ -47,6 +47,7 @@ res = sm.fk(mech, legs, all_solutions=True)
 d = res.to_dict()
 print(f"{d['n_real']} real of {d['search']['n_generic']} solutions; complete: {d['complete']} "
       f"({d['completeness']})")
+print("method:", d["method"])
 
 closes = [np.abs(np.linalg.norm(s.pose.p + platform @ s.pose.R.T - base, axis=1) - legs).max()
           for s in res.result.solutions]
@@ -59,6 +60,7 @@ for mine, theirs in zip(mech.limbs, file_mech.limbs, strict=True):
         assert all(np.allclose(f.screw, g.screw, atol=1e-12) and f.offset == g.offset
                    for f, g in zip(j.freedoms, k.freedoms, strict=True))
 
+assert d["method"].startswith("homotopy continuation") and not res.closed_form   # no silent multi-start fallback
 assert d["complete"] and d["search"]["n_generic"] == 40
 assert d["n_real"] == 40 and len(res.result.solutions) == 40
 assert max(closes) < 1e-9

@@ -12,12 +12,15 @@ from spatialmech.kinematics.closed_forms.three_rps import parasitic
 pose = ([0.0, 0.0, 0.33], ("ZYX", 0.0, 5.0, 5.0))  # metres, degrees
 r = sm.ik("three-rps", pose, degrees=True, free=["x", "y", "a1"])
 legs = list(r.actuators.values())
-print("given", r.task.given, "solved", r.task.solved)
+print("given", r.task.given, "solved", r.task.solved, "| limbs:", r.result.search["method"])
+assert r.task.converged and r.result.search["method"] == "Gauss-Newton per limb"
 print(f"x = {r.task.values['x'] * 1e3:.4f} mm, y = {r.task.values['y'] * 1e3:.6f} mm, "
       f"a1 = {np.degrees(r.task.values['a1']):.4f} deg; legs (m): {np.round(legs, 6)}")
 
 # 2. Forward position of those legs returns the same pose.
 back = sm.fk("three-rps", legs)
+print("forward:", back.to_dict()["method"])
+assert back.to_dict()["method"].startswith("Gauss-Newton with the actuators held")
 assert np.allclose(back.poses[0].p, r.pose.p, atol=1e-9) and np.allclose(back.poses[0].R, r.pose.R, atol=1e-9)
 
 # 3. The 3 x 3 input-output Jacobian: d legs / d (z, a2, a3), parasitic coordinates following.

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import ast
 import importlib.util
+import re
 import shutil
 import subprocess
 import sys
@@ -140,7 +141,119 @@ def literal_kernel_arguments(source: str, kernels: set[str]) -> list[str]:
     return found
 
 
+TESTS = ROOT / "tests"
+
+
+def suite_files() -> list[Path]:
+    return sorted(TESTS.glob("*.py"))
+
+
+def _decorator_name(d: ast.expr) -> str:
+    return ast.unparse(d.func if isinstance(d, ast.Call) else d)
+
+
+def _own_nodes(fn: ast.FunctionDef):
+    """The nodes of ``fn``'s body, not those of functions, lambdas or classes defined inside it."""
+    stack = list(fn.body)
+    while stack:
+        node = stack.pop()
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda, ast.ClassDef)):
+            continue
+        yield node
+        stack.extend(ast.iter_child_nodes(node))
+
+
+def given_test_returns(source: str) -> list[str]:
+    """``line: test`` for each ``return`` in a hypothesis test (a function decorated with
+    ``@given``): a return skips the rest of the example but hypothesis counts the example as
+    tested; ``hypothesis.assume(...)`` (or ``reject()``) says it does not apply, so hypothesis
+    draws another and reports when too few apply."""
+    found = []
+    for fn in ast.walk(ast.parse(source)):
+        if isinstance(fn, (ast.FunctionDef, ast.AsyncFunctionDef)) and any(
+                _decorator_name(d).split(".")[-1] == "given" for d in fn.decorator_list):
+            found += [f"{n.lineno}: {fn.name}" for n in _own_nodes(fn) if isinstance(n, ast.Return)]
+    return sorted(found, key=lambda x: int(x.split(":")[0]))
+
+
+#: Clock readings (``time.perf_counter()``, ``perf_counter()``, ...).
+CLOCKS = {"perf_counter", "perf_counter_ns", "monotonic", "monotonic_ns", "process_time", "process_time_ns",
+          "time", "time_ns"}
+#: Variables, and (with a unit suffix) attributes and keys, that hold a measured duration
+#: (``elapsed``, ``r.seconds``, ``out["first_solve_s"]``).
+DURATION_NAME = re.compile(r"(^|_)(seconds|elapsed|duration|wall)(_|$)")
+DURATION = re.compile(DURATION_NAME.pattern + r"|_(s|ms|us|ns)$")
+
+
+def _is_clock_call(node: ast.AST) -> bool:
+    if not isinstance(node, ast.Call):
+        return False
+    f = node.func
+    if isinstance(f, ast.Attribute):
+        return f.attr in CLOCKS and isinstance(f.value, ast.Name) and f.value.id == "time"
+    return isinstance(f, ast.Name) and f.id in CLOCKS - {"time", "time_ns"}
+
+
+def _clock_names(tree: ast.AST) -> set[str]:
+    """Names assigned (anywhere in ``tree``) from a clock reading or from another such name."""
+    names: set[str] = set()
+    while True:
+        before = len(names)
+        for node in ast.walk(tree):
+            if isinstance(node, (ast.Assign, ast.AnnAssign, ast.AugAssign, ast.NamedExpr)) and node.value is not None \
+                    and _is_timing(node.value, names):
+                targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+                names |= {n.id for t in targets for n in ast.walk(t) if isinstance(n, ast.Name)}
+        if len(names) == before:
+            return names
+
+
+def _is_timing(expr: ast.AST, clock_names: set[str]) -> bool:
+    for n in ast.walk(expr):
+        if _is_clock_call(n) or (isinstance(n, ast.Name) and (n.id in clock_names or DURATION_NAME.search(n.id))):
+            return True
+        if isinstance(n, ast.Attribute) and DURATION.search(n.attr):
+            return True
+        if isinstance(n, ast.Subscript) and isinstance(n.slice, ast.Constant) and isinstance(n.slice.value, str) \
+                and DURATION.search(n.slice.value):
+            return True
+    return False
+
+
+def wall_clock_asserts(source: str) -> list[str]:
+    """``line: assertion`` for each ``assert`` that bounds a wall-clock measurement (a clock
+    reading, a name assigned from one, or a value named as a duration: ``seconds``, ``elapsed``,
+    ``*_s``, ``*_ms``) with ``<``, ``<=``, ``>`` or ``>=``: its result depends on the machine's
+    load, so the target belongs in benchmarks/ (met / NOT met, against a baseline of the same
+    run).  A sign check against 0 (``> 0``: the benchmark measured something) is allowed."""
+    tree = ast.parse(source)
+    clock_names = _clock_names(tree)
+    found = []
+    for node in ast.walk(tree):
+        if not isinstance(node, ast.Assert):
+            continue
+        for cmp in (n for n in ast.walk(node.test) if isinstance(n, ast.Compare)):
+            if not all(isinstance(op, (ast.Lt, ast.LtE, ast.Gt, ast.GtE)) for op in cmp.ops):
+                continue
+            sides = [cmp.left, *cmp.comparators]
+            timed = [x for x in sides if _is_timing(x, clock_names)]
+            rest = [x for x in sides if not _is_timing(x, clock_names)]
+            if timed and not all(isinstance(x, ast.Constant) and x.value == 0 for x in rest):
+                found.append(f"{node.lineno}: {ast.unparse(cmp)}")
+    return found
+
+
 # ------------------------------------------------------------------ the checks
+def test_no_test_asserts_on_a_wall_clock_measurement():
+    bad = [f"{p.name}:{hit}" for p in suite_files() for hit in wall_clock_asserts(p.read_text(encoding="utf-8"))]
+    assert not bad, "tests asserting on elapsed time (move the target to benchmarks/):\n" + "\n".join(bad)
+
+
+def test_no_hypothesis_test_returns_early():
+    bad = [f"{p.name}:{hit}" for p in suite_files() for hit in given_test_returns(p.read_text(encoding="utf-8"))]
+    assert not bad, "@given tests that return to skip an example (use hypothesis.assume):\n" + "\n".join(bad)
+
+
 def test_no_kernel_passes_a_literal_constant_to_another_kernel():
     """First-call compilation: a bare constant between kernels compiles the callee again."""
     texts = {p: p.read_text(encoding="utf-8") for p in modules()}
@@ -215,3 +328,35 @@ def test_the_complexity_check_flags_a_complex_function(tmp_path):
     bad = tmp_path / "bad.py"
     bad.write_text(f"def f(x):\n{branches}    return None\n", encoding="utf-8")
     assert "C901" in complexity_violations([bad], MAX_DEFECT_COMPLEXITY)
+
+
+def test_the_hypothesis_return_check_flags_a_return_and_accepts_assume():
+    src = (
+        "from hypothesis import assume, given\nimport hypothesis\n\n"
+        "@given(x)\ndef test_a(x):\n    if x < 0:\n        return\n    assert x >= 0\n\n"
+        "@hypothesis.given(x)\ndef test_b(x):\n    for y in x:\n        if y:\n            return None\n\n"
+        "@given(x)\ndef test_c(x):\n    assume(x >= 0)\n    def f():\n        return x\n    g = lambda: x\n"
+        "    assert f() == g()\n\n"
+        "def test_d():\n    return\n"
+    )
+    assert given_test_returns(src) == ["7: test_a", "14: test_b"]
+
+
+@pytest.mark.parametrize("source", [
+    "import time\nt0 = time.perf_counter()\nf()\nassert time.perf_counter() - t0 < 1.0\n",
+    "from time import perf_counter\nt = perf_counter()\nf()\ndt = perf_counter() - t\nassert dt <= 5\n",
+    "import time\nt0 = time.monotonic()\nassert f() and time.monotonic() - t0 < 2\n",
+    "r = solve()\nassert r.cached and r.seconds < 2.0\n",
+    "out = bench()\nassert out['first_solve_s'] < 2.0\n",
+    "elapsed = run()\nassert 0 < elapsed < 3\n",
+])
+def test_the_wall_clock_check_flags_a_timed_assertion(source):
+    assert len(wall_clock_asserts(source)) == 1, source
+
+
+def test_the_wall_clock_check_accepts_other_assertions():
+    source = ("import time\nt0 = time.perf_counter()\nwhile time.perf_counter() - t0 < 5:\n    poll()\n"
+              "assert out['first_solve_s'] > 0 and out['resolve_median_ms'] > 0\n"
+              "assert r.cached and len(r.solutions) < 50 and r.residual < 1e-9\n"
+              "assert data['t_s'] == [0.0, 0.5]\n")
+    assert wall_clock_asserts(source) == []

@@ -5,10 +5,10 @@ and paper A's temporary directory.  Each test names the defect it pins ("Before:
 import codecs
 import dataclasses
 import importlib
+import importlib.util
 import re
 import tempfile
 import textwrap
-import time
 from pathlib import Path
 
 import numpy as np
@@ -325,14 +325,13 @@ def _lockable_chain(n_sm: int) -> sm.Mechanism:
 
 def test_too_many_implicit_modes_are_refused_at_once():
     """Before: 4 Sm joints (12 lockable freedoms, no modes) made ``mobility`` enumerate and
-    analyse 2^12 subsets (minutes; 2^30 for 10 joints: a hang)."""
+    analyse 2^12 subsets (minutes; 2^30 for 10 joints: a hang).  How long the refusal takes:
+    benchmarks/bench_refusals.py (``modes_refusal_s``, target < 1 s)."""
     mech = _lockable_chain(4)
-    t0 = time.perf_counter()
     with pytest.raises(SearchTooLargeError, match=r"12 lockable freedoms .* 2\^12 = 4096 .* declare the modes"):
         mech.all_modes()
     with pytest.raises(SearchTooLargeError):
         sm.mobility(mech)
-    assert time.perf_counter() - t0 < 1.0
     assert 2 ** len(_lockable_chain(3).lockable) <= MAX_IMPLICIT_MODES  # 9 lockable: still enumerated
     assert len(_lockable_chain(3).all_modes()) == 2**9
 
@@ -347,17 +346,16 @@ def test_one_implicit_mode_can_still_be_named_when_there_are_too_many_to_list():
 
 
 def test_mobility_cli_of_a_file_with_too_many_lockable_freedoms(tmp_path):
+    """Refused (in how long: benchmarks/bench_refusals.py, ``modes_cli_refusal_s``)."""
     f = tmp_path / "many.toml"
     sm.dump(_lockable_chain(4), f)
-    t0 = time.perf_counter()
     assert_one_line_error(run("mobility", f), 2, "declare the modes")
-    assert time.perf_counter() - t0 < 5.0
 
 
 def test_a_workspace_grid_over_the_limit_is_refused_with_its_size():
-    """Before: ``workspace --step-deg 1e-6`` allocated a 3.6e8-sample axis and hung."""
+    """Before: ``workspace --step-deg 1e-6`` allocated a 3.6e8-sample axis and hung.  In how
+    long it is refused: benchmarks/bench_refusals.py (``workspace_refusal_s``)."""
     mech = catalog.build("four-sps-cu")
-    t0 = time.perf_counter()
     with pytest.raises(SearchTooLargeError) as e:
         orientation_workspace(mech, at={"z": 0.1}, step=np.radians(1e-6))
     n = 360e6 * 180e6 * 360e6
@@ -369,7 +367,6 @@ def test_a_workspace_grid_over_the_limit_is_refused_with_its_size():
         orientation_workspace(mech, at={"z": 0.1}, step=1e-320)
     r = run("workspace", "four-sps-cu", "--step-deg", "1e-6")
     assert_one_line_error(r, 2, "--step-deg (step): the grid has about")
-    assert time.perf_counter() - t0 < 5.0
 
 
 @pytest.mark.slow
@@ -414,9 +411,22 @@ def test_workspace_bisection_survives_a_denormal_tolerance_and_checks_chunk():
     ],
 )
 def test_counts_from_the_command_line_are_bounded(args, contains):
-    t0 = time.perf_counter()
+    """Refused (in how long: benchmarks/bench_refusals.py, ``cli_counts_refusal_s``)."""
     assert_one_line_error(run(*args), 2, contains)
-    assert time.perf_counter() - t0 < 5.0
+
+
+def test_refusal_benchmark_runs_and_reports_its_targets():
+    """benchmarks/bench_refusals.py --quick: every case refused, a verdict and a ratio to the
+    same run's baseline per target (the times themselves are not asserted here)."""
+    path = Path(__file__).resolve().parents[1] / "benchmarks" / "bench_refusals.py"
+    spec = importlib.util.spec_from_file_location("bench_refusals", path)
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    out = bench.main(["--quick", "--json"])
+    assert all(out["refused"].values()), out["refused"]
+    assert set(out["met"]) == set(out["targets"]) == set(out["ratio_to_baseline"])
+    assert all(isinstance(v, bool) for v in out["met"].values())
+    assert set(out["cli_counts_by_command_s"]) == set(bench.CLI_COUNTS)
 
 
 # ------------------------------------------------------------------ the viewer and paper A

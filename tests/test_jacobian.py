@@ -99,6 +99,10 @@ def test_paper_A_linkage1_every_driver_changes_sign_figs_6_7():
     signs = _dj_signs("five-cs-1")
     for d, s in signs.items():
         assert abs(s.sum()) < 7, d
+
+
+def test_paper_A_linkage1_rot1_changes_sign_between_P6_P7_rot5_between_P3_P4_fig_14():
+    signs = _dj_signs("five-cs-1")
     # rot1 changes only between P6 and P7 (K2), rot5 between P3 and P4 (K1)
     assert list(np.flatnonzero(np.diff(signs["rot1"]))) == [5]
     assert list(np.flatnonzero(np.diff(signs["rot5"]))) == [2]

@@ -58,6 +58,15 @@ def test_paper_C_section5_eight_modes():
         assert r.dof == r.dof_instantaneous
 
 
+@pytest.mark.parametrize("driven, motion", list(THREE_SPS_SMPU_MODES.items()),
+                         ids=["+".join(d) or "Sm-locked" for d in THREE_SPS_SMPU_MODES])
+def test_paper_C_section5_smpu_mode(driven, motion):
+    """One motion mode of the 3-SPS/SmPU (section 5): 3 DOF plus one per driven Sm rotation."""
+    r = sm.mobility(catalog.build("three-sps-smpu"), "+".join(driven) or "Sm-locked")
+    assert r.dof == 3 + len(driven) == r.dof_instantaneous
+    assert motion_set(r.motion) == motion_set(motion)
+
+
 @pytest.mark.parametrize("k", [1, 2, 3])
 def test_paper_A_five_cs_is_one_dof(k):
     r = sm.mobility(catalog.build(f"five-cs-{k}"))

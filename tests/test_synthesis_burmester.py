@@ -67,6 +67,24 @@ def test_all_six_poles_lie_on_the_curves(task):
         assert abs(burmester_det(K_c, p["circle"])) < 1e-14, name
 
 
+def test_paper_D_burmester_curves_are_cubic_cones_through_the_poles(task, curves, rng):
+    """Paper D eqs 8-14: det B(u) and det A(v) are homogeneous cubics (cones through the centre),
+    the traced curves are their intersections with the unit sphere (|det| < 1e-12 on unit
+    vectors), and the six poles with their images lie on them (1e-14)."""
+    x, s = rng.normal(size=(20, 3)), rng.uniform(0.2, 3.0, size=20)
+    for K in (curves.K_circle, curves.K_center):
+        assert np.allclose(burmester_det(K, s[:, None] * x), s**3 * burmester_det(K, x), rtol=1e-12, atol=1e-14)
+    assert np.allclose(np.linalg.norm(curves.u, axis=1), 1, atol=1e-14)
+    assert np.allclose(np.linalg.norm(curves.v, axis=1), 1, atol=1e-14)
+    assert np.max(np.abs(burmester_det(curves.K_circle, curves.u))) < 1e-12
+    assert np.max(np.abs(burmester_det(curves.K_center, curves.v))) < 1e-12
+    P = poles(task)
+    assert len(P) == 6
+    for name, p in P.items():
+        assert abs(burmester_det(curves.K_center, np.array(p["center"]))) < 1e-14, name
+        assert abs(burmester_det(curves.K_circle, np.array(p["circle"]))) < 1e-14, name
+
+
 def test_gradient_matches_finite_differences(task, rng):
     K = burmester_matrices(task, "circle")
     for _ in range(5):

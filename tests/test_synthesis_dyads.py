@@ -3,7 +3,7 @@ positions is exact, and the slide formula agrees with an independent closest-poi
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import given, reject, settings
 from hypothesis import strategies as st
 
 from spatialmech.synthesis.burmester import burmester_curves
@@ -92,7 +92,7 @@ def test_rc_dyad_is_exact_for_three_positions(lon, lat):
     try:
         dy = rc_dyad_three_positions(t3, u)
     except ValueError:
-        return  # singular direction (reported, not silently wrong)
+        reject()  # singular direction (reported, not silently wrong): not an example
     assert dy.kind == "RC"
     assert np.max(np.abs(direction_residuals(t3, dy.u, dy.v))) < 1e-12
     ang, dist = dy.invariants(t3)

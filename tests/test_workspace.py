@@ -80,6 +80,20 @@ def test_paper_b_gamma_alone_is_the_maximum_leg_length(ws_z01):
 
 
 @pytest.mark.slow
+def test_paper_b_section6_extents_are_not_48_48_65_deg(ws_z01):
+    """NOT reproduced (section 6, fig 5): at z = 0.1 m the paper prints alpha_max = beta_max =
+    48 deg and gamma_max = 65 deg; the stated model gives +-atan(z/b) = 26.565 deg for alpha and
+    beta alone and +-128.682 deg for gamma alone (closed forms), none within 20 deg of the print."""
+    closed = {"alpha": np.degrees(np.arctan(0.1 / B)), "beta": np.degrees(np.arctan(0.1 / B)),
+              "gamma": np.degrees(gamma_leg_limit(0.1))}
+    printed = {"alpha": 48.0, "beta": 48.0, "gamma": 65.0}
+    for c, exact in closed.items():
+        e = ws_z01.alone[c]
+        assert abs(np.degrees(e.hi) - exact) <= TOL_DEG and abs(np.degrees(e.lo) + exact) <= TOL_DEG, c
+        assert abs(np.degrees(e.hi) - printed[c]) > 20, c
+
+
+@pytest.mark.slow
 def test_paper_b_whole_set_has_the_same_extents(ws_z01):
     """Over the whole 3-D set the extents equal the single-angle ones (conventions.md)."""
     for c in ("alpha", "beta", "gamma"):

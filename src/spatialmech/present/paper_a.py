@@ -60,7 +60,7 @@ def section(progress: Progress | None = None) -> Section:
             f"{m.formula()} (instantaneous {m.dof_instantaneous})",
             Verdict.REPRODUCED if m.dof == 1 == m.dof_instantaneous else Verdict.NOT_REPRODUCED,
             evidence={"dof": m.dof, "dof_instantaneous": m.dof_instantaneous, "gk_classic": m.gk_classic},
-            test="tests/test_mobility.py"))
+            test=f"tests/test_mobility.py::test_paper_A_five_cs_is_one_dof[{k}]"))
         say(f"paper A: defect analysis of {name} (DJ at the positions, circuits, branch points)")
         res[k] = defect_analysis(mech, drivers=list(DRIVERS))
         table = res[k].table
@@ -89,7 +89,7 @@ def section(progress: Progress | None = None) -> Section:
         Verdict.REPRODUCED if (c1, c5) == ([5], [2]) else Verdict.NOT_REPRODUCED,
         "located by the sign change between consecutive positions; the dual-drive plan itself is the defect analysis",
         {"sign_changes_after": {"rot1": c1, "rot5": c5}},
-        "tests/test_jacobian.py::test_paper_A_linkage1_every_driver_changes_sign_figs_6_7"))
+        "tests/test_jacobian.py::test_paper_A_linkage1_rot1_changes_sign_between_P6_P7_rot5_between_P3_P4_fig_14"))
     keep2 = [d for d in DRIVERS if t2.keeps_sign(d)]
     claims.append(Claim(
         "A", "Linkage 2: with the slide of C3, C4 or C5 as driver DJ keeps its sign at the 7 positions (figs 8-9)",
@@ -299,24 +299,27 @@ def _cs_dyad_claims():
               f"largest residual of the 14 equations over the 15 printed limbs {res:.4f}",
               Verdict.REPRODUCED if res < 0.02 else Verdict.NOT_REPRODUCED,
               "the tables are printed to 3 decimals (conventions.md: link lengths vary by up to 0.01)",
-              {"printed_residuals_len": d["printed_residuals_len"]}, "tests/test_cs_dyads.py"),
+              {"printed_residuals_len": d["printed_residuals_len"]},
+              "tests/test_cs_dyads.py::test_paper_a_printed_limbs_satisfy_eqs_24_25_to_the_printed_precision"),
         Claim("A", "The CS dyads for 7 positions form a one-parameter family (15 unknowns, 14 equations; section 3)",
               "a one-parameter infinity of dyads",
               f"a curve of dyads traced by continuation ({len(c.family.branches)} pieces); every printed limb lies "
               f"within {dist:.4f} of it and its slides are reproduced to {slide:.4f}",
               Verdict.REPRODUCED if dist < 0.01 else Verdict.NOT_REPRODUCED,
               "the Jacobian of the 14 equations has rank 14 along the family",
-              {"max_distance_len": dist, "max_slide_change_len": slide}, "tests/test_cs_dyads.py"),
+              {"max_distance_len": dist, "max_slide_change_len": slide},
+              "tests/test_cs_dyads.py::test_paper_a_printed_limbs_project_onto_the_synthesised_family"),
         Claim("A", "Any five dyads of the family form a 5-CS linkage guiding the body through the 7 positions (section 3)",
               "a 1-DOF 5-CS through P1..P7",
               f"five small-slide dyads assembled: pose errors <= {syn.max_pose_error:.1e}, mobility {syn.dof}",
               Verdict.REPRODUCED if syn.ok else Verdict.NOT_REPRODUCED,
               "checked by solving the assembled linkage's closure at the 7 poses",
-              {"position_errors_len": list(map(float, syn.position_errors)), "dof": syn.dof}, "tests/test_cs_dyads.py"),
+              {"position_errors_len": list(map(float, syn.position_errors)), "dof": syn.dof},
+              "tests/test_cs_dyads.py::test_paper_a_any_five_dyads_of_the_family_form_a_5cs"),
         Claim("A", "Dyads with small slides can be chosen from the family (section 3)", "choose small slides",
               f"the five picks have max |slide| {', '.join(f'{x:.2f}' for x in picks)}; the printed limbs "
               f"{min(printed_max):.2f}..{max(printed_max):.2f}",
               Verdict.REPRODUCED, "smallest max |slide| over the traced family, picks kept apart along it",
-              {"picks_max_abs_slide_len": picks}, "tests/test_cs_dyads.py"),
+              {"picks_max_abs_slide_len": picks}, "tests/test_cs_dyads.py::test_paper_a_small_slide_picks"),
     ]
     return out, d

@@ -114,7 +114,7 @@ def section(progress: Progress | None = None) -> Section:
                         f"{m.formula()}; lambda={m.lam}, t={m.t}, k={m.k}, v={m.v}, xi={m.xi}; {m.motion}; "
                         f"instantaneous {m.dof_instantaneous}", Verdict.REPRODUCED if ok else Verdict.NOT_REPRODUCED,
                         "v = t - k (paper C prints k - t; equal here since t = k)", m.to_dict(),
-                        "tests/test_mobility.py"))
+                        "tests/test_mobility.py::test_paper_B_four_sps_cu_mobility_breakdown"))
 
     rng = np.random.default_rng(SAMPLE_SEED)
     phi = np.column_stack([rng.uniform(*g.z_limits, SAMPLE_SIZE), rng.uniform(-np.pi / 6, np.pi / 6, (SAMPLE_SIZE, 3))])
@@ -387,7 +387,7 @@ def workspace_claim(step_deg: float = 4.0, *, polish: bool = True):
                    "closed_form_deg": {c: v for c, (v, _) in closed.items()},
                    "closed_form_limit": {c: lim for c, (_, lim) in closed.items()},
                    "gap_deg": gaps, "active_limits": res.active_limits, "step_deg": step_deg},
-                  "tests/test_workspace.py",
+                  "tests/test_workspace.py::test_paper_b_section6_extents_are_not_48_48_65_deg",
                   consistent=consistent,
                   consistency=f"measured extents vs their closed forms (agreement {WORKSPACE_AGREEMENT_DEG} deg): {check}")
     return claim, res

@@ -57,7 +57,7 @@ def section(progress: Progress | None = None) -> Section:
             (Verdict.CORRECTED if driven == ("R7",) else Verdict.REPRODUCED) if ok else Verdict.NOT_REPRODUCED,
             ("table 2 prints R7 -> Rx; R7 is the base joint about Z and drives Rz" if driven == ("R7",) else "")
             + ("; " if driven == ("R7",) else "") + "locked joints removed and their links merged (lambda = 3, d = 3)",
-            x.to_dict(), "tests/test_mobility.py"))
+            x.to_dict(), f"tests/test_mobility.py::test_paper_C_table2_three_rrr_modes[{x.mode}]"))
     say("paper C: mobility of the 3-SPS/SmPU (section 5)")
     smpu = catalog.build("three-sps-smpu")
     res2 = mobility_modes(smpu)
@@ -69,7 +69,7 @@ def section(progress: Progress | None = None) -> Section:
             "C", f"3-SPS/SmPU, Sm rotations driven: {', '.join(driven) or 'none'} (section 5)",
             f"{3 + len(driven)} DOF, {motion}", f"{x.dof} DOF, {x.motion} (instantaneous {x.dof_instantaneous})",
             Verdict.REPRODUCED if ok else Verdict.NOT_REPRODUCED, "generic dimensions (the paper gives none)", x.to_dict(),
-            "tests/test_mobility.py"))
+            f"tests/test_mobility.py::test_paper_C_section5_smpu_mode[{x.mode}]"))
     say("paper C: closed-form inverse kinematics and the section 4.2 motion")
     c42, fig42, data42 = _closed_form_claims()
     claims.extend(c42)
@@ -133,7 +133,7 @@ def _closed_form_claims():
                      f"matches finite differences to {err22:.1e}", Verdict.REPRODUCED,
                      "eq 22 maps Euler-angle rates (alpha', beta', gamma'), not angular velocity; the angular-velocity "
                      "Jacobian is given separately", {"max_fd_error": err22},
-                     "tests/test_spherical_rrr.py"))
+                     "tests/test_spherical_rrr.py::test_eq22_euler_rate_jacobian_matches_finite_differences"))
     expected = {0: (30.0, -30.0), 1: (39.81, -11.94), 2: (26.33, -34.72)}
 
     def th(tt, k):

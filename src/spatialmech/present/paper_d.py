@@ -78,7 +78,8 @@ def section(progress: Progress | None = None) -> Section:
         Verdict.REPRODUCED, "det B(u0) = 0 (circle points), det A(v) = 0 (center points), each sample Newton-projected",
         {"kinds": list(cur.kinds), "lengths_deg": [float(np.degrees(x)) for x in cur.lengths],
          "max_det_samples": max(det_u, det_v),
-         "max_det_poles": pole_res}, "tests/test_synthesis_burmester.py")]
+         "max_det_poles": pole_res},
+        "tests/test_synthesis_burmester.py::test_paper_D_burmester_curves_are_cubic_cones_through_the_poles")]
 
     for label, ex, eq in (("m1", PAPER_M1, "28"), ("m2", PAPER_M2, "30")):
         resid = {f"{a},{b}": direction_residuals(task, ex[a], ex[b]).tolist() for a, b in (("u0", "v"), ("u0*", "v*"))}
@@ -109,7 +110,7 @@ def section(progress: Progress | None = None) -> Section:
         f"(slides {', '.join(f'{s:+.3f}' for s in res.slides)} {unit})", Verdict.REPRODUCED,
         "slides are affine along a solution line: 3 conditions, 1 parameter",
         {"max_abs_slide_len": res.max_abs_slide, "slides_len": res.slides.tolist()},
-        "tests/test_synthesis_rccc.py"))
+        "tests/test_synthesis_rccc.py::test_rccc_best_pick_is_a_defect_free_crank_rocker_with_small_slides"))
     t3 = task.subset([0, 1, 3])
     u = cur.u[len(cur.u) // 3]
     dy = rc_dyad_three_positions(t3, u)
@@ -129,7 +130,8 @@ def section(progress: Progress | None = None) -> Section:
         Verdict.REPRODUCED if bool(np.all(ch.converged)) else Verdict.NOT_REPRODUCED,
         "orientation exact by construction; the position errors are the price of the R joint",
         {"position_errors_len": ch.position_errors.tolist(), "orientation_errors_deg": np.degrees(ch.orientation_errors).tolist(),
-         "type": res.linkage_type, "defects": res.defects}, "tests/test_synthesis_rccc.py"))
+         "type": res.linkage_type, "defects": res.defects},
+        "tests/test_synthesis_rccc.py::test_rccc_closure_reproduces_the_four_orientations_to_1e_9"))
 
     say("paper D: figures (curves, regions 1 and 2, solution lines, linkage)")
     figs = []

@@ -92,7 +92,8 @@ class Claim:
     ``paper_value``: what the paper states (text, as printed, translated); ``ours``: what the
     project's analysis gives (text with numbers and units); ``evidence``: the numbers behind
     ``ours`` (JSON-serialisable); ``note``: why it does (not) reproduce; ``test``: the test
-    of the suite that asserts the same thing (``file::function``).
+    function of the suite that asserts the same thing (``tests/test_x.py::test_function``, with
+    ``[id]`` for one case of a parametrised test; tests/test_claims.py checks that it exists).
 
     ``consistent``: the row's own cross-check, when it has one (``None``: none), e.g. measured
     values against the closed forms quoted in ``note``; ``consistency`` says what was compared.
