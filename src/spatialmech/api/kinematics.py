@@ -11,11 +11,14 @@ import numpy as np
 
 from ..errors import InputError, describe
 from ..geometry.tolerances import resolve as resolve_tolerances
+from ..kinematics.closed_forms.four_sps_cu_forward import ForwardAllResult
 from ..kinematics.closure import Configuration
+from ..kinematics.dispatch import AssemblyMode, Engine, ForwardAnswer, pose_with_free, solve_forward, solve_inverse
+from ..kinematics.forward import ForwardResult
 from ..kinematics.jacobian import CompleteJacobian, complete_jacobian
-from ..kinematics.position import InverseResult, PoseFit, configuration_at_pose, inverse_position, platform_pose
-from ..kinematics.forward import ForwardResult, forward_position
-from ..kinematics.task import TaskJacobian, TaskSolution, solve_pose, task_jacobian_at, task_solution_dict
+from ..kinematics.position import InverseResult, PoseFit, configuration_at_pose, platform_pose
+from ..kinematics.task import TaskJacobian, TaskSolution, default_task, task_jacobian_at, task_solution_dict
+from ..model.task import TaskCoordinates
 from ..model.mechanism import Mechanism, Pose
 from ..results import Progress
 from ..serialize import pose_dict
@@ -77,6 +80,12 @@ class IKResult:
         """Actuator values (SI: rad, length), by freedom id; raises when not reachable."""
         return self.result.actuator_values(self.mechanism)
 
+    @property
+    def default_task(self) -> TaskCoordinates:
+        """The model's task coordinates (its own, else those its output link's freedoms give):
+        fewer than six given ones say a full pose is reachable only with the others ``free``."""
+        return default_task(self.mechanism)
+
     def to_dict(self) -> dict:
         d = self.result.to_dict(self.mechanism)
         fit = self.pose_fit
@@ -108,75 +117,102 @@ def ik(model: ModelLike, pose, *, all_solutions: bool = False, n_seeds: int = 48
     degrees = check_bool(degrees, "degrees")
     all_solutions = check_bool(all_solutions, "all_solutions")
     P, position = as_pose(mech, pose, degrees)
-    task = None
-    if free is not None:
-        names = check_names(free, "free") or []
-        task = solve_pose(mech, P, names, euler=pose_sequence(pose))
-        if task.converged:
-            P = Pose(task.D[:3, :3], task.D[:3, :3] @ mech.platform_point + task.D[:3, 3], "requested, solved")
-    res = inverse_position(mech, P, all_solutions=all_solutions, n_seeds=check_int(n_seeds, "n_seeds", minimum=1),
-                           seed=check_int(seed, "seed"), tol=tol, fit=True,
-                           start=task.config if task is not None and task.converged else None)
-    return IKResult(mech, P, res, position, resolve_tolerances(tol, "closure").reachability, task)
+    names = None if free is None else (check_names(free, "free") or [])
+    ans = solve_inverse(mech, P, all_solutions=all_solutions, n_seeds=check_int(n_seeds, "n_seeds", minimum=1),
+                        seed=check_int(seed, "seed"), tol=tol, free=names, euler=pose_sequence(pose))
+    return IKResult(mech, ans.pose, ans.result, position, resolve_tolerances(tol, "closure").reachability, ans.task)
 
 
 @dataclass(frozen=True, eq=False)
 class FKResult:
-    """Forward position: the platform pose(s) for actuator values.
-
-    ``result`` is the general engine's :class:`~spatialmech.kinematics.forward.ForwardResult`, or,
-    for ``all_solutions`` on a 4-SPS/CU of paper B's layout, the closed form's
-    ``ForwardAllResult`` (``closed_form`` is True)."""
+    """Forward position: the platform pose(s) for actuator values, the same fields whatever
+    engine answered (:attr:`answer`, a :class:`~spatialmech.kinematics.dispatch.ForwardAnswer`):
+    :attr:`engine`, :attr:`modes` (each an
+    :class:`~spatialmech.kinematics.dispatch.AssemblyMode`), :attr:`complete` and
+    :attr:`completeness`.  :attr:`result` is the engine's own result: the general engine's
+    :class:`~spatialmech.kinematics.forward.ForwardResult`, or the 4-SPS/CU closed form's
+    ``ForwardAllResult``."""
 
     mechanism: Mechanism
     actuator_values: np.ndarray  # SI (rad, length), in mechanism.actuators order
-    result: object
-    closed_form: bool = False
+    answer: ForwardAnswer
+
+    @property
+    def engine(self) -> Engine:
+        """``"newton"``, ``"multistart"``, ``"closed-form"``, ``"homotopy"`` or ``"monodromy"``."""
+        return self.answer.engine
+
+    @property
+    def result(self) -> ForwardResult | ForwardAllResult:
+        return self.answer.detail
+
+    @property
+    def closed_form(self) -> bool:
+        return self.answer.engine == "closed-form"
+
+    @property
+    def complete(self) -> bool:
+        """The assembly modes are proven complete (homotopy continuation)."""
+        return self.answer.complete
+
+    @property
+    def completeness(self) -> str:
+        return self.answer.completeness
+
+    @property
+    def modes(self) -> tuple[AssemblyMode, ...]:
+        """Every converged result (assembly modes, singular roots, self-motion sets)."""
+        return self.answer.modes
 
     @property
     def poses(self) -> tuple[Pose, ...]:
         """The platform pose of every converged solution (assembly mode)."""
-        if self.closed_form:
-            from ..kinematics.closed_forms import four_sps_cu as k4
-
-            return tuple(Pose(k4.rotation(s.phi), k4.pose_transform(s.phi)[:3, 3], f"mode {n + 1}")
-                         for n, s in enumerate(self.result.solutions) if s.converged)
-        return tuple(s.pose for s in self.result.solutions if s.converged)
+        return tuple(m.pose for m in self.answer.modes)
 
     @property
     def converged(self) -> bool:
         """At least one assembly was found."""
-        return bool(self.poses)
+        return bool(self.answer.modes)
 
     def to_dict(self) -> dict:
-        if self.closed_form:
-            return self.result.to_dict(actuators=self.mechanism.actuators)
-        return self.result.to_dict(self.mechanism)
+        return self.answer.to_dict(self.mechanism)
 
 
-def fk(model: ModelLike, actuators, *, all_solutions: bool = False, seeds: int | None = None, seed: int = 0,
+def fk(model: ModelLike, actuators, *, all_solutions: bool = False, seeds: int | None = None, seed: int | None = None,
        degrees: bool = False, progress: Progress | None = None, method: str = "auto") -> FKResult:
     """Forward position: platform pose(s) for actuator values (``actuators``: a sequence in the
     order of ``mechanism.actuators`` or a mapping by freedom name; lengths in the model's unit,
     rotations in radians, or degrees with ``degrees=True``).
 
-    From the reference configuration by Newton; ``all_solutions``: every assembly mode a
-    multi-start search finds (``seeds`` starts: default 200, 512 on the 4-SPS/CU closed form).
-    ``method`` (with ``all_solutions``): ``"auto"`` (default: homotopy continuation where it
-    covers the model (S-P-S and R-P-S legs, passive C-U limbs), proven complete; on the 4-SPS/CU its closed form; else,
-    for limbs from the ground to the platform of R, P, C, U, Sm and S joints (at most one S, or an S-S rod, per limb), the
-    loop formulation solved by monodromy, *not* proven complete; else the multi-start), ``"homotopy"`` or
-    ``"multistart"``; see docs/homotopy.md.  The result's
-    ``to_dict()`` says ``complete`` and ``completeness``.
-    Nothing is raised when no assembly is found: see ``converged`` and ``to_dict()``.
+    Without ``all_solutions``: one Newton solve from the reference configuration (``method``,
+    ``seeds`` and ``seed`` are refused).  With ``all_solutions``, every assembly mode, by the
+    engine ``method`` picks (:mod:`spatialmech.kinematics.dispatch`, docs/kinematics.md):
+
+    - ``"auto"`` (default): a registered closed form where one recognises the model (the
+      4-SPS/CU of paper B's layout), else homotopy continuation where it covers the model (S-P-S
+      and R-P-S legs, passive C-U limbs: proven complete), else the loop formulation by
+      monodromy (limbs of R, P, C, U, Sm and S joints from the ground to the platform; complete
+      when its trace test passes), else the multi-start search;
+    - ``"closed-form"``: the registered closed form (``InputError`` on other models);
+    - ``"homotopy"``: homotopy continuation or the loop formulation, uncapped (``InputError``
+      where neither covers the model);
+    - ``"multistart"``: the general multi-start search, on every model (never a proof).
+
+    ``seeds``: the starts of a multi-start search (default 200; the closed form's 512; the
+    starts the loop formulation adds when it is not proven complete); refused where homotopy in
+    Study parameters answers (it takes no starts).  ``seed``: the random seed (the closed form's
+    quasi-random sequence).  The result says which ``engine`` answered, ``complete`` and
+    ``completeness``.  Nothing is raised when no assembly is found: see ``converged``.
 
     >>> import spatialmech as sm
     >>> r = sm.fk("stewart-6sps", [1.2] * 6)
-    >>> r.converged, len(r.poses)
-    (True, 1)
+    >>> r.converged, len(r.poses), r.engine
+    (True, 1, 'newton')
     >>> r = sm.fk("four-sps-cu", [0.216745, 0.23896, 0.227321, 0.206933], all_solutions=True)   # closed form
     >>> sorted(round(float(P.p[2]), 3) for P in r.poses)      # the pose z = 0.12 m, another mode, two mirrors
     [-0.149, -0.12, 0.12, 0.149]
+    >>> r.engine, r.complete
+    ('closed-form', False)
     """
     mech = as_mechanism(model)
     degrees = check_bool(degrees, "degrees")
@@ -206,29 +242,12 @@ def fk(model: ModelLike, actuators, *, all_solutions: bool = False, seeds: int |
                            for a, v in zip(acts, raw, strict=True)])
     if seeds is not None:
         seeds = check_int(seeds, "seeds", minimum=1)
-    seed = check_int(seed, "seed")
-    progress = optional_progress(progress)
-    if method not in ("auto", "homotopy", "multistart"):
-        raise InputError(f"method: expected 'auto', 'homotopy' or 'multistart', got {method!r}")
-    if all_solutions and method != "multistart":
-        from ..kinematics.homotopy import study as hc
-        from ..kinematics.closed_forms import four_sps_cu as k4c
-
-        closed = method == "auto" and k4c.geometry_of(mech) is not None  # the 4-SPS/CU keeps its closed form
-        if (hc.unsupported_reason(mech) is None and not closed) or method == "homotopy":
-            return FKResult(mech, values, forward_position(mech, values, all_solutions=True, seed=seed, method="homotopy"))
-    if all_solutions:
-        from ..kinematics.closed_forms import four_sps_cu as k4
-        from ..kinematics.closed_forms import four_sps_cu_forward as k4f
-
-        geom = k4.geometry_of(mech)
-        if geom is not None:
-            fa = k4f.forward_all(values, geometry=geom, **({} if seeds is None else {"n_seeds": seeds}))
-            return FKResult(mech, values, fa, True)
-    res: ForwardResult = forward_position(mech, values, all_solutions=all_solutions,
-                                          n_seeds=200 if seeds is None else seeds, seed=seed, progress=progress,
-                                          method="multistart" if method == "multistart" else "auto")
-    return FKResult(mech, values, res)
+    if seed is not None:
+        seed = check_int(seed, "seed")
+    method = check_choice(method, "method", ("auto", "closed-form", "homotopy", "multistart"))
+    ans = solve_forward(mech, values, all_solutions=all_solutions, method=method, seeds=seeds, seed=seed,
+                        progress=optional_progress(progress))
+    return FKResult(mech, values, ans)
 
 
 # ============================================================================ Jacobian, velocity
@@ -289,12 +308,11 @@ def jacobian(model: ModelLike, pose=None, *, config: Configuration | None = None
             raise InputError("free: needs a pose (and no config): the coordinates not named are held at its values")
         names = check_names(free, "free") or []
         P, _ = as_pose(mech, pose, degrees)
-        sol = solve_pose(mech, P, names, euler=pose_sequence(pose))
+        solved, sol = pose_with_free(mech, P, names, pose_sequence(pose))
         if not sol.converged:
             raise InputError(f"free: the held coordinates do not close with {', '.join(names)} solved ({sol.status}, "
                              f"residual {sol.residual:.2e}); the pose is out of reach")
         task = sol.task
-        solved = Pose(sol.D[:3, :3], sol.D[:3, :3] @ mech.platform_point + sol.D[:3, 3], "requested, solved")
         fit = configuration_at_pose(mech, solved, start=sol.config)
         if not fit.converged:
             raise InputError(f"pose: no closed configuration near it (residual {fit.ik_residual:.2e})")

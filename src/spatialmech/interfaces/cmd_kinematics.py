@@ -1,5 +1,9 @@
 """CLI commands of the position / Jacobian analyses: ``ik``, ``fk``, ``jacobian``.
 
+Each parses its options, calls ONE function of the public API (``sm.ik``, ``sm.fk``,
+``sm.jacobian``, ``sm.dj_table``: the engine is chosen there) and renders its result: the text
+below, or the result's ``to_dict()`` in the JSON envelope.
+
 Poses at the command line: ``--xyz X Y Z`` (the platform point, length unit of the model) and
 ``--euler SEQ A1 A2 A3`` (an explicitly named sequence, angles in degrees; upper case =
 intrinsic); or ``--position N`` for a model's built-in task positions (numbered from 1).
@@ -8,20 +12,16 @@ Rotational actuator values are in degrees, slides in the model's length unit.
 
 from __future__ import annotations
 
+import sys
+
 import click
 import numpy as np
 
-from .. import catalog
-from ..analysis.defects import dj_table as compute_dj_table
+from .. import api as sm
 from ..errors import InputError
 from ..geometry.rotations import euler_matrix, matrix_euler
 from ..geometry.tolerances import current as current_tolerances
-from ..kinematics.jacobian import complete_jacobian
-from ..kinematics.position import configuration_at_pose, inverse_position
-from ..kinematics.forward import forward_position
-from ..kinematics.task import TaskJacobian, default_task, solve_pose, task_jacobian_at, task_solution_dict
 from ..model.mechanism import Mechanism, Pose
-from ..serialize import pose_dict
 from .common import emit_json, json_option, parse_numbers, tol_option
 
 #: Largest number of starts of ``fk --all`` (each start is one Newton solve).
@@ -84,7 +84,9 @@ MAX_POSE_DISTANCE = 1e6
 MAX_ANGLE_DEG = 1e9
 
 
-def resolve_pose(mech: Mechanism, xyz, euler, position) -> Pose:
+def pose_argument(mech: Mechanism, xyz, euler, position):
+    """The pose options as the API's pose argument (angles in degrees): the task position number,
+    or ``(xyz, (seq, a1, a2, a3))`` / ``(xyz, None)``; checked here to name the options."""
     if position is not None:
         if xyz is not None or euler is not None:
             raise InputError("--position: give either --position or --xyz/--euler, not both")
@@ -92,7 +94,7 @@ def resolve_pose(mech: Mechanism, xyz, euler, position) -> Pose:
             raise InputError(f"--position: {mech.name} has no built-in task positions")
         if not 1 <= position <= len(mech.positions):
             raise InputError(f"--position: expected 1..{len(mech.positions)}, got {position}")
-        return mech.positions[position - 1]
+        return position
     if xyz is None and euler is None:
         raise InputError("--xyz/--euler: give a pose (or --position N)")
     p = np.asarray(xyz if xyz is not None else mech.platform_point, dtype=float)
@@ -105,20 +107,20 @@ def resolve_pose(mech: Mechanism, xyz, euler, position) -> Pose:
                          f"{mech.name}, more than {MAX_POSE_DISTANCE:g} times its size "
                          f"({mech.characteristic_length:.3g} {mech.length_unit}): out of range")
     if euler is None:
-        R = np.eye(3)
-    else:
-        seq, *ang = euler
-        if not np.all(np.isfinite(ang)):
-            raise InputError(f"--euler: expected finite angles (degrees), got {', '.join(f'{v:g}' for v in ang)}")
-        R = euler_matrix(seq, ang, degrees=True)
-    return Pose(R, p, "requested")
+        return (p, None)
+    seq, *ang = euler
+    if not np.all(np.isfinite(ang)):
+        raise InputError(f"--euler: expected finite angles (degrees), got {', '.join(f'{v:g}' for v in ang)}")
+    return (p, (seq, *ang))
 
 
-
-
-def _deg(a: float, ndigits: int = 4) -> float:
-    """Degrees rounded to ``ndigits``, without a negative zero (``-0.0000``) from round-off."""
-    return round(float(np.degrees(a)), ndigits) + 0.0
+def resolve_pose(mech: Mechanism, xyz, euler, position) -> Pose:
+    """The pose options as a :class:`Pose` (for the commands that take a pose object)."""
+    arg = pose_argument(mech, xyz, euler, position)
+    if isinstance(arg, int):
+        return mech.positions[arg - 1]
+    p, orient = arg
+    return Pose(np.eye(3) if orient is None else euler_matrix(orient[0], orient[1:], degrees=True), p, "requested")
 
 
 def _num(v, fmt: str) -> str:
@@ -153,41 +155,31 @@ def ik(model, xyz, euler, position, all_solutions, free, as_json):
       spatialmech ik five-cs-1 --position 3 --json
       spatialmech ik delta --xyz 0.02 0.01 -0.33 --all
     """
-    mech = catalog.resolve(model)
-    pose = resolve_pose(mech, xyz, euler, position)
-    task = None
-    if free is not None:
-        task = solve_pose(mech, pose, free_names(free), euler=euler[0] if euler is not None else "ZYX")
-        if task.converged:
-            pose = Pose(task.D[:3, :3], task.D[:3, :3] @ mech.platform_point + task.D[:3, 3], "requested, solved")
-    res = inverse_position(mech, pose, all_solutions=all_solutions, fit=True,
-                           start=task.config if task is not None and task.converged else None)
+    mech = sm.load_model(model)
+    r = sm.ik(mech, pose_argument(mech, xyz, euler, position), all_solutions=all_solutions, degrees=True,
+              free=None if free is None else free_names(free))
+    if as_json:
+        emit_json("ik", mech, r.to_dict())
+        return
+    _ik_text(r)
+
+
+def _ik_text(r: sm.IKResult) -> None:
     # A pose that does not close exactly (printed, rounded data: a task position, a pose printed
     # by fk) is fitted onto the closure: reachable when the nearest closed configuration is
     # within the reachability tolerance, and either way the distance is said, never hidden.
-    fit = res.pose_fit
-    reach_tol = current_tolerances().reachability
-    d = res.to_dict(mech)
-    d["task"] = None if task is None else task_solution_dict(task)
-    if as_json:
-        d["pose_fit"] = None if fit is None else {
-            **fit.to_dict(), "tolerance": reach_tol,
-            "note": "the pose does not close exactly (printed, rounded data?); pose_fit is the nearest closed "
-                    "configuration (configuration_at_pose); within the tolerance (pose_error: the larger of the "
-                    "angle error in rad and the position error over the characteristic length) the pose is "
-                    "reachable and the solutions are those of the fitted pose"}
-        emit_json("ik", mech, d)
-        return
-    order = {r.id: i for i, r in enumerate(mech.freedom_refs)}
+    mech, res, fit, reach_tol = r.mechanism, r.result, r.pose_fit, r.reachability
+    d = r.to_dict()
+    order = {f.id: i for i, f in enumerate(mech.freedom_refs)}
     fitted = (f" (fitted onto the closure: off by {fit.position_error:.3g} {mech.length_unit} and "
               f"{np.degrees(fit.angle_error):.3g} deg, within the tolerance {reach_tol:g})") if res.fitted else ""
     click.echo(f"{mech.name}: pose {'reachable' if res.reachable else 'NOT reachable'}{fitted}")
-    if task is not None:
+    if r.task is not None:
         t = d["task"]
         vals = {**t["values_len"], **t["values_deg"]}
         unit = {n: (mech.length_unit if n in t["values_len"] else "deg") for n in vals}
         click.echo(f"  task coordinates ({t['euler']}): given {', '.join(f'{n} = {vals[n]:.6g} {unit[n]}' for n in t['given'])}")
-        click.echo(f"  solved{'' if task.converged else ' (NOT converged: ' + t['status'] + ')'}: "
+        click.echo(f"  solved{'' if r.task.converged else ' (NOT converged: ' + t['status'] + ')'}: "
                    + ", ".join(f"{n} = {vals[n]:.6g} {unit[n]}" for n in t["solved"]))
     for limb in d["limbs"]:
         extra = f", solution set of dimension {limb['passive_dim']} (passive freedoms)" if limb["passive_dim"] else ""
@@ -198,16 +190,16 @@ def ik(model, xyz, euler, position, all_solutions, free, as_json):
             vals = ", ".join(f"{fid}={v:.6g}" for fid, v in values)
             lim = f"  outside limits: {', '.join(sol['outside_limits'])}" if sol["outside_limits"] else ""
             click.echo(f"    [{k + 1}] {vals}  (residual {sol['residual']:.1e}){lim}")
-    if res.config is not None:
-        click.echo("  actuators: " + ", ".join(f"{k} = {_fmt_value(mech, k, v)}" for k, v in res.actuator_values(mech).items()))
+    if r.config is not None:
+        click.echo("  actuators: " + ", ".join(f"{k} = {_fmt_value(mech, k, v)}" for k, v in r.actuators.items()))
     click.echo("  (rotations in degrees, slides in " + mech.length_unit + ")")
-    if task is None and not res.reachable:
-        dt = default_task(mech)
+    if r.task is None and not res.reachable:
+        dt = r.default_task
         if len(dt.given) < 6:
             click.echo(f"  note: {mech.name}'s output link has {len(dt.given)} freedoms: a full pose is reachable only with its "
                        f"parasitic coordinates solved; try --free {','.join(dt.solved)} (gives {', '.join(dt.given)})")
     if fit is not None and fit.converged and not res.reachable:
-        what = f"task position {position} is printed (rounded) data; " if position is not None else ""
+        what = f"task position {r.position} is printed (rounded) data; " if r.position is not None else ""
         click.echo(f"  note: {what}the nearest closed configuration is {fit.position_error:.3g} {mech.length_unit} and "
                    f"{np.degrees(fit.angle_error):.3g} deg from it (pose error {fit.error:.2g}, beyond the reachability "
                    f"tolerance {reach_tol:g}; `--tol` sets it; `spatialmech jacobian` uses that configuration)")
@@ -218,13 +210,16 @@ def ik(model, xyz, euler, position, all_solutions, free, as_json):
 @click.option("--actuators", "values", required=True,
               help="Comma-separated actuator values in mechanism order (degrees / length).")
 @click.option("--all", "all_solutions", is_flag=True,
-              help="All real assembly modes: homotopy continuation (proven complete) where it covers the model, "
-                   "else multi-start.")
-@click.option("--method", type=click.Choice(["auto", "homotopy", "multistart"]), default="auto", show_default=True,
-              help="Method of --all (homotopy: proven complete for S-P-S and R-P-S legs, passive C-U limbs, ...; "
-                   "by monodromy, not proven, for other limbs of R, P, C, U, S joints; see docs/homotopy.md).")
+              help="All real assembly modes: a closed form where one recognises the model (4-SPS/CU), else homotopy "
+                   "continuation (proven complete) where it covers the model, else multi-start.")
+@click.option("--method", type=click.Choice(["auto", "closed-form", "homotopy", "multistart"]), default="auto",
+              show_default=True,
+              help="Method of --all (closed-form: the 4-SPS/CU's; homotopy: proven complete for S-P-S and R-P-S legs, "
+                   "passive C-U limbs, ...; by monodromy, not proven, for other limbs of R, P, C, U, S joints; "
+                   "multistart: the general multi-start search on any model; see docs/homotopy.md).")
 @click.option("--seeds", type=click.IntRange(min=1, max=MAX_SEEDS), default=None,
-              help=f"Number of starts for --all (default: 200; 512 on the 4-SPS/CU closed form; at most {MAX_SEEDS}).")
+              help=f"Number of starts of a multi-start search with --all (default: 200; 512 on the 4-SPS/CU closed "
+                   f"form; at most {MAX_SEEDS}); refused where homotopy continuation answers.")
 @tol_option("newton")
 @json_option
 def fk(model, values, all_solutions, method, seeds, as_json):
@@ -236,7 +231,7 @@ def fk(model, values, all_solutions, method, seeds, as_json):
       spatialmech fk four-sps-cu --actuators 0.21,0.25,0.22,0.19 --all --json
       spatialmech fk stewart-6sps --actuators 1.2,1.2,1.2,1.2,1.2,1.2 --all
     """
-    mech = catalog.resolve(model)
+    mech = sm.load_model(model)
     raw = parse_numbers(values, "--actuators")
     acts = mech.actuators
     if len(raw) != len(acts):
@@ -248,107 +243,73 @@ def fk(model, values, all_solutions, method, seeds, as_json):
             unit = mech.length_unit if slide else "deg"
             why = f" (1e6 times the size of {mech.name})" if slide else ""
             raise InputError(f"--actuators: item {k} ({a} = {v:g} {unit}) is out of range: at most {top:.3g} {unit}{why}")
-    vals = [v if mech.freedom(a).freedom.kind == "P" else np.radians(v) for a, v in zip(acts, raw, strict=True)]
-    from ..kinematics.closed_forms import four_sps_cu as k4
-    from ..kinematics.closed_forms import four_sps_cu_forward as k4f
-
-    closed = all_solutions and method == "auto" and k4.geometry_of(mech) is not None  # the 4-SPS/CU keeps its closed form
-    pre = None
-    if all_solutions and method != "multistart" and not closed:
-        from ..kinematics.homotopy import study as hc
-        from ..kinematics.homotopy import general as hg
-
-        why = hc.unsupported_reason(mech)
-        gwhy = hg.general_reason(mech) if why is not None else None
-        if why is None or gwhy is None:
-            pre = forward_position(mech, vals, all_solutions=True, method="homotopy" if why is None else method,
-                                   n_seeds=200 if seeds is None else seeds)
-            if "n_generic" in pre.search:
-                _fk_homotopy(mech, pre, as_json)
-                return
-            # the loop formulation's monodromy stopped unsaturated: the multi-start ran instead (printed below)
-        elif method == "homotopy":
-            raise InputError(f"--method: homotopy does not cover {mech.name}: {why}; nor does the loop formulation: "
-                             f"{gwhy}; use --method multistart")
-    geom = k4.geometry_of(mech) if all_solutions and method != "multistart" else None
-    if geom is not None:  # the closed form of this limb layout: faster and more thorough
-        fa = k4f.forward_all(np.asarray(vals), geometry=geom, **({} if seeds is None else {"n_seeds": seeds}))
-        if as_json:
-            emit_json("fk", mech, fa.to_dict(actuators=acts))
-            return
-        if not fa.solutions:
-            raise InputError(f"actuators: no assembly found among {fa.search.n_seeds} starts of the closed form "
-                             f"({fa.search.n_converged} converged); not a proof that none exists: check the values "
-                             "against the leg limits, or try more --seeds")
-        click.echo(_fk_header(mech, [s_.kind for s_ in fa.solutions], "closed-form multi-start", fa.search.n_seeds,
-                              fa.search.n_converged) + f"; {fa.n_within_limits} within the leg and CU limits")
-        for n, s_ in enumerate(fa.solutions):
-            z, al, be, ga = s_.phi
-            click.echo(f"  [{n + 1}] z = {round(float(z), 6) + 0.0:.6f} m, alpha = {_deg(al):.4f}, beta = {_deg(be):.4f}, "
-                       f"gamma = {_deg(ga):.4f} deg ('ZYX')  {'within limits' if s_.within_limits else 'outside limits'}")
-            _fk_conditioning_lines(s_.kind, s_.sigma_min, s_.condition, s_.singular_below, s_.members, s_.self_motion,
-                                   mech.length_unit, None)
+    with _progress_bar(enabled=all_solutions and not as_json) as progress:
+        r = sm.fk(mech, raw, all_solutions=all_solutions, method=method, seeds=seeds, degrees=True, progress=progress)
+    if as_json:
+        emit_json("fk", mech, r.to_dict())
         return
-    seeds = 200 if seeds is None else seeds
-    if pre is not None:
-        res = pre
-    elif all_solutions and not as_json:
-        import sys
+    _fk_text(r)
 
-        with click.progressbar(length=seeds, label="assembly modes", file=sys.stderr) as bar:
-            res = forward_position(mech, vals, all_solutions=True, n_seeds=seeds, progress=lambda k, n, msg: bar.update(1))
+
+class _progress_bar:
+    """A progress callback for ``sm.fk`` that opens a bar on stderr at its first call (only the
+    engines that report progress call it), and closes it on exit."""
+
+    def __init__(self, enabled: bool):
+        self.enabled, self.bar = enabled, None
+
+    def __enter__(self):
+        return self if self.enabled else None
+
+    def __call__(self, done, total, message) -> None:
+        if self.bar is None:
+            self.bar = click.progressbar(length=total, label=message, file=sys.stderr)
+            self.bar.__enter__()
+        self.bar.update(1)
+
+    def __exit__(self, *exc):
+        if self.bar is not None:
+            self.bar.__exit__(*exc)
+        return False
+
+
+def _fk_text(r: sm.FKResult) -> None:
+    """``fk`` as text: the header (what was found, by which engine), completeness, every mode."""
+    mech, a = r.mechanism, r.answer
+    modes = a.modes
+    if a.endpoints is not None:  # homotopy continuation: counts of the path end points
+        e = a.endpoints
+        n_sm = sum(m.kind == "self-motion" for m in modes)
+        click.echo(f"{mech.name}: {len(modes)} real assembly mode{'s' if len(modes) != 1 else ''}"
+                   + (f" ({n_sm} of them self-motion sets)" if n_sm else "")
+                   + f"; end points: {e.n_real} real, {e.n_complex} complex, {e.n_singular} singular, "
+                   f"{e.n_at_infinity} at infinity, of {e.n_generic} generic solutions"
+                   + (f" ({e.n_spurious} spurious end points of the square system discarded)" if e.n_spurious is not None
+                      else "")
+                   + f" ({a.label}, {e.elapsed_s:.2f} s)")
+        how = a.completeness
+        if a.complete and how.startswith("complete (trace test): "):  # say "complete" once
+            how = "by the trace test: " + how[len("complete (trace test): "):]
+        click.echo(("  complete (proven): " if a.complete else "  NOT proven complete: ") + how)
     else:
-        res = forward_position(mech, vals, all_solutions=all_solutions, n_seeds=seeds)
-    if as_json:
-        emit_json("fk", mech, res.to_dict(mech))
-        return
-    converged = [s for s in res.solutions if s.converged]
-    if not converged:
-        if all_solutions:
-            raise InputError(f"actuators: no assembly found among {res.search['seeds']} starts "
-                             f"({res.search['converged_runs']} converged); not a proof that none exists: check the values "
-                             "against the limits and the mechanism's size, or try more --seeds")
-        r0 = res.solutions[0].residual if res.solutions else float("nan")
-        raise InputError(f"actuators: no assembly found (Newton did not converge; residual {r0:.2e}); try --all")
-    click.echo(_fk_header(mech, [s.kind for s in converged], res.search["method"], res.search["seeds"],
-                          res.search["converged_runs"]))
-    if all_solutions:
-        click.echo(f"  NOT proven complete: {res.search['completeness']}")
-    _fk_solution_lines(mech, converged)
-
-
-def _fk_solution_lines(mech: Mechanism, converged) -> None:
-    for k, s in enumerate(converged):
-        e = matrix_euler("ZYX", s.pose.R, degrees=True)
-        lim = "within limits" if not s.outside_limits else "outside limits: " + ", ".join(s.outside_limits)
-        click.echo(f"  [{k + 1}] platform point ({_num(s.pose.p, '.6g')}) {mech.length_unit}, "
+        if not modes:
+            if a.all_solutions:
+                raise InputError(f"actuators: no assembly found among {a.n_starts} starts ({a.n_converged} converged); "
+                                 "not a proof that none exists: check the values against the limits and the "
+                                 "mechanism's size, or try more --seeds")
+            raise InputError(f"actuators: no assembly found (Newton did not converge; residual {a.failed_residual:.2e}); "
+                             "try --all")
+        click.echo(_fk_header(mech, [m.kind for m in modes], a.label, a.n_starts, a.n_converged)
+                   + (f"; {a.n_within_limits} within limits" if a.all_solutions else ""))
+        if a.all_solutions:
+            click.echo(f"  NOT proven complete: {a.completeness}")
+    for k, m in enumerate(modes):
+        e = matrix_euler("ZYX", m.pose.R, degrees=True)
+        lim = "within limits" if m.within_limits else "outside limits: " + ", ".join(m.outside_limits)
+        click.echo(f"  [{k + 1}] platform point ({_num(m.pose.p, '.6g')}) {mech.length_unit}, "
                    f"ZYX angles ({_num(e, '.4f')}) deg  {lim}")
-        c = s.conditioning
-        _fk_conditioning_lines(s.kind, c.sigma_min, c.condition, c.threshold, s.members, s.self_motion, mech.length_unit,
-                               c.free_dim)
-
-
-def _fk_homotopy(mech: Mechanism, res, as_json: bool) -> None:
-    """``fk --all`` by homotopy continuation: counts, completeness, the real assembly modes."""
-    if as_json:
-        emit_json("fk", mech, res.to_dict(mech))
-        return
-    sr = res.search
-    sols = list(res.solutions)
-    kinds = [s.kind for s in sols]
-    n_sm = sum(k == "self-motion" for k in kinds)
-    click.echo(f"{mech.name}: {len(sols)} real assembly mode{'s' if len(sols) != 1 else ''}"
-               + (f" ({n_sm} of them self-motion sets)" if n_sm else "")
-               + f"; end points: {sr['n_real']} real, {sr['n_complex']} complex, {sr['n_singular']} singular, "
-               f"{sr['n_at_infinity']} at infinity, of {sr['n_generic']} generic solutions"
-               + (f" ({sr['n_spurious']} spurious end points of the square system discarded)" if "n_spurious" in sr else "")
-               + f" ({'loop formulation by monodromy' if 'n_spurious' in sr else 'homotopy continuation'}, "
-               f"{sr['elapsed_s']:.2f} s)")
-    how = sr["completeness"]
-    if sr["complete"] and how.startswith("complete (trace test): "):  # say "complete" once
-        how = "by the trace test: " + how[len("complete (trace test): "):]
-    click.echo(("  complete (proven): " if sr["complete"] else "  NOT proven complete: ") + how)
-    _fk_solution_lines(mech, sols)
+        _fk_conditioning_lines(m.kind, m.sigma_min, m.condition, m.singular_below, m.members, m.self_motion,
+                               mech.length_unit, m.free_dim)
 
 
 def _fk_header(mech: Mechanism, kinds, method: str, seeds: int, converged: int) -> str:
@@ -409,13 +370,13 @@ def jacobian(model, xyz, euler, position, drivers, dj_table, free, as_json):
       spatialmech jacobian four-sps-cu --xyz 0 0 0.12 --euler ZYX 34.38 -5.73 11.46
       spatialmech jacobian three-rps --pose 0,0,0.33,ZYX,0,5,5 --free x,y,a1
     """
-    mech = catalog.resolve(model)
+    mech = sm.load_model(model)
     if dj_table and free is not None:
         raise InputError("--free: not with --dj-table (the DJ table is at the built-in task positions)")
     if dj_table:
         if not mech.positions:
             raise InputError(f"--dj-table: {mech.name} has no built-in task positions")
-        t = compute_dj_table(mech, list(drivers) or None)
+        t = sm.dj_table(mech, list(drivers) or None)
         fits = t.fits
         data = t.to_dict()
         if as_json:
@@ -429,24 +390,12 @@ def jacobian(model, xyz, euler, position, drivers, dj_table, free, as_json):
         click.echo(f"  printed poses fitted onto the closure: largest error {worst.position_error:.3g} {mech.length_unit},"
                    f" {np.degrees(max(f.angle_error for f in fits)):.3g} deg")
         return
-    pose = resolve_pose(mech, xyz, euler, position)
-    sol = None
-    if free is not None:
-        sol = solve_pose(mech, pose, free_names(free), euler=euler[0] if euler is not None else "ZYX")
-        if not sol.converged:
-            raise InputError(f"--free: the held coordinates do not close with {free} solved ({sol.status}, residual "
-                             f"{sol.residual:.2e}); the pose is out of reach")
-        pose = Pose(sol.D[:3, :3], sol.D[:3, :3] @ mech.platform_point + sol.D[:3, 3], "requested, solved")
-    fit = configuration_at_pose(mech, pose, start=None if sol is None else sol.config)
-    if not fit.converged:
-        raise InputError(f"pose: no closed configuration near it (residual {fit.ik_residual:.2e})")
-    J = complete_jacobian(mech, fit.config, list(drivers) or None)
-    tj = task_jacobian_at(mech, fit.config, list(drivers) or None, task=None if sol is None else sol.task)
+    jr = sm.jacobian(mech, pose_argument(mech, xyz, euler, position), drivers=list(drivers) or None, degrees=True,
+                     free=None if free is None else free_names(free))
     if as_json:
-        emit_json("jacobian", mech, {"result": "complete_jacobian", "pose": pose_dict(pose.R, pose.p), **J.to_dict(),
-                                     "pose_fit": fit.to_dict(),
-                                     "task_jacobian": None if tj is None else tj.to_dict(mech)})
+        emit_json("jacobian", mech, jr.to_dict())
         return
+    J, fit = jr.jacobian, jr.pose_fit
     click.echo(f"{mech.name}: complete Jacobian (rows: {J.constraint_rows} constraint, {len(J.actuators)} actuation"
                f" [{', '.join(J.actuators)}]); J $p = (0, qdot)")
     for row in J.matrix:
@@ -459,15 +408,18 @@ def jacobian(model, xyz, euler, position, drivers, dj_table, free, as_json):
                    "`spatialmech singularity` gives its kind and the uncontrolled twist")
     if J.inverse_singular:
         click.echo(f"  inverse (serial) singular for: {', '.join(J.inverse_singular)}")
-    if not fit.exact:
+    if fit is not None and not fit.exact:
         click.echo(f"  note: the pose was fitted onto the closure (error {fit.position_error:.3g} {mech.length_unit}, "
                    f"{np.degrees(fit.angle_error):.3g} deg)")
-    if tj is not None:
-        _echo_task_jacobian(mech, tj)
+    if jr.task is not None:
+        _echo_task_jacobian(jr)
 
 
-def _echo_task_jacobian(mech: Mechanism, tj: TaskJacobian) -> None:
-    """The input-output Jacobian over the given task coordinates, as text (angles in degrees)."""
+def _echo_task_jacobian(jr: sm.JacobianResult) -> None:
+    """The input-output Jacobian over the given task coordinates (``jr.task``), as text (angles
+    in degrees)."""
+    mech, tj = jr.mechanism, jr.task
+    assert tj is not None
     sol = tj.solution
     u = mech.length_unit
     vals = ", ".join(f"{n} = {sol.values[n]:.6g} {u}" if n in ("x", "y", "z") else f"{n} = {np.degrees(sol.values[n]):.6g} deg"

@@ -63,6 +63,7 @@ __all__ = [
     "ForwardSolution",
     "forward_conditioning",
     "forward_position",
+    "homotopy_coverage",
     "locked_actuators",
 ]
 
@@ -302,6 +303,20 @@ def _trace_self_motion(mech: Mechanism, locked: Mechanism, config: Configuration
     return trace_set(MotionProblem(locked), config, lambda c: _pose_key(mech, c), h0=0.05, h_max=0.3, max_steps=600)
 
 
+def homotopy_coverage(mech: Mechanism) -> tuple[str | None, str | None]:
+    """Which homotopy covers ``mech``'s forward position: ``(why, gwhy)``, why homotopy
+    continuation in Study parameters does not (``None``: it does) and why the loop formulation
+    by monodromy does not (``None``: it does; asked only when the first does not)."""
+    from .homotopy import study as hc
+
+    why = hc.unsupported_reason(mech)
+    if why is None:
+        return None, None
+    from .homotopy import general as hg
+
+    return why, hg.general_reason(mech)
+
+
 def _fk_from(mech, config, targets, mask, max_iter, patience=None):
     q = config.q.copy()
     for i, v in targets.items():
@@ -351,16 +366,12 @@ def forward_position(
     if method not in ("multistart", "homotopy", "auto"):
         raise InputError(f"method: expected 'multistart', 'homotopy' or 'auto', got {method!r}")
     targets = _actuator_q(mech, actuator_values)
+    why: str | None = None  # why homotopy in Study parameters does not cover the model
     gwhy: str | None = None  # why the loop formulation (homotopy/general.py) does not cover the model
     if all_solutions and method != "multistart":
-        from .homotopy import study as hc
-
-        why = hc.unsupported_reason(mech)
+        why, gwhy = homotopy_coverage(mech)
         if why is None:
             return _forward_homotopy(mech, targets, seed, max_iter, n_seeds)
-        from .homotopy import general as hg
-
-        gwhy = hg.general_reason(mech)
         if gwhy is None:
             gres = _forward_general(mech, targets, seed, max_iter, n_seeds, fallback=method == "auto")
             if gres is not None:
@@ -429,7 +440,7 @@ def forward_position(
         search["complete"] = False
         search["completeness"] = ("multi-start search: not a proof; assembly modes may be missing" +
                                   ("" if method == "multistart" else f" (homotopy does not cover {mech.name}: "
-                                   f"{hc.unsupported_reason(mech)}; nor does the loop formulation: {gwhy})"))
+                                   f"{why}; nor does the loop formulation: {gwhy})"))
     return ForwardResult(tuple(sols), search)
 
 

@@ -1,0 +1,333 @@
+"""The front door of position analysis: ONE place decides which engine answers a forward or an
+inverse position request, refuses the options that engine would ignore, and returns one result
+type whatever the engine (``sm.fk`` / ``sm.ik`` and the ``fk`` / ``ik`` commands go through here).
+
+Forward position, :func:`solve_forward` (actuator values -> platform pose(s)):
+
+- without ``all_solutions``: one Gauss-Newton solve from the reference configuration (engine
+  ``"newton"``); ``method``, ``seeds`` and ``seed`` are refused (nothing to choose or to seed);
+- ``method="closed-form"``: the registered closed form that recognises the model
+  (:data:`FORWARD_CLOSED_FORMS`; today the 4-SPS/CU of paper B's layout), else ``InputError``;
+  its multi-seed search takes ``seeds`` (default 512) and ``seed`` (the quasi-random sequence's);
+- ``method="homotopy"``: homotopy continuation, in Study parameters where the limbs reduce to
+  them (engine ``"homotopy"``, proven complete; ``seeds`` refused: it tracks every path of a
+  total-degree homotopy, a multi-start adds roots only at singular end points, with its default
+  200 starts), else the loop formulation by monodromy (engine ``"monodromy"``; ``seeds`` sizes
+  the multi-start it adds when it is not proven complete), else ``InputError``;
+- ``method="multistart"``: the general engine's multi-start search (``seeds`` starts, default
+  200), on every model, the 4-SPS/CU included (never a proof of completeness);
+- ``method="auto"``: the closed form where one recognises the model, else what ``"homotopy"``
+  would run (the monodromy capped, the multi-start instead when it gives up), else the
+  multi-start.
+
+Inverse position, :func:`solve_inverse` (platform pose -> every limb's joint values): the task
+solve of the ``free`` coordinates (:func:`pose_with_free`), then a registered closed form
+(:data:`INVERSE_CLOSED_FORMS`; none yet: the closed forms give the actuator values only, not
+every limb's joints) or the general engine (:func:`.position.inverse_position`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+
+from ..errors import InputError
+from ..geometry.tolerances import Tolerances
+from ..model.mechanism import Mechanism, Pose
+from ..results import Progress
+from .assembly import AssemblyKind, SelfMotion
+from .closed_forms.four_sps_cu_forward import ForwardAllResult
+from .forward import ForwardResult, forward_position, homotopy_coverage
+from .position import InverseResult, inverse_position
+from .task import TaskSolution, solve_pose
+
+__all__ = [
+    "FORWARD_CLOSED_FORMS",
+    "FORWARD_METHODS",
+    "INVERSE_CLOSED_FORMS",
+    "AssemblyMode",
+    "ClosedForm",
+    "EndPoints",
+    "ForwardAnswer",
+    "InverseAnswer",
+    "forward_engine",
+    "pose_with_free",
+    "solve_forward",
+    "solve_inverse",
+]
+
+#: The engines that answer a forward-position request (``ForwardAnswer.engine``).
+Engine = Literal["newton", "multistart", "closed-form", "homotopy", "monodromy"]
+#: The values of ``method``.
+FORWARD_METHODS = ("auto", "closed-form", "homotopy", "multistart")
+#: Starts of the general multi-start search when ``seeds`` is not given.
+DEFAULT_SEEDS = 200
+
+
+# ============================================================================ one result
+@dataclass(frozen=True, eq=False)
+class AssemblyMode:
+    """One forward-position result, whatever the engine: the platform pose, what it is
+    (``kind``: regular, singular, self-motion), the conditioning (scale-free ``sigma_min``,
+    ``condition`` = sigma_min / sigma_max, ``singular_below``), the limits, how many converged
+    runs stand for it (``members``) and, for a self-motion, what its trace found."""
+
+    pose: Pose
+    kind: AssemblyKind
+    residual: float  # nondimensional
+    outside_limits: tuple[str, ...]
+    sigma_min: float
+    condition: float
+    singular_below: float
+    members: int = 1
+    self_motion: SelfMotion | None = None
+    free_dim: int | None = None  # free directions of the platform at a singular root (general engine)
+
+    @property
+    def within_limits(self) -> bool:
+        return not self.outside_limits
+
+
+@dataclass(frozen=True)
+class EndPoints:
+    """Homotopy continuation: the status of every path end point (complex solutions)."""
+
+    n_real: int
+    n_complex: int
+    n_singular: int
+    n_at_infinity: int
+    n_generic: int
+    n_spurious: int | None  # the loop formulation: end points of the square system that do not close
+    elapsed_s: float
+
+
+@dataclass(frozen=True, eq=False)
+class ForwardAnswer:
+    """The answer of :func:`solve_forward`, the same fields for every engine.
+
+    ``engine`` says which engine answered (:data:`Engine`), ``label`` names its method in a few
+    words; ``modes`` are the converged results (assembly modes, singular roots, self-motion
+    sets); ``complete`` is True only when the set is proven complete, ``completeness`` says how
+    or why not; ``n_starts`` / ``n_converged`` count the Newton starts (of a multi-start search,
+    or added to the homotopy's end points); ``endpoints`` (homotopy only) the path end points;
+    ``failed_residual`` the residual of a single solve that did not converge.  ``detail`` is the
+    engine's own result (:class:`.forward.ForwardResult`, or the closed form's)."""
+
+    engine: Engine
+    label: str
+    all_solutions: bool
+    modes: tuple[AssemblyMode, ...]
+    complete: bool
+    completeness: str
+    n_starts: int
+    n_converged: int
+    endpoints: EndPoints | None
+    failed_residual: float | None
+    detail: ForwardResult | ForwardAllResult
+
+    @property
+    def n_within_limits(self) -> int:
+        return sum(m.within_limits for m in self.modes)
+
+    def to_dict(self, mech: Mechanism) -> dict:
+        """JSON (docs/json.md, ``spatialmech fk --json``): the engine's fields and, for every
+        engine, ``engine``, ``complete`` and ``completeness``."""
+        if isinstance(self.detail, ForwardAllResult):
+            d = self.detail.to_dict(actuators=mech.actuators)
+        else:
+            d = self.detail.to_dict(mech)
+        return {"engine": self.engine, **d, "complete": self.complete, "completeness": self.completeness}
+
+
+# ============================================================================ the registry of closed forms
+@dataclass(frozen=True)
+class ClosedForm:
+    """A closed form of a position problem: ``recognise(mechanism)`` returns its solver when the
+    mechanism is of its layout (read from the mechanism itself), else ``None``.
+
+    A forward solver is called ``solver(mech, values, seeds=..., seed=...)`` (``values``: the
+    actuators' physical values in ``mech.actuators`` order; ``seeds``/``seed`` ``None`` for its
+    defaults) and returns a :class:`ForwardAnswer`; an inverse solver ``solver(mech, pose,
+    all_solutions=..., n_seeds=..., seed=..., tol=...)`` returns an
+    :class:`~.position.InverseResult`."""
+
+    name: str
+    recognise: Callable[[Mechanism], Callable | None]
+
+
+def _four_sps_cu_forward(mech: Mechanism):
+    """The 4-SPS/CU of paper B's layout: :func:`.closed_forms.four_sps_cu_forward.forward_all`."""
+    from .closed_forms import four_sps_cu as k4
+
+    geom = k4.geometry_of(mech)
+    if geom is None:
+        return None
+
+    def solve(mech: Mechanism, values, *, seeds: int | None, seed: int | None) -> ForwardAnswer:
+        from .closed_forms import four_sps_cu_forward as k4f
+
+        kw = {} if seeds is None else {"n_seeds": seeds}
+        fa = k4f.forward_all(np.asarray(values, float), geometry=geom, qmc_seed=0 if seed is None else seed, **kw)
+        modes = []
+        for n, s in enumerate(fa.solutions):
+            if not s.converged:
+                continue
+            d = s.to_dict(actuators=mech.actuators)
+            assert s.kind is not None
+            modes.append(AssemblyMode(Pose(k4.rotation(s.phi), k4.pose_transform(s.phi)[:3, 3], f"mode {n + 1}"),
+                                      s.kind, d["residual"], tuple(d["outside_limits"]), float(s.sigma_min),
+                                      float(s.condition), float(s.singular_below), s.members, s.self_motion))
+        return ForwardAnswer("closed-form", "closed-form multi-start", True, tuple(modes), False,
+                             "multi-seed search of the closed form: not a proof; assembly modes may be missing",
+                             fa.search.n_seeds, fa.search.n_converged, None, None, fa)
+
+    return solve
+
+
+#: Closed forms of forward position, tried in order by :func:`solve_forward`.  (The spherical
+#: 3-RRR's ``forward_orientation`` follows one assembly branch from a start and the 3-RPS's
+#: closed form is its parasitic motion: neither finds every assembly mode, none is registered.)
+FORWARD_CLOSED_FORMS: list[ClosedForm] = [ClosedForm("4-SPS/CU of paper B's layout", _four_sps_cu_forward)]
+#: Closed forms of inverse position, tried in order by :func:`solve_inverse`.  None yet: the
+#: closed forms (4-SPS/CU and S-P-S leg lengths, the spherical 3-RRR's actuator angles) give the
+#: actuator values only, where inverse position answers every limb's joint values.
+INVERSE_CLOSED_FORMS: list[ClosedForm] = []
+
+
+def _closed_form(registry: Sequence[ClosedForm], mech: Mechanism) -> Callable | None:
+    for cf in registry:
+        solver = cf.recognise(mech)
+        if solver is not None:
+            return solver
+    return None
+
+
+# ============================================================================ forward position
+def _mode(s) -> AssemblyMode:
+    c = s.conditioning
+    return AssemblyMode(s.pose, s.kind, float(s.residual), tuple(s.outside_limits), c.sigma_min, c.condition,
+                        c.threshold, s.members, s.self_motion, c.free_dim)
+
+
+def _general_answer(res: ForwardResult, all_solutions: bool) -> ForwardAnswer:
+    """The general engine's :class:`.forward.ForwardResult` as a :class:`ForwardAnswer`."""
+    sr = res.search
+    modes = tuple(_mode(s) for s in res.solutions if s.converged)
+    failed = None if modes or not res.solutions else float(res.solutions[0].residual)
+    if "n_generic" in sr:  # homotopy continuation: Study parameters, or the loop formulation ("n_spurious")
+        loop = "n_spurious" in sr
+        ends = EndPoints(sr["n_real"], sr["n_complex"], sr["n_singular"], sr["n_at_infinity"], sr["n_generic"],
+                         sr.get("n_spurious"), sr["elapsed_s"])
+        return ForwardAnswer("monodromy" if loop else "homotopy",
+                             "loop formulation by monodromy" if loop else "homotopy continuation", True, modes,
+                             bool(sr["complete"]), sr["completeness"], sr["seeds"], sr["converged_runs"], ends, failed,
+                             res)
+    if all_solutions:
+        return ForwardAnswer("multistart", sr["method"], True, modes, False, sr["completeness"], sr["seeds"],
+                             sr["converged_runs"], None, failed, res)
+    return ForwardAnswer("newton", sr["method"], False, modes, False,
+                         "one Newton solve from the reference configuration: one assembly mode at most "
+                         "(all_solutions for every one)", sr["seeds"], sr["converged_runs"], None, failed, res)
+
+
+def forward_engine(mech: Mechanism, method: str = "auto", all_solutions: bool = True) -> Engine:
+    """The engine :func:`solve_forward` runs for ``method`` (before it runs: with
+    ``method="auto"`` the capped monodromy may still give up and leave it to the multi-start)."""
+    if method not in FORWARD_METHODS:
+        raise InputError(f"method: expected one of {', '.join(map(repr, FORWARD_METHODS))}, got {method!r}")
+    if not all_solutions:
+        return "newton"
+    if method in ("auto", "closed-form") and _closed_form(FORWARD_CLOSED_FORMS, mech) is not None:
+        return "closed-form"
+    if method == "closed-form":
+        names = ", ".join(cf.name for cf in FORWARD_CLOSED_FORMS)
+        raise InputError(f"method: no closed form of forward position recognises {mech.name} (registered: {names}); "
+                         "use method='auto'")
+    if method == "multistart":
+        return "multistart"
+    why, gwhy = homotopy_coverage(mech)
+    if why is None:
+        return "homotopy"
+    if gwhy is None:
+        return "monodromy"
+    if method == "homotopy":
+        raise InputError(f"method: homotopy forward position does not cover {mech.name}: {why}; nor does the loop "
+                         f"formulation: {gwhy}; use method='multistart'")
+    return "multistart"
+
+
+def solve_forward(mech: Mechanism, values, *, all_solutions: bool = False, method: str = "auto",
+                  seeds: int | None = None, seed: int | None = None, progress: Progress | None = None
+                  ) -> ForwardAnswer:
+    """Forward position through the engine ``method`` picks (module docstring): ``values`` the
+    actuators' physical values (SI: length, rad) in ``mech.actuators`` order.  ``seeds`` /
+    ``seed``: the starts and the random seed of a multi-start search (``None``: the engine's
+    default); options the chosen engine would ignore raise :class:`InputError` naming them.
+    ``progress(done, total, message)`` is called by the engines that report progress (the
+    multi-start search)."""
+    if method not in FORWARD_METHODS:
+        raise InputError(f"method: expected one of {', '.join(map(repr, FORWARD_METHODS))}, got {method!r}")
+    if not all_solutions:
+        given = [n for n, v in (("method", method != "auto"), ("seeds", seeds is not None), ("seed", seed is not None))
+                 if v]
+        if given:
+            raise InputError(f"{', '.join(given)}: only with all_solutions (without it, one Newton solve from the "
+                             "reference configuration: no engine to choose, no starts)")
+        return _general_answer(forward_position(mech, values), False)
+    engine = forward_engine(mech, method)
+    if engine == "closed-form":
+        solver = _closed_form(FORWARD_CLOSED_FORMS, mech)
+        assert solver is not None
+        return solver(mech, values, seeds=seeds, seed=seed)
+    if engine == "homotopy" and seeds is not None:
+        raise InputError(f"seeds: homotopy continuation answers {mech.name} (method={method!r}), which takes no "
+                         "starts: it tracks every path of a total-degree homotopy and is proven complete; "
+                         "method='multistart' runs a multi-start search of that many starts")
+    res = forward_position(mech, values, all_solutions=True, n_seeds=DEFAULT_SEEDS if seeds is None else seeds,
+                           seed=0 if seed is None else seed, progress=progress, method=method)
+    return _general_answer(res, True)
+
+
+# ============================================================================ inverse position
+@dataclass(frozen=True, eq=False)
+class InverseAnswer:
+    """The answer of :func:`solve_inverse`: the pose solved (with ``free``: the task solve's),
+    every limb's joint values (``result``), the task solve (``None`` without ``free``) and the
+    engine (``"closed-form"`` or ``"numerical"``)."""
+
+    pose: Pose
+    result: InverseResult
+    task: TaskSolution | None
+    engine: Literal["closed-form", "numerical"]
+
+
+def pose_with_free(mech: Mechanism, pose: Pose, free: Sequence[str], euler: str = "ZYX") -> tuple[Pose, TaskSolution]:
+    """The task solve of a requested pose whose coordinates ``free`` (from ``x, y, z, a1, a2,
+    a3``, angles in sequence ``euler``) are solved and the others held: the solved pose (the
+    requested one when the solve did not converge) and the solve."""
+    task = solve_pose(mech, pose, list(free), euler=euler)
+    if task.converged:
+        R = task.D[:3, :3]
+        pose = Pose(R, R @ mech.platform_point + task.D[:3, 3], "requested, solved")
+    return pose, task
+
+
+def solve_inverse(mech: Mechanism, pose: Pose, *, all_solutions: bool = False, n_seeds: int = 48, seed: int = 0,
+                  tol: Tolerances | float | None = None, free: Sequence[str] | None = None,
+                  euler: str = "ZYX") -> InverseAnswer:
+    """Inverse position through the one front door: with ``free``, the task solve first
+    (:func:`pose_with_free`); then a registered closed form (:data:`INVERSE_CLOSED_FORMS`) or the
+    general engine, a pose that does not close exactly fitted onto the closure (``fit=True``)."""
+    task = None
+    if free is not None:
+        pose, task = pose_with_free(mech, pose, free, euler)
+    solver = _closed_form(INVERSE_CLOSED_FORMS, mech)
+    if solver is not None:
+        return InverseAnswer(pose, solver(mech, pose, all_solutions=all_solutions, n_seeds=n_seeds, seed=seed, tol=tol),
+                             task, "closed-form")
+    res = inverse_position(mech, pose, all_solutions=all_solutions, n_seeds=n_seeds, seed=seed, tol=tol, fit=True,
+                           start=task.config if task is not None and task.converged else None)
+    return InverseAnswer(pose, res, task, "numerical")
