@@ -140,7 +140,7 @@ def studio_session(model: ModelLike = "five-cs-3"):
     >>> import spatialmech as sm
     >>> s = sm.studio_session("rssr")
     >>> r = s.drive([10.0])                                  # the crank to 10 degrees
-    >>> r.status, round(s.state()["actuators_deg"]["A0.rot"], 9)
+    >>> str(r.status), round(s.state()["actuators_deg"]["A0.rot"], 9)
     ('reached', 10.0)
     """
     from ..interfaces.studio.session import Session
