@@ -193,6 +193,14 @@ def test_redundant_actuation_gets_the_minimum_norm_efforts():
     assert np.allclose(got, want, atol=1e-8), (got, want)
 
 
+@pytest.mark.parametrize("name", sm.models())
+def test_the_singular_flag_is_the_jacobians(name):
+    """One threshold: statics calls a configuration singular exactly when the complete Jacobian does."""
+    r = sm.statics(name, wrench=[1.0, 2.0, 3.0, 0.1, 0.2, 0.3])
+    assert r.singular == r.analysis.jacobian.singular, (r.sigma_min, r.analysis.jacobian.sigma_min)
+    assert (r.unbalanced_wrench is not None) == r.singular
+
+
 def test_overconstrained_linkage_flags_indeterminate_reactions():
     r = sm.statics("bennett", wrench=[1.0, 2.0, 3.0, 0.1, 0.2, 0.3])
     assert r.indeterminate and r.balanced and not r.redundant and not r.singular

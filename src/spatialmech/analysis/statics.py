@@ -178,8 +178,7 @@ def statics(mech: Mechanism, config: Configuration, wrench, drivers=None) -> Sta
     Fn = sc.nondimensional(F, L)
     # truncated SVD at the `singular` tolerance: the threshold of the complete Jacobian's flag
     U, s, vt = np.linalg.svd(M, full_matrices=True)
-    smax = float(s[0]) if s.size and s[0] > 0 else 1.0
-    r = int(np.sum(s > tol.singular * max(1.0, smax)))
+    r = int(np.sum(s > tol.singular))  # as CompleteJacobian.singular: absolute, the columns are unit
     y = -(vt[:r].T @ ((U[:, :r].T @ Fn) / s[:r]))
     N = vt[r:].T  # (n, n - r): intensities that balance nothing (to the singular tolerance)
     # redundancy: the least effort norm (torques / L), then the least constraint intensities

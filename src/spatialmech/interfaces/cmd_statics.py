@@ -60,7 +60,7 @@ def _text(r, unit: str) -> list[str]:
 @click.argument("model")
 @click.option("--wrench", "wrench_text", required=True, metavar="FX,FY,FZ,MX,MY,MZ",
               help="External wrench on the output link (screw convention: force in N, then its moment about the "
-                   "model's origin in N times the model's length unit).  Use --wrench=-10,0,... for a leading minus.")
+                   "model's origin in N times the model's length unit).")
 @with_pose
 @click.option("--driver", "drivers", multiple=True, help="Actuated freedom(s) (repeatable; default: the model's actuators).")
 @tol_option("singular")
