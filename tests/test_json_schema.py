@@ -92,6 +92,9 @@ CASES = [
     (["workspace", "three-upu", "--task", "--over", "x:-0.1:0.1:3", "--at", "z=0.3", "--limit", "actuators=0.3:0.4",
       "--tol", "1e-3"], "workspace", "three-upu"),
     (["singularity", "three-rps", "--slice", "a2:-30:30:3,a3:-30:30:3", "--at", "z=0.33"], "singularity", "three-rps"),
+    (["statics", "four-sps-cu", "--wrench", "0,0,-10,0,0,1", *POSE], "statics", "four-sps-cu"),
+    (["statics", "four-sps-cu", "--wrench", "0,0,-10,0,0,1"], "statics", "four-sps-cu"),  # singular: unbalanced
+    (["statics", "delta", "--wrench=-1,0,-10,0,0,0", "--xyz", "0.02", "0.01", "-0.33"], "statics", "delta"),  # graph
 ]
 SLOW_CASES = [  # more than ~1 s each: deselected by the quick loop (pytest -m "not slow")
     (["workspace", "four-sps-cu", "--orientation", "--at", "z=0.1", "--step-deg", "15"], "workspace", "four-sps-cu"),

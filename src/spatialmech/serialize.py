@@ -70,6 +70,8 @@ UNIT_SUFFIXES: dict[str, str] = {
     "_s": "seconds",
     "_per_s": "per second (a rate)",
     "seconds": "seconds (the key is the unit)",
+    "_N": "newtons (the force unit of a given wrench: statics is linear in it)",
+    "_N_len": "newtons times the document's length_unit (a torque, or a moment)",
 }
 
 #: Keys whose numbers have no unit, with their meaning: counts, indices, signs, nondimensional
@@ -283,6 +285,7 @@ SCREW_KEYS: dict[str, str] = {
     "matrix": "rows of the complete Jacobian, (moment ; direction)",
     "transversals": "Plücker lines",
     "twist": "uncontrolled platform twists (omega ; v)",
+    "unbalanced_wrench": "the wrench direction (f ; m) a singular configuration cannot balance (statics)",
     "wrenches": "wrenches of the complete Jacobian, (direction ; moment)",
 }
 

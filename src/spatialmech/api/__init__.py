@@ -26,7 +26,7 @@ position (from 1, as ``--position N``).
 The functions live in modules by concept (this package re-exports them; import them from here or
 from ``spatialmech``): :mod:`~spatialmech.api.structure` (models, mobility),
 :mod:`~spatialmech.api.kinematics` (position, Jacobian, velocity, singularity, workspace,
-parasitic motion), :mod:`~spatialmech.api.linkages` (tracking, defects, synthesis),
+parasitic motion), :mod:`~spatialmech.api.forces` (statics), :mod:`~spatialmech.api.linkages` (tracking, defects, synthesis),
 :mod:`~spatialmech.api.outputs` (report, viewer); :mod:`~spatialmech.api.checks` has the argument
 checks they share.
 """
@@ -34,6 +34,7 @@ checks they share.
 from __future__ import annotations
 
 from .checks import ModelLike as ModelLike  # the type of a model argument
+from .forces import StaticsResult, statics
 from .kinematics import (
     FKResult,
     IKResult,
@@ -61,6 +62,7 @@ __all__ = [
     "MobilityModes",
     "ReportResult",
     "SingularityAnalysis",
+    "StaticsResult",
     "TraceResult",
     "VelocityResult",
     "ViewResult",
@@ -77,6 +79,7 @@ __all__ = [
     "report",
     "screen",
     "singularity",
+    "statics",
     "studio_app",
     "studio_session",
     "synth_cs",

@@ -1,0 +1,88 @@
+"""``spatialmech statics``: actuator efforts and joint reactions against an external wrench on the
+output link (``sm.statics``; docs/statics.md).  Parse, call ``sm.statics``, render."""
+
+from __future__ import annotations
+
+import click
+import numpy as np
+
+from .. import api as sm
+from .cmd_kinematics import resolve_pose, with_pose
+from .common import emit_json, json_option, parse_numbers, tol_option
+
+
+def _vec(v, fmt: str = ".6g") -> str:
+    v = np.where(np.abs(np.asarray(v, float)) < 1e-12, 0.0, np.asarray(v, float))
+    return "(" + ", ".join(format(float(x) + 0.0, fmt) for x in v) + ")"
+
+
+def _text(r, unit: str) -> list[str]:
+    """The result as lines of text, units labelled (force N, torque N·length unit)."""
+    mech, d = r.mechanism, r.to_dict()
+    p = d["pose"]
+    where = "the reference configuration" if r.pose is None else "the requested pose"
+    lines = [f"{mech.name}: statics at {where}: platform point {_vec(p['position_len'])} {unit}, "
+             f"{p['euler_sequence']} angles {_vec(p['euler_deg'], '.4f')} deg",
+             f"  external wrench on the output link: force {_vec(r.wrench[:3])} N, moment about the origin "
+             f"{_vec(r.wrench[3:])} N {unit}",
+             "  actuator efforts (the force or torque each actuator exerts along its freedom):"]
+    w = max(len(a) for a in r.efforts)
+    for a, t in r.efforts.items():
+        kind, lab = ("force", "N") if a in d["forces_N"] else ("torque", f"N {unit}")
+        lines.append(f"    {a:<{w}}  {kind:<6s} {t:+.6g} {lab}")
+    if r.balanced:
+        lines.append("  balanced: the efforts and the constraint wrenches hold the external wrench")
+    else:
+        lines.append(f"  NOT balanced: residual force {_vec(r.residual[:3])} N, moment {_vec(r.residual[3:])} N {unit} "
+                     "(the part the mechanism cannot hold here)")
+    if r.singular:
+        u = r.unbalanced_wrench
+        lines.append(f"  SINGULAR (scale-free sigma_min {r.sigma_min:.3g} < {d['singular_below']:g}): the wrench "
+                     f"(f ; m) = ({' '.join(f'{x:+.4g}' for x in u[:3])} ; {' '.join(f'{x:+.4g}' for x in u[3:])}) "
+                     "cannot be balanced; the efforts are least-squares")
+    else:
+        lines.append(f"  scale-free sigma_min {r.sigma_min:.3g}")
+    for note in r.notes:
+        lines.append(f"  note: {note}")
+    if r.reactions:
+        lines.append("  joint reactions (the proximal body on the distal one, without the actuator efforts; "
+                     f"moment about the joint's point, N {unit}):")
+        for j in r.reactions:
+            lines.append(f"    {j.limb}/{j.joint} at {_vec(j.point)} {unit}: force {_vec(j.force)} N, "
+                         f"moment {_vec(j.moment_at_point)}")
+    if r.pose_fit is not None and not r.pose_fit.exact:
+        lines.append(f"  note: the pose was fitted onto the closure (error {r.pose_fit.position_error:.3g} {unit}, "
+                     f"{np.degrees(r.pose_fit.angle_error):.3g} deg)")
+    return lines
+
+
+@click.command(name="statics")
+@click.argument("model")
+@click.option("--wrench", "wrench_text", required=True, metavar="FX,FY,FZ,MX,MY,MZ",
+              help="External wrench on the output link (screw convention: force in N, then its moment about the "
+                   "model's origin in N times the model's length unit).")
+@with_pose
+@click.option("--driver", "drivers", multiple=True, help="Actuated freedom(s) (repeatable; default: the model's actuators).")
+@tol_option("singular")
+@json_option
+def statics_cmd(model, wrench_text, xyz, euler, position, drivers, as_json):
+    """Statics: every actuator's force or torque and every joint's reaction that hold the mechanism
+    against an external wrench on its output link (at the reference configuration unless a pose is
+    given).  Redundant actuation: minimum-norm efforts; a singular pose: least squares and the
+    wrench that cannot be balanced.
+
+    \b
+    Examples:
+      spatialmech statics stewart-6sps --wrench 0,0,-600,0,0,0
+      spatialmech statics three-rps --wrench 0,0,-100,0,0,0 --pose 0,0,0.33,ZYX,0,5,5 --json
+      spatialmech statics delta --wrench=0,0,-10,0,0,0 --xyz 0.02 0.01 -0.33
+    """
+    wrench = parse_numbers(wrench_text, "--wrench", count=6, what="components FX,FY,FZ,MX,MY,MZ")
+    mech = sm.load_model(model)
+    given = xyz is not None or euler is not None or position is not None
+    pose = resolve_pose(mech, xyz, euler, position) if given else None
+    r = sm.statics(mech, pose, wrench=wrench, drivers=list(drivers) or None)
+    if as_json:
+        emit_json("statics", mech, r.to_dict())
+        return
+    click.echo("\n".join(_text(r, mech.length_unit)))
