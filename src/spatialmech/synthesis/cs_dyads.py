@@ -64,7 +64,7 @@ from ..geometry.rotations import inverse_transform, rotation_angle, transform
 from ..geometry.validate import as_finite_array, as_unit_vector
 from ..kinematics import compiled
 from ..kinematics.jit import njit
-from ..kinematics.tracking import EuclideanProblem, correct_on_hyperplane, track
+from ..kinematics.tracking import EuclideanProblem, conventional_sense, correct_on_hyperplane, track
 from ..model.mechanism import Pose
 from ..results import BranchEnd
 
@@ -574,6 +574,7 @@ def _trace(prob, y0, *, h_max, max_arc, box):
 
     kw = dict(h0=0.01, h_max=h_max, h_min=1e-9, max_arc=max_arc, tol=_TOL, stop=out, max_steps=20000)
     t0 = prob.tangent(y0)
+    t0 = t0 * conventional_sense(t0)  # forward: the documented sense, not the SVD's sign
     fwd = track(prob, y0, direction=t0, **kw)
 
     def why(r) -> BranchEnd:
