@@ -641,6 +641,11 @@ def generic_configuration(
     Random directions avoid the special (often singular) symmetric reference poses of
     ready-made models.  ``step`` is nondimensional (radians, or lengths / L).  Raises
     ``RuntimeError`` if a correction does not converge.
+
+    Each direction is a seeded standard-normal vector of the local coordinates projected onto
+    the tangent space (``N^T N g``, the same for every orthonormal basis ``N``): the result
+    depends on the model, ``start``, ``seed``, ``step`` and ``steps`` only, not on the basis or
+    signs the SVD of the BLAS kernel in use returns (docs/conventions.md).
     """
     rng = np.random.default_rng(seed)
     if active is None:
@@ -655,8 +660,8 @@ def generic_configuration(
         N = vt[r:]
         if N.shape[0] == 0:
             break
-        c = rng.standard_normal(N.shape[0])
-        t = N.T @ c
+        g = rng.standard_normal(N.shape[1])
+        t = N.T @ (N @ g)  # the projection onto the tangent space: independent of the basis
         t *= step / max(float(np.linalg.norm(t)), 1e-300)
         trial = retract(mech, config, active, col * t)
         res = correct(mech, trial, active=active)

@@ -16,7 +16,9 @@ At a configuration ``x`` on the manifold, the tangent space is the null space of
 characteristic length ``L``; columns: joint rotations in rad, slides / ``L``, platform twist
 ``(w ; v / L)``).  One direction ``t0`` is chosen at the start, inside the part of the tangent
 space that moves the platform (the largest platform motion for a one-parameter manifold, a
-seeded random combination of the platform-moving directions otherwise).  Along the walk the
+seeded random vector projected onto the platform-moving directions otherwise), in the sense of
+a traced motion (the first actuator increasing, ...: docs/conventions.md), so that neither the
+loop nor its first half depends on the basis or signs an SVD returns.  Along the walk the
 direction is the projection of the previous one onto the current tangent space (so it never
 flips), scaled so that its platform part ``(w ; v / L)`` has unit norm: the walk parameter
 ``s`` is therefore a pseudo arc length of the platform, nondimensional (rad, or length / L).
@@ -43,6 +45,7 @@ from .closure import (
     retract,
 )
 from ..model.mechanism import Mechanism
+from .tracking import conventional_sense, sense_order
 
 __all__ = ["sample_motion", "tangent_space"]
 
@@ -73,8 +76,11 @@ def tangent_space(mech: Mechanism, config: Configuration, *, active: np.ndarray 
     return vt[r:]
 
 
-def _initial_direction(N: np.ndarray, rng: np.random.Generator) -> np.ndarray:
-    """A tangent direction (nondimensional) that moves the platform, platform part of norm 1."""
+def _initial_direction(N: np.ndarray, rng: np.random.Generator, order=()) -> np.ndarray:
+    """A tangent direction (nondimensional) that moves the platform, platform part of norm 1,
+    in the conventional sense (:func:`.tracking.conventional_sense` over ``order``).  It depends
+    on the span of ``N`` only: ``Q`` below spans the same subspace for every orthonormal basis
+    ``N``, and a seeded vector is projected onto it rather than combined with its columns."""
     Np = N[:, -6:]  # platform part of each null vector (k, 6)
     U, sv, _ = np.linalg.svd(Np, full_matrices=False)
     moving = int(np.sum(sv > 1e-8))
@@ -83,8 +89,9 @@ def _initial_direction(N: np.ndarray, rng: np.random.Generator) -> np.ndarray:
             "mech: no motion of the closure manifold moves the platform (a structure, or only idle "
             "spins at this configuration); nothing to animate"
         )
-    c = U[:, 0] if moving == 1 else U[:, :moving] @ rng.standard_normal(moving)
-    t = N.T @ c
+    Q = N.T @ U[:, :moving]  # orthonormal columns: the platform-moving part of the tangent space
+    t = Q[:, 0] if moving == 1 else Q @ (Q.T @ rng.standard_normal(N.shape[1]))
+    t = t * conventional_sense(t, order)
     return t / np.linalg.norm(t[-6:])
 
 
@@ -166,7 +173,8 @@ def sample_motion(
     if not res0.converged:
         raise InputError(f"start: not on (or near) the closure manifold (residual {res0.residual:.2e})")
     x0 = res0.config
-    t0 = _initial_direction(tangent_space(mech, x0, active=active), np.random.default_rng(seed))
+    t0 = _initial_direction(tangent_space(mech, x0, active=active), np.random.default_rng(seed),
+                            sense_order(mech, active))
 
     s = amplitude * np.sin(2.0 * np.pi * np.arange(n) / n)
     s = np.where(np.abs(s) < 1e-12 * amplitude, 0.0, s)
