@@ -717,7 +717,8 @@ def pick_small_slides(family: CSFamily, n: int = 5, *, separation: float = 1.0) 
                 continue  # an open end is where the box cut the branch
             if g[i] <= lo and g[i] <= hi:
                 half = max(float(np.linalg.norm(Y[min(i + 1, K - 1)] - Y[max(i - 1, 0)])), 1e-6)
-                z = _refine_min_slide(task, prob, Y[i], prob.tangent(Y[i]), half)
+                t = prob.tangent(Y[i])  # Brent's first trials: on the conventional side, not the SVD's
+                z = _refine_min_slide(task, prob, Y[i], t * conventional_sense(t), half)
                 minima.append((float(np.max(np.abs(z[9:]))), z))
     minima.sort(key=lambda c: c[0])
     others.sort(key=lambda c: c[0])
