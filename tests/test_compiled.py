@@ -126,7 +126,11 @@ def test_forward_position_from_the_reference_matches(name):
     for kw in ({"active": mask}, {"fix_platform": True}, {}):
         with pure():
             r0 = correct(mech, near, **kw)
-        same_correction(correct(mech, near, **kw), r0)
+        # nothing held: the correction is underdetermined (minimum-norm steps along the motion; an
+        # overconstrained linkage's rows nearly dependent), so the two solvers' rounding comes out
+        # amplified: bennett's seed-7 point differs by 1.03e-10 (seeds 2, 3, 5 of the configurations
+        # before issue 26 already gave 1.2e-10 to 1.7e-10)
+        same_correction(correct(mech, near, **kw), r0, tol=1e-10 if kw else 1e-9)
 
 
 @pytest.mark.parametrize("name", ["stewart-6sps", "delta", "five-cs-3"])

@@ -243,7 +243,10 @@ def test_a_users_platform_with_slides_off_the_leg_line_gets_the_same_pose(seed, 
     assert lp is not None
     held = active_mask(mech)
     held[lp.index[:, 1]] = False
-    target = generic_configuration(mech, seed=seed, step=0.2)
+    # near enough the reference that both Newtons, started there, reach the same assembly: with
+    # step 0.2 one sample in twelve (seed 3 since issue 26's generic configurations) sends the
+    # joint-space Newton to another one, 0.09 away (both closed: not a disagreement of the paths)
+    target = generic_configuration(mech, seed=seed, step=0.15)
     start = _seed(mech, lp, target, Configuration.reference(mech))
     auto = correct(mech, start, active=held)
     joints = correct(mech, start, active=held, method="joints")

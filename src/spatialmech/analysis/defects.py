@@ -35,6 +35,7 @@ from typing import cast
 import numpy as np
 
 from ..errors import InputError
+from ..geometry import screws as sc
 from ..kinematics.closure import Configuration, active_mask, closure_scales
 from ..kinematics.backend import closure_jacobian
 from ..kinematics.jacobian import complete_jacobian, driver_determinants
@@ -96,6 +97,12 @@ def dj_function(mech: Mechanism, drivers: list[str], reference: Configuration):
     U, sv, _ = np.linalg.svd(A0)
     r = int(np.sum(sv > current_tolerances().rank * sv[0]))
     P = U[:, :r].T
+    # orient the row-space basis against its reduced row-echelon basis (the same for every
+    # orthonormal basis of the row space), so that the sign of DJ does not follow the basis the
+    # SVD returned (docs/conventions.md)
+    E = sc.rref(P)
+    if E.shape[0] == P.shape[0] and np.linalg.det(P @ E.T) < 0:
+        P[0] = -P[0]
     idx = np.flatnonzero(active).tolist()
     cols = [idx.index(mech.freedom_refs.index(mech.freedom(d))) for d in drivers]
 

@@ -184,7 +184,9 @@ def singularity(
     if rank < 6:
         _, s2, vt = np.linalg.svd(M if M.size else np.zeros((1, 6)))
         r2 = int(np.sum(s2 > rtol * max(1.0, s2[0]))) if s2.size else 0
-        N = vt[r2:].copy()
+        # a deterministic basis (reduced row-echelon form of the nondimensional null space: each
+        # twist's first pivot positive), not the basis and signs the SVD happens to return
+        N = sc.rref(vt[r2:]) if r2 < vt.shape[0] else vt[r2:].copy()
         N[:, 3:] *= L
         out = []
         for n in N:  # unit angular part, or unit translation for a pure translation

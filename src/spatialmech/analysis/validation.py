@@ -294,7 +294,10 @@ def _loop_directions(mech: Mechanism, config: Configuration) -> tuple[np.ndarray
                              "a non-singular configuration") from None
         cols.append(np.r_[V[:3], V[3:] / L])
     _, _, wt = np.linalg.svd(np.array(cols).T)
-    return wt[-1], wt[-2]
+    from ..kinematics.tracking import conventional_sense
+
+    # signs by the documented convention (first non-negligible component positive), not the SVD's
+    return wt[-1] * conventional_sense(wt[-1]), wt[-2] * conventional_sense(wt[-2])
 
 
 def library_motion(mech: Mechanism, motion: str = "trace", *, start: Configuration | None = None, frames: int = 12,

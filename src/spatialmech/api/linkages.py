@@ -87,8 +87,9 @@ def track(model: ModelLike, start=None, *, increasing: str | None = None, sense:
     """Follow the one-degree-of-freedom motion by pseudo-arclength continuation from ``start``
     (a pose, fitted onto the closure; a Configuration; default the reference) until it closes
     (``status`` closed) or the arc length reaches ``max_arc`` (nondimensional).  ``increasing``:
-    a freedom whose variable grows at the start (``sense=-1``: decreases).  The sign changes of
-    DJ of the actuators are located as events.
+    a freedom whose variable grows at the start (``sense=-1``: decreases); without it the first
+    actuator's does (the convention of docs/conventions.md: the same sense on every machine).
+    The sign changes of DJ of the actuators are located as events.
 
     >>> import spatialmech as sm
     >>> m = sm.track("bennett")
@@ -156,7 +157,7 @@ def defects(model: ModelLike, positions=None, *, drivers=None, pose_tol: float |
     >>> P = [motion.poses[k] for k in (0, 9, 18)]
     >>> r = sm.defects("planar-4r", P)
     >>> r.circuit_defect, r.order_defect, r.usable_drivers, r.circuit_status
-    (False, False, ('A0.rot',), (<TrackStatus.CLOSED: 'closed'>,))
+    (False, False, ('A0.rot', 'B0.rot'), (<TrackStatus.CLOSED: 'closed'>,))
     """
     from ..analysis.defects import defect_analysis
 

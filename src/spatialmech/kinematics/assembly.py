@@ -37,7 +37,7 @@ import numpy as np
 from ..geometry.tolerances import Tolerances, current
 from ..results import TrackStatus
 from ..serialize import fields_dict
-from .tracking import correct_on_hyperplane, track
+from .tracking import conventional_sense, correct_on_hyperplane, track
 
 __all__ = [
     "AssemblyKind",
@@ -251,6 +251,7 @@ def trace_set(
     status = ""
     try:
         t0 = np.asarray(problem.tangent(x0), dtype=float)
+        t0 = t0 * conventional_sense(t0, getattr(problem, "sense_order", ()))  # not the SVD's sign
     except (RuntimeError, ValueError, np.linalg.LinAlgError) as e:
         return Trace((k0[None, :],), 0.0, False, 0, f"no tangent: {e}")
     budget = int(max_steps)

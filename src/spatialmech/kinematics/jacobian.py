@@ -301,7 +301,12 @@ def _graph_jacobian(mech: Mechanism, config: Configuration, act_ids: list[str]) 
     C = Ug[:, rg:].T @ H  # constraint part
     if C.shape[0]:
         _, sc_, Vc = np.linalg.svd(C, full_matrices=False)
-        C = Vc[: int(np.sum(sc_ > rtol * max(1.0, sc_[0] if sc_.size else 0.0)))]
+        C = Vc[: int(np.sum(sc_ > rtol * max(1.0, sc_[0] if sc_.size else 0.0)))].copy()
+        # oriented against the reduced row-echelon basis of the same system, so that the sign of
+        # det does not follow the basis the SVD returned (docs/conventions.md)
+        E = sc.rref(C)
+        if C.shape[0] and E.shape[0] == C.shape[0] and np.linalg.det(C @ E.T) < 0:
+            C[0] = -C[0]
     rows_out = [c / colV for c in C]
     singular, trans = [], []
     for k, a in enumerate(act_ids):

@@ -16,7 +16,9 @@ At a configuration ``x`` on the manifold, the tangent space is the null space of
 characteristic length ``L``; columns: joint rotations in rad, slides / ``L``, platform twist
 ``(w ; v / L)``).  One direction ``t0`` is chosen at the start, inside the part of the tangent
 space that moves the platform (the largest platform motion for a one-parameter manifold, a
-seeded random combination of the platform-moving directions otherwise).  Along the walk the
+seeded random vector projected onto the platform-moving directions otherwise), in the sense of
+a traced motion (the first actuator increasing, ...: docs/conventions.md), so that neither the
+loop nor its first half depends on the basis or signs an SVD returns.  Along the walk the
 direction is the projection of the previous one onto the current tangent space (so it never
 flips), scaled so that its platform part ``(w ; v / L)`` has unit norm: the walk parameter
 ``s`` is therefore a pseudo arc length of the platform, nondimensional (rad, or length / L).
@@ -38,6 +40,7 @@ from ..geometry.validate import as_finite_array
 from .closure import Configuration, active_mask, closure_scales
 from .backend import closure_jacobian, correct, retract
 from ..model.mechanism import Mechanism
+from .tracking import conventional_sense, sense_order
 
 __all__ = ["generic_configuration", "sample_motion", "tangent_space"]
 
@@ -68,8 +71,11 @@ def tangent_space(mech: Mechanism, config: Configuration, *, active: np.ndarray 
     return vt[r:]
 
 
-def _initial_direction(N: np.ndarray, rng: np.random.Generator) -> np.ndarray:
-    """A tangent direction (nondimensional) that moves the platform, platform part of norm 1."""
+def _initial_direction(N: np.ndarray, rng: np.random.Generator, order=()) -> np.ndarray:
+    """A tangent direction (nondimensional) that moves the platform, platform part of norm 1,
+    in the conventional sense (:func:`.tracking.conventional_sense` over ``order``).  It depends
+    on the span of ``N`` only: ``Q`` below spans the same subspace for every orthonormal basis
+    ``N``, and a seeded vector is projected onto it rather than combined with its columns."""
     Np = N[:, -6:]  # platform part of each null vector (k, 6)
     U, sv, _ = np.linalg.svd(Np, full_matrices=False)
     moving = int(np.sum(sv > 1e-8))
@@ -78,8 +84,9 @@ def _initial_direction(N: np.ndarray, rng: np.random.Generator) -> np.ndarray:
             "mech: no motion of the closure manifold moves the platform (a structure, or only idle "
             "spins at this configuration); nothing to animate"
         )
-    c = U[:, 0] if moving == 1 else U[:, :moving] @ rng.standard_normal(moving)
-    t = N.T @ c
+    Q = N.T @ U[:, :moving]  # orthonormal columns: the platform-moving part of the tangent space
+    t = Q[:, 0] if moving == 1 else Q @ (Q.T @ rng.standard_normal(N.shape[1]))
+    t = t * conventional_sense(t, order)
     return t / np.linalg.norm(t[-6:])
 
 
@@ -161,7 +168,8 @@ def sample_motion(
     if not res0.converged:
         raise InputError(f"start: not on (or near) the closure manifold (residual {res0.residual:.2e})")
     x0 = res0.config
-    t0 = _initial_direction(tangent_space(mech, x0, active=active), np.random.default_rng(seed))
+    t0 = _initial_direction(tangent_space(mech, x0, active=active), np.random.default_rng(seed),
+                            sense_order(mech, active))
 
     s = amplitude * np.sin(2.0 * np.pi * np.arange(n) / n)
     s = np.where(np.abs(s) < 1e-12 * amplitude, 0.0, s)
@@ -189,6 +197,11 @@ def generic_configuration(
     Random directions avoid the special (often singular) symmetric reference poses of
     ready-made models.  ``step`` is nondimensional (radians, or lengths / L).  Raises
     ``RuntimeError`` if a correction does not converge.
+
+    Each direction is a seeded standard-normal vector of the local coordinates projected onto
+    the tangent space (``N^T N g``, the same for every orthonormal basis ``N``): the result
+    depends on the model, ``start``, ``seed``, ``step`` and ``steps`` only, not on the basis or
+    signs the SVD of the BLAS kernel in use returns (docs/conventions.md).
     """
     rng = np.random.default_rng(seed)
     if active is None:
@@ -203,8 +216,8 @@ def generic_configuration(
         N = vt[r:]
         if N.shape[0] == 0:
             break
-        c = rng.standard_normal(N.shape[0])
-        t = N.T @ c
+        g = rng.standard_normal(N.shape[1])
+        t = N.T @ (N @ g)  # the projection onto the tangent space: independent of the basis
         t *= step / max(float(np.linalg.norm(t)), 1e-300)
         trial = retract(mech, config, active, col * t)
         res = correct(mech, trial, active=active)

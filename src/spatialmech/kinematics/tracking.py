@@ -38,14 +38,17 @@ from .closure import Configuration, active_mask, ball_groups, closure_scales, hu
 from .backend import closure_jacobian, retract
 
 __all__ = [
+    "SENSE_TOL",
     "ActuatorPathProblem",
     "CurveProblem",
     "EuclideanProblem",
     "Event",
     "MotionProblem",
     "TrackResult",
+    "conventional_sense",
     "correct_on_hyperplane",
     "predict_correct",
+    "sense_order",
     "trace_motion",
     "track",
 ]
@@ -65,6 +68,48 @@ class CurveProblem(Protocol):
         ...
 
     def tangent(self, x) -> np.ndarray: ...
+
+
+#: A component of a unit tangent (nondimensional local coordinates) counts for the sense
+#: convention (:func:`conventional_sense`) when its magnitude exceeds this. Rounding differences
+#: between the compiled and Python paths, or between BLAS kernels, are ~1e-13: far below it.
+SENSE_TOL = 1e-6
+
+
+def conventional_sense(t: np.ndarray, order=(), tol: float = SENSE_TOL) -> float:
+    """``+1.0`` or ``-1.0``: the sign that gives the tangent ``t`` the documented sense of travel
+    (docs/conventions.md, *Sense of a traced motion*), whatever sign the SVD returned.
+
+    The first coordinate in ``order`` (then every coordinate, in index order) whose component of
+    the unit tangent exceeds ``tol`` in magnitude is made positive.  A nonzero unit vector of
+    fewer than 1e12 coordinates always has one, so the rule depends on the model and the point
+    only, never on the linear-algebra kernel."""
+    t = np.asarray(t, dtype=float)
+    n = float(np.linalg.norm(t))
+    if not n > 0:
+        return 1.0
+    for i in (*order, *range(t.size)):
+        c = float(t[i]) / n
+        if abs(c) > tol:
+            return 1.0 if c > 0 else -1.0
+    return 1.0
+
+
+def sense_order(mech: Mechanism, active: np.ndarray, first: str | None = None) -> list[int]:
+    """Local coordinates (positions among the ``active`` freedoms) that decide the sense of a
+    traced motion, in priority order: ``first`` (a freedom name) when given, then the
+    mechanism's actuators in their declared order (those that are active)."""
+    refs = mech.freedom_refs
+    idx = np.flatnonzero(active).tolist()
+    out: list[int] = []
+    names = ([first] if first is not None else []) + list(mech.actuators)
+    for k, name in enumerate(names):
+        i = refs.index(mech.freedom(name))
+        if k == 0 and first is not None and not active[i]:
+            raise InputError(f"increasing: {first} is locked in this mode")
+        if active[i] and idx.index(i) not in out:
+            out.append(idx.index(i))
+    return out
 
 
 def _null_tangent(A: np.ndarray) -> np.ndarray:
@@ -266,9 +311,13 @@ def track(
     """Follow the solution curve of ``problem`` from ``x0`` (which must lie on it).
 
     ``direction``: local-coordinate vector giving the sense of travel (the tangent is oriented
-    to have a positive component on it).  ``monitors``: name -> function(x) whose sign changes
-    are located as :class:`Event` s; ``vector_monitor = (names, f)`` evaluates several at once
-    (``f(x)`` returns one value per name).  ``stop(x, s)``: return True to stop after a point.
+    to have a positive component on it).  Without it, or when the tangent's component on it is
+    negligible (below ``SENSE_TOL`` of ``|direction|``), the sense follows the documented
+    convention (:func:`conventional_sense` over the problem's ``sense_order``, times its
+    ``sense``; docs/conventions.md), never the sign an SVD happens to return.
+    ``monitors``: name -> function(x) whose sign changes are located as :class:`Event` s;
+    ``vector_monitor = (names, f)`` evaluates several at once (``f(x)`` returns one value per
+    name).  ``stop(x, s)``: return True to stop after a point.
     ``progress(s, max_arc, "tracing")`` is called after every accepted step.
     Arc length is measured in the problem's (nondimensional) local coordinates.
     """
@@ -288,8 +337,11 @@ def track(
             monitors[nm] = (lambda x, _k=j: float(_vec(x)[_k]))
     t = problem.tangent(x0)
     t = t / np.linalg.norm(t)
-    if direction is not None and float(t @ direction) < 0:
-        t = -t
+    along = float(t @ direction) if direction is not None else 0.0
+    if direction is not None and abs(along) > SENSE_TOL * float(np.linalg.norm(direction)):
+        t = t if along > 0 else -t
+    else:  # the documented convention: the sense depends on the model and the point only
+        t = t * (float(getattr(problem, "sense", 1.0)) * conventional_sense(t, getattr(problem, "sense_order", ())))
     t0 = t.copy()
     xs, ss, ts = [x0], [0.0], [t]
     mon = {k: [float(f(x0))] for k, f in monitors.items()}
@@ -427,9 +479,15 @@ def _locate(problem, x, t, h, f, name, fa, fb, s, step, tol, event_tol):
 
 # --------------------------------------------------------------------------- mechanisms
 class _MechanismBase:
+    #: ``+1``: the traced motion starts in the conventional sense (:func:`conventional_sense`
+    #: over ``sense_order``); ``-1``: the opposite one.
+    sense: float = 1.0
+
     def __init__(self, mech: Mechanism, active: np.ndarray):
         self.mech = mech
         self.active = active
+        #: the local coordinates that decide the sense of travel (:func:`sense_order`)
+        self.sense_order: list[int] = sense_order(mech, active)
         self.row, self.col = closure_scales(mech, active)
         self.na = int(active.sum())
         self.nh = 6 * hub_count(mech)  # twists of the output link and the internal bodies
@@ -470,10 +528,16 @@ class _MechanismBase:
 class MotionProblem(_MechanismBase):
     """The motion of a mechanism with one platform degree of freedom (actuators free), as a
     curve in (joint variables, platform twist) local coordinates.  Passive freedoms (e.g. the
-    spin of an SPS leg) are removed from the tangent, so the curve is one-dimensional."""
+    spin of an SPS leg) are removed from the tangent, so the curve is one-dimensional.
 
-    def __init__(self, mech: Mechanism):
+    Sense of travel (when :func:`track` gets no ``direction``): ``first`` (a freedom name), else
+    the first actuator, ... increasing; ``sense=-1``: decreasing (:func:`sense_order`)."""
+
+    def __init__(self, mech: Mechanism, *, first: str | None = None, sense: int = 1):
         super().__init__(mech, active_mask(mech))
+        if first is not None:
+            self.sense_order = sense_order(mech, self.active, first)
+        self.sense = 1.0 if sense >= 0 else -1.0
 
     def residual(self, x):
         return self._closure(x)[1]
@@ -522,6 +586,7 @@ class ActuatorPathProblem(_MechanismBase):
         for i in self.act_idx:
             mask[i] = False
         super().__init__(mech, mask)
+        self.sense_order = [self.na + self.nh]  # the path parameter lam increasing
         self.path = path
         self.dpath = path_derivative
 
@@ -570,10 +635,14 @@ def trace_motion(
 ) -> TrackResult:
     """Follow the one-degree-of-freedom motion of ``mech`` from ``start`` until it closes.
 
-    ``increasing``: a freedom name whose variable should increase at the start (``sense=-1``:
-    decrease), which sets the sense of travel.  Extra keyword arguments go to :func:`track`.
+    Sense of travel (docs/conventions.md): the variable of ``increasing`` (a freedom name) grows
+    at the start; without it, or where its rate is negligible, the first actuator's, then the
+    next actuator's, then the first freedom's (in the model's order) with a non-negligible rate
+    (:data:`SENSE_TOL` of the unit tangent).  ``sense=-1`` reverses it.  The same on the
+    compiled and Python paths and on every BLAS kernel.  Extra keyword arguments go to
+    :func:`track`.
     """
-    prob = MotionProblem(mech)
+    prob = MotionProblem(mech, first=increasing, sense=sense)
     A = prob.jacobian(start)
     sv = np.linalg.svd(A, compute_uv=False)
     r = int(np.sum(sv > current_tolerances().rank * max(1.0, sv[0])))
@@ -584,11 +653,4 @@ def trace_motion(
         if dof > 1:
             raise InputError(f"mechanism: trace_motion follows one-degree-of-freedom motions; {mech.name} has {dof} "
                              "here (lock or drive the others: an ActuatorPathProblem follows a path of actuator values)")
-    direction = None
-    if increasing is not None:
-        ref = mech.freedom(increasing)
-        i = mech.freedom_refs.index(ref)
-        idx = np.flatnonzero(prob.active).tolist()
-        direction = np.zeros(prob.na + prob.nh)
-        direction[idx.index(i)] = 1.0 if sense >= 0 else -1.0
-    return track(prob, start, direction=direction, monitors=monitors, **kw)
+    return track(prob, start, monitors=monitors, **kw)

@@ -64,7 +64,7 @@ from ..geometry.rotations import inverse_transform, rotation_angle, transform
 from ..geometry.validate import as_finite_array, as_unit_vector
 from ..kinematics import backend
 from ..kinematics.compiled.jit import njit
-from ..kinematics.tracking import EuclideanProblem, correct_on_hyperplane, track
+from ..kinematics.tracking import EuclideanProblem, conventional_sense, correct_on_hyperplane, track
 from ..model.mechanism import Pose
 from ..results import BranchEnd
 from ..serialize import fields_dict
@@ -568,6 +568,7 @@ def _trace(prob, y0, *, h_max, max_arc, box):
 
     kw = dict(h0=0.01, h_max=h_max, h_min=1e-9, max_arc=max_arc, tol=_TOL, stop=out, max_steps=20000)
     t0 = prob.tangent(y0)
+    t0 = t0 * conventional_sense(t0)  # forward: the documented sense, not the SVD's sign
     fwd = track(prob, y0, direction=t0, **kw)
 
     def why(r) -> BranchEnd:
@@ -710,7 +711,8 @@ def pick_small_slides(family: CSFamily, n: int = 5, *, separation: float = 1.0) 
                 continue  # an open end is where the box cut the branch
             if g[i] <= lo and g[i] <= hi:
                 half = max(float(np.linalg.norm(Y[min(i + 1, K - 1)] - Y[max(i - 1, 0)])), 1e-6)
-                z = _refine_min_slide(task, prob, Y[i], prob.tangent(Y[i]), half)
+                t = prob.tangent(Y[i])  # Brent's first trials: on the conventional side, not the SVD's
+                z = _refine_min_slide(task, prob, Y[i], t * conventional_sense(t), half)
                 minima.append((float(np.max(np.abs(z[9:]))), z))
     minima.sort(key=lambda c: c[0])
     others.sort(key=lambda c: c[0])

@@ -40,7 +40,7 @@ from ...kinematics.forward import forward_position
 from ...geometry.rotations import check_sequence
 from ...kinematics.position import freedom_values, platform_pose, within_limits
 from ...kinematics.task import default_task, task_values
-from ...kinematics.tracking import ActuatorPathProblem, track
+from ...kinematics.tracking import ActuatorPathProblem, conventional_sense, track
 from ...model.mechanism import Mechanism
 from ...model.task import TASK_NAMES, TaskCoordinates
 from ...present.shapes import joint_list, joint_meshes, mesh_json, platform_solid
@@ -459,7 +459,9 @@ class Session:
         ref_t: dict = {}
         tan0 = prob.tangent(x0)
         tan0 = tan0 / max(float(np.linalg.norm(tan0)), 1e-300)
-        tan0 = tan0 if tan0[-1] >= 0 else -tan0
+        # the sense of travel: lam increasing, by the documented convention when its rate is
+        # negligible (a dead point), not by the sign the SVD returned (docs/conventions.md)
+        tan0 = tan0 * conventional_sense(tan0, prob.sense_order)
         if len(m.actuators) == 1:
             # a dead point of a single driver: the path turns back in its value, where the rate of
             # the driver along the curve (the last component of the tangent, oriented as the last
@@ -499,7 +501,7 @@ class Session:
         # the first step's arc length reaches lam = ell along the start tangent (a small drag is one
         # step: the monitors are evaluated at one tracked point), at most 0.1 (the largest step)
         h = min(0.1, max(1.02 * ell / max(abs(float(tan0[-1])), 1e-3), 1e-6))
-        r = track(prob, x0, direction=np.r_[np.zeros(prob.na + prob.nh), 1.0], h0=h, h_max=0.1,
+        r = track(prob, x0, h0=h, h_max=0.1,
                   max_arc=200.0 * ell + 2.0, max_steps=MAX_STEPS, monitors=monitors, vector_monitor=vector,
                   detect_closure=False, stop=stop)
         steps = len(r.points) - 1
