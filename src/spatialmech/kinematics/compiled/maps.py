@@ -1,0 +1,378 @@
+"""Compiled kernels of the performance maps (:mod:`spatialmech.analysis.maps`): the indices of a
+complete Jacobian (:func:`nb_indices_many`) and, for models whose limbs all have a closed form
+(S-P-S / U-P-S legs, a C-U column), the whole chain from the pose to the indices
+(:func:`nb_maps_closed`).  The Python reference is :func:`spatialmech.analysis.maps.pose_indices`
+with :func:`~spatialmech.kinematics.jacobian.complete_jacobian`; the two agree to rounding
+(``tests/test_maps.py``).
+
+Singular values by one-sided (Hestenes) Jacobi rotations (relative accuracy, no LAPACK call per
+pose); determinants of 5x5 minors by Gaussian elimination with partial pivoting.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .jit import njit
+
+__all__ = ["N_SCALARS", "indices_many", "maps_closed", "nb_indices_many", "nb_maps_closed"]
+
+#: Scalars per pose in ``out``: sigma_min, condition, manipulability, iti, oti, lti, lci.
+N_SCALARS = 7
+
+
+@njit(cache=True)
+def nb_singular_values(A, out):
+    """Singular values (descending) of ``A`` (m, n) into ``out`` (min(m, n)): one-sided Jacobi."""
+    m, n = A.shape
+    if m >= n:
+        B = A.copy()
+    else:
+        B = A.T.copy()
+    r, c = B.shape
+    for _sweep in range(60):
+        rotated = False
+        for p in range(c - 1):
+            for q in range(p + 1, c):
+                alpha = 0.0
+                beta = 0.0
+                gamma = 0.0
+                for i in range(r):
+                    alpha += B[i, p] * B[i, p]
+                    beta += B[i, q] * B[i, q]
+                    gamma += B[i, p] * B[i, q]
+                if gamma == 0.0 or abs(gamma) <= 1e-16 * np.sqrt(alpha * beta):
+                    continue
+                rotated = True
+                zeta = (beta - alpha) / (2.0 * gamma)
+                t = (1.0 if zeta >= 0.0 else -1.0) / (abs(zeta) + np.sqrt(1.0 + zeta * zeta))
+                cs = 1.0 / np.sqrt(1.0 + t * t)
+                sn = cs * t
+                for i in range(r):
+                    bp = B[i, p]
+                    bq = B[i, q]
+                    B[i, p] = cs * bp - sn * bq
+                    B[i, q] = sn * bp + cs * bq
+        if not rotated:
+            break
+    for j in range(c):
+        s = 0.0
+        for i in range(r):
+            s += B[i, j] * B[i, j]
+        out[j] = np.sqrt(s)
+    out[:c] = np.sort(out[:c])[::-1]
+
+
+@njit(cache=True)
+def nb_det_small(M):
+    """Determinant of a small square matrix (copied) by Gaussian elimination, partial pivoting."""
+    A = M.copy()
+    n = A.shape[0]
+    det = 1.0
+    for c in range(n):
+        piv = c
+        big = abs(A[c, c])
+        for i in range(c + 1, n):
+            if abs(A[i, c]) > big:
+                big = abs(A[i, c])
+                piv = i
+        if big == 0.0:
+            return 0.0
+        if piv != c:
+            for j in range(n):
+                tmp = A[c, j]
+                A[c, j] = A[piv, j]
+                A[piv, j] = tmp
+            det = -det
+        det *= A[c, c]
+        for i in range(c + 1, n):
+            f = A[i, c] / A[c, c]
+            for j in range(c + 1, n):
+                A[i, j] -= f * A[c, j]
+    return det
+
+
+@njit(cache=True)
+def nb_power(W, T, L):
+    """Power coefficient of the wrench ``W = (f ; m)`` and the twist ``T = (w ; v)`` (SI):
+    :func:`spatialmech.analysis.maps.power_coefficient`."""
+    nf = np.sqrt(W[0] ** 2 + W[1] ** 2 + W[2] ** 2)
+    nm = np.sqrt(W[3] ** 2 + W[4] ** 2 + W[5] ** 2)
+    nw = np.sqrt(T[0] ** 2 + T[1] ** 2 + T[2] ** 2)
+    nv = np.sqrt(T[3] ** 2 + T[4] ** 2 + T[5] ** 2)
+    couple = nf <= 1e-12 * (nf + nm / L)
+    translation = nw <= 1e-12 * (nw + nv / L)
+    if couple and translation:
+        return 0.0
+    if couple:
+        if nm == 0.0:
+            return 0.0
+        return min(abs(W[3] * T[0] + W[4] * T[1] + W[5] * T[2]) / (nm * nw), 1.0)
+    if translation:
+        if nv == 0.0:
+            return 0.0
+        return min(abs(W[0] * T[3] + W[1] * T[4] + W[2] * T[5]) / (nf * nv), 1.0)
+    f = W[:3] / nf
+    m = W[3:] / nf
+    w = T[:3] / nw
+    v = T[3:] / nw
+    hw = f[0] * m[0] + f[1] * m[1] + f[2] * m[2]
+    ht = w[0] * v[0] + w[1] * v[1] + w[2] * v[2]
+    rw = np.cross(f, m)
+    rt = np.cross(w, v)
+    cr = np.cross(f, w)
+    s = np.sqrt(cr[0] ** 2 + cr[1] ** 2 + cr[2] ** 2)
+    dr = rt - rw
+    if s > 1e-12:
+        d = abs(dr[0] * cr[0] + dr[1] * cr[1] + dr[2] * cr[2]) / s
+    else:
+        x = np.cross(dr, f)
+        d = np.sqrt(x[0] ** 2 + x[1] ** 2 + x[2] ** 2)
+    dmax = max(d, L)
+    power = abs(f[0] * v[0] + f[1] * v[1] + f[2] * v[2] + m[0] * w[0] + m[1] * w[1] + m[2] * w[2])
+    return min(power / np.sqrt((hw + ht) ** 2 + dmax * dmax), 1.0)
+
+
+@njit(cache=True)
+def nb_indices(M, nc, inputs, act_scale, L, out, vaxes, faxes):
+    """The indices of one square complete Jacobian ``M`` (6, 6) (rows ``(moment ; force)``, the
+    first ``nc`` the constraints), the actuated joints' twists ``inputs`` (na, 6) and the rate
+    scale of each actuator (L for a slide, 1 for a rotation): :func:`..analysis.maps.pose_indices`."""
+    na = 6 - nc
+    Jn = M.copy()
+    for i in range(6):
+        for c in range(3, 6):
+            Jn[i, c] *= L
+    for a in range(na):
+        for c in range(6):
+            Jn[nc + a, c] /= act_scale[a]
+    Jr = Jn.copy()
+    for i in range(6):
+        s = 0.0
+        for c in range(6):
+            s += Jr[i, c] ** 2
+        s = np.sqrt(s)
+        if s > 0.0:
+            for c in range(6):
+                Jr[i, c] /= s
+    sv = np.empty(6)
+    nb_singular_values(Jr, sv)
+    out[0] = sv[5]
+    out[1] = sv[5] / sv[0] if sv[0] > 0.0 else 0.0
+    # velocity / force ellipsoids on the motion subspace: A_n projected off the constraint rows
+    Q = np.zeros((6, 6))
+    nq = 0
+    for i in range(nc):
+        x = Jr[i].copy()
+        for _twice in range(2):
+            for j in range(nq):
+                dot = 0.0
+                for c in range(6):
+                    dot += x[c] * Q[j, c]
+                for c in range(6):
+                    x[c] -= dot * Q[j, c]
+        nx = np.sqrt(np.sum(x * x))
+        if nx > 1e-12:
+            Q[nq] = x / nx
+            nq += 1
+    K = np.empty((6, na))
+    for a in range(na):
+        x = Jn[nc + a].copy()
+        for _twice in range(2):
+            for j in range(nq):
+                dot = 0.0
+                for c in range(6):
+                    dot += x[c] * Q[j, c]
+                for c in range(6):
+                    x[c] -= dot * Q[j, c]
+        for c in range(6):
+            K[c, a] = x[c]
+    fs = np.empty(na)
+    nb_singular_values(K, fs)
+    prod = 1.0
+    for a in range(na):
+        faxes[a] = fs[a]
+        vaxes[a] = 1.0 / fs[na - 1 - a] if fs[na - 1 - a] > 0.0 else np.inf
+        prod *= fs[a]
+    out[2] = 1.0 / prod if prod > 0.0 else np.inf
+    # transmission: input (actuated joint twist), output / restricted twists by cofactors
+    W = np.empty(6)
+    iti = 1.0
+    for a in range(na):
+        for c in range(3):
+            W[c] = M[nc + a, 3 + c]
+            W[3 + c] = M[nc + a, c]
+        iti = min(iti, nb_power(W, inputs[a], L))
+    oti = 1.0
+    lci = 1.0
+    minor = np.empty((5, 5))
+    y = np.empty(6)
+    T = np.empty(6)
+    for i in range(6):
+        for j in range(6):
+            r2 = 0
+            for r in range(6):
+                if r != i:
+                    c2 = 0
+                    for c in range(6):
+                        if c != j:
+                            minor[r2, c2] = Jr[r, c]
+                            c2 += 1
+                    r2 += 1
+            y[j] = (-1.0) ** j * nb_det_small(minor)
+        ny = np.sqrt(np.sum(y * y))
+        for c in range(3):
+            W[c] = M[i, 3 + c]
+            W[3 + c] = M[i, c]
+            T[c] = y[c]
+            T[3 + c] = y[3 + c] * L
+        z = nb_power(W, T, L) if ny > 1e-13 else 0.0
+        if i < nc:
+            lci = min(lci, z)
+        else:
+            oti = min(oti, z)
+    out[3] = iti
+    out[4] = oti
+    out[5] = min(iti, oti)
+    out[6] = lci if nc > 0 else 0.0
+
+
+@njit(cache=True)
+def nb_indices_many(Ms, nc, inputs, act_scale, L, out, vaxes, faxes):
+    """:func:`nb_indices` of many Jacobians ``Ms`` (N, 6, 6) and inputs (N, na, 6)."""
+    for s in range(Ms.shape[0]):
+        nb_indices(Ms[s], nc, inputs[s], act_scale, L, out[s], vaxes[s], faxes[s])
+
+
+@njit(cache=True)
+def nb_rref_rows(A, rank_tol, pivot_tol):
+    """:func:`..geometry.screws.rref` of the rows of ``A`` (r, 6) in place; returns the rank."""
+    rows, cols = A.shape
+    big0 = 0.0
+    for i in range(rows):
+        for c in range(cols):
+            big0 = max(big0, abs(A[i, c]))
+    floor = rank_tol * big0
+    r = 0
+    for c in range(cols):
+        if r == rows:
+            break
+        big = 0.0
+        for i in range(r, rows):
+            for cc in range(c, cols):
+                big = max(big, abs(A[i, cc]))
+        if big <= floor:
+            break
+        piv = r
+        for i in range(r + 1, rows):
+            if abs(A[i, c]) > abs(A[piv, c]):
+                piv = i
+        if abs(A[piv, c]) < pivot_tol * big:
+            continue
+        for cc in range(cols):
+            tmp = A[r, cc]
+            A[r, cc] = A[piv, cc]
+            A[piv, cc] = tmp
+        p = A[r, c]
+        for cc in range(cols):
+            A[r, cc] /= p
+        for i in range(rows):
+            if i != r:
+                f = A[i, c]
+                for cc in range(cols):
+                    A[i, cc] -= f * A[r, cc]
+        A[r, c] = 1.0
+        for i in range(rows):
+            if i != r:
+                A[i, c] = 0.0
+        r += 1
+    return r
+
+
+@njit(cache=True)
+def nb_maps_closed(R, p, kind, pa, pb, e1, e2, act_limb, act_scale, nc, L, rank_tol, pivot_tol, out, vaxes, faxes,
+                   ok):
+    """Poses ``(R, p)`` (platform point) to the indices, for limbs with a closed form: ``kind[k]``
+    0 (an S-P-S / U-P-S leg from the base centre ``pa[k]`` to the platform centre ``R pb[k] + p``,
+    actuated along the leg) or 1 (a C-U column: constraint forces through ``R pb[k] + p``
+    perpendicular to the column, spanned by ``e1[k]``, ``e2[k]``, basis put in reduced row-echelon
+    form as :func:`..jacobian.limb_constraint_wrenches` does).  ``ok[s]`` False: a degenerate
+    pose (a leg of zero length, a constraint basis of the wrong rank); the caller decides."""
+    na = act_limb.shape[0]
+    M = np.empty((6, 6))
+    inp = np.zeros((na, 6))
+    C = np.empty((2, 6))
+    for s in range(R.shape[0]):
+        ok[s] = True
+        row = 0
+        for k in range(kind.shape[0]):
+            if kind[k] != 1:
+                continue
+            u = np.empty(3)
+            for c in range(3):
+                u[c] = R[s, c, 0] * pb[k, 0] + R[s, c, 1] * pb[k, 1] + R[s, c, 2] * pb[k, 2] + p[s, c]
+            for b in range(2):
+                e = e1[k] if b == 0 else e2[k]
+                mom = np.cross(u, e)
+                for c in range(3):
+                    C[b, c] = e[c]
+                    C[b, 3 + c] = mom[c] / L
+            if nb_rref_rows(C, rank_tol, pivot_tol) != 2:
+                ok[s] = False
+            for b in range(2):
+                for c in range(3):  # matrix row: (moment ; force)
+                    M[row, c] = C[b, 3 + c] * L
+                    M[row, 3 + c] = C[b, c]
+                row += 1
+        if row != nc:
+            ok[s] = False
+            continue
+        for a in range(na):
+            k = act_limb[a]
+            B = pa[k]
+            d = np.empty(3)
+            for c in range(3):
+                d[c] = R[s, c, 0] * pb[k, 0] + R[s, c, 1] * pb[k, 1] + R[s, c, 2] * pb[k, 2] + p[s, c] - B[c]
+            ln = np.sqrt(np.sum(d * d))
+            if not ln > 1e-12 * L:
+                ok[s] = False
+                break
+            u = d / ln
+            mom = np.cross(B, u)
+            for c in range(3):
+                M[nc + a, c] = mom[c]
+                M[nc + a, 3 + c] = u[c]
+                inp[a, c] = 0.0
+                inp[a, 3 + c] = u[c]
+        if not ok[s]:
+            continue
+        nb_indices(M, nc, inp, act_scale, L, out[s], vaxes[s], faxes[s])
+
+
+def indices_many(Ms, nc: int, inputs, act_scale, L: float):
+    """``(out (N, 7), velocity axes (N, na), force axes (N, na))`` of Jacobians ``Ms`` (N, 6, 6)."""
+    Ms = np.ascontiguousarray(Ms, dtype=float)
+    N = Ms.shape[0]
+    na = 6 - int(nc)
+    out = np.zeros((N, N_SCALARS))
+    va = np.zeros((N, na))
+    fa = np.zeros((N, na))
+    nb_indices_many(Ms, np.int64(nc), np.ascontiguousarray(inputs, dtype=float), np.ascontiguousarray(act_scale, dtype=float),
+                    float(L), out, va, fa)
+    return out, va, fa
+
+
+def maps_closed(R, p, plan: dict, L: float, rank_tol: float, pivot_tol: float):
+    """:func:`nb_maps_closed` over poses ``R`` (N, 3, 3), ``p`` (N, 3); ``plan``: the arrays of
+    :func:`spatialmech.analysis.maps.closed_form_plan`.  Returns ``(out, vaxes, faxes, ok)``."""
+    R = np.ascontiguousarray(R, dtype=float)
+    p = np.ascontiguousarray(p, dtype=float)
+    N = R.shape[0]
+    na = plan["act_limb"].shape[0]
+    out = np.zeros((N, N_SCALARS))
+    va = np.zeros((N, na))
+    fa = np.zeros((N, na))
+    ok = np.zeros(N, dtype=np.bool_)
+    nb_maps_closed(R, p, plan["kind"], plan["pa"], plan["pb"], plan["e1"], plan["e2"], plan["act_limb"],
+                   plan["act_scale"], np.int64(plan["nc"]), float(L), float(rank_tol), float(pivot_tol), out, va, fa, ok)
+    return out, va, fa, ok
