@@ -50,7 +50,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError
-from ..geometry.rotations import euler_matrix
 from ..geometry.tolerances import current
 from ..kinematics import backend
 from ..kinematics.closure import Configuration, hub_displacements, limb_slices, recentre_balls
@@ -258,9 +257,18 @@ def map_poses(mech: Mechanism, kind: str, over: Mapping, at: Mapping | None = No
         raise InputError(f"over: {n} poses; at most {MAX_MAP_POSES}")
     mesh = dict(zip(axes, (g.ravel() for g in np.meshgrid(*axes.values(), indexing="ij")), strict=True))
     col = {c: mesh[c] if c in mesh else np.full(n, fixed[c]) for c in COORDINATES}
-    R = euler_matrix("ZYX", np.stack([col["gamma"], col["beta"], col["alpha"]], axis=-1))
     p = np.stack([col["x"], col["y"], col["z"]], axis=-1)
-    return axes, fixed, np.asarray(R).reshape(n, 3, 3), p, shape
+    return axes, fixed, _zyx(col["gamma"], col["beta"], col["alpha"]), p, shape
+
+
+def _zyx(g: np.ndarray, b: np.ndarray, a: np.ndarray) -> np.ndarray:
+    """``Rz(g) Ry(b) Rx(a)`` (N, 3, 3), as :func:`..geometry.rotations.euler_matrix` ``("ZYX", (g, b, a))``."""
+    cg, sg, cb, sb, ca, sa = np.cos(g), np.sin(g), np.cos(b), np.sin(b), np.cos(a), np.sin(a)
+    R = np.empty((g.size, 3, 3))
+    R[:, 0, 0], R[:, 0, 1], R[:, 0, 2] = cg * cb, cg * sb * sa - sg * ca, cg * sb * ca + sg * sa
+    R[:, 1, 0], R[:, 1, 1], R[:, 1, 2] = sg * cb, sg * sb * sa + cg * ca, sg * sb * ca - cg * sa
+    R[:, 2, 0], R[:, 2, 1], R[:, 2, 2] = -sb, cb * sa, cb * ca
+    return R
 
 
 # ------------------------------------------------------------------------------ the result

@@ -30,18 +30,22 @@ def nb_singular_values(A, out):
     else:
         B = A.T.copy()
     r, c = B.shape
+    nrm = np.empty(c)
     for _sweep in range(60):
+        for j in range(c):  # squared column norms, refreshed each sweep and updated by each rotation
+            s = 0.0
+            for i in range(r):
+                s += B[i, j] * B[i, j]
+            nrm[j] = s
         rotated = False
         for p in range(c - 1):
             for q in range(p + 1, c):
-                alpha = 0.0
-                beta = 0.0
+                alpha = nrm[p]
+                beta = nrm[q]
                 gamma = 0.0
                 for i in range(r):
-                    alpha += B[i, p] * B[i, p]
-                    beta += B[i, q] * B[i, q]
                     gamma += B[i, p] * B[i, q]
-                if gamma == 0.0 or abs(gamma) <= 1e-16 * np.sqrt(alpha * beta):
+                if gamma == 0.0 or abs(gamma) <= 1e-15 * np.sqrt(alpha * beta):
                     continue
                 rotated = True
                 zeta = (beta - alpha) / (2.0 * gamma)
@@ -53,6 +57,8 @@ def nb_singular_values(A, out):
                     bq = B[i, q]
                     B[i, p] = cs * bp - sn * bq
                     B[i, q] = sn * bp + cs * bq
+                nrm[p] = alpha - t * gamma
+                nrm[q] = beta + t * gamma
         if not rotated:
             break
     for j in range(c):
@@ -102,35 +108,68 @@ def nb_power(W, T, L):
     nv = np.sqrt(T[3] ** 2 + T[4] ** 2 + T[5] ** 2)
     couple = nf <= 1e-12 * (nf + nm / L)
     translation = nw <= 1e-12 * (nw + nv / L)
-    if couple and translation:
-        return 0.0
     if couple:
-        if nm == 0.0:
+        if translation or nm == 0.0:
             return 0.0
         return min(abs(W[3] * T[0] + W[4] * T[1] + W[5] * T[2]) / (nm * nw), 1.0)
     if translation:
         if nv == 0.0:
             return 0.0
         return min(abs(W[0] * T[3] + W[1] * T[4] + W[2] * T[5]) / (nf * nv), 1.0)
-    f = W[:3] / nf
-    m = W[3:] / nf
-    w = T[:3] / nw
-    v = T[3:] / nw
-    hw = f[0] * m[0] + f[1] * m[1] + f[2] * m[2]
-    ht = w[0] * v[0] + w[1] * v[1] + w[2] * v[2]
-    rw = np.cross(f, m)
-    rt = np.cross(w, v)
-    cr = np.cross(f, w)
-    s = np.sqrt(cr[0] ** 2 + cr[1] ** 2 + cr[2] ** 2)
-    dr = rt - rw
+    f0, f1, f2 = W[0] / nf, W[1] / nf, W[2] / nf
+    m0, m1, m2 = W[3] / nf, W[4] / nf, W[5] / nf
+    w0, w1, w2 = T[0] / nw, T[1] / nw, T[2] / nw
+    v0, v1, v2 = T[3] / nw, T[4] / nw, T[5] / nw
+    c0, c1, c2 = f1 * w2 - f2 * w1, f2 * w0 - f0 * w2, f0 * w1 - f1 * w0  # f x w
+    s = np.sqrt(c0 * c0 + c1 * c1 + c2 * c2)
+    d0 = (w1 * v2 - w2 * v1) - (f1 * m2 - f2 * m1)  # (w x v) - (f x m)
+    d1 = (w2 * v0 - w0 * v2) - (f2 * m0 - f0 * m2)
+    d2 = (w0 * v1 - w1 * v0) - (f0 * m1 - f1 * m0)
     if s > 1e-12:
-        d = abs(dr[0] * cr[0] + dr[1] * cr[1] + dr[2] * cr[2]) / s
+        d = abs(d0 * c0 + d1 * c1 + d2 * c2) / s
     else:
-        x = np.cross(dr, f)
-        d = np.sqrt(x[0] ** 2 + x[1] ** 2 + x[2] ** 2)
+        x0, x1, x2 = d1 * f2 - d2 * f1, d2 * f0 - d0 * f2, d0 * f1 - d1 * f0
+        d = np.sqrt(x0 * x0 + x1 * x1 + x2 * x2)
     dmax = max(d, L)
-    power = abs(f[0] * v[0] + f[1] * v[1] + f[2] * v[2] + m[0] * w[0] + m[1] * w[1] + m[2] * w[2])
-    return min(power / np.sqrt((hw + ht) ** 2 + dmax * dmax), 1.0)
+    h = f0 * m0 + f1 * m1 + f2 * m2 + w0 * v0 + w1 * v1 + w2 * v2
+    power = abs(f0 * v0 + f1 * v1 + f2 * v2 + m0 * w0 + m1 * w1 + m2 * w2)
+    return min(power / np.sqrt(h * h + dmax * dmax), 1.0)
+
+
+@njit(cache=True)
+def nb_inverse6(A, X):
+    """``X = A^-1`` (6, 6) by Gauss-Jordan elimination with partial pivoting; False if a pivot is 0."""
+    n = 6
+    G = np.empty((n, 2 * n))
+    for i in range(n):
+        for j in range(n):
+            G[i, j] = A[i, j]
+            G[i, n + j] = 1.0 if i == j else 0.0
+    for c in range(n):
+        piv = c
+        for i in range(c + 1, n):
+            if abs(G[i, c]) > abs(G[piv, c]):
+                piv = i
+        if G[piv, c] == 0.0:
+            return False
+        if piv != c:
+            for j in range(2 * n):
+                tmp = G[c, j]
+                G[c, j] = G[piv, j]
+                G[piv, j] = tmp
+        p = G[c, c]
+        for j in range(2 * n):
+            G[c, j] /= p
+        for i in range(n):
+            if i != c:
+                f = G[i, c]
+                if f != 0.0:
+                    for j in range(2 * n):
+                        G[i, j] -= f * G[c, j]
+    for i in range(n):
+        for j in range(n):
+            X[i, j] = G[i, n + j]
+    return True
 
 
 @njit(cache=True)
@@ -208,18 +247,26 @@ def nb_indices(M, nc, inputs, act_scale, L, out, vaxes, faxes):
     minor = np.empty((5, 5))
     y = np.empty(6)
     T = np.empty(6)
+    X = np.empty((6, 6))
+    # the twist reciprocal to every row but i: column i of Jr^-1 (the cofactors, up to scale and
+    # sign, which the power coefficient ignores); by the cofactors themselves near a singularity
+    by_inverse = sv[5] > 1e-6 and nb_inverse6(Jr, X)
     for i in range(6):
-        for j in range(6):
-            r2 = 0
-            for r in range(6):
-                if r != i:
-                    c2 = 0
-                    for c in range(6):
-                        if c != j:
-                            minor[r2, c2] = Jr[r, c]
-                            c2 += 1
-                    r2 += 1
-            y[j] = (-1.0) ** j * nb_det_small(minor)
+        if by_inverse:
+            for j in range(6):
+                y[j] = X[j, i]
+        else:
+            for j in range(6):
+                r2 = 0
+                for r in range(6):
+                    if r != i:
+                        c2 = 0
+                        for c in range(6):
+                            if c != j:
+                                minor[r2, c2] = Jr[r, c]
+                                c2 += 1
+                        r2 += 1
+                y[j] = (-1.0) ** j * nb_det_small(minor)
         ny = np.sqrt(np.sum(y * y))
         for c in range(3):
             W[c] = M[i, 3 + c]
