@@ -48,6 +48,7 @@ from .kinematics import (
     velocity,
     workspace,
 )
+from .maps import MapResult, maps
 from .linkages import CSSynthesisResult, TraceResult, defects, dj_table, screen, synth_cs, synth_rccc, track
 from .outputs import VIEW_MOTIONS as VIEW_MOTIONS  # the motions view() animates
 from .outputs import ReportResult, ViewResult, report, studio_app, studio_session, view
@@ -58,6 +59,7 @@ __all__ = [
     "FKResult",
     "IKResult",
     "JacobianResult",
+    "MapResult",
     "MobilityModes",
     "ReportResult",
     "SingularityAnalysis",
@@ -70,6 +72,7 @@ __all__ = [
     "ik",
     "jacobian",
     "load_model",
+    "maps",
     "mobility",
     "mobility_modes",
     "models",
