@@ -55,15 +55,15 @@ def _diff(a, b) -> float:
 def run(name: str, n: int, n_loop: int) -> dict:
     kind, coords, (lo, hi), at = CASES[name]
     mech = catalog.build(name)
-    over = {c: (lo, hi, n) for c in coords}
-    performance_map(mech, kind=kind, over={c: (lo, hi, 3) for c in coords}, at=at)  # compile / load the kernels
+    over = dict.fromkeys(coords, (lo, hi, n))
+    performance_map(mech, kind=kind, over=dict.fromkeys(coords, (lo, hi, 3)), at=at)  # compile / load the kernels
     best = np.inf
     for _ in range(3):
         t = time.perf_counter()
         r = performance_map(mech, kind=kind, over=over, at=at)
         best = min(best, time.perf_counter() - t)
     rate = r.n_poses / best
-    small = {c: (lo, hi, n_loop) for c in coords}
+    small = dict.fromkeys(coords, (lo, hi, n_loop))
     t = time.perf_counter()
     with backend.python_reference():
         ref = performance_map(mech, kind=kind, over=small, at=at, method="loop")

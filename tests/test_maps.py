@@ -49,7 +49,7 @@ def test_loop_and_batched_kernel_agree(name, kind, over, at):
 
 @pytest.mark.parametrize("name", ["stewart-6sps", "four-sps-cu", "three-rps"])
 def test_index_kernel_equals_python_on_the_same_jacobians(name):
-    from spatialmech.analysis.maps import _actuation, _jacobian_at  # noqa: PLC2701  (the test reaches in)
+    from spatialmech.analysis.maps import _actuation, _jacobian_at
 
     mech = catalog.build(name)
     pose = {"stewart-6sps": ([0.05, -0.03, 1.02], ("ZYX", 5, -3, 4)),
@@ -77,12 +77,12 @@ def test_stewart_home_hand_checks():
     assert r.values["lti"][centre] == pytest.approx(r.values["oti"][centre])
     # at the symmetric home every leg's output transmission is the same: OTI is the common value
     mech = catalog.build("stewart-6sps")
-    from spatialmech.analysis.maps import _actuation, _jacobian_at  # noqa: PLC2701
+    from spatialmech.analysis.maps import _actuation, _jacobian_at
 
-    where, scale = _actuation(mech)
+    where, _scale = _actuation(mech)
     from spatialmech.kinematics.closure import Configuration
 
-    M, inputs, _ = _jacobian_at(mech, Configuration.reference(mech), where)
+    M, _inputs, _ = _jacobian_at(mech, Configuration.reference(mech), where)
     Jr = M.copy()
     Jr[:, 3:] *= mech.characteristic_length
     Jr /= np.linalg.norm(Jr, axis=1, keepdims=True)

@@ -420,7 +420,9 @@ def _batched_general(mech: Mechanism, R, p, status, fast):
     D[:, :3, :3] = R[live]
     D[:, :3, 3] = p[live] - np.einsum("nij,j->ni", R[live], mech.platform_point)
     D[:, 3, 3] = 1.0
-    q, _res, ok = fast.limb_inverse_many(mech, D) if live.size else (None, None, np.zeros((0, 1), dtype=bool))
+    q, ok = np.zeros((0, len(mech.freedom_refs))), np.zeros((0, 1), dtype=bool)
+    if live.size:
+        q, _res, ok = fast.limb_inverse_many(mech, D)
     Ms, inputs, inv = np.zeros((live.size, 6, 6)), np.zeros((live.size, na, 6)), np.zeros(n, dtype=bool)
     for j, i in enumerate(live):
         config = None

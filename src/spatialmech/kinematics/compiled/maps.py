@@ -25,10 +25,7 @@ N_SCALARS = 7
 def nb_singular_values(A, out):
     """Singular values (descending) of ``A`` (m, n) into ``out`` (min(m, n)): one-sided Jacobi."""
     m, n = A.shape
-    if m >= n:
-        B = A.copy()
-    else:
-        B = A.T.copy()
+    B = A.copy() if m >= n else A.T.copy()
     r, c = B.shape
     nrm = np.empty(c)
     for _sweep in range(60):
@@ -137,6 +134,23 @@ def nb_power(W, T, L):
 
 
 @njit(cache=True)
+def nb_pivot(G, c):
+    """Swap into row ``c`` the row (from ``c`` down) with the largest ``|G[., c]|``; False if it is 0."""
+    piv = c
+    for i in range(c + 1, G.shape[0]):
+        if abs(G[i, c]) > abs(G[piv, c]):
+            piv = i
+    if G[piv, c] == 0.0:
+        return False
+    if piv != c:
+        for j in range(G.shape[1]):
+            tmp = G[c, j]
+            G[c, j] = G[piv, j]
+            G[piv, j] = tmp
+    return True
+
+
+@njit(cache=True)
 def nb_inverse6(A, X):
     """``X = A^-1`` (6, 6) by Gauss-Jordan elimination with partial pivoting; False if a pivot is 0."""
     n = 6
@@ -146,17 +160,8 @@ def nb_inverse6(A, X):
             G[i, j] = A[i, j]
             G[i, n + j] = 1.0 if i == j else 0.0
     for c in range(n):
-        piv = c
-        for i in range(c + 1, n):
-            if abs(G[i, c]) > abs(G[piv, c]):
-                piv = i
-        if G[piv, c] == 0.0:
+        if not nb_pivot(G, c):
             return False
-        if piv != c:
-            for j in range(2 * n):
-                tmp = G[c, j]
-                G[c, j] = G[piv, j]
-                G[piv, j] = tmp
         p = G[c, c]
         for j in range(2 * n):
             G[c, j] /= p
@@ -173,43 +178,27 @@ def nb_inverse6(A, X):
 
 
 @njit(cache=True)
-def nb_indices(M, nc, inputs, act_scale, L, out, vaxes, faxes):
-    """The indices of one square complete Jacobian ``M`` (6, 6) (rows ``(moment ; force)``, the
-    first ``nc`` the constraints), the actuated joints' twists ``inputs`` (na, 6) and the rate
-    scale of each actuator (L for a slide, 1 for a rotation): :func:`..analysis.maps.pose_indices`."""
-    na = 6 - nc
-    Jn = M.copy()
-    for i in range(6):
-        for c in range(3, 6):
-            Jn[i, c] *= L
-    for a in range(na):
-        for c in range(6):
-            Jn[nc + a, c] /= act_scale[a]
-    Jr = Jn.copy()
-    for i in range(6):
-        s = 0.0
-        for c in range(6):
-            s += Jr[i, c] ** 2
-        s = np.sqrt(s)
-        if s > 0.0:
+def nb_project_out(x, Q, nq):
+    """``x`` minus its components along the orthonormal rows ``Q[:nq]`` (twice, for accuracy)."""
+    for _twice in range(2):
+        for j in range(nq):
+            dot = 0.0
             for c in range(6):
-                Jr[i, c] /= s
-    sv = np.empty(6)
-    nb_singular_values(Jr, sv)
-    out[0] = sv[5]
-    out[1] = sv[5] / sv[0] if sv[0] > 0.0 else 0.0
-    # velocity / force ellipsoids on the motion subspace: A_n projected off the constraint rows
+                dot += x[c] * Q[j, c]
+            for c in range(6):
+                x[c] -= dot * Q[j, c]
+
+
+@njit(cache=True)
+def nb_ellipsoids(Jn, Jr, nc, out, vaxes, faxes):
+    """Velocity / force ellipsoids on the motion subspace: the actuation rows ``Jn[nc:]`` projected
+    off the constraint rows; ``out[2]`` the manipulability."""
+    na = 6 - nc
     Q = np.zeros((6, 6))
     nq = 0
     for i in range(nc):
         x = Jr[i].copy()
-        for _twice in range(2):
-            for j in range(nq):
-                dot = 0.0
-                for c in range(6):
-                    dot += x[c] * Q[j, c]
-                for c in range(6):
-                    x[c] -= dot * Q[j, c]
+        nb_project_out(x, Q, nq)
         nx = np.sqrt(np.sum(x * x))
         if nx > 1e-12:
             Q[nq] = x / nx
@@ -217,15 +206,8 @@ def nb_indices(M, nc, inputs, act_scale, L, out, vaxes, faxes):
     K = np.empty((6, na))
     for a in range(na):
         x = Jn[nc + a].copy()
-        for _twice in range(2):
-            for j in range(nq):
-                dot = 0.0
-                for c in range(6):
-                    dot += x[c] * Q[j, c]
-                for c in range(6):
-                    x[c] -= dot * Q[j, c]
-        for c in range(6):
-            K[c, a] = x[c]
+        nb_project_out(x, Q, nq)
+        K[:, a] = x
     fs = np.empty(na)
     nb_singular_values(K, fs)
     prod = 1.0
@@ -234,7 +216,30 @@ def nb_indices(M, nc, inputs, act_scale, L, out, vaxes, faxes):
         vaxes[a] = 1.0 / fs[na - 1 - a] if fs[na - 1 - a] > 0.0 else np.inf
         prod *= fs[a]
     out[2] = 1.0 / prod if prod > 0.0 else np.inf
-    # transmission: input (actuated joint twist), output / restricted twists by cofactors
+
+
+@njit(cache=True)
+def nb_cofactor_twist(Jr, i, y):
+    """``y_j = (-1)^j det(Jr without row i and column j)``: the twist reciprocal to every other row."""
+    minor = np.empty((5, 5))
+    for j in range(6):
+        r2 = 0
+        for r in range(6):
+            if r != i:
+                c2 = 0
+                for c in range(6):
+                    if c != j:
+                        minor[r2, c2] = Jr[r, c]
+                        c2 += 1
+                r2 += 1
+        y[j] = (-1.0) ** j * nb_det_small(minor)
+
+
+@njit(cache=True)
+def nb_transmission(M, Jr, sigma_min, nc, inputs, L, out):
+    """ITI, OTI, LTI, LCI into ``out[3:7]``: power coefficients of each row's wrench with the
+    actuated joint's twist (ITI) and with the twist reciprocal to every other row (OTI, LCI)."""
+    na = 6 - nc
     W = np.empty(6)
     iti = 1.0
     for a in range(na):
@@ -244,29 +249,17 @@ def nb_indices(M, nc, inputs, act_scale, L, out, vaxes, faxes):
         iti = min(iti, nb_power(W, inputs[a], L))
     oti = 1.0
     lci = 1.0
-    minor = np.empty((5, 5))
     y = np.empty(6)
     T = np.empty(6)
     X = np.empty((6, 6))
-    # the twist reciprocal to every row but i: column i of Jr^-1 (the cofactors, up to scale and
-    # sign, which the power coefficient ignores); by the cofactors themselves near a singularity
-    by_inverse = sv[5] > 1e-6 and nb_inverse6(Jr, X)
+    # column i of Jr^-1 is the cofactor twist up to scale and sign (which the power coefficient
+    # ignores); near a singularity the cofactors themselves
+    by_inverse = sigma_min > 1e-6 and nb_inverse6(Jr, X)
     for i in range(6):
         if by_inverse:
-            for j in range(6):
-                y[j] = X[j, i]
+            y[:] = X[:, i]
         else:
-            for j in range(6):
-                r2 = 0
-                for r in range(6):
-                    if r != i:
-                        c2 = 0
-                        for c in range(6):
-                            if c != j:
-                                minor[r2, c2] = Jr[r, c]
-                                c2 += 1
-                        r2 += 1
-                y[j] = (-1.0) ** j * nb_det_small(minor)
+            nb_cofactor_twist(Jr, i, y)
         ny = np.sqrt(np.sum(y * y))
         for c in range(3):
             W[c] = M[i, 3 + c]
@@ -285,6 +278,28 @@ def nb_indices(M, nc, inputs, act_scale, L, out, vaxes, faxes):
 
 
 @njit(cache=True)
+def nb_indices(M, nc, inputs, act_scale, L, out, vaxes, faxes):
+    """The indices of one square complete Jacobian ``M`` (6, 6) (rows ``(moment ; force)``, the
+    first ``nc`` the constraints), the actuated joints' twists ``inputs`` (na, 6) and the rate
+    scale of each actuator (L for a slide, 1 for a rotation): :func:`..analysis.maps.pose_indices`."""
+    Jn = M.copy()
+    Jn[:, 3:] *= L
+    for a in range(6 - nc):
+        Jn[nc + a] /= act_scale[a]
+    Jr = Jn.copy()
+    for i in range(6):
+        s = np.sqrt(np.sum(Jr[i] * Jr[i]))
+        if s > 0.0:
+            Jr[i] /= s
+    sv = np.empty(6)
+    nb_singular_values(Jr, sv)
+    out[0] = sv[5]
+    out[1] = sv[5] / sv[0] if sv[0] > 0.0 else 0.0
+    nb_ellipsoids(Jn, Jr, nc, out, vaxes, faxes)
+    nb_transmission(M, Jr, sv[5], nc, inputs, L, out)
+
+
+@njit(cache=True)
 def nb_indices_many(Ms, nc, inputs, act_scale, L, out, vaxes, faxes):
     """:func:`nb_indices` of many Jacobians ``Ms`` (N, 6, 6) and inputs (N, na, 6)."""
     for s in range(Ms.shape[0]):
@@ -292,22 +307,41 @@ def nb_indices_many(Ms, nc, inputs, act_scale, L, out, vaxes, faxes):
 
 
 @njit(cache=True)
+def nb_block_max(A, r, c):
+    """Largest ``|A[r:, c:]|``."""
+    big = 0.0
+    for i in range(r, A.shape[0]):
+        for cc in range(c, A.shape[1]):
+            big = max(big, abs(A[i, cc]))
+    return big
+
+
+@njit(cache=True)
+def nb_eliminate(A, r, c):
+    """Scale row ``r`` to a unit pivot in column ``c`` and clear that column elsewhere."""
+    rows, cols = A.shape
+    p = A[r, c]
+    for cc in range(cols):
+        A[r, cc] /= p
+    for i in range(rows):
+        if i != r:
+            f = A[i, c]
+            for cc in range(cols):
+                A[i, cc] -= f * A[r, cc]
+            A[i, c] = 0.0
+    A[r, c] = 1.0
+
+
+@njit(cache=True)
 def nb_rref_rows(A, rank_tol, pivot_tol):
     """:func:`..geometry.screws.rref` of the rows of ``A`` (r, 6) in place; returns the rank."""
     rows, cols = A.shape
-    big0 = 0.0
-    for i in range(rows):
-        for c in range(cols):
-            big0 = max(big0, abs(A[i, c]))
-    floor = rank_tol * big0
+    floor = rank_tol * nb_block_max(A, np.int64(0), np.int64(0))
     r = 0
     for c in range(cols):
         if r == rows:
             break
-        big = 0.0
-        for i in range(r, rows):
-            for cc in range(c, cols):
-                big = max(big, abs(A[i, cc]))
+        big = nb_block_max(A, r, c)
         if big <= floor:
             break
         piv = r
@@ -320,20 +354,33 @@ def nb_rref_rows(A, rank_tol, pivot_tol):
             tmp = A[r, cc]
             A[r, cc] = A[piv, cc]
             A[piv, cc] = tmp
-        p = A[r, c]
-        for cc in range(cols):
-            A[r, cc] /= p
-        for i in range(rows):
-            if i != r:
-                f = A[i, c]
-                for cc in range(cols):
-                    A[i, cc] -= f * A[r, cc]
-        A[r, c] = 1.0
-        for i in range(rows):
-            if i != r:
-                A[i, c] = 0.0
+        nb_eliminate(A, r, c)
         r += 1
     return r
+
+
+@njit(cache=True)
+def nb_cu_rows(R, p, pb, e1, e2, L, rank_tol, pivot_tol, M, row):
+    """The two constraint rows of a C-U column at ``M[row]``, ``M[row + 1]``: forces through the
+    U centre ``R pb + p`` perpendicular to the column, basis in reduced row-echelon form."""
+    C = np.empty((2, 6))
+    u = np.empty(3)
+    for c in range(3):
+        u[c] = R[c, 0] * pb[0] + R[c, 1] * pb[1] + R[c, 2] * pb[2] + p[c]
+    for b in range(2):
+        e = e1 if b == 0 else e2
+        C[b, 0] = e[0]
+        C[b, 1] = e[1]
+        C[b, 2] = e[2]
+        C[b, 3] = (u[1] * e[2] - u[2] * e[1]) / L
+        C[b, 4] = (u[2] * e[0] - u[0] * e[2]) / L
+        C[b, 5] = (u[0] * e[1] - u[1] * e[0]) / L
+    good = nb_rref_rows(C, rank_tol, pivot_tol) == 2
+    for b in range(2):
+        for c in range(3):  # matrix row: (moment ; force)
+            M[row + b, c] = C[b, 3 + c] * L
+            M[row + b, 3 + c] = C[b, c]
+    return good
 
 
 @njit(cache=True)
@@ -348,29 +395,14 @@ def nb_maps_closed(R, p, kind, pa, pb, e1, e2, act_limb, act_scale, nc, L, rank_
     na = act_limb.shape[0]
     M = np.empty((6, 6))
     inp = np.zeros((na, 6))
-    C = np.empty((2, 6))
     for s in range(R.shape[0]):
         ok[s] = True
         row = 0
         for k in range(kind.shape[0]):
-            if kind[k] != 1:
-                continue
-            u = np.empty(3)
-            for c in range(3):
-                u[c] = R[s, c, 0] * pb[k, 0] + R[s, c, 1] * pb[k, 1] + R[s, c, 2] * pb[k, 2] + p[s, c]
-            for b in range(2):
-                e = e1[k] if b == 0 else e2[k]
-                mom = np.cross(u, e)
-                for c in range(3):
-                    C[b, c] = e[c]
-                    C[b, 3 + c] = mom[c] / L
-            if nb_rref_rows(C, rank_tol, pivot_tol) != 2:
-                ok[s] = False
-            for b in range(2):
-                for c in range(3):  # matrix row: (moment ; force)
-                    M[row, c] = C[b, 3 + c] * L
-                    M[row, 3 + c] = C[b, c]
-                row += 1
+            if kind[k] == 1:
+                if not nb_cu_rows(R[s], p[s], pb[k], e1[k], e2[k], L, rank_tol, pivot_tol, M, row):
+                    ok[s] = False
+                row += 2
         if row != nc:
             ok[s] = False
             continue
