@@ -265,13 +265,23 @@ UNIT_FREE_KEYS: dict[str, str] = {
     "density": "dyads sampled per unit nondimensional arc length of the family",
     "separation": "smallest nondimensional distance between two limbs of a candidate",
     "min_closure_sigma_at_positions": "smallest scale-free closure sigma over the task positions",
+    # performance maps (docs/maps.md)
+    "manipulability": "sqrt det(G^T G) of the nondimensional forward velocity Jacobian (maps)",
+    "iti": "input transmission index, in [0, 1] (maps)",
+    "oti": "output transmission index, in [0, 1] (maps)",
+    "lti": "local transmission index min(ITI, OTI), in [0, 1] (maps)",
+    "lci": "local constraint index, in [0, 1] (maps)",
+    "velocity_axes": "semi-axes of the nondimensional velocity ellipsoid (maps)",
+    "force_axes": "semi-axes of the nondimensional force ellipsoid (maps)",
+    "status_counts": "grid cells of each status (maps)",
 }
 
 #: Unit-free keys that hold a map by name (actuator, limit, monomial) of unit-free numbers; any
 #: other object under a unit-free key names the units of its own fields.
 UNIT_FREE_MAPS: frozenset[str] = frozenset({"active_limits", "branch_point_arcs", "center_cubic", "circle_cubic",
                                             "residuals", "rejected_by_stage", "sign_changes_after", "dj_by_driver",
-                                            "signs", "trace_sigma_min", "transmission"})
+                                            "signs", "trace_sigma_min", "transmission",
+                                            "status_counts"})
 
 #: Keys holding screws: ``(direction ; moment)`` 6-vectors (or matrices of them) whose direction
 #: part is unit-free and whose moment part is in ``length_unit`` (the Jacobian ``matrix`` rows

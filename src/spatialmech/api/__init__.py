@@ -49,6 +49,7 @@ from .kinematics import (
     velocity,
     workspace,
 )
+from .maps import MapResult, maps
 from .linkages import CSSynthesisResult, TraceResult, defects, dj_table, screen, synth_cs, synth_rccc, track
 from .outputs import VIEW_MOTIONS as VIEW_MOTIONS  # the motions view() animates
 from .outputs import ReportResult, ViewResult, report, studio_app, studio_session, view
@@ -59,6 +60,7 @@ __all__ = [
     "FKResult",
     "IKResult",
     "JacobianResult",
+    "MapResult",
     "MobilityModes",
     "ReportResult",
     "SingularityAnalysis",
@@ -72,6 +74,7 @@ __all__ = [
     "ik",
     "jacobian",
     "load_model",
+    "maps",
     "mobility",
     "mobility_modes",
     "models",

@@ -292,6 +292,7 @@ def report(model, out, no_trace, as_json):
 
 from .cmd_defects import defects  # noqa: E402
 from .cmd_kinematics import fk, ik, jacobian  # noqa: E402  (commands defined in their own modules)
+from .cmd_maps import maps_cmd  # noqa: E402
 from .cmd_parasitic import parasitic_cmd  # noqa: E402
 from .cmd_screen import screen  # noqa: E402
 from .cmd_singularity import singularity_cmd  # noqa: E402
@@ -303,7 +304,7 @@ from .cmd_validate import validate_cmd  # noqa: E402
 from .cmd_workspace import workspace  # noqa: E402
 
 for _cmd in (ik, fk, jacobian, parasitic_cmd, synth, view, defects, workspace, singularity_cmd, validate_cmd, studio, screen,
-             statics_cmd):
+             statics_cmd, maps_cmd):
     cli.add_command(_cmd)
 
 

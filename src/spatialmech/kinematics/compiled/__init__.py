@@ -43,6 +43,7 @@ from .kernels_homotopy import track_parameter
 from .kernels_loops import pack as pack_loop_system
 from .kernels_loops import square_batch as loop_square_batch
 from .legs import correct_legs
+from . import maps as maps  # performance-map kernels (analysis/maps.py)
 
 __all__ = [
     "AVAILABLE",
