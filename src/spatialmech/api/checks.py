@@ -106,15 +106,21 @@ def optional_progress(progress) -> Progress | None:
 
 
 # ============================================================================ models, poses, paths
-def as_mechanism(model, name: str = "model") -> Mechanism:
-    """A :class:`Mechanism` from a Mechanism, a ready-made model name or a TOML file path."""
+def as_mechanism(model, name: str | None = "model") -> Mechanism:
+    """A :class:`Mechanism` from a Mechanism, a ready-made model name or a TOML file path.
+    ``name``: the argument in the error messages; ``None`` for a value typed without a name (the
+    command line's MODEL): an unknown name or a missing file is then reported by its value,
+    ``NAME: not a file and not a ready-made model (...)``."""
     if isinstance(model, Mechanism):
         return model
     if not isinstance(model, (str, os.PathLike)):
-        raise TypeError(f"{name}: expected a Mechanism, a ready-made model name or a TOML file path, got {describe(model)}")
+        raise TypeError(f"{name or 'model'}: expected a Mechanism, a ready-made model name or a TOML file path, "
+                        f"got {describe(model)}")
     s = os.fspath(model)
     if isinstance(s, bytes):
-        raise TypeError(f"{name}: expected a str path, got bytes {s!r}")
+        raise TypeError(f"{name or 'model'}: expected a str path, got bytes {s!r}")
+    if name is None:
+        return catalog.resolve(s)
     if s in catalog.REGISTRY:
         return catalog.build(s)
     p = Path(s)

@@ -293,7 +293,8 @@ def screen(task=None, out: str | os.PathLike = "screen.parquet", *, candidates: 
 
     ``task``: ``None``/``"five-cs-positions"`` (paper A table 9), a model with seven task
     positions, a positions TOML file or seven Pose.  Returns a
-    :class:`~spatialmech.interfaces.batch_screen.ScreenSummary` (``to_dict()`` for JSON).
+    :class:`~spatialmech.services.screening.ScreenSummary` (``to_dict()`` for JSON, with
+    ``positions_source``: where the positions came from).
 
     >>> import tempfile
     >>> import spatialmech as sm
@@ -301,14 +302,17 @@ def screen(task=None, out: str | os.PathLike = "screen.parquet", *, candidates: 
     >>> s.judged, sum(s.rejected_by_stage.values()) + s.usable
     (2, 2)
     """
-    from ..interfaces.batch_screen import run_screen
+    from ..services.screening import run_screen
 
-    poses, _ = seven_positions(task)
+    poses, source = seven_positions(task)
     for nm, v, lo in (("candidates", candidates, 1), ("top", top, 0), ("starts", starts, 1),
                       ("chunk_size", chunk_size, 1)):
         check_int(v, nm, minimum=lo)
     if workers is not None:
         check_int(workers, "workers", minimum=0)
-    return run_screen(poses, out, candidates=candidates, density=check_number(density, "density"), seed=check_int(seed, "seed"),
-                      starts=starts, separation=check_number(separation, "separation"), chunk_size=chunk_size,
-                      workers=workers, scheduler=scheduler, top=top, rank_by=rank_by, progress=optional_progress(progress))
+    summary = run_screen(poses, out, candidates=candidates, density=check_number(density, "density"),
+                         seed=check_int(seed, "seed"), starts=starts, separation=check_number(separation, "separation"),
+                         chunk_size=chunk_size, workers=workers, scheduler=scheduler, top=top, rank_by=rank_by,
+                         progress=optional_progress(progress))
+    summary.positions_source = source
+    return summary
