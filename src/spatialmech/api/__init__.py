@@ -56,7 +56,7 @@ from .exchange import EXPORT_FORMATS as EXPORT_FORMATS  # the formats export() w
 from .exchange import VALIDATION_METHODS as VALIDATION_METHODS  # validate()'s methods and default tolerance
 from .exchange import VALIDATION_TOL as VALIDATION_TOL
 from .exchange import ExportResult, export, validate
-from .linkages import CSSynthesisResult, TraceResult, defects, dj_table, screen, synth_cs, synth_rccc, track
+from .linkages import CSSynthesisResult, DefectAnalysis, TraceResult, defects, dj_table, screen, synth_cs, synth_rccc, track
 from .outputs import VIEW_MOTIONS as VIEW_MOTIONS  # the motions view() animates
 from .outputs import ReportResult, ViewResult, demo, report, studio_session, view
 from .regions import TASK_COORDINATES as TASK_COORDINATES  # the names of grids and held coordinates
@@ -68,6 +68,7 @@ from .structure import MobilityModes, load_model, mobility, mobility_modes, mode
 
 __all__ = [
     "CSSynthesisResult",
+    "DefectAnalysis",
     "ExportResult",
     "FKResult",
     "IKResult",
