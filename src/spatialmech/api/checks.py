@@ -10,6 +10,7 @@ from __future__ import annotations
 import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
+from typing import Literal, overload
 
 import numpy as np
 
@@ -45,6 +46,10 @@ def check_int(value, name: str, *, minimum: int | None = None, maximum: int | No
     return v
 
 
+@overload
+def check_number(value, name: str, *, positive: bool = ..., optional: Literal[False] = ...) -> float: ...
+@overload
+def check_number(value, name: str, *, positive: bool = ..., optional: bool) -> float | None: ...
 def check_number(value, name: str, *, positive: bool = False, optional: bool = False) -> float | None:
     """A finite number (not a bool) as a float; ``None`` passes when ``optional``."""
     if value is None and optional:
@@ -201,7 +206,7 @@ def as_positions(positions) -> tuple[Pose, ...] | None:
     if isinstance(positions, (str, os.PathLike)):
         from ..model.schema import load_positions
 
-        return load_positions(positions)
+        return load_positions(Path(positions))
     if not isinstance(positions, Sequence):
         raise TypeError(f"positions: expected a sequence of Pose or a TOML file path, got {describe(positions)}")
     for k, p in enumerate(positions):

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -15,6 +16,12 @@ from ..kinematics.closure import Configuration
 from ..kinematics.position import freedom_values, platform_pose
 from ..model.mechanism import Mechanism, Pose
 from ..results import Progress, TrackStatus
+if TYPE_CHECKING:
+    from ..analysis.defects import DefectResult
+    from ..kinematics.tracking import TrackResult
+    from ..synthesis.cs_dyads import CSFamily
+    from ..synthesis.five_cs import FiveCSCheck
+
 from .checks import (
     ModelLike,
     as_configuration,
@@ -38,7 +45,7 @@ class TraceResult:
     the sign changes of DJ of the actuators as events (zeros: branch points)."""
 
     mechanism: Mechanism
-    result: object
+    result: TrackResult
 
     @property
     def status(self) -> TrackStatus:
@@ -154,7 +161,7 @@ class DefectAnalysis:
 
     mechanism: Mechanism
     positions: tuple[Pose, ...]
-    result: object
+    result: DefectResult
     figures: tuple = ()
 
     def __getattr__(self, name):
@@ -245,11 +252,11 @@ class CSSynthesisResult:
     picked dyads (``family.picks``), and with five picks the assembled 5-CS ``linkage`` and its
     ``check`` at the seven positions."""
 
-    family: object
+    family: CSFamily
     positions_source: str
     samples: int
     linkage: Mechanism | None = None
-    check: object | None = None
+    check: FiveCSCheck | None = None
 
     @property
     def success(self) -> bool | None:

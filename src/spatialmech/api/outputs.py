@@ -6,10 +6,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..analysis.mobility import mobility as _mobility
 from ..errors import InputError
 from ..results import Progress, check_progress
+if TYPE_CHECKING:
+    from ..present.viewer import ViewerFile
+
 from .checks import ModelLike, as_mechanism, check_bool, check_choice, check_int, check_path
 
 
@@ -95,7 +99,7 @@ class ViewResult:
     """The viewer page written (:attr:`file`: ``out``, ``frames``, ``bytes``) and the motion shown
     (``"trace"`` or ``"demo"``)."""
 
-    file: object
+    file: ViewerFile
     motion: str
 
     @property

@@ -4,8 +4,9 @@ lower-mobility mechanism (``sm.suggest_task_grid``) -- and the names those grids
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -51,7 +52,7 @@ def _grid(over, count: int) -> list[tuple[str, np.ndarray]]:
     return [(str(k), check_numbers(v, f"over[{k}]").reshape(-1)) for k, v in over.items()]
 
 
-def singularity_slice(model: ModelLike, over: Mapping[str, Sequence[float]], *, pose=None,
+def singularity_slice(model: ModelLike, over: Mapping[str, Any], *, pose=None,
                       at: Mapping[str, float] | None = None, free=None, drivers=None, degrees: bool = False,
                       progress: Progress | None = None):
     """The singularity loci (zero set of ``det J``) and the scale-free ``sigma_min`` on a 2-D
@@ -82,7 +83,7 @@ def singularity_slice(model: ModelLike, over: Mapping[str, Sequence[float]], *, 
     if pose is None:
         from ..analysis.task_slice import task_singularity_slice
 
-        axes = dict(_grid(over, 2))
+        axes: dict[str, Any] = dict(_grid(over, 2))
         if degrees:
             axes = {k: np.radians(v) if k.startswith("a") else v for k, v in axes.items()}
         if at is not None and not isinstance(at, Mapping):
@@ -121,7 +122,7 @@ def _pose_slice(mech: Mechanism, axes, pose, acts, degrees: bool, progress):
         vals = {"x": x0, "y": y0, "z": z0, "a1": b1, "a2": b2, "a3": b3}
         vals[n1], vals[n2] = u, v
         R = euler_matrix(seq, [vals["a1"], vals["a2"], vals["a3"]], degrees=True)
-        return Pose(R, [vals["x"], vals["y"], vals["z"]])
+        return Pose(R, np.array([vals["x"], vals["y"], vals["z"]]))
 
     units = tuple("deg" if n.startswith("a") else mech.length_unit for n in (n1, n2))
     return _slice(mech, pose_of, g1, g2, names=(n1, n2), units=units, actuators=acts,

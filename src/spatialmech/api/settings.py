@@ -26,6 +26,7 @@ def tolerances(spec=None, *, primary: str = "rank") -> Iterator[_tol.Tolerances]
     """
     if not isinstance(primary, str):
         raise TypeError(f"primary: expected a tolerance name (str), got {describe(primary)}")
+    t: _tol.Tolerances | None
     if isinstance(spec, str):
         t = _tol.Tolerances.parse(spec, primary=primary)
     elif spec is None or isinstance(spec, _tol.Tolerances):

@@ -36,13 +36,17 @@ def _one_line(e: BaseException) -> str:
     return "; ".join(part.strip() for part in str(e).splitlines() if part.strip())
 
 
+class _FailedComputation(UserError):
+    """A computation that did not converge: one line, exit code 1."""
+
+    exit_code = 1
+
+
 def _user_error(e: BaseException) -> UserError | None:
     """The one-line error of a user error (exit 2; 1 for a computation that did not converge),
     or ``None`` when ``e`` is a programming error."""
     if isinstance(e, ConvergenceError):
-        err = UserError(f"the computation failed: {_one_line(e)}")
-        err.exit_code = 1
-        return err
+        return _FailedComputation(f"the computation failed: {_one_line(e)}")
     if isinstance(e, SpatialmechError):
         return UserError(_one_line(e))
     if isinstance(e, OSError):  # a path the user gave: cannot read, cannot write, no such directory

@@ -47,7 +47,7 @@ def _task_slice(mech, slice_spec: str, at, free, acts, plot, as_json) -> None:
 
     def prog(done, total, msg):
         if bar is not None:
-            bar.length = max(bar.length, int(total or done))
+            bar.length = max(bar.length or 0, int(total or done))
             bar.update(int(done) - bar.pos)
 
     res = sm.singularity_slice(mech, axes, at=held, free=free_names, drivers=acts, progress=prog if bar else None)

@@ -13,7 +13,7 @@ import click
 
 from .. import api as sm
 from ..errors import ConvergenceError, InputError
-from .common import check_output_file, emit_json, load_model
+from .common import UserError, check_output_file, emit_json, load_model
 
 #: Largest number of frames (each is a configuration drawn into the page).
 MAX_FRAMES = 2000
@@ -28,15 +28,11 @@ __all__ = ["MOTIONS", "view"]
 MOTIONS = sm.VIEW_MOTIONS
 
 
-class _Error(click.ClickException):
-    """One line ``error: ...`` on stderr (exit code 2 for bad input, 1 for a failed computation)."""
+class _Failed(UserError):
+    """A computation of the motion that did not converge: one line ``error: ...``, exit code 1
+    (bad input: :class:`~.common.UserError`, exit code 2)."""
 
-    def __init__(self, message: str, code: int = 2):
-        super().__init__(message)
-        self.exit_code = code
-
-    def show(self, file=None):
-        click.echo(f"error: {self.format_message()}", err=True, file=file)
+    exit_code = 1
 
 
 @click.command(name="view")
@@ -68,15 +64,15 @@ def view(model, motion, out, frames, plotly, as_json):
         check_output_file(out, "--out")
         mech = load_model(model)
     except InputError as e:  # anything else is a bug: the main group shows it as one (exit 3)
-        raise _Error(str(e)) from None
+        raise UserError(str(e)) from None
     try:
         written = sm.view(mech, out, motion=motion, frames=frames, plotly=plotly)
     except OSError as e:
-        raise _Error(f"--out: cannot write {out}: {e.strerror or e}") from None
+        raise UserError(f"--out: cannot write {out}: {e.strerror or e}") from None
     except InputError as e:
-        raise _Error(str(e)) from None
+        raise UserError(str(e)) from None
     except ConvergenceError as e:
-        raise _Error(str(e), code=1) from None
+        raise _Failed(str(e)) from None
     if as_json:
         emit_json("view", mech, written.to_dict())
     else:

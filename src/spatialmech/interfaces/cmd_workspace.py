@@ -10,6 +10,7 @@ takes ``name=value`` pairs separated by commas: ``x, y, z`` (m) and ``alpha, bet
 from __future__ import annotations
 
 import sys
+from typing import Any
 
 import click
 import numpy as np
@@ -237,7 +238,7 @@ def workspace(model, orientation_flag, position_flag, at, step_deg, tol_deg, ste
                     raise InputError(f"{name}: only with --task (the workspace over task coordinates)")
         check_output_file(plot, "--plot", suffixes=(".png", ".svg", ".pdf"))
         mech = load_model(model)
-        limit_args = {"freedom_limits": freedom_limits(freedom_limits_text, mech) or None,
+        limit_args: dict[str, Any] = {"freedom_limits": freedom_limits(freedom_limits_text, mech) or None,
                       "cones": cone_limits(cones, mech) or None}
         if link_diameter is not None or no_interference:
             _check_diameter(link_diameter)
