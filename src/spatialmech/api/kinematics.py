@@ -475,26 +475,9 @@ def workspace(model: ModelLike, *, kind: str = "orientation", at: Mapping[str, f
     >>> t.solved, t.reachable_fraction
     (('x', 'y', 'a1'), 1.0)
     """
-    from ..analysis.workspace import (
-        ConeLimit,
-        WorkspaceLimits,
-        default_limits,
-        orientation_workspace,
-        pose_checker,
-        position_workspace,
-        with_freedom_limits,
-    )
+    from ..analysis.workspace import orientation_workspace, pose_checker, position_workspace
 
-    mech = as_mechanism(model)
-    if freedom_limits is not None:
-        if not isinstance(freedom_limits, Mapping):
-            raise TypeError(f"freedom_limits: expected a mapping of freedom -> (lo, hi), got {describe(freedom_limits)}")
-        named = {}
-        for name, rng in freedom_limits.items():
-            for fid in (mech.actuators if name == "actuators" else (name,)):
-                named[fid] = rng
-        if named:
-            mech = with_freedom_limits(mech, named)
+    mech = _with_freedom_limits(as_mechanism(model), freedom_limits)
     kind = check_choice(kind, "kind", ("orientation", "position", "task"))
     method = check_choice(method, "method", ("auto", "closed-form", "general"))
     interference = check_bool(interference, "interference")
@@ -510,6 +493,40 @@ def workspace(model: ModelLike, *, kind: str = "orientation", at: Mapping[str, f
         max_poses = check_int(max_poses, "max_poses", minimum=1)
     if max_general_poses is not None:
         max_general_poses = check_int(max_general_poses, "max_general_poses", minimum=1)
+    limits = _workspace_limits(mech, limits, cones, link_diameter, interference)
+    if kind == "task":
+        return _task_workspace(mech, over, at, free, limits, tol, step, bounds, max_poses, progress)
+    for name, value in (("over", over), ("free", free)):
+        if value is not None:
+            raise InputError(f"{name}: only with kind='task' (the workspace over task coordinates)")
+    if max_poses is None and max_general_poses is not None and pose_checker(mech, limits, method=method).path == "general":
+        max_poses = max_general_poses
+    kw = dict(at=at, limits=limits, bounds=bounds, method=method, max_poses=max_poses, progress=optional_progress(progress))
+    if kind == "orientation":
+        return orientation_workspace(mech, step=np.radians(2.0) if step is None else step,
+                                     tol=np.radians(1e-3) if tol is None else tol, **kw)
+    return position_workspace(mech, step=step, tol=tol, **kw)
+
+
+def _with_freedom_limits(mech: Mechanism, freedom_limits) -> Mechanism:
+    """``mech`` with other limits on some freedoms (``workspace(freedom_limits=...)``; the name
+    ``"actuators"`` sets every actuator)."""
+    from ..analysis.workspace import with_freedom_limits
+
+    if freedom_limits is None:
+        return mech
+    if not isinstance(freedom_limits, Mapping):
+        raise TypeError(f"freedom_limits: expected a mapping of freedom -> (lo, hi), got {describe(freedom_limits)}")
+    named = {fid: rng for name, rng in freedom_limits.items()
+             for fid in (mech.actuators if name == "actuators" else (name,))}
+    return with_freedom_limits(mech, named) if named else mech
+
+
+def _workspace_limits(mech: Mechanism, limits, cones, link_diameter, interference: bool):
+    """The limits of ``workspace``: ``limits`` (default: the model's), with the extra ``cones``
+    and the interference check's ``link_diameter`` (none without ``interference``)."""
+    from ..analysis.workspace import ConeLimit, WorkspaceLimits, default_limits
+
     if limits is not None and not isinstance(limits, WorkspaceLimits):
         raise TypeError(f"limits: expected a WorkspaceLimits, got {describe(limits)}")
     limits = default_limits(mech) if limits is None else limits
@@ -523,18 +540,7 @@ def workspace(model: ModelLike, *, kind: str = "orientation", at: Mapping[str, f
                                  (limits.source + " + " if limits.source else "") + "cones")
     if link_diameter is not None or not interference:
         limits = WorkspaceLimits(limits.cones, link_diameter if interference else None, limits.freedom_limits, limits.source)
-    if kind == "task":
-        return _task_workspace(mech, over, at, free, limits, tol, step, bounds, max_poses, progress)
-    for name, value in (("over", over), ("free", free)):
-        if value is not None:
-            raise InputError(f"{name}: only with kind='task' (the workspace over task coordinates)")
-    if max_poses is None and max_general_poses is not None and pose_checker(mech, limits, method=method).path == "general":
-        max_poses = max_general_poses
-    kw = dict(at=at, limits=limits, bounds=bounds, method=method, max_poses=max_poses, progress=optional_progress(progress))
-    if kind == "orientation":
-        return orientation_workspace(mech, step=np.radians(2.0) if step is None else step,
-                                     tol=np.radians(1e-3) if tol is None else tol, **kw)
-    return position_workspace(mech, step=step, tol=tol, **kw)
+    return limits
 
 
 def _task_workspace(mech: Mechanism, over, at, free, limits, tol, step, bounds, max_poses, progress):
