@@ -31,7 +31,7 @@ from pathlib import Path
 
 from spatialmech.analysis.defects import defect_analysis
 from spatialmech.catalog.papers import five_cs_positions
-from spatialmech.interfaces.batch_screen import read_rows, run_screen
+from spatialmech.services.screening import read_rows, run_screen
 from spatialmech.synthesis.cs_dyads import synthesize_cs
 from spatialmech.synthesis.screening import candidate_linkage, candidate_sets, dyad_pool
 

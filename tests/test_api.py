@@ -379,7 +379,26 @@ PARITY = [
     ("synth-rccc", lambda: sm.synth_rccc(samples=60), ["synth", "rccc", "--samples", "60"]),
     ("synth-cs", lambda: sm.synth_cs(pick=0, starts=4, samples=10),
      ["synth", "cs", "--pick", "0", "--starts", "4", "--samples", "10"]),
+    ("mobility-mode", lambda: sm.mobility_modes("three-rrr-sm", mode="R1+R4"),
+     ["mobility", "three-rrr-sm", "--mode", "R1+R4"]),
+    ("singularity-slice-pose", lambda: _Tagged("singularity_slice", sm.singularity_slice(
+        "four-sps-cu", {"a2": [-10, 0, 10], "a3": [-10, 0, 10]}, pose=([0, 0, 0.12], ("ZYX", 20, 0, 0)), degrees=True)),
+     ["singularity", "four-sps-cu", "--xyz", "0", "0", "0.12", "--euler", "ZYX", "20", "0", "0",
+      "--slice", "a2:-10:10:3,a3:-10:10:3"]),
+    ("singularity-slice-task", lambda: _Tagged("singularity_task_slice", sm.singularity_slice(
+        "three-rps", {"a2": np.radians([-10, 0, 10]), "a3": np.radians([-10, 0, 10])}, at={"z": 0.33})),
+     ["singularity", "three-rps", "--slice", "a2:-10:10:3,a3:-10:10:3", "--at", "z=0.33"]),
 ]
+
+
+class _Tagged:
+    """A result whose command prints ``{"result": TAG, **to_dict()}`` (singularity's three kinds)."""
+
+    def __init__(self, tag, result):
+        self.tag, self.result = tag, result
+
+    def to_dict(self):
+        return {"result": self.tag, **self.result.to_dict()}
 
 
 @pytest.mark.slow
@@ -388,3 +407,49 @@ def test_to_dict_is_the_payload_of_the_command(facade, args):
     """``to_dict()`` of a facade result is what ``spatialmech ... --json`` prints inside its
     envelope.  Fails when a command's JSON changes and the facade does not (or the other way)."""
     assert _without(strict_json(facade()), CLI_ONLY) == _cli_payload(args)
+
+
+# ------------------------------------------------------------------ the verbs the command line needs (issue 26)
+def test_load_model_without_a_name_reports_the_value():
+    """What the command line's MODEL argument says for an unknown name: the value, not 'model:'."""
+    with pytest.raises(sm.ModelFileError, match=r"^no-such: not a file and not a ready-made model \(ready-made: "):
+        sm.load_model("no-such", name=None)
+    with pytest.raises(sm.UnknownNameError, match=r"model: unknown ready-made model 'no-such'"):
+        sm.load_model("no-such")
+    assert sm.load_model("rssr", name=None).name == "rssr"
+
+
+def test_export_writes_each_format_and_checks_first(tmp_path):
+    for name, fmt in (("r.toml", "toml"), ("r.xml", "mjcf"), ("r.urdf", "urdf")):
+        r = sm.export("rssr", tmp_path / name)
+        assert (r.format, r.out.is_file(), r.to_dict()["bytes"] > 0) == (fmt, True, True)
+    assert sm.load(tmp_path / "r.toml").name == "rssr"
+    with pytest.raises(sm.InputError, match="format"):
+        sm.export("no-such-model", tmp_path / "r.png")  # the file's format is refused before the model is loaded
+    with pytest.raises(sm.InputError, match="format: expected one of"):
+        sm.export("rssr", tmp_path / "r.toml", format="step")
+
+
+def test_tolerances_apply_inside_the_block_only():
+    before = sm.default_tolerance("rank")
+    with sm.tolerances("2e-3", primary="rank") as t:
+        assert t.rank == 2e-3
+        with sm.tolerances("singular=0.5") as u:
+            assert (u.rank, u.singular) == (2e-3, 0.5)
+    with sm.tolerances() as t:
+        assert t.rank == before
+    with pytest.raises(sm.InputError, match="unknown tolerance"):
+        sm.default_tolerance("no-such")
+
+
+def test_suggest_task_grid_names_given_and_solved_coordinates():
+    g = sm.suggest_task_grid("three-rps", degrees=True)
+    assert (g.given, g.solved, g.euler) == (("z", "a2", "a3"), ("x", "y", "a1"), "ZYX")
+    assert g.over == {"a2": (-20.0, 20.0, 41), "a3": (-20.0, 20.0, 41)} and set(g.at) == {"z"}
+    r = sm.suggest_task_grid("three-rps", free=["x", "y", "z"])
+    assert r.given == ("a1", "a2", "a3") and r.over["a1"][1] == pytest.approx(np.radians(20))
+
+
+def test_mobility_modes_of_one_mode():
+    one = sm.mobility_modes("three-rrr-sm", mode="R1+R4")
+    assert len(one) == 1 and one[0].dof == sm.mobility("three-rrr-sm", "R1+R4").dof

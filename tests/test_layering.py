@@ -12,6 +12,16 @@ Two checks, each able to fail (the last tests feed them a violation):
   drag in.  The package's own ``spatialmech/__init__.py`` is not run there (it imports the API
   facade, which may use the catalogue): a bare package object with the same ``__path__`` stands in
   for it, so each core module is imported exactly with what it imports itself.
+
+Above the core (issue 26, "Every driver goes through ``sm.*``"), three more rules, checked
+statically the same way (:func:`layer_violations`):
+
+- ``interfaces/`` (the drivers: the command line, the studio's web app) imports only the facade
+  (``spatialmech.api``, or ``spatialmech`` itself), ``spatialmech.errors``, ``.results``,
+  ``.serialize``, ``.present`` and its own modules (and third-party packages);
+- ``api/`` never imports ``interfaces/``;
+- ``services/`` (orchestrators below the API: the screen, the studio session) never imports
+  ``api/`` nor ``interfaces/``.
 """
 
 from __future__ import annotations
@@ -289,3 +299,118 @@ def test_the_cycle_check_finds_a_cycle():
         "spatialmech.kinematics.closure", "spatialmech.kinematics.leg_platform", "spatialmech.kinematics.compiled.legs"]
     graph["spatialmech.kinematics.leg_platform"] = set()
     assert reaches(graph, "spatialmech.kinematics.closure", COMPILED) is None
+
+
+# ------------------------------------------------------------------ the layers above the core
+#: Parts of spatialmech the drivers (``interfaces/``) may import, each with its sub-modules;
+#: ``spatialmech`` itself (the package, i.e. the facade it re-exports) is allowed as the exact name.
+DRIVER_ALLOWED = ("spatialmech.api", "spatialmech.errors", "spatialmech.results", "spatialmech.serialize",
+                  "spatialmech.present", "spatialmech.interfaces")
+#: Driver files exempt from the rule above, with the reason.  Keep this list short and explicit.
+DRIVER_EXEMPT = {
+    # issue 26: cmd_kinematics.py (ik, fk, jacobian) is being rewritten onto sm.ik / sm.fk /
+    # sm.jacobian on another branch; its exemption is removed when that branch is merged.
+    "interfaces/cmd_kinematics.py",
+}
+#: Layer (a folder of the package) -> the parts of spatialmech it must not import.
+LAYER_FORBIDDEN = {
+    "api": ("spatialmech.interfaces",),
+    "services": ("spatialmech.api", "spatialmech.interfaces"),
+}
+
+
+def _within(name: str, part: str) -> bool:
+    return name == part or name.startswith(part + ".")
+
+
+def layer_files(layer: str) -> list[Path]:
+    return sorted(p for p in (PKG / layer).rglob("*.py") if "__pycache__" not in p.parts)
+
+
+def layer_rule(layer: str, name: str) -> str | None:
+    """Why ``name`` (an absolute module name) may not be imported from ``layer``, or ``None``."""
+    if not _within(name, "spatialmech"):
+        return None  # the standard library and third-party packages
+    if layer == "interfaces":
+        if name == "spatialmech" or any(_within(name, a) for a in DRIVER_ALLOWED):
+            return None
+        top = name.split(".")
+        if len(top) == 2 and not (PKG / top[1]).is_dir() and not (PKG / f"{top[1]}.py").is_file():
+            return None  # ``from spatialmech import mobility, __version__``: a name of the facade, not a module
+        return "a driver imports only spatialmech.api (or spatialmech), errors, results, serialize, present"
+    for part in LAYER_FORBIDDEN.get(layer, ()):
+        if _within(name, part):
+            return f"{layer}/ must not import {part}"
+    return None
+
+
+def layer_violations(path: Path, source: str | None = None) -> list[str]:
+    """Messages ``file:line: imports NAME (RULE)`` for one file of ``interfaces/``, ``api/`` or
+    ``services/`` (its layer is the folder below the package)."""
+    source = path.read_text(encoding="utf-8") if source is None else source
+    layer = path.relative_to(PKG).parts[0]
+    rel = path.relative_to(ROOT) if path.is_relative_to(ROOT) else path
+    first: dict[int, tuple[str, str]] = {}
+    for line, name in imported_names(source, module_name(path), path.name == "__init__.py"):
+        if (rule := layer_rule(layer, name)) is not None:
+            first.setdefault(line, (name, rule))
+    return [f"{rel}:{line}: imports {name} ({rule})" for line, (name, rule) in sorted(first.items())]
+
+
+def test_the_layers_are_where_the_test_looks():
+    files = {layer: layer_files(layer) for layer in ("interfaces", "api", "services")}
+    assert len(files["interfaces"]) > 10 and len(files["api"]) > 5 and len(files["services"]) >= 3, files
+    for exempt in DRIVER_EXEMPT:  # an exemption of a file that is gone must be removed
+        assert (PKG / exempt).is_file(), f"DRIVER_EXEMPT names {exempt}, which does not exist"
+
+
+def test_drivers_import_only_the_facade():
+    problems = [m for f in layer_files("interfaces") if str(f.relative_to(PKG)) not in DRIVER_EXEMPT
+                for m in layer_violations(f)]
+    assert not problems, ("the drivers (interfaces/) must go through sm.* (add what they need to spatialmech.api):\n"
+                          + "\n".join(problems))
+
+
+def test_the_api_does_not_import_the_drivers_and_services_not_the_api():
+    problems = [m for layer in ("api", "services") for f in layer_files(layer) for m in layer_violations(f)]
+    assert not problems, "\n".join(problems)
+
+
+@pytest.mark.parametrize(("where", "source", "expected"), [
+    ("interfaces/cmd_example.py", "from ..analysis.defects import defect_analysis\n", "spatialmech.analysis.defects"),
+    ("interfaces/cmd_example.py", "from .. import catalog\n", "spatialmech.catalog"),
+    ("interfaces/cmd_example.py", "from .. import __version__, kinematics\n", "spatialmech.kinematics"),
+    ("interfaces/cmd_example.py", "def f():\n    from ..kinematics.jit import announce_compilation\n",
+     "spatialmech.kinematics.jit"),
+    ("interfaces/studio/example.py", "from ...synthesis.tasks import resolve_task\n", "spatialmech.synthesis.tasks"),
+    ("interfaces/example.py", "import spatialmech.model.schema\n", "spatialmech.model.schema"),
+    ("interfaces/example.py", "from spatialmech.services.screening import run_screen\n", "spatialmech.services"),
+    ("interfaces/example.py", "from ..geometry.tolerances import use\n", "spatialmech.geometry.tolerances"),
+    ("interfaces/example.py", "import importlib\nm = importlib.import_module('spatialmech.exchange')\n",
+     "spatialmech.exchange"),
+    ("api/example.py", "def f():\n    from ..interfaces.studio.app import create_app\n", "spatialmech.interfaces"),
+    ("services/example.py", "from ..api.checks import as_mechanism\n", "spatialmech.api"),
+    ("services/studio/example.py", "from ... import api\n", "spatialmech.api"),
+    ("services/example.py", "from spatialmech.interfaces.common import emit_json\n", "spatialmech.interfaces"),
+])
+def test_the_layer_check_flags_a_forbidden_import(where, source, expected):
+    found = layer_violations(PKG / where, source)
+    assert len(found) >= 1 and all(expected in m for m in found), found
+
+
+def test_the_layer_check_accepts_allowed_imports():
+    driver = ("import click\nimport numpy as np\nfrom .. import api as sm\nimport spatialmech\n"
+              "from ..errors import InputError\nfrom ..serialize import envelope\nfrom ..results import Progress\n"
+              "from ..present.viewer import write_viewer\nfrom .common import emit_json\nfrom .studio.app import create_app\n"
+              "from spatialmech.api.regions import TASK_COORDINATES\nfrom .. import __version__, mobility\n")
+    assert layer_violations(PKG / "interfaces" / "cmd_example.py", driver) == []
+    api = "from ..analysis.defects import defect_analysis\nfrom ..services.screening import run_screen\n"
+    assert layer_violations(PKG / "api" / "example.py", api) == []
+    services = "from ...kinematics.tracking import track\nfrom ... import catalog\nfrom ...present.viewer import drawing\n"
+    assert layer_violations(PKG / "services" / "studio" / "example.py", services) == []
+
+
+def test_the_exemptions_are_still_needed():
+    """An exempt driver that already keeps the rule must leave the list (it would hide a regression)."""
+    for exempt in DRIVER_EXEMPT:
+        assert layer_violations(PKG / exempt), f"{exempt} keeps the rule: remove it from DRIVER_EXEMPT"

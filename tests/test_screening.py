@@ -16,7 +16,7 @@ import spatialmech as sm
 from spatialmech.analysis.defects import defect_analysis
 from spatialmech.catalog.papers import five_cs_positions
 from spatialmech.errors import InputError
-from spatialmech.interfaces.batch_screen import MANIFEST, read_rows, run_screen
+from spatialmech.services.screening import MANIFEST, read_rows, run_screen
 from spatialmech.interfaces.cli import cli
 from spatialmech.model.schema import load
 from spatialmech.synthesis.screening import (
@@ -105,7 +105,7 @@ def test_bad_arguments_name_the_field(family, pool, tmp_path):
         other = list(five_cs_positions())
         other[3] = type(other[3])(other[3].R, other[3].p + 1.0, other[3].name)
         run_screen(other, tmp_path / "b", family=family)
-    import spatialmech.interfaces.batch_screen as bs
+    import spatialmech.services.screening as bs
 
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr(bs, "CONNECT_TIMEOUT", "1s")

@@ -11,7 +11,7 @@ import spatialmech as sm
 from spatialmech import catalog
 from spatialmech.interfaces.cli import cli
 from spatialmech.interfaces.studio.app import create_app
-from spatialmech.interfaces.studio.session import Session
+from spatialmech.services.studio.session import Session
 from spatialmech.kinematics.backend import closure_residual
 
 

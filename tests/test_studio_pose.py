@@ -10,7 +10,7 @@ from fastapi.testclient import TestClient
 import spatialmech as sm
 from spatialmech.geometry.rotations import euler_matrix
 from spatialmech.interfaces.studio.app import create_app
-from spatialmech.interfaces.studio.session import Session
+from spatialmech.services.studio.session import Session
 
 
 def pose_of(state) -> tuple[np.ndarray, np.ndarray]:

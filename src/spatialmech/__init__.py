@@ -8,8 +8,8 @@ plots), always labelled; Euler sequences always named explicitly (``"ZXY"`` intr
 Every analysis by a short name (one page: docs/api.md; the functions are in
 :mod:`spatialmech.api`): ``sm.load_model``, ``sm.mobility``, ``sm.ik``, ``sm.fk``,
 ``sm.jacobian``, ``sm.velocity``, ``sm.statics``, ``sm.singularity``, ``sm.workspace``, ``sm.parasitic``, ``sm.track``,
-``sm.defects``, ``sm.synth_rccc``, ``sm.synth_cs``, ``sm.screen``, ``sm.report``, ``sm.view``, ``sm.studio_session``,
-``sm.studio_app``.  Each takes a
+``sm.defects``, ``sm.synth_rccc``, ``sm.synth_cs``, ``sm.screen``, ``sm.report``, ``sm.demo``, ``sm.view``,
+``sm.export``, ``sm.validate``, ``sm.singularity_slice``, ``sm.studio_session``, ``sm.studio_app``.  Each takes a
 :class:`Mechanism`, a ready-made model name or a TOML file path, checks its arguments
 (``TypeError``, :class:`InputError`) and returns a result whose ``to_dict()`` is its JSON.
 
@@ -27,8 +27,12 @@ from importlib.metadata import PackageNotFoundError, version
 
 from . import results
 from .api import (
+    announce_compilation,
+    default_tolerance,
     defects,
+    demo,
     dj_table,
+    export,
     fk,
     ik,
     jacobian,
@@ -40,13 +44,16 @@ from .api import (
     parasitic,
     report,
     singularity,
+    singularity_slice,
     statics,
-    studio_app,
     studio_session,
+    suggest_task_grid,
     screen,
     synth_cs,
     synth_rccc,
+    tolerances,
     track,
+    validate,
     velocity,
     view,
     workspace,
@@ -102,11 +109,15 @@ __all__ = [
     "U",
     "UnknownNameError",
     "__version__",
+    "announce_compilation",
     "closed_forms",
+    "default_tolerance",
     "defects",
+    "demo",
     "dj_table",
     "dump",
     "dumps",
+    "export",
     "fk",
     "ik",
     "jacobian",
@@ -122,22 +133,38 @@ __all__ = [
     "results",
     "screen",
     "singularity",
+    "singularity_slice",
     "statics",
     "studio_app",
     "studio_session",
+    "suggest_task_grid",
     "synth_cs",
     "synth_rccc",
+    "tolerances",
     "track",
+    "validate",
     "velocity",
     "view",
     "workspace",
 ]
 
 
-def __getattr__(name: str):
-    """``sm.closed_forms``: the closed-form kernels (imported on first use: they load scipy.stats)."""
-    if name == "closed_forms":
-        import importlib
+#: Names resolved on first use (:func:`__getattr__`), listed by ``dir(spatialmech)``.
+_LAZY = ("closed_forms", "studio_app")
 
+
+def __getattr__(name: str):
+    """``sm.closed_forms``: the closed-form kernels (imported on first use: they load scipy.stats);
+    ``sm.studio_app``: the design studio's web app, a driver (FastAPI) that lives in
+    :mod:`spatialmech.interfaces.studio.app` above the API, imported on first use."""
+    import importlib
+
+    if name == "closed_forms":
         return importlib.import_module(".kinematics.closed_forms", __name__)
+    if name == "studio_app":
+        return importlib.import_module(".interfaces.studio.app", __name__).studio_app
     raise AttributeError(f"module 'spatialmech' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *_LAZY})

@@ -27,8 +27,11 @@ The functions live in modules by concept (this package re-exports them; import t
 from ``spatialmech``): :mod:`~spatialmech.api.structure` (models, mobility),
 :mod:`~spatialmech.api.kinematics` (position, Jacobian, velocity, singularity, workspace,
 parasitic motion), :mod:`~spatialmech.api.forces` (statics), :mod:`~spatialmech.api.linkages` (tracking, defects, synthesis),
-:mod:`~spatialmech.api.outputs` (report, viewer); :mod:`~spatialmech.api.checks` has the argument
-checks they share.
+:mod:`~spatialmech.api.outputs` (report, demo, viewer, studio session), :mod:`~spatialmech.api.exchange`
+(export, validation in MuJoCo), :mod:`~spatialmech.api.regions` (singularity slices, task grids),
+:mod:`~spatialmech.api.settings` (tolerances, compilation notices); :mod:`~spatialmech.api.checks` has
+the argument checks they share.  The command line and the studio's web app
+(:mod:`spatialmech.interfaces`) are drivers over these functions and nothing below them.
 """
 
 from __future__ import annotations
@@ -49,14 +52,25 @@ from .kinematics import (
     velocity,
     workspace,
 )
+from .exchange import EXPORT_FORMATS as EXPORT_FORMATS  # the formats export() writes
+from .exchange import VALIDATION_METHODS as VALIDATION_METHODS  # validate()'s methods and default tolerance
+from .exchange import VALIDATION_TOL as VALIDATION_TOL
+from .exchange import ExportResult, export, validate
+from .linkages import CSSynthesisResult, DefectAnalysis, TraceResult, defects, dj_table, screen, synth_cs, synth_rccc, track
 from .maps import MapResult, maps
-from .linkages import CSSynthesisResult, TraceResult, defects, dj_table, screen, synth_cs, synth_rccc, track
 from .outputs import VIEW_MOTIONS as VIEW_MOTIONS  # the motions view() animates
-from .outputs import ReportResult, ViewResult, report, studio_app, studio_session, view
+from .outputs import ReportResult, ViewResult, demo, report, studio_session, view
+from .regions import TASK_COORDINATES as TASK_COORDINATES  # the names of grids and held coordinates
+from .regions import WORKSPACE_COORDINATES as WORKSPACE_COORDINATES
+from .regions import WORKSPACE_MAX_POSES as WORKSPACE_MAX_POSES
+from .regions import TaskGridSuggestion, singularity_slice, suggest_task_grid
+from .settings import announce_compilation, default_tolerance, tolerances
 from .structure import MobilityModes, load_model, mobility, mobility_modes, models
 
 __all__ = [
     "CSSynthesisResult",
+    "DefectAnalysis",
+    "ExportResult",
     "FKResult",
     "IKResult",
     "JacobianResult",
@@ -65,11 +79,16 @@ __all__ = [
     "ReportResult",
     "SingularityAnalysis",
     "StaticsResult",
+    "TaskGridSuggestion",
     "TraceResult",
     "VelocityResult",
     "ViewResult",
+    "announce_compilation",
+    "default_tolerance",
     "defects",
+    "demo",
     "dj_table",
+    "export",
     "fk",
     "ik",
     "jacobian",
@@ -82,12 +101,15 @@ __all__ = [
     "report",
     "screen",
     "singularity",
+    "singularity_slice",
     "statics",
-    "studio_app",
     "studio_session",
+    "suggest_task_grid",
     "synth_cs",
     "synth_rccc",
+    "tolerances",
     "track",
+    "validate",
     "velocity",
     "view",
     "workspace",

@@ -10,6 +10,7 @@ from __future__ import annotations
 import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
+from typing import Literal, overload
 
 import numpy as np
 
@@ -45,6 +46,10 @@ def check_int(value, name: str, *, minimum: int | None = None, maximum: int | No
     return v
 
 
+@overload
+def check_number(value, name: str, *, positive: bool = ..., optional: Literal[False] = ...) -> float: ...
+@overload
+def check_number(value, name: str, *, positive: bool = ..., optional: bool) -> float | None: ...
 def check_number(value, name: str, *, positive: bool = False, optional: bool = False) -> float | None:
     """A finite number (not a bool) as a float; ``None`` passes when ``optional``."""
     if value is None and optional:
@@ -106,15 +111,21 @@ def optional_progress(progress) -> Progress | None:
 
 
 # ============================================================================ models, poses, paths
-def as_mechanism(model, name: str = "model") -> Mechanism:
-    """A :class:`Mechanism` from a Mechanism, a ready-made model name or a TOML file path."""
+def as_mechanism(model, name: str | None = "model") -> Mechanism:
+    """A :class:`Mechanism` from a Mechanism, a ready-made model name or a TOML file path.
+    ``name``: the argument in the error messages; ``None`` for a value typed without a name (the
+    command line's MODEL): an unknown name or a missing file is then reported by its value,
+    ``NAME: not a file and not a ready-made model (...)``."""
     if isinstance(model, Mechanism):
         return model
     if not isinstance(model, (str, os.PathLike)):
-        raise TypeError(f"{name}: expected a Mechanism, a ready-made model name or a TOML file path, got {describe(model)}")
+        raise TypeError(f"{name or 'model'}: expected a Mechanism, a ready-made model name or a TOML file path, "
+                        f"got {describe(model)}")
     s = os.fspath(model)
     if isinstance(s, bytes):
-        raise TypeError(f"{name}: expected a str path, got bytes {s!r}")
+        raise TypeError(f"{name or 'model'}: expected a str path, got bytes {s!r}")
+    if name is None:
+        return catalog.resolve(s)
     if s in catalog.REGISTRY:
         return catalog.build(s)
     p = Path(s)
@@ -195,7 +206,7 @@ def as_positions(positions) -> tuple[Pose, ...] | None:
     if isinstance(positions, (str, os.PathLike)):
         from ..model.schema import load_positions
 
-        return load_positions(positions)
+        return load_positions(Path(positions))
     if not isinstance(positions, Sequence):
         raise TypeError(f"positions: expected a sequence of Pose or a TOML file path, got {describe(positions)}")
     for k, p in enumerate(positions):

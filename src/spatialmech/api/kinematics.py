@@ -441,7 +441,9 @@ def singularity(model: ModelLike, pose=None, *, config: Configuration | None = N
 def workspace(model: ModelLike, *, kind: str = "orientation", at: Mapping[str, float] | None = None,
               step: float | None = None, tol=None, bounds=None, method: str = "auto",
               link_diameter: float | None = None, interference: bool = True, max_poses: int | None = None,
-              progress: Progress | None = None, over: Mapping | None = None, free=None, limits=None):
+              progress: Progress | None = None, over: Mapping | None = None, free=None, limits=None,
+              cones: Mapping[str, float] | None = None, freedom_limits: Mapping | None = None,
+              max_general_poses: int | None = None):
     """Workspace under joint limits (strokes, joint cones, link interference), sampled and
     refined at the boundary: ``kind="orientation"`` at a fixed position (free angles alpha,
     beta, gamma of ``R = Rz(gamma) Ry(beta) Rx(alpha)``), or ``"position"`` at a fixed
@@ -449,7 +451,12 @@ def workspace(model: ModelLike, *, kind: str = "orientation", at: Mapping[str, f
     ``alpha, beta, gamma`` rad); ``step``/``tol`` are radians (orientation; default 2 deg and
     0.001 deg) or lengths (position).  ``link_diameter`` overrides the interference check's
     capsules, ``interference=False`` skips it; ``limits`` (a
-    :class:`~spatialmech.analysis.workspace.WorkspaceLimits`) replaces the default limits.
+    :class:`~spatialmech.analysis.workspace.WorkspaceLimits`) replaces the default limits;
+    ``cones`` adds cone limits of S or U joints (joint name -> largest angle, rad, between the
+    link at the joint and the platform's ``z`` axis, the base's at a limb's first joint) and
+    ``freedom_limits`` replaces the limits of freedoms' values (name -> ``(lo, hi)``, SI, rad;
+    ``"actuators"`` sets every actuator).  ``max_general_poses``: the largest grid on the general
+    (per-pose) path when ``max_poses`` is not given.
     Returns a :class:`~spatialmech.analysis.workspace.WorkspaceResult`.
 
     ``kind="task"``: over the task coordinates of a lower-mobility mechanism (docs/workspace.md):
@@ -468,9 +475,9 @@ def workspace(model: ModelLike, *, kind: str = "orientation", at: Mapping[str, f
     >>> t.solved, t.reachable_fraction
     (('x', 'y', 'a1'), 1.0)
     """
-    from ..analysis.workspace import WorkspaceLimits, default_limits, orientation_workspace, position_workspace
+    from ..analysis.workspace import orientation_workspace, pose_checker, position_workspace
 
-    mech = as_mechanism(model)
+    mech = _with_freedom_limits(as_mechanism(model), freedom_limits)
     kind = check_choice(kind, "kind", ("orientation", "position", "task"))
     method = check_choice(method, "method", ("auto", "closed-form", "general"))
     interference = check_bool(interference, "interference")
@@ -484,21 +491,56 @@ def workspace(model: ModelLike, *, kind: str = "orientation", at: Mapping[str, f
         raise InputError(f"link_diameter: expected a non-negative length, got {link_diameter}")
     if max_poses is not None:
         max_poses = check_int(max_poses, "max_poses", minimum=1)
-    if limits is not None and not isinstance(limits, WorkspaceLimits):
-        raise TypeError(f"limits: expected a WorkspaceLimits, got {describe(limits)}")
-    limits = default_limits(mech) if limits is None else limits
-    if link_diameter is not None or not interference:
-        limits = WorkspaceLimits(limits.cones, link_diameter if interference else None, limits.freedom_limits, limits.source)
+    if max_general_poses is not None:
+        max_general_poses = check_int(max_general_poses, "max_general_poses", minimum=1)
+    limits = _workspace_limits(mech, limits, cones, link_diameter, interference)
     if kind == "task":
         return _task_workspace(mech, over, at, free, limits, tol, step, bounds, max_poses, progress)
     for name, value in (("over", over), ("free", free)):
         if value is not None:
             raise InputError(f"{name}: only with kind='task' (the workspace over task coordinates)")
+    if max_poses is None and max_general_poses is not None and pose_checker(mech, limits, method=method).path == "general":
+        max_poses = max_general_poses
     kw = dict(at=at, limits=limits, bounds=bounds, method=method, max_poses=max_poses, progress=optional_progress(progress))
     if kind == "orientation":
         return orientation_workspace(mech, step=np.radians(2.0) if step is None else step,
                                      tol=np.radians(1e-3) if tol is None else tol, **kw)
     return position_workspace(mech, step=step, tol=tol, **kw)
+
+
+def _with_freedom_limits(mech: Mechanism, freedom_limits) -> Mechanism:
+    """``mech`` with other limits on some freedoms (``workspace(freedom_limits=...)``; the name
+    ``"actuators"`` sets every actuator)."""
+    from ..analysis.workspace import with_freedom_limits
+
+    if freedom_limits is None:
+        return mech
+    if not isinstance(freedom_limits, Mapping):
+        raise TypeError(f"freedom_limits: expected a mapping of freedom -> (lo, hi), got {describe(freedom_limits)}")
+    named = {fid: rng for name, rng in freedom_limits.items()
+             for fid in (mech.actuators if name == "actuators" else (name,))}
+    return with_freedom_limits(mech, named) if named else mech
+
+
+def _workspace_limits(mech: Mechanism, limits, cones, link_diameter, interference: bool):
+    """The limits of ``workspace``: ``limits`` (default: the model's), with the extra ``cones``
+    and the interference check's ``link_diameter`` (none without ``interference``)."""
+    from ..analysis.workspace import ConeLimit, WorkspaceLimits, default_limits
+
+    if limits is not None and not isinstance(limits, WorkspaceLimits):
+        raise TypeError(f"limits: expected a WorkspaceLimits, got {describe(limits)}")
+    limits = default_limits(mech) if limits is None else limits
+    if cones:
+        if not isinstance(cones, Mapping):
+            raise TypeError(f"cones: expected a mapping of joint -> angle (rad), got {describe(cones)}")
+        first = {limb.joints[0].name for limb in mech.limbs if limb.joints}
+        extra = tuple(ConeLimit(j, (0.0, 0.0, 1.0), "base" if j in first else "platform",
+                                check_number(a, f"cones[{j}]", positive=True)) for j, a in cones.items())
+        limits = WorkspaceLimits(limits.cones + extra, limits.link_diameter, limits.freedom_limits,
+                                 (limits.source + " + " if limits.source else "") + "cones")
+    if link_diameter is not None or not interference:
+        limits = WorkspaceLimits(limits.cones, link_diameter if interference else None, limits.freedom_limits, limits.source)
+    return limits
 
 
 def _task_workspace(mech: Mechanism, over, at, free, limits, tol, step, bounds, max_poses, progress):

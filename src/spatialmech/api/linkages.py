@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -15,6 +16,12 @@ from ..kinematics.closure import Configuration
 from ..kinematics.position import freedom_values, platform_pose
 from ..model.mechanism import Mechanism, Pose
 from ..results import Progress, TrackStatus
+if TYPE_CHECKING:
+    from ..analysis.defects import DefectResult
+    from ..kinematics.tracking import TrackResult
+    from ..synthesis.cs_dyads import CSFamily
+    from ..synthesis.five_cs import FiveCSCheck
+
 from .checks import (
     ModelLike,
     as_configuration,
@@ -25,6 +32,7 @@ from .checks import (
     check_int,
     check_names,
     check_number,
+    check_path,
     optional_progress,
 )
 
@@ -37,7 +45,7 @@ class TraceResult:
     the sign changes of DJ of the actuators as events (zeros: branch points)."""
 
     mechanism: Mechanism
-    result: object
+    result: TrackResult
 
     @property
     def status(self) -> TrackStatus:
@@ -143,13 +151,36 @@ def dj_table(model: ModelLike, drivers=None, positions=None):
     return _dj_table(mech, check_names(drivers, "drivers"), as_positions(positions))
 
 
+@dataclass(frozen=True, eq=False)
+class DefectAnalysis:
+    """The defect analysis of a linkage (:attr:`result`, a
+    :class:`~spatialmech.analysis.defects.DefectResult`: ``circuits``, ``circuit_defect``,
+    ``order_defect``, ``drivers``, ``usable_drivers``, ``plan`` ...; its attributes are readable
+    here directly), the task :attr:`positions` it was judged at, and the :attr:`figures` written
+    (``plot=``).  ``to_dict()`` is the result's."""
+
+    mechanism: Mechanism
+    positions: tuple[Pose, ...]
+    result: DefectResult
+    figures: tuple = ()
+
+    def __getattr__(self, name):
+        if name.startswith("_") or name == "result":
+            raise AttributeError(name)
+        return getattr(self.result, name)
+
+    def to_dict(self) -> dict:
+        return self.result.to_dict()
+
+
 def defects(model: ModelLike, positions=None, *, drivers=None, pose_tol: float | None = None,
             angle_tol_deg: float = 1.0, monte_carlo: int = 0, seed: int = 0, precision: float = 5e-4,
-            progress: Progress | None = None):
+            plot: str | os.PathLike | None = None, progress: Progress | None = None) -> DefectAnalysis:
     """Circuit, branch and order defects of a one-degree-of-freedom linkage for its task
     positions (``positions``: default the model's own; a sequence of Pose or a TOML file),
     the drivers that can be used, and a dual-drive plan when no single one can (paper A).
-    Returns a :class:`~spatialmech.analysis.defects.DefectResult` (``circuit_status``:
+    ``plot``: a directory to write the figures into.  Returns a :class:`DefectAnalysis` (the
+    attributes of :class:`~spatialmech.analysis.defects.DefectResult`; ``circuit_status``:
     :class:`~spatialmech.results.TrackStatus`).
 
     >>> import spatialmech as sm
@@ -166,18 +197,28 @@ def defects(model: ModelLike, positions=None, *, drivers=None, pose_tol: float |
     pose_tol = check_number(pose_tol, "pose_tol", positive=True, optional=True)
     angle_tol_deg = check_number(angle_tol_deg, "angle_tol_deg", positive=True)
     precision = check_number(precision, "precision")
-    return defect_analysis(mech, positions, drivers=check_names(drivers, "drivers"), pose_tol=pose_tol,
-                           angle_tol_deg=angle_tol_deg, monte_carlo=check_int(monte_carlo, "monte_carlo", minimum=0),
-                           seed=check_int(seed, "seed"), precision=precision, progress=optional_progress(progress))
+    plot = None if plot is None else check_path(plot, "plot")
+    res = defect_analysis(mech, positions, drivers=check_names(drivers, "drivers"), pose_tol=pose_tol,
+                          angle_tol_deg=angle_tol_deg, monte_carlo=check_int(monte_carlo, "monte_carlo", minimum=0),
+                          seed=check_int(seed, "seed"), precision=precision, progress=optional_progress(progress))
+    figures: tuple = ()
+    if plot is not None:
+        from ..present.defect_figures import write_defect_figures
+
+        figures = tuple(write_defect_figures(mech, res, plot))
+    return DefectAnalysis(mech, tuple(positions if positions is not None else mech.positions), res, figures)
 
 
 # ============================================================================ synthesis
-def synth_rccc(task="rccc-four-positions", *, pick: str = "best-rc", samples: int = 360):
+def synth_rccc(task="rccc-four-positions", *, pick: str = "best-rc", samples: int = 360,
+               save: str | os.PathLike | None = None, plot: str | os.PathLike | None = None):
     """Four-position RCCC synthesis by solution regions (paper D).  ``task``: a ready-made task
     name, a TOML task file, or a ``TaskPositions``; ``pick``: ``"best-rc"`` (the smallest
     largest input slide) or ``"interior"`` (the most interior defect-free crank-rocker);
-    ``samples`` per Burmester-curve branch.  Returns a
-    :class:`~spatialmech.synthesis.RCCCResult` (``linkage`` is a Mechanism).
+    ``samples`` per Burmester-curve branch; ``save``: write the RCCC as a model file (TOML);
+    ``plot``: write the figures (curves, regions, solution lines, linkage) into that directory.
+    Returns a :class:`~spatialmech.synthesis.RCCCResult` (``linkage`` is a Mechanism, ``task``
+    the task positions).
 
     >>> import spatialmech as sm
     >>> r = sm.synth_rccc(samples=60)
@@ -191,7 +232,18 @@ def synth_rccc(task="rccc-four-positions", *, pick: str = "best-rc", samples: in
         raise TypeError(f"task: expected a task name, a TOML file path or a TaskPositions, got {describe(task)}")
     pick = check_choice(pick, "pick", ("best-rc", "interior"))
     samples = check_int(samples, "samples", minimum=8)
-    return synthesize_rccc(resolve_task(task), pick=pick, samples=samples)
+    save = None if save is None else check_path(save, "save")
+    plot = None if plot is None else check_path(plot, "plot")
+    res = synthesize_rccc(resolve_task(task), pick=pick, samples=samples)
+    if save is not None:
+        from ..model.schema import dump
+
+        dump(res.linkage, save)
+    if plot is not None:
+        from ..present.synthesis_figures import write_all
+
+        write_all(res, plot)
+    return res
 
 
 @dataclass(frozen=True, eq=False)
@@ -200,11 +252,11 @@ class CSSynthesisResult:
     picked dyads (``family.picks``), and with five picks the assembled 5-CS ``linkage`` and its
     ``check`` at the seven positions."""
 
-    family: object
+    family: CSFamily
     positions_source: str
     samples: int
     linkage: Mechanism | None = None
-    check: object | None = None
+    check: FiveCSCheck | None = None
 
     @property
     def success(self) -> bool | None:
@@ -242,13 +294,15 @@ def seven_positions(positions) -> tuple[tuple[Pose, ...], str]:
 
 
 def synth_cs(positions=None, *, pick: int = 5, starts: int = 60, seed: int = 0, samples: int = 40,
-             check_defects: bool = True, progress: Progress | None = None) -> CSSynthesisResult:
+             check_defects: bool = True, save: str | os.PathLike | None = None,
+             progress: Progress | None = None) -> CSSynthesisResult:
     """Seven-position synthesis of CS dyads and a 5-CS linkage (paper A, section 3).
     ``positions``: seven task poses -- default paper A's table 9; a model name or Mechanism (its
     task positions), a TOML file of ``[[positions]]``, or a sequence of Pose.  ``starts`` random
     starts (``seed``); ``pick`` small-slide dyads (5: also assemble and check the 5-CS, and with
     ``check_defects`` its circuit, order and branch defects, about 10 s; ``progress``
-    reports on it); ``samples``: family points listed in ``to_dict()``.
+    reports on it); ``samples``: family points listed in ``to_dict()``; ``save``: write the 5-CS
+    as a model file (TOML; needs ``pick=5``).
 
     >>> import spatialmech as sm
     >>> r = sm.synth_cs(pick=0, starts=4)
@@ -264,6 +318,9 @@ def synth_cs(positions=None, *, pick: int = 5, starts: int = 60, seed: int = 0, 
     starts = check_int(starts, "starts", minimum=1)
     seed = check_int(seed, "seed")
     samples = check_int(samples, "samples", minimum=2)
+    save = None if save is None else check_path(save, "save")
+    if save is not None and pick != 5:
+        raise InputError(f"save: a 5-CS linkage needs pick=5 (got pick={pick})")
     poses, source = seven_positions(positions)
     fam = synthesize_cs(poses, n_starts=starts, seed=seed, pick=pick)
     if pick != 5:
@@ -272,6 +329,10 @@ def synth_cs(positions=None, *, pick: int = 5, starts: int = 60, seed: int = 0, 
         raise InputError(f"pick: only {len(fam.picks)} well separated dyads found; try more starts")
     linkage = assemble_5cs(fam.task, fam.picks)
     check = check_5cs(linkage, fam.picks, defects=check_defects, progress=progress)
+    if save is not None:
+        from ..model.schema import dump
+
+        dump(linkage, save)
     return CSSynthesisResult(fam, source, samples, linkage, check)
 
 
@@ -293,7 +354,8 @@ def screen(task=None, out: str | os.PathLike = "screen.parquet", *, candidates: 
 
     ``task``: ``None``/``"five-cs-positions"`` (paper A table 9), a model with seven task
     positions, a positions TOML file or seven Pose.  Returns a
-    :class:`~spatialmech.interfaces.batch_screen.ScreenSummary` (``to_dict()`` for JSON).
+    :class:`~spatialmech.services.screening.ScreenSummary` (``to_dict()`` for JSON, with
+    ``positions_source``: where the positions came from).
 
     >>> import tempfile
     >>> import spatialmech as sm
@@ -301,14 +363,17 @@ def screen(task=None, out: str | os.PathLike = "screen.parquet", *, candidates: 
     >>> s.judged, sum(s.rejected_by_stage.values()) + s.usable
     (2, 2)
     """
-    from ..interfaces.batch_screen import run_screen
+    from ..services.screening import run_screen
 
-    poses, _ = seven_positions(task)
+    poses, source = seven_positions(task)
     for nm, v, lo in (("candidates", candidates, 1), ("top", top, 0), ("starts", starts, 1),
                       ("chunk_size", chunk_size, 1)):
         check_int(v, nm, minimum=lo)
     if workers is not None:
         check_int(workers, "workers", minimum=0)
-    return run_screen(poses, out, candidates=candidates, density=check_number(density, "density"), seed=check_int(seed, "seed"),
-                      starts=starts, separation=check_number(separation, "separation"), chunk_size=chunk_size,
-                      workers=workers, scheduler=scheduler, top=top, rank_by=rank_by, progress=optional_progress(progress))
+    summary = run_screen(poses, out, candidates=candidates, density=check_number(density, "density"),
+                         seed=check_int(seed, "seed"), starts=starts, separation=check_number(separation, "separation"),
+                         chunk_size=chunk_size, workers=workers, scheduler=scheduler, top=top, rank_by=rank_by,
+                         progress=optional_progress(progress))
+    summary.positions_source = source
+    return summary

@@ -1,14 +1,19 @@
-"""The public API: what is written to files -- a model's report and its 3-D viewer
-(``sm.report``, ``sm.view``)."""
+"""The public API: what is written to files -- a model's report, the papers' demonstration
+report and a model's 3-D viewer (``sm.report``, ``sm.demo``, ``sm.view``), and the design
+studio's session (``sm.studio_session``)."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..analysis.mobility import mobility as _mobility
 from ..errors import InputError
 from ..results import Progress, check_progress
+if TYPE_CHECKING:
+    from ..present.viewer import ViewerFile
+
 from .checks import ModelLike, as_mechanism, check_bool, check_choice, check_int, check_path
 
 
@@ -60,6 +65,31 @@ def report(model: ModelLike, out=None, *, trace: bool = True, progress: bool | P
     return ReportResult(out, data)
 
 
+def demo(out="report", *, progress: bool | Progress | None = None) -> ReportResult:
+    """Reproduce the four papers' examples into a report in the directory ``out``:
+    ``index.html`` (self-contained, opens offline), ``results.json`` (every number) and
+    ``figures/``; each claim of a paper is a row (the paper's value, ours, reproduced or not and
+    why; ``data["summary"]`` counts them).  About 45 s.  ``progress``: True prints on stderr, or a
+    callback.
+
+    >>> import spatialmech as sm
+    >>> sm.demo(out=42)
+    Traceback (most recent call last):
+    ...
+    TypeError: out: expected a path (str or os.PathLike), got int 42
+    """
+    from ..present.report import build_demo
+
+    out = check_path(out, "out")
+    if progress is not None and not isinstance(progress, bool):
+        progress = check_progress(progress)
+    if out.exists() and not out.is_dir():
+        raise InputError(f"out: {out} is a file, not a directory")
+    out.mkdir(parents=True, exist_ok=True)  # fail now on an unwritable directory, not after the work
+    data = build_demo(out, progress=False if progress is None else progress)
+    return ReportResult(out, data)
+
+
 #: The motions :func:`view` can animate.
 VIEW_MOTIONS = ("auto", "trace", "demo")
 
@@ -69,7 +99,7 @@ class ViewResult:
     """The viewer page written (:attr:`file`: ``out``, ``frames``, ``bytes``) and the motion shown
     (``"trace"`` or ``"demo"``)."""
 
-    file: object
+    file: ViewerFile
     motion: str
 
     @property
@@ -120,7 +150,7 @@ def view(model: ModelLike, out, *, motion: str = "auto", frames: int = 60, plotl
         motion = "trace" if (not mech.is_metamorphic and _mobility(mech).dof_instantaneous == 1) else "demo"
     if motion == "trace":
         configs, singular = traced_motion(mech, frames=frames)
-        title = (f"{mech.name}: the traced circuit ({len(configs)} frames); x: DJ zeros of "
+        title = (f"{mech.name}: the traced circuit ({len(configs)} frames); +: DJ zeros of "
                  f"{', '.join(mech.actuators[:1]) or '-'}")
     else:
         configs = sample_motion(mech, n=frames)
@@ -143,23 +173,7 @@ def studio_session(model: ModelLike = "five-cs-3"):
     >>> str(r.status), round(s.state()["actuators_deg"]["A0.rot"], 9)
     ('reached', 10.0)
     """
-    from ..interfaces.studio.session import Session
+    from ..services.studio.session import Session
 
     return Session(as_mechanism(model))
 
-
-def studio_app(model: ModelLike = "five-cs-3"):
-    """The design studio's web app (FastAPI) on a new session: serve it with uvicorn, or call
-    its JSON API directly (docs/studio.md).
-
-    >>> import spatialmech as sm
-    >>> from fastapi.testclient import TestClient
-    >>> client = TestClient(sm.studio_app("rssr"))
-    >>> client.post("/api/drive", json={"actuators": [10.0]}).json()["status"]
-    'reached'
-    >>> client.post("/api/drive", json={"actuators": [1, 2]}).json()["error"]
-    'actuators: expected 1 values (A0.rot), got 2'
-    """
-    from ..interfaces.studio.app import create_app
-
-    return create_app(studio_session(model))

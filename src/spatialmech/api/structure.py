@@ -25,18 +25,22 @@ def models() -> dict[str, str]:
     return {n: catalog.describe(n) for n in catalog.names()}
 
 
-def load_model(model: ModelLike) -> Mechanism:
+def load_model(model: ModelLike, *, name: str | None = "model") -> Mechanism:
     """A mechanism from a ready-made name, a TOML file path, or a Mechanism (returned as is).
 
     Unknown names raise :class:`~spatialmech.UnknownNameError` (listing the known ones); a
     malformed file :class:`~spatialmech.ModelFileError` naming the file and the field.
+    ``name``: the argument named in those messages; ``None`` names the value itself, as the
+    command line does for its MODEL argument (``NAME: not a file and not a ready-made model``).
 
     >>> import spatialmech as sm
     >>> mech = sm.load_model("rssr")
     >>> mech.name, mech.actuators
     ('rssr', ('A0.rot',))
     """
-    return as_mechanism(model)
+    if name is not None and not isinstance(name, str):
+        raise TypeError(f"name: expected a str or None, got {describe(name)}")
+    return as_mechanism(model, name)
 
 
 # ============================================================================ mobility
@@ -78,13 +82,16 @@ class MobilityModes:
         return {"metamorphic": self.mechanism.is_metamorphic, "modes": [r.to_dict() for r in self.modes]}
 
 
-def mobility_modes(model: ModelLike, *, seed: int = 0, tol=None) -> MobilityModes:
-    """Mobility of every motion mode (one result for a mechanism that is not metamorphic);
-    ``to_dict()`` is the payload of ``spatialmech mobility --json``.
+def mobility_modes(model: ModelLike, *, mode: str | None = None, seed: int = 0, tol=None) -> MobilityModes:
+    """Mobility of every motion mode (one result for a mechanism that is not metamorphic; only
+    ``mode`` when given); ``to_dict()`` is the payload of ``spatialmech mobility --json``.
 
     >>> import spatialmech as sm
     >>> [r.dof for r in sm.mobility_modes("three-rrr-sm")]
     [1, 1, 1, 2, 2, 2, 3]
     """
     mech = as_mechanism(model)
-    return MobilityModes(mech, tuple(_mobility_modes(mech, seed=check_int(seed, "seed"), tol=tol)))
+    seed = check_int(seed, "seed")
+    if mode is not None:
+        return MobilityModes(mech, (mobility(mech, mode, seed=seed, tol=tol),))
+    return MobilityModes(mech, tuple(_mobility_modes(mech, seed=seed, tol=tol)))

@@ -1,4 +1,5 @@
-"""The ``spatialmech`` command line (click).  Thin: parse, call an analysis, print text or JSON.
+"""The ``spatialmech`` command line (click).  Thin: parse, call one function of the public API
+(``sm.*``), print its result as text or its ``to_dict()`` as JSON.
 
 User errors (bad files, unknown names, impossible requests) print one line to stderr and exit
 with code 2 (1 when a computation did not converge); any other exception is a bug: exit code 3,
@@ -15,11 +16,10 @@ from pathlib import Path
 
 import click
 
-from .. import __version__, catalog
-from ..analysis.mobility import mobility, mobility_modes
+from .. import __version__
+from .. import api as sm
 from ..errors import ConvergenceError, SpatialmechError
-from ..kinematics.compiled.jit import announce_compilation
-from .common import UserError, check_output_dir, check_output_file, emit_json, json_option, tol_option
+from .common import UserError, check_output_dir, check_output_file, emit_json, json_option, load_model, tol_option
 
 
 def _one_line_usage(e: click.UsageError) -> UserError:
@@ -36,13 +36,17 @@ def _one_line(e: BaseException) -> str:
     return "; ".join(part.strip() for part in str(e).splitlines() if part.strip())
 
 
+class _FailedComputation(UserError):
+    """A computation that did not converge: one line, exit code 1."""
+
+    exit_code = 1
+
+
 def _user_error(e: BaseException) -> UserError | None:
     """The one-line error of a user error (exit 2; 1 for a computation that did not converge),
     or ``None`` when ``e`` is a programming error."""
     if isinstance(e, ConvergenceError):
-        err = UserError(f"the computation failed: {_one_line(e)}")
-        err.exit_code = 1
-        return err
+        return _FailedComputation(f"the computation failed: {_one_line(e)}")
     if isinstance(e, SpatialmechError):
         return UserError(_one_line(e))
     if isinstance(e, OSError):  # a path the user gave: cannot read, cannot write, no such directory
@@ -112,10 +116,6 @@ class InternalError(click.ClickException):
         click.echo(f"error: {self.format_message()}", err=True, file=file)
 
 
-def _model(spec: str):
-    return catalog.resolve(spec)
-
-
 
 
 @click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
@@ -134,7 +134,7 @@ def cli(debug):
       spatialmech mobility four-sps-cu
     """
     if sys.stderr.isatty():  # a person waiting: say when a kernel compiles (first use only)
-        announce_compilation(sys.stderr)
+        sm.announce_compilation(sys.stderr)
 
 
 @cli.command()
@@ -146,7 +146,7 @@ def models(as_json):
     Example:
       spatialmech models --json
     """
-    rows = [{"name": n, "description": catalog.describe(n)} for n in catalog.names()]
+    rows = [{"name": n, "description": d} for n, d in sm.models().items()]
     if as_json:
         emit_json("models", None, {"models": rows})
         return
@@ -192,10 +192,10 @@ def mobility_cmd(model, mode, as_json):
       spatialmech mobility three-rrr-sm --mode R1+R4 --json
       spatialmech mobility my-mechanism.toml --tol 1e-4
     """
-    mech = _model(model)
-    results = [mobility(mech, mode)] if mode is not None else mobility_modes(mech)
+    mech = load_model(model)
+    results = sm.mobility_modes(mech, mode=mode)
     if as_json:  # one shape for every model: the list of modes (one for an ordinary mechanism)
-        emit_json("mobility", mech, {"metamorphic": mech.is_metamorphic, "modes": [r.to_dict() for r in results]})
+        emit_json("mobility", mech, results.to_dict())
         return
     click.echo("\n\n".join(_mobility_text(r) for r in results))
 
@@ -219,18 +219,12 @@ def export(model, file, fmt, mode, as_json):
       spatialmech export four-sps-cu four-sps-cu.xml     # MJCF: python -m mujoco.viewer --mjcf=four-sps-cu.xml
       spatialmech export stewart-6sps stewart.urdf       # URDF, loop closures in an extension block
     """
-    from ..exchange import export_model, format_of
-
-    fmt = format_of(file, fmt)  # before any work: a file name whose format is unknown
     check_output_file(file, "FILE")
-    mech = _model(model)
-    if mode is not None:
-        mech = mech.in_mode(mode)
-    fmt = export_model(mech, file, fmt)
+    r = sm.export(load_model(model), file, format=fmt, mode=mode)
     if as_json:
-        emit_json("export", mech, {"out": str(file), "format": fmt, "bytes": file.stat().st_size})
+        emit_json("export", r.mechanism, r.to_dict())
     else:
-        click.echo(f"wrote {file} ({fmt})")
+        click.echo(f"wrote {file} ({r.format})")
 
 
 @cli.command()
@@ -246,15 +240,12 @@ def demo(out, as_json):
     Example:
       spatialmech demo --out report
     """
-    from ..present.report import build_demo
-
     check_output_dir(out, "--out")  # fail now on an unwritable --out, not after the work
-    out.mkdir(parents=True, exist_ok=True)
-    results = build_demo(out, progress=not as_json)
+    r = sm.demo(out, progress=not as_json)
     if as_json:
-        emit_json("demo", None, {k: v for k, v in results.items() if k != "model"})
+        emit_json("demo", None, r.to_dict())
     else:
-        s = results["summary"]
+        s = r.data["summary"]
         click.echo(f"report written to {out / 'index.html'} and {out / 'results.json'}: {s['claims']} claims, "
                    f"{s['reproduced']} reproduced, {s['reproduced after correction']} after correction, "
                    f"{s['not reproduced']} not reproduced")
@@ -276,16 +267,13 @@ def report(model, out, no_trace, as_json):
       spatialmech report bennett --out bennett-report
       spatialmech report my-rssr.toml --json
     """
-    from ..present.report import build_model_report
-
     check_output_dir(out, "--out")  # fail now on an unwritable --out, not after the work
-    mech = _model(model)
+    mech = load_model(model)
     out = out if out is not None else Path(f"report-{mech.name}")
     check_output_dir(out, "--out")
-    out.mkdir(parents=True, exist_ok=True)
-    results = build_model_report(mech, out, progress=not as_json, trace=not no_trace)
+    r = sm.report(mech, out, trace=not no_trace, progress=not as_json)
     if as_json:
-        emit_json("report", mech, {k: v for k, v in results.items() if k != "model"})
+        emit_json("report", mech, r.to_dict())
     else:
         click.echo(f"report written to {out / 'index.html'} and {out / 'results.json'}")
 

@@ -7,11 +7,9 @@ from pathlib import Path
 import click
 import numpy as np
 
-from .. import catalog
-from ..analysis.defects import defect_analysis
-from ..model.schema import load_positions
+from .. import api as sm
 from ..errors import InputError
-from .common import check_output_dir, emit_json, json_option
+from .common import check_output_dir, emit_json, json_option, load_model
 
 #: Largest --monte-carlo: each sample is a whole defect analysis (seconds to tens of seconds).
 MAX_MONTE_CARLO = 1000
@@ -45,16 +43,11 @@ def defects(model, positions_file, drivers, pose_tol, angle_tol_deg, monte_carlo
         raise InputError(f"--monte-carlo: at most {MAX_MONTE_CARLO} samples (each is a whole defect analysis), "
                          f"got {monte_carlo}")
     check_output_dir(plot_dir, "--plot")
-    mech = catalog.resolve(model)
-    positions = load_positions(positions_file) if positions_file else None
+    mech = load_model(model)
     say = None if as_json else (lambda done, total, msg: click.echo(f"  ... {msg}", err=True))
-    res = defect_analysis(mech, positions, drivers=list(drivers) or None, pose_tol=pose_tol, angle_tol_deg=angle_tol_deg,
-                          monte_carlo=monte_carlo, seed=seed, precision=precision, progress=say)
-    paths = []
-    if plot_dir is not None:
-        from ..present.defect_figures import write_defect_figures
-
-        paths = write_defect_figures(mech, res, plot_dir)
+    res = sm.defects(mech, positions_file, drivers=list(drivers) or None, pose_tol=pose_tol, angle_tol_deg=angle_tol_deg,
+                     monte_carlo=monte_carlo, seed=seed, precision=precision, plot=plot_dir, progress=say)
+    paths = res.figures
     if as_json:
         emit_json("defects", mech, {**res.to_dict(), "figures": [str(p) for p in paths]})
         return
@@ -64,7 +57,7 @@ def defects(model, positions_file, drivers, pose_tol, angle_tol_deg, monte_carlo
                + ("" if res.circuit_defect else f"   (positions met in order {', '.join(f'P{j}' for j in res.order)})"))
     click.echo(f"  DJ: {res.dj_method}; membership tolerance {res.tolerances['pose']:.3g} {mech.length_unit}, "
                f"{res.tolerances['angle_deg']:g} deg")
-    names = [p.name for p in (positions if positions is not None else mech.positions)]
+    names = [p.name for p in res.positions]
     for j, f in enumerate(res.fits):
         if np.hypot(f.position_error / res.tolerances["pose"], np.degrees(f.angle_error) / res.tolerances["angle_deg"]) > 1:
             click.echo(f"  note: the pose of {names[j] or f'P{j + 1}'} is {f.position_error:.3g} {mech.length_unit} and "

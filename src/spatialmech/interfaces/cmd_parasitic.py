@@ -5,10 +5,9 @@ from __future__ import annotations
 import click
 import numpy as np
 
-from .. import catalog
-from ..analysis.parasitic import parasitic_table
-from .common import check_output_file, emit_json, json_option
-from .task_args import parse_axes, parse_task_at, task_from_free
+from .. import api as sm
+from .common import check_output_file, emit_json, json_option, load_model
+from .task_args import parse_axes, parse_free, parse_task_at
 
 
 def _held(name: str, v: float, unit: str) -> str:
@@ -34,19 +33,16 @@ def parasitic_cmd(model, over_text, at_text, free_text, euler, plot, as_json):
       spatialmech parasitic three-rps --over a2:-20:20:41,a3:-20:20:41 --at z=0.33 --plot rps.png
       spatialmech parasitic three-prs --over a2:-10:10:5 --at z=0.3,a3=0 --json
     """
-    mech = catalog.resolve(model)
+    mech = load_model(model)
     plot_path = check_output_file(plot, "--plot", suffixes=(".png", ".pdf", ".svg"))
     over = parse_axes(over_text, "--over", min_axes=1, max_axes=2)
     at = parse_task_at(at_text)
-    task = task_from_free(free_text, mech, euler)
-    table = parasitic_table(mech, over, at=at, task=task)
+    free = parse_free(free_text)
+    # --euler names the sequence of the task --free defines (without --free: the model's own task)
+    table = sm.parasitic(mech, over, at=at, free=free, euler=euler if free is not None else None, plot=plot_path)
     grid = table.grid
     solved = grid.solved
     n_ok = int(grid.converged.sum())
-    if plot_path is not None:
-        from ..present.parasitic import parasitic_figure
-
-        parasitic_figure(grid, plot_path)
     if as_json:
         emit_json("parasitic", mech, table.to_dict(plot_path))
         return

@@ -1,5 +1,5 @@
 """CLI: ``spatialmech screen`` (defect screening of 5-CS linkages from a seven-position CS dyad
-family, on Dask, into a Parquet dataset; :mod:`.batch_screen`)."""
+family, on Dask, into a Parquet dataset; ``sm.screen``, :mod:`spatialmech.services.screening`)."""
 
 from __future__ import annotations
 
@@ -7,6 +7,7 @@ from pathlib import Path
 
 import click
 
+from .. import api as sm
 from .common import emit_json, json_option
 
 __all__ = ["screen"]
@@ -54,23 +55,19 @@ def screen(task, out, candidates, density, workers, scheduler, top, rank_by, see
       spatialmech screen my-7-positions.toml --candidates 200 --workers 0 --out s.parquet --json
       spatialmech screen --candidates 100000 --scheduler tcp://10.0.0.5:8786 --out big.parquet
     """
-    from ..api.linkages import seven_positions
-    from .batch_screen import run_screen
-
-    poses, source = seven_positions(task)
-
     def say(done, total, msg):
         click.echo(f"  ... {msg}", err=True)
 
     try:
-        summary = run_screen(poses, out, candidates=candidates, density=density, seed=seed, starts=starts,
-                             separation=separation, chunk_size=chunk_size, workers=workers, scheduler=scheduler,
-                             top=top, rank_by=rank_by, progress=say)
+        summary = sm.screen(task, out, candidates=candidates, density=density, seed=seed, starts=starts,
+                            separation=separation, chunk_size=chunk_size, workers=workers, scheduler=scheduler,
+                            top=top, rank_by=rank_by, progress=say)
     except KeyboardInterrupt:
         click.echo(f"interrupted: the chunks written so far are kept in {out}; rerun the same command to resume",
                    err=True)
         raise SystemExit(130) from None
-    d = {**summary.to_dict(), "positions_source": source}
+    d = summary.to_dict()
+    source = summary.positions_source
     if as_json:
         emit_json("screen", None, d, length_unit="unit")
         return

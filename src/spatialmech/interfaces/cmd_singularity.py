@@ -8,17 +8,11 @@ from pathlib import Path
 import click
 import numpy as np
 
-from .. import catalog
-from ..analysis.singularity import singularity, singularity_slice
+from .. import api as sm
 from ..errors import InputError
-from ..geometry.rotations import euler_matrix
-from ..geometry.tolerances import current as current_tolerances
-from ..kinematics.closure import Configuration
-from ..kinematics.position import configuration_at_pose
-from ..model.mechanism import Pose
 from .cmd_kinematics import resolve_pose, with_pose
-from .common import check_output_file, emit_json, json_option, tol_option
-from .task_args import parse_axes, parse_task_at, task_from_free
+from .common import check_output_file, emit_json, json_option, load_model, tol_option
+from .task_args import parse_axes, parse_free, parse_task_at
 
 _SLICE_NAMES = ("x", "y", "z", "a1", "a2", "a3")
 
@@ -46,20 +40,17 @@ def _parse_slice(text: str):
 
 def _task_slice(mech, slice_spec: str, at, free, acts, plot, as_json) -> None:
     """``singularity --slice ... [--at ...]`` without a pose: a slice over task coordinates."""
-    from ..analysis.task_slice import task_singularity_slice
-    from ..analysis.workspace.task import euler_convention
-
     axes = parse_axes(slice_spec, "--slice", min_axes=2, max_axes=2)
     held = parse_task_at(at, "--at")
-    task = task_from_free(free, mech)
+    free_names = parse_free(free)
     bar = None if as_json else click.progressbar(length=1, label="slice (solving task coordinates)", file=sys.stderr)
 
     def prog(done, total, msg):
         if bar is not None:
-            bar.length = max(bar.length, int(total or done))
+            bar.length = max(bar.length or 0, int(total or done))
             bar.update(int(done) - bar.pos)
 
-    res = task_singularity_slice(mech, axes, at=held, task=task, actuators=acts, progress=prog if bar else None)
+    res = sm.singularity_slice(mech, axes, at=held, free=free_names, drivers=acts, progress=prog if bar else None)
     if bar:
         bar.render_finish()
     (n1, n2) = res.names
@@ -82,7 +73,7 @@ def _task_slice(mech, slice_spec: str, at, free, acts, plot, as_json) -> None:
                + (f", {held_text} held" if held_text else "") + f"; solved {', '.join(res.solved) or 'none'}; "
                f"{int(finite.sum())} close): {int(np.sum(det[finite] > 0))} positive, {int(np.sum(det[finite] < 0))} "
                f"negative, smallest sigma_min {np.nanmin(res.sigma_min):.3g}")
-    click.echo(f"  orientation: {euler_convention(res.euler)}; {res.n_solves} solves in {res.seconds:.2f} s")
+    click.echo(f"  orientation: {res.to_dict()['orientation_convention']}; {res.n_solves} solves in {res.seconds:.2f} s")
     if plot is not None:
         click.echo(f"  wrote {plot}")
 
@@ -128,7 +119,7 @@ def singularity_cmd(model, xyz, euler, position, reference, drivers, slice_spec,
             raise InputError(f"{name}: only with --slice and no pose (a slice over task coordinates, the parasitic "
                              "ones solved); with a pose, --slice varies the pose itself")
     check_output_file(plot, "--plot")
-    mech = catalog.resolve(model)
+    mech = load_model(model)
     acts = list(drivers) or None
     if slice_spec is not None and not posed:
         _task_slice(mech, slice_spec, at, free, acts, plot, as_json)
@@ -137,20 +128,10 @@ def singularity_cmd(model, xyz, euler, position, reference, drivers, slice_spec,
         if euler is None or xyz is None:
             raise InputError("--slice: give the base pose with --xyz and --euler")
         (n1, g1), (n2, g2) = _parse_slice(slice_spec)
-        seq, *ang = euler
-
-        def pose_of(u, v):
-            vals = {"x": xyz[0], "y": xyz[1], "z": xyz[2], "a1": ang[0], "a2": ang[1], "a3": ang[2]}
-            vals[n1], vals[n2] = u, v
-            R = euler_matrix(seq, [vals["a1"], vals["a2"], vals["a3"]], degrees=True)
-            return Pose(R, [vals["x"], vals["y"], vals["z"]])
-
         bar = None if as_json else click.progressbar(length=len(g2), label="slice", file=sys.stderr)
         prog = (lambda j, n, msg: bar.update(1)) if bar else None
-        units = tuple("deg" if n.startswith("a") else mech.length_unit for n in (n1, n2))
-        res = singularity_slice(mech, pose_of, g1, g2, names=(n1, n2), units=units, actuators=acts,
-                                fixed={"position_len": list(xyz), "euler_sequence": seq, "euler_deg": list(ang)},
-                                progress=prog)
+        res = sm.singularity_slice(mech, {n1: g1, n2: g2}, pose=(list(xyz), tuple(euler)), drivers=acts, degrees=True,
+                                   progress=prog)
         if bar:
             bar.render_finish()
         if not np.isfinite(res.det).any():
@@ -159,7 +140,7 @@ def singularity_cmd(model, xyz, euler, position, reference, drivers, slice_spec,
         if plot is not None:
             from ..present.singularity import slice_figure
 
-            slice_figure(res, f"{mech.name}: singularity loci ({seq}, angles in degrees)").savefig(plot)
+            slice_figure(res, f"{mech.name}: singularity loci ({euler[0]}, angles in degrees)").savefig(plot)
         d = res.to_dict()
         if as_json:
             emit_json("singularity", mech, {"result": "singularity_slice", **d})
@@ -172,17 +153,10 @@ def singularity_cmd(model, xyz, euler, position, reference, drivers, slice_spec,
         if plot is not None:
             click.echo(f"  wrote {plot}")
         return
-    if reference:
-        config = Configuration.reference(mech)
-    else:
-        pose = resolve_pose(mech, xyz, euler, position)
-        fit = configuration_at_pose(mech, pose)
-        if not fit.converged:
-            raise InputError(f"pose: no closed configuration near it (residual {fit.ik_residual:.2e})")
-        config = fit.config
-    r = singularity(mech, config, acts, rtol=current_tolerances().singular)
+    pose = None if reference else resolve_pose(mech, xyz, euler, position)  # None: the reference configuration
+    r = sm.singularity(mech, pose, drivers=acts)
     if as_json:
-        emit_json("singularity", mech, {"result": "singularity", **r.to_dict()})
+        emit_json("singularity", mech, r.to_dict())
         return
     click.echo(f"{mech.name}: {r.kind if r.kind != 'none' else 'not singular'}; "
                f"wrench-system rank {r.rank} of {r.expected_rank}; "

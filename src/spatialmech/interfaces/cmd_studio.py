@@ -1,7 +1,7 @@
 """``spatialmech studio``: the interactive design studio in the browser (docs/studio.md).
 
-Thin: load the model into a session, build the app (:mod:`.studio.app`), serve it with uvicorn
-on 127.0.0.1 and open the browser.
+Thin: load the model into a session (``sm.studio_session``), build the app (:mod:`.studio.app`),
+serve it with uvicorn on 127.0.0.1 and open the browser.
 """
 
 from __future__ import annotations
@@ -12,7 +12,8 @@ import webbrowser
 
 import click
 
-from .common import UserError, emit_json
+from .. import api as sm
+from .common import UserError, emit_json, load_model
 
 __all__ = ["studio"]
 
@@ -48,9 +49,8 @@ def studio(model, port, no_browser, as_json):
     import uvicorn
 
     from .studio.app import COMMAND, create_app
-    from .studio.session import Session
 
-    session = Session(model)  # bad models fail here, with the CLI's one-line error
+    session = sm.studio_session(load_model(model))  # bad models fail here, with the CLI's one-line error
     if port == 0:
         with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
             s.bind(("127.0.0.1", 0))

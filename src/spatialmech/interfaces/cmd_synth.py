@@ -11,6 +11,7 @@ from pathlib import Path
 import click
 import numpy as np
 
+from .. import api as sm
 from ..errors import InputError
 from .common import check_output_dir, check_output_file, emit_json
 
@@ -51,20 +52,10 @@ def rccc(task, as_json, plot_dir, save_file, pick, samples):
       spatialmech synth rccc
       spatialmech synth rccc my-task.toml --json --plot figs --save rccc.toml
     """
-    from ..model.schema import dump
-    from ..synthesis.rccc import synthesize_rccc
-    from ..synthesis.tasks import resolve_task
-
     check_output_file(save_file, "--save")
     check_output_dir(plot_dir, "--plot")
-    t = resolve_task(task)
-    res = synthesize_rccc(t, pick=pick, samples=samples)
-    if save_file is not None:
-        dump(res.linkage, save_file)
-    if plot_dir is not None:
-        from ..present.synthesis_figures import write_all
-
-        write_all(res, plot_dir)
+    res = sm.synth_rccc(task, pick=pick, samples=samples, save=save_file, plot=plot_dir)
+    t = res.task
     if as_json:
         emit_json("synth rccc", None, res.to_dict(), length_unit=t.length_unit)
         return
@@ -124,35 +115,14 @@ def cs(positions_file, as_json, samples, pick, save_file, starts, seed, skip_def
       spatialmech synth cs --positions my-7-positions.toml --json --save five-cs.toml
       spatialmech synth cs --skip-defects
     """
-    from ..model.schema import dump, load_positions
-    from ..synthesis.cs_dyads import synthesize_cs
-    from ..synthesis.five_cs import assemble_5cs, check_5cs
-
     if save_file is not None and pick != 5:
         raise InputError(f"save: a 5-CS linkage needs --pick 5 (got --pick {pick})")
     check_output_file(save_file, "--save")
-    if positions_file is not None:
-        poses = load_positions(positions_file)
-        source = str(positions_file)
-    else:
-        from ..catalog.papers import five_cs_positions
-
-        poses = five_cs_positions()
-        source = "paper A table 9"
-    fam = synthesize_cs(poses, n_starts=starts, seed=seed, pick=pick)
-    d = {**fam.to_dict(samples=samples), "positions_source": source, "five_cs": None, "success": None, "verdict": None}
-    check = mech = None
-    if pick == 5:
-        if len(fam.picks) < 5:
-            raise InputError(f"pick: only {len(fam.picks)} well separated dyads found; try more --starts")
-        mech = assemble_5cs(fam.task, fam.picks)
-        say = None if as_json else (lambda done, total, msg: click.echo(f"  ... defects: {msg}", err=True))
-        check = check_5cs(mech, fam.picks, defects=not skip_defects, progress=say)
-        d["five_cs"] = check.to_dict()
-        d["success"] = check.success
-        d["verdict"] = check.verdict()
-        if save_file is not None:
-            dump(mech, save_file)
+    say = None if as_json else (lambda done, total, msg: click.echo(f"  ... defects: {msg}", err=True))
+    r = sm.synth_cs(positions_file, pick=pick, starts=starts, seed=seed, samples=samples,
+                    check_defects=not skip_defects, save=save_file, progress=say)
+    fam, check, source = r.family, r.check, r.positions_source
+    d = r.to_dict()
     if as_json:  # lengths in the positions' own unit (a positions file names none)
         emit_json("synth cs", None, d, length_unit="unit")
         return

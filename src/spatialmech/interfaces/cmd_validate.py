@@ -1,5 +1,5 @@
 """CLI command ``validate``: replay a motion of the library in MuJoCo and compare the output-link
-poses (:mod:`spatialmech.analysis.validation`; docs/validation.md).
+poses (``sm.validate``; docs/validation.md).
 
 An actuator path file (``--actuators-path``) is CSV: a header naming the actuators (freedom ids
 or aliases), rotations with the suffix ``_deg`` (degrees), slides bare or with ``_len`` (the
@@ -19,15 +19,13 @@ from pathlib import Path
 import click
 import numpy as np
 
-from .. import catalog
-from ..analysis.validation import DEFAULT_TOL, METHODS, ValidationResult, validate
+from .. import api as sm
 from ..errors import InputError
-from ..model.mechanism import Mechanism
 from .cmd_kinematics import resolve_pose, with_pose
-from .common import check_output_file, emit_json, json_option
+from .common import check_output_file, emit_json, json_option, load_model
 
 
-def read_actuator_path(mech: Mechanism, path: Path) -> np.ndarray:
+def read_actuator_path(mech, path: Path) -> np.ndarray:
     """Rows of actuator values (SI: rad, length) in ``mech.actuators`` order from a CSV file (the
     module docstring)."""
     try:
@@ -78,7 +76,7 @@ def read_actuator_path(mech: Mechanism, path: Path) -> np.ndarray:
     return out
 
 
-def _text(r: ValidationResult) -> str:
+def _text(r) -> str:
     mech = r.mechanism
     u, L = mech.length_unit, mech.characteristic_length
     head = (f"{mech.name}{f'  mode {r.mode}' if r.mode else ''}: {r.simulator}, method {r.method}, motion {r.motion} "
@@ -115,10 +113,10 @@ def _text(r: ValidationResult) -> str:
               help="loop: actuator amplitude (rad, or fraction of the characteristic length for slides).")
 @click.option("--arc", type=float, default=2.0, show_default=True,
               help="trace: arc length to follow (nondimensional: rad, length / characteristic length).")
-@click.option("--method", type=click.Choice(METHODS), default="project", show_default=True,
+@click.option("--method", type=click.Choice(sm.VALIDATION_METHODS), default="project", show_default=True,
               help="project: solve MuJoCo's constraints with the actuated joints held; settle: simulate with "
                    "the position actuators until at rest.")
-@click.option("--max-error", "max_error", type=float, default=DEFAULT_TOL, show_default=True,
+@click.option("--max-error", "max_error", type=float, default=sm.VALIDATION_TOL, show_default=True,
               help="Largest error that passes: a fraction of the characteristic length (and rad).")
 @click.option("--mjcf", "mjcf_out", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="Also write the MJCF model that was simulated.")
@@ -138,18 +136,14 @@ def validate_cmd(model, motion, actuators_path, mode, xyz, euler, position, to_p
       spatialmech validate four-sps-cu --pose 0,0,0.12,ZYX,17.19,17.19,17.19 --method settle
     """
     check_output_file(mjcf_out, "--mjcf")
-    model_mech = catalog.resolve(model)
+    model_mech = load_model(model)
     mech = model_mech.in_mode(mode) if mode is not None else model_mech
     if actuators_path is not None and motion is not None:
         raise InputError("--actuators-path: give either --actuators-path or --motion, not both")
     start = None if (xyz is None and euler is None and position is None) else resolve_pose(mech, xyz, euler, position)
     path = read_actuator_path(mech, actuators_path) if actuators_path is not None else None
-    r = validate(model_mech, "actuators" if path is not None else motion, method=method, start=start, frames=frames,
-                 to_position=to_position, amplitude=amplitude, arc=arc, actuator_path=path, tol=max_error, mode=mode)
-    if mjcf_out is not None:
-        from ..exchange import to_mjcf
-
-        mjcf_out.write_text(to_mjcf(mech), encoding="utf-8")
+    r = sm.validate(model_mech, motion, mode=mode, method=method, start=start, frames=frames, to_position=to_position,
+                    amplitude=amplitude, arc=arc, actuator_path=path, tol=max_error, mjcf=mjcf_out)
     if as_json:
         emit_json("validate", mech, r.to_dict())
     else:

@@ -1,7 +1,8 @@
 """``spatialmech view``: write the interactive 3-D viewer page of a model.
 
-Thin: resolve the model, compute the motion, write the page (:mod:`..present.viewer`).
-Register it in the main group with ``cli.add_command(view)``.
+Thin: check the output path, load the model, let ``sm.view`` compute the motion and write the
+page (:mod:`spatialmech.present.viewer`).  Register it in the main group with
+``cli.add_command(view)``.
 """
 
 from __future__ import annotations
@@ -10,32 +11,28 @@ from pathlib import Path
 
 import click
 
-from .. import catalog
+from .. import api as sm
 from ..errors import ConvergenceError, InputError
-from .common import check_output_file, emit_json
+from .common import UserError, check_output_file, emit_json, load_model
 
 #: Largest number of frames (each is a configuration drawn into the page).
 MAX_FRAMES = 2000
 
 __all__ = ["MOTIONS", "view"]
 
-#: Motions the command can compute.  "trace": the whole circuit of a one-degree-of-freedom
-#: mechanism through its reference configuration, followed by the continuation tracker, with the
-#: zeros of DJ (branch points of the first actuator) marked as singular points; "demo":
-#: :func:`..kinematics.motion.sample_motion`, a short loop along the closure manifold (any mobility);
-#: "auto": trace when the mechanism has one degree of freedom, else demo.
-MOTIONS = ("auto", "trace", "demo")
+#: Motions the command can compute (``sm.view``).  "trace": the whole circuit of a
+#: one-degree-of-freedom mechanism through its reference configuration, followed by the
+#: continuation tracker, with the zeros of DJ (branch points of the first actuator) marked as
+#: singular points; "demo": a short loop along the closure manifold (any mobility); "auto":
+#: trace when the mechanism has one degree of freedom, else demo.
+MOTIONS = sm.VIEW_MOTIONS
 
 
-class _Error(click.ClickException):
-    """One line ``error: ...`` on stderr (exit code 2 for bad input, 1 for a failed computation)."""
+class _Failed(UserError):
+    """A computation of the motion that did not converge: one line ``error: ...``, exit code 1
+    (bad input: :class:`~.common.UserError`, exit code 2)."""
 
-    def __init__(self, message: str, code: int = 2):
-        super().__init__(message)
-        self.exit_code = code
-
-    def show(self, file=None):
-        click.echo(f"error: {self.format_message()}", err=True, file=file)
+    exit_code = 1
 
 
 @click.command(name="view")
@@ -63,35 +60,20 @@ def view(model, motion, out, frames, plotly, as_json):
       spatialmech view bennett --motion trace --out bennett.html
       spatialmech view rssr --out pages/rssr.html --plotly directory
     """
-    from ..analysis.traced_motion import traced_motion
-    from ..kinematics.motion import sample_motion
-    from ..present.viewer import write_viewer
-
-    singular = ()
     try:
         check_output_file(out, "--out")
-        mech = catalog.resolve(model)
-        if motion == "auto":
-            from ..analysis.mobility import mobility
-
-            motion = "trace" if (not mech.is_metamorphic and mobility(mech).dof_instantaneous == 1) else "demo"
-        if motion == "trace":
-            configs, singular = traced_motion(mech, frames=frames)
-            zeros_of = ", ".join(mech.actuators[:1]) or "-"
-            title = f"{mech.name}: the traced circuit ({len(configs)} frames); +: DJ zeros of {zeros_of}"
-        else:
-            configs = sample_motion(mech, n=frames)
-            title = f"{mech.name}: a demonstration loop, {len(configs)} configurations (not the tracker)"
+        mech = load_model(model)
     except InputError as e:  # anything else is a bug: the main group shows it as one (exit 3)
-        raise _Error(str(e)) from None
-    except ConvergenceError as e:
-        raise _Error(str(e), code=1) from None
+        raise UserError(str(e)) from None
     try:
-        written = write_viewer(out, mech, configs, title=title, task_positions=mech.positions, singular_points=singular,
-                               plotly=plotly)
+        written = sm.view(mech, out, motion=motion, frames=frames, plotly=plotly)
     except OSError as e:
-        raise _Error(f"--out: cannot write {out}: {e.strerror or e}") from None
+        raise UserError(f"--out: cannot write {out}: {e.strerror or e}") from None
+    except InputError as e:
+        raise UserError(str(e)) from None
+    except ConvergenceError as e:
+        raise _Failed(str(e)) from None
     if as_json:
-        emit_json("view", mech, {**written.to_dict(), "motion": motion})
+        emit_json("view", mech, written.to_dict())
     else:
         click.echo(f"wrote {written.out} ({written.frames} frames, {written.bytes} bytes)")

@@ -10,24 +10,15 @@ takes ``name=value`` pairs separated by commas: ``x, y, z`` (m) and ``alpha, bet
 from __future__ import annotations
 
 import sys
+from typing import Any
 
 import click
 import numpy as np
 
-from .. import catalog
-from ..analysis.workspace import (
-    COORDINATES,
-    MAX_POSES,
-    WorkspaceLimits,
-    default_limits,
-    orientation_workspace,
-    pose_checker,
-    position_workspace,
-    with_freedom_limits,
-)
+from .. import api as sm
 from ..errors import InputError
-from .common import UserError, check_output_file, emit_json, json_option, parse_number
-from .task_args import cone_limits, freedom_limits, parse_axes, parse_task_at, task_from_free
+from .common import UserError, check_output_file, emit_json, json_option, load_model, parse_number
+from .task_args import cone_limits, freedom_limits, parse_axes, parse_free, parse_task_at
 
 _ANGLES = ("alpha", "beta", "gamma")
 #: Largest grid (poses) the slow general kernel accepts from the CLI unless --max-poses says more.
@@ -46,8 +37,8 @@ def parse_at(text: str | None) -> dict[str, float]:
         if "=" not in part:
             raise InputError(f"--at: expected name=value pairs separated by commas, got {part!r}")
         k, v = (s.strip() for s in part.split("=", 1))
-        if k not in COORDINATES:
-            raise InputError(f"--at: unknown coordinate {k!r}; expected one of {', '.join(COORDINATES)}")
+        if k not in sm.WORKSPACE_COORDINATES:
+            raise InputError(f"--at: unknown coordinate {k!r}; expected one of {', '.join(sm.WORKSPACE_COORDINATES)}")
         val = parse_number(v, "--at", k)
         out[k] = float(np.radians(val)) if k in _ANGLES else val
     return out
@@ -84,10 +75,9 @@ def _text(res, length_unit: str = "m") -> str:
     return "\n".join(lines)
 
 
-def _with_diameter(limits: WorkspaceLimits, link_diameter, no_interference: bool) -> WorkspaceLimits:
+def _check_diameter(link_diameter) -> None:
     if link_diameter is not None and not (np.isfinite(link_diameter) and link_diameter >= 0):
         raise InputError(f"--link-diameter: expected a non-negative number of metres, got {link_diameter}")
-    return WorkspaceLimits(limits.cones, None if no_interference else link_diameter, limits.freedom_limits, limits.source)
 
 
 def _progress_bar():
@@ -112,7 +102,6 @@ def _progress_bar():
 
 def _task_text(res, length_unit: str) -> str:
     """The text report of a workspace over task coordinates."""
-    from ..analysis.workspace.task import euler_convention
 
     def show(c: str, v: float) -> str:
         return f"{np.degrees(v):.4f} deg" if c.startswith("a") else f"{v:.6g} {length_unit}"
@@ -120,7 +109,7 @@ def _task_text(res, length_unit: str) -> str:
     held = ", ".join(f"{c} = {show(c, v)}" for c, v in res.fixed.items())
     lines = [f"{res.mechanism}: workspace over task coordinates {', '.join(res.over)}"
              + (f" ({held} held)" if held else "") + f"; solved: {', '.join(res.solved) or 'none'}",
-             f"orientation: {euler_convention(res.euler)}"]
+             f"orientation: {res.to_dict()['orientation_convention']}"]
     for c in res.over:
         e = res.extents[c]
         lines.append(f"  {c:3s}: empty" if e is None else
@@ -150,18 +139,14 @@ def _measure(res, length_unit: str) -> str:
     return f"{res.volume:.6g} {length_unit}" + (f"^{d}" if d > 1 else "")
 
 
-def _task_workspace(mech, over, at, free, limits, tol_deg, tol_m, max_cells, plot, as_json) -> None:
+def _task_workspace(mech, over, at, free, limit_args, tol_deg, tol_m, max_cells, plot, as_json) -> None:
     """``workspace --task``: the grid, the held coordinates, the solve, the output."""
-    from ..analysis.workspace.task import task_workspace
-
-    task = task_from_free(free, mech)
+    free_names = parse_free(free)
     if over is None:
-        from ..kinematics.task import default_task
-
-        shown = task if task is not None else default_task(mech)
-        over_s, at_s = _task_grid_suggestion(mech, shown)
+        hint = sm.suggest_task_grid(mech, free=free_names, degrees=True)
+        over_s, at_s = _grid_text(hint)
         raise InputError(f"--task: give the grid with --over NAME:MIN:MAX:N[,...] over the given coordinates "
-                         f"({', '.join(shown.given)}), e.g. --over {over_s}" + (f" --at {at_s}" if at_s else ""))
+                         f"({', '.join(hint.given)}), e.g. --over {over_s}" + (f" --at {at_s}" if at_s else ""))
     axes = parse_axes(over, "--over")
     held = parse_task_at(at, "--at")
     for name, v in (("--tol-deg", tol_deg), ("--tol", tol_m)):
@@ -171,8 +156,8 @@ def _task_workspace(mech, over, at, free, limits, tol_deg, tol_m, max_cells, plo
     tol = {c: (np.radians(tol_deg) if c.startswith("a") else (tol_m if tol_m is not None else 1e-6 * L)) for c in axes}
     progress, close = (None, lambda: None) if as_json else _progress_bar()
     try:
-        res = task_workspace(mech, axes, at=held, task=task, limits=limits, tol=tol, max_cells=max_cells,
-                             progress=progress)
+        res = sm.workspace(mech, kind="task", over=axes, at=held, free=free_names, tol=tol, max_poses=max_cells,
+                           progress=progress, **limit_args)
     finally:
         close()
     if plot:
@@ -205,7 +190,7 @@ def _task_workspace(mech, over, at, free, limits, tol_deg, tol_m, max_cells, plo
               help="Link capsule diameter (m) for the interference check (default: the paper's, or none).")
 @click.option("--no-interference", is_flag=True, help="Skip the link interference check.")
 @click.option("--max-poses", type=click.IntRange(min=1), default=None,
-              help=f"Largest grid accepted (default: {MAX_POSES:.0e} on the closed-form path, {GENERAL_MAX_POSES} "
+              help=f"Largest grid accepted (default: {sm.WORKSPACE_MAX_POSES:.0e} on the closed-form path, {GENERAL_MAX_POSES} "
                    "on the general path); a larger grid is refused with its size before any work.")
 @click.option("--task", "task_flag", is_flag=True,
               help="Workspace over the task coordinates of a lower-mobility mechanism: sample --over, hold --at, "
@@ -252,41 +237,31 @@ def workspace(model, orientation_flag, position_flag, at, step_deg, tol_deg, ste
                 if v is not None:
                     raise InputError(f"{name}: only with --task (the workspace over task coordinates)")
         check_output_file(plot, "--plot", suffixes=(".png", ".svg", ".pdf"))
-        mech = catalog.resolve(model)
-        new_limits = freedom_limits(freedom_limits_text, mech)
-        if new_limits:
-            mech = with_freedom_limits(mech, new_limits)
-        limits = default_limits(mech)
-        extra_cones = cone_limits(cones, mech)
-        if extra_cones:
-            limits = WorkspaceLimits(limits.cones + extra_cones, limits.link_diameter, limits.freedom_limits,
-                                     (limits.source + " + " if limits.source else "") + "--cone")
+        mech = load_model(model)
+        limit_args: dict[str, Any] = {"freedom_limits": freedom_limits(freedom_limits_text, mech) or None,
+                      "cones": cone_limits(cones, mech) or None}
+        if link_diameter is not None or no_interference:
+            _check_diameter(link_diameter)
+            limit_args.update(link_diameter=link_diameter, interference=not no_interference)
         if task_flag:
-            if link_diameter is not None or no_interference:
-                limits = _with_diameter(limits, link_diameter, no_interference)
-            _task_workspace(mech, over, at, free, limits, tol_deg, tol_m, max_poses, plot, as_json)
+            _task_workspace(mech, over, at, free, limit_args, tol_deg, tol_m, max_poses, plot, as_json)
             return
         fixed = parse_at(at)
-        if link_diameter is not None or no_interference:
-            limits = _with_diameter(limits, link_diameter, no_interference)
         for name, v in (("--step-deg", step_deg), ("--tol-deg", tol_deg)):
             if not (np.isfinite(v) and v > 0):
                 raise InputError(f"{name}: must be a positive number of degrees, got {v}")
-        path_kind = pose_checker(mech, limits, method=method).path
-        if max_poses is None and path_kind == "general":
-            max_poses = GENERAL_MAX_POSES
-        kw = dict(at=fixed, limits=limits, method=method, max_poses=max_poses)
+        kw = dict(kind=kind, at=fixed, method=method, max_poses=max_poses, max_general_poses=GENERAL_MAX_POSES,
+                  **limit_args)
         if kind == "orientation":
-            run = lambda progress: orientation_workspace(  # noqa: E731
-                mech, step=np.radians(step_deg), tol=np.radians(tol_deg), progress=progress, **kw)
+            kw.update(step=np.radians(step_deg), tol=np.radians(tol_deg))
         else:
-            run = lambda progress: position_workspace(mech, step=step_m, tol=tol_m, progress=progress, **kw)  # noqa: E731
+            kw.update(step=step_m, tol=tol_m)
         if as_json:
-            res = run(None)
+            res = sm.workspace(mech, **kw)
         else:
             progress, close = _progress_bar()  # opened at the first report: none before an input error
             try:
-                res = run(progress)
+                res = sm.workspace(mech, progress=progress, **kw)
             finally:
                 close()
         if plot:
@@ -313,35 +288,24 @@ def workspace(model, orientation_flag, position_flag, at, step_deg, tol_deg, ste
         click.echo(f"plot written to {plot}")
 
 
-def _task_grid_suggestion(mech, task) -> tuple[str, str]:
-    """A first --over / --at for ``workspace --task``: the first two given coordinates (angles first;
-    +-20 deg, or +-L/2 about the reference), the others held at their reference values."""
-    from ..kinematics.task import task_values
-    from ..model.task import TASK_NAMES
-
-    ref = dict(zip(TASK_NAMES, task_values(mech, np.eye(4), task.euler), strict=True))
-    L = mech.characteristic_length
-    order = sorted(task.given, key=lambda c: not c.startswith("a"))  # angles first
-    over = ",".join(f"{c}:-20:20:41" if c.startswith("a") else f"{c}:{ref[c] - L / 2:.4g}:{ref[c] + L / 2:.4g}:41"
-                    for c in order[:2])
-    at = ",".join(f"{c}={np.degrees(ref[c]):.4g}" if c.startswith("a") else f"{c}={ref[c]:.4g}" for c in order[2:])
+def _grid_text(hint) -> tuple[str, str]:
+    """A first --over / --at for ``workspace --task`` (``sm.suggest_task_grid(..., degrees=True)``)."""
+    over = ",".join(f"{c}:{lo:.4g}:{hi:.4g}:{n}" for c, (lo, hi, n) in hint.over.items())
+    at = ",".join(f"{c}={v:.4g}" for c, v in hint.at.items())
     return over, at
 
 
 def _lower_mobility_hint(mech) -> str:
     """For a pose workspace bounded by closure (or empty) of a mechanism with fewer than six output
     freedoms: why, and the command that samples its task coordinates instead."""
-    from ..kinematics.task import default_task
-
     try:
-        task = default_task(mech)
+        hint = sm.suggest_task_grid(mech, degrees=True)
     except InputError:
         return ""
-    if len(task.given) == 6:
+    if len(hint.given) == 6:
         return ""
-    given = task.given
-    over, at = _task_grid_suggestion(mech, task)
-    return (f"note: {mech.name}'s output has {len(given)} freedoms ({', '.join(given)} given; "
-            f"{', '.join(task.solved)} parasitic): a grid of six-coordinate poses almost never lies on its "
+    over, at = _grid_text(hint)
+    return (f"note: {mech.name}'s output has {len(hint.given)} freedoms ({', '.join(hint.given)} given; "
+            f"{', '.join(hint.solved)} parasitic): a grid of six-coordinate poses almost never lies on its "
             f"closure set.  Sample its task coordinates instead: spatialmech workspace {mech.name} --task "
             f"--over {over}" + (f" --at {at}" if at else ""))

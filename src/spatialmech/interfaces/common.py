@@ -1,5 +1,10 @@
-"""Helpers shared by the command modules: one-line user errors, JSON output, the --json flag,
-checks of output paths (before the work starts) and parsing of comma-separated numbers."""
+"""Helpers shared by the command modules: loading the MODEL argument, one-line user errors, JSON
+output, the --json flag, checks of output paths (before the work starts), parsing of
+comma-separated numbers and the --tol option.
+
+The command modules are drivers: they parse, call one function of the public API
+(``spatialmech.api``, imported as ``sm``) and render its result; they import nothing below it
+(tests/test_layering.py)."""
 
 from __future__ import annotations
 
@@ -10,8 +15,15 @@ from pathlib import Path
 
 import click
 
+from .. import api as sm
 from ..errors import InputError
 from ..serialize import envelope, json_default
+
+
+def load_model(spec):
+    """The mechanism of a MODEL argument (a ready-made name or a TOML file): an unknown name is
+    reported by its value, ``NAME: not a file and not a ready-made model (...)``."""
+    return sm.load_model(spec, name=None)
 
 
 class UserError(click.ClickException):
@@ -147,23 +159,21 @@ def tol_option(primary: str):
     """``--tol``: run the command with other tolerances (geometry/tolerances.py).  A number sets
     ``primary`` (the tolerance the command decides on); ``NAME=VALUE[,NAME=VALUE]`` sets named
     ones (rank, singular, newton, closure, reachability, dedup, pivot, contains, unit).  The
-    command body runs inside :func:`~spatialmech.geometry.tolerances.use`."""
+    command body runs inside :func:`spatialmech.tolerances`."""
     import functools
-
-    from ..geometry.tolerances import DEFAULT, Tolerances, use
 
     def deco(f):
         @functools.wraps(f)
         def wrapper(*args, tol_text=None, **kw):
             if tol_text is None:
                 return f(*args, **kw)
-            with use(Tolerances.parse(tol_text, primary=primary)):
+            with sm.tolerances(tol_text, primary=primary):
                 return f(*args, **kw)
 
         return click.option(
             "--tol", "tol_text", default=None, metavar="TOL",
             help=f"Tolerance: a number sets '{primary}' ({_TOL_MEANING.get(primary, primary)}; default "
-                 f"{getattr(DEFAULT, primary):g}); or NAME=VALUE,... for others (docs/conventions.md, Tolerances).",
+                 f"{sm.default_tolerance(primary):g}); or NAME=VALUE,... for others (docs/conventions.md, Tolerances).",
         )(wrapper)
 
     return deco

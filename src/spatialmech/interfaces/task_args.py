@@ -16,14 +16,15 @@ import math
 
 import numpy as np
 
-from ..analysis.workspace import ConeLimit
+from .. import api as sm
 from ..errors import InputError
-from ..model.mechanism import Mechanism
-from ..model.task import TASK_NAMES, TaskCoordinates
 from .common import parse_number
 
-__all__ = ["MAX_AXIS_POINTS", "TASK_NAMES", "cone_limits", "freedom_limits", "parse_axes", "parse_task_at",
-           "task_from_free"]
+__all__ = ["MAX_AXIS_POINTS", "TASK_NAMES", "cone_limits", "freedom_limits", "parse_axes", "parse_free",
+           "parse_task_at"]
+
+#: The task coordinates, in order.
+TASK_NAMES = sm.TASK_COORDINATES
 
 #: Largest number of points along one grid axis.
 MAX_AXIS_POINTS = 400
@@ -83,10 +84,9 @@ def parse_task_at(text: str | None, option: str = "--at") -> dict[str, float]:
     return out
 
 
-def task_from_free(text: str | None, mech: Mechanism, euler: str | None = None,
-                   option: str = "--free") -> TaskCoordinates | None:
-    """``"x,y,a1"`` -> the task that solves those and gives the others (``None`` without text).
-    ``euler``: the sequence (default: the model's task's, else ``"ZYX"``)."""
+def parse_free(text: str | None, option: str = "--free") -> list[str] | None:
+    """``"x,y,a1"`` -> ``["x", "y", "a1"]``, the task coordinates to solve (the others are given);
+    ``None`` without text."""
     if text is None:
         return None
     free = [s.strip() for s in str(text).split(",") if s.strip()]
@@ -95,18 +95,16 @@ def task_from_free(text: str | None, mech: Mechanism, euler: str | None = None,
             raise InputError(f"{option}: unknown task coordinate {n!r}; expected some of {', '.join(TASK_NAMES)}")
     if len(set(free)) != len(free):
         raise InputError(f"{option}: {text!r} names a coordinate twice")
-    own = getattr(mech, "task", None)
-    seq = euler or (own.euler if own is not None else "ZYX")
-    return TaskCoordinates(given=tuple(n for n in TASK_NAMES if n not in free), euler=seq)
+    return free
 
 
-def cone_limits(items, mech: Mechanism, option: str = "--cone") -> tuple[ConeLimit, ...]:
-    """``["S1=40", "S2=40"]`` or ``["S1=40,S2=40"]`` -> cone limits (degrees at the command line)
-    of S or U joints: the angle between the limb's link at the joint and the ``z`` axis of the
-    platform (a joint after the limb's first) or of the base (the limb's first joint)."""
-    first = {limb.joints[0].name for limb in mech.limbs if limb.joints}
+def cone_limits(items, mech, option: str = "--cone") -> dict[str, float]:
+    """``["S1=40", "S2=40"]`` or ``["S1=40,S2=40"]`` -> ``{"S1": radians(40), ...}``: cone limits
+    (degrees at the command line) of S or U joints of ``mech`` (``sm.workspace(cones=...)``: the
+    angle between the limb's link at the joint and the ``z`` axis of the platform, or of the base
+    at the limb's first joint)."""
     known = {j.name for limb in mech.limbs for j in limb.joints}
-    out = []
+    out: dict[str, float] = {}
     for item in items or ():
         for part in str(item).split(","):
             part = part.strip()
@@ -120,11 +118,11 @@ def cone_limits(items, mech: Mechanism, option: str = "--cone") -> tuple[ConeLim
             angle = parse_number(deg, option, joint)
             if not 0 < angle <= 180:
                 raise InputError(f"{option}: {joint} expects 0 < DEG <= 180, got {deg}")
-            out.append(ConeLimit(joint, (0.0, 0.0, 1.0), "base" if joint in first else "platform", math.radians(angle)))
-    return tuple(out)
+            out[joint] = min(out.get(joint, math.inf), math.radians(angle))  # twice: both hold, the narrower
+    return out
 
 
-def freedom_limits(items, mech: Mechanism, option: str = "--limit") -> dict[str, tuple[float, float]]:
+def freedom_limits(items, mech, option: str = "--limit") -> dict[str, tuple[float, float]]:
     """``["L1.slide=0.25:0.45"]`` -> ``{"L1.slide": (0.25, 0.45)}`` (SI: a rotation's limits are
     typed in degrees); ``actuators`` as the name sets every actuator."""
     out: dict[str, tuple[float, float]] = {}

@@ -1,5 +1,5 @@
 """The design studio's web app (FastAPI): the page, plotly.js from the installed plotly package
-(nothing from a CDN: it works offline), and a JSON API over one :class:`~.session.Session`.
+(nothing from a CDN: it works offline), and a JSON API over one :class:`~spatialmech.services.studio.session.Session`.
 
 Every API answer is a JSON document with the envelope of docs/json.md (``command: "studio"``)
 and units in the field names; bad input answers 4xx with ``{"error": "<field>: ..."}``.
@@ -37,11 +37,11 @@ from pathlib import Path
 from fastapi import FastAPI, Request
 from fastapi.responses import HTMLResponse, Response
 
+from ... import api as sm
 from ...errors import ConvergenceError, InputError
 from ...serialize import envelope, json_default
-from .session import Session
 
-__all__ = ["COMMAND", "create_app", "plotly_js_path"]
+__all__ = ["COMMAND", "create_app", "plotly_js_path", "studio_app"]
 
 #: The ``command`` of every API document (and of ``spatialmech studio --json``).
 COMMAND = "studio"
@@ -66,8 +66,9 @@ def _json(doc: dict, status: int = 200) -> Response:
                     media_type="application/json")
 
 
-def create_app(session: Session) -> FastAPI:
-    """The app over ``session`` (one model at a time, one user: each call holds a lock)."""
+def create_app(session) -> FastAPI:
+    """The app over ``session`` (a :func:`spatialmech.studio_session`; one model at a time, one
+    user: each call holds a lock)."""
     app = FastAPI(title="spatialmech studio", docs_url=None, redoc_url=None, openapi_url=None)
     lock = threading.Lock()
     app.state.session = session
@@ -188,3 +189,18 @@ def create_app(session: Session) -> FastAPI:
                      ("/api/load", load)):
         app.add_api_route(path, guarded(fn), methods=["POST"])
     return app
+
+
+def studio_app(model: sm.ModelLike = "five-cs-3") -> FastAPI:
+    """The design studio's web app (FastAPI) on a new session (:func:`spatialmech.studio_session`):
+    serve it with uvicorn, or call its JSON API directly (docs/studio.md).  Also ``sm.studio_app``.
+
+    >>> import spatialmech as sm
+    >>> from fastapi.testclient import TestClient
+    >>> client = TestClient(sm.studio_app("rssr"))
+    >>> client.post("/api/drive", json={"actuators": [10.0]}).json()["status"]
+    'reached'
+    >>> client.post("/api/drive", json={"actuators": [1, 2]}).json()["error"]
+    'actuators: expected 1 values (A0.rot), got 2'
+    """
+    return create_app(sm.studio_session(model))

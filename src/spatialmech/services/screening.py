@@ -105,6 +105,8 @@ class ScreenSummary:
     family: dict
     top: list = field(default_factory=list)
     rank_by: str = "singularity"
+    #: Where the seven task positions came from (set by ``sm.screen``; listed by ``to_dict`` when set).
+    positions_source: str | None = None
 
     @property
     def rate(self) -> float | None:
@@ -121,7 +123,7 @@ class ScreenSummary:
             "pool": dict(self.pool), "family": dict(self.family), "top": list(self.top),
             "ranking": ("min_sigma_on_path (larger first), then stroke_len (smaller first)" if self.rank_by == "singularity"
                         else "stroke_len (smaller first), then min_sigma_on_path (larger first)"),
-        }
+        } | ({} if self.positions_source is None else {"positions_source": self.positions_source})
 
 
 # ------------------------------------------------------------------------------ helpers

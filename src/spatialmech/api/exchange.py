@@ -1,0 +1,117 @@
+"""The public API: models carried to other tools -- writing a model as TOML, MJCF or URDF, and
+checking the library's motion in MuJoCo (``sm.export``, ``sm.validate``)."""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..errors import InputError, describe
+from ..model.mechanism import Mechanism
+from .checks import ModelLike, as_mechanism, as_pose, check_bool, check_choice, check_int, check_number, check_path
+
+#: The formats :func:`export` writes.
+EXPORT_FORMATS = ("toml", "mjcf", "urdf")
+#: The ways :func:`validate` drives the simulator, and the largest error that passes by default
+#: (a fraction of the characteristic length, and radians).
+VALIDATION_METHODS = ("project", "settle")
+VALIDATION_TOL = 1e-8
+
+
+@dataclass(frozen=True, eq=False)
+class ExportResult:
+    """A model written to :attr:`out` in :attr:`format` (``"toml"``, ``"mjcf"`` or ``"urdf"``);
+    ``to_dict()`` is the payload of ``spatialmech export --json``."""
+
+    mechanism: Mechanism
+    out: Path
+    format: str
+
+    @property
+    def bytes(self) -> int:
+        return self.out.stat().st_size
+
+    def to_dict(self) -> dict:
+        return {"out": str(self.out), "format": self.format, "bytes": self.bytes}
+
+
+def export(model: ModelLike, file, *, format: str | None = None, mode: str | None = None) -> ExportResult:
+    """Write a model as a TOML model file (to start your own from), a MuJoCo model (MJCF) or a
+    URDF (loop closures in an extension block; docs/validation.md).  ``format``: ``"toml"``,
+    ``"mjcf"`` or ``"urdf"``, default from the extension of ``file`` (.toml, .xml, .urdf);
+    ``mode``: write a metamorphic mechanism in that motion mode (its other lockable freedoms
+    locked).
+
+    >>> import spatialmech as sm, tempfile, os
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     r = sm.export("rssr", os.path.join(d, "rssr.xml"))
+    ...     r.format, r.bytes > 0
+    ('mjcf', True)
+    """
+    from ..exchange import export_model, format_of
+
+    if format is not None:
+        check_choice(format, "format", EXPORT_FORMATS)
+    out = check_path(file, "file")
+    fmt = format_of(out, format)  # before any work: a file name whose format is unknown
+    mech = as_mechanism(model)
+    if mode is not None:
+        if not isinstance(mode, str):
+            raise TypeError(f"mode: expected a mode name (str) or None, got {describe(mode)}")
+        mech = mech.in_mode(mode)
+    return ExportResult(mech, out, export_model(mech, out, fmt))
+
+
+def validate(model: ModelLike, motion: str | None = None, *, mode: str | None = None, start=None,
+             degrees: bool = False, method: str = "project", frames: int = 12, to_position: int | None = None,
+             amplitude: float = 0.02, arc: float = 2.0, actuator_path=None, tol: float = VALIDATION_TOL,
+             mjcf: str | os.PathLike | None = None):
+    """Drive the model exported to MuJoCo through a motion computed by the library and compare
+    the simulated output-link pose with the library's at every pose (docs/validation.md; needs
+    the ``mujoco`` package).  ``motion``: ``"trace"`` (the 1-DOF motion; default with one
+    actuator), ``"loop"`` (a loop of the actuators; default otherwise) or ``"actuators"``
+    (``actuator_path``: rows of actuator values, SI, in the order of the actuators); ``mode``: a
+    motion mode of a metamorphic mechanism; ``start``: the first pose (a pose as in :func:`ik`,
+    or a Configuration; default the reference); ``method``: ``"project"`` or ``"settle"``;
+    ``tol``: the largest error that passes (a fraction of the characteristic length, and rad);
+    ``mjcf``: also write the simulated MJCF model there.  Returns a
+    :class:`~spatialmech.analysis.validation.ValidationResult` (``passed``, ``to_dict()``).
+
+    >>> import spatialmech as sm
+    >>> r = sm.validate("rssr", frames=3, arc=0.2)                    # doctest: +SKIP
+    >>> r.passed                                                      # doctest: +SKIP
+    True
+    >>> sm.validate("rssr", method="guess")
+    Traceback (most recent call last):
+    ...
+    spatialmech.errors.InputError: method: expected one of 'project', 'settle', got 'guess'
+    """
+    from ..analysis.validation import validate as _validate
+    from ..kinematics.closure import Configuration
+
+    method = check_choice(method, "method", VALIDATION_METHODS)
+    mech = as_mechanism(model)
+    if mode is not None and not isinstance(mode, str):
+        raise TypeError(f"mode: expected a mode name (str) or None, got {describe(mode)}")
+    posed = mech.in_mode(mode) if mode is not None else mech
+    degrees = check_bool(degrees, "degrees")
+    frames = check_int(frames, "frames", minimum=2)
+    if to_position is not None:
+        to_position = check_int(to_position, "to_position")
+    amplitude = check_number(amplitude, "amplitude")
+    arc = check_number(arc, "arc")
+    tol = check_number(tol, "tol", positive=True)
+    out = None if mjcf is None else check_path(mjcf, "mjcf")
+    if actuator_path is not None and motion not in (None, "actuators"):
+        raise InputError(f"actuator_path: give either an actuator path or motion={motion!r}, not both")
+    if start is not None and not isinstance(start, Configuration):
+        start, _ = as_pose(posed, start, degrees, "start")
+    r = _validate(mech, "actuators" if actuator_path is not None else motion, method=method, start=start,
+                  frames=frames, to_position=to_position, amplitude=amplitude, arc=arc, actuator_path=actuator_path,
+                  tol=tol, mode=mode)
+    if out is not None:
+        from ..exchange import to_mjcf
+
+        out.write_text(to_mjcf(posed), encoding="utf-8")
+    return r

@@ -1,0 +1,67 @@
+"""The public API: the settings a run is made with -- the tolerances in force and the notice of
+numba compilations (``sm.tolerances``, ``sm.default_tolerance``, ``sm.announce_compilation``)."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from contextlib import contextmanager
+
+from ..errors import InputError, describe
+from ..geometry import tolerances as _tol
+
+
+@contextmanager
+def tolerances(spec=None, *, primary: str = "rank") -> Iterator[_tol.Tolerances]:
+    """Run a block with other tolerances (docs/conventions.md, Tolerances): ``spec`` is ``None``
+    (the tolerances in force), a :class:`~spatialmech.geometry.tolerances.Tolerances`, a number
+    (sets ``primary``) or the text ``NAME=VALUE[,NAME=VALUE]`` (what ``--tol`` takes; a bare
+    number sets ``primary``).
+
+    >>> import spatialmech as sm
+    >>> with sm.tolerances("1e-4", primary="rank") as t:
+    ...     t.rank, sm.mobility("four-sps-cu").dof
+    (0.0001, 4)
+    >>> sm.default_tolerance("rank") == 1e-4
+    False
+    """
+    if not isinstance(primary, str):
+        raise TypeError(f"primary: expected a tolerance name (str), got {describe(primary)}")
+    t: _tol.Tolerances | None
+    if isinstance(spec, str):
+        t = _tol.Tolerances.parse(spec, primary=primary)
+    elif spec is None or isinstance(spec, _tol.Tolerances):
+        t = spec
+    else:
+        t = _tol.resolve(spec, primary)
+    with _tol.use(t) as inside:
+        yield inside
+
+
+def default_tolerance(name: str) -> float:
+    """The library's default value of one tolerance (``"rank"``, ``"singular"``, ``"newton"``,
+    ``"reachability"`` ...), as printed by ``--help``.
+
+    >>> import spatialmech as sm
+    >>> sm.default_tolerance("singular") > 0
+    True
+    """
+    if not isinstance(name, str):
+        raise TypeError(f"name: expected a tolerance name (str), got {describe(name)}")
+    value = getattr(_tol.DEFAULT, name, None)
+    if not isinstance(value, float):
+        raise InputError(f"name: unknown tolerance {name!r}")
+    return value
+
+
+def announce_compilation(stream) -> bool:
+    """Write to ``stream`` (e.g. ``sys.stderr`` when it is a terminal) one line per numba kernel
+    that compiles (a miss of the on-disk cache: the first use after installation), with its
+    seconds; ``None`` removes the listener.  Returns whether a listener is installed.
+
+    >>> import spatialmech as sm
+    >>> sm.announce_compilation(None)
+    False
+    """
+    from ..kinematics.compiled.jit import announce_compilation as _announce
+
+    return _announce(stream)

@@ -1,0 +1,1 @@
+"""The design studio's session (:mod:`.session`) and output-link posing (:mod:`.posing`)."""
