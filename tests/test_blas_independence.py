@@ -25,7 +25,7 @@ import spatialmech
 from spatialmech import catalog
 from spatialmech.analysis.defects import candidate_drivers, dj_function
 from spatialmech.analysis.singularity import singularity
-from spatialmech.interfaces.studio.session import Session
+from spatialmech.services.studio.session import Session
 from spatialmech.kinematics import tracking
 from spatialmech.kinematics.closure import Configuration
 from spatialmech.kinematics.motion import generic_configuration
