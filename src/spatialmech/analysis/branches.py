@@ -13,8 +13,9 @@ that Newton pulled back next to it says how the mechanism moves.  The set is exp
    along the retraction (step :data:`~spatialmech.geometry.tolerances.CONE_DIFFERENCE_STEP`).
    Their real zeros on the unit sphere are sought by damped Gauss-Newton from seeded starts
    (a seeded vector of the local coordinates projected onto the kernel, ``K K^T g``, which does
-   not depend on the basis or the signs the SVD returns).  No real zero at all (``|Q| >
-   CONE_EMPTY`` at every start) proves the configuration isolated: rigid there.
+   not depend on the basis or the signs the SVD returns); a zero is ``|Q| <= CONE_ZERO`` (or the
+   rank tolerance, if looser).  No real zero at all (``|Q| > CONE_EMPTY`` at every start, or ten
+   times the zero threshold) proves the configuration isolated: rigid there.
 2. *Following.*  Each zero direction, one per line ``+-v``, is a candidate tangent of a branch:
    a predictor step ``BRANCH_STEP`` along it and Newton on the hyperplane orthogonal to it (every
    corrected point is at least a step away from ``x0``, so the corrector cannot fall back onto
@@ -82,6 +83,8 @@ class Exploration:
     corank: int
     branches: tuple[Branch, ...]
     undecided: str = ""
+    #: The smallest second-order obstruction met by the cone search (relative; 0: none).
+    obstruction: float = 0.0
 
     @property
     def dimension(self) -> int | None:
@@ -128,20 +131,20 @@ def _cone_zero(Hs: np.ndarray, a: np.ndarray) -> tuple[float, np.ndarray]:
     return float(np.sqrt(f)), a
 
 
-def _cone(prob: MotionProblem, x0, K: np.ndarray, C: np.ndarray, rng) -> tuple[list[np.ndarray], float]:
+def _cone(prob: MotionProblem, x0, K: np.ndarray, C: np.ndarray, rng, zero: float) -> tuple[list[np.ndarray], float]:
     """Unit directions ``v`` (one per line) of the real second-order tangent cone, and the smallest
     relative obstruction met (0 when the cone is the whole kernel)."""
     k = K.shape[1]
     starts = [K.T @ rng.standard_normal(K.shape[0]) for _ in range(_STARTS + 4 * k)]
     H = _quadrics(prob, x0, K, C) if C.shape[1] else np.zeros((0, k, k))
     scale = float(np.max(np.linalg.norm(H.reshape(H.shape[0], -1), axis=1), initial=0.0))
-    if scale <= CONE_ZERO:  # no second-order obstruction: every kernel direction is a candidate
+    if scale <= zero:  # no second-order obstruction: every kernel direction is a candidate
         return [K @ (a / np.linalg.norm(a)) for a in starts], 0.0
     found, best = [], np.inf
     for a in starts:
         q, a = _cone_zero(H / scale, a / np.linalg.norm(a))
         best = min(best, q)
-        if q <= CONE_ZERO:
+        if q <= zero:
             found.append(K @ a)
     return found, best
 
@@ -215,12 +218,13 @@ def explore(mech: Mechanism, x0: Configuration, dof_at: Callable, *, seed: int =
     K, C = vt[r:].T, U[:, r:]
     if K.shape[1] == 0:
         return Exploration(0, ())
-    vs, best = _cone(prob, x0, K, C, np.random.default_rng(seed))
+    zero = max(CONE_ZERO, rtol)  # a looser rank tolerance (rounded data) loosens the cone's zero too
+    vs, best = _cone(prob, x0, K, C, np.random.default_rng(seed), zero)
     if not vs:
-        if best > CONE_EMPTY:
-            return Exploration(K.shape[1], ())
+        if best > max(CONE_EMPTY, 10 * zero):
+            return Exploration(K.shape[1], (), obstruction=best)
         return Exploration(K.shape[1], (), f"the second-order tangent cone is ambiguous (smallest obstruction "
-                                           f"{best:.2g}, between {CONE_ZERO:g} and {CONE_EMPTY:g})")
+                                           f"{best:.2g}, between {zero:g} and {max(CONE_EMPTY, 10 * zero):g})", best)
     branches: list[Branch] = []
     spaces: list[np.ndarray] = []
     problems: list[str] = []

@@ -416,6 +416,17 @@ def _tolerance_note(steps: tuple[ToleranceStep, ...], tol: float, dof: int) -> s
     return "Tolerance: " + "; ".join(parts) + hint + "."
 
 
+def _generic(m: Mechanism, ref: Configuration, seed: int, rtol: float):
+    """(generic configuration, instantaneous mobility and platform twists there, a note)."""
+    try:
+        gen = generic_configuration(m, seed=seed)
+        dof_inst, _, Vgen = _instantaneous(m, gen, rtol)
+        return gen, dof_inst, Vgen, ""
+    except RuntimeError as e:  # reported, not hidden
+        dof_inst, _, Vgen = _instantaneous(m, ref, rtol)
+        return ref, dof_inst, Vgen, f" (no generic configuration could be reached: {e}; the reference was used)"
+
+
 @dataclass(frozen=True)
 class _Reference:
     """Whether the reference is singular, the instantaneous mobility there, and the branches
@@ -427,7 +438,7 @@ class _Reference:
 
     def note(self) -> str:
         e = self.exploration
-        if e is None:
+        if e is None or not self.singular:
             return ""
         head = (f"The reference configuration is singular (instantaneous mobility {self.dof_ref} there; "
                 f"corank {e.corank} of the closure Jacobian)")
@@ -437,8 +448,8 @@ class _Reference:
             return (f"{head}; the branches through it are undecided: {e.undecided}"
                     + (f" (found: {found})." if found else "."))
         if not dims:
-            return (f"{head}, but no real branch leaves it (its second-order tangent cone is empty): an isolated "
-                    "configuration, rigid there.")
+            return (f"{head}, but no real branch leaves it (its second-order tangent cone is empty: smallest "
+                    f"obstruction {e.obstruction:.2g}): an isolated configuration, rigid there.")
         return f"{head}; branches through it: {found}; the mobility is the largest, {max(dims)}."
 
 
@@ -456,7 +467,11 @@ def _reference_check(m: Mechanism, ref: Configuration, gen: Configuration, seed:
     left = float(np.linalg.norm(MotionProblem(m).difference(ref, gen)))
     if left > SINGULAR_LEFT and dof_at(gen)[1] == null_ref:
         return _Reference(False, dof_ref)
-    return _Reference(True, dof_ref, explore(m, ref, dof_at, seed=seed))
+    e = explore(m, ref, dof_at, seed=seed)
+    # one branch, of the reference's own instantaneous mobility: the reference is regular (the
+    # generic configuration fell near another singular point)
+    regular = not e.undecided and [b.dimension for b in e.branches] == [dof_ref]
+    return _Reference(not regular, dof_ref, e)
 
 
 def mobility(mech: Mechanism, mode: Mode | str | None = None, *, seed: int = 0,
@@ -525,22 +540,18 @@ def _mobility(mech: Mechanism, mode, seed: int, tols: Tolerances) -> MobilityRes
         Wall = sc.reciprocal_basis(Vref, length_scale=L, rtol=rtol) if Vref.shape[0] else np.eye(6)
     else:  # the free platform twist system at the reference: reciprocal to all limb constraints
         Vref = sc.reciprocal_basis(Wall, length_scale=L, rtol=rtol)
-    try:
-        gen = generic_configuration(m, seed=seed)
-        dof_inst, _, Vgen = _instantaneous(m, gen, rtol)
-        generic_note = ""
-    except RuntimeError as e:  # reported, not hidden
-        gen = ref
-        dof_inst, _, Vgen = _instantaneous(m, ref, rtol)
-        generic_note = f" (no generic configuration could be reached: {e}; the reference was used)"
-
+    gen, dof_inst, Vgen, generic_note = _generic(m, ref, seed, rtol)
     sing = _reference_check(m, ref, gen, seed, rtol)
     where = "at a generic configuration"
-    if sing.exploration is not None and sing.exploration.dimension is not None:  # decided at a singular reference
+    if sing.exploration is not None and sing.exploration.dimension is not None:  # the branches decided
         dof_inst = sing.exploration.dimension
         gen = sing.exploration.branches[0].sample if sing.exploration.branches else ref
         Vgen = _instantaneous(m, gen, rtol)[2] if dof_inst else np.zeros((0, 6))
-        where = "on the first branch through the singular reference" if dof_inst else "at the (isolated) reference"
+        where = ("at the (isolated) reference" if not dof_inst else
+                 "on the first branch through the singular reference" if sing.singular else "on the reference's branch")
+        if not sing.singular:
+            generic_note += (" (the generic configuration fell near another singular configuration; the "
+                             "reference's own branch was followed instead)")
     if Vref.shape[0] == dof_inst and not sing.singular:
         motion, mclass = motion_type(Vref, m.platform_point, length_scale=L, rtol=rtol)
         where = "at the reference configuration"
@@ -598,7 +609,7 @@ def _mobility(mech: Mechanism, mode, seed: int, tols: Tolerances) -> MobilityRes
         reference_singular=sing.singular,
         dof_at_reference=sing.dof_ref,
         local_dof=(int(dof_inst) if sing.exploration is None else sing.exploration.dimension),
-        branches=sing.exploration.branches if sing.exploration is not None else (),
+        branches=sing.exploration.branches if sing.exploration is not None and sing.singular else (),
         singular_note=sing.note(),
         undecided=sing.exploration.undecided if sing.exploration is not None else "",
     )
