@@ -137,6 +137,8 @@ def _cone(prob: MotionProblem, x0, K: np.ndarray, C: np.ndarray, rng, zero: floa
     k = K.shape[1]
     starts = [K.T @ rng.standard_normal(K.shape[0]) for _ in range(_STARTS + 4 * k)]
     H = _quadrics(prob, x0, K, C) if C.shape[1] else np.zeros((0, k, k))
+    if not np.all(np.isfinite(H)):
+        return [], np.nan
     scale = float(np.max(np.linalg.norm(H.reshape(H.shape[0], -1), axis=1), initial=0.0))
     if scale <= zero:  # no second-order obstruction: every kernel direction is a candidate
         return [K @ (a / np.linalg.norm(a)) for a in starts], 0.0
@@ -221,6 +223,8 @@ def explore(mech: Mechanism, x0: Configuration, dof_at: Callable, *, seed: int =
     zero = max(CONE_ZERO, rtol)  # a looser rank tolerance (rounded data) loosens the cone's zero too
     vs, best = _cone(prob, x0, K, C, np.random.default_rng(seed), zero)
     if not vs:
+        if np.isnan(best):
+            return Exploration(K.shape[1], (), "the closure residual is not finite near the reference", best)
         if best > max(CONE_EMPTY, 10 * zero):
             return Exploration(K.shape[1], (), obstruction=best)
         return Exploration(K.shape[1], (), f"the second-order tangent cone is ambiguous (smallest obstruction "
