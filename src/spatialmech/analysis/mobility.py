@@ -40,10 +40,12 @@ import numpy as np
 
 from ..errors import ConvergenceError, InputError
 from ..geometry import screws as sc
-from ..geometry.tolerances import Tolerances, current, resolve, use
+from ..geometry.tolerances import SINGULAR_LEFT, Tolerances, current, resolve, use
 from ..kinematics.closure import Configuration, active_mask, closure_scales, hub_count, limb_slices
 from ..kinematics.backend import closure_jacobian, joint_twists
 from ..kinematics.motion import generic_configuration
+from ..kinematics.tracking import MotionProblem
+from .branches import Branch, Exploration, explore
 from ..model.mechanism import Mechanism, Mode
 from ..serialize import fields_dict
 
@@ -150,6 +152,21 @@ class MobilityResult:
     dof_by_tolerance: tuple[ToleranceStep, ...] = field(default=())
     #: One line about that dependence (empty when there is nothing to say).
     tolerance_note: str = ""
+    #: The reference configuration is singular: the generic configuration did not leave it, or
+    #: the closure Jacobian's nullity there exceeds the nullity at the generic configuration.
+    reference_singular: bool = False
+    #: The instantaneous mobility at the reference itself (nullity less passive freedoms there).
+    dof_at_reference: int = 0
+    #: The mobility near the reference: ``dof_instantaneous`` at a regular reference, the largest
+    #: dimension of the branches through a singular one (0: an isolated configuration), ``None``
+    #: when that could not be decided (:attr:`undecided`).
+    local_dof: int | None = None
+    #: The branches through a singular reference (:mod:`.branches`), largest dimension first.
+    branches: tuple[Branch, ...] = field(default=())
+    #: One line about a singular reference (empty at a regular one).
+    singular_note: str = ""
+    #: Why the branches through a singular reference could not be decided (empty when they were).
+    undecided: str = ""
 
     def dof_at(self, tolerance: float) -> int | None:
         """The count at another rank tolerance (within the scanned range; else ``None``)."""
@@ -175,6 +192,7 @@ class MobilityResult:
         d["passive"] = list(self.passive)
         d["constraint_wrenches"] = [list(w) for w in self.constraint_wrenches]
         d["dof_by_tolerance"] = [s.to_dict() for s in self.dof_by_tolerance]
+        d["branches"] = [b.to_dict() for b in self.branches]
         d["dof_at_tolerance"] = [{"tolerance": t, "dof": self.dof_at(t)} for t in _DECADES]
         return d
 
@@ -398,6 +416,64 @@ def _tolerance_note(steps: tuple[ToleranceStep, ...], tol: float, dof: int) -> s
     return "Tolerance: " + "; ".join(parts) + hint + "."
 
 
+def _generic(m: Mechanism, ref: Configuration, seed: int, rtol: float):
+    """(generic configuration, instantaneous mobility and platform twists there, a note)."""
+    try:
+        gen = generic_configuration(m, seed=seed)
+        dof_inst, _, Vgen = _instantaneous(m, gen, rtol)
+        return gen, dof_inst, Vgen, ""
+    except RuntimeError as e:  # reported, not hidden
+        dof_inst, _, Vgen = _instantaneous(m, ref, rtol)
+        return ref, dof_inst, Vgen, f" (no generic configuration could be reached: {e}; the reference was used)"
+
+
+@dataclass(frozen=True)
+class _Reference:
+    """Whether the reference is singular, the instantaneous mobility there, and the branches
+    through it (explored only when singular)."""
+
+    singular: bool
+    dof_ref: int
+    exploration: Exploration | None = None
+
+    def note(self) -> str:
+        e = self.exploration
+        if e is None or not self.singular:
+            return ""
+        head = (f"The reference configuration is singular (instantaneous mobility {self.dof_ref} there; "
+                f"corank {e.corank} of the closure Jacobian)")
+        dims = [b.dimension for b in e.branches]
+        found = ", ".join(f"{dims.count(d)} of dimension {d}" for d in sorted(set(dims), reverse=True))
+        if e.undecided:
+            return (f"{head}; the branches through it are undecided: {e.undecided}"
+                    + (f" (found: {found})." if found else "."))
+        if not dims:
+            return (f"{head}, but no real branch leaves it (its second-order tangent cone is empty: smallest "
+                    f"obstruction {e.obstruction:.2g}): an isolated configuration, rigid there.")
+        return f"{head}; branches through it: {found}; the mobility is the largest, {max(dims)}."
+
+
+def _reference_check(m: Mechanism, ref: Configuration, gen: Configuration, seed: int, rtol: float) -> _Reference:
+    """Singular reference: the generic configuration stayed within ``SINGULAR_LEFT`` of it, or the
+    nullity there is not the reference's; then its branches are explored (:mod:`.branches`)."""
+
+    def dof_at(c: Configuration) -> tuple[int, int]:
+        dof, xi, _ = _instantaneous(m, c, rtol)
+        return dof, dof + xi
+
+    dof_ref, null_ref = dof_at(ref)
+    if null_ref == 0:
+        return _Reference(False, dof_ref)
+    left = float(np.linalg.norm(MotionProblem(m).difference(ref, gen)))
+    if left > SINGULAR_LEFT and dof_at(gen)[1] == null_ref:
+        return _Reference(False, dof_ref)
+    e = explore(m, ref, dof_at, seed=seed)
+    # one branch, of the reference's own instantaneous mobility: the reference is regular (the
+    # generic configuration fell near another singular point)
+    regular = not e.undecided and [b.dimension for b in e.branches] == [dof_ref]
+    return _Reference(not regular, dof_ref, e)
+
+
 def mobility(mech: Mechanism, mode: Mode | str | None = None, *, seed: int = 0,
              tol: Tolerances | float | None = None) -> MobilityResult:
     """Mobility of ``mech`` (in ``mode`` for a metamorphic mechanism).
@@ -464,22 +540,24 @@ def _mobility(mech: Mechanism, mode, seed: int, tols: Tolerances) -> MobilityRes
         Wall = sc.reciprocal_basis(Vref, length_scale=L, rtol=rtol) if Vref.shape[0] else np.eye(6)
     else:  # the free platform twist system at the reference: reciprocal to all limb constraints
         Vref = sc.reciprocal_basis(Wall, length_scale=L, rtol=rtol)
-    try:
-        gen = generic_configuration(m, seed=seed)
-        dof_inst, _, Vgen = _instantaneous(m, gen, rtol)
-        generic_note = ""
-    except RuntimeError as e:  # reported, not hidden
-        gen = ref
-        dof_inst, _, Vgen = _instantaneous(m, ref, rtol)
-        generic_note = f" (no generic configuration could be reached: {e}; the reference was used)"
-
-    if Vref.shape[0] == dof_inst:
+    gen, dof_inst, Vgen, generic_note = _generic(m, ref, seed, rtol)
+    sing = _reference_check(m, ref, gen, seed, rtol)
+    where = "at a generic configuration"
+    if sing.exploration is not None and sing.exploration.dimension is not None:  # the branches decided
+        dof_inst = sing.exploration.dimension
+        gen = sing.exploration.branches[0].sample if sing.exploration.branches else ref
+        Vgen = _instantaneous(m, gen, rtol)[2] if dof_inst else np.zeros((0, 6))
+        where = ("at the (isolated) reference" if not dof_inst else
+                 "on the first branch through the singular reference" if sing.singular else "on the reference's branch")
+        if not sing.singular:
+            generic_note += (" (the generic configuration fell near another singular configuration; the "
+                             "reference's own branch was followed instead)")
+    if Vref.shape[0] == dof_inst and not sing.singular:
         motion, mclass = motion_type(Vref, m.platform_point, length_scale=L, rtol=rtol)
         where = "at the reference configuration"
     else:
         p_now = gen.D[:3, :3] @ m.platform_point + gen.D[:3, 3]
         motion, mclass = motion_type(Vgen, p_now, length_scale=L, rtol=rtol)
-        where = "at a generic configuration"
 
     notes = []
     if gk != M:
@@ -528,6 +606,12 @@ def _mobility(mech: Mechanism, mode, seed: int, tols: Tolerances) -> MobilityRes
         tolerance=float(rtol),
         dof_by_tolerance=steps,
         tolerance_note=note,
+        reference_singular=sing.singular,
+        dof_at_reference=sing.dof_ref,
+        local_dof=(int(dof_inst) if sing.exploration is None else sing.exploration.dimension),
+        branches=sing.exploration.branches if sing.exploration is not None and sing.singular else (),
+        singular_note=sing.note(),
+        undecided=sing.exploration.undecided if sing.exploration is not None else "",
     )
 
 

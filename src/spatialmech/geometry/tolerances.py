@@ -48,6 +48,11 @@ from ..serialize import fields_dict
 __all__ = [
     "BLOCK_MAX_COND",
     "BLOCK_RANK_ZERO",
+    "BRANCH_REACH",
+    "BRANCH_STEP",
+    "CONE_DIFFERENCE_STEP",
+    "CONE_EMPTY",
+    "CONE_ZERO",
     "DEFAULT",
     "ENDGAME_AGREE",
     "ENDGAME_CLOSED",
@@ -69,6 +74,7 @@ __all__ = [
     "MONODROMY_RESIDUAL",
     "MONODROMY_STALE_LOOPS",
     "NEAR_SINGULAR",
+    "SINGULAR_LEFT",
     "TRACE_MAX_LOOPS",
     "TRACE_MAX_WORK",
     "TRACE_MAX_WORK_FULL",
@@ -326,3 +332,20 @@ TRACE_MAX_WORK_FULL = 2_000_000
 #: general least-squares solver (the SVD decides there).
 BLOCK_RANK_ZERO = 1e-13
 BLOCK_MAX_COND = 1e8
+
+#: Mobility at a singular reference (analysis/mobility.py, docs/mobility.md), all nondimensional
+#: (rad, and length / L, in the local coordinates of the closure manifold): the distance a generic
+#: configuration must have moved from the reference to count as having left it; the step of the
+#: central second differences of the closure residual along the kernel (their error is about
+#: 1e-8 of the quadrics' size); the size of the second-order obstruction ``|Q(v)|`` (relative to
+#: the largest quadric, ``|v| = 1``) below which a kernel direction ``v`` lies in the tangent cone
+#: (100 times that error; the rank tolerance when looser), and above which at every start the cone
+#: has no real direction (1000 times the error; between the two: undecided);
+#: the predictor step along a branch and the distance out to which it is followed before its
+#: dimension is read (the rank there is ~BRANCH_REACH times the rank jump away from the tolerance).
+SINGULAR_LEFT = 1e-3
+CONE_DIFFERENCE_STEP = 1e-4
+CONE_ZERO = 1e-6
+CONE_EMPTY = 1e-5
+BRANCH_STEP = 0.01
+BRANCH_REACH = 0.1

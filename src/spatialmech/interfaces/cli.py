@@ -171,6 +171,8 @@ def _mobility_text(r) -> str:
         lines.append("  platform constraint wrenches (f ; m):")
         for w in r.constraint_wrenches:
             lines.append("    (" + " ".join(f"{x:+.4g}" for x in w[:3]) + " ; " + " ".join(f"{x:+.4g}" for x in w[3:]) + ")")
+    if r.singular_note:  # the branches through a singular reference (docs/mobility.md)
+        lines.append(f"  {r.singular_note}")
     lines.append(f"  {r.explanation}")
     if r.tolerance_note:
         lines.append(f"  {r.tolerance_note}")
