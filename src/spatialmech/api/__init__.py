@@ -26,7 +26,7 @@ position (from 1, as ``--position N``).
 The functions live in modules by concept (this package re-exports them; import them from here or
 from ``spatialmech``): :mod:`~spatialmech.api.structure` (models, mobility),
 :mod:`~spatialmech.api.kinematics` (position, Jacobian, velocity, singularity, workspace,
-parasitic motion), :mod:`~spatialmech.api.forces` (statics), :mod:`~spatialmech.api.linkages` (tracking, defects, synthesis),
+parasitic motion), :mod:`~spatialmech.api.forces` (statics), :mod:`~spatialmech.api.stiffness` (stiffness), :mod:`~spatialmech.api.linkages` (tracking, defects, synthesis),
 :mod:`~spatialmech.api.outputs` (report, viewer); :mod:`~spatialmech.api.checks` has the argument
 checks they share.
 """
@@ -50,6 +50,7 @@ from .kinematics import (
     workspace,
 )
 from .maps import MapResult, maps
+from .stiffness import StiffnessMap, StiffnessResult, stiffness, stiffness_map
 from .linkages import CSSynthesisResult, TraceResult, defects, dj_table, screen, synth_cs, synth_rccc, track
 from .outputs import VIEW_MOTIONS as VIEW_MOTIONS  # the motions view() animates
 from .outputs import ReportResult, ViewResult, report, studio_app, studio_session, view
@@ -65,6 +66,8 @@ __all__ = [
     "ReportResult",
     "SingularityAnalysis",
     "StaticsResult",
+    "StiffnessMap",
+    "StiffnessResult",
     "TraceResult",
     "VelocityResult",
     "ViewResult",
@@ -83,6 +86,8 @@ __all__ = [
     "screen",
     "singularity",
     "statics",
+    "stiffness",
+    "stiffness_map",
     "studio_app",
     "studio_session",
     "synth_cs",
