@@ -254,7 +254,8 @@ name = "leg1"
 constraint_stiffness = 5e4
 joints = [
   {name = "R1", type = "R", point = [0, 300, 0], axis = [-1, 0, 0]},
-  {name = "L1", type = "P", point = [0, 300, 0], axis = [0, -0.4472135954999579, 0.8944271909999159], actuated = true, offset = 335.4101966249685, stiffness = 2000},
+  {name = "L1", type = "P", point = [0, 300, 0], axis = [0, -0.4472135954999579, 0.8944271909999159],
+   actuated = true, offset = 335.4101966249685, stiffness = 2000},
   {name = "S1", type = "S", point = [0, 150, 300]},
 ]
 """
@@ -289,7 +290,7 @@ def test_bad_stiffness_in_a_file_names_the_field(old, new, field):
 def test_bad_arguments_name_them():
     with pytest.raises(sm.InputError, match="actuator_stiffness"):
         sm.stiffness("stewart-6sps", actuator_stiffness=-1)
-    with pytest.raises(sm.InputError, match="actuator_stiffness.*nan"):
+    with pytest.raises(sm.InputError, match=r"actuator_stiffness.*nan"):
         sm.stiffness("stewart-6sps", actuator_stiffness=float("nan"))
     with pytest.raises(TypeError, match="actuator_stiffness"):
         sm.stiffness("stewart-6sps", actuator_stiffness="stiff")

@@ -337,6 +337,6 @@ def with_stiffness(mech: Mechanism, *, actuators=None, constraints=None) -> Mech
             fs = tuple(replace(f, stiffness=acts[f"{joint.name}.{f.name}"]) if f"{joint.name}.{f.name}" in acts else f
                        for f in joint.freedoms)
             joints.append(replace(joint, freedoms=fs))
-        kc = cons[limb.name] if limb.name in cons else limb.constraint_stiffness
+        kc = cons.get(limb.name, limb.constraint_stiffness)
         limbs.append(replace(limb, joints=tuple(joints), constraint_stiffness=kc))
     return replace(mech, limbs=tuple(limbs))

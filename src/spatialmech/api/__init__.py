@@ -26,7 +26,8 @@ position (from 1, as ``--position N``).
 The functions live in modules by concept (this package re-exports them; import them from here or
 from ``spatialmech``): :mod:`~spatialmech.api.structure` (models, mobility),
 :mod:`~spatialmech.api.kinematics` (position, Jacobian, velocity, singularity, workspace,
-parasitic motion), :mod:`~spatialmech.api.forces` (statics), :mod:`~spatialmech.api.stiffness` (stiffness), :mod:`~spatialmech.api.linkages` (tracking, defects, synthesis),
+parasitic motion), :mod:`~spatialmech.api.forces` (statics),
+:mod:`~spatialmech.api.stiffness` (stiffness), :mod:`~spatialmech.api.linkages` (tracking, defects, synthesis),
 :mod:`~spatialmech.api.outputs` (report, viewer); :mod:`~spatialmech.api.checks` has the argument
 checks they share.
 """

@@ -416,10 +416,16 @@ def _joint_dict(j: Joint) -> dict:
     for key, tab in (("limits", lim), ("limits_deg", lim_deg), ("offset", off), ("offset_deg", off_deg)):
         if tab:
             d[key] = tab
-    stiff = {f.name: f.stiffness for f in fs if f.stiffness is not None}
-    if stiff:
-        d["stiffness"] = stiff[fs[0].name] if len(fs) == 1 else stiff
+    d.update(_stiffness_entry(fs))
     return d
+
+
+def _stiffness_entry(fs) -> dict:
+    """``{"stiffness": k}`` (one freedom) or a table by freedom name; ``{}`` when none is given."""
+    stiff = {f.name: f.stiffness for f in fs if f.stiffness is not None}
+    if not stiff:
+        return {}
+    return {"stiffness": stiff[fs[0].name] if len(fs) == 1 else stiff}
 
 
 def to_dict(mech: Mechanism) -> dict[str, Any]:
