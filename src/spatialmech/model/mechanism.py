@@ -125,10 +125,10 @@ class Limb:
                     raise TypeError(f"limb {self.name!r}.links[{k}]: expected a link name (str), got {describe(v)}")
         object.__setattr__(self, "links", links)
         if self.constraint_stiffness is not None:
-            k = as_finite_array(self.constraint_stiffness, f"limb {self.name!r}.constraint_stiffness", shape=())
-            if not float(k) > 0.0:
-                raise InputError(f"limb {self.name!r}.constraint_stiffness: a stiffness must be positive, got {float(k):g}")
-            object.__setattr__(self, "constraint_stiffness", float(k))
+            kc = float(as_finite_array(self.constraint_stiffness, f"limb {self.name!r}.constraint_stiffness", shape=()))
+            if not kc > 0.0:
+                raise InputError(f"limb {self.name!r}.constraint_stiffness: a stiffness must be positive, got {kc:g}")
+            object.__setattr__(self, "constraint_stiffness", kc)
 
     @property
     def dof(self) -> int:
