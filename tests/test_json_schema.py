@@ -95,6 +95,10 @@ CASES = [
     (["statics", "four-sps-cu", "--wrench", "0,0,-10,0,0,1", *POSE], "statics", "four-sps-cu"),
     (["statics", "four-sps-cu", "--wrench", "0,0,-10,0,0,1"], "statics", "four-sps-cu"),  # singular: unbalanced
     (["statics", "delta", "--wrench=-1,0,-10,0,0,0", "--xyz", "0.02", "0.01", "-0.33"], "statics", "delta"),  # graph
+    (["stiffness", "stewart-6sps", "--k", "2e6"], "stiffness", "stewart-6sps"),
+    (["stiffness", "three-rps", "--k", "1e6", "--kc", "leg1=1e8", "--pose", "0,0,0.33,ZYX,0,5,5"], "stiffness", "three-rps"),
+    (["stiffness", "four-sps-cu"], "stiffness", "four-sps-cu"),  # singular at the reference: compliance null
+    (["stiffness", "delta", "--over", "x:-0.02:0.02:2,y:-0.02:0.02:2", "--at", "z=-0.33"], "stiffness", "delta"),
 ]
 SLOW_CASES = [  # more than ~1 s each: deselected by the quick loop (pytest -m "not slow")
     (["workspace", "four-sps-cu", "--orientation", "--at", "z=0.1", "--step-deg", "15"], "workspace", "four-sps-cu"),

@@ -7,7 +7,8 @@ plots), always labelled; Euler sequences always named explicitly (``"ZXY"`` intr
 
 Every analysis by a short name (one page: docs/api.md; the functions are in
 :mod:`spatialmech.api`): ``sm.load_model``, ``sm.mobility``, ``sm.ik``, ``sm.fk``,
-``sm.jacobian``, ``sm.velocity``, ``sm.statics``, ``sm.singularity``, ``sm.workspace``, ``sm.parasitic``, ``sm.track``,
+``sm.jacobian``, ``sm.velocity``, ``sm.statics``, ``sm.stiffness``, ``sm.singularity``, ``sm.workspace``, ``sm.parasitic``,
+``sm.track``,
 ``sm.defects``, ``sm.synth_rccc``, ``sm.synth_cs``, ``sm.screen``, ``sm.report``, ``sm.demo``, ``sm.view``,
 ``sm.export``, ``sm.validate``, ``sm.singularity_slice``, ``sm.studio_session``, ``sm.studio_app``.  Each takes a
 :class:`Mechanism`, a ready-made model name or a TOML file path, checks its arguments
@@ -46,6 +47,8 @@ from .api import (
     singularity,
     singularity_slice,
     statics,
+    stiffness,
+    stiffness_map,
     studio_session,
     suggest_task_grid,
     screen,
@@ -135,6 +138,8 @@ __all__ = [
     "singularity",
     "singularity_slice",
     "statics",
+    "stiffness",
+    "stiffness_map",
     "studio_app",
     "studio_session",
     "suggest_task_grid",

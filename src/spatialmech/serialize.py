@@ -72,6 +72,10 @@ UNIT_SUFFIXES: dict[str, str] = {
     "seconds": "seconds (the key is the unit)",
     "_N": "newtons (the force unit of a given wrench: statics is linear in it)",
     "_N_len": "newtons times the document's length_unit (a torque, or a moment)",
+    "_N_per_len": "newtons per length_unit (a linear stiffness)",
+    "_len_per_N": "length_unit per newton (a linear compliance)",
+    "_per_N": "per newton (a coupling compliance: length_unit per N length_unit, or rad per N)",
+    "_per_N_len": "per newton length_unit (a rotational compliance: rad per N length_unit)",
 }
 
 #: Keys whose numbers have no unit, with their meaning: counts, indices, signs, nondimensional
@@ -277,6 +281,9 @@ UNIT_FREE_KEYS: dict[str, str] = {
     "velocity_axes": "semi-axes of the nondimensional velocity ellipsoid (maps)",
     "force_axes": "semi-axes of the nondimensional force ellipsoid (maps)",
     "status_counts": "grid cells of each status (maps)",
+    # stiffness (docs/stiffness.md)
+    "rigid_rank": "independent rigid constraint wrenches (stiffness)",
+    "repeated": "how many principal stiffnesses equal this one (stiffness)",
 }
 
 #: Unit-free keys that hold a map by name (actuator, limit, monomial) of unit-free numbers; any
@@ -297,7 +304,8 @@ SCREW_KEYS: dict[str, str] = {
     "line": "a Plücker line",
     "matrix": "rows of the complete Jacobian, (moment ; direction)",
     "transversals": "Plücker lines",
-    "twist": "uncontrolled platform twists (omega ; v)",
+    "twist": "uncontrolled platform twists (omega ; v); stiffness: a principal displacement (dtheta ; dp)",
+    "softest_twist": "the softest displacement (dtheta ; dp) of each grid cell (stiffness --over)",
     "unbalanced_wrench": "the wrench direction (f ; m) a singular configuration cannot balance (statics)",
     "wrenches": "wrenches of the complete Jacobian, (direction ; moment)",
 }

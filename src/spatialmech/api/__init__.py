@@ -26,7 +26,8 @@ position (from 1, as ``--position N``).
 The functions live in modules by concept (this package re-exports them; import them from here or
 from ``spatialmech``): :mod:`~spatialmech.api.structure` (models, mobility),
 :mod:`~spatialmech.api.kinematics` (position, Jacobian, velocity, singularity, workspace,
-parasitic motion), :mod:`~spatialmech.api.forces` (statics), :mod:`~spatialmech.api.linkages` (tracking, defects, synthesis),
+parasitic motion), :mod:`~spatialmech.api.forces` (statics),
+:mod:`~spatialmech.api.stiffness` (stiffness), :mod:`~spatialmech.api.linkages` (tracking, defects, synthesis),
 :mod:`~spatialmech.api.outputs` (report, demo, viewer, studio session), :mod:`~spatialmech.api.exchange`
 (export, validation in MuJoCo), :mod:`~spatialmech.api.regions` (singularity slices, task grids),
 :mod:`~spatialmech.api.settings` (tolerances, compilation notices); :mod:`~spatialmech.api.checks` has
@@ -58,6 +59,7 @@ from .exchange import VALIDATION_TOL as VALIDATION_TOL
 from .exchange import ExportResult, export, validate
 from .linkages import CSSynthesisResult, DefectAnalysis, TraceResult, defects, dj_table, screen, synth_cs, synth_rccc, track
 from .maps import MapResult, maps
+from .stiffness import StiffnessMap, StiffnessResult, stiffness, stiffness_map
 from .outputs import VIEW_MOTIONS as VIEW_MOTIONS  # the motions view() animates
 from .outputs import ReportResult, ViewResult, demo, report, studio_session, view
 from .regions import TASK_COORDINATES as TASK_COORDINATES  # the names of grids and held coordinates
@@ -79,6 +81,8 @@ __all__ = [
     "ReportResult",
     "SingularityAnalysis",
     "StaticsResult",
+    "StiffnessMap",
+    "StiffnessResult",
     "TaskGridSuggestion",
     "TraceResult",
     "VelocityResult",
@@ -103,6 +107,8 @@ __all__ = [
     "singularity",
     "singularity_slice",
     "statics",
+    "stiffness",
+    "stiffness_map",
     "studio_session",
     "suggest_task_grid",
     "synth_cs",

@@ -287,6 +287,7 @@ from .cmd_parasitic import parasitic_cmd  # noqa: E402
 from .cmd_screen import screen  # noqa: E402
 from .cmd_singularity import singularity_cmd  # noqa: E402
 from .cmd_statics import statics_cmd  # noqa: E402
+from .cmd_stiffness import stiffness_cmd  # noqa: E402
 from .cmd_studio import studio  # noqa: E402
 from .cmd_synth import synth  # noqa: E402
 from .cmd_view import view  # noqa: E402
@@ -296,6 +297,7 @@ from .cmd_workspace import workspace  # noqa: E402
 for _cmd in (ik, fk, jacobian, parasitic_cmd, synth, view, defects, workspace, singularity_cmd, validate_cmd, studio, screen,
              statics_cmd, maps_cmd):
     cli.add_command(_cmd)
+cli.add_command(stiffness_cmd)
 
 
 def main(argv=None):  # console-script entry point

@@ -59,6 +59,10 @@ class Freedom:
     locked: bool = False
     limits: tuple[float, float] | None = None
     offset: float = 0.0
+    #: Lumped stiffness along this freedom when it is actuated (docs/stiffness.md): force per
+    #: length unit for a slide (P), torque (force x length unit) per radian for a rotation (R, H);
+    #: ``None``: not given (the stiffness analysis then assumes 1 and says so).
+    stiffness: float | None = None
 
     @property
     def screw(self) -> np.ndarray:
@@ -148,6 +152,16 @@ def _per_freedom(value, names: tuple[str, ...], field_name: str) -> dict:
     return {names[0]: value}
 
 
+def _check_stiffness(k, field_name: str) -> float | None:
+    """A stiffness: ``None`` or a positive finite number."""
+    if k is None:
+        return None
+    v = float(as_model_number(k, field_name))
+    if not v > 0.0:
+        raise InputError(f"{field_name}: a stiffness must be positive, got {v:g}")
+    return v
+
+
 def _check_limits(lim, field_name: str):
     if lim is None:
         return None
@@ -173,8 +187,11 @@ def make_joint(
     freedom_names=None,
     normalize: bool = False,
     field: str | None = None,
+    stiffness=None,
 ) -> Joint:
-    """Build and validate a joint of any type.  ``field`` prefixes error messages."""
+    """Build and validate a joint of any type.  ``field`` prefixes error messages.  ``stiffness``:
+    a positive number (one-freedom joint) or a table by freedom name: the lumped stiffness of an
+    actuated freedom (:attr:`Freedom.stiffness`)."""
     where = field or f"joint {name!r}"
     if type not in JOINT_TYPES:
         raise InputError(f"{where}.type: unknown joint type {type!r}; expected one of {sorted(JOINT_TYPES)}")
@@ -228,6 +245,7 @@ def make_joint(
         lk = set(names)
     lims = _per_freedom(limits, names, f"{where}.limits")
     offs = _per_freedom(offset, names, f"{where}.offset")
+    stiff = _per_freedom(stiffness, names, f"{where}.stiffness")
     freedoms = []
     for kind, nm, d in zip(kinds, names, dirs, strict=True):
         freedoms.append(
@@ -242,6 +260,7 @@ def make_joint(
                 locked=nm in lkd,
                 limits=_check_limits(lims.get(nm), f"{where}.limits.{nm}"),
                 offset=as_model_number(offs.get(nm, 0.0), f"{where}.offset.{nm}"),
+                stiffness=_check_stiffness(stiff.get(nm), f"{where}.stiffness" + (f".{nm}" if len(names) > 1 else "")),
             )
         )
     return Joint(name=name, type=type, point=p, freedoms=tuple(freedoms))

@@ -101,6 +101,9 @@ class Limb:
     base: str = GROUND
     tip: str | None = None  # None: the mechanism's output link
     links: tuple[str, ...] = ()
+    #: Stiffness of the limb against the displacements its constraint wrenches forbid (force per
+    #: length unit, on unit nondimensional constraint wrenches; docs/stiffness.md); ``None``: rigid.
+    constraint_stiffness: float | None = None
 
     def __post_init__(self):
         if not isinstance(self.name, str):
@@ -121,6 +124,11 @@ class Limb:
                 if not (isinstance(v, str) and v):
                     raise TypeError(f"limb {self.name!r}.links[{k}]: expected a link name (str), got {describe(v)}")
         object.__setattr__(self, "links", links)
+        if self.constraint_stiffness is not None:
+            kc = float(as_finite_array(self.constraint_stiffness, f"limb {self.name!r}.constraint_stiffness", shape=()))
+            if not kc > 0.0:
+                raise InputError(f"limb {self.name!r}.constraint_stiffness: a stiffness must be positive, got {kc:g}")
+            object.__setattr__(self, "constraint_stiffness", kc)
 
     @property
     def dof(self) -> int:

@@ -128,11 +128,13 @@ class JointSpec(_Strict):
     offset: NumberOrTable = None
     offset_deg: NumberOrTable = None
     freedom_names: list[str] | None = None
+    stiffness: NumberOrTable = None
 
 
 class LimbSpec(_Strict):
     name: str
     joints: Annotated[list[JointSpec], Len(1)]
+    constraint_stiffness: float | None = None
 
 
 class GraphJointSpec(JointSpec):
@@ -249,7 +251,7 @@ def _joint(js: JointSpec, where: str, normalize: bool) -> Joint:
             actuated=js.actuated, lockable=js.lockable, locked=js.locked,
             limits=_merge_units(js, kinds, where, "limits", "limits_deg"),
             offset=_merge_units(js, kinds, where, "offset", "offset_deg"),
-            freedom_names=js.freedom_names, normalize=normalize, field=where,
+            freedom_names=js.freedom_names, normalize=normalize, field=where, stiffness=js.stiffness,
         )
     except ModelFileError:
         raise
@@ -310,7 +312,10 @@ def from_dict(data: dict[str, Any], *, source: str = "<dict>") -> Mechanism:
         limbs = []
         for i, ls in enumerate(spec.limbs or []):
             joints = tuple(_joint(js, f"limbs[{i}].joints[{j}]", spec.normalize_axes) for j, js in enumerate(ls.joints))
-            limbs.append(Limb(ls.name, joints))
+            try:
+                limbs.append(Limb(ls.name, joints, constraint_stiffness=ls.constraint_stiffness))
+            except InputError as e:
+                raise ModelFileError(f"limbs[{i}].constraint_stiffness: {str(e).split(': ', 1)[-1]}") from None
         return Mechanism(name=spec.name, limbs=tuple(limbs), **common)
     except ModelFileError:
         raise
@@ -411,7 +416,16 @@ def _joint_dict(j: Joint) -> dict:
     for key, tab in (("limits", lim), ("limits_deg", lim_deg), ("offset", off), ("offset_deg", off_deg)):
         if tab:
             d[key] = tab
+    d.update(_stiffness_entry(fs))
     return d
+
+
+def _stiffness_entry(fs) -> dict:
+    """``{"stiffness": k}`` (one freedom) or a table by freedom name; ``{}`` when none is given."""
+    stiff = {f.name: f.stiffness for f in fs if f.stiffness is not None}
+    if not stiff:
+        return {}
+    return {"stiffness": stiff[fs[0].name] if len(fs) == 1 else stiff}
 
 
 def to_dict(mech: Mechanism) -> dict[str, Any]:
@@ -439,7 +453,9 @@ def to_dict(mech: Mechanism) -> dict[str, Any]:
         d["links"] = hubs + [k.name for k in g.links if k.name not in hubs]
         d["joints"] = [{**_joint_dict(j.joint), "links": [j.a, j.b]} for j in g.joints]
     else:
-        d["limbs"] = [{"name": l.name, "joints": [_joint_dict(j) for j in l.joints]} for l in mech.limbs]
+        d["limbs"] = [{"name": l.name, "joints": [_joint_dict(j) for j in l.joints],
+                       **({} if l.constraint_stiffness is None else {"constraint_stiffness": l.constraint_stiffness})}
+                      for l in mech.limbs]
     if mech.modes:
         d["modes"] = [{"name": m.name, "driven": list(m.driven), "description": m.description} for m in mech.modes]
     if mech.positions:
