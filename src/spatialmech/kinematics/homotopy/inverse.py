@@ -57,6 +57,7 @@ import numpy as np
 from ...errors import InputError
 from ...geometry.rotations import matrix_rotvec
 from ...geometry.tolerances import (
+    HOMOTOPY_NEAR_REAL,
     HOMOTOPY_REAL,
     HOMOTOPY_SINGULAR,
     MONODROMY_DIVERGED,
@@ -657,12 +658,16 @@ def _classify(sysm: LimbIK, X, P1, done) -> tuple[list[np.ndarray], dict[str, in
         if len(kept) and np.min(np.linalg.norm(kept - x, axis=1) / (1 + np.linalg.norm(x))) < 1e-6:
             continue  # two paths to one (singular) end point
         kept = np.vstack([kept, x[None]])
+        imag = np.max(np.abs(x.imag)) / (1 + np.max(np.abs(x.real)))
+        if imag > HOMOTOPY_NEAR_REAL:  # far from real (however ill-conditioned: large complex angles)
+            cnt["complex"] += 1
+            continue
         rows = J[n] / np.maximum(np.linalg.norm(J[n], axis=1, keepdims=True), 1e-300)
         sv = np.linalg.svd(rows, compute_uv=False)
         if not sv[-1] >= HOMOTOPY_SINGULAR * sv[0]:
             cnt["singular"] += 1
             continue
-        if np.max(np.abs(x.imag)) / (1 + np.max(np.abs(x.real))) < HOMOTOPY_REAL:
+        if imag < HOMOTOPY_REAL:
             real.append(x.real.copy())
         else:
             cnt["complex"] += 1
