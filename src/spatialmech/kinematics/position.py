@@ -597,10 +597,11 @@ def _solve_limb(mech: Mechanism, li: int, D: np.ndarray, q_start: np.ndarray, q_
     why = f"multi-start Gauss-Newton from {starts} start(s) (no completeness argument)"
     if res.passive_dim:
         why += f"; the solution set has dimension {res.passive_dim} (passive freedoms), the multi-start's path"
-    rep = {"limb": name, "method": "multistart", "complete": False, "completeness": f"NOT proven: {why}"}
+    if refused:
+        why += f"; the homotopy refused the limb: {refused}"
+    rep: dict = {"limb": name, "method": "multistart", "complete": False, "completeness": f"NOT proven: {why}"}
     if refused:
         rep["homotopy_refused"] = refused
-        rep["completeness"] += f"; the homotopy refused the limb: {refused}"
     return res, rep
 
 

@@ -62,6 +62,8 @@ __all__ = [
     "correct_on_hyperplane",
     "driver_determinants",
     "driver_determinants_many",
+    "ik_pack",
+    "ik_track",
     "limb_gn",
     "limb_inverse_many",
     "loop_square_batch",
@@ -71,7 +73,5 @@ __all__ = [
     "retract",
     "sps_leg_lengths",
     "track_parameter",
-    "ik_pack",
-    "ik_track",
     "warm_up",
 ]

@@ -106,72 +106,94 @@ def nb_ik_system(th, P, dP, lk, lA, lA2, li, rk, rA, rA2, ri, point, centre, C, 
     rt = np.zeros(size, dtype=np.complex128)
     dr = np.zeros((size, n), dtype=np.complex128)
     if point:
-        for a in range(3):
-            u = 0j
-            v = 0j
+        _point_eqs(TL, dTL, TR, dTR, E, dE, s, ds, P, dP, centre, r, rt, dr)
+    else:
+        _full_eqs(TL, dTL, TR, dTR, E, dE, s, ds, P, dP, r, rt, dr)
+    _compress(C, P, dP, r, rt, dr, F, J, Ft)
+
+
+@njit(cache=True)
+def _point_eqs(TL, dTL, TR, dTR, E, dE, s, ds, P, dP, centre, r, rt, dr):
+    """The S joint's centre seen from both sides, and its derivatives."""
+    n = dTL.shape[0]
+    for a in range(3):
+        u = 0j
+        v = 0j
+        for b in range(4):
+            u += TL[a, b] * centre[b]
+        Ev = 0j
+        dEv = 0j
+        for c in range(3):
+            vc = 0j
             for b in range(4):
-                u += TL[a, b] * centre[b]
-            Ev = 0j
-            dEv = 0j
+                vc += TR[c, b] * centre[b]
+            Ev += E[a, c] * vc
+            dEv += dE[a, c] * vc
+        v = Ev
+        r[a] = s * (u - P[4 + a]) - v
+        rt[a] = ds * (u - P[4 + a]) - s * dP[4 + a] - dEv
+        for z in range(n):
+            du = 0j
+            for b in range(4):
+                du += dTL[z, a, b] * centre[b]
+            dv = 0j
             for c in range(3):
                 vc = 0j
                 for b in range(4):
-                    vc += TR[c, b] * centre[b]
-                Ev += E[a, c] * vc
-                dEv += dE[a, c] * vc
-            v = Ev
-            r[a] = s * (u - P[4 + a]) - v
-            rt[a] = ds * (u - P[4 + a]) - s * dP[4 + a] - dEv
-            for z in range(n):
-                du = 0j
-                for b in range(4):
-                    du += dTL[z, a, b] * centre[b]
-                dv = 0j
-                for c in range(3):
-                    vc = 0j
-                    for b in range(4):
-                        vc += dTR[z, c, b] * centre[b]
-                    dv += E[a, c] * vc
-                dr[a, z] = s * du - dv
-    else:
-        # Pm = RL^T E RR: the entries (0, 1), (0, 2), (1, 2); LE = RL^T E, ER = E RR
-        LE = np.zeros((3, 3), dtype=np.complex128)
-        ER = np.zeros((3, 3), dtype=np.complex128)
-        LdE = np.zeros((3, 3), dtype=np.complex128)
-        for a in range(3):
-            for b in range(3):
-                for c in range(3):
-                    LE[a, b] += TL[c, a] * E[c, b]
-                    ER[a, b] += E[a, c] * TR[c, b]
-                    LdE[a, b] += TL[c, a] * dE[c, b]
-        for e in range(3):
-            a = 0 if e < 2 else 1
-            b = 1 if e == 0 else 2
-            acc = 0j
-            acct = 0j
+                    vc += dTR[z, c, b] * centre[b]
+                dv += E[a, c] * vc
+            dr[a, z] = s * du - dv
+
+
+@njit(cache=True)
+def _full_eqs(TL, dTL, TR, dTR, E, dE, s, ds, P, dP, r, rt, dr):
+    """The off-diagonal rotation entries and the translation, and their derivatives."""
+    n = dTL.shape[0]
+    # Pm = RL^T E RR: the entries (0, 1), (0, 2), (1, 2); LE = RL^T E, ER = E RR
+    LE = np.zeros((3, 3), dtype=np.complex128)
+    ER = np.zeros((3, 3), dtype=np.complex128)
+    LdE = np.zeros((3, 3), dtype=np.complex128)
+    for a in range(3):
+        for b in range(3):
             for c in range(3):
-                acc += LE[a, c] * TR[c, b]
-                acct += LdE[a, c] * TR[c, b]
-            r[e] = acc
-            rt[e] = acct
-            for z in range(n):
-                d = 0j
-                for c in range(3):
-                    d += dTL[z, c, a] * ER[c, b] + LE[a, c] * dTR[z, c, b]
-                dr[e, z] = d
-        for a in range(3):
-            Ep = 0j
-            dEp = 0j
+                LE[a, b] += TL[c, a] * E[c, b]
+                ER[a, b] += E[a, c] * TR[c, b]
+                LdE[a, b] += TL[c, a] * dE[c, b]
+    for e in range(3):
+        a = 0 if e < 2 else 1
+        b = 1 if e == 0 else 2
+        acc = 0j
+        acct = 0j
+        for c in range(3):
+            acc += LE[a, c] * TR[c, b]
+            acct += LdE[a, c] * TR[c, b]
+        r[e] = acc
+        rt[e] = acct
+        for z in range(n):
+            d = 0j
             for c in range(3):
-                Ep += E[a, c] * TR[c, 3]
-                dEp += dE[a, c] * TR[c, 3]
-            r[3 + a] = s * (TL[a, 3] - P[4 + a]) - Ep
-            rt[3 + a] = ds * (TL[a, 3] - P[4 + a]) - s * dP[4 + a] - dEp
-            for z in range(n):
-                d = 0j
-                for c in range(3):
-                    d += E[a, c] * dTR[z, c, 3]
-                dr[3 + a, z] = s * dTL[z, a, 3] - d
+                d += dTL[z, c, a] * ER[c, b] + LE[a, c] * dTR[z, c, b]
+            dr[e, z] = d
+    for a in range(3):
+        Ep = 0j
+        dEp = 0j
+        for c in range(3):
+            Ep += E[a, c] * TR[c, 3]
+            dEp += dE[a, c] * TR[c, 3]
+        r[3 + a] = s * (TL[a, 3] - P[4 + a]) - Ep
+        rt[3 + a] = ds * (TL[a, 3] - P[4 + a]) - s * dP[4 + a] - dEp
+        for z in range(n):
+            d = 0j
+            for c in range(3):
+                d += E[a, c] * dTR[z, c, 3]
+            dr[3 + a, z] = s * dTL[z, a, 3] - d
+
+
+@njit(cache=True)
+def _compress(C, P, dP, r, rt, dr, F, J, Ft):
+    """``C r - b`` and its derivatives."""
+    n = dr.shape[1]
+    size = C.shape[1]
     for i in range(C.shape[0]):
         f = -P[7 + i]
         ft = -dP[7 + i]
@@ -200,6 +222,40 @@ def _vel(th, P0, dP, t, sysargs, F, J, Ft, Pt, ws, out):
 
 
 @njit(cache=True)
+def _step(x, P0, dP, t, hh, sysargs, F, J, Ft, Pt, ws, ks, xs, xc, dx):
+    """One RK4 predictor step of ``hh`` from ``(x, t)`` and two Newton corrections into ``xc``:
+    ``(ok, d0, d1)``, the corrections' sizes relative to ``1 + |x|``."""
+    n = x.shape[0]
+    ok = _vel(x, P0, dP, t, sysargs, F, J, Ft, Pt, ws, ks[0])
+    for k, frac in ((1, 0.5), (2, 0.5), (3, 1.0)):
+        if ok:
+            for i in range(n):
+                xs[i] = x[i] + frac * hh * ks[k - 1, i]
+            ok = _vel(xs, P0, dP, t + frac * hh, sysargs, F, J, Ft, Pt, ws, ks[k])
+    d = np.full(2, np.inf)
+    if not ok:
+        return False, d[0], d[1]
+    nx = 0.0
+    for i in range(n):
+        xc[i] = x[i] + hh / 6.0 * (ks[0, i] + 2.0 * ks[1, i] + 2.0 * ks[2, i] + ks[3, i])
+        nx += abs(xc[i]) ** 2
+    nx = 1.0 + np.sqrt(nx)
+    lk, lA, lA2, li, rk, rA, rA2, ri, point, centre, C = sysargs
+    for c in range(2):
+        for a in range(P0.shape[0]):
+            Pt[a] = P0[a] + (t + hh) * dP[a]
+        nb_ik_system(xc, Pt, dP, lk, lA, lA2, li, rk, rA, rA2, ri, point, centre, C, F, J, Ft, ws)
+        if not nb_lu_solve(J, F, dx):
+            return False, d[0], d[1]
+        sq = 0.0
+        for i in range(n):
+            sq += abs(dx[i]) ** 2
+            xc[i] -= dx[i]
+        d[c] = np.sqrt(sq) / nx
+    return True, d[0], d[1]
+
+
+@njit(cache=True)
 def nb_ik_track(X0, P0s, P1s, lk, lA, lA2, li, rk, rA, rA2, ri, point, centre, C, h0, hmin, max_steps, jump, newton,
                 X, T, done, steps):
     """Track every path ``X0[p]`` from ``P0s[p]`` to ``P1s[p]`` (straight segments)."""
@@ -216,76 +272,30 @@ def nb_ik_track(X0, P0s, P1s, lk, lA, lA2, li, rk, rA, rA2, ri, point, centre, C
     Ft = np.empty(n, dtype=np.complex128)
     Pt = np.empty(P0s.shape[1], dtype=np.complex128)
     dP = np.empty(P0s.shape[1], dtype=np.complex128)
-    k1 = np.empty(n, dtype=np.complex128)
-    k2 = np.empty(n, dtype=np.complex128)
-    k3 = np.empty(n, dtype=np.complex128)
-    k4 = np.empty(n, dtype=np.complex128)
+    ks = np.empty((4, n), dtype=np.complex128)
     xs = np.empty(n, dtype=np.complex128)
     xc = np.empty(n, dtype=np.complex128)
     dx = np.empty(n, dtype=np.complex128)
     for p in range(X0.shape[0]):
         x = X[p]
-        for i in range(n):
-            x[i] = X0[p, i]
-        for a in range(P0s.shape[1]):
-            dP[a] = P1s[p, a] - P0s[p, a]
-        P0 = P0s[p]
+        x[:] = X0[p]
+        dP[:] = P1s[p] - P0s[p]
         t = 0.0
         h = h0
         good = 0
-        fin = False
         for _ in range(max_steps):
             hh = min(h, 1.0 - t)
-            ok = _vel(x, P0, dP, t, sysargs, F, J, Ft, Pt, ws, k1)
-            if ok:
-                for i in range(n):
-                    xs[i] = x[i] + 0.5 * hh * k1[i]
-                ok = _vel(xs, P0, dP, t + 0.5 * hh, sysargs, F, J, Ft, Pt, ws, k2)
-            if ok:
-                for i in range(n):
-                    xs[i] = x[i] + 0.5 * hh * k2[i]
-                ok = _vel(xs, P0, dP, t + 0.5 * hh, sysargs, F, J, Ft, Pt, ws, k3)
-            if ok:
-                for i in range(n):
-                    xs[i] = x[i] + hh * k3[i]
-                ok = _vel(xs, P0, dP, t + hh, sysargs, F, J, Ft, Pt, ws, k4)
-            d0 = np.inf
-            d1 = np.inf
-            tn = t + hh
-            if ok:
-                nx = 0.0
-                for i in range(n):
-                    xc[i] = x[i] + hh / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
-                    nx += abs(xc[i]) ** 2
-                nx = 1.0 + np.sqrt(nx)
-                for c in range(2):
-                    if not ok:
-                        break
-                    for a in range(P0.shape[0]):
-                        Pt[a] = P0[a] + tn * dP[a]
-                    nb_ik_system(xc, Pt, dP, lk, lA, lA2, li, rk, rA, rA2, ri, point, centre, C, F, J, Ft, ws)
-                    ok = nb_lu_solve(J, F, dx)
-                    if ok:
-                        sq = 0.0
-                        for i in range(n):
-                            sq += abs(dx[i]) ** 2
-                            xc[i] -= dx[i]
-                        if c == 0:
-                            d0 = np.sqrt(sq) / nx
-                        else:
-                            d1 = np.sqrt(sq) / nx
-            acc = ok and np.isfinite(d0) and np.isfinite(d1) and d0 < jump and (d1 < 0.1 * d0 or d1 < newton)
-            if acc:
-                for i in range(n):
-                    x[i] = xc[i]
-                t = tn
+            ok, d0, d1 = _step(x, P0s[p], dP, t, hh, sysargs, F, J, Ft, Pt, ws, ks, xs, xc, dx)
+            if ok and np.isfinite(d0) and np.isfinite(d1) and d0 < jump and (d1 < 0.1 * d0 or d1 < newton):
+                x[:] = xc
+                t += hh
                 steps[p] += 1
                 good += 1
                 if good >= 2:
                     h *= 2.0
                     good = 0
                 if t >= 1.0:
-                    fin = True
+                    done[p] = True
                     break
             else:
                 h *= 0.5
@@ -293,7 +303,6 @@ def nb_ik_track(X0, P0s, P1s, lk, lA, lA2, li, rk, rA, rA2, ri, point, centre, C
                 if h < hmin:
                     break
         T[p] = t
-        done[p] = fin
 
 
 def ik_pack(sysm) -> tuple:
