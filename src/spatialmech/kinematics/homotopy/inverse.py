@@ -713,8 +713,7 @@ def limb_inverse(mech: Mechanism, li: int, D: np.ndarray, *, seed: int = 0) -> L
     g, cached = _generic(sysm, seed)
     P1 = sysm.pose_parameters(np.asarray(D, float))
     P1[:4] *= P1[:4] @ g.P0[:4]  # the same rotation; the quaternion nearest P0's (a shorter path)
-    X, _, done = _segment(sysm, g.X, g.P0, P1)
-    X = _refine(sysm, X, P1)
+    X, _, done = _segment(sysm, g.X, g.P0, P1)  # a finished path ends with two Newton corrections
     cand = np.flatnonzero(~done & np.all(np.isfinite(X), axis=1) & (np.linalg.norm(X, axis=1) < MONODROMY_DIVERGED))
     if len(cand):  # stopped short, not diverging: the Cauchy end game
 
