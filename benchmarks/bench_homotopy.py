@@ -10,6 +10,12 @@ blackbox solver (goal: under 2 s), and a parameter-homotopy re-solve for new leg
 Cases: the ready-made stewart-6sps (a symmetric geometry: 28 generic solutions) and a random
 general 6-6 platform (40).  ``phc`` is Debian's phcpack; without it that baseline is
 skipped and said so.
+
+Inverse position of one limb by homotopy (kinematics/homotopy/inverse.py, issue 27), reported
+under ``ik``: ``ik_6r_first_s`` (a random general 6R: the generic solve, monodromy to the 16 of
+the root count, then the pose; target < 2 s; numba compilation excluded by a warm-up on another
+geometry), ``ik_6r_resolve_ms`` (median re-solve at new poses, the 16 cached paths; target
+< 50 ms) and ``ik_puma_solutions`` (the PUMA 560: 8).
 """
 
 from __future__ import annotations
@@ -30,6 +36,67 @@ from spatialmech.kinematics.homotopy import study as hc
 
 TARGET_FIRST_S = 2.0
 TARGET_RESOLVE_MS = 50.0
+TARGET_IK_FIRST_S = 2.0
+TARGET_IK_RESOLVE_MS = 50.0
+
+
+def _dh_arm(dh):
+    """A serial arm of standard-DH R joints (as tests/test_ik_distinct.py) and its pose function."""
+    from spatialmech.model.joints import R
+    from spatialmech.model.mechanism import Limb, Mechanism, Pose
+
+    def frames(theta):
+        T = np.eye(4)
+        out = [T]
+        for (d, a, al), t in zip(dh, theta, strict=True):
+            ct, st, ca, sa = np.cos(t), np.sin(t), np.cos(al), np.sin(al)
+            T = T @ np.array([[ct, -st * ca, st * sa, a * ct], [st, ct * ca, -ct * sa, a * st], [0, sa, ca, d],
+                              [0, 0, 0, 1.0]])
+            out.append(T)
+        return out
+
+    F = frames(np.zeros(len(dh)))
+    mech = Mechanism("arm", (Limb("arm", tuple(R(f"J{i + 1}", F[i][:3, 3], F[i][:3, 2]) for i in range(len(dh)))),),
+                     platform_point=F[-1][:3, 3])
+
+    def pose(theta):
+        return Pose.from_displacement(frames(theta)[-1] @ np.linalg.inv(F[-1]), F[-1][:3, 3])
+
+    return mech, pose
+
+
+def ik_case(resolves: int) -> dict:
+    """The limb inverse position by homotopy: a random 6R and the PUMA 560."""
+    from spatialmech.kinematics.homotopy import inverse as ikh
+    from spatialmech.kinematics.position import inverse_position
+
+    puma = [(0.0, 0.0, np.pi / 2), (0.0, 0.4318, 0.0), (0.15005, 0.0203, -np.pi / 2), (0.4318, 0.0, np.pi / 2),
+            (0.0, 0.0, -np.pi / 2), (0.0, 0.0, 0.0)]
+    rng = np.random.default_rng(0)
+    warm = [(rng.uniform(-0.5, 0.5), rng.uniform(0.1, 0.6), rng.uniform(-np.pi, np.pi)) for _ in range(6)]
+    m, pose = _dh_arm(warm)
+    inverse_position(m, pose(np.zeros(6)), all_solutions=True)  # numba compilation, not timed
+    dh = [(rng.uniform(-0.5, 0.5), rng.uniform(0.1, 0.6), rng.uniform(-np.pi, np.pi)) for _ in range(6)]
+    m, pose = _dh_arm(dh)
+    ikh.clear_cache()
+    t0 = time.perf_counter()
+    res = inverse_position(m, pose(rng.uniform(-np.pi, np.pi, 6)), all_solutions=True, method="homotopy")
+    first = time.perf_counter() - t0
+    rep = res.search["limbs"][0]
+    times = []
+    for _ in range(resolves):
+        p = pose(rng.uniform(-np.pi, np.pi, 6))
+        t0 = time.perf_counter()
+        inverse_position(m, p, all_solutions=True, method="homotopy")
+        times.append(time.perf_counter() - t0)
+    mp, posep = _dh_arm(puma)
+    rp = inverse_position(mp, posep(np.array([0.3, -0.7, 0.5, 0.9, 0.6, -0.4])), all_solutions=True, method="homotopy")
+    resolve_ms = float(np.median(times) * 1e3)
+    return {"ik_6r_first_s": first, "ik_6r_resolve_ms": resolve_ms, "ik_6r_resolve_speedup": first * 1e3 / resolve_ms,
+            "ik_6r_paths": rep["n_paths"], "ik_6r_real": rep["n_real"], "ik_6r_complete": rep["complete"],
+            "ik_puma_solutions": len(rp.limbs[0].solutions), "ik_puma_complete": rp.search["limbs"][0]["complete"],
+            "ik_first_met": first < TARGET_IK_FIRST_S, "ik_resolve_met": resolve_ms < TARGET_IK_RESOLVE_MS,
+            "ik_puma_met": len(rp.limbs[0].solutions) == 8}
 
 
 def phc_blackbox(sysm, values, c) -> tuple[float, int] | None:
@@ -85,8 +152,12 @@ def main(argv=None) -> dict:
         c["first_met"] = c["first_solve_s"] < TARGET_FIRST_S and (c.get("phc_blackbox_s") is None
                                                                    or c["first_solve_s"] < c["phc_blackbox_s"])
         c["resolve_met"] = c["resolve_median_ms"] is not None and c["resolve_median_ms"] < TARGET_RESOLVE_MS
-    out = {"cases": cases, "targets": {"first_solve_s": TARGET_FIRST_S, "resolve_ms": TARGET_RESOLVE_MS},
-           "phc": shutil.which("phc") is not None}
+    ik = ik_case(3 if args.quick else 20)
+    out = {"cases": cases, "targets": {"first_solve_s": TARGET_FIRST_S, "resolve_ms": TARGET_RESOLVE_MS,
+                                       "ik_6r_first_s": TARGET_IK_FIRST_S, "ik_6r_resolve_ms": TARGET_IK_RESOLVE_MS,
+                                       "ik_puma_solutions": 8},
+           "phc": shutil.which("phc") is not None, "ik": ik, **{k: ik[k] for k in
+                                                                ("ik_6r_first_s", "ik_6r_resolve_ms", "ik_puma_solutions")}}
     if args.json:
         print(json.dumps(out, indent=2))
         return out
@@ -99,6 +170,12 @@ def main(argv=None) -> dict:
               f"than PHCpack): {word[c['first_met']]}")
         print(f"  re-solve       {c['resolve_median_ms']:.0f} ms median, {c['resolve_speedup']:.0f} x faster than the "
               f"first solve (target < {TARGET_RESOLVE_MS:g} ms): {word[c['resolve_met']]}")
+    print(f"limb IK 6R     {ik['ik_6r_paths']} paths, {ik['ik_6r_real']} real, complete {ik['ik_6r_complete']}")
+    print(f"  first solve    {ik['ik_6r_first_s']:.2f} s (target < {TARGET_IK_FIRST_S:g} s): {word[ik['ik_first_met']]}")
+    print(f"  re-solve       {ik['ik_6r_resolve_ms']:.0f} ms median, {ik['ik_6r_resolve_speedup']:.0f} x faster than the "
+          f"first solve (target < {TARGET_IK_RESOLVE_MS:g} ms): {word[ik['ik_resolve_met']]}")
+    print(f"limb IK PUMA   {ik['ik_puma_solutions']} solutions (target 8), complete {ik['ik_puma_complete']}: "
+          f"{word[ik['ik_puma_met']]}")
     return out
 
 

@@ -38,6 +38,7 @@ from .closure import (
 from .backend import closure_jacobian, correct, retract
 
 __all__ = [
+    "INVERSE_METHODS",
     "InverseResult",
     "LimbSolutions",
     "PoseFit",
@@ -453,6 +454,7 @@ def inverse_position(
     start: Configuration | None = None,
     tol: Tolerances | float | None = None,
     fit: bool = False,
+    method: str = "auto",
 ) -> InverseResult:
     """Joint values of every limb for a platform pose.
 
@@ -470,15 +472,27 @@ def inverse_position(
     is within the ``reachability`` tolerance (nondimensional: rad, and length / L) the pose is
     reachable and the solutions are those of the fitted pose; either way :attr:`InverseResult.pose_fit`
     says how far it is.
+
+    ``method`` (with ``all_solutions``; :data:`INVERSE_METHODS`): ``"homotopy"``: every limb
+    from the ground to the output link that :mod:`.homotopy.inverse` covers (R, P, C, U joints,
+    helical ones of pitch 0, at most one S joint; finitely many solutions) by a parameter
+    homotopy, with a completeness statement (proven by a root count or a trace test, or "NOT
+    proven: <reason>"); the other limbs by the multi-start, labelled with the reason (a helical
+    joint of nonzero pitch: transcendental; passive freedoms: a positive-dimensional solution
+    set; limbs coupled through internal bodies).  ``"auto"``: the same (the homotopy where it
+    covers the limb, else the multi-start).  ``"multistart"``: the multi-start for every limb.
+    ``search["limbs"]`` reports, per limb, the method, ``complete`` and ``completeness``.
     """
+    if method not in INVERSE_METHODS:
+        raise InputError(f"method: {method!r} is not one of {', '.join(INVERSE_METHODS)}")
     t = resolve_tolerances(tol, "closure")
-    res = _inverse(mech, pose, all_solutions, n_seeds, seed, start, t)
+    res = _inverse(mech, pose, all_solutions, n_seeds, seed, start, t, method)
     if not fit or res.reachable:
         return res
     pf = configuration_at_pose(mech, pose, start=start, tol=t.closure)
     if pf.converged and pf.error <= t.reachability:
         fitted_pose = platform_pose(mech, pf.config, name=pose.name)
-        res2 = _inverse(mech, fitted_pose, all_solutions, n_seeds, seed, pf.config, t)
+        res2 = _inverse(mech, fitted_pose, all_solutions, n_seeds, seed, pf.config, t, method)
         if res2.reachable:
             return replace(res2, pose=pose, pose_fit=pf,
                            search={**res2.search, "fitted": "the solutions are those of the nearest closed pose"})
@@ -512,7 +526,7 @@ def limb_clusters(mech: Mechanism) -> list[list[int]]:
 
 
 def _inverse(mech: Mechanism, pose: Pose, all_solutions: bool, n_seeds: int, seed: int,
-             start: Configuration | None, t: Tolerances) -> InverseResult:
+             start: Configuration | None, t: Tolerances, method: str = "multistart") -> InverseResult:
     D = pose.displacement(mech.platform_point)
     rng = np.random.default_rng(seed)
     q_start = start.q if start is not None else np.zeros(len(mech.freedom_refs))
@@ -521,12 +535,17 @@ def _inverse(mech: Mechanism, pose: Pose, all_solutions: bool, n_seeds: int, see
     B_all = hub_displacements(mech, q_start, D) if start is None else start.B.copy()
     all_ok = True
     clusters = []
+    reports: list[dict] = [{}] * len(mech.limbs)
     for cl in limb_clusters(mech):
         if len(cl) == 1 and mech.limb_ends[cl[0]] == (None, 0):
-            res_l = _inverse_limb(mech, cl[0], D, q_start, q_all, all_solutions, n_seeds, rng, t)
+            res_l, reports[cl[0]] = _solve_limb(mech, cl[0], D, q_start, q_all, all_solutions, n_seeds, rng, t, method, seed)
             out[cl[0]] = res_l
             all_ok &= res_l.reachable
         else:
+            for i in cl:
+                reports[i] = {"limb": mech.limbs[i].name, "method": "multistart", "complete": False,
+                              "completeness": ("NOT proven: multi-start Gauss-Newton on limbs coupled through internal "
+                                               "bodies (the homotopy covers a limb from the ground to the output link)")}
             sols, B_all = _inverse_cluster(mech, cl, D, q_start, q_all, B_all, all_solutions, n_seeds, rng, t)
             clusters.append({"limbs": [mech.limbs[i].name for i in cl],
                              "bodies": sorted({mech.hubs[h + 1] for i in cl for h in mech.limb_ends[i]
@@ -540,11 +559,78 @@ def _inverse(mech: Mechanism, pose: Pose, all_solutions: bool, n_seeds: int, see
               "tolerance": t.closure, "dedup_tol": t.dedup,
               "distinct_by": ("joint values: angles modulo 2 pi (2 sin(d / 2)), slides / L, S joints by their rotation; "
                               "solutions joined by a continuum (a passive spin) count once")}
+    homotopy = any(r.get("method") == "homotopy" for r in reports)
+    if homotopy:
+        search["method"] = "homotopy continuation per limb (Gauss-Newton multi-start where it does not cover the limb)"
+    if all_solutions:
+        search["method_requested"] = method
+        search["limbs"] = reports
+        search["complete"] = all(r.get("complete", False) for r in reports)
     if clusters:
         search["clusters"] = clusters
         search["coupled"] = ("limbs that share an internal body are solved together with the body (Gauss-Newton on their "
                              "closure equations); their solutions correspond index by index")
     return InverseResult(pose, tuple(x for x in out if x is not None), config, search)
+
+
+#: The values of ``inverse_position(method=...)``.
+INVERSE_METHODS = ("auto", "homotopy", "multistart")
+
+
+def _solve_limb(mech: Mechanism, li: int, D: np.ndarray, q_start: np.ndarray, q_all: np.ndarray, all_solutions: bool,
+                n_seeds: int, rng: np.random.Generator, t: Tolerances, method: str, seed: int) -> tuple[LimbSolutions, dict]:
+    """One limb from the ground to the output link: by the homotopy (:func:`_homotopy_limb`) when
+    asked and it covers the limb, else by the multi-start; and its per-limb search report."""
+    name = mech.limbs[li].name
+    refused = ""
+    if all_solutions and method != "multistart":
+        from .homotopy.inverse import limb_inverse
+
+        try:
+            hres = limb_inverse(mech, li, D, seed=seed)
+        except InputError as exc:
+            refused = str(exc)
+        else:
+            return _homotopy_limb(mech, li, D, q_all, hres, t), {"limb": name, **hres.report()}
+    res = _inverse_limb(mech, li, D, q_start, q_all, all_solutions, n_seeds, rng, t)
+    starts = 1 + (n_seeds if all_solutions else 0)
+    why = f"multi-start Gauss-Newton from {starts} start(s) (no completeness argument)"
+    if res.passive_dim:
+        why += f"; the solution set has dimension {res.passive_dim} (passive freedoms), the multi-start's path"
+    if refused:
+        why += f"; the homotopy refused the limb: {refused}"
+    rep: dict = {"limb": name, "method": "multistart", "complete": False, "completeness": f"NOT proven: {why}"}
+    if refused:
+        rep["homotopy_refused"] = refused
+    return res, rep
+
+
+def _homotopy_limb(mech: Mechanism, li: int, D: np.ndarray, q_all: np.ndarray, hres, t: Tolerances) -> LimbSolutions:
+    """The homotopy's real solutions of a limb, polished by Gauss-Newton on the limb, checked
+    against the closure tolerance and told apart (:func:`solution_key`); fills ``q_all``."""
+    L = mech.characteristic_length
+    ch, sl = limb_chains(mech)[li], limb_slices(mech)[li]
+    lin = np.array([r.freedom.kind == "P" for r in mech.freedom_refs[sl]])
+    form = solution_form(mech, li)
+    sols: list[np.ndarray] = []
+    res: list[float] = []
+    keys: list[np.ndarray] = []
+    for q0 in hres.solutions:
+        q, rn, ok = limb_gauss_newton(ch, D, np.asarray(q0, float).copy(), lin, L, tol=t.closure)
+        if not ok:
+            continue
+        q = wrap_rotations(mech, q, range(sl.start, sl.stop))
+        key = solution_key(form, q)
+        if any(np.linalg.norm(key - k2) < t.dedup for k2 in keys):
+            continue
+        keys.append(key)
+        sols.append(q)
+        res.append(rn)
+    idx_l = set(range(sl.start, sl.stop))
+    if sols:
+        q_all[sl] = sols[0]
+    viol = tuple(tuple(within_limits(mech, np.r_[q_all[: sl.start], s, q_all[sl.stop :]], indices=idx_l)) for s in sols)
+    return LimbSolutions(mech.limbs[li].name, tuple(sols), tuple(float(r) for r in res), bool(sols), 0, viol)
 
 
 def random_joint_values(mech: Mechanism, rng: np.random.Generator, sl: slice, keep: np.ndarray, held) -> np.ndarray:

@@ -6,7 +6,7 @@ the kernels are plain-array ``@njit(cache=True)`` functions in :mod:`.kernels_se
 :mod:`.kernels_closure`, :mod:`.kernels_blocks`, :mod:`.kernels_drivers`, :mod:`.kernels_legs`
 (with its entry :mod:`.legs`: six S-P-S legs in pose coordinates), :mod:`.kernels_homotopy` (the
 Study formulation's parameter homotopy) and :mod:`.kernels_loops` (the loop formulation's square
-system); :mod:`.jit` is numba's ``njit`` or its stand-in.
+system), :mod:`.kernels_ik` (one limb's inverse position); :mod:`.jit` is numba's ``njit`` or its stand-in.
 
 Callers do not choose between this package and the Python reference themselves:
 :mod:`spatialmech.kinematics.backend` does (``backend.engine()`` is this package when it is in
@@ -40,6 +40,7 @@ from .engine import (
 )
 from .jit import AVAILABLE, UNAVAILABLE_REASON
 from .kernels_homotopy import track_parameter
+from .kernels_ik import ik_pack, ik_track
 from .kernels_loops import pack as pack_loop_system
 from .kernels_loops import square_batch as loop_square_batch
 from .legs import correct_legs
@@ -62,6 +63,8 @@ __all__ = [
     "correct_on_hyperplane",
     "driver_determinants",
     "driver_determinants_many",
+    "ik_pack",
+    "ik_track",
     "limb_gn",
     "limb_inverse_many",
     "loop_square_batch",

@@ -1,0 +1,155 @@
+"""Every inverse solution of a limb by homotopy continuation, with a completeness statement
+(issue 27: "Complete inverse position of any limb or serial chain")."""
+
+import numpy as np
+import pytest
+
+import spatialmech as sm
+from spatialmech.errors import InputError
+from spatialmech.kinematics.closure import chain_forward
+from spatialmech.kinematics.homotopy import inverse as ikh
+from spatialmech.kinematics.position import inverse_position
+from spatialmech.model.joints import H, R, S, U, P
+from spatialmech.model.mechanism import Limb, Mechanism
+
+from .test_ik_distinct import PUMA560_DH, _check_serial_solutions, dh_pose, serial_arm
+
+
+def _closes(mech, li, pose, sols, tol=1e-9):
+    D = pose.displacement(mech.platform_point)
+    ch = sm.kinematics.closure.limb_chains(mech)[li]
+    for q in sols:
+        T, _ = chain_forward(ch, np.asarray(q))
+        assert np.max(np.abs(T - D)) < tol
+
+
+def _wrapped(x):
+    return np.angle(np.exp(1j * np.asarray(x)))
+
+
+def _same_sets(a, b):
+    assert len(a) == len(b)
+    for q in a:
+        assert any(np.max(np.abs(_wrapped(q - p))) < 1e-7 for p in b)
+
+
+def test_puma560_eight_of_eight_proven():
+    m = serial_arm("puma560", PUMA560_DH)
+    theta = np.array([0.3, -0.7, 0.5, 0.9, 0.6, -0.4])
+    pose = dh_pose(PUMA560_DH, theta)
+    res = inverse_position(m, pose, all_solutions=True, method="homotopy")
+    rep = res.search["limbs"][0]
+    assert rep["method"] == "homotopy" and rep["complete"] and rep["completeness"].startswith("complete (proven")
+    assert "Pieper" in rep["completeness"] and rep["n_paths"] == 8
+    sols = [np.asarray(q) for q in res.limbs[0].solutions]
+    assert len(sols) == 8 and res.search["complete"]
+    _check_serial_solutions(PUMA560_DH, theta, sols)
+    ms = inverse_position(m, pose, all_solutions=True, method="multistart", n_seeds=200)
+    assert ms.search["limbs"][0]["method"] == "multistart" and not ms.search["limbs"][0]["complete"]
+    _same_sets(sols, [np.asarray(q) for q in ms.limbs[0].solutions])
+    # a re-solve at another pose tracks the cached 8 paths
+    theta2 = np.array([-1.0, 0.4, -0.3, 0.2, -0.9, 1.1])
+    res2 = inverse_position(m, dh_pose(PUMA560_DH, theta2), all_solutions=True)
+    assert res2.search["limbs"][0]["cached"] and len(res2.limbs[0].solutions) == 8
+    _check_serial_solutions(PUMA560_DH, theta2, [np.asarray(q) for q in res2.limbs[0].solutions])
+
+
+def random_6r(seed=0):
+    """A random general 6R (no published 16-real example was found with reliable numbers: the
+    count checked is the 16 complex solutions, proven by the root count)."""
+    rng = np.random.default_rng(seed)
+    dh = [(rng.uniform(-0.5, 0.5), rng.uniform(0.1, 0.6), rng.uniform(-np.pi, np.pi)) for _ in range(6)]
+    return dh, rng.uniform(-np.pi, np.pi, 6)
+
+
+def test_general_6r_sixteen_proven_and_real_ones_close():
+    dh, theta = random_6r(0)
+    m = serial_arm("random-6r", dh)
+    res = inverse_position(m, dh_pose(dh, theta), all_solutions=True)  # auto: the homotopy covers a 6R
+    rep = res.search["limbs"][0]
+    assert rep["method"] == "homotopy" and rep["complete"] and rep["n_paths"] == 16
+    assert "root count: 16" in rep["completeness"]
+    assert rep["n_real"] + rep["n_complex"] + rep["n_at_infinity"] + rep["n_singular"] == 16
+    sols = [np.asarray(q) for q in res.limbs[0].solutions]
+    assert len(sols) == rep["n_real"] >= 1 and len(sols) % 2 == 0  # complex ones come in pairs
+    _check_serial_solutions(dh, theta, sols)
+    # the multi-start finds no real solution the homotopy misses
+    ms = inverse_position(m, dh_pose(dh, theta), all_solutions=True, method="multistart", n_seeds=300)
+    for q in ms.limbs[0].solutions:
+        assert any(np.max(np.abs(_wrapped(np.asarray(q) - p))) < 1e-7 for p in sols)
+
+
+def planar_rrr_leg():
+    """One leg of a planar 3-RRR (three parallel axes): two working modes."""
+    z = np.array([0, 0, 1.0])
+    return Mechanism("rrr-leg", (Limb("leg", (R("A", [1.0, 0, 0], z, actuated=True), R("B", [1.0, 0.6, 0], z),
+                                                   R("C", [0.3, 0, 0], z))),), platform_point=np.zeros(3))
+
+
+def test_planar_rrr_leg_two_modes_proven_by_trace_test():
+    m = planar_rrr_leg()
+    from scipy.spatial.transform import Rotation
+
+    pose = sm.Pose(Rotation.from_rotvec([0, 0, 0.1]).as_matrix(), [0.05, -0.02, 0])
+    res = inverse_position(m, pose, all_solutions=True, method="homotopy")
+    rep = res.search["limbs"][0]
+    assert rep["method"] == "homotopy" and rep["complete"] and "trace test passed" in rep["completeness"]
+    assert len(res.limbs[0].solutions) == 2
+    _closes(m, 0, pose, res.limbs[0].solutions)
+
+
+def test_rrrp_and_rps_type_limbs():
+    e = np.eye(3)
+    # an R-U-S limb: three revolutes place the S joint's centre (Pieper's quartic bounds it)
+    rus = Mechanism("rus", (Limb("leg", (R("A", [0.2, 0, 0], e[2]), U("U", [0.2, 0.1, 0.3], [e[0], [0, 0.6, 0.8]]),
+                                         S("S", [0.1, 0.05, 0.6]))),), platform_point=np.array([0.1, 0.05, 0.6]))
+    q = np.array([0.3, -0.4, 0.2, 0.1, 0.2, -0.3])
+    T, _ = chain_forward(sm.kinematics.closure.limb_chains(rus)[0], q)
+    pose = sm.Pose.from_displacement(T, rus.platform_point)
+    res = inverse_position(rus, pose, all_solutions=True, method="homotopy")
+    rep = res.search["limbs"][0]
+    assert rep["method"] == "homotopy" and rep["complete"], rep["completeness"]
+    assert 1 <= len(res.limbs[0].solutions) <= 4
+    _closes(rus, 0, pose, res.limbs[0].solutions)
+    # an R-R-R-P serial chain (fewer freedoms than conditions: the random combination and offset)
+    rrrp = Mechanism("rrrp", (Limb("arm", (R("A", [0, 0, 0], e[2]), R("B", [0.3, 0, 0.2], e[1]),
+                                           R("C", [0.6, 0.1, 0.2], [0, 0.6, 0.8]), P("D", [0.8, 0.1, 0.3], e[0]))),),
+                     platform_point=np.array([0.9, 0.1, 0.3]))
+    q = np.array([0.4, -0.2, 0.7, 0.05])
+    T, _ = chain_forward(sm.kinematics.closure.limb_chains(rrrp)[0], q)
+    pose = sm.Pose.from_displacement(T, rrrp.platform_point)
+    res = inverse_position(rrrp, pose, all_solutions=True, method="homotopy")
+    rep = res.search["limbs"][0]
+    assert rep["method"] == "homotopy"
+    assert any(np.max(np.abs(_wrapped(np.asarray(s) - q))) < 1e-7 for s in res.limbs[0].solutions)
+    _closes(rrrp, 0, pose, res.limbs[0].solutions)
+
+
+def test_helical_pitch_refused_to_multistart_with_a_label():
+    e = np.eye(3)
+    m = Mechanism("rhr", (Limb("arm", (R("A", [0, 0, 0], e[2]), H("H", [0.3, 0, 0], e[0], pitch=0.02),
+                                       R("C", [0.5, 0.2, 0], e[1]))),), platform_point=np.array([0.6, 0.2, 0]))
+    with pytest.raises(InputError, match="transcendental"):
+        ikh.limb_ik_system(m, 0)
+    T, _ = chain_forward(sm.kinematics.closure.limb_chains(m)[0], np.array([0.2, 0.3, -0.1]))
+    res = inverse_position(m, sm.Pose.from_displacement(T, m.platform_point), all_solutions=True, method="homotopy")
+    rep = res.search["limbs"][0]
+    assert rep["method"] == "multistart" and not rep["complete"]
+    assert "transcendental" in rep["homotopy_refused"] and rep["completeness"].startswith("NOT proven")
+    assert res.reachable
+
+
+def test_passive_spin_keeps_the_multistart():
+    m = sm.catalog.build("stewart-6sps") if "stewart-6sps" in sm.catalog.names() else None
+    if m is None:
+        pytest.skip("no Stewart model in the catalogue")
+    res = inverse_position(m, sm.kinematics.position.platform_pose(m, sm.kinematics.closure.Configuration.reference(m)),
+                           all_solutions=True, n_seeds=4)
+    for rep in res.search["limbs"]:
+        assert rep["method"] == "multistart" and "passive" in rep["completeness"]
+
+
+def test_unknown_method_is_refused():
+    m = planar_rrr_leg()
+    with pytest.raises(InputError, match="method"):
+        inverse_position(m, sm.Pose(np.eye(3), [0, 0, 0]), all_solutions=True, method="bogus")
