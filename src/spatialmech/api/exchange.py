@@ -6,9 +6,13 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..errors import InputError, describe
 from ..model.mechanism import Mechanism
+if TYPE_CHECKING:  # imported where it runs (it loads the simulator's bindings lazily)
+    from ..analysis.validation import ValidationResult
+
 from .checks import ModelLike, as_mechanism, as_pose, check_bool, check_choice, check_int, check_number, check_path
 
 #: The formats :func:`export` writes.
@@ -66,7 +70,7 @@ def export(model: ModelLike, file, *, format: str | None = None, mode: str | Non
 def validate(model: ModelLike, motion: str | None = None, *, mode: str | None = None, start=None,
              degrees: bool = False, method: str = "project", frames: int = 12, to_position: int | None = None,
              amplitude: float = 0.02, arc: float = 2.0, actuator_path=None, tol: float = VALIDATION_TOL,
-             mjcf: str | os.PathLike | None = None):
+             mjcf: str | os.PathLike | None = None) -> ValidationResult:
     """Drive the model exported to MuJoCo through a motion computed by the library and compare
     the simulated output-link pose with the library's at every pose (docs/validation.md; needs
     the ``mujoco`` package).  ``motion``: ``"trace"`` (the 1-DOF motion; default with one

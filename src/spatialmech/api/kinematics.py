@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -22,6 +23,11 @@ from ..model.task import TaskCoordinates
 from ..model.mechanism import Mechanism, Pose
 from ..results import Progress
 from ..serialize import pose_dict
+if TYPE_CHECKING:  # the analyses are imported where they run (lazily): their types only here
+    from ..analysis.parasitic import ParasiticTable
+    from ..analysis.singularity import SingularityResult
+    from ..analysis.workspace import TaskWorkspaceResult, WorkspaceLimits, WorkspaceResult
+
 from .checks import (
     ModelLike,
     as_configuration,
@@ -303,6 +309,8 @@ def jacobian(model: ModelLike, pose=None, *, config: Configuration | None = None
     degrees = check_bool(degrees, "degrees")
     drivers = check_names(drivers, "drivers")
     task = None
+    fit: PoseFit | None
+    requested: Pose | None
     if free is not None:
         if pose is None or config is not None:
             raise InputError("free: needs a pose (and no config): the coordinates not named are held at its values")
@@ -406,10 +414,10 @@ class SingularityAnalysis:
 
     mechanism: Mechanism
     config: Configuration
-    result: object
+    result: SingularityResult
     pose_fit: PoseFit | None = None
 
-    def __getattr__(self, name):
+    def __getattr__(self, name: str) -> Any:
         if name.startswith("_") or name == "result":
             raise AttributeError(name)
         return getattr(self.result, name)
@@ -443,7 +451,7 @@ def workspace(model: ModelLike, *, kind: str = "orientation", at: Mapping[str, f
               link_diameter: float | None = None, interference: bool = True, max_poses: int | None = None,
               progress: Progress | None = None, over: Mapping | None = None, free=None, limits=None,
               cones: Mapping[str, float] | None = None, freedom_limits: Mapping | None = None,
-              max_general_poses: int | None = None):
+              max_general_poses: int | None = None) -> WorkspaceResult | TaskWorkspaceResult:
     """Workspace under joint limits (strokes, joint cones, link interference), sampled and
     refined at the boundary: ``kind="orientation"`` at a fixed position (free angles alpha,
     beta, gamma of ``R = Rz(gamma) Ry(beta) Rx(alpha)``), or ``"position"`` at a fixed
@@ -522,7 +530,7 @@ def _with_freedom_limits(mech: Mechanism, freedom_limits) -> Mechanism:
     return with_freedom_limits(mech, named) if named else mech
 
 
-def _workspace_limits(mech: Mechanism, limits, cones, link_diameter, interference: bool):
+def _workspace_limits(mech: Mechanism, limits, cones, link_diameter, interference: bool) -> WorkspaceLimits:
     """The limits of ``workspace``: ``limits`` (default: the model's), with the extra ``cones``
     and the interference check's ``link_diameter`` (none without ``interference``)."""
     from ..analysis.workspace import ConeLimit, WorkspaceLimits, default_limits
@@ -543,7 +551,8 @@ def _workspace_limits(mech: Mechanism, limits, cones, link_diameter, interferenc
     return limits
 
 
-def _task_workspace(mech: Mechanism, over, at, free, limits, tol, step, bounds, max_poses, progress):
+def _task_workspace(mech: Mechanism, over, at, free, limits, tol, step, bounds, max_poses,
+                    progress) -> TaskWorkspaceResult:
     """``workspace(kind="task")``: the checks of its own arguments, then the analysis."""
     from ..analysis.workspace import task_workspace
     from ..model.task import TASK_NAMES, TaskCoordinates
@@ -571,7 +580,7 @@ def _task_workspace(mech: Mechanism, over, at, free, limits, tol, step, bounds, 
 
 
 def parasitic(model: ModelLike, over: Mapping, *, at: Mapping[str, float] | None = None, free=None,
-              euler: str | None = None, plot=None, progress: Progress | None = None):
+              euler: str | None = None, plot=None, progress: Progress | None = None) -> ParasiticTable:
     """The parasitic motion of a lower-mobility mechanism: its solved task coordinates over a grid
     of one or two given ones (``spatialmech parasitic``, docs/lower-mobility.md).
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -17,7 +17,11 @@ from ..kinematics.position import freedom_values, platform_pose
 from ..model.mechanism import Mechanism, Pose
 from ..results import Progress, TrackStatus
 if TYPE_CHECKING:
-    from ..analysis.defects import DefectResult
+    from pathlib import Path
+
+    from ..analysis.defects import DefectResult, DJTable
+    from ..services.screening import ScreenSummary
+    from ..synthesis.rccc import RCCCResult
     from ..kinematics.tracking import TrackResult
     from ..synthesis.cs_dyads import CSFamily
     from ..synthesis.five_cs import FiveCSCheck
@@ -135,7 +139,7 @@ def track(model: ModelLike, start=None, *, increasing: str | None = None, sense:
 
 
 # ============================================================================ defects
-def dj_table(model: ModelLike, drivers=None, positions=None):
+def dj_table(model: ModelLike, drivers=None, positions=None) -> DJTable:
     """DJ (det of the complete Jacobian) at the model's task positions, per driver (default:
     every base-joint freedom); only the signs along one driver are comparable.  Returns a
     :class:`~spatialmech.analysis.defects.DJTable`.
@@ -162,9 +166,9 @@ class DefectAnalysis:
     mechanism: Mechanism
     positions: tuple[Pose, ...]
     result: DefectResult
-    figures: tuple = ()
+    figures: tuple[Path, ...] = ()
 
-    def __getattr__(self, name):
+    def __getattr__(self, name: str) -> Any:
         if name.startswith("_") or name == "result":
             raise AttributeError(name)
         return getattr(self.result, name)
@@ -201,7 +205,7 @@ def defects(model: ModelLike, positions=None, *, drivers=None, pose_tol: float |
     res = defect_analysis(mech, positions, drivers=check_names(drivers, "drivers"), pose_tol=pose_tol,
                           angle_tol_deg=angle_tol_deg, monte_carlo=check_int(monte_carlo, "monte_carlo", minimum=0),
                           seed=check_int(seed, "seed"), precision=precision, progress=optional_progress(progress))
-    figures: tuple = ()
+    figures: tuple[Path, ...] = ()
     if plot is not None:
         from ..present.defect_figures import write_defect_figures
 
@@ -211,7 +215,7 @@ def defects(model: ModelLike, positions=None, *, drivers=None, pose_tol: float |
 
 # ============================================================================ synthesis
 def synth_rccc(task="rccc-four-positions", *, pick: str = "best-rc", samples: int = 360,
-               save: str | os.PathLike | None = None, plot: str | os.PathLike | None = None):
+               save: str | os.PathLike | None = None, plot: str | os.PathLike | None = None) -> RCCCResult:
     """Four-position RCCC synthesis by solution regions (paper D).  ``task``: a ready-made task
     name, a TOML task file, or a ``TaskPositions``; ``pick``: ``"best-rc"`` (the smallest
     largest input slide) or ``"interior"`` (the most interior defect-free crank-rocker);
@@ -340,7 +344,7 @@ def synth_cs(positions=None, *, pick: int = 5, starts: int = 60, seed: int = 0, 
 def screen(task=None, out: str | os.PathLike = "screen.parquet", *, candidates: int = 1000, density: float = 0.5,
            workers: int | None = None, scheduler: str | None = None, top: int = 5, rank_by: str = "singularity",
            seed: int = 0, starts: int = 60, separation: float = 0.5, chunk_size: int = 20,
-           progress: Progress | None = None):
+           progress: Progress | None = None) -> ScreenSummary:
     """Defect screening of 5-CS linkages for seven task positions (docs/screening.md): the CS
     dyad family is sampled (``density`` dyads per unit nondimensional arc length), up to
     ``candidates`` sets of five dyads are formed (small slides preferred, limbs at least

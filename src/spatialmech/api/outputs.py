@@ -13,6 +13,7 @@ from ..errors import InputError
 from ..results import Progress, check_progress
 if TYPE_CHECKING:
     from ..present.viewer import ViewerFile
+    from ..services.studio.session import Session
 
 from .checks import ModelLike, as_mechanism, check_bool, check_choice, check_int, check_path
 
@@ -161,7 +162,7 @@ def view(model: ModelLike, out, *, motion: str = "auto", frames: int = 60, plotl
 
 
 # ============================================================================ design studio
-def studio_session(model: ModelLike = "five-cs-3"):
+def studio_session(model: ModelLike = "five-cs-3") -> Session:
     """A design-studio session on ``model`` (what ``spatialmech studio`` serves, without HTTP):
     ``drive(values)`` moves the actuators (model units, degrees for rotations) along the current
     branch by continuation and says how it went; ``state()`` is the readout (JSON payload,

@@ -4,9 +4,9 @@ lower-mobility mechanism (``sm.suggest_task_grid``) -- and the names those grids
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any, overload
 
 import numpy as np
 
@@ -16,6 +16,10 @@ from ..errors import InputError, describe
 from ..model.mechanism import Mechanism
 from ..model.task import TASK_NAMES, TaskCoordinates
 from ..results import Progress
+if TYPE_CHECKING:
+    from ..analysis.singularity import SliceResult
+    from ..analysis.task_slice import TaskSliceResult
+
 from .checks import ModelLike, as_mechanism, check_bool, check_names, check_numbers, optional_progress
 
 #: The coordinates of a pose workspace's ``at`` (``x, y, z`` length; ``alpha, beta, gamma`` rad of
@@ -52,9 +56,17 @@ def _grid(over, count: int) -> list[tuple[str, np.ndarray]]:
     return [(str(k), check_numbers(v, f"over[{k}]").reshape(-1)) for k, v in over.items()]
 
 
-def singularity_slice(model: ModelLike, over: Mapping[str, Any], *, pose=None,
+@overload
+def singularity_slice(model: ModelLike, over: Mapping[str, Any], *, pose: None = None,
                       at: Mapping[str, float] | None = None, free=None, drivers=None, degrees: bool = False,
-                      progress: Progress | None = None):
+                      progress: Progress | None = None) -> TaskSliceResult: ...
+@overload
+def singularity_slice(model: ModelLike, over: Mapping[str, Any], *, pose: Sequence[Any],
+                      at: None = None, free: None = None, drivers=None, degrees: bool = False,
+                      progress: Progress | None = None) -> SliceResult: ...
+def singularity_slice(model: ModelLike, over: Mapping[str, Any], *, pose: Sequence[Any] | None = None,
+                      at: Mapping[str, float] | None = None, free=None, drivers=None, degrees: bool = False,
+                      progress: Progress | None = None) -> SliceResult | TaskSliceResult:
     """The singularity loci (zero set of ``det J``) and the scale-free ``sigma_min`` on a 2-D
     slice; ``over`` maps two coordinates to their grid values (the first the columns ``u``, the
     second the rows ``v``).
@@ -97,7 +109,7 @@ def singularity_slice(model: ModelLike, over: Mapping[str, Any], *, pose=None,
     return _pose_slice(mech, _grid(over, 2), pose, acts, degrees, progress)
 
 
-def _pose_slice(mech: Mechanism, axes, pose, acts, degrees: bool, progress):
+def _pose_slice(mech: Mechanism, axes, pose, acts, degrees: bool, progress) -> SliceResult:
     from ..analysis.singularity import singularity_slice as _slice
     from ..geometry.rotations import euler_matrix
     from ..model.mechanism import Pose
@@ -140,8 +152,8 @@ class TaskGridSuggestion:
     given: tuple[str, ...]
     solved: tuple[str, ...]
     euler: str
-    over: dict
-    at: dict
+    over: dict[str, tuple[float, float, int]]
+    at: dict[str, float]
 
     def to_dict(self) -> dict:
         return {"given": list(self.given), "solved": list(self.solved), "euler": self.euler,

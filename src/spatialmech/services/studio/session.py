@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from typing import cast
 
 import numpy as np
 
@@ -353,15 +354,15 @@ class Session:
         joints = [{"name": j["name"], "type": j["type"], "limb_index": j["limb_index"],
                    "joint_axes": [v.tolist() for v in j["axes"]], "centre_len": j["centre"].tolist()} for j in jl]
         solid = platform_solid(m, d.platform, d.limbs, d.platform_point)
-        hull = solid is not None and solid["hull"]
+        hull = solid if solid is not None and solid["hull"] else None  # the platform mesh, when it is a hull
         return {
             "limbs_len": [l.tolist() for l in d.limbs],
             "limb_names": [l.name for l in m.limbs],
             "limb_colours": [LIMB_COLOURS[i % len(LIMB_COLOURS)] for i in range(len(m.limbs))],
             "base_len": d.base.tolist(),
             "platform_len": d.platform.tolist(),
-            "platform_hull_len": solid["vertices"].tolist() if hull else [],
-            "hull_faces": solid["triangles"].tolist() if hull else [],
+            "platform_hull_len": hull["vertices"].tolist() if hull is not None else [],
+            "hull_faces": hull["triangles"].tolist() if hull is not None else [],
             "platform_mesh": mesh_json(solid),
             "joint_meshes": [mesh_json(x) for x in joint_meshes(jl, len(m.limbs), float(d.scale))],
             "bodies_len": d.bodies.tolist(),
@@ -509,9 +510,10 @@ class Session:
         step_of: dict[int, int] = {}  # event -> index of the tracked point its step starts from
         own_crossed = None
         for e in r.events:
-            if float(e.x[1]) > ell:  # in the overshoot of the last step: not on the way to the target
+            xe = cast(np.ndarray, e.x)  # the drag problem's points are vectors (the pose's x, lambda)
+            if float(xe[1]) > ell:  # in the overshoot of the last step: not on the way to the target
                 continue
-            a_e = a0 + (float(e.x[1]) / ell) * delta
+            a_e = a0 + (float(xe[1]) / ell) * delta
             ev = {"name": e.name, "kind": str(e.kind), **self._display(a_e)}
             if e.name == DEAD_POINT:
                 if str(e.kind) != "zero" or own_crossed is not None:
@@ -657,6 +659,7 @@ class Session:
             bad = within_limits(m, q, act_idx)
             if bad:
                 f = m.freedom(bad[0]).freedom
+                assert f.limits is not None  # within_limits names only freedoms with limits
                 lo, hi = f.limits
                 shown = (f"[{np.degrees(lo):.6g}, {np.degrees(hi):.6g}] deg" if f.kind != "P"
                          else f"[{lo:.6g}, {hi:.6g}] {m.length_unit}")
