@@ -306,12 +306,6 @@ def test_the_cycle_check_finds_a_cycle():
 #: ``spatialmech`` itself (the package, i.e. the facade it re-exports) is allowed as the exact name.
 DRIVER_ALLOWED = ("spatialmech.api", "spatialmech.errors", "spatialmech.results", "spatialmech.serialize",
                   "spatialmech.present", "spatialmech.interfaces")
-#: Driver files exempt from the rule above, with the reason.  Keep this list short and explicit.
-DRIVER_EXEMPT = {
-    # issue 26: cmd_kinematics.py (ik, fk, jacobian) is being rewritten onto sm.ik / sm.fk /
-    # sm.jacobian on another branch; its exemption is removed when that branch is merged.
-    "interfaces/cmd_kinematics.py",
-}
 #: Layer (a folder of the package) -> the parts of spatialmech it must not import.
 LAYER_FORBIDDEN = {
     "api": ("spatialmech.interfaces",),
@@ -360,13 +354,11 @@ def layer_violations(path: Path, source: str | None = None) -> list[str]:
 def test_the_layers_are_where_the_test_looks():
     files = {layer: layer_files(layer) for layer in ("interfaces", "api", "services")}
     assert len(files["interfaces"]) > 10 and len(files["api"]) > 5 and len(files["services"]) >= 3, files
-    for exempt in DRIVER_EXEMPT:  # an exemption of a file that is gone must be removed
-        assert (PKG / exempt).is_file(), f"DRIVER_EXEMPT names {exempt}, which does not exist"
 
 
 def test_drivers_import_only_the_facade():
-    problems = [m for f in layer_files("interfaces") if str(f.relative_to(PKG)) not in DRIVER_EXEMPT
-                for m in layer_violations(f)]
+    # no driver is exempt (issue 26: cmd_kinematics.py was the last, now on sm.* like the others)
+    problems = [m for f in layer_files("interfaces") for m in layer_violations(f)]
     assert not problems, ("the drivers (interfaces/) must go through sm.* (add what they need to spatialmech.api):\n"
                           + "\n".join(problems))
 
@@ -409,8 +401,3 @@ def test_the_layer_check_accepts_allowed_imports():
     services = "from ...kinematics.tracking import track\nfrom ... import catalog\nfrom ...present.viewer import drawing\n"
     assert layer_violations(PKG / "services" / "studio" / "example.py", services) == []
 
-
-def test_the_exemptions_are_still_needed():
-    """An exempt driver that already keeps the rule must leave the list (it would hide a regression)."""
-    for exempt in DRIVER_EXEMPT:
-        assert layer_violations(PKG / exempt), f"{exempt} keeps the rule: remove it from DRIVER_EXEMPT"

@@ -78,10 +78,40 @@ def test_drive_a_parallel_mechanism_checked_by_inverse_position(studio_ok):
     named = {k: v - 0.01 for k, v in s["actuators_len"].items()}
     d2 = studio_ok(c.post("/api/drive", json={"actuators": named}))
     assert d2["status"] == "reached" and d2["state"]["actuators_len"] == pytest.approx(named, abs=1e-12)
-    modes = studio_ok(c.post("/api/fk_all", json={"seeds": 12}))
+    modes = studio_ok(c.post("/api/fk_all", json={}))
     assert modes["n_solutions"] >= 1 and modes["solutions"][0]["mode_number"] == 1
     back = studio_ok(c.post("/api/mode", json={"mode_number": 1}))["state"]
     assert np.allclose(back["pose"]["position_len"], modes["solutions"][0]["pose"]["position_len"], atol=1e-9)
+    # homotopy continuation answers the 6-SPS (as `fk --all`): it takes no starts
+    r = c.post("/api/fk_all", json={"seeds": 12})
+    assert r.status_code == 422 and r.json()["error"].startswith("seeds: homotopy"), r.text
+
+
+@pytest.mark.parametrize(("model", "engine", "n_modes"), [("four-sps-cu", "closed-form", 4),
+                                                          ("stewart-6sps", "homotopy", 8)])
+def test_the_studio_finds_the_modes_of_sm_fk(model, engine, n_modes, studio_ok):
+    """fk_all goes through the one dispatcher (solve_forward): the studio's assembly modes are
+    those of ``sm.fk(..., all_solutions=True)`` at the same actuator values (the current one
+    first), and each can be picked (a closed form gives poses: the configuration is fitted)."""
+    session = Session(model)
+    c = TestClient(create_app(session))
+    got = studio_ok(c.post("/api/fk_all", json={}))["solutions"]
+    ref = sm.fk(model, session.actuator_values(), all_solutions=True)
+    assert ref.engine == engine and len(ref.modes) == n_modes and len(got) == n_modes
+    unmatched = list(ref.modes)
+    for g in got:
+        R, p = np.array(g["pose"]["rotation_matrix"]), np.array(g["pose"]["position_len"])
+        k = next(i for i, m in enumerate(unmatched) if np.allclose(m.pose.R, R, atol=1e-9)
+                 and np.allclose(m.pose.p, p, atol=1e-9))
+        m = unmatched.pop(k)
+        assert g["kind"] == str(m.kind) and g["sigma_min"] == pytest.approx(m.sigma_min, rel=1e-9)
+        assert g["singular"] == (m.sigma_min < m.singular_below) and g["within_limits"] == m.within_limits
+    assert not unmatched
+    here = studio_ok(c.get("/api/state"))["state"]["pose"]["position_len"]
+    assert np.allclose(got[0]["pose"]["position_len"], here, atol=1e-9)  # the current configuration's mode first
+    last = studio_ok(c.post("/api/mode", json={"mode_number": n_modes}))["state"]
+    assert np.allclose(last["pose"]["position_len"], got[-1]["pose"]["position_len"], atol=1e-9)
+    assert last["residual"] < 1e-9
 
 
 def test_a_rocker_driven_past_its_dead_point_stops_before_it(studio_ok):

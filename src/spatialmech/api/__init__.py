@@ -37,6 +37,11 @@ the argument checks they share.  The command line and the studio's web app
 
 from __future__ import annotations
 
+from ..geometry.rotations import euler_matrix as euler_matrix  # Euler angles <-> rotation matrices, for
+from ..geometry.rotations import matrix_euler as matrix_euler  # the drivers (named sequences, as Pose.from_euler)
+from ..geometry.tolerances import Tolerances as Tolerances  # what sm.tolerances() yields
+from ..model.mechanism import Mechanism as Mechanism  # the model and pose types the verbs take
+from ..model.mechanism import Pose as Pose
 from .checks import ModelLike as ModelLike  # the type of a model argument
 from .forces import StaticsResult, statics
 from .kinematics import (

@@ -6,9 +6,13 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..errors import InputError, describe
 from ..model.mechanism import Mechanism
+if TYPE_CHECKING:  # imported where it runs (it loads the simulator's bindings lazily)
+    from ..analysis.validation import ValidationResult
+
 from .checks import ModelLike, as_mechanism, as_pose, check_bool, check_choice, check_int, check_number, check_path
 
 #: The formats :func:`export` writes.
@@ -37,12 +41,41 @@ class ExportResult:
 
 
 def export(model: ModelLike, file, *, format: str | None = None, mode: str | None = None) -> ExportResult:
-    """Write a model as a TOML model file (to start your own from), a MuJoCo model (MJCF) or a
-    URDF (loop closures in an extension block; docs/validation.md).  ``format``: ``"toml"``,
-    ``"mjcf"`` or ``"urdf"``, default from the extension of ``file`` (.toml, .xml, .urdf);
-    ``mode``: write a metamorphic mechanism in that motion mode (its other lockable freedoms
-    locked).
+    """Write a model as a TOML model file, a MuJoCo model (MJCF) or a URDF.
 
+    A TOML file to start your own from; MJCF and URDF for other tools (URDF: loop closures in an
+    extension block; docs/validation.md).
+
+    Parameters
+    ----------
+    model : Mechanism, str or path
+        The mechanism, a ready-made model name (``sm.models()``) or a TOML model file.
+    file : str or path
+        The file written.
+    format : {"toml", "mjcf", "urdf"}, optional
+        Default: from the extension of ``file`` (.toml, .xml, .urdf).
+    mode : str, optional
+        Write a metamorphic mechanism in that motion mode (its other lockable freedoms locked).
+
+    Returns
+    -------
+    ExportResult
+        ``out`` (the path), ``format``, ``bytes``; ``to_dict()`` is the payload of
+        ``spatialmech export --json``.
+
+    Raises
+    ------
+    TypeError
+        An argument of the wrong type (named in the message).
+    InputError
+        A bad value (a ``ValueError``, the argument named); an unknown model name raises
+        :class:`~spatialmech.UnknownNameError`, a malformed model file
+        :class:`~spatialmech.ModelFileError` (both ``InputError``).
+    OSError
+        The file cannot be written.
+
+    Examples
+    --------
     >>> import spatialmech as sm, tempfile, os
     >>> with tempfile.TemporaryDirectory() as d:
     ...     r = sm.export("rssr", os.path.join(d, "rssr.xml"))
@@ -66,18 +99,62 @@ def export(model: ModelLike, file, *, format: str | None = None, mode: str | Non
 def validate(model: ModelLike, motion: str | None = None, *, mode: str | None = None, start=None,
              degrees: bool = False, method: str = "project", frames: int = 12, to_position: int | None = None,
              amplitude: float = 0.02, arc: float = 2.0, actuator_path=None, tol: float = VALIDATION_TOL,
-             mjcf: str | os.PathLike | None = None):
-    """Drive the model exported to MuJoCo through a motion computed by the library and compare
-    the simulated output-link pose with the library's at every pose (docs/validation.md; needs
-    the ``mujoco`` package).  ``motion``: ``"trace"`` (the 1-DOF motion; default with one
-    actuator), ``"loop"`` (a loop of the actuators; default otherwise) or ``"actuators"``
-    (``actuator_path``: rows of actuator values, SI, in the order of the actuators); ``mode``: a
-    motion mode of a metamorphic mechanism; ``start``: the first pose (a pose as in :func:`ik`,
-    or a Configuration; default the reference); ``method``: ``"project"`` or ``"settle"``;
-    ``tol``: the largest error that passes (a fraction of the characteristic length, and rad);
-    ``mjcf``: also write the simulated MJCF model there.  Returns a
-    :class:`~spatialmech.analysis.validation.ValidationResult` (``passed``, ``to_dict()``).
+             mjcf: str | os.PathLike | None = None) -> ValidationResult:
+    """Check the library's motion in MuJoCo (docs/validation.md; needs the ``mujoco`` package).
 
+    The model exported to MuJoCo is driven through a motion computed by the library and the
+    simulated output-link pose compared with the library's at every pose.
+
+    Parameters
+    ----------
+    model : Mechanism, str or path
+        The mechanism, a ready-made model name (``sm.models()``) or a TOML model file.
+    motion : {"trace", "loop", "actuators"}, optional
+        ``"trace"``: the 1-DOF motion (default with one actuator); ``"loop"``: a loop of the
+        actuators (default otherwise); ``"actuators"``: the rows of ``actuator_path``.
+    mode : str, optional
+        A motion mode of a metamorphic mechanism.
+    start : Pose, tuple, int or Configuration, optional
+        The first pose (a pose as in :func:`ik`) or configuration; default: the reference.
+    degrees : bool
+        Read the angles of a ``start`` pose tuple in degrees.
+    method : {"project", "settle"}
+        How the simulator is driven.
+    frames : int
+        Poses compared (at least 2).
+    to_position : int, optional
+        Trace towards the model's task position N (from 1).
+    amplitude : float
+        The loop's amplitude (SI: rad or length unit).
+    arc : float
+        The traced arc length (nondimensional).
+    actuator_path : array of shape (n, n_actuators), optional
+        Rows of actuator values, SI (rad, length), in the order of the actuators.
+    tol : float
+        The largest error that passes (a fraction of the characteristic length, and rad).
+    mjcf : str or path, optional
+        Also write the simulated MJCF model there.
+
+    Returns
+    -------
+    ValidationResult
+        ``passed``, the errors at every pose; ``to_dict()`` is its JSON.
+
+    Raises
+    ------
+    TypeError
+        An argument of the wrong type (named in the message).
+    InputError
+        A bad value (a ``ValueError``, the argument named); an unknown model name raises
+        :class:`~spatialmech.UnknownNameError`, a malformed model file
+        :class:`~spatialmech.ModelFileError` (both ``InputError``).
+    ConvergenceError
+        The library's motion cannot be computed (the closure does not converge).
+
+    The missing ``mujoco`` package is an ``InputError`` naming it.
+
+    Examples
+    --------
     >>> import spatialmech as sm
     >>> r = sm.validate("rssr", frames=3, arc=0.2)                    # doctest: +SKIP
     >>> r.passed                                                      # doctest: +SKIP

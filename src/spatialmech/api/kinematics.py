@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -22,6 +23,11 @@ from ..model.task import TaskCoordinates
 from ..model.mechanism import Mechanism, Pose
 from ..results import Progress
 from ..serialize import pose_dict
+if TYPE_CHECKING:  # the analyses are imported where they run (lazily): their types only here
+    from ..analysis.parasitic import ParasiticTable
+    from ..analysis.singularity import SingularityResult
+    from ..analysis.workspace import TaskWorkspaceResult, WorkspaceLimits, WorkspaceResult
+
 from .checks import (
     ModelLike,
     as_configuration,
@@ -98,12 +104,51 @@ def ik(model: ModelLike, pose, *, all_solutions: bool = False, n_seeds: int = 48
        degrees: bool = False, tol=None, free=None) -> IKResult:
     """Inverse position: the joint values of every limb for a platform pose.
 
-    ``all_solutions``: also ``n_seeds`` random starts per limb (every real solution it finds).
-    ``tol``: a :class:`~spatialmech.geometry.tolerances.Tolerances` or the closure tolerance.
-    ``free``: task coordinates to solve (names from ``x, y, z, a1, a2, a3``; angles in the pose's
-    Euler sequence, ``"ZYX"`` when it gives none): for a lower-mobility mechanism, the parasitic
-    ones (:attr:`IKResult.task` has the solved values); the others are held at the pose's values.
+    Parameters
+    ----------
+    model : Mechanism, str or path
+        The mechanism, a ready-made model name (``sm.models()``) or a TOML model file.
+    pose : Pose, tuple or int
+        The platform (output link) pose: a :class:`~spatialmech.Pose`, ``(xyz, (seq, a1, a2, a3))``
+        (``xyz`` shape (3,) in the model's length unit, a named Euler sequence and its angles: rad,
+        degrees with ``degrees=True``), ``(xyz, R)`` (``R`` shape (3, 3), a rotation matrix),
+        ``(xyz, None)`` (the reference orientation) or ``int`` N, the model's N-th task position
+        (from 1).
+    all_solutions : bool
+        Also ``n_seeds`` random starts per limb (every real solution it finds).
+    n_seeds : int
+        Random starts per limb with ``all_solutions``.
+    seed : int
+        Their random seed.
+    degrees : bool
+        Read the angles of a pose tuple (and angular values) in degrees instead of radians.
+    tol : Tolerances or float, optional
+        A :class:`~spatialmech.geometry.tolerances.Tolerances` or the closure tolerance
+        (nondimensional; default: the tolerances in force).
+    free : str or sequence of str, optional
+        Task coordinates to solve (names from ``x, y, z, a1, a2, a3``; angles in the pose's Euler
+        sequence, ``"ZYX"`` when it gives none): for a lower-mobility mechanism, the parasitic
+        ones; the others are held at the pose's values.
 
+    Returns
+    -------
+    IKResult
+        ``reachable``, ``actuators`` (SI: rad, length, by freedom id), ``config``, every limb's
+        solutions (``result``), ``pose_fit`` (a pose that does not close exactly is fitted onto the
+        closure) and, with ``free``, ``task`` (the solved coordinates); ``to_dict()`` is the payload
+        of ``spatialmech ik --json``.  An unreachable pose is not an error: see ``reachable``.
+
+    Raises
+    ------
+    TypeError
+        An argument of the wrong type (named in the message).
+    InputError
+        A bad value (a ``ValueError``, the argument named); an unknown model name raises
+        :class:`~spatialmech.UnknownNameError`, a malformed model file
+        :class:`~spatialmech.ModelFileError` (both ``InputError``).
+
+    Examples
+    --------
     >>> import spatialmech as sm
     >>> r = sm.ik("three-rps", ([0, 0, 0.33], ("ZYX", 0, 5, 5)), degrees=True, free=["x", "y", "a1"])
     >>> r.reachable, [round(v, 6) for v in r.actuators.values()]
@@ -180,30 +225,61 @@ class FKResult:
 
 def fk(model: ModelLike, actuators, *, all_solutions: bool = False, seeds: int | None = None, seed: int | None = None,
        degrees: bool = False, progress: Progress | None = None, method: str = "auto") -> FKResult:
-    """Forward position: platform pose(s) for actuator values (``actuators``: a sequence in the
-    order of ``mechanism.actuators`` or a mapping by freedom name; lengths in the model's unit,
-    rotations in radians, or degrees with ``degrees=True``).
+    """Forward position: platform pose(s) for actuator values.
 
     Without ``all_solutions``: one Newton solve from the reference configuration (``method``,
     ``seeds`` and ``seed`` are refused).  With ``all_solutions``, every assembly mode, by the
-    engine ``method`` picks (:mod:`spatialmech.kinematics.dispatch`, docs/kinematics.md):
+    engine ``method`` picks (:mod:`spatialmech.kinematics.dispatch`, docs/kinematics.md).
 
-    - ``"auto"`` (default): a registered closed form where one recognises the model (the
-      4-SPS/CU of paper B's layout), else homotopy continuation where it covers the model (S-P-S
-      and R-P-S legs, passive C-U limbs: proven complete), else the loop formulation by
-      monodromy (limbs of R, P, C, U, Sm and S joints from the ground to the platform; complete
-      when its trace test passes), else the multi-start search;
-    - ``"closed-form"``: the registered closed form (``InputError`` on other models);
-    - ``"homotopy"``: homotopy continuation or the loop formulation, uncapped (``InputError``
-      where neither covers the model);
-    - ``"multistart"``: the general multi-start search, on every model (never a proof).
+    Parameters
+    ----------
+    model : Mechanism, str or path
+        The mechanism, a ready-made model name (``sm.models()``) or a TOML model file.
+    actuators : array_like of shape (n_actuators,) or mapping
+        The actuator values in the order of ``mechanism.actuators``, or a mapping by freedom name:
+        lengths in the model's length unit, rotations in rad (degrees with ``degrees=True``).
+    all_solutions : bool
+        Every assembly mode instead of one Newton solve.
+    seeds : int, optional
+        The starts of a multi-start search (default 200; the closed form's 512; the starts the
+        loop formulation adds when it is not proven complete); refused where homotopy in Study
+        parameters answers (it takes no starts).
+    seed : int, optional
+        The random seed (the closed form's quasi-random sequence).
+    degrees : bool
+        Rotational actuator values in degrees.
+    progress : callable, optional
+        ``progress(done, total_or_None, message)``, called as the work goes on.
+    method : {"auto", "closed-form", "homotopy", "multistart"}
+        With ``all_solutions``: ``"auto"``: a registered closed form where one recognises the model
+        (the 4-SPS/CU of paper B's layout), else homotopy continuation where it covers the model
+        (S-P-S and R-P-S legs, passive C-U limbs: proven complete), else the loop formulation by
+        monodromy (limbs of R, P, C, U, Sm and S joints; complete when its trace test passes),
+        else the multi-start search; ``"closed-form"``: the registered closed form;
+        ``"homotopy"``: homotopy continuation or the loop formulation, uncapped;
+        ``"multistart"``: the general multi-start search (never a proof).
 
-    ``seeds``: the starts of a multi-start search (default 200; the closed form's 512; the
-    starts the loop formulation adds when it is not proven complete); refused where homotopy in
-    Study parameters answers (it takes no starts).  ``seed``: the random seed (the closed form's
-    quasi-random sequence).  The result says which ``engine`` answered, ``complete`` and
-    ``completeness``.  Nothing is raised when no assembly is found: see ``converged``.
+    Returns
+    -------
+    FKResult
+        ``engine`` (which answered), ``modes`` (each an
+        :class:`~spatialmech.kinematics.dispatch.AssemblyMode`: pose, kind, conditioning),
+        ``poses``, ``complete`` and ``completeness``, ``converged``; ``to_dict()`` is the payload of
+        ``spatialmech fk --json``.  Nothing is raised when no assembly is found: see ``converged``.
 
+    Raises
+    ------
+    TypeError
+        An argument of the wrong type (named in the message).
+    InputError
+        A bad value (a ``ValueError``, the argument named); an unknown model name raises
+        :class:`~spatialmech.UnknownNameError`, a malformed model file
+        :class:`~spatialmech.ModelFileError` (both ``InputError``).
+        ``method``, ``seeds`` or ``seed`` the chosen engine would ignore; a ``method`` that does
+        not cover the model.
+
+    Examples
+    --------
     >>> import spatialmech as sm
     >>> r = sm.fk("stewart-6sps", [1.2] * 6)
     >>> r.converged, len(r.poses), r.engine
@@ -282,15 +358,54 @@ class JacobianResult:
 
 def jacobian(model: ModelLike, pose=None, *, config: Configuration | None = None, drivers=None,
              degrees: bool = False, free=None) -> JacobianResult:
-    """The complete Jacobian (constraint + actuation wrenches), ``det J`` and its conditioning at
-    a pose (fitted onto the closure), a configuration, or the reference configuration; for a
+    """The complete Jacobian (constraint + actuation wrenches), ``det J`` and its conditioning.
+
+    At a pose (fitted onto the closure), a configuration, or the reference configuration; for a
     lower-mobility model also :attr:`JacobianResult.task`, the input-output Jacobian over the
     given task coordinates (the parasitic ones solved).
 
-    ``drivers``: the actuated freedom(s) (default: the model's actuators).  ``free``: as in
-    :func:`ik`, task coordinates to solve, the others held at the pose's values (and the
-    coordinates of the input-output Jacobian; default: the model's task).
+    Parameters
+    ----------
+    model : Mechanism, str or path
+        The mechanism, a ready-made model name (``sm.models()``) or a TOML model file.
+    pose : Pose, tuple or int, optional
+        The platform (output link) pose: a :class:`~spatialmech.Pose`, ``(xyz, (seq, a1, a2, a3))``
+        (``xyz`` shape (3,) in the model's length unit, a named Euler sequence and its angles: rad,
+        degrees with ``degrees=True``), ``(xyz, R)`` (``R`` shape (3, 3), a rotation matrix),
+        ``(xyz, None)`` (the reference orientation) or ``int`` N, the model's N-th task position
+        (from 1).  Fitted onto the closure; default: the reference configuration.
+    config : Configuration, optional
+        A configuration instead of a pose (not with ``pose``).
+    drivers : str or sequence of str, optional
+        The actuated freedoms (default: the model's actuators).
+    degrees : bool
+        Read the angles of a pose tuple (and angular values) in degrees instead of radians.
+    free : str or sequence of str, optional
+        Task coordinates to solve (names from ``x, y, z, a1, a2, a3``; angles in the pose's Euler
+        sequence, ``"ZYX"`` when it gives none): for a lower-mobility mechanism, the parasitic
+        ones; the others are held at the pose's values (needs ``pose``, not
+        ``config``); also the coordinates of the input-output Jacobian (default: the model's task).
 
+    Returns
+    -------
+    JacobianResult
+        ``jacobian`` (:class:`~spatialmech.kinematics.jacobian.CompleteJacobian`: ``matrix`` of
+        shape (6, 6) for a square problem, ``det``, ``sigma_min``, ``condition``), ``pose_fit``,
+        ``task``; ``to_dict()`` is the payload of ``spatialmech jacobian --json``.
+
+    Raises
+    ------
+    TypeError
+        An argument of the wrong type (named in the message).
+    InputError
+        A bad value (a ``ValueError``, the argument named); an unknown model name raises
+        :class:`~spatialmech.UnknownNameError`, a malformed model file
+        :class:`~spatialmech.ModelFileError` (both ``InputError``).
+        A pose out of reach (no closed configuration near it, or the held coordinates do not
+        close with ``free`` solved).
+
+    Examples
+    --------
     >>> import spatialmech as sm
     >>> J = sm.jacobian("five-cs-1", 3, drivers="rot1")
     >>> J.det > 0, J.jacobian.matrix.shape, J.pose_fit.exact
@@ -303,6 +418,8 @@ def jacobian(model: ModelLike, pose=None, *, config: Configuration | None = None
     degrees = check_bool(degrees, "degrees")
     drivers = check_names(drivers, "drivers")
     task = None
+    fit: PoseFit | None
+    requested: Pose | None
     if free is not None:
         if pose is None or config is not None:
             raise InputError("free: needs a pose (and no config): the coordinates not named are held at its values")
@@ -364,12 +481,52 @@ class VelocityResult:
 
 def velocity(model: ModelLike, pose=None, *, config: Configuration | None = None, twist=None, actuator_rates=None,
              drivers=None, degrees: bool = False) -> VelocityResult:
-    """Velocity analysis at a pose (fitted onto the closure), a configuration or the reference
-    configuration: give the platform ``twist`` ``(omega ; v)`` (inverse velocity: the joint
-    rates) or the ``actuator_rates`` of ``drivers`` (default: the model's actuators; forward
-    velocity: the twist and the joint rates).  Rates in SI (rad/s, length/s); ``degrees=True``:
-    angular rates and pose angles in degrees.
+    """Velocity analysis: inverse (from the platform twist) or forward (from actuator rates).
 
+    At a pose (fitted onto the closure), a configuration or the reference configuration; give
+    exactly one of ``twist`` and ``actuator_rates``.
+
+    Parameters
+    ----------
+    model : Mechanism, str or path
+        The mechanism, a ready-made model name (``sm.models()``) or a TOML model file.
+    pose : Pose, tuple or int, optional
+        The platform (output link) pose: a :class:`~spatialmech.Pose`, ``(xyz, (seq, a1, a2, a3))``
+        (``xyz`` shape (3,) in the model's length unit, a named Euler sequence and its angles: rad,
+        degrees with ``degrees=True``), ``(xyz, R)`` (``R`` shape (3, 3), a rotation matrix),
+        ``(xyz, None)`` (the reference orientation) or ``int`` N, the model's N-th task position
+        (from 1).  Fitted onto the closure; default: the reference configuration.
+    config : Configuration, optional
+        A configuration instead of a pose (not with ``pose``).
+    twist : array_like of shape (6,), optional
+        The platform twist ``(omega ; v)``: ``omega`` rad/s (degrees/s with ``degrees=True``),
+        ``v`` the velocity of the body point at the origin (length unit/s).  Inverse velocity.
+    actuator_rates : array_like of shape (n_drivers,), optional
+        The rates of ``drivers`` (rad/s or length unit/s; degrees/s with ``degrees=True``).
+        Forward velocity.
+    drivers : str or sequence of str, optional
+        The actuated freedoms (default: the model's actuators).
+    degrees : bool
+        Angular rates and pose angles in degrees.
+
+    Returns
+    -------
+    VelocityResult
+        ``twist`` (shape (6,), SI), ``joint_rates`` (every freedom, SI), ``actuator_rates`` (by
+        freedom id), ``given``; ``to_dict()`` is its JSON.
+
+    Raises
+    ------
+    TypeError
+        An argument of the wrong type (named in the message).
+    InputError
+        A bad value (a ``ValueError``, the argument named); an unknown model name raises
+        :class:`~spatialmech.UnknownNameError`, a malformed model file
+        :class:`~spatialmech.ModelFileError` (both ``InputError``).
+        Both or neither of ``twist`` and ``actuator_rates``.
+
+    Examples
+    --------
     >>> import spatialmech as sm
     >>> v = sm.velocity("four-sps-cu", ([0, 0, 0.12], ("ZYX", 30, -5, 10)), twist=[0, 0, 0, 0, 0, 0.01], degrees=True)
     >>> sorted(round(r, 4) for r in v.actuator_rates.values())
@@ -406,10 +563,10 @@ class SingularityAnalysis:
 
     mechanism: Mechanism
     config: Configuration
-    result: object
+    result: SingularityResult
     pose_fit: PoseFit | None = None
 
-    def __getattr__(self, name):
+    def __getattr__(self, name: str) -> Any:
         if name.startswith("_") or name == "result":
             raise AttributeError(name)
         return getattr(self.result, name)
@@ -420,10 +577,47 @@ class SingularityAnalysis:
 
 def singularity(model: ModelLike, pose=None, *, config: Configuration | None = None, drivers=None,
                 degrees: bool = False) -> SingularityAnalysis:
-    """Singularity analysis at a pose (fitted onto the closure), a configuration, or the
-    reference configuration: rank and kind (:class:`~spatialmech.results.SingularityKind`),
-    uncontrolled twists, line geometry of the wrenches, finite self-motion.
+    """Singularity analysis at a pose, a configuration, or the reference configuration.
 
+    Rank and kind (:class:`~spatialmech.results.SingularityKind`), uncontrolled twists, line
+    geometry of the wrenches, finite self-motion.
+
+    Parameters
+    ----------
+    model : Mechanism, str or path
+        The mechanism, a ready-made model name (``sm.models()``) or a TOML model file.
+    pose : Pose, tuple or int, optional
+        The platform (output link) pose: a :class:`~spatialmech.Pose`, ``(xyz, (seq, a1, a2, a3))``
+        (``xyz`` shape (3,) in the model's length unit, a named Euler sequence and its angles: rad,
+        degrees with ``degrees=True``), ``(xyz, R)`` (``R`` shape (3, 3), a rotation matrix),
+        ``(xyz, None)`` (the reference orientation) or ``int`` N, the model's N-th task position
+        (from 1).  Fitted onto the closure; default: the reference configuration.
+    config : Configuration, optional
+        A configuration instead of a pose (not with ``pose``).
+    drivers : str or sequence of str, optional
+        The actuated freedoms (default: the model's actuators).
+    degrees : bool
+        Read the angles of a pose tuple (and angular values) in degrees instead of radians.
+
+    Returns
+    -------
+    SingularityAnalysis
+        ``result`` (:class:`~spatialmech.analysis.singularity.SingularityResult`, its attributes
+        readable directly: ``kind``, ``rank``, ``twist``, ``line_geometry``, ``self_motion``
+        ...), ``config``, ``pose_fit``; ``to_dict()`` is the payload of
+        ``spatialmech singularity --json``.
+
+    Raises
+    ------
+    TypeError
+        An argument of the wrong type (named in the message).
+    InputError
+        A bad value (a ``ValueError``, the argument named); an unknown model name raises
+        :class:`~spatialmech.UnknownNameError`, a malformed model file
+        :class:`~spatialmech.ModelFileError` (both ``InputError``).
+
+    Examples
+    --------
     >>> import spatialmech as sm
     >>> r = sm.singularity("four-sps-cu")            # the reference pose, alpha = beta = 0
     >>> r.kind, r.kind.singular
@@ -443,30 +637,77 @@ def workspace(model: ModelLike, *, kind: str = "orientation", at: Mapping[str, f
               link_diameter: float | None = None, interference: bool = True, max_poses: int | None = None,
               progress: Progress | None = None, over: Mapping | None = None, free=None, limits=None,
               cones: Mapping[str, float] | None = None, freedom_limits: Mapping | None = None,
-              max_general_poses: int | None = None):
-    """Workspace under joint limits (strokes, joint cones, link interference), sampled and
-    refined at the boundary: ``kind="orientation"`` at a fixed position (free angles alpha,
-    beta, gamma of ``R = Rz(gamma) Ry(beta) Rx(alpha)``), or ``"position"`` at a fixed
-    orientation.  SI and radians: ``at`` fixes coordinates (``x, y, z`` length,
-    ``alpha, beta, gamma`` rad); ``step``/``tol`` are radians (orientation; default 2 deg and
-    0.001 deg) or lengths (position).  ``link_diameter`` overrides the interference check's
-    capsules, ``interference=False`` skips it; ``limits`` (a
-    :class:`~spatialmech.analysis.workspace.WorkspaceLimits`) replaces the default limits;
-    ``cones`` adds cone limits of S or U joints (joint name -> largest angle, rad, between the
-    link at the joint and the platform's ``z`` axis, the base's at a limb's first joint) and
-    ``freedom_limits`` replaces the limits of freedoms' values (name -> ``(lo, hi)``, SI, rad;
-    ``"actuators"`` sets every actuator).  ``max_general_poses``: the largest grid on the general
-    (per-pose) path when ``max_poses`` is not given.
-    Returns a :class:`~spatialmech.analysis.workspace.WorkspaceResult`.
+              max_general_poses: int | None = None) -> WorkspaceResult | TaskWorkspaceResult:
+    """Workspace under joint limits (strokes, joint cones, link interference).
 
-    ``kind="task"``: over the task coordinates of a lower-mobility mechanism (docs/workspace.md):
-    ``over`` maps 1 to 3 given task coordinates (``x, y, z`` length, ``a1, a2, a3`` rad) to
-    ``(lo, hi, n)`` or grid values, ``at`` holds other given ones, ``free`` names the coordinates
-    to solve (default: the model's task); ``tol`` is the boundary tolerance (a number, or by
-    coordinate; default 1e-3 of the grid step), ``max_poses`` the largest grid.  The parasitic
-    coordinates are solved at every cell.  Returns a
-    :class:`~spatialmech.analysis.workspace.TaskWorkspaceResult`.
+    Sampled and refined at the boundary: ``kind="orientation"`` at a fixed position (free
+    angles alpha, beta, gamma of ``R = Rz(gamma) Ry(beta) Rx(alpha)``), ``"position"`` at a
+    fixed orientation, or ``"task"`` over the task coordinates of a lower-mobility mechanism
+    (docs/workspace.md; the parasitic coordinates solved at every cell).
 
+    Parameters
+    ----------
+    model : Mechanism, str or path
+        The mechanism, a ready-made model name (``sm.models()``) or a TOML model file.
+    kind : {"orientation", "position", "task"}
+        The workspace computed.
+    at : mapping, optional
+        Fixed coordinates (``x, y, z`` length unit, ``alpha, beta, gamma`` rad; task: other
+        given task coordinates held).
+    step : float, optional
+        The sampling step: rad (orientation; default 2 deg) or length unit (position).
+    tol : float or mapping, optional
+        The boundary tolerance: rad (orientation; default 0.001 deg) or length unit (position);
+        task: a number or by coordinate (default 1e-3 of the grid step).
+    bounds : mapping, optional
+        Coordinate -> ``(lo, hi)`` searched (SI, rad; not with ``kind="task"``).
+    method : {"auto", "closed-form", "general"}
+        The pose checker (the 4-SPS/CU's closed form, or the general per-pose path).
+    link_diameter : float, optional
+        Overrides the interference check's capsule diameter (length unit).
+    interference : bool
+        ``False`` skips the interference check.
+    max_poses : int, optional
+        The largest grid.
+    progress : callable, optional
+        ``progress(done, total_or_None, message)``, called as the work goes on.
+    over : mapping, optional
+        ``kind="task"``: 1 to 3 given task coordinates (``x, y, z`` length, ``a1, a2, a3`` rad)
+        -> ``(lo, hi, n)`` or grid values.
+    free : str or sequence of str, optional
+        ``kind="task"``: the coordinates to solve (default: the model's task).
+    limits : WorkspaceLimits, optional
+        Replaces the default limits (:class:`~spatialmech.analysis.workspace.WorkspaceLimits`).
+    cones : mapping, optional
+        Extra cone limits of S or U joints: joint name -> largest angle (rad) between the link at
+        the joint and the platform's ``z`` axis (the base's at a limb's first joint).
+    freedom_limits : mapping, optional
+        Replaces the limits of freedoms' values: name -> ``(lo, hi)`` (SI, rad; ``"actuators"``
+        sets every actuator).
+    max_general_poses : int, optional
+        The largest grid on the general (per-pose) path when ``max_poses`` is not given.
+
+    Returns
+    -------
+    WorkspaceResult or TaskWorkspaceResult
+        A :class:`~spatialmech.analysis.workspace.WorkspaceResult` (orientation, position:
+        ``alone`` extents with the limits that bound them, the sampled grid) or, with
+        ``kind="task"``, a :class:`~spatialmech.analysis.workspace.TaskWorkspaceResult`
+        (``solved``, ``reachable_fraction`` ...); ``to_dict()`` is its JSON.
+
+    Raises
+    ------
+    TypeError
+        An argument of the wrong type (named in the message).
+    InputError
+        A bad value (a ``ValueError``, the argument named); an unknown model name raises
+        :class:`~spatialmech.UnknownNameError`, a malformed model file
+        :class:`~spatialmech.ModelFileError` (both ``InputError``).
+    SearchTooLargeError
+        The grid exceeds ``max_poses`` (an ``InputError``).
+
+    Examples
+    --------
     >>> import numpy as np, spatialmech as sm
     >>> ws = sm.workspace("four-sps-cu", at={"z": 0.1}, step=np.radians(10))
     >>> round(float(np.degrees(ws.alone["alpha"].hi)), 1), ws.alone["alpha"].hi_limit
@@ -522,7 +763,7 @@ def _with_freedom_limits(mech: Mechanism, freedom_limits) -> Mechanism:
     return with_freedom_limits(mech, named) if named else mech
 
 
-def _workspace_limits(mech: Mechanism, limits, cones, link_diameter, interference: bool):
+def _workspace_limits(mech: Mechanism, limits, cones, link_diameter, interference: bool) -> WorkspaceLimits:
     """The limits of ``workspace``: ``limits`` (default: the model's), with the extra ``cones``
     and the interference check's ``link_diameter`` (none without ``interference``)."""
     from ..analysis.workspace import ConeLimit, WorkspaceLimits, default_limits
@@ -543,7 +784,8 @@ def _workspace_limits(mech: Mechanism, limits, cones, link_diameter, interferenc
     return limits
 
 
-def _task_workspace(mech: Mechanism, over, at, free, limits, tol, step, bounds, max_poses, progress):
+def _task_workspace(mech: Mechanism, over, at, free, limits, tol, step, bounds, max_poses,
+                    progress) -> TaskWorkspaceResult:
     """``workspace(kind="task")``: the checks of its own arguments, then the analysis."""
     from ..analysis.workspace import task_workspace
     from ..model.task import TASK_NAMES, TaskCoordinates
@@ -571,18 +813,47 @@ def _task_workspace(mech: Mechanism, over, at, free, limits, tol, step, bounds, 
 
 
 def parasitic(model: ModelLike, over: Mapping, *, at: Mapping[str, float] | None = None, free=None,
-              euler: str | None = None, plot=None, progress: Progress | None = None):
-    """The parasitic motion of a lower-mobility mechanism: its solved task coordinates over a grid
-    of one or two given ones (``spatialmech parasitic``, docs/lower-mobility.md).
+              euler: str | None = None, plot=None, progress: Progress | None = None) -> ParasiticTable:
+    """The parasitic motion of a lower-mobility mechanism over a grid of given coordinates.
 
-    SI and radians: ``over`` maps the grid's given coordinates (``x, y, z`` length, ``a1, a2, a3``
-    rad) to ``(lo, hi, n)`` or increasing values; ``at`` holds other given ones (default: their
-    reference values); ``free`` names the coordinates to solve (default: those the model's task
-    does not give) and ``euler`` the sequence of ``a1, a2, a3`` (default: the model's task's, else
-    ``"ZYX"``).  ``plot``: a figure file (.png, .pdf, .svg), one panel per solved coordinate.
-    Returns a :class:`~spatialmech.analysis.parasitic.ParasiticTable` (``values(name)``,
-    ``ranges``, ``to_dict()``).
+    Its solved task coordinates over a grid of one or two given ones (``spatialmech parasitic``,
+    docs/lower-mobility.md).
 
+    Parameters
+    ----------
+    model : Mechanism, str or path
+        The mechanism, a ready-made model name (``sm.models()``) or a TOML model file.
+    over : mapping
+        The grid's given coordinates (``x, y, z`` length unit, ``a1, a2, a3`` rad) -> ``(lo, hi, n)``
+        or increasing values.
+    at : mapping, optional
+        Other given coordinates held (default: their reference values; SI, rad).
+    free : str or sequence of str, optional
+        The coordinates to solve (default: those the model's task does not give).
+    euler : str, optional
+        The Euler sequence of ``a1, a2, a3`` (default: the model's task's, else ``"ZYX"``).
+    plot : str or path, optional
+        A figure file (.png, .pdf, .svg), one panel per solved coordinate.
+    progress : callable, optional
+        ``progress(done, total_or_None, message)``, called as the work goes on.
+
+    Returns
+    -------
+    ParasiticTable
+        :class:`~spatialmech.analysis.parasitic.ParasiticTable`: ``solved``, ``values(name)``
+        (arrays of the grid's shape), ``ranges``; ``to_dict()`` is its JSON.
+
+    Raises
+    ------
+    TypeError
+        An argument of the wrong type (named in the message).
+    InputError
+        A bad value (a ``ValueError``, the argument named); an unknown model name raises
+        :class:`~spatialmech.UnknownNameError`, a malformed model file
+        :class:`~spatialmech.ModelFileError` (both ``InputError``).
+
+    Examples
+    --------
     >>> import spatialmech as sm
     >>> t = sm.parasitic("three-rps", {"a2": (-0.1, 0.1, 3), "a3": (-0.1, 0.1, 3)}, at={"z": 0.33})
     >>> t.solved, {n: round(hi, 6) for n, (lo, hi) in t.ranges.items()}

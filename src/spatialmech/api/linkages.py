@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -17,7 +17,11 @@ from ..kinematics.position import freedom_values, platform_pose
 from ..model.mechanism import Mechanism, Pose
 from ..results import Progress, TrackStatus
 if TYPE_CHECKING:
-    from ..analysis.defects import DefectResult
+    from pathlib import Path
+
+    from ..analysis.defects import DefectResult, DJTable
+    from ..services.screening import ScreenSummary
+    from ..synthesis.rccc import RCCCResult
     from ..kinematics.tracking import TrackResult
     from ..synthesis.cs_dyads import CSFamily
     from ..synthesis.five_cs import FiveCSCheck
@@ -92,13 +96,51 @@ class TraceResult:
 def track(model: ModelLike, start=None, *, increasing: str | None = None, sense: int = 1, max_arc: float = 50.0,
           max_steps: int = 20000, h0: float = 0.02, degrees: bool = False,
           progress: Progress | None = None) -> TraceResult:
-    """Follow the one-degree-of-freedom motion by pseudo-arclength continuation from ``start``
-    (a pose, fitted onto the closure; a Configuration; default the reference) until it closes
-    (``status`` closed) or the arc length reaches ``max_arc`` (nondimensional).  ``increasing``:
-    a freedom whose variable grows at the start (``sense=-1``: decreases); without it the first
-    actuator's does (the convention of docs/conventions.md: the same sense on every machine).
-    The sign changes of DJ of the actuators are located as events.
+    """Follow the one-degree-of-freedom motion by pseudo-arclength continuation.
 
+    From ``start`` until the motion closes (``status`` closed) or the arc length reaches
+    ``max_arc``; the sign changes of DJ of the actuators are located as events.
+
+    Parameters
+    ----------
+    model : Mechanism, str or path
+        The mechanism, a ready-made model name (``sm.models()``) or a TOML model file.
+    start : Pose, tuple, int or Configuration, optional
+        The first pose (as ``pose`` in :func:`ik`, fitted onto the closure) or configuration;
+        default: the reference configuration.
+    increasing : str, optional
+        A freedom whose variable grows at the start (default: the first actuator's: the
+        convention of docs/conventions.md, the same sense on every machine).
+    sense : {1, -1}
+        ``-1``: that variable decreases at the start.
+    max_arc : float
+        The largest arc length (nondimensional).
+    max_steps : int
+        The largest number of continuation steps.
+    h0 : float
+        The first step (nondimensional arc length).
+    degrees : bool
+        Read the angles of a pose tuple (and angular values) in degrees instead of radians.
+    progress : callable, optional
+        ``progress(done, total_or_None, message)``, called as the work goes on.
+
+    Returns
+    -------
+    TraceResult
+        ``status`` (:class:`~spatialmech.results.TrackStatus`), ``closed``, ``configurations``,
+        ``poses`` and the DJ events; ``to_dict()`` is its JSON.
+
+    Raises
+    ------
+    TypeError
+        An argument of the wrong type (named in the message).
+    InputError
+        A bad value (a ``ValueError``, the argument named); an unknown model name raises
+        :class:`~spatialmech.UnknownNameError`, a malformed model file
+        :class:`~spatialmech.ModelFileError` (both ``InputError``).
+
+    Examples
+    --------
     >>> import spatialmech as sm
     >>> m = sm.track("bennett")
     >>> m.status, m.closed
@@ -135,11 +177,39 @@ def track(model: ModelLike, start=None, *, increasing: str | None = None, sense:
 
 
 # ============================================================================ defects
-def dj_table(model: ModelLike, drivers=None, positions=None):
-    """DJ (det of the complete Jacobian) at the model's task positions, per driver (default:
-    every base-joint freedom); only the signs along one driver are comparable.  Returns a
-    :class:`~spatialmech.analysis.defects.DJTable`.
+def dj_table(model: ModelLike, drivers=None, positions=None) -> DJTable:
+    """DJ (det of the complete Jacobian) at the model's task positions, per driver.
 
+    Only the signs along one driver are comparable.
+
+    Parameters
+    ----------
+    model : Mechanism, str or path
+        The mechanism, a ready-made model name (``sm.models()``) or a TOML model file.
+    drivers : str or sequence of str, optional
+        The drivers (default: every base-joint freedom).
+    positions : sequence of Pose, str or path, optional
+        The task positions (default: the model's own): a sequence of
+        :class:`~spatialmech.Pose` (``R`` shape (3, 3), ``p`` shape (3,) in the model's length
+        unit) or a TOML file of ``[[positions]]``.
+
+    Returns
+    -------
+    DJTable
+        :class:`~spatialmech.analysis.defects.DJTable`: the signs per driver and position,
+        ``keeps_sign(driver)``, the fits of the printed poses (``fits``); ``to_dict()`` its JSON.
+
+    Raises
+    ------
+    TypeError
+        An argument of the wrong type (named in the message).
+    InputError
+        A bad value (a ``ValueError``, the argument named); an unknown model name raises
+        :class:`~spatialmech.UnknownNameError`, a malformed model file
+        :class:`~spatialmech.ModelFileError` (both ``InputError``).
+
+    Examples
+    --------
     >>> import spatialmech as sm
     >>> t = sm.dj_table("five-cs-3", ["rot1", "rot3"])
     >>> t.keeps_sign("rot1"), t.keeps_sign("rot3")
@@ -162,9 +232,9 @@ class DefectAnalysis:
     mechanism: Mechanism
     positions: tuple[Pose, ...]
     result: DefectResult
-    figures: tuple = ()
+    figures: tuple[Path, ...] = ()
 
-    def __getattr__(self, name):
+    def __getattr__(self, name: str) -> Any:
         if name.startswith("_") or name == "result":
             raise AttributeError(name)
         return getattr(self.result, name)
@@ -176,13 +246,56 @@ class DefectAnalysis:
 def defects(model: ModelLike, positions=None, *, drivers=None, pose_tol: float | None = None,
             angle_tol_deg: float = 1.0, monte_carlo: int = 0, seed: int = 0, precision: float = 5e-4,
             plot: str | os.PathLike | None = None, progress: Progress | None = None) -> DefectAnalysis:
-    """Circuit, branch and order defects of a one-degree-of-freedom linkage for its task
-    positions (``positions``: default the model's own; a sequence of Pose or a TOML file),
-    the drivers that can be used, and a dual-drive plan when no single one can (paper A).
-    ``plot``: a directory to write the figures into.  Returns a :class:`DefectAnalysis` (the
-    attributes of :class:`~spatialmech.analysis.defects.DefectResult`; ``circuit_status``:
-    :class:`~spatialmech.results.TrackStatus`).
+    """Circuit, branch and order defects of a one-degree-of-freedom linkage (paper A).
 
+    For its task positions: the drivers that can be used, and a dual-drive plan when no single
+    one can.
+
+    Parameters
+    ----------
+    model : Mechanism, str or path
+        The mechanism, a ready-made model name (``sm.models()``) or a TOML model file.
+    positions : sequence of Pose, str or path, optional
+        The task positions (default: the model's own): a sequence of
+        :class:`~spatialmech.Pose` (``R`` shape (3, 3), ``p`` shape (3,) in the model's length
+        unit) or a TOML file of ``[[positions]]``.
+    drivers : str or sequence of str, optional
+        The candidate drivers (default: every base-joint freedom).
+    pose_tol : float, optional
+        A position belongs to a circuit that passes within ``pose_tol`` of it (length unit;
+        default 2 % of the characteristic length) and ``angle_tol_deg``.
+    angle_tol_deg : float
+        The angle tolerance of matching a position (degrees).
+    monte_carlo : int
+        Random perturbations of the positions within their printed precision (0: none).
+    seed : int
+        The random seed of those perturbations.
+    precision : float
+        The printed precision of the positions (length unit; axes by ``precision`` per unit).
+    plot : str or path, optional
+        A directory to write the figures into.
+    progress : callable, optional
+        ``progress(done, total_or_None, message)``, called as the work goes on.
+
+    Returns
+    -------
+    DefectAnalysis
+        The attributes of :class:`~spatialmech.analysis.defects.DefectResult` (``circuits``,
+        ``circuit_defect``, ``order_defect``, ``usable_drivers``, ``plan``, ``circuit_status``:
+        :class:`~spatialmech.results.TrackStatus` ...), the ``positions`` and the ``figures``
+        written.
+
+    Raises
+    ------
+    TypeError
+        An argument of the wrong type (named in the message).
+    InputError
+        A bad value (a ``ValueError``, the argument named); an unknown model name raises
+        :class:`~spatialmech.UnknownNameError`, a malformed model file
+        :class:`~spatialmech.ModelFileError` (both ``InputError``).
+
+    Examples
+    --------
     >>> import spatialmech as sm
     >>> motion = sm.track("planar-4r")                  # three positions on its circuit, in order
     >>> P = [motion.poses[k] for k in (0, 9, 18)]
@@ -201,7 +314,7 @@ def defects(model: ModelLike, positions=None, *, drivers=None, pose_tol: float |
     res = defect_analysis(mech, positions, drivers=check_names(drivers, "drivers"), pose_tol=pose_tol,
                           angle_tol_deg=angle_tol_deg, monte_carlo=check_int(monte_carlo, "monte_carlo", minimum=0),
                           seed=check_int(seed, "seed"), precision=precision, progress=optional_progress(progress))
-    figures: tuple = ()
+    figures: tuple[Path, ...] = ()
     if plot is not None:
         from ..present.defect_figures import write_defect_figures
 
@@ -211,15 +324,40 @@ def defects(model: ModelLike, positions=None, *, drivers=None, pose_tol: float |
 
 # ============================================================================ synthesis
 def synth_rccc(task="rccc-four-positions", *, pick: str = "best-rc", samples: int = 360,
-               save: str | os.PathLike | None = None, plot: str | os.PathLike | None = None):
-    """Four-position RCCC synthesis by solution regions (paper D).  ``task``: a ready-made task
-    name, a TOML task file, or a ``TaskPositions``; ``pick``: ``"best-rc"`` (the smallest
-    largest input slide) or ``"interior"`` (the most interior defect-free crank-rocker);
-    ``samples`` per Burmester-curve branch; ``save``: write the RCCC as a model file (TOML);
-    ``plot``: write the figures (curves, regions, solution lines, linkage) into that directory.
-    Returns a :class:`~spatialmech.synthesis.RCCCResult` (``linkage`` is a Mechanism, ``task``
-    the task positions).
+               save: str | os.PathLike | None = None, plot: str | os.PathLike | None = None) -> RCCCResult:
+    """Four-position RCCC synthesis by solution regions (paper D).
 
+    Parameters
+    ----------
+    task : str, path or TaskPositions
+        A ready-made task name, a TOML task file, or a ``TaskPositions``.
+    pick : {"best-rc", "interior"}
+        ``"best-rc"``: the smallest largest input slide; ``"interior"``: the most interior
+        defect-free crank-rocker.
+    samples : int
+        Points per Burmester-curve branch (at least 8).
+    save : str or path, optional
+        Write the RCCC as a model file (TOML).
+    plot : str or path, optional
+        Write the figures (curves, regions, solution lines, linkage) into that directory.
+
+    Returns
+    -------
+    RCCCResult
+        :class:`~spatialmech.synthesis.RCCCResult`: ``linkage`` (a Mechanism), ``task`` (the task
+        positions), ``linkage_type``, ``defects`` ...
+
+    Raises
+    ------
+    TypeError
+        An argument of the wrong type (named in the message).
+    InputError
+        A bad value (a ``ValueError``, the argument named); an unknown model name raises
+        :class:`~spatialmech.UnknownNameError`, a malformed model file
+        :class:`~spatialmech.ModelFileError` (both ``InputError``).
+
+    Examples
+    --------
     >>> import spatialmech as sm
     >>> r = sm.synth_rccc(samples=60)
     >>> r.linkage_type, r.defects
@@ -297,13 +435,45 @@ def synth_cs(positions=None, *, pick: int = 5, starts: int = 60, seed: int = 0, 
              check_defects: bool = True, save: str | os.PathLike | None = None,
              progress: Progress | None = None) -> CSSynthesisResult:
     """Seven-position synthesis of CS dyads and a 5-CS linkage (paper A, section 3).
-    ``positions``: seven task poses -- default paper A's table 9; a model name or Mechanism (its
-    task positions), a TOML file of ``[[positions]]``, or a sequence of Pose.  ``starts`` random
-    starts (``seed``); ``pick`` small-slide dyads (5: also assemble and check the 5-CS, and with
-    ``check_defects`` its circuit, order and branch defects, about 10 s; ``progress``
-    reports on it); ``samples``: family points listed in ``to_dict()``; ``save``: write the 5-CS
-    as a model file (TOML; needs ``pick=5``).
 
+    Parameters
+    ----------
+    positions : str, Mechanism, path or sequence of Pose, optional
+        Seven task poses: default paper A's table 9; a model name or Mechanism (its task
+        positions), a TOML file of ``[[positions]]``, or seven :class:`~spatialmech.Pose`
+        (``R`` shape (3, 3), ``p`` shape (3,), length unit).
+    pick : int
+        Small-slide dyads picked (5: also assemble and check the 5-CS).
+    starts : int
+        Random starts of the family's synthesis.
+    seed : int
+        Their random seed.
+    samples : int
+        Family points listed in ``to_dict()``.
+    check_defects : bool
+        With ``pick=5``: also the circuit, order and branch defects (about 10 s).
+    save : str or path, optional
+        Write the 5-CS as a model file (TOML; needs ``pick=5``).
+    progress : callable, optional
+        ``progress(done, total_or_None, message)``, called as the work goes on.
+
+    Returns
+    -------
+    CSSynthesisResult
+        The ``family`` of dyads and its picks; with five picks the assembled ``linkage`` and its
+        ``check`` at the seven positions.
+
+    Raises
+    ------
+    TypeError
+        An argument of the wrong type (named in the message).
+    InputError
+        A bad value (a ``ValueError``, the argument named); an unknown model name raises
+        :class:`~spatialmech.UnknownNameError`, a malformed model file
+        :class:`~spatialmech.ModelFileError` (both ``InputError``).
+
+    Examples
+    --------
     >>> import spatialmech as sm
     >>> r = sm.synth_cs(pick=0, starts=4)
     >>> len(r.family.branches) >= 1, r.linkage is None
@@ -340,23 +510,62 @@ def synth_cs(positions=None, *, pick: int = 5, starts: int = 60, seed: int = 0, 
 def screen(task=None, out: str | os.PathLike = "screen.parquet", *, candidates: int = 1000, density: float = 0.5,
            workers: int | None = None, scheduler: str | None = None, top: int = 5, rank_by: str = "singularity",
            seed: int = 0, starts: int = 60, separation: float = 0.5, chunk_size: int = 20,
-           progress: Progress | None = None):
-    """Defect screening of 5-CS linkages for seven task positions (docs/screening.md): the CS
-    dyad family is sampled (``density`` dyads per unit nondimensional arc length), up to
-    ``candidates`` sets of five dyads are formed (small slides preferred, limbs at least
-    ``separation`` apart), each is judged in stages (assembly at the positions, DJ signs, the
-    full defect analysis) on Dask -- a local cluster of ``workers`` processes (``None``: one per
-    core, ``0``: serial without Dask) or the cluster at ``scheduler`` -- and the verdicts go to
-    the Parquet dataset ``out`` (resumable: a rerun with the same arguments skips finished
-    chunks).  The ``top`` usable linkages, ranked by ``rank_by`` (``"singularity"``: the largest
-    distance to a singularity along the path first; ``"slide"``: the smallest C-slide stroke
-    first), are written as model files (``out/_top/``).
+           progress: Progress | None = None) -> ScreenSummary:
+    """Defect screening of 5-CS linkages for seven task positions (docs/screening.md).
 
-    ``task``: ``None``/``"five-cs-positions"`` (paper A table 9), a model with seven task
-    positions, a positions TOML file or seven Pose.  Returns a
-    :class:`~spatialmech.services.screening.ScreenSummary` (``to_dict()`` for JSON, with
-    ``positions_source``: where the positions came from).
+    The CS dyad family is sampled, up to ``candidates`` sets of five dyads are formed, each is
+    judged in stages (assembly at the positions, DJ signs, the full defect analysis) on Dask and
+    the verdicts go to a Parquet dataset (resumable: a rerun with the same arguments skips
+    finished chunks); the best usable linkages are written as model files (``out/_top/``).
 
+    Parameters
+    ----------
+    task : str, Mechanism, path or sequence of Pose, optional
+        ``None`` / ``"five-cs-positions"`` (paper A table 9), a model with seven task positions, a
+        positions TOML file or seven :class:`~spatialmech.Pose`.
+    out : str or path
+        The Parquet dataset written.
+    candidates : int
+        The largest number of candidate sets.
+    density : float
+        Dyads per unit nondimensional arc length of the family.
+    workers : int, optional
+        Local worker processes (``None``: one per core, ``0``: serial without Dask).
+    scheduler : str, optional
+        The address of an existing Dask scheduler (then ``workers`` is ignored).
+    top : int
+        How many of the best usable linkages to write as model files.
+    rank_by : {"singularity", "slide"}
+        ``"singularity"``: the largest distance to a singularity along the path first;
+        ``"slide"``: the smallest C-slide stroke first.
+    seed : int
+        The random seed (sampling and the family's synthesis).
+    starts : int
+        Random starts of the family's synthesis.
+    separation : float
+        The smallest distance between limbs (nondimensional).
+    chunk_size : int
+        Candidates per Parquet file and per Dask task.
+    progress : callable, optional
+        ``progress(done, total_or_None, message)``, called as the work goes on.
+
+    Returns
+    -------
+    ScreenSummary
+        :class:`~spatialmech.services.screening.ScreenSummary`: counts by stage, the usable ones,
+        the files written; ``to_dict()`` for JSON, with ``positions_source``.
+
+    Raises
+    ------
+    TypeError
+        An argument of the wrong type (named in the message).
+    InputError
+        A bad value (a ``ValueError``, the argument named); an unknown model name raises
+        :class:`~spatialmech.UnknownNameError`, a malformed model file
+        :class:`~spatialmech.ModelFileError` (both ``InputError``).
+
+    Examples
+    --------
     >>> import tempfile
     >>> import spatialmech as sm
     >>> s = sm.screen(out=tempfile.mkdtemp() + "/s.parquet", candidates=2, starts=4, workers=0, top=0)

@@ -45,6 +45,14 @@ def maps(model: ModelLike, *, kind: str = "position", over: Mapping, at: Mapping
         :attr:`~MapResult.characteristic_length`), a status per cell; ``to_dict()`` is the JSON
         of ``spatialmech maps --json``.
 
+    Raises
+    ------
+    TypeError
+        An argument of the wrong type (named in the message).
+    InputError
+        A bad value (the argument named): an unknown model, coordinate or index, a grid too
+        large, a Jacobian that is not 6 x 6.
+
     Examples
     --------
     >>> import spatialmech as sm

@@ -13,6 +13,7 @@ from ..errors import InputError
 from ..results import Progress, check_progress
 if TYPE_CHECKING:
     from ..present.viewer import ViewerFile
+    from ..services.studio.session import Session
 
 from .checks import ModelLike, as_mechanism, check_bool, check_choice, check_int, check_path
 
@@ -40,11 +41,41 @@ class ReportResult:
 
 
 def report(model: ModelLike, out=None, *, trace: bool = True, progress: bool | Progress | None = None) -> ReportResult:
-    """Every analysis that applies to one model, written as a report into the directory
-    ``out`` (default ``report-NAME``): mobility of every mode, the complete Jacobian, DJ at the
-    task positions, the traced motion (1 DOF; ``trace=False`` skips it) and a 3-D viewer.
-    ``progress``: True prints on stderr, or a callback.
+    """Every analysis that applies to one model, written as a report into a directory.
 
+    Mobility of every mode, the complete Jacobian, DJ at the task positions, the traced motion
+    (1 DOF) and a 3-D viewer.
+
+    Parameters
+    ----------
+    model : Mechanism, str or path
+        The mechanism, a ready-made model name (``sm.models()``) or a TOML model file.
+    out : str or path, optional
+        The directory (default ``report-NAME``); created if needed.
+    trace : bool
+        Trace the one-degree-of-freedom motion (``False`` skips it).
+    progress : bool or callable, optional
+        ``True`` prints on stderr; a callable ``progress(done, total_or_None, message)``.
+
+    Returns
+    -------
+    ReportResult
+        ``out``, ``index_html`` (opens offline), ``results_json`` and ``data`` (every number);
+        ``to_dict()`` is the payload of ``spatialmech report --json``.
+
+    Raises
+    ------
+    TypeError
+        An argument of the wrong type (named in the message).
+    InputError
+        A bad value (a ``ValueError``, the argument named); an unknown model name raises
+        :class:`~spatialmech.UnknownNameError`, a malformed model file
+        :class:`~spatialmech.ModelFileError` (both ``InputError``).
+    OSError
+        The directory cannot be written.
+
+    Examples
+    --------
     >>> import spatialmech as sm, tempfile
     >>> with tempfile.TemporaryDirectory() as d:
     ...     r = sm.report("planar-4r", d, trace=False)
@@ -66,12 +97,35 @@ def report(model: ModelLike, out=None, *, trace: bool = True, progress: bool | P
 
 
 def demo(out="report", *, progress: bool | Progress | None = None) -> ReportResult:
-    """Reproduce the four papers' examples into a report in the directory ``out``:
+    """Reproduce the four papers' examples into a report (about 45 s).
+
     ``index.html`` (self-contained, opens offline), ``results.json`` (every number) and
     ``figures/``; each claim of a paper is a row (the paper's value, ours, reproduced or not and
-    why; ``data["summary"]`` counts them).  About 45 s.  ``progress``: True prints on stderr, or a
-    callback.
+    why; ``data["summary"]`` counts them).
 
+    Parameters
+    ----------
+    out : str or path
+        The directory (created if needed).
+    progress : bool or callable, optional
+        ``True`` prints on stderr; a callable ``progress(done, total_or_None, message)``.
+
+    Returns
+    -------
+    ReportResult
+        As :func:`report`.
+
+    Raises
+    ------
+    TypeError
+        ``out`` is not a path, ``progress`` not a bool or callable.
+    InputError
+        ``out`` exists and is not a directory.
+    OSError
+        The directory cannot be written.
+
+    Examples
+    --------
     >>> import spatialmech as sm
     >>> sm.demo(out=42)
     Traceback (most recent call last):
@@ -119,13 +173,44 @@ class ViewResult:
 
 
 def view(model: ModelLike, out, *, motion: str = "auto", frames: int = 60, plotly: str = "inline") -> ViewResult:
-    """Write the interactive 3-D viewer of a model (one self-contained HTML file, opens
-    offline) animated along a motion: ``"trace"`` (1 DOF: the whole circuit by continuation,
-    with the zeros of DJ marked), ``"demo"`` (a short loop along the closure manifold, any
-    mobility) or ``"auto"`` (trace when the mechanism has one degree of freedom).  ``plotly``:
-    ``"inline"`` (plotly.js in the page), ``"cdn"`` (loaded from cdn.plot.ly: needs the network)
-    or ``"directory"`` (``plotly.min.js`` written once next to the page: small pages, offline).
+    """Write the interactive 3-D viewer of a model, animated along a motion.
 
+    One self-contained HTML file (opens offline).
+
+    Parameters
+    ----------
+    model : Mechanism, str or path
+        The mechanism, a ready-made model name (``sm.models()``) or a TOML model file.
+    out : str or path
+        The HTML file (its directory must exist).
+    motion : {"auto", "trace", "demo"}
+        ``"trace"`` (1 DOF: the whole circuit by continuation, the zeros of DJ marked),
+        ``"demo"`` (a short loop along the closure manifold, any mobility) or ``"auto"`` (trace
+        when the mechanism has one degree of freedom).
+    frames : int
+        The number of frames (at least 2).
+    plotly : {"inline", "cdn", "directory"}
+        plotly.js in the page, loaded from cdn.plot.ly (needs the network), or ``plotly.min.js``
+        written once next to the page (small pages, offline).
+
+    Returns
+    -------
+    ViewResult
+        The file written (``out``, ``frames``, ``bytes``) and the ``motion`` shown.
+
+    Raises
+    ------
+    TypeError
+        An argument of the wrong type (named in the message).
+    InputError
+        A bad value (a ``ValueError``, the argument named); an unknown model name raises
+        :class:`~spatialmech.UnknownNameError`, a malformed model file
+        :class:`~spatialmech.ModelFileError` (both ``InputError``).
+    OSError
+        The directory cannot be written.
+
+    Examples
+    --------
     >>> import spatialmech as sm, tempfile, os
     >>> with tempfile.TemporaryDirectory() as d:
     ...     v = sm.view("rssr", os.path.join(d, "rssr.html"), frames=12)
@@ -161,12 +246,37 @@ def view(model: ModelLike, out, *, motion: str = "auto", frames: int = 60, plotl
 
 
 # ============================================================================ design studio
-def studio_session(model: ModelLike = "five-cs-3"):
-    """A design-studio session on ``model`` (what ``spatialmech studio`` serves, without HTTP):
+def studio_session(model: ModelLike = "five-cs-3") -> Session:
+    """A design-studio session on a model: what ``spatialmech studio`` serves, without HTTP.
+
     ``drive(values)`` moves the actuators (model units, degrees for rotations) along the current
     branch by continuation and says how it went; ``state()`` is the readout (JSON payload,
-    docs/studio.md); ``set_drivers``, ``fk_all``, ``pick_mode``.
+    docs/studio.md); ``set_drivers``, ``fk_all`` (the modes of ``fk(..., all_solutions=True)``),
+    ``pick_mode``.
 
+    Parameters
+    ----------
+    model : Mechanism, str or path
+        The mechanism, a ready-made model name (``sm.models()``) or a TOML model file.
+
+    Returns
+    -------
+    Session
+        The session (:class:`spatialmech.services.studio.session.Session`), at the model's
+        reference configuration (or a generic one near it).
+
+    Raises
+    ------
+    TypeError
+        An argument of the wrong type (named in the message).
+    InputError
+        A bad value (a ``ValueError``, the argument named); an unknown model name raises
+        :class:`~spatialmech.UnknownNameError`, a malformed model file
+        :class:`~spatialmech.ModelFileError` (both ``InputError``).
+        A metamorphic model is refused (export one of its modes).
+
+    Examples
+    --------
     >>> import spatialmech as sm
     >>> s = sm.studio_session("rssr")
     >>> r = s.drive([10.0])                                  # the crank to 10 degrees

@@ -4,9 +4,9 @@ lower-mobility mechanism (``sm.suggest_task_grid``) -- and the names those grids
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any, overload
 
 import numpy as np
 
@@ -16,6 +16,10 @@ from ..errors import InputError, describe
 from ..model.mechanism import Mechanism
 from ..model.task import TASK_NAMES, TaskCoordinates
 from ..results import Progress
+if TYPE_CHECKING:
+    from ..analysis.singularity import SliceResult
+    from ..analysis.task_slice import TaskSliceResult
+
 from .checks import ModelLike, as_mechanism, check_bool, check_names, check_numbers, optional_progress
 
 #: The coordinates of a pose workspace's ``at`` (``x, y, z`` length; ``alpha, beta, gamma`` rad of
@@ -52,24 +56,64 @@ def _grid(over, count: int) -> list[tuple[str, np.ndarray]]:
     return [(str(k), check_numbers(v, f"over[{k}]").reshape(-1)) for k, v in over.items()]
 
 
-def singularity_slice(model: ModelLike, over: Mapping[str, Any], *, pose=None,
+@overload
+def singularity_slice(model: ModelLike, over: Mapping[str, Any], *, pose: None = None,
                       at: Mapping[str, float] | None = None, free=None, drivers=None, degrees: bool = False,
-                      progress: Progress | None = None):
-    """The singularity loci (zero set of ``det J``) and the scale-free ``sigma_min`` on a 2-D
-    slice; ``over`` maps two coordinates to their grid values (the first the columns ``u``, the
-    second the rows ``v``).
+                      progress: Progress | None = None) -> TaskSliceResult: ...
+@overload
+def singularity_slice(model: ModelLike, over: Mapping[str, Any], *, pose: Sequence[Any],
+                      at: None = None, free: None = None, drivers=None, degrees: bool = False,
+                      progress: Progress | None = None) -> SliceResult: ...
+def singularity_slice(model: ModelLike, over: Mapping[str, Any], *, pose: Sequence[Any] | None = None,
+                      at: Mapping[str, float] | None = None, free=None, drivers=None, degrees: bool = False,
+                      progress: Progress | None = None) -> SliceResult | TaskSliceResult:
+    """The singularity loci (zero set of ``det J``) and the scale-free ``sigma_min`` on a 2-D slice.
 
-    - With ``pose`` ``(xyz, (seq, a1, a2, a3))``: the slice varies that pose, coordinates ``x, y,
-      z`` (length) or ``a1, a2, a3`` (its Euler angles; degrees with ``degrees=True``, as the
-      grid values), each grid row solved by continuation from its neighbour.  Returns a
-      :class:`~spatialmech.analysis.singularity.SliceResult`.
-    - Without: over the task coordinates of a lower-mobility mechanism (SI, rad), ``at`` holding
-      other given ones, ``free`` naming the coordinates to solve (default: the model's task); the
-      parasitic ones are solved at every point.  Returns a
-      :class:`~spatialmech.analysis.task_slice.TaskSliceResult`.
+    With ``pose``: the slice varies that pose, each grid row solved by continuation from its
+    neighbour.  Without: over the task coordinates of a lower-mobility mechanism, the parasitic
+    ones solved at every point.
 
-    ``drivers``: the actuated freedoms (default: the model's actuators).
+    Parameters
+    ----------
+    model : Mechanism, str or path
+        The mechanism, a ready-made model name (``sm.models()``) or a TOML model file.
+    over : mapping
+        Two coordinates -> their grid values, shape (n,) each (the first the columns ``u``, the
+        second the rows ``v``): with ``pose`` ``x, y, z`` (length unit) or ``a1, a2, a3`` (the
+        pose's Euler angles: rad, degrees with ``degrees=True``); without, task coordinates (SI,
+        rad).
+    pose : tuple, optional
+        ``(xyz, (seq, a1, a2, a3))``: ``xyz`` shape (3,) (length unit), a named Euler sequence
+        and its angles (rad, degrees with ``degrees=True``).
+    at : mapping, optional
+        Without ``pose``: other given task coordinates held (SI, rad).
+    free : str or sequence of str, optional
+        Without ``pose``: the task coordinates to solve (default: the model's task).
+    drivers : str or sequence of str, optional
+        The actuated freedoms (default: the model's actuators).
+    degrees : bool
+        Read the angles of a pose tuple (and angular values) in degrees instead of radians.
+    progress : callable, optional
+        ``progress(done, total_or_None, message)``, called as the work goes on.
 
+    Returns
+    -------
+    SliceResult or TaskSliceResult
+        With ``pose`` a :class:`~spatialmech.analysis.singularity.SliceResult`, without a
+        :class:`~spatialmech.analysis.task_slice.TaskSliceResult`: the grid, ``det`` and
+        ``sigma_min`` arrays of shape (len(v), len(u)); ``to_dict()`` is its JSON.
+
+    Raises
+    ------
+    TypeError
+        An argument of the wrong type (named in the message).
+    InputError
+        A bad value (a ``ValueError``, the argument named); an unknown model name raises
+        :class:`~spatialmech.UnknownNameError`, a malformed model file
+        :class:`~spatialmech.ModelFileError` (both ``InputError``).
+
+    Examples
+    --------
     >>> import numpy as np, spatialmech as sm
     >>> s = sm.singularity_slice("three-rps", {"a2": np.radians([-10, 0, 10]), "a3": np.radians([-10, 0, 10])},
     ...                          at={"z": 0.33})
@@ -97,7 +141,7 @@ def singularity_slice(model: ModelLike, over: Mapping[str, Any], *, pose=None,
     return _pose_slice(mech, _grid(over, 2), pose, acts, degrees, progress)
 
 
-def _pose_slice(mech: Mechanism, axes, pose, acts, degrees: bool, progress):
+def _pose_slice(mech: Mechanism, axes, pose, acts, degrees: bool, progress) -> SliceResult:
     from ..analysis.singularity import singularity_slice as _slice
     from ..geometry.rotations import euler_matrix
     from ..model.mechanism import Pose
@@ -140,8 +184,8 @@ class TaskGridSuggestion:
     given: tuple[str, ...]
     solved: tuple[str, ...]
     euler: str
-    over: dict
-    at: dict
+    over: dict[str, tuple[float, float, int]]
+    at: dict[str, float]
 
     def to_dict(self) -> dict:
         return {"given": list(self.given), "solved": list(self.solved), "euler": self.euler,
@@ -149,11 +193,38 @@ class TaskGridSuggestion:
 
 
 def suggest_task_grid(model: ModelLike, *, free=None, degrees: bool = False) -> TaskGridSuggestion:
-    """A first grid over the task coordinates of ``model`` (for ``sm.workspace(kind="task")`` or
-    :func:`singularity_slice`): the model's task (or the one solving ``free``), its first two
-    given coordinates as grid axes, the others held.  Raises :class:`~spatialmech.InputError`
-    when the output's freedoms cannot be told.
+    """A first grid over the task coordinates of a model.
 
+    For ``sm.workspace(kind="task")`` or :func:`singularity_slice`: the model's task (or the one
+    solving ``free``), its first two given coordinates as grid axes, the others held.
+
+    Parameters
+    ----------
+    model : Mechanism, str or path
+        The mechanism, a ready-made model name (``sm.models()``) or a TOML model file.
+    free : str or sequence of str, optional
+        The task coordinates to solve (default: the model's task).
+    degrees : bool
+        Give the angles of the grid in degrees instead of radians.
+
+    Returns
+    -------
+    TaskGridSuggestion
+        ``given``, ``solved``, ``euler``, ``over`` (the first two given ones, angles first:
+        name -> ``(lo, hi, n)``, +-20 deg or +-L/2 about the reference) and ``at`` (the others).
+
+    Raises
+    ------
+    TypeError
+        An argument of the wrong type (named in the message).
+    InputError
+        A bad value (a ``ValueError``, the argument named); an unknown model name raises
+        :class:`~spatialmech.UnknownNameError`, a malformed model file
+        :class:`~spatialmech.ModelFileError` (both ``InputError``).
+        The output's freedoms cannot be told (an ``InputError``).
+
+    Examples
+    --------
     >>> import spatialmech as sm
     >>> g = sm.suggest_task_grid("three-rps", degrees=True)
     >>> g.given, g.solved, g.over["a2"]

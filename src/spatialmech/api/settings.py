@@ -12,11 +12,32 @@ from ..geometry import tolerances as _tol
 
 @contextmanager
 def tolerances(spec=None, *, primary: str = "rank") -> Iterator[_tol.Tolerances]:
-    """Run a block with other tolerances (docs/conventions.md, Tolerances): ``spec`` is ``None``
-    (the tolerances in force), a :class:`~spatialmech.geometry.tolerances.Tolerances`, a number
-    (sets ``primary``) or the text ``NAME=VALUE[,NAME=VALUE]`` (what ``--tol`` takes; a bare
-    number sets ``primary``).
+    """Run a block with other tolerances (docs/conventions.md, Tolerances); a context manager.
 
+    Parameters
+    ----------
+    spec : Tolerances, float, str or None
+        ``None``: the tolerances in force; a :class:`~spatialmech.geometry.tolerances.Tolerances`;
+        a number (nondimensional, sets ``primary``); or the text ``NAME=VALUE[,NAME=VALUE]`` (what
+        ``--tol`` takes; a bare number sets ``primary``).
+    primary : str
+        The tolerance a bare number sets (``"rank"``, ``"singular"``, ``"newton"``, ...).
+
+    Returns
+    -------
+    Iterator[Tolerances]
+        Used as ``with sm.tolerances(...) as t``: ``t`` is the tolerances in force inside the block
+        (the previous ones are restored on exit).
+
+    Raises
+    ------
+    TypeError
+        ``primary`` is not a str.
+    InputError
+        ``spec`` of another type, an unknown tolerance name or a value out of its range.
+
+    Examples
+    --------
     >>> import spatialmech as sm
     >>> with sm.tolerances("1e-4", primary="rank") as t:
     ...     t.rank, sm.mobility("four-sps-cu").dof
@@ -38,9 +59,28 @@ def tolerances(spec=None, *, primary: str = "rank") -> Iterator[_tol.Tolerances]
 
 
 def default_tolerance(name: str) -> float:
-    """The library's default value of one tolerance (``"rank"``, ``"singular"``, ``"newton"``,
-    ``"reachability"`` ...), as printed by ``--help``.
+    """The library's default value of one tolerance, as printed by ``--help``.
 
+    Parameters
+    ----------
+    name : str
+        ``"rank"``, ``"singular"``, ``"newton"``, ``"reachability"`` ... (the fields of
+        :class:`~spatialmech.geometry.tolerances.Tolerances`).
+
+    Returns
+    -------
+    float
+        The default value (nondimensional).
+
+    Raises
+    ------
+    TypeError
+        ``name`` is not a str.
+    InputError
+        An unknown tolerance name.
+
+    Examples
+    --------
     >>> import spatialmech as sm
     >>> sm.default_tolerance("singular") > 0
     True
@@ -54,14 +94,33 @@ def default_tolerance(name: str) -> float:
 
 
 def announce_compilation(stream) -> bool:
-    """Write to ``stream`` (e.g. ``sys.stderr`` when it is a terminal) one line per numba kernel
-    that compiles (a miss of the on-disk cache: the first use after installation), with its
-    seconds; ``None`` removes the listener.  Returns whether a listener is installed.
+    """Announce numba compilations: one line per kernel that compiles (a miss of the on-disk
+    cache: the first use after installation), with its seconds.
 
+    Parameters
+    ----------
+    stream : text stream or None
+        Where the lines go (e.g. ``sys.stderr`` when it is a terminal); ``None`` removes the
+        listener.
+
+    Returns
+    -------
+    bool
+        Whether a listener is installed.
+
+    Raises
+    ------
+    TypeError
+        ``stream`` has no ``write`` method.
+
+    Examples
+    --------
     >>> import spatialmech as sm
     >>> sm.announce_compilation(None)
     False
     """
     from ..kinematics.compiled.jit import announce_compilation as _announce
 
+    if stream is not None and not callable(getattr(stream, "write", None)):
+        raise TypeError(f"stream: expected a text stream (with a write method) or None, got {describe(stream)}")
     return _announce(stream)

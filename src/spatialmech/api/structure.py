@@ -16,8 +16,15 @@ from .checks import ModelLike, as_mechanism, check_int
 
 # ============================================================================ models
 def models() -> dict[str, str]:
-    """The ready-made models: name -> one-line description.
+    """The ready-made models (the catalogue).
 
+    Returns
+    -------
+    dict[str, str]
+        Model name -> one-line description.
+
+    Examples
+    --------
     >>> import spatialmech as sm
     >>> "bennett" in sm.models() and "four-sps-cu" in sm.models()
     True
@@ -28,11 +35,30 @@ def models() -> dict[str, str]:
 def load_model(model: ModelLike, *, name: str | None = "model") -> Mechanism:
     """A mechanism from a ready-made name, a TOML file path, or a Mechanism (returned as is).
 
-    Unknown names raise :class:`~spatialmech.UnknownNameError` (listing the known ones); a
-    malformed file :class:`~spatialmech.ModelFileError` naming the file and the field.
-    ``name``: the argument named in those messages; ``None`` names the value itself, as the
-    command line does for its MODEL argument (``NAME: not a file and not a ready-made model``).
+    Parameters
+    ----------
+    model : Mechanism, str or path
+        The mechanism, a ready-made model name (``sm.models()``) or a TOML model file.
+    name : str or None
+        The argument named in error messages; ``None`` names the value itself, as the command line
+        does for its MODEL argument (``NAME: not a file and not a ready-made model``).
 
+    Returns
+    -------
+    Mechanism
+        The model (SI lengths in the model's length unit, radians).
+
+    Raises
+    ------
+    TypeError
+        ``model`` is not a Mechanism, str or path; ``name`` not a str or None.
+    UnknownNameError
+        Neither a file nor a ready-made model (the message lists the known ones).
+    ModelFileError
+        A malformed model file (naming the file and the field).
+
+    Examples
+    --------
     >>> import spatialmech as sm
     >>> mech = sm.load_model("rssr")
     >>> mech.name, mech.actuators
@@ -45,11 +71,39 @@ def load_model(model: ModelLike, *, name: str | None = "model") -> Mechanism:
 
 # ============================================================================ mobility
 def mobility(model: ModelLike, mode: str | None = None, *, seed: int = 0, tol=None) -> MobilityResult:
-    """Mobility by the modified Kutzbach-Grübler formula, checked numerically (one mode of a
-    metamorphic mechanism: ``mode``; every mode: :func:`mobility_modes`).  ``tol``: a
-    :class:`~spatialmech.geometry.tolerances.Tolerances` or the rank tolerance (default: the
-    tolerances in force).
+    """Mobility by the modified Kutzbach-Grübler formula, checked numerically.
 
+    One motion mode of a metamorphic mechanism (``mode``); every mode: :func:`mobility_modes`.
+
+    Parameters
+    ----------
+    model : Mechanism, str or path
+        The mechanism, a ready-made model name (``sm.models()``) or a TOML model file.
+    mode : str, optional
+        A motion mode of a metamorphic mechanism (default: its first / only one).
+    seed : int
+        The random seed of the generic configuration the rank is checked at.
+    tol : Tolerances or float, optional
+        A :class:`~spatialmech.geometry.tolerances.Tolerances` or the rank tolerance
+        (nondimensional; default: the tolerances in force).
+
+    Returns
+    -------
+    MobilityResult
+        ``dof``, ``motion`` (e.g. ``"RxRyRzTz"``), the formula's terms, the numerical rank ...;
+        ``to_dict()`` is its JSON.
+
+    Raises
+    ------
+    TypeError
+        An argument of the wrong type (named in the message).
+    InputError
+        A bad value (a ``ValueError``, the argument named); an unknown model name raises
+        :class:`~spatialmech.UnknownNameError`, a malformed model file
+        :class:`~spatialmech.ModelFileError` (both ``InputError``).
+
+    Examples
+    --------
     >>> import spatialmech as sm
     >>> r = sm.mobility("four-sps-cu")
     >>> (r.dof, r.motion)
@@ -83,9 +137,36 @@ class MobilityModes:
 
 
 def mobility_modes(model: ModelLike, *, mode: str | None = None, seed: int = 0, tol=None) -> MobilityModes:
-    """Mobility of every motion mode (one result for a mechanism that is not metamorphic; only
-    ``mode`` when given); ``to_dict()`` is the payload of ``spatialmech mobility --json``.
+    """Mobility of every motion mode (one result for a mechanism that is not metamorphic).
 
+    Parameters
+    ----------
+    model : Mechanism, str or path
+        The mechanism, a ready-made model name (``sm.models()``) or a TOML model file.
+    mode : str, optional
+        Only this motion mode.
+    seed : int
+        The random seed of the generic configurations.
+    tol : Tolerances or float, optional
+        As in :func:`mobility`.
+
+    Returns
+    -------
+    MobilityModes
+        A sequence of :class:`~spatialmech.analysis.mobility.MobilityResult`; ``to_dict()`` is the
+        payload of ``spatialmech mobility --json``.
+
+    Raises
+    ------
+    TypeError
+        An argument of the wrong type (named in the message).
+    InputError
+        A bad value (a ``ValueError``, the argument named); an unknown model name raises
+        :class:`~spatialmech.UnknownNameError`, a malformed model file
+        :class:`~spatialmech.ModelFileError` (both ``InputError``).
+
+    Examples
+    --------
     >>> import spatialmech as sm
     >>> [r.dof for r in sm.mobility_modes("three-rrr-sm")]
     [1, 1, 1, 2, 2, 2, 3]

@@ -14,15 +14,18 @@ from __future__ import annotations
 
 import sys
 
+from typing import TYPE_CHECKING
+
 import click
 import numpy as np
 
 from .. import api as sm
+from ..api import Mechanism, Pose, matrix_euler
 from ..errors import InputError
-from ..geometry.rotations import euler_matrix, matrix_euler
-from ..geometry.tolerances import current as current_tolerances
-from ..model.mechanism import Mechanism, Pose
 from .common import emit_json, json_option, parse_numbers, tol_option
+
+if TYPE_CHECKING:
+    from click._termui_impl import ProgressBar  # what click.progressbar returns
 
 #: Largest number of starts of ``fk --all`` (each start is one Newton solve).
 MAX_SEEDS = 20_000
@@ -120,7 +123,15 @@ def resolve_pose(mech: Mechanism, xyz, euler, position) -> Pose:
     if isinstance(arg, int):
         return mech.positions[arg - 1]
     p, orient = arg
-    return Pose(np.eye(3) if orient is None else euler_matrix(orient[0], orient[1:], degrees=True), p, "requested")
+    if orient is None:
+        return Pose(np.eye(3), p, "requested")
+    return Pose.from_euler(orient[0], orient[1:], p, degrees=True, name="requested")
+
+
+def current_tolerances() -> sm.Tolerances:
+    """The tolerances in force (those ``--tol`` set)."""
+    with sm.tolerances() as t:
+        return t
 
 
 def _num(v, fmt: str) -> str:
@@ -172,7 +183,8 @@ def _ik_text(r: sm.IKResult) -> None:
     d = r.to_dict()
     order = {f.id: i for i, f in enumerate(mech.freedom_refs)}
     fitted = (f" (fitted onto the closure: off by {fit.position_error:.3g} {mech.length_unit} and "
-              f"{np.degrees(fit.angle_error):.3g} deg, within the tolerance {reach_tol:g})") if res.fitted else ""
+              f"{np.degrees(fit.angle_error):.3g} deg, within the tolerance {reach_tol:g})"
+              ) if res.fitted and fit is not None else ""  # fitted: the pose has a fit
     click.echo(f"{mech.name}: pose {'reachable' if res.reachable else 'NOT reachable'}{fitted}")
     if r.task is not None:
         t = d["task"]
@@ -187,9 +199,9 @@ def _ik_text(r: sm.IKResult) -> None:
                    + ("" if limb["reachable"] else " [least-squares, not closed]"))
         for k, sol in enumerate(limb["solutions"]):
             values = sorted({**sol["joints_deg"], **sol["joints_len"]}.items(), key=lambda kv: order[kv[0]])
-            vals = ", ".join(f"{fid}={v:.6g}" for fid, v in values)
+            shown = ", ".join(f"{fid}={v:.6g}" for fid, v in values)
             lim = f"  outside limits: {', '.join(sol['outside_limits'])}" if sol["outside_limits"] else ""
-            click.echo(f"    [{k + 1}] {vals}  (residual {sol['residual']:.1e}){lim}")
+            click.echo(f"    [{k + 1}] {shown}  (residual {sol['residual']:.1e}){lim}")
     if r.config is not None:
         click.echo("  actuators: " + ", ".join(f"{k} = {_fmt_value(mech, k, v)}" for k, v in r.actuators.items()))
     click.echo("  (rotations in degrees, slides in " + mech.length_unit + ")")
@@ -256,7 +268,8 @@ class _progress_bar:
     engines that report progress call it), and closes it on exit."""
 
     def __init__(self, enabled: bool):
-        self.enabled, self.bar = enabled, None
+        self.enabled = enabled
+        self.bar: ProgressBar[int] | None = None
 
     def __enter__(self):
         return self if self.enabled else None
@@ -304,10 +317,10 @@ def _fk_text(r: sm.FKResult) -> None:
         if a.all_solutions:
             click.echo(f"  NOT proven complete: {a.completeness}")
     for k, m in enumerate(modes):
-        e = matrix_euler("ZYX", m.pose.R, degrees=True)
+        ang = matrix_euler("ZYX", m.pose.R, degrees=True)
         lim = "within limits" if m.within_limits else "outside limits: " + ", ".join(m.outside_limits)
         click.echo(f"  [{k + 1}] platform point ({_num(m.pose.p, '.6g')}) {mech.length_unit}, "
-                   f"ZYX angles ({_num(e, '.4f')}) deg  {lim}")
+                   f"ZYX angles ({_num(ang, '.4f')}) deg  {lim}")
         _fk_conditioning_lines(m.kind, m.sigma_min, m.condition, m.singular_below, m.members, m.self_motion,
                                mech.length_unit, m.free_dim)
 

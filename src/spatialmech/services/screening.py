@@ -305,10 +305,10 @@ def run_screen(
         raise InputError(f"workers: expected a whole number >= 0 (0: serial), got {workers!r}")
     if scheduler is not None and not str(scheduler).strip():
         raise InputError("scheduler: expected a Dask scheduler address such as tcp://10.0.0.5:8786, got an empty value")
-    for nm, v in (("density", density), ("separation", separation)):
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v < 0 \
-                or (nm == "density" and v == 0):
-            raise InputError(f"{nm}: expected a {'positive' if nm == 'density' else 'non-negative'} number, got {v!r}")
+    for nm, x in (("density", density), ("separation", separation)):
+        if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x) or x < 0 \
+                or (nm == "density" and x == 0):
+            raise InputError(f"{nm}: expected a {'positive' if nm == 'density' else 'non-negative'} number, got {x!r}")
     out = Path(out)
     task = cs_task(positions)
     arguments = {"candidates": int(candidates), "density": float(density), "seed": int(seed), "starts": int(starts),

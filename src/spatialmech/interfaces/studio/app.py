@@ -166,7 +166,7 @@ def create_app(session) -> FastAPI:
     async def fk_all(request: Request):
         data = await body(request, None)
         with lock:
-            sols = session.fk_all(data.get("seeds", 40))
+            sols = session.fk_all(data.get("seeds"))
             return _json(doc({"n_solutions": len(sols), "solutions": sols}))
 
     async def mode(request: Request):

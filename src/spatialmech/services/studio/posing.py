@@ -142,6 +142,7 @@ def pose_path(mech: Mechanism, start: Configuration, task: TaskCoordinates, targ
 
 def _show_limits(mech: Mechanism, fid: str) -> str:
     f = mech.freedom(fid).freedom
+    assert f.limits is not None  # called for the freedoms within_limits names: they have limits
     lo, hi = f.limits
     if f.kind == "P":
         return f"[{lo:.6g}, {hi:.6g}] {mech.length_unit}"

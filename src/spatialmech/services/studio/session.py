@@ -14,8 +14,10 @@ chosen drivers, and the operations the page asks for.
   with a near-singular flag (:data:`~spatialmech.geometry.tolerances.NEAR_SINGULAR`), and the
   geometry the page draws.
 * :meth:`Session.set_drivers` switches the actuated freedoms (same count), :meth:`Session.fk_all`
-  runs the multi-start forward position at the current actuator values, :meth:`Session.pick_mode`
-  moves to one of the modes found (an explicit branch change).
+  runs forward position at the current actuator values through the one dispatcher
+  (:func:`~spatialmech.kinematics.dispatch.solve_forward`, as ``sm.fk(..., all_solutions=True)``
+  and ``fk --all``: the same engine, the same modes), :meth:`Session.pick_mode` moves to one of
+  the modes found (an explicit branch change).
 
 Values in and out are in the model's units with rotations in degrees (the edge of the
 library); inside, SI and radians.  Every method raises :class:`~spatialmech.errors.InputError`
@@ -26,6 +28,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from typing import cast
 
 import numpy as np
 
@@ -36,9 +39,10 @@ from ...kinematics.closure import Configuration, active_mask
 from ...kinematics.backend import closure_residual, correct
 from ...kinematics.motion import generic_configuration
 from ...kinematics.jacobian import complete_jacobian, driver_determinants
-from ...kinematics.forward import forward_position
+from ...kinematics.dispatch import AssemblyMode, ForwardAnswer, forward_engine, solve_forward
+from ...kinematics.forward import ForwardResult
 from ...geometry.rotations import check_sequence
-from ...kinematics.position import freedom_values, platform_pose, within_limits
+from ...kinematics.position import configuration_at_pose, freedom_values, platform_pose, within_limits
 from ...kinematics.task import default_task, task_values
 from ...kinematics.tracking import ActuatorPathProblem, conventional_sense, track
 from ...model.mechanism import Mechanism
@@ -70,7 +74,8 @@ SLIDER_HALF_DEG = 360.0
 SLIDER_HALF_L = 1.0
 #: Largest number of tracker steps per drive (a drag is answered quickly or stops).
 MAX_STEPS = 400
-#: Default number of starts of fk_all (the ready-made models' modes are found with this many).
+#: Default number of starts of fk_all where the multi-start search answers (interactive: the
+#: ready-made models' modes are found with this many; the other engines take their own defaults).
 FK_ALL_SEEDS = 40
 
 
@@ -116,7 +121,8 @@ class Session:
         self.base = mech
         self.mech = mech
         self.note = ""
-        self.fk_modes: list = []
+        #: The modes of the last fk_all, each with its configuration (None: fitted when picked).
+        self.fk_modes: list[tuple[AssemblyMode, Configuration | None]] = []
         self.fk_branch: object = object()  # a new object whenever the branch is changed on purpose
         self._circuit: dict = {}
         self.history: list[np.ndarray] = []  # platform-point path, for the page's trail
@@ -353,15 +359,15 @@ class Session:
         joints = [{"name": j["name"], "type": j["type"], "limb_index": j["limb_index"],
                    "joint_axes": [v.tolist() for v in j["axes"]], "centre_len": j["centre"].tolist()} for j in jl]
         solid = platform_solid(m, d.platform, d.limbs, d.platform_point)
-        hull = solid is not None and solid["hull"]
+        hull = solid if solid is not None and solid["hull"] else None  # the platform mesh, when it is a hull
         return {
             "limbs_len": [l.tolist() for l in d.limbs],
             "limb_names": [l.name for l in m.limbs],
             "limb_colours": [LIMB_COLOURS[i % len(LIMB_COLOURS)] for i in range(len(m.limbs))],
             "base_len": d.base.tolist(),
             "platform_len": d.platform.tolist(),
-            "platform_hull_len": solid["vertices"].tolist() if hull else [],
-            "hull_faces": solid["triangles"].tolist() if hull else [],
+            "platform_hull_len": hull["vertices"].tolist() if hull is not None else [],
+            "hull_faces": hull["triangles"].tolist() if hull is not None else [],
             "platform_mesh": mesh_json(solid),
             "joint_meshes": [mesh_json(x) for x in joint_meshes(jl, len(m.limbs), float(d.scale))],
             "bodies_len": d.bodies.tolist(),
@@ -509,9 +515,10 @@ class Session:
         step_of: dict[int, int] = {}  # event -> index of the tracked point its step starts from
         own_crossed = None
         for e in r.events:
-            if float(e.x[1]) > ell:  # in the overshoot of the last step: not on the way to the target
+            xe = cast(np.ndarray, e.x)  # the drag problem's points are vectors (the pose's x, lambda)
+            if float(xe[1]) > ell:  # in the overshoot of the last step: not on the way to the target
                 continue
-            a_e = a0 + (float(e.x[1]) / ell) * delta
+            a_e = a0 + (float(xe[1]) / ell) * delta
             ev = {"name": e.name, "kind": str(e.kind), **self._display(a_e)}
             if e.name == DEAD_POINT:
                 if str(e.kind) != "zero" or own_crossed is not None:
@@ -657,6 +664,7 @@ class Session:
             bad = within_limits(m, q, act_idx)
             if bad:
                 f = m.freedom(bad[0]).freedom
+                assert f.limits is not None  # within_limits names only freedoms with limits
                 lo, hi = f.limits
                 shown = (f"[{np.degrees(lo):.6g}, {np.degrees(hi):.6g}] deg" if f.kind != "P"
                          else f"[{lo:.6g}, {hi:.6g}] {m.length_unit}")
@@ -694,19 +702,29 @@ class Session:
                              "dj_zeros_len": [self._platform_point(z).tolist() for z in zeros]}
         return {k: v for k, v in self._circuit.items() if k != "key"}
 
-    def fk_all(self, seeds: int = FK_ALL_SEEDS) -> list[dict]:
-        """Every assembly mode a multi-start search finds at the current actuator values
-        (``fk --all``); the current configuration's mode is first."""
-        if isinstance(seeds, bool) or not isinstance(seeds, int) or not 1 <= seeds <= 2000:
+    def fk_all(self, seeds: int | None = None) -> list[dict]:
+        """Every assembly mode at the current actuator values, by the engine the one dispatcher
+        picks (:func:`~spatialmech.kinematics.dispatch.solve_forward` with ``method="auto"``: the
+        modes of ``sm.fk(..., all_solutions=True)`` and ``fk --all``); the mode nearest the
+        current configuration first.  ``seeds``: the starts of a multi-start search (default: the
+        engine's, :data:`FK_ALL_SEEDS` where the multi-start search answers); refused where
+        homotopy continuation answers (it takes no starts)."""
+        if seeds is not None and (isinstance(seeds, bool) or not isinstance(seeds, int) or not 1 <= seeds <= 2000):
             raise InputError(f"seeds: expected a whole number of starts from 1 to 2000, got {seeds!r}")
-        res = forward_position(self.mech, self.actuator_values(), start=self.config, all_solutions=True, n_seeds=seeds)
-        self.fk_modes = [s for s in res.solutions if s.converged]
-        out = []
-        for k, s in enumerate(self.fk_modes):
-            out.append({"mode_number": k + 1, "kind": str(s.kind), "pose": pose_dict(s.pose.R, s.pose.p),
-                        "sigma_min": float(s.conditioning.sigma_min), "singular": bool(s.singular),
-                        "within_limits": not s.outside_limits})
-        return out
+        if seeds is None and forward_engine(self.mech) == "multistart":
+            seeds = FK_ALL_SEEDS
+        ans = solve_forward(self.mech, self.actuator_values(), all_solutions=True, seeds=seeds)
+        modes = list(zip(ans.modes, _mode_configurations(ans), strict=True))
+        here = platform_pose(self.mech, self.config)
+        L = self.mech.characteristic_length
+        if modes:  # the current configuration's mode first, the others in the dispatcher's order
+            near = min(range(len(modes)), key=lambda k: float(np.linalg.norm(modes[k][0].pose.p - here.p)) / L
+                       + float(np.linalg.norm(modes[k][0].pose.R - here.R)))
+            modes.insert(0, modes.pop(near))
+        self.fk_modes = modes
+        return [{"mode_number": k + 1, "kind": str(m.kind), "pose": pose_dict(m.pose.R, m.pose.p),
+                 "sigma_min": float(m.sigma_min), "singular": bool(m.sigma_min < m.singular_below),
+                 "within_limits": m.within_limits} for k, (m, _) in enumerate(modes)]
 
     def pick_mode(self, number) -> None:
         """Move to assembly mode ``number`` (from 1) of the last :meth:`fk_all` (an explicit
@@ -717,6 +735,21 @@ class Session:
             raise InputError("mode_number: run fk_all first (POST /api/fk_all)")
         if not 1 <= number <= len(self.fk_modes):
             raise InputError(f"mode_number: expected 1 to {len(self.fk_modes)}, got {number}")
-        self.config = self.fk_modes[number - 1].config
+        mode, config = self.fk_modes[number - 1]
+        if config is None:  # an engine that gives the pose only (a closed form): the configuration at it
+            fit = configuration_at_pose(self.mech, mode.pose, start=self.config)
+            if not fit.converged:
+                raise InputError(f"mode_number: no closed configuration at mode {number}'s pose "
+                                 f"(residual {fit.ik_residual:.2e})")
+            config = fit.config
+        self.config = config
         self.fk_branch = object()
         self.history = [self._platform_point(self.config)]
+
+
+def _mode_configurations(ans: ForwardAnswer) -> list[Configuration | None]:
+    """The configuration of every mode of ``ans`` where its engine gives one (the general
+    engine's converged solutions, in the order of the modes), else ``None``."""
+    if isinstance(ans.detail, ForwardResult):
+        return [s.config for s in ans.detail.solutions if s.converged]
+    return [None] * len(ans.modes)
