@@ -216,6 +216,14 @@ def stiffness_map(model: ModelLike, *, over: Mapping, at: Mapping[str, float] | 
         ``softest`` (grid; NaN where a cell has none, 0 where singular), ``softest_twist``,
         ``status`` codes of ``STATUS``; ``minimum()``.
 
+    Raises
+    ------
+    TypeError
+        ``over`` or ``at`` is not a mapping, or another argument has the wrong type.
+    InputError
+        A bad value (unknown coordinate or kind, a grid that is not increasing, a stiffness that
+        is not positive and finite), named in the message.
+
     Examples
     --------
     >>> import spatialmech as sm
