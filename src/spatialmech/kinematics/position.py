@@ -479,8 +479,11 @@ def inverse_position(
     homotopy, with a completeness statement (proven by a root count or a trace test, or "NOT
     proven: <reason>"); the other limbs by the multi-start, labelled with the reason (a helical
     joint of nonzero pitch: transcendental; passive freedoms: a positive-dimensional solution
-    set; limbs coupled through internal bodies).  ``"auto"``: the same (the homotopy where it
-    covers the limb, else the multi-start).  ``"multistart"``: the multi-start for every limb.
+    set; limbs coupled through internal bodies).  ``"auto"``: the homotopy where it covers the
+    limb and a known root count bounds its solutions (6R: 16; a 6R wrist-partitioned arm: 8; a
+    3R placing a point: 4), or its generic solve is cached; else the multi-start, labelled with
+    the reason (a proof there needs the trace test, tens of seconds per limb geometry: ask
+    ``"homotopy"``).  ``"multistart"``: the multi-start for every limb.
     ``search["limbs"]`` reports, per limb, the method, ``complete`` and ``completeness``.
     """
     if method not in INVERSE_METHODS:
@@ -584,14 +587,15 @@ def _solve_limb(mech: Mechanism, li: int, D: np.ndarray, q_start: np.ndarray, q_
     name = mech.limbs[li].name
     refused = ""
     if all_solutions and method != "multistart":
-        from .homotopy.inverse import limb_inverse
+        from .homotopy.inverse import auto_reason, limb_inverse
 
         try:
-            hres = limb_inverse(mech, li, D, seed=seed)
+            refused = (auto_reason(mech, li, seed) if method == "auto" else None) or ""
+            if not refused:
+                hres = limb_inverse(mech, li, D, seed=seed)
+                return _homotopy_limb(mech, li, D, q_all, hres, t), {"limb": name, **hres.report()}
         except InputError as exc:
             refused = str(exc)
-        else:
-            return _homotopy_limb(mech, li, D, q_all, hres, t), {"limb": name, **hres.report()}
     res = _inverse_limb(mech, li, D, q_start, q_all, all_solutions, n_seeds, rng, t)
     starts = 1 + (n_seeds if all_solutions else 0)
     why = f"multi-start Gauss-Newton from {starts} start(s) (no completeness argument)"

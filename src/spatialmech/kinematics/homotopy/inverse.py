@@ -414,6 +414,19 @@ def ik_reason(mech: Mechanism, li: int) -> str | None:
     return None
 
 
+def auto_reason(mech: Mechanism, li: int, seed: int = 0) -> str | None:
+    """``None`` when ``method="auto"`` takes the homotopy for limb ``li``: it covers the limb and
+    either a known root count bounds its generic solutions (the proof is then a count, found in
+    well under a second) or its generic solve is already cached; else why the multi-start
+    answers instead (the homotopy would need a trace test: tens of seconds per limb geometry;
+    ``method="homotopy"`` runs it)."""
+    sysm = limb_ik_system(mech, li, seed)  # InputError when not covered at all
+    if sysm.bound or sysm.key in _CACHE:
+        return None
+    return ("no root-count bound is known for this limb: a proof needs the trace test (tens of seconds per limb "
+            "geometry); method='homotopy' runs it")
+
+
 # ------------------------------------------------------------------------------ solving
 def _crand(rng: np.random.Generator, *shape: int) -> np.ndarray:
     return rng.normal(size=shape) + 1j * rng.normal(size=shape)
