@@ -153,3 +153,34 @@ def test_unknown_method_is_refused():
     m = planar_rrr_leg()
     with pytest.raises(InputError, match="method"):
         inverse_position(m, sm.Pose(np.eye(3), [0, 0, 0]), all_solutions=True, method="bogus")
+
+
+def test_auto_takes_the_homotopy_only_where_a_root_count_proves_the_limb(tmp_path):
+    """``method="auto"`` (the default of ``sm.ik`` and ``ik --all``): the PUMA 560 (Pieper's bound
+    of 8) by the homotopy, proven; the planar RRR leg (no root count known, a proof would need
+    the trace test) by the multi-start, labelled with the reason."""
+    from click.testing import CliRunner
+
+    from spatialmech.interfaces.cli import cli
+
+    ikh.clear_cache()
+    puma = serial_arm("puma560", PUMA560_DH)
+    pose = dh_pose(PUMA560_DH, np.array([0.2, -0.5, 0.4, 0.7, 0.5, -0.3]))
+    r = sm.ik(puma, pose, all_solutions=True)
+    rep = r.to_dict()["search"]["limbs"][0]
+    assert rep["method"] == "homotopy" and rep["complete"] and len(r.result.limbs[0].solutions) == 8
+    leg = planar_rrr_leg()
+    leg_pose = sm.Pose(np.eye(3), [0.05, -0.02, 0])
+    rep = sm.ik(leg, leg_pose, all_solutions=True).to_dict()["search"]["limbs"][0]
+    assert rep["method"] == "multistart" and not rep["complete"] and "root-count bound" in rep["completeness"]
+    with pytest.raises(InputError, match="method"):
+        sm.ik(puma, pose, method="homotopy")  # method needs all_solutions
+    with pytest.raises(InputError, match="method"):
+        sm.ik(puma, pose, all_solutions=True, method="newton")
+    # the command line says it per limb, next to the solutions
+    path = str(tmp_path / "puma560.toml")
+    sm.export(puma, path)
+    out = CliRunner().invoke(cli, ["ik", path, "--xyz", *map(str, pose.p), "--euler", "ZYX",
+                                   *map(str, np.degrees(sm.api.matrix_euler("ZYX", pose.R))), "--all"])
+    assert out.exit_code == 0, out.output
+    assert "8 solution(s)" in out.output and "homotopy: complete (proven" in out.output

@@ -101,7 +101,7 @@ class IKResult:
 
 
 def ik(model: ModelLike, pose, *, all_solutions: bool = False, n_seeds: int = 48, seed: int = 0,
-       degrees: bool = False, tol=None, free=None) -> IKResult:
+       degrees: bool = False, tol=None, free=None, method: str = "auto") -> IKResult:
     """Inverse position: the joint values of every limb for a platform pose.
 
     Parameters
@@ -129,6 +129,12 @@ def ik(model: ModelLike, pose, *, all_solutions: bool = False, n_seeds: int = 48
         Task coordinates to solve (names from ``x, y, z, a1, a2, a3``; angles in the pose's Euler
         sequence, ``"ZYX"`` when it gives none): for a lower-mobility mechanism, the parasitic
         ones; the others are held at the pose's values.
+    method : {"auto", "homotopy", "multistart"}
+        With ``all_solutions``, how every solution is searched: ``"auto"`` (a registered closed
+        form, else per limb homotopy continuation where it covers the limb and a root count
+        proves it complete, else the multi-start, labelled not proven), ``"homotopy"`` (every
+        limb it covers, proven by a root count or the trace test) or ``"multistart"``.  The
+        result's ``to_dict()["search"]`` says per limb the method and its completeness.
 
     Returns
     -------
@@ -164,7 +170,8 @@ def ik(model: ModelLike, pose, *, all_solutions: bool = False, n_seeds: int = 48
     P, position = as_pose(mech, pose, degrees)
     names = None if free is None else (check_names(free, "free") or [])
     ans = solve_inverse(mech, P, all_solutions=all_solutions, n_seeds=check_int(n_seeds, "n_seeds", minimum=1),
-                        seed=check_int(seed, "seed"), tol=tol, free=names, euler=pose_sequence(pose))
+                        seed=check_int(seed, "seed"), tol=tol, free=names, euler=pose_sequence(pose),
+                        method=check_choice(method, "method", ("auto", "homotopy", "multistart")))
     return IKResult(mech, ans.pose, ans.result, position, resolve_tolerances(tol, "closure").reachability, ans.task)
 
 

@@ -149,13 +149,17 @@ def _fmt_value(mech: Mechanism, fid: str, v: float) -> str:
 @click.argument("model")
 @with_pose
 @click.option("--all", "all_solutions", is_flag=True, help="Search every real solution of every limb.")
+@click.option("--method", "method", type=click.Choice(["auto", "homotopy", "multistart"]), default="auto",
+              show_default=True,
+              help="Method of --all: homotopy continuation per limb (proven complete by a root count or the trace "
+                   "test), multistart (not proven), or auto (homotopy where a root count proves the limb).")
 @click.option("--free", "free", default=None,
               help="Task coordinates to SOLVE (parasitic), comma-separated from x,y,z,a1,a2,a3 (a1..a3: the --euler "
                    "sequence's angles, default ZYX); the others are held at the pose's values. For lower-mobility "
                    "mechanisms, e.g. --free x,y,a1 for a 3-RPS.")
 @tol_option("reachability")
 @json_option
-def ik(model, xyz, euler, position, all_solutions, free, as_json):
+def ik(model, xyz, euler, position, all_solutions, method, free, as_json):
     """Inverse position: joint values of every limb for a platform pose.
 
     \b
@@ -165,14 +169,22 @@ def ik(model, xyz, euler, position, all_solutions, free, as_json):
       spatialmech ik four-sps-cu --pose 0,0,0.12,ZYX,34.38,-5.73,11.46 --json
       spatialmech ik five-cs-1 --position 3 --json
       spatialmech ik delta --xyz 0.02 0.01 -0.33 --all
+      spatialmech ik my-arm.toml --xyz 0.4 0.1 0.3 --euler ZYX 10 20 30 --all --method homotopy
     """
     mech = sm.load_model(model)
     r = sm.ik(mech, pose_argument(mech, xyz, euler, position), all_solutions=all_solutions, degrees=True,
-              free=None if free is None else free_names(free))
+              free=None if free is None else free_names(free), method=method)
     if as_json:
         emit_json("ik", mech, r.to_dict())
         return
     _ik_text(r)
+
+
+def _completeness_lines(search: dict) -> dict[str, str]:
+    """Per limb name, ``"homotopy: complete (proven ...): ..."`` or ``"multistart: NOT proven:
+    ..."`` of an ``ik --all`` search (nothing without ``--all``)."""
+    return {str(rep.get("limb")): f"{rep.get('method')}: {rep.get('completeness', '')}"
+            for rep in search.get("limbs") or ()}
 
 
 def _ik_text(r: sm.IKResult) -> None:
@@ -182,6 +194,7 @@ def _ik_text(r: sm.IKResult) -> None:
     mech, res, fit, reach_tol = r.mechanism, r.result, r.pose_fit, r.reachability
     d = r.to_dict()
     order = {f.id: i for i, f in enumerate(mech.freedom_refs)}
+    searched = _completeness_lines(d.get("search") or {})
     fitted = (f" (fitted onto the closure: off by {fit.position_error:.3g} {mech.length_unit} and "
               f"{np.degrees(fit.angle_error):.3g} deg, within the tolerance {reach_tol:g})"
               ) if res.fitted and fit is not None else ""  # fitted: the pose has a fit
@@ -197,6 +210,9 @@ def _ik_text(r: sm.IKResult) -> None:
         extra = f", solution set of dimension {limb['passive_dim']} (passive freedoms)" if limb["passive_dim"] else ""
         click.echo(f"  {limb['limb']}: {len(limb['solutions'])} solution(s){extra}"
                    + ("" if limb["reachable"] else " [least-squares, not closed]"))
+        how = searched.get(limb["limb"])
+        if how is not None:
+            click.echo(f"    {how}")
         for k, sol in enumerate(limb["solutions"]):
             values = sorted({**sol["joints_deg"], **sol["joints_len"]}.items(), key=lambda kv: order[kv[0]])
             shown = ", ".join(f"{fid}={v:.6g}" for fid, v in values)

@@ -41,7 +41,7 @@ from ..results import Progress
 from .assembly import AssemblyKind, SelfMotion
 from .closed_forms.four_sps_cu_forward import ForwardAllResult
 from .forward import ForwardResult, forward_position, homotopy_coverage
-from .position import InverseResult, inverse_position
+from .position import INVERSE_METHODS, InverseResult, inverse_position
 from .task import TaskSolution, solve_pose
 
 __all__ = [
@@ -317,17 +317,24 @@ def pose_with_free(mech: Mechanism, pose: Pose, free: Sequence[str], euler: str 
 
 def solve_inverse(mech: Mechanism, pose: Pose, *, all_solutions: bool = False, n_seeds: int = 48, seed: int = 0,
                   tol: Tolerances | float | None = None, free: Sequence[str] | None = None,
-                  euler: str = "ZYX") -> InverseAnswer:
+                  euler: str = "ZYX", method: str = "auto") -> InverseAnswer:
     """Inverse position through the one front door: with ``free``, the task solve first
     (:func:`pose_with_free`); then a registered closed form (:data:`INVERSE_CLOSED_FORMS`) or the
-    general engine, a pose that does not close exactly fitted onto the closure (``fit=True``)."""
+    general engine, a pose that does not close exactly fitted onto the closure (``fit=True``).
+    ``method`` (with ``all_solutions``): ``"auto"``, ``"homotopy"`` or ``"multistart"``, as
+    :func:`~spatialmech.kinematics.position.inverse_position` (a closed form answers only under
+    ``"auto"``)."""
     task = None
     if free is not None:
         pose, task = pose_with_free(mech, pose, free, euler)
-    solver = _closed_form(INVERSE_CLOSED_FORMS, mech)
+    if method not in INVERSE_METHODS:
+        raise InputError(f"method: expected one of {', '.join(map(repr, INVERSE_METHODS))}, got {method!r}")
+    if method != "auto" and not all_solutions:
+        raise InputError(f"method: {method!r} chooses how every solution is searched; it needs all_solutions=True")
+    solver = _closed_form(INVERSE_CLOSED_FORMS, mech) if method == "auto" else None
     if solver is not None:
         return InverseAnswer(pose, solver(mech, pose, all_solutions=all_solutions, n_seeds=n_seeds, seed=seed, tol=tol),
                              task, "closed-form")
     res = inverse_position(mech, pose, all_solutions=all_solutions, n_seeds=n_seeds, seed=seed, tol=tol, fit=True,
-                           start=task.config if task is not None and task.converged else None)
+                           start=task.config if task is not None and task.converged else None, method=method)
     return InverseAnswer(pose, res, task, "numerical")
