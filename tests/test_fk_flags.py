@@ -85,6 +85,7 @@ def test_wrist_text_counts_and_flags(wrist):
     assert out.count("flags: forward singular no, inverse singular yes, input-independent yes") == 4
 
 
+@pytest.mark.slow
 def test_wrist_default_engine_reports_the_same(wrist):
     """The default engine (the loop formulation by monodromy, capped, gives up here and leaves it
     to the multi-start) flags the same 4 input-independent poses."""
@@ -178,7 +179,7 @@ def registry():
 def _validated(args, registry) -> dict:
     r = CliRunner().invoke(cli, [*args, "--json"], catch_exceptions=False)
     assert r.exit_code == 0, r.output
-    doc = json.loads(r.output)
+    doc = json.loads(r.stdout)
     errors = list(Draft202012Validator(load_schema("fk"), registry=registry).iter_errors(doc))
     assert not errors, [(list(e.absolute_path), e.message[:300]) for e in errors[:5]]
     return doc
