@@ -267,8 +267,7 @@ def _general_answer(mech: Mechanism, values, res: ForwardResult, all_solutions: 
     """The general engine's :class:`.forward.ForwardResult` as a :class:`ForwardAnswer`, every
     converged solution flagged (:func:`.solution_flags.solution_flags`)."""
     sr = res.search
-    targets = actuator_targets(mech, values) if not isinstance(values, dict) else {
-        mech.freedom_refs.index(mech.freedom(k)): float(v) - mech.freedom(k).freedom.offset for k, v in values.items()}
+    targets = actuator_targets(mech, values)
     modes = tuple(_mode(mech, s, targets) for s in res.solutions if s.converged)
     failed = None if modes or not res.solutions else float(res.solutions[0].residual)
     if "n_generic" in sr:  # homotopy continuation: Study parameters, or the loop formulation ("n_spurious")

@@ -38,7 +38,7 @@ from .backend import correct
 from .closure import Configuration, active_mask
 from .jacobian import complete_jacobian
 
-__all__ = ["SolutionFlags", "configuration_at_pose", "input_independent", "solution_flags"]
+__all__ = ["SolutionFlags", "actuator_targets", "configuration_at_pose", "input_independent", "solution_flags"]
 
 
 @dataclass(frozen=True)
@@ -69,13 +69,11 @@ class SolutionFlags:
 
 
 def actuator_targets(mech: Mechanism, values) -> dict[int, float]:
-    """The joint variables (``value - offset``) of the actuators, by freedom index."""
-    refs = mech.freedom_refs
-    out = {}
-    for a, v in zip(mech.actuators, np.asarray(values, dtype=float).ravel(), strict=True):
-        r = mech.freedom(a)
-        out[refs.index(r)] = float(v) - r.freedom.offset
-    return out
+    """The joint variables (``value - offset``) of the actuators, by freedom index (``values``
+    in ``mech.actuators`` order, or a mapping by name), as forward position holds them."""
+    from .forward import _actuator_q
+
+    return _actuator_q(mech, values)
 
 
 def input_independent(mech: Mechanism, config: Configuration, targets: dict[int, float]) -> bool:
