@@ -21,7 +21,9 @@ from referencing import Registry, Resource
 import spatialmech as sm
 from spatialmech.interfaces.cli import cli
 from spatialmech.interfaces.common import load_schema
-from spatialmech.kinematics.closure import Configuration
+from spatialmech.geometry.rotations import transform
+from spatialmech.kinematics.backend import correct
+from spatialmech.kinematics.closure import Configuration, active_mask
 from spatialmech.kinematics.solution_flags import actuator_targets, input_independent, solution_flags
 
 WRIST_INPUTS = [0.3, -0.2, 0.5]  # rad: R1, R4, R7
@@ -167,6 +169,19 @@ def test_input_independence_test_on_a_hand_built_configuration(wrist):
     assert not input_independent(wrist, home, t)
     f = solution_flags(wrist, home, t, forward_singular=False)
     assert not (f.inverse_singular or f.input_independent)
+    # each leg's platform axis on its base axis: R Z = Y (leg 1), R Y = X (leg 2), R X = Z (leg 3)
+    R = np.array([[0.0, 1, 0], [0, 0, 1], [1, 0, 0]])
+    t = actuator_targets(wrist, WRIST_INPUTS)
+    q = np.zeros(len(wrist.freedom_refs))
+    for i, v in t.items():
+        q[i] = v
+    mask = active_mask(wrist)
+    mask[list(t)] = False
+    c = correct(wrist, Configuration(q, transform(R, np.zeros(3))), active=mask, fix_platform=True)
+    assert c.converged
+    assert input_independent(wrist, c.config, t)
+    f = solution_flags(wrist, c.config, t, forward_singular=False)
+    assert f.input_independent and f.inverse_singular_actuators == ("R1.rot", "R4.rot", "R7.rot")
 
 
 # ------------------------------------------------------------------ JSON

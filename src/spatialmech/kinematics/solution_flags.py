@@ -12,7 +12,10 @@ Every forward solution carries three flags next to its conditioning:
   closure on which the actuators move and the platform does not): the same platform pose still
   closes after random changes of every actuator value (:func:`input_independent`; sizes, count,
   seed and steps from :mod:`spatialmech.geometry.tolerances`, ``INPUT_PERTURBATION*``).  Such a
-  solution is always inverse singular; it is no assembly mode of the requested actuator values.
+  solution lets every actuator move with the platform locked (it is inverse singular in every
+  actuator), so the test runs only where every actuator's transmission index is below the
+  forward-singular threshold (:func:`.assembly.singular_threshold`); it is no assembly mode of
+  the requested actuator values.
 
 Homotopy engines also say which end point a solution came from (``endpoint``: ``"real"``, or
 ``"singular"`` for a near-real singular end point polished by Newton; ``None`` when only the
@@ -34,6 +37,7 @@ from ..geometry.tolerances import (
     current,
 )
 from ..model.mechanism import Mechanism, Pose
+from .assembly import singular_threshold
 from .backend import correct
 from .closure import Configuration, active_mask
 from .jacobian import complete_jacobian
@@ -110,7 +114,16 @@ def solution_flags(mech: Mechanism, config: Configuration, targets: dict[int, fl
     the engine's conditioning verdict, ``targets`` the actuators' joint variables held."""
     J = complete_jacobian(mech, config)
     inv = tuple(J.inverse_singular)
-    return SolutionFlags(bool(forward_singular), bool(inv), input_independent(mech, config, targets), inv, endpoint)
+    # a pose that holds for every actuator value lets each actuator move with the platform
+    # locked: only where every actuator's transmission is (nearly) zero is the test run; below
+    # the forward-singular threshold rather than the rank tolerance, for roots found to a few
+    # digits only
+    thr = singular_threshold()
+    nearly = len(J.transmission) == len(targets) and all(t < thr for t in J.transmission)
+    ii = nearly and input_independent(mech, config, targets)
+    if ii and len(inv) < len(J.actuators):  # the perturbations moved every actuator: all of them are free
+        inv = tuple(J.actuators)
+    return SolutionFlags(bool(forward_singular), bool(inv), ii, inv, endpoint)
 
 
 def configuration_at_pose(mech: Mechanism, pose: Pose, targets: dict[int, float]) -> Configuration:
