@@ -116,6 +116,18 @@ def test_homotopy_solutions_name_their_end_point():
         assert m.flags.endpoint == "real" and not m.input_independent
 
 
+@pytest.mark.slow
+def test_study_homotopy_solutions_are_flagged():
+    """three-rps by homotopy in Study parameters (16 generic, 8 real): every real mode from a real
+    end point, none flagged; the complex end points are counted, not listed."""
+    r = sm.fk("three-rps", [0.34, 0.36, 0.32], all_solutions=True)
+    assert r.engine == "homotopy" and len(r.modes) == r.answer.endpoints.n_real == 8
+    assert r.answer.endpoints.n_complex == 8
+    for m in r.modes:
+        assert m.flags.endpoint == "real" and m.assembly_mode
+        assert not (m.forward_singular or m.inverse_singular or m.input_independent)
+
+
 def test_four_sps_cu_at_paper_b_reference_is_forward_singular():
     """Every leg sqrt(0.06) m (the reference, z0 = 0.2, no rotation): the platform moves with
     the legs locked (a self-motion); the legs cannot move with the platform locked."""

@@ -294,7 +294,7 @@ def _fk_text(r: sm.FKResult) -> None:
     ii = (f", {n_ii} input-independent (the actuators move without moving the platform)" if n_ii else "")
     if a.endpoints is not None:  # homotopy continuation: counts of the path end points
         e = a.endpoints
-        n_sm = sum(m.kind == "self-motion" for m in modes)
+        n_sm = sum(m.kind == "self-motion" and not m.input_independent for m in modes)
         n_real = len(modes) - n_ii
         click.echo(f"{mech.name}: {n_real} real assembly mode{'s' if n_real != 1 else ''}"
                    + (f" ({n_sm} of them self-motion sets)" if n_sm else "") + ii
