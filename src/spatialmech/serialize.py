@@ -125,6 +125,7 @@ UNIT_FREE_KEYS: dict[str, str] = {
     "n_points": "number of points",
     "n_poses_checked": "poses checked",
     "n_seeds": "number of starts",
+    "n_input_independent": "forward solutions that hold for every actuator value (input-independent: not assembly modes)",
     "n_solutions": "number of solutions found",
     "n_tried": "number of starts tried",
     "n_within_limits": "solutions within the limits",

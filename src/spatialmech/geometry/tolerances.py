@@ -65,6 +65,10 @@ __all__ = [
     "HOMOTOPY_NEWTON",
     "HOMOTOPY_REAL",
     "HOMOTOPY_SINGULAR",
+    "INPUT_PERTURBATION",
+    "INPUT_PERTURBATIONS",
+    "INPUT_PERTURBATION_SEED",
+    "INPUT_PERTURBATION_STEPS",
     "LOCAL_DIMENSION_STEP",
     "MONODROMY_DIVERGED",
     "MONODROMY_MAX_LOOPS",
@@ -284,6 +288,20 @@ HOMOTOPY_SINGULAR = 1e-7
 HOMOTOPY_INFINITY = 1e-7
 HOMOTOPY_REAL = 1e-7
 HOMOTOPY_NEAR_REAL = 1e-3
+
+#: Forward-position solution flags (kinematics/solution_flags.py).  A solution is
+#: *input-independent* (it persists for every actuator value: the actuators move without moving
+#: the platform) when the same platform pose still closes after each of ``INPUT_PERTURBATIONS``
+#: random changes of every actuator value at once (seed ``INPUT_PERTURBATION_SEED``), each change
+#: of a random sign and a size between half and one ``INPUT_PERTURBATION`` (rad, or length / L):
+#: the joints solved by Newton (at most ``INPUT_PERTURBATION_STEPS`` steps) from the solution's,
+#: with the platform and the actuators held, must reach the ``closure`` tolerance.  The change is
+#: not tiny on purpose: at an inverse singularity (a leg stretched) the closure error of a held
+#: pose grows with the square of the change, about 1e-4 here, far above the closure tolerance.
+INPUT_PERTURBATION = 1e-2
+INPUT_PERTURBATIONS = 3
+INPUT_PERTURBATION_SEED = 27
+INPUT_PERTURBATION_STEPS = 30
 
 #: Cauchy end game (:mod:`spatialmech.kinematics.homotopy.endgame`), nondimensional: the first radius of
 #: the loops about ``t = 1`` (in the homotopy parameter), the points per loop, the most loops

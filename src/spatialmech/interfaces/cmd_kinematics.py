@@ -306,11 +306,14 @@ def _fk_text(r: sm.FKResult) -> None:
     """``fk`` as text: the header (what was found, by which engine), completeness, every mode."""
     mech, a = r.mechanism, r.answer
     modes = a.modes
+    n_ii = a.n_input_independent
+    ii = (f", {n_ii} input-independent (the actuators move without moving the platform)" if n_ii else "")
     if a.endpoints is not None:  # homotopy continuation: counts of the path end points
         e = a.endpoints
-        n_sm = sum(m.kind == "self-motion" for m in modes)
-        click.echo(f"{mech.name}: {len(modes)} real assembly mode{'s' if len(modes) != 1 else ''}"
-                   + (f" ({n_sm} of them self-motion sets)" if n_sm else "")
+        n_sm = sum(m.kind == "self-motion" and not m.input_independent for m in modes)
+        n_real = len(modes) - n_ii
+        click.echo(f"{mech.name}: {n_real} real assembly mode{'s' if n_real != 1 else ''}"
+                   + (f" ({n_sm} of them self-motion sets)" if n_sm else "") + ii
                    + f"; end points: {e.n_real} real, {e.n_complex} complex, {e.n_singular} singular, "
                    f"{e.n_at_infinity} at infinity, of {e.n_generic} generic solutions"
                    + (f" ({e.n_spurious} spurious end points of the square system discarded)" if e.n_spurious is not None
@@ -328,7 +331,8 @@ def _fk_text(r: sm.FKResult) -> None:
                                  "mechanism's size, or try more --seeds")
             raise InputError(f"actuators: no assembly found (Newton did not converge; residual {a.failed_residual:.2e}); "
                              "try --all")
-        click.echo(_fk_header(mech, [m.kind for m in modes], a.label, a.n_starts, a.n_converged)
+        click.echo(_fk_header(mech, [m.kind for m in modes if not m.input_independent], a.label, a.n_starts,
+                              a.n_converged, n_ii)
                    + (f"; {a.n_within_limits} within limits" if a.all_solutions else ""))
         if a.all_solutions:
             click.echo(f"  NOT proven complete: {a.completeness}")
@@ -339,10 +343,26 @@ def _fk_text(r: sm.FKResult) -> None:
                    f"ZYX angles ({_num(ang, '.4f')}) deg  {lim}")
         _fk_conditioning_lines(m.kind, m.sigma_min, m.condition, m.singular_below, m.members, m.self_motion,
                                mech.length_unit, m.free_dim)
+        _fk_flag_lines(m)
 
 
-def _fk_header(mech: Mechanism, kinds, method: str, seeds: int, converged: int) -> str:
-    """``NAME: 2 assembly modes, 1 self-motion set (method, N starts, M converged)``."""
+def _fk_flag_lines(m) -> None:
+    """The flags of one forward-position result beside its conditioning (forward singular is
+    the conditioning line above): input-independent, inverse singular, the homotopy end point."""
+    f = m.flags
+    if f is None:
+        return
+    yn = {True: "yes", False: "no"}
+    click.echo(f"      flags: forward singular {yn[m.forward_singular]}, inverse singular {yn[f.inverse_singular]}, "
+               f"input-independent {yn[f.input_independent]}"
+               + (f"; from a {f.endpoint} end point of the homotopy" if f.endpoint is not None else ""))
+    for w in f.words():
+        click.echo(f"      {w}")
+
+
+def _fk_header(mech: Mechanism, kinds, method: str, seeds: int, converged: int, n_input_independent: int = 0) -> str:
+    """``NAME: 2 assembly modes, 1 self-motion set, 4 input-independent (...) (method, N starts,
+    M converged)``; ``kinds`` those of the input-dependent results."""
     n_reg = sum(k == "regular" for k in kinds)
     n_sing = sum(k == "singular" for k in kinds)
     n_sm = sum(k == "self-motion" for k in kinds)
@@ -351,6 +371,8 @@ def _fk_header(mech: Mechanism, kinds, method: str, seeds: int, converged: int) 
         parts.append(f"{n_sing} singular root{'s' if n_sing != 1 else ''}")
     if n_sm:
         parts.append(f"{n_sm} self-motion set{'s' if n_sm != 1 else ''} (a continuum of poses with the actuators held)")
+    if n_input_independent:
+        parts.append(f"{n_input_independent} input-independent (the actuators move without moving the platform)")
     return f"{mech.name}: {', '.join(parts)} found ({method}, {seeds} start(s), {converged} converged)"
 
 

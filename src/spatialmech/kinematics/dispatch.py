@@ -42,6 +42,7 @@ from .assembly import AssemblyKind, SelfMotion
 from .closed_forms.four_sps_cu_forward import ForwardAllResult
 from .forward import ForwardResult, forward_position, homotopy_coverage
 from .position import INVERSE_METHODS, InverseResult, inverse_position
+from .solution_flags import SolutionFlags, actuator_targets, configuration_at_pose, solution_flags
 from .task import TaskSolution, solve_pose
 
 __all__ = [
@@ -73,7 +74,9 @@ class AssemblyMode:
     """One forward-position result, whatever the engine: the platform pose, what it is
     (``kind``: regular, singular, self-motion), the conditioning (scale-free ``sigma_min``,
     ``condition`` = sigma_min / sigma_max, ``singular_below``), the limits, how many converged
-    runs stand for it (``members``) and, for a self-motion, what its trace found."""
+    runs stand for it (``members``), for a self-motion what its trace found, and its ``flags``
+    (:class:`.solution_flags.SolutionFlags`: forward singular, inverse singular,
+    input-independent, the homotopy end point it came from)."""
 
     pose: Pose
     kind: AssemblyKind
@@ -85,10 +88,33 @@ class AssemblyMode:
     members: int = 1
     self_motion: SelfMotion | None = None
     free_dim: int | None = None  # free directions of the platform at a singular root (general engine)
+    flags: SolutionFlags | None = None  # None only where a caller built the mode without them
 
     @property
     def within_limits(self) -> bool:
         return not self.outside_limits
+
+    @property
+    def forward_singular(self) -> bool:
+        """The platform moves with the actuators locked (the conditioning: ``sigma_min`` below
+        ``singular_below``)."""
+        return bool(self.sigma_min < self.singular_below)
+
+    @property
+    def inverse_singular(self) -> bool:
+        """With the platform locked, an actuator can still move."""
+        return self.flags is not None and self.flags.inverse_singular
+
+    @property
+    def input_independent(self) -> bool:
+        """The pose closes for every actuator value (the actuators move without moving the
+        platform): not an assembly mode of the requested values."""
+        return self.flags is not None and self.flags.input_independent
+
+    @property
+    def assembly_mode(self) -> bool:
+        """A regular, input-dependent root: one assembly mode of the requested values."""
+        return self.kind == AssemblyKind.REGULAR and not self.input_independent
 
 
 @dataclass(frozen=True)
@@ -132,14 +158,34 @@ class ForwardAnswer:
     def n_within_limits(self) -> int:
         return sum(m.within_limits for m in self.modes)
 
+    @property
+    def n_input_independent(self) -> int:
+        """Solutions that hold for every actuator value (:attr:`AssemblyMode.input_independent`)."""
+        return sum(m.input_independent for m in self.modes)
+
     def to_dict(self, mech: Mechanism) -> dict:
         """JSON (docs/json.md, ``spatialmech fk --json``): the engine's fields and, for every
-        engine, ``engine``, ``complete`` and ``completeness``."""
+        engine, ``engine``, ``complete``, ``completeness``, ``n_input_independent`` and, on every
+        solution, its flags (``forward_singular``, ``inverse_singular``,
+        ``inverse_singular_actuators``, ``input_independent``, ``endpoint``; ``None`` on a
+        failed attempt)."""
         if isinstance(self.detail, ForwardAllResult):
             d = self.detail.to_dict(actuators=mech.actuators)
         else:
             d = self.detail.to_dict(mech)
-        return {"engine": self.engine, **d, "complete": self.complete, "completeness": self.completeness}
+        modes = iter(self.modes)
+        for s in d["solutions"]:  # the converged solutions are the modes, in the same order
+            m = next(modes, None) if s["converged"] else None
+            f = m.flags if m is not None else None
+            s.update(f.to_dict() if f is not None else dict.fromkeys(_FLAG_KEYS))
+            if m is not None:
+                s["forward_singular"] = m.forward_singular
+        return {"engine": self.engine, **d, "complete": self.complete, "completeness": self.completeness,
+                "n_input_independent": self.n_input_independent}
+
+
+#: The flags of every solution in JSON (:meth:`.solution_flags.SolutionFlags.to_dict`).
+_FLAG_KEYS = ("forward_singular", "inverse_singular", "inverse_singular_actuators", "input_independent", "endpoint")
 
 
 # ============================================================================ the registry of closed forms
@@ -172,14 +218,18 @@ def _four_sps_cu_forward(mech: Mechanism):
         kw = {} if seeds is None else {"n_seeds": seeds}
         fa = k4f.forward_all(np.asarray(values, float), geometry=geom, qmc_seed=0 if seed is None else seed, **kw)
         modes = []
+        targets = actuator_targets(mech, values)
         for n, s in enumerate(fa.solutions):
             if not s.converged:
                 continue
             d = s.to_dict(actuators=mech.actuators)
             assert s.kind is not None
-            modes.append(AssemblyMode(Pose(k4.rotation(s.phi), k4.pose_transform(s.phi)[:3, 3], f"mode {n + 1}"),
-                                      s.kind, d["residual"], tuple(d["outside_limits"]), float(s.sigma_min),
-                                      float(s.condition), float(s.singular_below), s.members, s.self_motion))
+            pose = Pose(k4.rotation(s.phi), k4.pose_transform(s.phi)[:3, 3], f"mode {n + 1}")
+            flags = solution_flags(mech, configuration_at_pose(mech, pose, targets), targets,
+                                   forward_singular=bool(s.sigma_min < s.singular_below))
+            modes.append(AssemblyMode(pose, s.kind, d["residual"], tuple(d["outside_limits"]), float(s.sigma_min),
+                                      float(s.condition), float(s.singular_below), s.members, s.self_motion,
+                                      flags=flags))
         return ForwardAnswer("closed-form", "closed-form multi-start", True, tuple(modes), False,
                              "multi-seed search of the closed form: not a proof; assembly modes may be missing",
                              fa.search.n_seeds, fa.search.n_converged, None, None, fa)
@@ -206,16 +256,19 @@ def _closed_form(registry: Sequence[ClosedForm], mech: Mechanism) -> Callable | 
 
 
 # ============================================================================ forward position
-def _mode(s) -> AssemblyMode:
+def _mode(mech: Mechanism, s, targets: dict[int, float]) -> AssemblyMode:
     c = s.conditioning
+    flags = solution_flags(mech, s.config, targets, forward_singular=c.singular, endpoint=s.endpoint)
     return AssemblyMode(s.pose, s.kind, float(s.residual), tuple(s.outside_limits), c.sigma_min, c.condition,
-                        c.threshold, s.members, s.self_motion, c.free_dim)
+                        c.threshold, s.members, s.self_motion, c.free_dim, flags)
 
 
-def _general_answer(res: ForwardResult, all_solutions: bool) -> ForwardAnswer:
-    """The general engine's :class:`.forward.ForwardResult` as a :class:`ForwardAnswer`."""
+def _general_answer(mech: Mechanism, values, res: ForwardResult, all_solutions: bool) -> ForwardAnswer:
+    """The general engine's :class:`.forward.ForwardResult` as a :class:`ForwardAnswer`, every
+    converged solution flagged (:func:`.solution_flags.solution_flags`)."""
     sr = res.search
-    modes = tuple(_mode(s) for s in res.solutions if s.converged)
+    targets = actuator_targets(mech, values)
+    modes = tuple(_mode(mech, s, targets) for s in res.solutions if s.converged)
     failed = None if modes or not res.solutions else float(res.solutions[0].residual)
     if "n_generic" in sr:  # homotopy continuation: Study parameters, or the loop formulation ("n_spurious")
         loop = "n_spurious" in sr
@@ -276,7 +329,7 @@ def solve_forward(mech: Mechanism, values, *, all_solutions: bool = False, metho
         if given:
             raise InputError(f"{', '.join(given)}: only with all_solutions (without it, one Newton solve from the "
                              "reference configuration: no engine to choose, no starts)")
-        return _general_answer(forward_position(mech, values), False)
+        return _general_answer(mech, values, forward_position(mech, values), False)
     engine = forward_engine(mech, method)
     if engine == "closed-form":
         solver = _closed_form(FORWARD_CLOSED_FORMS, mech)
@@ -288,7 +341,7 @@ def solve_forward(mech: Mechanism, values, *, all_solutions: bool = False, metho
                          "method='multistart' runs a multi-start search of that many starts")
     res = forward_position(mech, values, all_solutions=True, n_seeds=DEFAULT_SEEDS if seeds is None else seeds,
                            seed=0 if seed is None else seed, progress=progress, method=method)
-    return _general_answer(res, True)
+    return _general_answer(mech, values, res, True)
 
 
 # ============================================================================ inverse position

@@ -80,6 +80,7 @@ class ForwardSolution:
     kind: AssemblyKind | None = None  # regular, singular or self-motion (None for a failed attempt)
     members: int = 1  # converged runs that this result stands for
     self_motion: SelfMotion | None = None  # the continuum traced through a self-motion result
+    endpoint: str | None = None  # homotopy: status of the end point it came from (None: found by a multi-start)
 
     @property
     def singular(self) -> bool:
@@ -520,7 +521,7 @@ def _forward_homotopy(mech: Mechanism, targets: dict[int, float], seed: int, max
     mask = active_mask(mech)
     for i in targets:
         mask[i] = False
-    runs = []
+    runs, origins = [], []
     q0 = np.zeros(len(refs))
     for i, v in targets.items():  # the slides start at their values (not the leg reversed through its base)
         q0[i] = v
@@ -529,13 +530,14 @@ def _forward_homotopy(mech: Mechanism, targets: dict[int, float], seed: int, max
             continue
         D = transform(e.R, e.p)
         runs.append(_fk_from(mech, _limbs_at(mech, D, q0, targets, seed), targets, mask, max_iter))
+        origins.append(str(e.status))
     n_endpoint_runs = len(runs)
     if hr.count(EndPointStatus.SINGULAR):
         # singular end points (a continuum, as the 4-SPS/CU's self-motion at its home legs, or a
         # multiple root) are located to a few digits only: the multi-start search adds its roots,
         # and a singular root is followed along its self-motion and reported as one continuum
         runs += _multistart_runs(mech, targets, mask, n_seeds, seed, max_iter)
-    sols, conv = _group_runs(mech, runs)
+    sols, conv = _group_runs(mech, runs, origins)
     kinds = [s.kind for s in sols]
     extra = len(runs) - n_endpoint_runs
     search = {"method": "homotopy continuation (Study parameters), real end points polished by Newton"
@@ -553,9 +555,13 @@ def _forward_homotopy(mech: Mechanism, targets: dict[int, float], seed: int, max
     return ForwardResult(tuple(sols), search)
 
 
-def _group_runs(mech: Mechanism, runs: list) -> tuple[list, list]:
-    """The converged runs grouped into results (distinct poses, self-motions), in the order found."""
-    conv = [r for r in runs if r.converged]
+def _group_runs(mech: Mechanism, runs: list, origins: list[str] | None = None) -> tuple[list, list]:
+    """The converged runs grouped into results (distinct poses, self-motions), in the order found;
+    ``origins[i]`` the status of the homotopy end point that run ``i`` polished (the runs past
+    them: a multi-start's), so that each result says the best end point it came from."""
+    conv_idx = [i for i, r in enumerate(runs) if r.converged]
+    conv = [runs[i] for i in conv_idx]
+    origin = [origins[i] if origins is not None and i < len(origins) else None for i in conv_idx]
     dedup, sdedup = dedup_tolerances()
     locked = locked_actuators(mech)
     L = mech.characteristic_length
@@ -568,9 +574,11 @@ def _group_runs(mech: Mechanism, runs: list) -> tuple[list, list]:
     sols = []
     for g in sorted(groups, key=lambda g: min(g.members)):
         r = conv[g.rep]
+        ends = {o for j in g.members if (o := origin[j]) is not None}
+        end = "real" if "real" in ends else min(ends) if ends else None
         sols.append(ForwardSolution(r.config, platform_pose(mech, r.config), True, r.residual, r.iterations,
                                     tuple(within_limits(mech, r.config.q)), conds[g.rep], g.kind, len(g.members),
-                                    g.self_motion(keys, L)))
+                                    g.self_motion(keys, L), end))
     return sols, conv
 
 
@@ -594,11 +602,12 @@ def _forward_general(mech: Mechanism, targets: dict[int, float], seed: int, max_
     for i in targets:
         mask[i] = False
     runs = [_fk_from(mech, hg.configuration(e), targets, mask, max_iter) for e in hr.solutions if e.q is not None]
+    origins = [str(e.status) for e in hr.solutions if e.q is not None]
     n_endpoint_runs = len(runs)
     # a continuum, a multiple root, or no proof: the multi-start adds its roots
     if hr.count(EndPointStatus.SINGULAR) or not hr.complete:
         runs += _multistart_runs(mech, targets, mask, n_seeds, seed, max_iter)
-    sols, conv = _group_runs(mech, runs)
+    sols, conv = _group_runs(mech, runs, origins)
     kinds = [s.kind for s in sols]
     extra = len(runs) - n_endpoint_runs
     why_more = "singular end points" if hr.count(EndPointStatus.SINGULAR) else "not proven complete"
