@@ -32,11 +32,13 @@ __all__ = [
 
 
 def trace_circuit(mech: Mechanism, start: Configuration, names: list[str], djf: Callable, max_arc: float,
-                  h0: float, progress: Progress | None = None) -> tuple[MotionProblem, TrackResult]:
+                  h0: float, progress: Progress | None = None, *,
+                  sense: int = 1) -> tuple[MotionProblem, TrackResult]:
     """The circuit of ``mech`` through ``start``, traced by the continuation tracker with the DJ
     of every driver in ``names`` (``djf``: configuration -> array, one value per driver) as a
-    vector monitor, so that its zeros (branch points) and poles become events of the track."""
-    prob = MotionProblem(mech)
+    vector monitor, so that its zeros (branch points) and poles become events of the track.
+    ``sense``: ``1`` the conventional sense of travel, ``-1`` the opposite one."""
+    prob = MotionProblem(mech, sense=sense)
     tr = track(prob, start, vector_monitor=(names, djf), max_arc=max_arc, h0=h0, event_tol=1e-9,
                progress=progress)
     return prob, tr

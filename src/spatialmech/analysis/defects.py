@@ -390,6 +390,7 @@ def defect_analysis(
     angle_precision_deg: float = 0.05,
     sigma_along_path: bool = True,
     progress: Progress | None = None,
+    sense: int = 1,
 ) -> DefectResult:
     """Defect judgement of a 1-DOF linkage for its task positions (default: the model's own).
 
@@ -397,7 +398,10 @@ def defect_analysis(
     default 2 % of the characteristic length) and ``angle_tol_deg`` of it (combined as
     ``hypot(dp / pose_tol, dtheta / angle_tol) <= 1``); among the traced circuits the fewest
     that hold every position are kept.  ``progress(done, None, message)`` is called with the
-    number of the step and a short message while it works.
+    number of the step and a short message while it works.  ``sense``: the sense every circuit
+    is traced in (``1``: the conventional one of :func:`~..kinematics.tracking.trace_motion`,
+    ``-1``: the opposite); the verdict (circuits, defects, usable drivers) does not depend on it,
+    only the traced arcs and ``direction`` do.
 
     The steps (module docstring): :func:`_checked_arguments`, :func:`dj_table` (fits and DJ),
     :func:`_trace_circuits`, :func:`_assign_circuits`, :func:`_path_along_first_circuit`,
@@ -414,7 +418,7 @@ def defect_analysis(
     djf, dj_method = dj_function(mech, drivers, fits[0].config)
     dj_pos = table.dj.T  # (positions, drivers)
 
-    problems, traces = _trace_circuits(mech, fits, drivers, djf, on_curve_tol, max_arc, h0, say)
+    problems, traces = _trace_circuits(mech, fits, drivers, djf, on_curve_tol, max_arc, h0, say, sense)
     say("assigning the positions to circuits")
     circ = _assign_circuits(mech, positions, fits, problems, traces, pose_tol=pose_tol,
                             angle_tol=np.radians(angle_tol_deg), on_curve_tol=on_curve_tol)
@@ -498,7 +502,8 @@ def _check_one_dof(mech: Mechanism) -> None:
 
 
 def _trace_circuits(mech: Mechanism, fits: list[PoseFit], drivers: list[str], djf, on_curve_tol: float,
-                    max_arc: float, h0: float, say: Steps) -> tuple[list[MotionProblem], list[TrackResult]]:
+                    max_arc: float, h0: float, say: Steps,
+                    sense: int = 1) -> tuple[list[MotionProblem], list[TrackResult]]:
     """Step 3a: trace circuits until every fitted position lies on a traced curve (to
     ``on_curve_tol``, nondimensional): the circuit through position 1, then one through each
     position that no traced circuit passes through, in order."""
@@ -509,7 +514,7 @@ def _trace_circuits(mech: Mechanism, fits: list[PoseFit], drivers: list[str], dj
                for pr, tr in zip(problems, traces, strict=True)):
             continue
         say(f"tracing the circuit through position {j + 1}")
-        prob, tr = trace_circuit(mech, fit.config, drivers, djf, max_arc, h0, None)
+        prob, tr = trace_circuit(mech, fit.config, drivers, djf, max_arc, h0, None, sense=sense)
         traces.append(tr)
         problems.append(prob)
     return problems, traces

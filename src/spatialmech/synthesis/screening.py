@@ -33,7 +33,7 @@ import itertools
 import math
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -42,7 +42,8 @@ from ..geometry.tolerances import current as current_tolerances
 from ..model.mechanism import Mechanism
 from ..results import ScreenStage
 from ..serialize import fields_dict
-from .cs_dyads import CSDyad, CSFamily, CSTask, cs_task, dyad_from_vector
+from ..kinematics.tracking import conventional_sense
+from .cs_dyads import CSBranch, CSDyad, CSFamily, CSTask, cs_task, dyad_from_vector
 from .five_cs import assemble_5cs, cs_configuration
 
 __all__ = [
@@ -58,6 +59,7 @@ __all__ = [
     "judge_candidate",
     "judge_candidates",
     "nondimensional",
+    "oriented",
     "rank_key",
 ]
 
@@ -115,14 +117,33 @@ class DyadPool:
         return tuple(self.dyad(i) for i in idx)
 
 
+def oriented(task: CSTask, branch: CSBranch) -> CSBranch:
+    """``branch`` in the pool's orientation, which depends on the branch as a curve, not on the
+    sense it was traced in: an open branch runs from the end to the other so that the chord
+    between its ends (nondimensional, :func:`nondimensional`) has its first non-negligible
+    component positive (the rule of :func:`~spatialmech.kinematics.tracking.conventional_sense`);
+    a closed one is kept as traced (from its start, in the tracer's conventional sense).  The
+    same open branch traced the other way is the same points in the reverse order, so it gives
+    the same pool: neither the dyads sampled nor their indices follow the tracer's sense."""
+    if branch.closed or len(branch.arc) < 2:
+        return branch
+    ends = nondimensional(task, branch.points[[0, -1]])
+    if conventional_sense(ends[1] - ends[0]) > 0:
+        return branch
+    arc = branch.arc[-1] - branch.arc[::-1]
+    return replace(branch, points=branch.points[::-1], arc=arc, ends=branch.ends[::-1])
+
+
 def dyad_pool(family: CSFamily, density: float) -> DyadPool:
     """Dyads spread evenly in arc length along every branch of ``family``: ``max(2, round(density
     * arc length))`` per branch (ends included), ``density`` in dyads per unit of nondimensional
-    arc length (the family is traced in task scales)."""
+    arc length (the family is traced in task scales).  Each branch is sampled in its
+    :func:`oriented` order, so the pool does not depend on the sense its branches were traced in."""
     if not (isinstance(density, (int, float)) and math.isfinite(density) and density > 0):
         raise InputError(f"density: expected a positive number of dyads per unit arc length, got {density!r}")
     vecs, br, arc = [], [], []
     for k, b in enumerate(family.branches):
+        b = oriented(family.task, b)
         n = max(2, round(density * float(b.arc[-1] - b.arc[0])))
         idx = b.sample(n)
         vecs.append(b.points[idx])
