@@ -54,8 +54,8 @@ def plausibility_warnings(mech: Mechanism, points: Iterable = (), slides: Mappin
                    f"is the unit of the values wrong (the model is in {unit})?")
     neg = {fid: v for fid, v in slides.items() if v < 0 and mech.freedom(fid).freedom.limits is None}
     if neg:
-        out.append(f"negative leg length: {_listed(neg, unit)} (no joint limits in the model to refuse it: the leg "
-                   "passes through its own joint, an assembly the hardware cannot take)")
+        out.append(f"negative leg length: {_listed(neg, unit)} (no joint limits in the model to refuse it; a real "
+                   "leg's length is positive: give the model limits to flag it as outside them)")
     return out
 
 
