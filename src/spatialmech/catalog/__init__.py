@@ -77,7 +77,7 @@ def resolve(spec) -> Mechanism:
     """
     from pathlib import Path
 
-    from ..model.schema import ModelFileError, load
+    from ..model.schema import ModelFileError
 
     if isinstance(spec, Mechanism):
         return spec

@@ -246,7 +246,8 @@ def _ik_text(r: sm.IKResult) -> None:
             lim = f"  outside limits: {', '.join(sol['outside_limits'])}" if sol["outside_limits"] else ""
             click.echo(f"    [{k + 1}] {shown}  (residual {sol['residual']:.1e}){lim}")
     if r.config is not None:
-        click.echo(("  actuators: " if r.reachable else "  actuators (of the limbs' solutions, not of the pose asked for): ") + ", ".join(f"{k} = {_fmt_value(mech, k, v)}" for k, v in r.actuators.items()))
+        head = "  actuators: " if r.reachable else "  actuators (of the limbs' solutions, not of the pose asked for): "
+        click.echo(head + ", ".join(f"{k} = {_fmt_value(mech, k, v)}" for k, v in r.actuators.items()))
     click.echo("  (rotations in degrees, slides in " + mech.length_unit + ")")
     _warning_lines(d["warnings"])
     if r.task is None and not res.reachable:
