@@ -115,3 +115,20 @@ def test_model_from_mjcf_and_urdf_refused(tmp_path):
     assert out.exit_code == 2 and "URDF" in out.output and ".xml" in out.output and "not valid TOML" not in out.output
     with pytest.raises(sm.InputError, match="URDF"):
         sm.load_model(urdf)
+
+
+def test_headline_never_reachable_when_the_task_solve_failed(capsys):
+    """The limbs close at the pose asked for, the task solve did not converge: not 'reachable'."""
+    from dataclasses import replace
+
+    from spatialmech.interfaces.cmd_kinematics import _ik_text
+    from spatialmech.results import SolveStatus
+
+    r = sm.ik("three-rps", POSE, degrees=True, free=["x", "y", "a1"])
+    assert r.reachable and r.result.reachable
+    bad = replace(r, task=replace(r.task, converged=False, status=SolveStatus.MAX_ITER, continuation=0.25))
+    assert not bad.reachable and bad.to_dict()["reachable"] is False
+    _ik_text(bad)
+    head = capsys.readouterr().out.splitlines()[0]
+    assert "pose reachable" not in head and "not found from the reference" in head
+    assert "failed at s=0.25" in head and "the limbs close at the pose asked for" in head
