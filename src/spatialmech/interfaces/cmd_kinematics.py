@@ -336,6 +336,7 @@ def _fk_text(r: sm.FKResult) -> None:
     """``fk`` as text: the header (what was found, by which engine), completeness, every mode."""
     mech, a = r.mechanism, r.answer
     modes = a.modes
+    limited = any(f.freedom.limits is not None for f in mech.freedom_refs)
     if a.endpoints is not None:  # homotopy continuation: counts of the path end points
         e = a.endpoints
         n_sm = sum(m.kind == "self-motion" for m in modes)
@@ -359,14 +360,14 @@ def _fk_text(r: sm.FKResult) -> None:
             raise InputError(f"actuators: no assembly found (Newton did not converge; residual {a.failed_residual:.2e}); "
                              "try --all")
         click.echo(_fk_header(mech, [m.kind for m in modes], a.label, a.n_starts, a.n_converged)
-                   + (f"; {a.n_within_limits} within limits" if a.all_solutions else ""))
+                   + ("" if not a.all_solutions else f"; {a.n_within_limits} within limits" if limited
+                      else "; no joint limits in the model"))
         if a.all_solutions:
             click.echo(f"  NOT proven complete: {a.completeness}")
     for k, m in enumerate(modes):
         ang = matrix_euler("ZYX", m.pose.R, degrees=True)
         lim = ("outside limits: " + ", ".join(m.outside_limits) if not m.within_limits
-               else "within limits" if any(f.freedom.limits is not None for f in mech.freedom_refs)
-               else "no joint limits in the model")
+               else "within limits" if limited else "no joint limits in the model")
         click.echo(f"  [{k + 1}] platform point ({_num(m.pose.p, '.6g')}) {mech.length_unit}, "
                    f"ZYX angles ({_num(ang, '.4f')}) deg  {lim}")
         _fk_conditioning_lines(m.kind, m.sigma_min, m.condition, m.singular_below, m.members, m.self_motion,
