@@ -17,6 +17,7 @@ from ..kinematics.closure import Configuration
 from ..kinematics.dispatch import AssemblyMode, Engine, ForwardAnswer, pose_with_free, solve_forward, solve_inverse
 from ..kinematics.forward import ForwardResult
 from ..kinematics.jacobian import CompleteJacobian, complete_jacobian
+from ..kinematics.plausibility import plausibility_warnings
 from ..kinematics.position import InverseResult, PoseFit, configuration_at_pose, platform_pose
 from ..kinematics.task import TaskJacobian, TaskSolution, default_task, task_jacobian_at, task_solution_dict
 from ..model.task import TaskCoordinates
@@ -70,7 +71,23 @@ class IKResult:
 
     @property
     def reachable(self) -> bool:
-        return self.result.reachable
+        """Every limb closes at the pose and, with ``free``, the task solve converged (a pose whose
+        held coordinates did not close with the others solved is not the pose asked for)."""
+        return self.result.reachable and (self.task is None or self.task.converged)
+
+    @property
+    def proven_unreachable(self) -> bool:
+        """Not reachable, and proven so: every limb's search complete (``all_solutions`` with a
+        proof) and found nothing, the task solve (if any) converged."""
+        return (not self.result.reachable and bool(self.result.search.get("complete"))
+                and (self.task is None or self.task.converged))
+
+    @property
+    def warnings(self) -> list[str]:
+        """Plausibility (:func:`~spatialmech.kinematics.plausibility.plausibility_warnings`): a pose
+        or actuator far beyond the model's size (a unit mistake?), a negative leg length."""
+        acts = self.actuators if self.result.config is not None else {}
+        return plausibility_warnings(self.mechanism, [self.pose.p], acts)
 
     @property
     def pose_fit(self) -> PoseFit | None:
@@ -97,6 +114,8 @@ class IKResult:
         fit = self.pose_fit
         d["pose_fit"] = None if fit is None else {**fit.to_dict(), "tolerance": self.reachability, "note": _IK_FIT_NOTE}
         d["task"] = None if self.task is None else task_solution_dict(self.task)
+        d["reachable"] = bool(self.reachable)
+        d["warnings"] = self.warnings
         return d
 
 
@@ -226,8 +245,16 @@ class FKResult:
         """At least one assembly was found."""
         return bool(self.answer.modes)
 
+    @property
+    def warnings(self) -> list[str]:
+        """Plausibility (:func:`~spatialmech.kinematics.plausibility.plausibility_warnings`): a
+        platform point or an actuator slide far beyond the model's size (a unit mistake?), a
+        negative leg length."""
+        acts = dict(zip(self.mechanism.actuators, map(float, self.actuator_values), strict=True))
+        return plausibility_warnings(self.mechanism, [m.pose.p for m in self.modes], acts)
+
     def to_dict(self) -> dict:
-        return self.answer.to_dict(self.mechanism)
+        return {**self.answer.to_dict(self.mechanism), "warnings": self.warnings}
 
 
 def fk(model: ModelLike, actuators, *, all_solutions: bool = False, seeds: int | None = None, seed: int | None = None,

@@ -35,10 +35,14 @@ def models() -> dict[str, str]:
 def load_model(model: ModelLike, *, name: str | None = "model") -> Mechanism:
     """A mechanism from a ready-made name, a TOML file path, or a Mechanism (returned as is).
 
+    An MJCF file (``.xml`` / ``.mjcf``, as ``spatialmech export`` writes) is read through the
+    importer (:func:`spatialmech.exchange.from_mjcf`); a URDF is refused (no importer), the
+    message pointing to the TOML and MJCF forms.
+
     Parameters
     ----------
     model : Mechanism, str or path
-        The mechanism, a ready-made model name (``sm.models()``) or a TOML model file.
+        The mechanism, a ready-made model name (``sm.models()``), a TOML model file or an MJCF file.
     name : str or None
         The argument named in error messages; ``None`` names the value itself, as the command line
         does for its MODEL argument (``NAME: not a file and not a ready-made model``).

@@ -48,6 +48,28 @@ def build(name: str) -> Mechanism:
     return builder()
 
 
+def _load_file(p) -> Mechanism:
+    """A model file: TOML (the model format), or MJCF (``.xml`` / ``.mjcf``, e.g. written by
+    ``spatialmech export``) through the importer :func:`spatialmech.exchange.from_mjcf`; a URDF
+    is refused (no importer: its loop closures are not standard URDF), pointing to the others."""
+    from ..model.schema import ModelFileError, load
+
+    suffix = p.suffix.lower()
+    if suffix in (".xml", ".mjcf"):
+        from ..errors import InputError
+        from ..exchange import from_mjcf
+
+        try:
+            return from_mjcf(p)
+        except InputError as e:
+            raise ModelFileError(f"{p}: read as MJCF (.xml): {e}") from None
+    if suffix == ".urdf":
+        raise ModelFileError(f"{p}: a URDF cannot be read back (no URDF importer: loop closures are not standard "
+                             "URDF); give the model's TOML file, or its MJCF (spatialmech export MODEL FILE.xml), "
+                             "which is imported")
+    return load(p)
+
+
 def resolve(spec) -> Mechanism:
     """A mechanism from a ready-made name, a file path, or a Mechanism (returned as is).
 
@@ -55,7 +77,7 @@ def resolve(spec) -> Mechanism:
     """
     from pathlib import Path
 
-    from ..model.schema import ModelFileError, load
+    from ..model.schema import ModelFileError
 
     if isinstance(spec, Mechanism):
         return spec
@@ -64,7 +86,7 @@ def resolve(spec) -> Mechanism:
         return build(s)
     p = Path(s)
     if p.exists():
-        return load(p)
+        return _load_file(p)
     raise ModelFileError(
         f"{s}: not a file and not a ready-made model (ready-made: {', '.join(REGISTRY)})"
     )

@@ -187,6 +187,33 @@ def _completeness_lines(search: dict) -> dict[str, str]:
             for rep in search.get("limbs") or ()}
 
 
+def _ik_headline(r: sm.IKResult) -> str:
+    """``reachable``; ``NOT reachable`` only where proven (a complete search found nothing, or the
+    nearest closed configuration is beyond the tolerance); else ``not found from the reference``
+    with why: the task solve's status and how far the continuation from the reference pose got."""
+    res, fit = r.result, r.pose_fit
+    if r.reachable:
+        return "reachable"
+    if r.task is not None and not r.task.converged:
+        s = r.task.continuation
+        cont = f"; continuation from the reference pose failed at s={s:.3g}" if s is not None else ""
+        limbs = " (the limbs close at the pose asked for, but not with the given coordinates held)" if res.reachable \
+            else ""
+        return (f"not found from the reference (the task solve of {', '.join(r.task.solved)} did not converge: "
+                f"{r.task.status}{cont}){limbs}")
+    if r.proven_unreachable:
+        return "NOT reachable (proven: every limb's search is complete)"
+    if fit is not None and fit.converged:
+        return "NOT reachable within the tolerance (see the note)"
+    return "not found from the reference (a Newton solve per limb; --all searches every solution)"
+
+
+def _warning_lines(warnings) -> None:
+    """``warning: ...`` lines of a result's plausibility warnings."""
+    for w in warnings:
+        click.echo(f"warning: {w}")
+
+
 def _ik_text(r: sm.IKResult) -> None:
     # A pose that does not close exactly (printed, rounded data: a task position, a pose printed
     # by fk) is fitted onto the closure: reachable when the nearest closed configuration is
@@ -198,7 +225,7 @@ def _ik_text(r: sm.IKResult) -> None:
     fitted = (f" (fitted onto the closure: off by {fit.position_error:.3g} {mech.length_unit} and "
               f"{np.degrees(fit.angle_error):.3g} deg, within the tolerance {reach_tol:g})"
               ) if res.fitted and fit is not None else ""  # fitted: the pose has a fit
-    click.echo(f"{mech.name}: pose {'reachable' if res.reachable else 'NOT reachable'}{fitted}")
+    click.echo(f"{mech.name}: pose {_ik_headline(r)}{fitted if r.reachable else ''}")
     if r.task is not None:
         t = d["task"]
         vals = {**t["values_len"], **t["values_deg"]}
@@ -219,8 +246,10 @@ def _ik_text(r: sm.IKResult) -> None:
             lim = f"  outside limits: {', '.join(sol['outside_limits'])}" if sol["outside_limits"] else ""
             click.echo(f"    [{k + 1}] {shown}  (residual {sol['residual']:.1e}){lim}")
     if r.config is not None:
-        click.echo("  actuators: " + ", ".join(f"{k} = {_fmt_value(mech, k, v)}" for k, v in r.actuators.items()))
+        head = "  actuators: " if r.reachable else "  actuators (of the limbs' solutions, not of the pose asked for): "
+        click.echo(head + ", ".join(f"{k} = {_fmt_value(mech, k, v)}" for k, v in r.actuators.items()))
     click.echo("  (rotations in degrees, slides in " + mech.length_unit + ")")
+    _warning_lines(d["warnings"])
     if r.task is None and not res.reachable:
         dt = r.default_task
         if len(dt.given) < 6:
@@ -277,6 +306,7 @@ def fk(model, values, all_solutions, method, seeds, as_json):
         emit_json("fk", mech, r.to_dict())
         return
     _fk_text(r)
+    _warning_lines(r.warnings)
 
 
 class _progress_bar:
@@ -308,6 +338,7 @@ def _fk_text(r: sm.FKResult) -> None:
     modes = a.modes
     n_ii = a.n_input_independent
     ii = (f", {n_ii} input-independent (the actuators move without moving the platform)" if n_ii else "")
+    limited = any(f.freedom.limits is not None for f in mech.freedom_refs)
     if a.endpoints is not None:  # homotopy continuation: counts of the path end points
         e = a.endpoints
         n_sm = sum(m.kind == "self-motion" and not m.input_independent for m in modes)
@@ -333,12 +364,14 @@ def _fk_text(r: sm.FKResult) -> None:
                              "try --all")
         click.echo(_fk_header(mech, [m.kind for m in modes if not m.input_independent], a.label, a.n_starts,
                               a.n_converged, n_ii)
-                   + (f"; {a.n_within_limits} within limits" if a.all_solutions else ""))
+                   + ("" if not a.all_solutions else f"; {a.n_within_limits} within limits" if limited
+                      else "; no joint limits in the model"))
         if a.all_solutions:
             click.echo(f"  NOT proven complete: {a.completeness}")
     for k, m in enumerate(modes):
         ang = matrix_euler("ZYX", m.pose.R, degrees=True)
-        lim = "within limits" if m.within_limits else "outside limits: " + ", ".join(m.outside_limits)
+        lim = ("outside limits: " + ", ".join(m.outside_limits) if not m.within_limits
+               else "within limits" if limited else "no joint limits in the model")
         click.echo(f"  [{k + 1}] platform point ({_num(m.pose.p, '.6g')}) {mech.length_unit}, "
                    f"ZYX angles ({_num(ang, '.4f')}) deg  {lim}")
         _fk_conditioning_lines(m.kind, m.sigma_min, m.condition, m.singular_below, m.members, m.self_motion,

@@ -24,7 +24,7 @@ coordinates from the output link's twist space at the reference configuration.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from itertools import combinations
 
 import numpy as np
@@ -42,6 +42,7 @@ from .velocity import euler_rate_matrix
 __all__ = [
     "TaskJacobian",
     "TaskSolution",
+    "continue_task",
     "coordinate_map",
     "default_task",
     "pose_from_task",
@@ -132,6 +133,9 @@ class TaskSolution:
     residual: float  # nondimensional closure residual
     iterations: int
     status: SolveStatus
+    #: How far (path parameter ``s`` in [0, 1]) a continuation from the reference pose got when
+    #: the direct solve failed (:func:`continue_task`); ``None`` when none was run.
+    continuation: float | None = None
 
     @property
     def given(self) -> tuple[str, ...]:
@@ -215,7 +219,10 @@ def solve_task(mech: Mechanism, given: Mapping[str, float], *, task: TaskCoordin
 def solve_pose(mech: Mechanism, pose, free, *, euler: str = "ZYX", seed: Configuration | None = None) -> TaskSolution:
     """A requested output pose (:class:`~spatialmech.model.mechanism.Pose`) whose coordinates
     ``free`` (names from ``x, y, z, a1, a2, a3``, angles in sequence ``euler``) are to be solved:
-    the other coordinates are held at the pose's values and :func:`solve_task` finds the rest."""
+    the other coordinates are held at the pose's values and :func:`solve_task` finds the rest.
+    As many coordinates must stay given as the output link has freedoms (:func:`default_task`),
+    else :class:`InputError` names both counts.  From the reference (no ``seed``), a failed solve
+    is retried by :func:`continue_task` (continuation from the reference pose)."""
     names = [str(n).strip() for n in free]
     for k, n in enumerate(names):
         if n not in TASK_NAMES:
@@ -225,8 +232,77 @@ def solve_pose(mech: Mechanism, pose, free, *, euler: str = "ZYX", seed: Configu
     if len(names) >= 6:
         raise InputError("free: at least one coordinate must be given (held)")
     task = TaskCoordinates(tuple(n for n in TASK_NAMES if n not in names), euler)
+    _check_count(mech, task, names)
     values = task_values(mech, pose.displacement(mech.platform_point), euler)
-    return solve_task(mech, {n: float(values[TASK_NAMES.index(n)]) for n in task.given}, task=task, seed=seed)
+    given = {n: float(values[TASK_NAMES.index(n)]) for n in task.given}
+    sol = solve_task(mech, given, task=task, seed=seed)
+    if sol.converged or seed is not None:
+        return sol
+    far, s = continue_task(mech, given, task=task)
+    return far if far is not None else replace(sol, continuation=s)
+
+
+def _check_count(mech: Mechanism, task: TaskCoordinates, names: list[str]) -> None:
+    """Refuse a task that gives more or fewer coordinates than the output link has freedoms
+    (over-determined: generally no pose; under-determined: one of a family, picked silently)."""
+    own = default_task(mech, task.euler)
+    m = len(own.given)
+    if len(task.given) == m:
+        return
+    what = "over-determined" if len(task.given) > m else "under-determined"
+    hint = f"e.g. --free {','.join(own.solved)}" if own.solved else "give no --free"
+    raise InputError(f"free (--free): {mech.name}'s output link has {m} freedoms, so {m} task coordinates are given "
+                     f"and {6 - m} solved; --free {','.join(names) or '(none)'} solves {len(names)} and leaves "
+                     f"{len(task.given)} given ({', '.join(task.given)}): {what}; name {6 - m} to solve ({hint})")
+
+
+#: Continuation from the reference: the first and largest step of the path (nondimensional:
+#: rad, characteristic lengths), the smallest, and the most steps.
+CONTINUATION_STEP = 0.05
+CONTINUATION_MIN_STEP = 1e-4
+CONTINUATION_MAX_STEPS = 2000
+
+
+def continue_task(mech: Mechanism, given: Mapping[str, float], *, task: TaskCoordinates,
+                  start: Configuration | None = None) -> tuple[TaskSolution | None, float]:
+    """Natural-parameter continuation (a homotopy in the pose, as the studio's pose drag,
+    :mod:`spatialmech.services.studio.posing`): the given coordinates are moved along the straight
+    path from their values at ``start`` (default: the reference) to ``given`` (angles the short
+    way round), each step corrected by :func:`solve_task` from the previous configuration and
+    halved when it does not converge.  Returns ``(solution, s)``: the converged solve at the
+    target (its ``continuation`` 1.0) and ``s = 1``, or ``None`` and the path parameter ``s`` in
+    [0, 1) where the steps could not go on."""
+    g = _check_given(task, given)
+    start = Configuration.reference(mech) if start is None else start
+    L = mech.characteristic_length
+    v0 = task_values(mech, start.D, task.euler)
+    gi = [TASK_NAMES.index(n) for n in g]
+    delta = np.zeros(6)
+    delta[gi] = np.array([g[n] for n in g]) - v0[gi]
+    delta[3:] = (delta[3:] + np.pi) % (2 * np.pi) - np.pi
+    ell = float(np.linalg.norm(np.r_[delta[:3] / L, delta[3:]]))
+
+    def at(s: float, seed: Configuration, max_iter: int = 12) -> TaskSolution:
+        v = v0 + s * delta
+        return solve_task(mech, {n: float(v[TASK_NAMES.index(n)]) for n in g}, task=task, seed=seed,
+                          max_iter=max_iter)
+
+    cur, s, h = start, 0.0, min(CONTINUATION_STEP, ell)
+    for _ in range(CONTINUATION_MAX_STEPS):
+        if s >= 1.0 or ell == 0.0:
+            break
+        nxt = min(1.0, s + h / ell)
+        r = at(nxt, cur)
+        if not r.converged:
+            h *= 0.5
+            if h < CONTINUATION_MIN_STEP:
+                break
+            continue
+        cur, s, h = r.config, nxt, min(CONTINUATION_STEP, 1.5 * h)
+    if s < 1.0:
+        return None, float(s)
+    final = at(1.0, cur, 60)
+    return (replace(final, continuation=1.0) if final.converged else None), float(s)
 
 
 def task_solution_dict(sol: TaskSolution) -> dict:
@@ -234,6 +310,7 @@ def task_solution_dict(sol: TaskSolution) -> dict:
     values (``values_len``: x, y, z in the model's length unit; ``values_deg``: a1, a2, a3)."""
     return {"given": list(sol.given), "solved": list(sol.solved), "euler": sol.task.euler,
             "converged": bool(sol.converged), "status": str(sol.status), "residual": float(sol.residual),
+            "continuation_s": None if sol.continuation is None else float(sol.continuation),
             "values_len": {n: float(sol.values[n]) for n in TASK_NAMES[:3]},
             "values_deg": {n: float(np.degrees(sol.values[n])) for n in TASK_NAMES[3:]}}
 
