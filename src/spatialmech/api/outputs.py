@@ -144,8 +144,7 @@ def demo(out="report", *, progress: bool | Progress | None = None) -> ReportResu
     return ReportResult(out, data)
 
 
-#: The motions :func:`view` can animate.
-VIEW_MOTIONS = ("auto", "trace", "demo")
+from .constants import VIEW_MOTIONS as VIEW_MOTIONS  # the motions view() can animate  # noqa: E402
 
 
 @dataclass(frozen=True, eq=False)

@@ -10,8 +10,6 @@ from typing import TYPE_CHECKING, Any, overload
 
 import numpy as np
 
-from ..analysis.workspace import COORDINATES
-from ..analysis.workspace.search import MAX_POSES
 from ..errors import InputError, describe
 from ..model.mechanism import Mechanism
 from ..model.task import TASK_NAMES, TaskCoordinates
@@ -22,14 +20,10 @@ if TYPE_CHECKING:
 
 from .checks import ModelLike, as_mechanism, check_bool, check_names, check_numbers, optional_progress
 
-#: The coordinates of a pose workspace's ``at`` (``x, y, z`` length; ``alpha, beta, gamma`` rad of
-#: ``R = Rz(gamma) Ry(beta) Rx(alpha)``).
-WORKSPACE_COORDINATES = COORDINATES
-#: The task coordinates: ``x, y, z`` of the output point, ``a1, a2, a3`` Euler angles in a named
-#: sequence.
-TASK_COORDINATES = TASK_NAMES
-#: The largest grid a pose workspace accepts by default (``max_poses``).
-WORKSPACE_MAX_POSES = MAX_POSES
+# the names of grids and held coordinates, the largest grid: see constants.py
+from .constants import TASK_COORDINATES as TASK_COORDINATES
+from .constants import WORKSPACE_COORDINATES as WORKSPACE_COORDINATES
+from .constants import WORKSPACE_MAX_POSES as WORKSPACE_MAX_POSES
 
 __all__ = ["TASK_COORDINATES", "WORKSPACE_COORDINATES", "WORKSPACE_MAX_POSES", "TaskGridSuggestion",
            "singularity_slice", "suggest_task_grid", "task_coordinates"]
