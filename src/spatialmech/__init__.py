@@ -166,6 +166,7 @@ def __getattr__(name: str):
     module, bind the name here (later lookups are plain attribute reads) and return it."""
     import importlib
 
+    value: object
     if name == "__version__":
         value = _version()
     elif (where := _LAZY.get(name)) is not None:
