@@ -19,6 +19,7 @@ if TYPE_CHECKING:
     from ..analysis.task_slice import TaskSliceResult
 
 from .checks import ModelLike, as_mechanism, check_bool, check_names, check_numbers, optional_progress
+from .threads import one_blas_thread
 
 # the names of grids and held coordinates, the largest grid: see constants.py
 from .constants import TASK_COORDINATES as TASK_COORDINATES
@@ -58,6 +59,7 @@ def singularity_slice(model: ModelLike, over: Mapping[str, Any], *, pose: None =
 def singularity_slice(model: ModelLike, over: Mapping[str, Any], *, pose: Sequence[Any],
                       at: None = None, free: None = None, drivers=None, degrees: bool = False,
                       progress: Progress | None = None) -> SliceResult: ...
+@one_blas_thread
 def singularity_slice(model: ModelLike, over: Mapping[str, Any], *, pose: Sequence[Any] | None = None,
                       at: Mapping[str, float] | None = None, free=None, drivers=None, degrees: bool = False,
                       progress: Progress | None = None) -> SliceResult | TaskSliceResult:

@@ -300,8 +300,11 @@ cli.add_command(stiffness_cmd)
 
 
 def main(argv=None):  # console-script entry point
+    from ..api.threads import blas_threads  # small matrices: one BLAS thread for the whole run (issue 29)
+
     try:
-        cli.main(args=argv, prog_name="spatialmech", standalone_mode=True)
+        with blas_threads():
+            cli.main(args=argv, prog_name="spatialmech", standalone_mode=True)
     except SystemExit as e:
         if e.code not in (0, None):
             sys.exit(e.code)
