@@ -63,7 +63,7 @@ def test_lazy_names_are_the_eager_ones():
     for name in sm.__all__:
         assert getattr(sm, name) is not None, name
     assert sm.fk is sm.api.fk and sm.Mechanism is sm.api.Mechanism
-    import spatialmech.api.maps  # noqa: F401  (a submodule named as a verb: the verb stays)
+    import spatialmech.api.maps
     import spatialmech.api.stiffness  # noqa: F401
     assert callable(sm.api.maps) and callable(sm.api.stiffness) and sm.maps is sm.api.maps
     assert isinstance(sm.__version__, str)
@@ -133,6 +133,5 @@ def test_fk_all_solutions_inside_runs_on_one_thread(monkeypatch):
 
 def test_the_environment_sets_the_cap(monkeypatch):
     monkeypatch.setenv("SPATIALMECH_BLAS_THREADS", "0")
-    with threadpoolctl.threadpool_limits(2, "blas"):
-        with blas_threads():
-            assert set(_blas_threads()) == {2}
+    with threadpoolctl.threadpool_limits(2, "blas"), blas_threads():
+        assert set(_blas_threads()) == {2}
