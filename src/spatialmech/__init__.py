@@ -24,70 +24,53 @@ Quick example::
     True
 """
 
-from importlib.metadata import PackageNotFoundError, version
+from typing import TYPE_CHECKING
 
 from . import results
-from .api import (
-    announce_compilation,
-    default_tolerance,
-    defects,
-    demo,
-    dj_table,
-    export,
-    fk,
-    ik,
-    jacobian,
-    load_model,
-    maps,
-    mobility,
-    mobility_modes,
-    models,
-    parasitic,
-    report,
-    singularity,
-    singularity_slice,
-    statics,
-    stiffness,
-    stiffness_map,
-    studio_session,
-    suggest_task_grid,
-    screen,
-    synth_cs,
-    synth_rccc,
-    tolerances,
-    track,
-    validate,
-    velocity,
-    view,
-    workspace,
-)
 from .errors import ConvergenceError, InputError, SearchTooLargeError, SpatialmechError, UnknownNameError
-from .kinematics.closure import Configuration
-from .model import (
-    C,
-    H,
-    Joint,
-    Limb,
-    Mechanism,
-    Mode,
-    ModelFileError,
-    P,
-    Pose,
-    R,
-    S,
-    Sm,
-    U,
-    dump,
-    dumps,
-    load,
-    loads,
-)
 from .results import Progress, TrackStatus
 
-try:
-    __version__ = version("spatialmech")
-except PackageNotFoundError:  # pragma: no cover
-    __version__ = "0+unknown"
+if TYPE_CHECKING:  # what mypy sees; at run time :func:`__getattr__` imports these on first use
+    from .api import (
+        announce_compilation,
+        default_tolerance,
+        defects,
+        demo,
+        dj_table,
+        export,
+        fk,
+        ik,
+        jacobian,
+        load_model,
+        maps,
+        mobility,
+        mobility_modes,
+        models,
+        parasitic,
+        report,
+        screen,
+        singularity,
+        singularity_slice,
+        statics,
+        stiffness,
+        stiffness_map,
+        studio_session,
+        suggest_task_grid,
+        synth_cs,
+        synth_rccc,
+        tolerances,
+        track,
+        validate,
+        velocity,
+        view,
+        workspace,
+    )
+    from .interfaces.studio.app import studio_app
+    from .kinematics import closed_forms
+    from .kinematics.closure import Configuration
+    from .model import C, H, Joint, Limb, Mechanism, Mode, ModelFileError, P, Pose, R, S, Sm, U, dump, dumps, load, loads
+
+    __version__: str
 
 __all__ = [
     "C",
@@ -154,22 +137,46 @@ __all__ = [
 ]
 
 
-#: Names resolved on first use (:func:`__getattr__`), listed by ``dir(spatialmech)``.
-_LAZY = ("closed_forms", "studio_app")
+#: Names resolved on first use (PEP 562, :func:`__getattr__`) -> the module that defines them;
+#: ``dir(spatialmech)`` lists them.  ``import spatialmech`` thus loads the errors and the result
+#: enums only: no analysis, no scipy.spatial, no numba until a verb runs (issue 29).
+_LAZY: dict[str, str] = {
+    **dict.fromkeys(("C", "H", "Joint", "Limb", "Mechanism", "Mode", "ModelFileError", "P", "Pose", "R", "S", "Sm",
+                     "U", "dump", "dumps", "load", "loads"), ".model"),
+    "Configuration": ".kinematics.closure",
+    "closed_forms": ".kinematics.closed_forms",  # the closed-form kernels (a module; they load scipy.stats)
+    "studio_app": ".interfaces.studio.app",  # the studio's web app, a driver (FastAPI) above the API
+    **{name: ".api" for name in __all__ if name[0].islower() and name not in {"__version__", "closed_forms",
+                                                                               "dump", "dumps", "load", "loads",
+                                                                               "results", "studio_app"}},
+}
+
+
+def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("spatialmech")
+    except PackageNotFoundError:  # pragma: no cover
+        return "0+unknown"
 
 
 def __getattr__(name: str):
-    """``sm.closed_forms``: the closed-form kernels (imported on first use: they load scipy.stats);
-    ``sm.studio_app``: the design studio's web app, a driver (FastAPI) that lives in
-    :mod:`spatialmech.interfaces.studio.app` above the API, imported on first use."""
+    """A name of :data:`_LAZY` (or ``__version__``, read from the installed metadata): import its
+    module, bind the name here (later lookups are plain attribute reads) and return it."""
     import importlib
 
-    if name == "closed_forms":
-        return importlib.import_module(".kinematics.closed_forms", __name__)
-    if name == "studio_app":
-        return importlib.import_module(".interfaces.studio.app", __name__).studio_app
-    raise AttributeError(f"module 'spatialmech' has no attribute {name!r}")
+    value: object
+    if name == "__version__":
+        value = _version()
+    elif (where := _LAZY.get(name)) is not None:
+        module = importlib.import_module(where, __name__)
+        value = module if where.endswith("." + name) else getattr(module, name)
+    else:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    globals()[name] = value
+    return value
 
 
 def __dir__() -> list[str]:
-    return sorted({*globals(), *_LAZY})
+    return sorted({*globals(), *_LAZY, "__version__"})

@@ -37,42 +37,73 @@ the argument checks they share.  The command line and the studio's web app
 
 from __future__ import annotations
 
+import importlib
+import sys
+import types
+from typing import TYPE_CHECKING
+
 from ..geometry.rotations import euler_matrix as euler_matrix  # Euler angles <-> rotation matrices, for
 from ..geometry.rotations import matrix_euler as matrix_euler  # the drivers (named sequences, as Pose.from_euler)
 from ..geometry.tolerances import Tolerances as Tolerances  # what sm.tolerances() yields
-from ..model.mechanism import Mechanism as Mechanism  # the model and pose types the verbs take
-from ..model.mechanism import Pose as Pose
-from .checks import ModelLike as ModelLike  # the type of a model argument
-from .forces import StaticsResult, statics
-from .kinematics import (
-    FKResult,
-    IKResult,
-    JacobianResult,
-    SingularityAnalysis,
-    VelocityResult,
-    fk,
-    ik,
-    jacobian,
-    parasitic,
-    singularity,
-    velocity,
-    workspace,
-)
-from .exchange import EXPORT_FORMATS as EXPORT_FORMATS  # the formats export() writes
-from .exchange import VALIDATION_METHODS as VALIDATION_METHODS  # validate()'s methods and default tolerance
-from .exchange import VALIDATION_TOL as VALIDATION_TOL
-from .exchange import ExportResult, export, validate
-from .linkages import CSSynthesisResult, DefectAnalysis, TraceResult, defects, dj_table, screen, synth_cs, synth_rccc, track
-from .maps import MapResult, maps
-from .stiffness import StiffnessMap, StiffnessResult, stiffness, stiffness_map
-from .outputs import VIEW_MOTIONS as VIEW_MOTIONS  # the motions view() animates
-from .outputs import ReportResult, ViewResult, demo, report, studio_session, view
-from .regions import TASK_COORDINATES as TASK_COORDINATES  # the names of grids and held coordinates
-from .regions import WORKSPACE_COORDINATES as WORKSPACE_COORDINATES
-from .regions import WORKSPACE_MAX_POSES as WORKSPACE_MAX_POSES
-from .regions import TaskGridSuggestion, singularity_slice, suggest_task_grid
-from .settings import announce_compilation, default_tolerance, tolerances
-from .structure import MobilityModes, load_model, mobility, mobility_modes, models
+
+if TYPE_CHECKING:  # what mypy (and a reader) sees; at run time __getattr__ imports these on first use
+    from ..model.mechanism import Mechanism as Mechanism  # the model and pose types the verbs take
+    from ..model.mechanism import Pose as Pose
+    from .checks import ModelLike as ModelLike  # the type of a model argument
+    from .constants import (  # the choices and defaults the drivers show (a light module: no analysis)
+        EXPORT_FORMATS as EXPORT_FORMATS,
+        TASK_COORDINATES as TASK_COORDINATES,
+        VALIDATION_METHODS as VALIDATION_METHODS,
+        VALIDATION_TOL as VALIDATION_TOL,
+        VIEW_MOTIONS as VIEW_MOTIONS,
+        WORKSPACE_COORDINATES as WORKSPACE_COORDINATES,
+        WORKSPACE_MAX_POSES as WORKSPACE_MAX_POSES,
+    )
+    from .forces import StaticsResult, statics
+    from .kinematics import (
+        FKResult,
+        IKResult,
+        JacobianResult,
+        SingularityAnalysis,
+        VelocityResult,
+        fk,
+        ik,
+        jacobian,
+        parasitic,
+        singularity,
+        velocity,
+        workspace,
+    )
+    from .exchange import ExportResult, export, validate
+    from .linkages import CSSynthesisResult, DefectAnalysis, TraceResult, defects, dj_table, screen, synth_cs, synth_rccc, track
+    from .maps import MapResult, maps
+    from .stiffness import StiffnessMap, StiffnessResult, stiffness, stiffness_map
+    from .outputs import ReportResult, ViewResult, demo, report, studio_session, view
+    from .regions import TaskGridSuggestion, singularity_slice, suggest_task_grid
+    from .settings import announce_compilation, default_tolerance, tolerances
+    from .structure import MobilityModes, load_model, mobility, mobility_modes, models
+
+#: Name -> the module (relative to this package) that defines it: every function and result type
+#: is imported on first use (PEP 562, :func:`__getattr__`), so ``import spatialmech`` loads none
+#: of the analyses (nor scipy.spatial, numba, ...) until one is called.
+_LAZY: dict[str, str] = {
+    **dict.fromkeys(("Mechanism", "Pose"), "..model.mechanism"),
+    **dict.fromkeys(("ModelLike",), ".checks"),
+    **dict.fromkeys(("StaticsResult", "statics"), ".forces"),
+    **dict.fromkeys(("FKResult", "IKResult", "JacobianResult", "SingularityAnalysis", "VelocityResult", "fk", "ik",
+                     "jacobian", "parasitic", "singularity", "velocity", "workspace"), ".kinematics"),
+    **dict.fromkeys(("EXPORT_FORMATS", "TASK_COORDINATES", "VALIDATION_METHODS", "VALIDATION_TOL", "VIEW_MOTIONS",
+                     "WORKSPACE_COORDINATES", "WORKSPACE_MAX_POSES"), ".constants"),
+    **dict.fromkeys(("ExportResult", "export", "validate"), ".exchange"),
+    **dict.fromkeys(("CSSynthesisResult", "DefectAnalysis", "TraceResult", "defects", "dj_table", "screen", "synth_cs",
+                     "synth_rccc", "track"), ".linkages"),
+    **dict.fromkeys(("MapResult", "maps"), ".maps"),
+    **dict.fromkeys(("StiffnessMap", "StiffnessResult", "stiffness", "stiffness_map"), ".stiffness"),
+    **dict.fromkeys(("ReportResult", "ViewResult", "demo", "report", "studio_session", "view"), ".outputs"),
+    **dict.fromkeys(("TaskGridSuggestion", "singularity_slice", "suggest_task_grid"), ".regions"),
+    **dict.fromkeys(("announce_compilation", "default_tolerance", "tolerances"), ".settings"),
+    **dict.fromkeys(("MobilityModes", "load_model", "mobility", "mobility_modes", "models"), ".structure"),
+}
 
 __all__ = [
     "CSSynthesisResult",
@@ -125,3 +156,33 @@ __all__ = [
     "view",
     "workspace",
 ]
+
+
+def __getattr__(name: str):
+    """A name of :data:`_LAZY`: import its module, bind the name here (later lookups are plain
+    attribute reads) and return it."""
+    where = _LAZY.get(name)
+    if where is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(where, __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *_LAZY})
+
+
+class _Facade(types.ModuleType):
+    """This package's module type: importing ``api/maps.py`` or ``api/stiffness.py`` (a module
+    named as a function of the facade) must not rebind ``api.maps`` / ``api.stiffness`` to the
+    module, as the import system does for a submodule; the function stays (as when this package
+    imported everything eagerly)."""
+
+    def __setattr__(self, name: str, value) -> None:
+        if isinstance(value, types.ModuleType) and _LAZY.get(name) == "." + name:
+            return
+        super().__setattr__(name, value)
+
+
+sys.modules[__name__].__class__ = _Facade

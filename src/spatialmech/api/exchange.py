@@ -15,12 +15,9 @@ if TYPE_CHECKING:  # imported where it runs (it loads the simulator's bindings l
 
 from .checks import ModelLike, as_mechanism, as_pose, check_bool, check_choice, check_int, check_number, check_path
 
-#: The formats :func:`export` writes.
-EXPORT_FORMATS = ("toml", "mjcf", "urdf")
-#: The ways :func:`validate` drives the simulator, and the largest error that passes by default
-#: (a fraction of the characteristic length, and radians).
-VALIDATION_METHODS = ("project", "settle")
-VALIDATION_TOL = 1e-8
+from .constants import EXPORT_FORMATS as EXPORT_FORMATS  # the formats export() writes
+from .constants import VALIDATION_METHODS as VALIDATION_METHODS  # validate()'s methods and default tolerance
+from .constants import VALIDATION_TOL as VALIDATION_TOL
 
 
 @dataclass(frozen=True, eq=False)

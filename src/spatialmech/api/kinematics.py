@@ -44,6 +44,7 @@ from .checks import (
     optional_progress,
     pose_sequence,
 )
+from .threads import one_blas_thread
 
 
 #: The note on ``pose_fit`` in the JSON of ``ik`` (as ``spatialmech ik --json``).
@@ -119,6 +120,7 @@ class IKResult:
         return d
 
 
+@one_blas_thread
 def ik(model: ModelLike, pose, *, all_solutions: bool = False, n_seeds: int = 48, seed: int = 0,
        degrees: bool = False, tol=None, free=None, method: str = "auto") -> IKResult:
     """Inverse position: the joint values of every limb for a platform pose.
@@ -257,6 +259,7 @@ class FKResult:
         return {**self.answer.to_dict(self.mechanism), "warnings": self.warnings}
 
 
+@one_blas_thread
 def fk(model: ModelLike, actuators, *, all_solutions: bool = False, seeds: int | None = None, seed: int | None = None,
        degrees: bool = False, progress: Progress | None = None, method: str = "auto") -> FKResult:
     """Forward position: platform pose(s) for actuator values.
@@ -609,6 +612,7 @@ class SingularityAnalysis:
         return {"result": "singularity", **self.result.to_dict()}
 
 
+@one_blas_thread
 def singularity(model: ModelLike, pose=None, *, config: Configuration | None = None, drivers=None,
                 degrees: bool = False) -> SingularityAnalysis:
     """Singularity analysis at a pose, a configuration, or the reference configuration.
@@ -666,6 +670,7 @@ def singularity(model: ModelLike, pose=None, *, config: Configuration | None = N
     return SingularityAnalysis(mech, c, _singularity(mech, c, drivers), fit)
 
 
+@one_blas_thread
 def workspace(model: ModelLike, *, kind: str = "orientation", at: Mapping[str, float] | None = None,
               step: float | None = None, tol=None, bounds=None, method: str = "auto",
               link_diameter: float | None = None, interference: bool = True, max_poses: int | None = None,
@@ -846,6 +851,7 @@ def _task_workspace(mech: Mechanism, over, at, free, limits, tol, step, bounds, 
                           progress=optional_progress(progress))
 
 
+@one_blas_thread
 def parasitic(model: ModelLike, over: Mapping, *, at: Mapping[str, float] | None = None, free=None,
               euler: str | None = None, plot=None, progress: Progress | None = None) -> ParasiticTable:
     """The parasitic motion of a lower-mobility mechanism over a grid of given coordinates.

@@ -39,6 +39,7 @@ from .checks import (
     check_path,
     optional_progress,
 )
+from .threads import one_blas_thread
 
 
 # ============================================================================ tracking
@@ -93,6 +94,7 @@ class TraceResult:
         }
 
 
+@one_blas_thread
 def track(model: ModelLike, start=None, *, increasing: str | None = None, sense: int = 1, max_arc: float = 50.0,
           max_steps: int = 20000, h0: float = 0.02, degrees: bool = False,
           progress: Progress | None = None) -> TraceResult:
@@ -243,6 +245,7 @@ class DefectAnalysis:
         return self.result.to_dict()
 
 
+@one_blas_thread
 def defects(model: ModelLike, positions=None, *, drivers=None, pose_tol: float | None = None,
             angle_tol_deg: float = 1.0, monte_carlo: int = 0, seed: int = 0, precision: float = 5e-4,
             plot: str | os.PathLike | None = None, progress: Progress | None = None) -> DefectAnalysis:
@@ -323,6 +326,7 @@ def defects(model: ModelLike, positions=None, *, drivers=None, pose_tol: float |
 
 
 # ============================================================================ synthesis
+@one_blas_thread
 def synth_rccc(task="rccc-four-positions", *, pick: str = "best-rc", samples: int = 360,
                save: str | os.PathLike | None = None, plot: str | os.PathLike | None = None) -> RCCCResult:
     """Four-position RCCC synthesis by solution regions (paper D).
@@ -431,6 +435,7 @@ def seven_positions(positions) -> tuple[tuple[Pose, ...], str]:
     return poses, os.fspath(positions) if isinstance(positions, (str, os.PathLike)) else "given poses"
 
 
+@one_blas_thread
 def synth_cs(positions=None, *, pick: int = 5, starts: int = 60, seed: int = 0, samples: int = 40,
              check_defects: bool = True, save: str | os.PathLike | None = None,
              progress: Progress | None = None) -> CSSynthesisResult:
@@ -507,6 +512,7 @@ def synth_cs(positions=None, *, pick: int = 5, starts: int = 60, seed: int = 0, 
 
 
 # ============================================================================ screening
+@one_blas_thread
 def screen(task=None, out: str | os.PathLike = "screen.parquet", *, candidates: int = 1000, density: float = 0.5,
            workers: int | None = None, scheduler: str | None = None, top: int = 5, rank_by: str = "singularity",
            seed: int = 0, starts: int = 60, separation: float = 0.5, chunk_size: int = 20,

@@ -8,10 +8,12 @@ from ..analysis.maps import INDICES, MapResult, performance_map
 from ..analysis.workspace import WorkspaceLimits
 from ..errors import InputError, describe
 from .checks import ModelLike, as_mechanism, check_choice, check_names
+from .threads import one_blas_thread
 
 __all__ = ["MapResult", "maps"]
 
 
+@one_blas_thread
 def maps(model: ModelLike, *, kind: str = "position", over: Mapping, at: Mapping[str, float] | None = None,
          indices=None, limits: WorkspaceLimits | None = None, method: str = "auto") -> MapResult:
     """Performance maps: kinetostatic indices at every pose of a grid (docs/maps.md).

@@ -16,6 +16,7 @@ if TYPE_CHECKING:
     from ..services.studio.session import Session
 
 from .checks import ModelLike, as_mechanism, check_bool, check_choice, check_int, check_path
+from .threads import one_blas_thread
 
 
 # ============================================================================ report, viewer
@@ -40,6 +41,7 @@ class ReportResult:
         return {k: v for k, v in self.data.items() if k != "model"}
 
 
+@one_blas_thread
 def report(model: ModelLike, out=None, *, trace: bool = True, progress: bool | Progress | None = None) -> ReportResult:
     """Every analysis that applies to one model, written as a report into a directory.
 
@@ -96,6 +98,7 @@ def report(model: ModelLike, out=None, *, trace: bool = True, progress: bool | P
     return ReportResult(out, data)
 
 
+@one_blas_thread
 def demo(out="report", *, progress: bool | Progress | None = None) -> ReportResult:
     """Reproduce the four papers' examples into a report (about 45 s).
 
@@ -144,8 +147,7 @@ def demo(out="report", *, progress: bool | Progress | None = None) -> ReportResu
     return ReportResult(out, data)
 
 
-#: The motions :func:`view` can animate.
-VIEW_MOTIONS = ("auto", "trace", "demo")
+from .constants import VIEW_MOTIONS as VIEW_MOTIONS  # the motions view() can animate  # noqa: E402
 
 
 @dataclass(frozen=True, eq=False)

@@ -10,8 +10,6 @@ from typing import TYPE_CHECKING, Any, overload
 
 import numpy as np
 
-from ..analysis.workspace import COORDINATES
-from ..analysis.workspace.search import MAX_POSES
 from ..errors import InputError, describe
 from ..model.mechanism import Mechanism
 from ..model.task import TASK_NAMES, TaskCoordinates
@@ -21,15 +19,12 @@ if TYPE_CHECKING:
     from ..analysis.task_slice import TaskSliceResult
 
 from .checks import ModelLike, as_mechanism, check_bool, check_names, check_numbers, optional_progress
+from .threads import one_blas_thread
 
-#: The coordinates of a pose workspace's ``at`` (``x, y, z`` length; ``alpha, beta, gamma`` rad of
-#: ``R = Rz(gamma) Ry(beta) Rx(alpha)``).
-WORKSPACE_COORDINATES = COORDINATES
-#: The task coordinates: ``x, y, z`` of the output point, ``a1, a2, a3`` Euler angles in a named
-#: sequence.
-TASK_COORDINATES = TASK_NAMES
-#: The largest grid a pose workspace accepts by default (``max_poses``).
-WORKSPACE_MAX_POSES = MAX_POSES
+# the names of grids and held coordinates, the largest grid: see constants.py
+from .constants import TASK_COORDINATES as TASK_COORDINATES
+from .constants import WORKSPACE_COORDINATES as WORKSPACE_COORDINATES
+from .constants import WORKSPACE_MAX_POSES as WORKSPACE_MAX_POSES
 
 __all__ = ["TASK_COORDINATES", "WORKSPACE_COORDINATES", "WORKSPACE_MAX_POSES", "TaskGridSuggestion",
            "singularity_slice", "suggest_task_grid", "task_coordinates"]
@@ -64,6 +59,7 @@ def singularity_slice(model: ModelLike, over: Mapping[str, Any], *, pose: None =
 def singularity_slice(model: ModelLike, over: Mapping[str, Any], *, pose: Sequence[Any],
                       at: None = None, free: None = None, drivers=None, degrees: bool = False,
                       progress: Progress | None = None) -> SliceResult: ...
+@one_blas_thread
 def singularity_slice(model: ModelLike, over: Mapping[str, Any], *, pose: Sequence[Any] | None = None,
                       at: Mapping[str, float] | None = None, free=None, drivers=None, degrees: bool = False,
                       progress: Progress | None = None) -> SliceResult | TaskSliceResult:

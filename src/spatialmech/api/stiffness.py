@@ -22,6 +22,7 @@ from ..kinematics.position import PoseFit, platform_pose
 from ..model.mechanism import Mechanism, Pose
 from ..serialize import pose_dict
 from .checks import ModelLike, as_configuration, as_mechanism, as_pose, check_bool, check_choice, check_names
+from .threads import one_blas_thread
 
 __all__ = ["StiffnessMap", "StiffnessResult", "stiffness", "stiffness_map"]
 
@@ -188,6 +189,7 @@ def _plain(v):
     return dict(v) if isinstance(v, Mapping) else v
 
 
+@one_blas_thread
 def stiffness_map(model: ModelLike, *, over: Mapping, at: Mapping[str, float] | None = None, kind: str = "position",
                   drivers=None, actuator_stiffness=None, constraint_stiffness=None,
                   limits: WorkspaceLimits | None = None) -> StiffnessMap:

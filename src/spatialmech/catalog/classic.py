@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from ..errors import InputError
 from ..geometry.rotations import euler_matrix, transform
@@ -229,6 +228,8 @@ def bennett(a: float = 1.0, alpha_deg: float = 30.0, b: float = 1.5, theta1_deg:
     def resid(x):
         T = chain([th1, *x])[-1]
         return np.r_[T[:3, :3].ravel() - np.eye(3).ravel(), T[:3, 3]]
+
+    from scipy.optimize import least_squares  # on first use: scipy.optimize loads scipy.spatial (issue 29)
 
     best = None
     for guess in ([2.0, 2 * np.pi - th1, -2.0], [1.0, -th1, 1.0], [3.0, np.pi, 3.0], [-1.0, th1, -1.0]):

@@ -17,8 +17,9 @@ the origin, i.e. the moment ``r x omega``).
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from ..errors import InputError
 from .validate import as_finite_array
@@ -32,12 +33,26 @@ __all__ = [
     "matrix_euler",
     "matrix_rotvec",
     "rotation_angle",
+    "rotation_class",
     "rotvec_matrix",
     "skew",
     "transform",
 ]
 
 _AXES = set("xyzXYZ")
+
+if TYPE_CHECKING:
+    from scipy.spatial.transform import Rotation as _RotationType
+
+
+def rotation_class() -> type[_RotationType]:
+    """``scipy.spatial.transform.Rotation``, imported on first use: ``scipy.spatial`` costs about
+    half a second (k-d trees, Qhull, distances), which ``import spatialmech`` and the command
+    line's start-up should not pay.  Modules use ``rotation_class().from_matrix(...)``, never a
+    module-level ``from scipy.spatial.transform import Rotation`` (tests/test_startup.py)."""
+    from scipy.spatial.transform import Rotation
+
+    return Rotation
 
 
 def check_sequence(seq: str) -> str:
@@ -60,7 +75,7 @@ def euler_matrix(seq: str, angles, *, degrees: bool = False) -> np.ndarray:
     if a.shape[-1:] != (3,):
         raise InputError(f"angles: expected shape (..., 3), got {a.shape}")
     flat = a.reshape(-1, 3)
-    R = Rotation.from_euler(seq, flat, degrees=degrees).as_matrix()
+    R = rotation_class().from_euler(seq, flat, degrees=degrees).as_matrix()
     return R.reshape((*a.shape[:-1], 3, 3))
 
 
@@ -69,7 +84,7 @@ def matrix_euler(seq: str, R, *, degrees: bool = False) -> np.ndarray:
     check_sequence(seq)
     R = as_finite_array(R, "R")
     flat = R.reshape(-1, 3, 3)
-    a = Rotation.from_matrix(flat).as_euler(seq, degrees=degrees)
+    a = rotation_class().from_matrix(flat).as_euler(seq, degrees=degrees)
     return a.reshape((*R.shape[:-2], 3))
 
 
@@ -144,7 +159,7 @@ def log_transform(T) -> np.ndarray:
     """The twist ``xi`` (6,) with ``exp_twist(xi, 1) = T``, rotation angle in ``[0, pi]``."""
     T = np.asarray(T, dtype=float)
     flat = T.reshape(-1, 4, 4)
-    rv = Rotation.from_matrix(flat[:, :3, :3]).as_rotvec()
+    rv = rotation_class().from_matrix(flat[:, :3, :3]).as_rotvec()
     th = np.linalg.norm(rv, axis=-1)
     out = np.zeros((flat.shape[0], 6))
     for i in range(flat.shape[0]):
@@ -175,7 +190,7 @@ def matrix_rotvec(R) -> np.ndarray:
     R = np.asarray(R, dtype=float)
     c = (np.trace(R) - 1.0) / 2.0
     if c < -0.999:  # near a half turn: scipy's robust branch
-        return Rotation.from_matrix(R).as_rotvec()
+        return rotation_class().from_matrix(R).as_rotvec()
     w = np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
     sn = 0.5 * float(np.sqrt(w @ w))
     th = float(np.arctan2(sn, c))
@@ -187,6 +202,6 @@ def matrix_rotvec(R) -> np.ndarray:
 def rotation_angle(R) -> np.ndarray:
     """Rotation angle in ``[0, pi]`` of a rotation matrix (stacks allowed)."""
     R = np.asarray(R, dtype=float)
-    return np.linalg.norm(Rotation.from_matrix(R.reshape(-1, 3, 3)).as_rotvec(), axis=-1).reshape(
+    return np.linalg.norm(rotation_class().from_matrix(R.reshape(-1, 3, 3)).as_rotvec(), axis=-1).reshape(
         R.shape[:-2]
     )

@@ -16,7 +16,6 @@ from pathlib import Path
 
 import click
 
-from .. import __version__
 from .. import api as sm
 from ..errors import ConvergenceError, SpatialmechError
 from .common import UserError, check_output_dir, check_output_file, emit_json, json_option, load_model, tol_option
@@ -119,7 +118,7 @@ class InternalError(click.ClickException):
 
 
 @click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
-@click.version_option(__version__, prog_name="spatialmech")
+@click.version_option(package_name="spatialmech", prog_name="spatialmech")  # read on --version only
 @click.option("--debug", is_flag=True,
               help=f"On a bug (exit code 3) print its traceback, as {DEBUG_ENV}=1 does.")
 def cli(debug):
@@ -301,8 +300,11 @@ cli.add_command(stiffness_cmd)
 
 
 def main(argv=None):  # console-script entry point
+    from ..api.threads import blas_threads  # small matrices: one BLAS thread for the whole run (issue 29)
+
     try:
-        cli.main(args=argv, prog_name="spatialmech", standalone_mode=True)
+        with blas_threads():
+            cli.main(args=argv, prog_name="spatialmech", standalone_mode=True)
     except SystemExit as e:
         if e.code not in (0, None):
             sys.exit(e.code)

@@ -9,7 +9,7 @@ import math
 import click
 import numpy as np
 
-from ..api import maps as sm_maps
+from .. import api as sm
 from ..errors import InputError
 from .common import check_output_file, emit_json, json_option, parse_number
 from .cmd_workspace import parse_at
@@ -93,7 +93,7 @@ def maps_cmd(model, over_text, at_text, index_text, plot, as_json):
     if plot_path is not None and len(over) > 2:
         raise InputError("--plot: 1 or 2 grid axes")
     indices = [s.strip() for s in index_text.split(",") if s.strip()] if index_text else None
-    result = sm_maps(model, kind=_kind(over), over=over, at=parse_at(at_text), indices=indices)
+    result = sm.maps(model, kind=_kind(over), over=over, at=parse_at(at_text), indices=indices)
     if plot_path is not None:
         from ..present.maps import write_maps_plot
 

@@ -7,7 +7,7 @@ agree to rounding; ``tests/test_compiled.py`` compares both on every ready-made 
   legs in pose coordinates) and the NumPy paths of :mod:`.tracking`, :mod:`.position`,
   :mod:`.jacobian` and :mod:`.homotopy`; it never imports the compiled package;
 - the **compiled engine**, :mod:`spatialmech.kinematics.compiled` (numba), which builds on the
-  reference's data types.
+  reference's data types; this module imports it on first use (:func:`enabled`), never at import.
 
 This module is the only place that picks one.  Callers take the closure's entry points from here
 (:func:`correct`, :func:`closure_residual`, :func:`closure_jacobian`, :func:`retract`,
@@ -38,7 +38,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..model.mechanism import Mechanism
-from . import closure, compiled, leg_platform
+from . import closure, leg_platform
 from .closure import Configuration, CorrectionResult
 
 __all__ = [
@@ -69,6 +69,19 @@ _PURE: ContextVar[bool] = ContextVar("spatialmech_pure", default=_ENV_PURE)
 _NOTED = False
 
 
+_COMPILED: list[ModuleType] = []  # the compiled package once imported (a hot path: no import statement per call)
+
+
+def _compiled() -> ModuleType:
+    """The compiled package, imported on first use (numba and the kernels: about a second), so
+    that importing spatialmech -- or a closed form -- loads none of it."""
+    if not _COMPILED:
+        from . import compiled
+
+        _COMPILED.append(compiled)
+    return _COMPILED[0]
+
+
 def enabled() -> bool:
     """True when the compiled engine runs: numba imports, ``SPATIALMECH_PURE`` was unset (or
     ``0``) when spatialmech was imported, and no :func:`python_reference` block is open.  Without
@@ -76,6 +89,7 @@ def enabled() -> bool:
     global _NOTED
     if _PURE.get():
         return False
+    compiled = _compiled()
     if not compiled.AVAILABLE:
         if not _NOTED:
             _NOTED = True
@@ -88,7 +102,7 @@ def enabled() -> bool:
 def engine() -> ModuleType | None:
     """The compiled package (:mod:`spatialmech.kinematics.compiled`) when it is in use
     (:func:`enabled`), else ``None``: the caller runs its Python reference."""
-    return compiled if enabled() else None
+    return _compiled() if enabled() else None
 
 
 @contextmanager

@@ -15,10 +15,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from ..errors import InputError
-from ..geometry.rotations import inverse_transform, log_transform, rotation_angle
+from ..geometry.rotations import inverse_transform, log_transform, rotation_angle, rotation_class
 from ..geometry.tolerances import Tolerances
 from ..geometry.tolerances import resolve as resolve_tolerances
 from ..model.mechanism import Mechanism, Pose
@@ -285,7 +284,7 @@ def limb_gauss_newton(chain, D, q, lin, L, tol=1e-12, max_iter=60, hold=None):
         q_new = q + dq
         for k, _, A in chain.balls:
             sl = slice(k, k + 3)
-            q_new[sl] = A.T @ (Rotation.from_rotvec(A @ dq[sl]) * Rotation.from_rotvec(A @ q[sl])).as_rotvec()
+            q_new[sl] = A.T @ (rotation_class().from_rotvec(A @ dq[sl]) * rotation_class().from_rotvec(A @ q[sl])).as_rotvec()
         q = q_new
     return q, rn, rn < tol
 
@@ -343,7 +342,7 @@ def solution_form(mech: Mechanism, li: int) -> SolutionForm:
 def _serial_rotation(A: np.ndarray, q: np.ndarray) -> np.ndarray:
     Rm = np.eye(3)
     for j in range(3):
-        Rm = Rm @ Rotation.from_rotvec(A[:, j] * q[j]).as_matrix()
+        Rm = Rm @ rotation_class().from_rotvec(A[:, j] * q[j]).as_matrix()
     return Rm
 
 
@@ -362,7 +361,7 @@ def solution_key(form: SolutionForm, q) -> np.ndarray:
     a = q[form.angles]
     parts = [np.cos(a), np.sin(a), q[form.exact] * form.exact_scale]
     for k, A in form.balls:
-        parts.append(Rotation.from_rotvec(A @ q[k : k + 3]).as_matrix().ravel() / np.sqrt(2.0))
+        parts.append(rotation_class().from_rotvec(A @ q[k : k + 3]).as_matrix().ravel() / np.sqrt(2.0))
     for k, A in form.serial_balls:
         parts.append(_serial_rotation(A, q[k : k + 3]).ravel() / np.sqrt(2.0))
     return np.concatenate(parts)
@@ -374,7 +373,7 @@ def _difference(form: SolutionForm, q: np.ndarray, q_to: np.ndarray) -> np.ndarr
     d = q_to - q
     d[form.wrap] = (d[form.wrap] + np.pi) % (2 * np.pi) - np.pi
     for k, A in form.balls:
-        rel = Rotation.from_rotvec(A @ q_to[k : k + 3]) * Rotation.from_rotvec(A @ q[k : k + 3]).inv()
+        rel = rotation_class().from_rotvec(A @ q_to[k : k + 3]) * rotation_class().from_rotvec(A @ q[k : k + 3]).inv()
         d[k : k + 3] = A.T @ rel.as_rotvec()
     return d
 
@@ -411,7 +410,7 @@ def _joins(form: SolutionForm, q_from: np.ndarray, q_to: np.ndarray, t: Toleranc
         q_new = q + dq
         for k, A in form.balls:
             sl = slice(k, k + 3)
-            q_new[sl] = A.T @ (Rotation.from_rotvec(A @ dq[sl]) * Rotation.from_rotvec(A @ q[sl])).as_rotvec()
+            q_new[sl] = A.T @ (rotation_class().from_rotvec(A @ dq[sl]) * rotation_class().from_rotvec(A @ q[sl])).as_rotvec()
         q, _, ok = limb_gauss_newton(ch, T, q_new, form.lin, L, tol=t.closure)
         if not ok:
             return False

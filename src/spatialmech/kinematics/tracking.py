@@ -26,10 +26,9 @@ from dataclasses import dataclass, field
 from typing import Protocol
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from ..errors import ConvergenceError, InputError
-from ..geometry.rotations import inverse_transform, log_transform
+from ..geometry.rotations import inverse_transform, log_transform, rotation_class
 from ..geometry.tolerances import current as current_tolerances
 from ..model.mechanism import Mechanism
 from ..results import EventKind, Progress, TrackStatus
@@ -515,7 +514,7 @@ class _MechanismBase:
         dq_all = b.q - a.q
         for i, A in ball_groups(self.mech):  # relative rotation of each S joint
             sl = slice(i, i + 3)
-            rel = Rotation.from_rotvec(A @ b.q[sl]) * Rotation.from_rotvec(A @ a.q[sl]).inv()
+            rel = rotation_class().from_rotvec(A @ b.q[sl]) * rotation_class().from_rotvec(A @ a.q[sl]).inv()
             dq_all[sl] = A.T @ rel.as_rotvec()
         dq = dq_all[self.active]
         rot = self.kinds != "P"

@@ -2,7 +2,14 @@
 
 from .joints import JOINT_TYPES, C, Freedom, H, Joint, P, R, S, Sm, U, make_joint
 from .mechanism import Limb, Mechanism, Mode, Pose
-from .schema import ModelFileError, dump, dumps, load, loads
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from .schema import ModelFileError, dump, dumps, load, loads
+
+#: The TOML file format (:mod:`.schema`, built on pydantic: a third of a second to import) loads on
+#: first use (PEP 562): the model types above do not need it.
+_SCHEMA = ("ModelFileError", "dump", "dumps", "load", "loads")
 
 __all__ = [
     "JOINT_TYPES",
@@ -26,3 +33,15 @@ __all__ = [
     "loads",
     "make_joint",
 ]
+
+
+def __getattr__(name: str):
+    if name in _SCHEMA:
+        from . import schema
+
+        return getattr(schema, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *_SCHEMA})

@@ -36,9 +36,9 @@ from dataclasses import dataclass
 from itertools import combinations
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from ..errors import ConvergenceError, InputError
+from ..geometry.rotations import rotation_class
 from .tasks import TaskPositions
 
 __all__ = [
@@ -71,7 +71,7 @@ def _rotations(task_or_C) -> np.ndarray:
         C = np.asarray(task_or_C, dtype=float)
     if C.shape != (3, 3, 3):
         raise InputError(f"C: expected three relative rotations (3, 3, 3), got {C.shape}")
-    ang = np.linalg.norm(Rotation.from_matrix(C).as_rotvec(), axis=-1)
+    ang = np.linalg.norm(rotation_class().from_matrix(C).as_rotvec(), axis=-1)
     for j in range(3):
         if ang[j] < 1e-9:
             raise InputError(
@@ -79,7 +79,7 @@ def _rotations(task_or_C) -> np.ndarray:
                 " problem is degenerate (every direction is a solution)"
             )
     for j, k in combinations(range(3), 2):
-        if np.linalg.norm(Rotation.from_matrix(C[k] @ C[j].T).as_rotvec()) < 1e-9:
+        if np.linalg.norm(rotation_class().from_matrix(C[k] @ C[j].T).as_rotvec()) < 1e-9:
             raise InputError(
                 f"positions[{k + 1}]: same orientation as positions[{j + 1}]: the spherical"
                 " Burmester problem is degenerate"
@@ -189,7 +189,7 @@ def circle_point(task_or_C, v) -> np.ndarray:
 
 
 def _axis(R: np.ndarray) -> np.ndarray:
-    rv = Rotation.from_matrix(R).as_rotvec()
+    rv = rotation_class().from_matrix(R).as_rotvec()
     return rv / np.linalg.norm(rv)
 
 
@@ -207,7 +207,7 @@ def poles(task: TaskPositions) -> dict[str, dict[str, list[float]]]:
         out[f"P{i + 1}{k + 1}"] = {
             "center": _axis(task.R[k] @ task.R[i].T).tolist(),
             "circle": _axis(C[k].T @ C[i]).tolist(),
-            "angle_deg": float(np.degrees(np.linalg.norm(Rotation.from_matrix(task.R[k] @ task.R[i].T).as_rotvec()))),
+            "angle_deg": float(np.degrees(np.linalg.norm(rotation_class().from_matrix(task.R[k] @ task.R[i].T).as_rotvec()))),
         }
     return out
 

@@ -53,6 +53,7 @@ Example (paper A table 9)::
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -63,7 +64,6 @@ from ..errors import InputError
 from ..geometry.rotations import inverse_transform, rotation_angle, transform
 from ..geometry.validate import as_finite_array, as_unit_vector
 from ..kinematics import backend
-from ..kinematics.compiled.jit import njit
 from ..kinematics.tracking import EuclideanProblem, conventional_sense, correct_on_hyperplane, track
 from ..model.mechanism import Pose
 from ..results import BranchEnd
@@ -195,10 +195,10 @@ def _link_vectors(x: np.ndarray, D: np.ndarray):
     return d, s_all
 
 
-@njit(cache=True)
-def _dyad_system(x, D, want_J, r, J):
+def _dyad_system_py(x, D, want_J, r, J):
     """:func:`dyad_residual` (into ``r``) and, when ``want_J``, :func:`dyad_jacobian` (into
-    ``J``, which must be zero) of one dyad ``x`` (15,), compiled: the same sums in the same order."""
+    ``J``, which must be zero) of one dyad ``x`` (15,), compiled by :func:`_dyad_system` on first
+    use: the same sums in the same order."""
     B1, M1, u = x[0:3], x[3:6], x[6:9]
     d = np.empty((7, 3))
     s_all = np.zeros(7)
@@ -241,6 +241,15 @@ def _dyad_system(x, D, want_J, r, J):
         J[13, 6 + b] = 2 * u[b]
 
 
+@functools.cache
+def _dyad_system():
+    """:func:`_dyad_system_py` compiled (numba, ``cache=True``), on first use: importing this
+    module loads no numba.  Called only where :func:`_one_dyad` (the compiled engine is on)."""
+    from ..kinematics.compiled.jit import njit
+
+    return njit(cache=True)(_dyad_system_py)
+
+
 def _one_dyad(x, D) -> bool:
     """True when the compiled single-dyad kernel serves this call."""
     return backend.enabled() and x.shape == (_NX,) and D.shape == (N_POSITIONS, 4, 4)
@@ -258,7 +267,7 @@ def dyad_residual(x, D) -> np.ndarray:
     D = np.asarray(D, dtype=float)
     if _one_dyad(x, D):
         r = np.empty(_NF)
-        _dyad_system(x, D, False, r, np.empty((0, 0)))
+        _dyad_system()(x, D, False, r, np.empty((0, 0)))
         return r
     d, _ = _link_vectors(x, D)
     u = x[..., 6:9]
@@ -275,7 +284,7 @@ def dyad_jacobian(x, D) -> np.ndarray:
     D = np.asarray(D, dtype=float)
     if _one_dyad(x, D):
         J1 = np.zeros((_NF, _NX))
-        _dyad_system(x, D, True, np.empty(_NF), J1)
+        _dyad_system()(x, D, True, np.empty(_NF), J1)
         return J1
     d, s_all = _link_vectors(x, D)
     u = x[..., 6:9]

@@ -7,7 +7,6 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import minimize
 
 from ...errors import InputError, SearchTooLargeError
 from ...geometry.rotations import euler_matrix
@@ -310,6 +309,8 @@ def _polish(ev: _Evaluator, checker: PoseChecker, x0: np.ndarray, k: int, sign: 
 
     def cons(x):
         return (ev.margins(x[None])[0] / scales)
+
+    from scipy.optimize import minimize  # on first use: scipy.optimize (it loads scipy.spatial) is costly
 
     try:
         res = minimize(lambda x: -sign * x[k], x0, method="SLSQP", bounds=bounds,

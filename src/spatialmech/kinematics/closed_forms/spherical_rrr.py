@@ -49,10 +49,9 @@ import warnings
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from ...errors import InputError
-from ...geometry.rotations import euler_matrix, matrix_euler
+from ...geometry.rotations import euler_matrix, matrix_euler, rotation_class
 from ...geometry.validate import as_finite_array
 
 __all__ = [
@@ -326,7 +325,7 @@ def _newton(R, theta, tol, max_iter):
         nrm = np.linalg.norm(dw, axis=-1, keepdims=True)
         dw = dw * np.minimum(1.0, 0.5 / np.maximum(nrm, 1e-300))
         dw = np.where((res < tol)[..., None], 0.0, dw)
-        R = Rotation.from_rotvec(dw.reshape(-1, 3)).as_matrix().reshape((*dw.shape, 3)) @ R
+        R = rotation_class().from_rotvec(dw.reshape(-1, 3)).as_matrix().reshape((*dw.shape, 3)) @ R
     return R, res, its
 
 

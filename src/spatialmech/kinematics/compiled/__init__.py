@@ -6,7 +6,9 @@ the kernels are plain-array ``@njit(cache=True)`` functions in :mod:`.kernels_se
 :mod:`.kernels_closure`, :mod:`.kernels_blocks`, :mod:`.kernels_drivers`, :mod:`.kernels_legs`
 (with its entry :mod:`.legs`: six S-P-S legs in pose coordinates), :mod:`.kernels_homotopy` (the
 Study formulation's parameter homotopy) and :mod:`.kernels_loops` (the loop formulation's square
-system), :mod:`.kernels_ik` (one limb's inverse position); :mod:`.jit` is numba's ``njit`` or its stand-in.
+system), :mod:`.kernels_ik` (one limb's inverse position),
+:mod:`.kernels_four_sps_cu` (the 4-SPS/CU closed-form leg lengths); :mod:`.jit` is numba's ``njit`` or its
+stand-in.
 
 Callers do not choose between this package and the Python reference themselves:
 :mod:`spatialmech.kinematics.backend` does (``backend.engine()`` is this package when it is in
@@ -39,6 +41,7 @@ from .engine import (
     warm_up,
 )
 from .jit import AVAILABLE, UNAVAILABLE_REASON
+from .kernels_four_sps_cu import four_sps_cu_legs
 from .kernels_homotopy import track_parameter
 from .kernels_ik import ik_pack, ik_track
 from .kernels_loops import pack as pack_loop_system
@@ -63,6 +66,7 @@ __all__ = [
     "correct_on_hyperplane",
     "driver_determinants",
     "driver_determinants_many",
+    "four_sps_cu_legs",
     "ik_pack",
     "ik_track",
     "limb_gn",
