@@ -50,7 +50,7 @@ def test_ik_headline_reflects_a_failed_task_solve():
     r = sm.ik("three-prs", ([0, 0, 0.791], ("ZYX", 0, 70.19, -76.37)), degrees=True, free=["x", "y", "a1"])
     assert r.task is not None and not r.task.converged and not r.reachable
     d = r.to_dict()
-    assert d["reachable"] is False and 0.0 <= d["task"]["continuation_s"] < 1.0
+    assert d["reachable"] is False and 0.0 <= d["task"]["continuation_fraction"] < 1.0
     out = run("ik", "three-prs", "--pose", FAR_PRS, "--free", "x,y,a1")
     assert out.exit_code == 0, out.output
     head = out.output.splitlines()[0]
@@ -79,7 +79,7 @@ def test_fk_far_assembly_modes_found_by_ik_through_continuation():
     assert continued >= 2
     out = run("ik", "three-upu", "--xyz", "0.0336", "-0.0856", "-0.5516", "--free", "a1,a2,a3", "--json")
     d = json.loads(out.output)
-    assert d["reachable"] and d["task"]["continuation_s"] == 1.0
+    assert d["reachable"] and d["task"]["continuation_fraction"] == 1.0
 
 
 # ------------------------------------------------------------------ (d) plausibility

@@ -310,7 +310,7 @@ def task_solution_dict(sol: TaskSolution) -> dict:
     values (``values_len``: x, y, z in the model's length unit; ``values_deg``: a1, a2, a3)."""
     return {"given": list(sol.given), "solved": list(sol.solved), "euler": sol.task.euler,
             "converged": bool(sol.converged), "status": str(sol.status), "residual": float(sol.residual),
-            "continuation_s": None if sol.continuation is None else float(sol.continuation),
+            "continuation_fraction": None if sol.continuation is None else float(sol.continuation),
             "values_len": {n: float(sol.values[n]) for n in TASK_NAMES[:3]},
             "values_deg": {n: float(np.degrees(sol.values[n])) for n in TASK_NAMES[3:]}}
 
