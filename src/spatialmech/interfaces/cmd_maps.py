@@ -58,6 +58,19 @@ def parse_grid(over_text: str, plot, suffixes: tuple[str, ...]):
     return over, plot_path
 
 
+def emit_map(command: str, result, plot_path, as_json: bool, text) -> None:
+    """Print a map over a grid of poses: its JSON (with the figure's path as ``plot``), or
+    ``text()`` and the figure's path."""
+    if as_json:
+        doc = result.to_dict()
+        doc["plot"] = None if plot_path is None else str(plot_path)
+        emit_json(command, result.mechanism, doc, length_unit=result.length_unit)
+        return
+    click.echo(text())
+    if plot_path is not None:
+        click.echo(f"  figure: {plot_path}")
+
+
 def _fmt(v: float) -> str:
     return "-" if not math.isfinite(v) else f"{v:.4g}"
 
@@ -106,12 +119,5 @@ def maps_cmd(model, over_text, at_text, index_text, plot, as_json):
         from ..present.maps import write_maps_plot
 
         write_maps_plot(result, plot_path)
-    if as_json:
-        doc = result.to_dict()
-        doc["plot"] = None if plot_path is None else str(plot_path)
-        emit_json("maps", result.mechanism, doc, length_unit=result.length_unit)
-        return
-    click.echo(_text(result))
-    if plot_path is not None:
-        click.echo(f"  figure: {plot_path}")
+    emit_map("maps", result, plot_path, as_json, lambda: _text(result))
 

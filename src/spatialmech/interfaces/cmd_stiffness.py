@@ -10,7 +10,7 @@ import numpy as np
 from .. import api as sm
 from ..errors import InputError
 from .cmd_kinematics import resolve_pose, with_pose
-from .cmd_maps import over_kind, parse_grid
+from .cmd_maps import emit_map, over_kind, parse_grid
 from .cmd_workspace import parse_at
 from .common import emit_json, json_option, parse_number, tol_option
 
@@ -154,11 +154,4 @@ def stiffness_cmd(model, xyz, euler, position, drivers, k_text, kc_text, over_te
         from ..present.stiffness import write_stiffness_plot
 
         write_stiffness_plot(m, plot_path)
-    if as_json:
-        doc = m.to_dict()
-        doc["plot"] = None if plot_path is None else str(plot_path)
-        emit_json("stiffness", m.mechanism, doc, length_unit=m.length_unit)
-        return
-    click.echo("\n".join(_map_text(m)))
-    if plot_path is not None:
-        click.echo(f"  figure: {plot_path}")
+    emit_map("stiffness", m, plot_path, as_json, lambda: "\n".join(_map_text(m)))
