@@ -105,6 +105,20 @@ def check_names(value, name: str) -> list[str] | None:
     return list(value) or None
 
 
+def check_grid(over, at, limits) -> None:
+    """The grid of a map over poses: ``over`` a mapping of coordinate -> ``(lo, hi, n)`` or
+    values, ``at`` ``None`` or a mapping of coordinate -> value, ``limits`` ``None`` or a
+    :class:`~spatialmech.analysis.workspace.WorkspaceLimits`."""
+    from ..analysis.workspace import WorkspaceLimits
+
+    if not isinstance(over, Mapping):
+        raise TypeError(f"over: expected a mapping of coordinate -> (lo, hi, n) or values, got {describe(over)}")
+    if at is not None and not isinstance(at, Mapping):
+        raise TypeError(f"at: expected a mapping of coordinate -> value (SI, rad), got {describe(at)}")
+    if limits is not None and not isinstance(limits, WorkspaceLimits):
+        raise TypeError(f"limits: expected a WorkspaceLimits, got {describe(limits)}")
+
+
 def optional_progress(progress) -> Progress | None:
     """``None`` or a progress callback of the one signature (:func:`~spatialmech.results.check_progress`)."""
     return None if progress is None else check_progress(progress)

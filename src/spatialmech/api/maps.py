@@ -6,8 +6,8 @@ from collections.abc import Mapping
 
 from ..analysis.maps import INDICES, MapResult, performance_map
 from ..analysis.workspace import WorkspaceLimits
-from ..errors import InputError, describe
-from .checks import ModelLike, as_mechanism, check_choice, check_names
+from ..errors import InputError
+from .checks import ModelLike, as_mechanism, check_choice, check_grid, check_names
 from .threads import one_blas_thread
 
 __all__ = ["MapResult", "maps"]
@@ -67,12 +67,7 @@ def maps(model: ModelLike, *, kind: str = "position", over: Mapping, at: Mapping
     mech = as_mechanism(model)
     kind = check_choice(kind, "kind", ("position", "orientation"))
     method = check_choice(method, "method", ("auto", "loop", "batched"))
-    if not isinstance(over, Mapping):
-        raise TypeError(f"over: expected a mapping of coordinate -> (lo, hi, n) or values, got {describe(over)}")
-    if at is not None and not isinstance(at, Mapping):
-        raise TypeError(f"at: expected a mapping of coordinate -> value (SI, rad), got {describe(at)}")
-    if limits is not None and not isinstance(limits, WorkspaceLimits):
-        raise TypeError(f"limits: expected a WorkspaceLimits, got {describe(limits)}")
+    check_grid(over, at, limits)
     names = check_names(indices, "indices")
     if names is not None:
         for n in names:

@@ -21,7 +21,7 @@ from ..kinematics.closure import Configuration
 from ..kinematics.position import PoseFit, platform_pose
 from ..model.mechanism import Mechanism, Pose
 from ..serialize import pose_dict
-from .checks import ModelLike, as_configuration, as_mechanism, as_pose, check_bool, check_choice, check_names
+from .checks import ModelLike, as_configuration, as_mechanism, as_pose, check_bool, check_choice, check_grid, check_names
 from .threads import one_blas_thread
 
 __all__ = ["StiffnessMap", "StiffnessResult", "stiffness", "stiffness_map"]
@@ -236,12 +236,7 @@ def stiffness_map(model: ModelLike, *, over: Mapping, at: Mapping[str, float] | 
     mech = as_mechanism(model)
     kind = check_choice(kind, "kind", ("position", "orientation"))
     drivers = check_names(drivers, "drivers")
-    if not isinstance(over, Mapping):
-        raise TypeError(f"over: expected a mapping of coordinate -> (lo, hi, n) or values, got {describe(over)}")
-    if at is not None and not isinstance(at, Mapping):
-        raise TypeError(f"at: expected a mapping of coordinate -> value (SI, rad), got {describe(at)}")
-    if limits is not None and not isinstance(limits, WorkspaceLimits):
-        raise TypeError(f"limits: expected a WorkspaceLimits, got {describe(limits)}")
+    check_grid(over, at, limits)
     mech = with_stiffness(mech, actuators=None if actuator_stiffness is None else _plain(actuator_stiffness),
                           constraints=None if constraint_stiffness is None else _plain(constraint_stiffness))
     return _stiffness_map(mech, kind=kind, over=over, at=at, limits=limits, drivers=drivers)

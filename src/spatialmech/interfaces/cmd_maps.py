@@ -39,12 +39,36 @@ def parse_over(text: str) -> dict[str, np.ndarray]:
     return out
 
 
-def _kind(over: dict) -> str:
+def over_kind(over: dict) -> str:
+    """The ``kind`` of a map over the grid axes ``over``: ``"position"`` or ``"orientation"``."""
     if all(n in _POSITION for n in over):
         return "position"
     if all(n in _ANGLES for n in over):
         return "orientation"
     raise InputError("--over: either position coordinates (x, y, z) or angles (alpha, beta, gamma), not both")
+
+
+def parse_grid(over_text: str, plot, suffixes: tuple[str, ...]):
+    """``--over`` and ``--plot`` of a map over a grid of poses: ``(over, plot file or None)``; a
+    figure takes 1 or 2 grid axes."""
+    plot_path = check_output_file(plot, "--plot", suffixes=suffixes)
+    over = parse_over(over_text)
+    if plot_path is not None and len(over) > 2:
+        raise InputError("--plot: 1 or 2 grid axes")
+    return over, plot_path
+
+
+def emit_map(command: str, result, plot_path, as_json: bool, text) -> None:
+    """Print a map over a grid of poses: its JSON (with the figure's path as ``plot``), or
+    ``text()`` and the figure's path."""
+    if as_json:
+        doc = result.to_dict()
+        doc["plot"] = None if plot_path is None else str(plot_path)
+        emit_json(command, result.mechanism, doc, length_unit=result.length_unit)
+        return
+    click.echo(text())
+    if plot_path is not None:
+        click.echo(f"  figure: {plot_path}")
 
 
 def _fmt(v: float) -> str:
@@ -88,22 +112,12 @@ def maps_cmd(model, over_text, at_text, index_text, plot, as_json):
       spatialmech maps stewart-6sps --over x:-0.1:0.1:41,y:-0.1:0.1:41 --plot stewart.png
       spatialmech maps four-sps-cu --over alpha:-30:30:31,beta:-30:30:31 --at z=0.12 --index sigma_min,lti --json
     """
-    plot_path = check_output_file(plot, "--plot", suffixes=(".png", ".pdf", ".svg", ".html"))
-    over = parse_over(over_text)
-    if plot_path is not None and len(over) > 2:
-        raise InputError("--plot: 1 or 2 grid axes")
+    over, plot_path = parse_grid(over_text, plot, (".png", ".pdf", ".svg", ".html"))
     indices = [s.strip() for s in index_text.split(",") if s.strip()] if index_text else None
-    result = sm.maps(model, kind=_kind(over), over=over, at=parse_at(at_text), indices=indices)
+    result = sm.maps(model, kind=over_kind(over), over=over, at=parse_at(at_text), indices=indices)
     if plot_path is not None:
         from ..present.maps import write_maps_plot
 
         write_maps_plot(result, plot_path)
-    if as_json:
-        doc = result.to_dict()
-        doc["plot"] = None if plot_path is None else str(plot_path)
-        emit_json("maps", result.mechanism, doc, length_unit=result.length_unit)
-        return
-    click.echo(_text(result))
-    if plot_path is not None:
-        click.echo(f"  figure: {plot_path}")
+    emit_map("maps", result, plot_path, as_json, lambda: _text(result))
 

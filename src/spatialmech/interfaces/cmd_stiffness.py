@@ -10,9 +10,9 @@ import numpy as np
 from .. import api as sm
 from ..errors import InputError
 from .cmd_kinematics import resolve_pose, with_pose
-from .cmd_maps import parse_over
+from .cmd_maps import emit_map, over_kind, parse_grid
 from .cmd_workspace import parse_at
-from .common import check_output_file, emit_json, json_option, parse_number, tol_option
+from .common import emit_json, json_option, parse_number, tol_option
 
 
 def parse_stiffness(text: str | None, option: str):
@@ -28,14 +28,6 @@ def parse_stiffness(text: str | None, option: str):
         k, v = (s.strip() for s in part.split("=", 1))
         out[k] = parse_number(v, option, k)
     return out
-
-
-def _kind(over: dict) -> str:
-    if all(n in ("x", "y", "z") for n in over):
-        return "position"
-    if all(n in ("alpha", "beta", "gamma") for n in over):
-        return "orientation"
-    raise InputError("--over: either position coordinates (x, y, z) or angles (alpha, beta, gamma), not both")
 
 
 def _vec(v, fmt: str = ".4g") -> str:
@@ -155,21 +147,11 @@ def stiffness_cmd(model, xyz, euler, position, drivers, k_text, kc_text, over_te
         return
     if given:
         raise InputError("--over: give the fixed coordinates with --at, not a pose")
-    plot_path = check_output_file(plot, "--plot", suffixes=(".png", ".pdf", ".svg"))
-    over = parse_over(over_text)
-    if plot_path is not None and len(over) > 2:
-        raise InputError("--plot: 1 or 2 grid axes")
-    m = sm.stiffness_map(model, over=over, at=parse_at(at_text), kind=_kind(over), drivers=list(drivers) or None,
+    over, plot_path = parse_grid(over_text, plot, (".png", ".pdf", ".svg"))
+    m = sm.stiffness_map(model, over=over, at=parse_at(at_text), kind=over_kind(over), drivers=list(drivers) or None,
                          actuator_stiffness=k, constraint_stiffness=kc)
     if plot_path is not None:
         from ..present.stiffness import write_stiffness_plot
 
         write_stiffness_plot(m, plot_path)
-    if as_json:
-        doc = m.to_dict()
-        doc["plot"] = None if plot_path is None else str(plot_path)
-        emit_json("stiffness", m.mechanism, doc, length_unit=m.length_unit)
-        return
-    click.echo("\n".join(_map_text(m)))
-    if plot_path is not None:
-        click.echo(f"  figure: {plot_path}")
+    emit_map("stiffness", m, plot_path, as_json, lambda: "\n".join(_map_text(m)))

@@ -9,7 +9,7 @@ import numpy as np
 from ...geometry.tolerances import HOMOTOPY_JUMP, HOMOTOPY_NEWTON
 from .jit import njit
 
-__all__ = ["nb_lu_solve", "nb_param_system", "nb_param_vel", "nb_track_param", "track_parameter"]
+__all__ = ["nb_lu_solve", "nb_param_system", "nb_param_vel", "nb_step_control", "nb_track_param", "track_parameter"]
 
 
 @njit(cache=True)
@@ -82,6 +82,24 @@ def nb_param_vel(Q0, dQ, c, x, t, F, J, Ht, out):
 
 
 @njit(cache=True)
+def nb_step_control(ok, d0, d1, jump, newton, h, good):
+    """The trackers' acceptance test of a step (the step ``ok``, both Newton corrections ``d0``,
+    ``d1`` finite, the first below ``jump``, the second contracting or below ``newton``) and
+    their step control: the step ``h`` doubles after two accepted steps in a row (``good`` counts
+    them) and halves on a rejected one.  Returns ``(accepted, h, good)``."""
+    acc = ok and np.isfinite(d0) and np.isfinite(d1) and d0 < jump and (d1 < 0.1 * d0 or d1 < newton)
+    if acc:
+        good += 1
+        if good >= 2:
+            h *= 2.0
+            good = 0
+    else:
+        h *= 0.5
+        good = 0
+    return acc, h, good
+
+
+@njit(cache=True)
 def nb_track_param(Q0, dQ, c, X0, h0, hmin, max_steps, jump, newton, X, T, done):
     """:func:`track` of the parameter homotopy, path by path (compiled): the same RK4 predictor,
     two Newton corrections, acceptance test and step control."""
@@ -144,23 +162,16 @@ def nb_track_param(Q0, dQ, c, X0, h0, hmin, max_steps, jump, newton, X, T, done)
                         s1 += abs(dx[i]) ** 2
                         xc[i] -= dx[i]
                     d1 = np.sqrt(s1) / nx
-            acc = ok and np.isfinite(d0) and np.isfinite(d1) and d0 < jump and (d1 < 0.1 * d0 or d1 < newton)
+            acc, h, good = nb_step_control(ok, d0, d1, jump, newton, h, good)
             if acc:
                 for i in range(n):
                     x[i] = xc[i]
                 t = tn
-                good += 1
-                if good >= 2:
-                    h *= 2.0
-                    good = 0
                 if t >= 1.0:
                     fin = True
                     break
-            else:
-                h *= 0.5
-                good = 0
-                if h < hmin:
-                    break
+            elif h < hmin:
+                break
         T[p] = t
         done[p] = fin
 

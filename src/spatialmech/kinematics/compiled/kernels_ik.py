@@ -20,19 +20,10 @@ import numpy as np
 
 from ...geometry.tolerances import HOMOTOPY_JUMP, HOMOTOPY_NEWTON
 from .jit import njit
-from .kernels_homotopy import nb_lu_solve
+from .kernels_homotopy import nb_lu_solve, nb_step_control
+from .kernels_se3 import nb_mm4c
 
 __all__ = ["ik_pack", "ik_track", "nb_ik_system", "nb_ik_track"]
-
-
-@njit(cache=True)
-def _mm4(A, B, out):
-    for i in range(4):
-        for j in range(4):
-            acc = 0j
-            for k in range(4):
-                acc += A[i, k] * B[k, j]
-            out[i, j] = acc
 
 
 @njit(cache=True)
@@ -54,13 +45,13 @@ def _chain(th, kinds, A, A2, idx, sg, T, dT, pre, suf, Ms, tmp):
             for a in range(4):
                 for b in range(4):
                     Ms[i, a, b] = (1.0 if a == b else 0.0) + sg * v * A[i, a, b]
-        _mm4(pre[i], Ms[i], pre[i + 1])
+        nb_mm4c(pre[i], Ms[i], pre[i + 1])
     for i in range(m - 1, -1, -1):
-        _mm4(Ms[i], suf[i + 1], suf[i])
+        nb_mm4c(Ms[i], suf[i + 1], suf[i])
     T[:, :] = pre[m]
     for i in range(m):
-        _mm4(pre[i], A[i], tmp)
-        _mm4(tmp, suf[i], dT[idx[i]])
+        nb_mm4c(pre[i], A[i], tmp)
+        nb_mm4c(tmp, suf[i], dT[idx[i]])
         for a in range(4):
             for b in range(4):
                 dT[idx[i], a, b] *= sg
@@ -286,22 +277,16 @@ def nb_ik_track(X0, P0s, P1s, lk, lA, lA2, li, rk, rA, rA2, ri, point, centre, C
         for _ in range(max_steps):
             hh = min(h, 1.0 - t)
             ok, d0, d1 = _step(x, P0s[p], dP, t, hh, sysargs, F, J, Ft, Pt, ws, ks, xs, xc, dx)
-            if ok and np.isfinite(d0) and np.isfinite(d1) and d0 < jump and (d1 < 0.1 * d0 or d1 < newton):
+            acc, h, good = nb_step_control(ok, d0, d1, jump, newton, h, good)
+            if acc:
                 x[:] = xc
                 t += hh
                 steps[p] += 1
-                good += 1
-                if good >= 2:
-                    h *= 2.0
-                    good = 0
                 if t >= 1.0:
                     done[p] = True
                     break
-            else:
-                h *= 0.5
-                good = 0
-                if h < hmin:
-                    break
+            elif h < hmin:
+                break
         T[p] = t
 
 

@@ -16,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from .jit import njit
+from .kernels_se3 import nb_mm4c
 
 __all__ = ["pack", "square_batch"]
 
@@ -76,17 +77,6 @@ def pack(sysm, study_q: np.ndarray) -> tuple:
 
 
 @njit(cache=True)
-def _mm4c(A, B, out):
-    """``out = A B`` for complex 4x4 matrices (``out`` must not be ``A`` or ``B``)."""
-    for a in range(4):
-        for b in range(4):
-            acc = 0.0j
-            for e in range(4):
-                acc += A[a, e] * B[e, b]
-            out[a, b] = acc
-
-
-@njit(cache=True)
 def _chain(kind, sign, i0, i1, A, A2, lo, hi, z, T, dT, nzd):
     for a in range(4):
         for b in range(4):
@@ -108,7 +98,7 @@ def _chain(kind, sign, i0, i1, A, A2, lo, hi, z, T, dT, nzd):
                 for b in range(4):
                     M[a, b] = (1.0 if a == b else 0.0) + sg * d * A[f, a, b]
         for k in range(nzd):  # dT <- dT M
-            _mm4c(dT[k], M, tmp)
+            nb_mm4c(dT[k], M, tmp)
             dT[k] = tmp
         for a in range(4 if nzd > 0 else 0):  # + T dM
             for b in range(4):
@@ -125,14 +115,14 @@ def _chain(kind, sign, i0, i1, A, A2, lo, hi, z, T, dT, nzd):
                     for e in range(4):
                         acc += T[a, e] * A[f, e, b]
                     dT[i0[f], a, b] += sg * acc
-        _mm4c(T, M, tmp)
+        nb_mm4c(T, M, tmp)
         T[:] = tmp
 
 
 @njit(cache=True)
 def _mul_hub(H, dH, T, dT, out, dout, nzd):
     """``out = H T`` and ``dout = dH T + H dT`` (4x4, with ``nzd`` derivatives)."""
-    _mm4c(H, T, out)
+    nb_mm4c(H, T, out)
     for v in range(nzd):
         for a in range(4):
             for b in range(4):

@@ -26,6 +26,7 @@ __all__ = [
     "nb_minnorm_qr",
     "nb_mm",
     "nb_mm4",
+    "nb_mm4c",
     "nb_mv",
     "nb_orthonormal",
     "nb_quat_rotvec",
@@ -237,6 +238,17 @@ def nb_mm4(A, B, out):
     for i in range(4):
         for j in range(4):
             out[i, j] = A[i, 0] * B[0, j] + A[i, 1] * B[1, j] + A[i, 2] * B[2, j] + A[i, 3] * B[3, j]
+
+
+@njit(cache=True)
+def nb_mm4c(A, B, out):
+    """``out = A B`` for complex 4x4 matrices (``out`` must not be ``A`` or ``B``)."""
+    for a in range(4):
+        for b in range(4):
+            acc = 0.0j
+            for e in range(4):
+                acc += A[a, e] * B[e, b]
+            out[a, b] = acc
 
 
 @njit(cache=True)

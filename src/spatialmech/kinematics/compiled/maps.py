@@ -6,7 +6,7 @@ with :func:`~spatialmech.kinematics.jacobian.complete_jacobian`; the two agree t
 (``tests/test_maps.py``).
 
 Singular values by one-sided (Hestenes) Jacobi rotations (relative accuracy, no LAPACK call per
-pose); determinants of 5x5 minors by Gaussian elimination with partial pivoting.
+pose); determinants of 5x5 minors by :func:`.kernels_se3.nb_det` (LU, partial pivoting).
 """
 
 from __future__ import annotations
@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from .jit import njit
+from .kernels_se3 import nb_det
 
 __all__ = ["N_SCALARS", "indices_many", "maps_closed", "nb_indices_many", "nb_maps_closed"]
 
@@ -64,35 +65,6 @@ def nb_singular_values(A, out):
             s += B[i, j] * B[i, j]
         out[j] = np.sqrt(s)
     out[:c] = np.sort(out[:c])[::-1]
-
-
-@njit(cache=True)
-def nb_det_small(M):
-    """Determinant of a small square matrix (copied) by Gaussian elimination, partial pivoting."""
-    A = M.copy()
-    n = A.shape[0]
-    det = 1.0
-    for c in range(n):
-        piv = c
-        big = abs(A[c, c])
-        for i in range(c + 1, n):
-            if abs(A[i, c]) > big:
-                big = abs(A[i, c])
-                piv = i
-        if big == 0.0:
-            return 0.0
-        if piv != c:
-            for j in range(n):
-                tmp = A[c, j]
-                A[c, j] = A[piv, j]
-                A[piv, j] = tmp
-            det = -det
-        det *= A[c, c]
-        for i in range(c + 1, n):
-            f = A[i, c] / A[c, c]
-            for j in range(c + 1, n):
-                A[i, j] -= f * A[c, j]
-    return det
 
 
 @njit(cache=True)
@@ -232,7 +204,7 @@ def nb_cofactor_twist(Jr, i, y):
                         minor[r2, c2] = Jr[r, c]
                         c2 += 1
                 r2 += 1
-        y[j] = (-1.0) ** j * nb_det_small(minor)
+        y[j] = (-1.0) ** j * nb_det(minor)
 
 
 @njit(cache=True)

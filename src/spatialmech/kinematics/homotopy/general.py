@@ -59,7 +59,7 @@ from ..closure import Configuration, limb_slices
 from .endgame import cauchy_endgame
 from .study import study_to_pose, track
 from .loop_system import LoopSystem, general_reason, loop_system, variables
-from .trace_test import TraceResult, new_points, trace_test
+from .trace_test import TraceResult, add_new_points, around_triangle, trace_test
 
 __all__ = [
     "GeneralResult",
@@ -281,20 +281,12 @@ def _monodromy(sysm: LoopSystem, seed: int, capped: bool) -> _GenericLoop:
         B2 = np.repeat(waypoints(k), len(known), axis=0)
         X = np.tile(known, (k, 1))
         before, n_paths = steps[0], 3 * len(X) + k
-        for leg in range(3):
-            a, b = ((P0, B1), (B1, B2), (B2, P0))[leg]
-            X, _, done = _segment(sysm, X, a, b, steps)
-            X, B1, B2 = X[done], B1[done], B2[done]  # a failed path is dropped
+        X = around_triangle(lambda Xs, a, b: _segment(sysm, Xs, a, b, steps), X, P0, B1, B2)
         xr, Pr = _start_pairs(sysm, rng, k)  # and fresh start pairs, moved to P0
         Xr, _, done = _segment(sysm, xr, Pr, P0, steps)
         per_path = (steps[0] - before) / n_paths
         X = np.vstack([X, Xr[done]])
-        new = new_points(known, X)
-        if len(new):
-            known = np.vstack([known, new])
-            stale = 0
-        else:
-            stale += k
+        known, stale = add_new_points(known, X, stale, k)
     g = _GenericLoop(P0, known, loops, time.perf_counter() - t0, stale >= MONODROMY_STALE_LOOPS)
     if not capped_out:  # a capped run is redone in full when asked without the caps
         _CACHE[key] = g

@@ -74,7 +74,7 @@ from ..closure import limb_chains, limb_slices
 from .endgame import cauchy_endgame
 from .loop_system import _rotation_forms, _twist_matrix
 from .study import track
-from .trace_test import TraceResult, new_points, trace_test
+from .trace_test import TraceResult, add_new_points, around_triangle, trace_test
 
 __all__ = [
     "LimbIK",
@@ -530,20 +530,12 @@ def _monodromy(sysm: LimbIK, rng: np.random.Generator) -> tuple[np.ndarray, np.n
         loops += k
         B1, B2 = waypoints(k), waypoints(k)
         X = np.tile(known, (k, 1))
-        for leg in range(3):
-            a, b = ((P0, B1), (B1, B2), (B2, P0))[leg]
-            X, _, done = _segment(sysm, X, a, b)
-            X, B1, B2 = X[done], B1[done], B2[done]
+        X = around_triangle(lambda Xs, a, b: _segment(sysm, Xs, a, b), X, P0, B1, B2)
         fresh = [_start_pair(sysm, rng) for _ in range(k)]
         Xr, _, done = _segment(sysm, np.array([f[0] for f in fresh]), np.array([f[1] for f in fresh]), P0)
         X = np.vstack([X, Xr[done]])
         X = X[np.all(np.isfinite(X), axis=1) & (np.linalg.norm(X, axis=1) < MONODROMY_DIVERGED)]
-        new = new_points(known, X)
-        if len(new):
-            known = np.vstack([known, new])
-            stale = 0
-        else:
-            stale += k
+        known, stale = add_new_points(known, X, stale, k)
     saturated = stale >= MONODROMY_STALE_LOOPS or bool(sysm.bound and len(known) >= sysm.bound)
     return P0, known, loops, saturated
 

@@ -40,7 +40,7 @@ from ...geometry.tolerances import MONODROMY_PARALLEL, TRACE_MAX_LOOPS, TRACE_ST
 from ...results import TraceVerdict
 from .study import track
 
-__all__ = ["TraceResult", "new_points", "trace_test"]
+__all__ = ["TraceResult", "add_new_points", "around_triangle", "new_points", "trace_test"]
 
 Curve = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]]
 
@@ -77,6 +77,27 @@ def new_points(known: np.ndarray, cand: np.ndarray, tol: float = 1e-6) -> np.nda
         if np.all(np.linalg.norm(ref - y, axis=1) / (1 + np.linalg.norm(y)) > tol):
             out.append(y)
     return np.array(out, dtype=complex).reshape(-1, known.shape[1])
+
+
+def add_new_points(known: np.ndarray, cand: np.ndarray, stale: int, k: int) -> tuple[np.ndarray, int]:
+    """A monodromy round's bookkeeping: ``known`` with the :func:`new_points` of ``cand`` appended,
+    and the count of loops without a new point, ``stale``: back to 0 when there were some, else
+    grown by the round's ``k`` loops."""
+    new = new_points(known, cand)
+    if len(new):
+        return np.vstack([known, new]), 0
+    return known, stale + k
+
+
+def around_triangle(segment: Callable, X: np.ndarray, P0: np.ndarray, B1: np.ndarray, B2: np.ndarray) -> np.ndarray:
+    """A monodromy loop: the points ``X`` carried from the parameters ``P0`` through ``B1`` and
+    ``B2`` (one row per point) back to ``P0`` by ``segment(X, a, b) -> (X, t, done)``; a path that
+    fails is dropped (with its waypoints).  Returns the points back at ``P0``."""
+    for leg in range(3):
+        a, b = ((P0, B1), (B1, B2), (B2, P0))[leg]
+        X, _, done = segment(X, a, b)
+        X, B1, B2 = X[done], B1[done], B2[done]
+    return X
 
 
 def _move_slices(curve: Curve, Y: np.ndarray, A0: np.ndarray, A1: np.ndarray):
