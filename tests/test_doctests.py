@@ -17,12 +17,13 @@ import pytest
 import spatialmech
 
 #: Modules whose examples take more than a few seconds (run by the full suite only).
-SLOW = {"spatialmech.synthesis.cs_dyads", "spatialmech.api", "spatialmech.api.kinematics",
+SLOW = {"spatialmech.synthesis.cs_dyads", "spatialmech.api", "spatialmech.api.kinematics", "spatialmech.api.spaces",
         "spatialmech.api.linkages", "spatialmech.api.outputs", "spatialmech.analysis.workspace",
         "spatialmech.synthesis"}
 
 #: Modules that must have examples (the public API page's functions, the errors, the package).
 REQUIRED = {"spatialmech", "spatialmech.api", "spatialmech.api.structure", "spatialmech.api.kinematics",
+            "spatialmech.api.spaces",
             "spatialmech.api.linkages", "spatialmech.api.outputs", "spatialmech.errors", "spatialmech.results"}
 
 

@@ -25,8 +25,8 @@ position (from 1, as ``--position N``).
 
 The functions live in modules by concept (this package re-exports them; import them from here or
 from ``spatialmech``): :mod:`~spatialmech.api.structure` (models, mobility),
-:mod:`~spatialmech.api.kinematics` (position, Jacobian, velocity, singularity, workspace,
-parasitic motion), :mod:`~spatialmech.api.forces` (statics),
+:mod:`~spatialmech.api.kinematics` (position, Jacobian, velocity), :mod:`~spatialmech.api.spaces`
+(singularity, workspace, parasitic motion), :mod:`~spatialmech.api.forces` (statics),
 :mod:`~spatialmech.api.stiffness` (stiffness), :mod:`~spatialmech.api.linkages` (tracking, defects, synthesis),
 :mod:`~spatialmech.api.outputs` (report, demo, viewer, studio session), :mod:`~spatialmech.api.exchange`
 (export, validation in MuJoCo), :mod:`~spatialmech.api.regions` (singularity slices, task grids),
@@ -64,16 +64,13 @@ if TYPE_CHECKING:  # what mypy (and a reader) sees; at run time __getattr__ impo
         FKResult,
         IKResult,
         JacobianResult,
-        SingularityAnalysis,
         VelocityResult,
         fk,
         ik,
         jacobian,
-        parasitic,
-        singularity,
         velocity,
-        workspace,
     )
+    from .spaces import SingularityAnalysis, parasitic, singularity, workspace
     from .exchange import ExportResult, export, validate
     from .linkages import CSSynthesisResult, DefectAnalysis, TraceResult, defects, dj_table, screen, synth_cs, synth_rccc, track
     from .maps import MapResult, maps
@@ -90,8 +87,9 @@ _LAZY: dict[str, str] = {
     **dict.fromkeys(("Mechanism", "Pose"), "..model.mechanism"),
     **dict.fromkeys(("ModelLike",), ".checks"),
     **dict.fromkeys(("StaticsResult", "statics"), ".forces"),
-    **dict.fromkeys(("FKResult", "IKResult", "JacobianResult", "SingularityAnalysis", "VelocityResult", "fk", "ik",
-                     "jacobian", "parasitic", "singularity", "velocity", "workspace"), ".kinematics"),
+    **dict.fromkeys(("FKResult", "IKResult", "JacobianResult", "VelocityResult", "fk", "ik", "jacobian", "velocity"),
+                    ".kinematics"),
+    **dict.fromkeys(("SingularityAnalysis", "parasitic", "singularity", "workspace"), ".spaces"),
     **dict.fromkeys(("EXPORT_FORMATS", "TASK_COORDINATES", "VALIDATION_METHODS", "VALIDATION_TOL", "VIEW_MOTIONS",
                      "WORKSPACE_COORDINATES", "WORKSPACE_MAX_POSES"), ".constants"),
     **dict.fromkeys(("ExportResult", "export", "validate"), ".exchange"),

@@ -61,9 +61,11 @@ __all__ = [
     "FK_CONDITIONING_MEASURE",
     "ForwardResult",
     "ForwardSolution",
+    "actuator_q",
     "forward_conditioning",
     "forward_position",
     "homotopy_coverage",
+    "limbs_at",
     "locked_actuators",
 ]
 
@@ -149,7 +151,7 @@ class ForwardResult:
 _COMPLETENESS_KEYS = ("complete", "completeness", "n_complex", "n_real", "n_singular", "n_at_infinity", "endpoints")
 
 
-def _actuator_q(mech: Mechanism, values) -> dict[int, float]:
+def actuator_q(mech: Mechanism, values) -> dict[int, float]:
     acts = list(mech.actuators)
     if isinstance(values, dict):
         items = {mech.freedom(k).id: float(v) for k, v in values.items()}
@@ -366,7 +368,7 @@ def forward_position(
     """
     if method not in ("multistart", "homotopy", "auto"):
         raise InputError(f"method: expected 'multistart', 'homotopy' or 'auto', got {method!r}")
-    targets = _actuator_q(mech, actuator_values)
+    targets = actuator_q(mech, actuator_values)
     why: str | None = None  # why homotopy in Study parameters does not cover the model
     gwhy: str | None = None  # why the loop formulation (homotopy/general.py) does not cover the model
     if all_solutions and method != "multistart":
@@ -445,7 +447,7 @@ def forward_position(
     return ForwardResult(tuple(sols), search)
 
 
-def _limbs_at(mech: Mechanism, D: np.ndarray, q0: np.ndarray, targets: dict[int, float], seed: int) -> Configuration:
+def limbs_at(mech: Mechanism, D: np.ndarray, q0: np.ndarray, targets: dict[int, float], seed: int) -> Configuration:
     """Every limb solved for the platform displacement ``D`` with its actuator held at its value
     (from ``q0``, then from seeded random starts: an S-P-S leg also reaches its platform point
     reversed through its base, with the opposite slide)."""
@@ -529,7 +531,7 @@ def _forward_homotopy(mech: Mechanism, targets: dict[int, float], seed: int, max
         if e.R is None or e.p is None:
             continue
         D = transform(e.R, e.p)
-        runs.append(_fk_from(mech, _limbs_at(mech, D, q0, targets, seed), targets, mask, max_iter))
+        runs.append(_fk_from(mech, limbs_at(mech, D, q0, targets, seed), targets, mask, max_iter))
         origins.append(str(e.status))
     n_endpoint_runs = len(runs)
     if hr.count(EndPointStatus.SINGULAR):

@@ -75,9 +75,9 @@ class SolutionFlags:
 def actuator_targets(mech: Mechanism, values) -> dict[int, float]:
     """The joint variables (``value - offset``) of the actuators, by freedom index (``values``
     in ``mech.actuators`` order, or a mapping by name), as forward position holds them."""
-    from .forward import _actuator_q
+    from .forward import actuator_q
 
-    return _actuator_q(mech, values)
+    return actuator_q(mech, values)
 
 
 def input_independent(mech: Mechanism, config: Configuration, targets: dict[int, float]) -> bool:
@@ -129,9 +129,9 @@ def solution_flags(mech: Mechanism, config: Configuration, targets: dict[int, fl
 def configuration_at_pose(mech: Mechanism, pose: Pose, targets: dict[int, float]) -> Configuration:
     """Every limb solved for the platform ``pose`` with the actuators held at ``targets`` (for a
     closed form, which gives the pose only)."""
-    from .forward import _limbs_at
+    from .forward import limbs_at
 
     q0 = np.zeros(len(mech.freedom_refs))
     for i, v in targets.items():
         q0[i] = v
-    return _limbs_at(mech, pose.displacement(mech.platform_point), q0, targets, 0)
+    return limbs_at(mech, pose.displacement(mech.platform_point), q0, targets, 0)

@@ -376,7 +376,7 @@ class GeneralResult:
 
 def general_forward(mech: Mechanism, targets: dict[int, float], *, seed: int = 0, capped: bool = False) -> GeneralResult:
     """Every solution found of the forward position of ``mech`` with the actuators at
-    ``targets`` (joint variables by freedom index, as ``forward._actuator_q`` gives them);
+    ``targets`` (joint variables by freedom index, as ``forward.actuator_q`` gives them);
     ``capped``: the monodromy gives up early on large systems (``saturated`` false)."""
     t0 = time.perf_counter()
     sysm = loop_system(mech)

@@ -72,7 +72,7 @@ from ...results import TraceVerdict
 from .. import backend
 from ..closure import limb_chains, limb_slices
 from .endgame import cauchy_endgame
-from .loop_system import _rotation_forms, _twist_matrix
+from .loop_system import rotation_forms, twist_matrix
 from .study import track
 from .trace_test import TraceResult, add_new_points, around_triangle, trace_test
 
@@ -181,13 +181,13 @@ class LimbIK:
         derivative in ``x`` (n, k, nx) and along ``dP`` (n, k; ``None`` without ``dP``);
         ``full``: every entry of the rotation (9) instead of the three above the diagonal."""
         q, t = P[:, :4], P[:, 4:7]
-        E = _rotation_forms(q)
+        E = rotation_forms(q)
         s = np.einsum("ni,ni->n", q, q)
         TL, dTL = self._chain(self.left, X)
         TR, dTR = self._chain(self.right, X)
         if dP is not None:
             dq, dt = dP[:, :4], dP[:, 4:7]
-            dE = 0.5 * (_rotation_forms(q + dq) - _rotation_forms(q - dq))  # exact: E is quadratic
+            dE = 0.5 * (rotation_forms(q + dq) - rotation_forms(q - dq))  # exact: E is quadratic
             ds = 2 * np.einsum("ni,ni->n", q, dq)
         if self.kind == "point":
             u, du = TL @ self.centre, dTL @ self.centre
@@ -350,7 +350,7 @@ def limb_ik_system(mech: Mechanism, li: int, seed: int = 0) -> LimbIK:
         if ball >= 0 and ball <= k < ball + 3:
             slots.append(("S", ball))
             continue
-        A = _twist_matrix(r.freedom.screw, L, r.freedom.kind == "P")
+        A = twist_matrix(r.freedom.screw, L, r.freedom.kind == "P")
         if r.freedom.kind == "P":
             slots.append(("P", nx))
             facts.append(_Factor("P", A, A @ A, (nx,), 1.0, len(facts)))
@@ -454,7 +454,7 @@ def _start_pair(sysm: LimbIK, rng: np.random.Generator, genuine: bool | None = N
         q = _crand(rng, 4)
         TL = sysm._chain(sysm.left, x[None])[0][0]
         TR = sysm._chain(sysm.right, x[None])[0][0]
-        E = _rotation_forms(q[None])[0] / (q @ q)
+        E = rotation_forms(q[None])[0] / (q @ q)
         P[:4], P[4:7] = q, (TL @ sysm.centre)[:3] - E @ (TR @ sysm.centre)[:3]
     else:
         P[:7] = _crand(rng, 7)

@@ -54,6 +54,8 @@ __all__ = [
     "LoopSystem",
     "general_reason",
     "loop_system",
+    "rotation_forms",
+    "twist_matrix",
     "variables",
 ]
 
@@ -285,7 +287,7 @@ class LoopSystem:
                 jac.append(dr[:, :, :3].reshape(n, -1, 12).transpose(0, 2, 1))
                 continue
             if le.kind == "full":  # with the offset (q, t): R_b -> R_b E(q), p_b -> p_b + R_b t
-                Eq = _rotation_forms(w_k[:, :4])
+                Eq = rotation_forms(w_k[:, :4])
                 A, dA = Tb[:, :3, :3], dTb[:, :, :3, :3]
                 B, dB = D[:, :3, :3] @ Eq, dD[:, :, :3, :3] @ Eq[:, None]
                 P = np.einsum("nai,naj->nij", A, B)
@@ -390,7 +392,7 @@ class LoopSystem:
         return p
 
 
-def _rotation_forms(q: np.ndarray) -> np.ndarray:
+def rotation_forms(q: np.ndarray) -> np.ndarray:
     """``E(q) = (q.q) R(q)`` (n, 3, 3) of quaternions ``q`` (n, 4), complex allowed."""
     w, i, j, k = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
     return np.stack([np.stack([w * w + i * i - j * j - k * k, 2 * (i * j - w * k), 2 * (i * k + w * j)], -1),
@@ -427,7 +429,7 @@ _STUDY_Q = _study_forms()
 _PACKED: weakref.WeakKeyDictionary[LoopSystem, tuple] = weakref.WeakKeyDictionary()
 
 
-def _twist_matrix(S: np.ndarray, L: float, slide: bool) -> np.ndarray:
+def twist_matrix(S: np.ndarray, L: float, slide: bool) -> np.ndarray:
     """The 4x4 matrix of a unit twist in units of ``L``: a rotation's moment over ``L``; a
     slide's direction as it is (its variable is the slide over ``L``)."""
     A = np.zeros((4, 4))
@@ -538,7 +540,7 @@ def loop_system(mech: Mechanism, seed: int = 0) -> LoopSystem:
             if v[0] in ("L", "S"):
                 continue
             kind = "P" if refs[i].freedom.kind == "P" else "R"
-            A = _twist_matrix(refs[i].freedom.screw, L, kind == "P")
+            A = twist_matrix(refs[i].freedom.screw, L, kind == "P")
             out.append(_Factor(kind, A, A @ A, tuple(v[1:])))
         return out
 
