@@ -470,3 +470,64 @@ def test_importing_paper_a_creates_no_temporary_directory(monkeypatch):
     importlib.reload(paper_a)
     assert made == [] and not hasattr(paper_a, "_TMP")
     assert set(Path(tempfile.gettempdir()).glob("spatialmech-paper-a-*")) == before
+
+
+# ------------------------------------------------------------------ issue 30, item 11: found by fuzzing
+SERIAL_RR = textwrap.dedent(
+    """
+    name = "serial-rr"
+    links = ["ground", "arm", "platform"]
+
+    [[joints]]
+    name = "A"
+    type = "R"
+    links = ["ground", "arm"]
+    point = [0, 0, 0]
+    axis = [0, 0, 1]
+    actuated = true
+
+    [[joints]]
+    name = "B"
+    type = "R"
+    links = ["arm", "platform"]
+    point = [1, 0, 0]
+    axis = [0, 0, 1]
+    actuated = true
+    """
+)
+ONE_R = textwrap.dedent(
+    """
+    name = "one-r"
+    links = ["ground", "platform"]
+
+    [[joints]]
+    name = "A"
+    type = "R"
+    links = ["ground", "platform"]
+    point = [0, 0, 0]
+    axis = [0, 0, 1]
+    actuated = true
+    """
+)
+
+
+@pytest.mark.parametrize("text, values", [(SERIAL_RR, "10,20"), (ONE_R, "10")])
+def test_fk_all_on_a_serial_chain_answers_its_one_pose(tmp_path, text, values):
+    """Before: ``fk --all`` on a serial chain (no loop) stopped with an internal error
+    (``cannot reshape array of size 0``, exit 3) or ran on without an answer."""
+    f = tmp_path / "serial.toml"
+    f.write_text(text)
+    r = run("fk", f, "--actuators", values, "--all")
+    assert r.exit_code == 0, r.output
+    assert "1 assembly mode" in r.output and "serial chain" in r.output and "complete: " in r.output
+    acts = [float(v) for v in values.split(",")]
+    res = sm.fk(sm.load(f), acts, all_solutions=True)
+    assert res.complete and len(res.poses) == 1
+    np.testing.assert_allclose(res.poses[0].p, sm.fk(sm.load(f), acts).poses[0].p, atol=1e-9)
+    assert_one_line_error(run("fk", f, "--actuators", values, "--all", "--seeds", 5), contains="serial chain")
+
+
+def test_fk_all_on_a_serial_chain_with_a_passive_joint_is_refused(tmp_path):
+    f = tmp_path / "serial.toml"
+    f.write_text(SERIAL_RR.replace("actuated = true\n", "", 1))
+    assert_one_line_error(run("fk", f, "--actuators", "20", "--all"), contains="passive")

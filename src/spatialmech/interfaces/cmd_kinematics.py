@@ -331,7 +331,7 @@ def _fk_text(r: sm.FKResult) -> None:
         click.echo(_fk_header(mech, [m.kind for m in modes], a.label, a.n_starts, a.n_converged)
                    + (f"; {a.n_within_limits} within limits" if a.all_solutions else ""))
         if a.all_solutions:
-            click.echo(f"  NOT proven complete: {a.completeness}")
+            click.echo(("  complete: " if a.complete else "  NOT proven complete: ") + a.completeness)
     for k, m in enumerate(modes):
         ang = matrix_euler("ZYX", m.pose.R, degrees=True)
         lim = "within limits" if m.within_limits else "outside limits: " + ", ".join(m.outside_limits)
