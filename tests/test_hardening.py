@@ -531,3 +531,16 @@ def test_fk_all_on_a_serial_chain_with_a_passive_joint_is_refused(tmp_path):
     f = tmp_path / "serial.toml"
     f.write_text(SERIAL_RR.replace("actuated = true\n", "", 1))
     assert_one_line_error(run("fk", f, "--actuators", "20", "--all"), contains="passive")
+
+
+@pytest.mark.parametrize("args", [["mobility"], ["ik", "--xyz", "1", "0", "0"], ["fk", "--actuators", "1,2"],
+                                  ["singularity", "--xyz", "1", "0", "0"], ["export", "OUT"]])
+@pytest.mark.parametrize("name", ["", " ", " arm"])
+def test_an_empty_link_name_in_a_graph_file_names_the_field(tmp_path, args, name):
+    """Before: an empty link name stopped mobility, ik, fk, singularity and export with an
+    internal error (a ``TypeError``, exit 3)."""
+    f = tmp_path / "bad.toml"
+    f.write_text(SERIAL_RR.replace('links = ["ground", "arm", "platform"]', f'links = ["ground", "{name}", "platform"]'))
+    args = [str(tmp_path / "out.toml") if a == "OUT" else a for a in args]
+    assert_one_line_error(run(args[0], f, *args[1:]), contains="links[1]: a link name must be non-empty")
+    assert not (tmp_path / "out.toml").exists()

@@ -223,8 +223,11 @@ def _link_names(links) -> list[str]:
         raise TypeError(f"links: expected a sequence of link names, got {type(links).__name__}")
     names = list(links)
     for k, ln in enumerate(names):
-        if not (isinstance(ln, str) and ln):
+        if not isinstance(ln, str):
             raise TypeError(f"links[{k}]: expected a link name (str), got {ln!r}")
+        if not ln.strip() or ln != ln.strip():
+            raise InputError(f"links[{k}]: a link name must be non-empty, without leading or trailing spaces; "
+                             f"got {ln!r}")
     if len(set(names)) != len(names):
         dup = sorted({x for x in names if names.count(x) > 1})
         raise InputError(f"links: duplicate link names {dup}")
