@@ -544,3 +544,23 @@ def test_an_empty_link_name_in_a_graph_file_names_the_field(tmp_path, args, name
     args = [str(tmp_path / "out.toml") if a == "OUT" else a for a in args]
     assert_one_line_error(run(args[0], f, *args[1:]), contains="links[1]: a link name must be non-empty")
     assert not (tmp_path / "out.toml").exists()
+
+
+def test_parasitic_honours_euler_without_free():
+    """Before: ``parasitic three-rps --over a2:-20:20:5 --euler xyz`` silently used ZYX (the
+    option was dropped without --free)."""
+    import json
+
+    r = run("parasitic", "three-rps", "--over", "a2:-20:20:5", "--euler", "xyz", "--json")
+    assert r.exit_code == 0, r.output
+    assert json.loads(r.stdout)["task"]["euler"] == "xyz"
+    r = run("parasitic", "three-rps", "--over", "a2:-20:20:5")
+    assert r.exit_code == 0 and "task ZYX" in r.output, r.output
+
+
+@pytest.mark.parametrize("extra, contains", [(["--euler", "QQQ"], "--euler: expected three axis letters"),
+                                             (["--free", "x,y,a1", "--euler", "QQQ"], "--euler: expected three"),
+                                             (["--euler", "ZXZ"], "--euler: the angles of 'ZXZ' are singular")])
+def test_parasitic_names_euler_in_its_errors(extra, contains):
+    r = CliRunner().invoke(cli, ["parasitic", "three-rps", "--over", "a2:-20:20:5", *extra])
+    assert r.exit_code == 2 and contains in r.stderr and "Traceback" not in r.output, r.output
