@@ -581,7 +581,7 @@ def screen(task=None, out: str | os.PathLike = "screen.parquet", *, candidates: 
     if workers is not None:
         check_int(workers, "workers", minimum=0)
     summary = run_screen(poses, out, candidates=candidates, density=check_number(density, "density"),
-                         seed=check_int(seed, "seed"), starts=starts, separation=check_number(separation, "separation"),
+                         seed=check_int(seed, "seed", minimum=0, maximum=2**63 - 1), starts=starts, separation=check_number(separation, "separation"),
                          chunk_size=chunk_size, workers=workers, scheduler=scheduler, top=top, rank_by=rank_by,
                          progress=optional_progress(progress))
     summary.positions_source = source
