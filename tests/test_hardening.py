@@ -564,3 +564,25 @@ def test_parasitic_honours_euler_without_free():
 def test_parasitic_names_euler_in_its_errors(extra, contains):
     r = CliRunner().invoke(cli, ["parasitic", "three-rps", "--over", "a2:-20:20:5", *extra])
     assert r.exit_code == 2 and contains in r.stderr and "Traceback" not in r.output, r.output
+
+
+def _delta_text(joint: str, old: str, new: str) -> str:
+    text = sm.dumps(catalog.build("delta"))
+    i = text.index(f'name = "{joint}"')
+    j = text.index(old, i)
+    return text[:j] + new + text[j + len(old):]
+
+
+@pytest.mark.parametrize("text, contains", [
+    (_delta_text("W1a", 'links = ["rod1a", "platform"]', 'links = ["rod1a", "arm1"]'),  # a rod joined to the wrong link
+     "joint 'W1a' joins links 'rod1a' and 'arm1', already joined by joint 'E1a'"),
+    (sm.dumps(catalog.build("delta")) + '\n[[joints]]\nname = "W1a2"\ntype = "S"\npoint = [0, 0, 0]\n'
+     'links = ["platform", "rod1a"]\n', "joint 'W1a2' joins links 'platform' and 'rod1a', already joined by joint 'W1a'"),
+])
+@pytest.mark.parametrize("command", [["fk", "--actuators", "10,10,10", "--all"], ["singularity", "--reference"]])
+def test_two_joints_between_the_same_two_links_are_refused(tmp_path, text, contains, command):
+    """Before: ``fk --all`` on a Delta with a rod joined to the wrong link, or two links joined
+    by a joint twice, ran past 60 s (a loop with no link in it: a spurious self-motion)."""
+    f = tmp_path / "bad.toml"
+    f.write_text(text)
+    assert_one_line_error(run(command[0], f, *command[1:]), contains=contains)

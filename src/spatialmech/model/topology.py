@@ -267,6 +267,11 @@ def _graph_edges(joints, names: list[str]) -> list[_Edge]:
             raise InputError(f"joints[{k}].links: joint {j.name!r} connects link {a!r} to itself")
         if j.name in seen:
             raise InputError(f"joints[{k}].name: duplicate joint name {j.name!r}")
+        twin = next((e[0].name for e in edges if {e[1], e[2]} == {a, b}), None)
+        if twin is not None:
+            raise InputError(f"joints[{k}].links: joint {j.name!r} joins links {a!r} and {b!r}, already joined by "
+                             f"joint {twin!r}: two joints between the same two links make a loop with no link in it "
+                             "(one joint between two links; check the links of both)")
         seen.add(j.name)
         edges.append((j, a, b))
     if not edges:
