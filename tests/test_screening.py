@@ -257,6 +257,7 @@ def test_a_scheduler_address_that_is_not_dask_fails_within_the_timeout(tmp_path,
     """Before: ``screen --scheduler`` at a server that accepts and is not a Dask scheduler hung
     past 120 s (Dask bounds the connection, not the handshake), or failed with an internal
     error on its garbage."""
+    import contextlib
     import socket
     import threading
     import time
@@ -275,10 +276,8 @@ def test_a_scheduler_address_that_is_not_dask_fails_within_the_timeout(tmp_path,
             except OSError:
                 return
             held.append(c)
-            try:
+            with contextlib.suppress(OSError):
                 c.sendall(payload)
-            except OSError:
-                pass
 
     threading.Thread(target=serve, daemon=True).start()
     try:

@@ -251,7 +251,7 @@ def _connect(client_type, scheduler: str):
     def attempt() -> None:
         try:
             c = client_type(scheduler, timeout=CONNECT_TIMEOUT)
-        except Exception as e:  # noqa: BLE001 - any failure of the handshake is the address's fault
+        except Exception as e:  # any failure of the handshake is the address's fault
             box["error"] = e
             return
         with lock:
