@@ -198,8 +198,9 @@ def mechanism_from_graph(name: str, links, joints, *, output: str | None = None,
     links with two joints are the chains' intermediate links.  A chain is traversed in the
     direction most of its joints were described in (a joint traversed backwards is
     :meth:`~spatialmech.model.joints.Joint.flipped`, so its variables keep their meaning).
-    Errors name the field: unknown or duplicate links, a joint from a link to itself, links
-    not connected to the ground, a link held by one joint only (it would move freely).
+    Errors name the field: unknown, duplicate or empty link names, a joint from a link to
+    itself, two joints between the same two links, links not connected to the ground, a link
+    held by one joint only (it would move freely).
     """
     names = _link_names(links)
     output = _output_link(names, output)
