@@ -450,3 +450,74 @@ def test_fuzz_cli_workspace(kinds, at, step_deg, step_m, tol, link, max_poses, a
     if max_poses is not None:
         args += ["--max-poses", max_poses]
     _invoke(args)
+
+
+# ============================================================== (c) graph files (issue 30, item 11)
+#: Graph-form files to mutate: the spatial six-bar, the Delta (11 links, 15 joints) and a serial
+#: R-R chain (no loop); each with actuator values that fit the unmutated model.
+GRAPH_SEEDS = {
+    "spatial-six-bar": (tomllib.loads(sm.dumps(catalog.build("spatial-six-bar"))), "10"),
+    "delta": (tomllib.loads(sm.dumps(catalog.build("delta"))), "10,10,10"),
+    "serial-rr": ({"format": 1, "name": "serial-rr", "links": ["ground", "arm", "platform"], "joints": [
+        {"name": "A", "type": "R", "links": ["ground", "arm"], "point": [0, 0, 0], "axis": [0, 0, 1], "actuated": True},
+        {"name": "B", "type": "R", "links": ["arm", "platform"], "point": [1, 0, 0], "axis": [0, 0, 1],
+         "actuated": True}]}, "10,20"),
+}
+
+
+@st.composite
+def mutated_graphs(draw):
+    """``(name, file dict, actuator values)``: a graph file with one to three mutations: a joint
+    dropped, a link name emptied, a joint duplicated (between the same links, under a new
+    name), a joint's link replaced by another (or an unknown one), a joint's ends swapped, a
+    link dropped from ``links``."""
+    name = draw(st.sampled_from(sorted(GRAPH_SEEDS)))
+    d, acts = GRAPH_SEEDS[name]
+    d = _copy(d)
+    for _ in range(draw(st.integers(1, 3))):
+        joints, links = d["joints"], d["links"]
+        op = draw(st.sampled_from(["drop-joint", "empty-name", "duplicate", "wrong-link", "wrong-link", "swap",
+                                   "drop-link"]))
+        if not joints or not links:
+            break
+        j = draw(st.sampled_from(joints))
+        if op == "drop-joint":
+            joints.remove(j)
+        elif op == "empty-name":
+            k = draw(st.integers(0, len(links) - 1))
+            new = draw(st.sampled_from(["", " ", links[k] + " "]))
+            if draw(st.booleans()):
+                j["links"] = [new if x == links[k] else x for x in j["links"]]
+            else:
+                links[k] = new
+        elif op == "duplicate":
+            joints.append({**_copy(j), "name": j["name"] + "2", "actuated": False})
+        elif op == "wrong-link":
+            j["links"][draw(st.integers(0, 1))] = draw(st.sampled_from([*links, "nosuch"]))
+        elif op == "swap":
+            j["links"] = j["links"][::-1]
+        else:
+            links.remove(draw(st.sampled_from(links)))
+    return name, d, acts
+
+
+@settings(max_examples=examples(60), **SETTINGS)
+@given(mutated_graphs(), st.sampled_from(["mobility", "fk", "fk --all", "singularity --reference", "export"]))
+def test_fuzz_cli_on_mutated_graph_files(graph, command):
+    """Every command on a mutated graph file: a valid run or a clear error (exit 0, 1 or 2,
+    never 3), each within :data:`CALL_SECONDS`.  The Delta's ``fk --all`` by the loop
+    formulation can take a minute on a valid mutant: it runs a two-start multi-start search."""
+    name, d, acts = graph
+    with tempfile.TemporaryDirectory() as tmp:
+        f = Path(tmp) / "graph.toml"
+        f.write_text(tomli_w.dumps(d), encoding="utf-8")
+        verb, *rest = command.split()
+        args = [verb, str(f), *rest]
+        if verb == "fk":
+            args += ["--actuators", acts]
+            if "--all" in rest and name != "serial-rr":
+                args += ["--method", "multistart", "--seeds", "2"]
+        elif verb == "export":
+            args.append(str(Path(tmp) / "out.toml"))
+        event(f"{name} {command}")
+        _invoke(args)

@@ -470,3 +470,119 @@ def test_importing_paper_a_creates_no_temporary_directory(monkeypatch):
     importlib.reload(paper_a)
     assert made == [] and not hasattr(paper_a, "_TMP")
     assert set(Path(tempfile.gettempdir()).glob("spatialmech-paper-a-*")) == before
+
+
+# ------------------------------------------------------------------ issue 30, item 11: found by fuzzing
+SERIAL_RR = textwrap.dedent(
+    """
+    name = "serial-rr"
+    links = ["ground", "arm", "platform"]
+
+    [[joints]]
+    name = "A"
+    type = "R"
+    links = ["ground", "arm"]
+    point = [0, 0, 0]
+    axis = [0, 0, 1]
+    actuated = true
+
+    [[joints]]
+    name = "B"
+    type = "R"
+    links = ["arm", "platform"]
+    point = [1, 0, 0]
+    axis = [0, 0, 1]
+    actuated = true
+    """
+)
+ONE_R = textwrap.dedent(
+    """
+    name = "one-r"
+    links = ["ground", "platform"]
+
+    [[joints]]
+    name = "A"
+    type = "R"
+    links = ["ground", "platform"]
+    point = [0, 0, 0]
+    axis = [0, 0, 1]
+    actuated = true
+    """
+)
+
+
+@pytest.mark.parametrize("text, values", [(SERIAL_RR, "10,20"), (ONE_R, "10")])
+def test_fk_all_on_a_serial_chain_answers_its_one_pose(tmp_path, text, values):
+    """Before: ``fk --all`` on a serial chain (no loop) stopped with an internal error
+    (``cannot reshape array of size 0``, exit 3) or ran on without an answer."""
+    f = tmp_path / "serial.toml"
+    f.write_text(text)
+    r = run("fk", f, "--actuators", values, "--all")
+    assert r.exit_code == 0, r.output
+    assert "1 assembly mode" in r.output and "serial chain" in r.output and "complete: " in r.output
+    acts = [float(v) for v in values.split(",")]
+    res = sm.fk(sm.load(f), acts, all_solutions=True)
+    assert res.complete and len(res.poses) == 1
+    np.testing.assert_allclose(res.poses[0].p, sm.fk(sm.load(f), acts).poses[0].p, atol=1e-9)
+    assert_one_line_error(run("fk", f, "--actuators", values, "--all", "--seeds", 5), contains="serial chain")
+
+
+def test_fk_all_on_a_serial_chain_with_a_passive_joint_is_refused(tmp_path):
+    f = tmp_path / "serial.toml"
+    f.write_text(SERIAL_RR.replace("actuated = true\n", "", 1))
+    assert_one_line_error(run("fk", f, "--actuators", "20", "--all"), contains="passive")
+
+
+@pytest.mark.parametrize("args", [["mobility"], ["ik", "--xyz", "1", "0", "0"], ["fk", "--actuators", "1,2"],
+                                  ["singularity", "--xyz", "1", "0", "0"], ["export", "OUT"]])
+@pytest.mark.parametrize("name", ["", " ", " arm"])
+def test_an_empty_link_name_in_a_graph_file_names_the_field(tmp_path, args, name):
+    """Before: an empty link name stopped mobility, ik, fk, singularity and export with an
+    internal error (a ``TypeError``, exit 3)."""
+    f = tmp_path / "bad.toml"
+    f.write_text(SERIAL_RR.replace('links = ["ground", "arm", "platform"]', f'links = ["ground", "{name}", "platform"]'))
+    args = [str(tmp_path / "out.toml") if a == "OUT" else a for a in args]
+    assert_one_line_error(run(args[0], f, *args[1:]), contains="links[1]: a link name must be non-empty")
+    assert not (tmp_path / "out.toml").exists()
+
+
+def test_parasitic_honours_euler_without_free():
+    """Before: ``parasitic three-rps --over a2:-20:20:5 --euler xyz`` silently used ZYX (the
+    option was dropped without --free)."""
+    import json
+
+    r = run("parasitic", "three-rps", "--over", "a2:-20:20:5", "--euler", "xyz", "--json")
+    assert r.exit_code == 0, r.output
+    assert json.loads(r.stdout)["task"]["euler"] == "xyz"
+    r = run("parasitic", "three-rps", "--over", "a2:-20:20:5")
+    assert r.exit_code == 0 and "task ZYX" in r.output, r.output
+
+
+@pytest.mark.parametrize("extra, contains", [(["--euler", "QQQ"], "--euler: expected three axis letters"),
+                                             (["--free", "x,y,a1", "--euler", "QQQ"], "--euler: expected three"),
+                                             (["--euler", "ZXZ"], "--euler: the angles of 'ZXZ' are singular")])
+def test_parasitic_names_euler_in_its_errors(extra, contains):
+    r = CliRunner().invoke(cli, ["parasitic", "three-rps", "--over", "a2:-20:20:5", *extra])
+    assert r.exit_code == 2 and contains in r.stderr and "Traceback" not in r.output, r.output
+
+
+def _delta_text(joint: str, old: str, new: str) -> str:
+    text = sm.dumps(catalog.build("delta"))
+    i = text.index(f'name = "{joint}"')
+    j = text.index(old, i)
+    return text[:j] + new + text[j + len(old):]
+
+
+@pytest.mark.parametrize("text, contains", [
+    (_delta_text("W1a", 'links = ["rod1a", "platform"]', 'links = ["rod1a", "arm1"]'),  # a rod joined to the wrong link
+     "joint 'W1a' joins links 'rod1a' and 'arm1', already joined by joint 'E1a'"),
+    (sm.dumps(catalog.build("delta")) + '\n[[joints]]\nname = "W1a2"\ntype = "S"\npoint = [0, 0, 0]\n'
+     'links = ["platform", "rod1a"]\n', "joint 'W1a2' joins links 'platform' and 'rod1a', already joined by joint 'W1a'"),
+])
+@pytest.mark.parametrize("command", [["fk", "--actuators", "10,10,10", "--all"], ["singularity", "--reference"]])
+def test_two_joints_between_the_same_two_links_are_refused(tmp_path, text, contains, command):
+    """Before: ``fk --all`` on a Delta with a rod joined to the wrong link, or two links joined
+    by a joint twice, ran past 60 s (a loop with no link in it: a spurious self-motion)."""
+    f = tmp_path / "bad.toml"
+    f.write_text(text)
+    assert_one_line_error(run(command[0], f, *command[1:]), contains=contains)

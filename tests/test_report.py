@@ -348,3 +348,54 @@ def test_examples_readme_lists_every_example():
     readme = (ROOT / "examples" / "README.md").read_text(encoding="utf-8")
     for p in (ROOT / "examples").glob("*.py"):
         assert f"({p.name})" in readme, p.name
+
+
+# ------------------------------------------------------------------ issue 30, item 11: atomic, with the envelope
+def _tiny_sections():
+    from spatialmech.present.figures import ReportFigure
+    from spatialmech.present.report import Section, Table
+
+    fig = ReportFigure("a.png", "A", "a figure", b"\x89PNG\r\n\x1a\nnot really")
+    return [Section("s", "S", tables=(Table("t", ("x_len",), ((1.0,),)),), figures=(fig,), length_unit="m")]
+
+
+def test_results_json_has_the_json_envelope(tmp_path):
+    """Before: ``results.json`` lacked the envelope docs/json.md promises."""
+    from spatialmech.present.report import write_report
+    from spatialmech.serialize import SCHEMA_VERSION
+
+    doc = write_report(tmp_path / "rep", "T", _tiny_sections(), 1.0, {"model": "m"}, command="report",
+                       length_unit="mm")
+    on_disk = json.loads((tmp_path / "rep" / "results.json").read_text())
+    assert on_disk == doc
+    assert list(doc)[:4] == ["schema_version", "command", "model", "length_unit"]
+    assert (doc["schema_version"], doc["command"], doc["model"], doc["length_unit"]) == (SCHEMA_VERSION, "report", "m", "mm")
+    doc = write_report(tmp_path / "demo", "T", _tiny_sections(), 1.0)
+    assert (doc["command"], doc["model"], doc["length_unit"]) == ("demo", None, None)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["demo", "rep"]
+
+
+@pytest.mark.parametrize("existing", [False, True])
+def test_an_interrupted_report_leaves_nothing_partial(tmp_path, monkeypatch, existing):
+    """Before: an interrupted ``report`` left a partial ``results.json`` and figures behind."""
+    import spatialmech.present.report as rep
+
+    out = tmp_path / "rep"
+    if existing:
+        rep.write_report(out, "old", _tiny_sections(), 1.0)
+        (out / "notes.txt").write_text("mine")
+    before = {p.relative_to(tmp_path): p.read_bytes() for p in tmp_path.rglob("*") if p.is_file()}
+
+    def interrupted(*a, **k):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(rep, "render_html", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        rep.write_report(out, "new", _tiny_sections(), 1.0)
+    after = {p.relative_to(tmp_path): p.read_bytes() for p in tmp_path.rglob("*") if p.is_file()}
+    assert after == before  # no partial results.json, no figures, no staging folder
+    monkeypatch.undo()
+    rep.write_report(out, "new", _tiny_sections(), 2.0)  # a rerun replaces the report, keeps other files
+    assert json.loads((out / "results.json").read_text())["title"] == "new"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["rep"]
+    assert (out / "notes.txt").exists() == existing

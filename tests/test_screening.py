@@ -272,3 +272,57 @@ def test_sm_screen_is_the_public_entry(family, tmp_path):
     with pytest.raises(InputError, match="density"):
         sm.screen("five-cs-positions", tmp_path / "y", workers=0, density=-1.0)
     assert not (tmp_path / "y").exists()  # refused before any work
+
+
+# ------------------------------------------------------------------------------ issue 30, item 11
+@pytest.mark.parametrize("seed", ["-1", str(2**63)])
+def test_screen_refuses_a_negative_seed_naming_the_option(tmp_path, seed):
+    """Before: ``screen --seed -1`` failed with an internal ValueError (numpy's seed) after the setup."""
+    r = CliRunner().invoke(cli, ["screen", "--seed", seed, "--candidates", "2", "--workers", "0",
+                                 "--out", str(tmp_path / "s.parquet")])
+    assert r.exit_code == 2 and "--seed" in r.output and "Traceback" not in r.output, r.output
+    assert not (tmp_path / "s.parquet").exists()
+    with pytest.raises(InputError, match="seed: expected an integer >= 0"):
+        sm.screen(out=tmp_path / "t.parquet", seed=-1)
+
+
+@pytest.mark.parametrize("payload", [b"", b"HTTP/1.1 200 OK\r\n\r\nnot dask", b"\x00" * 8])
+def test_a_scheduler_address_that_is_not_dask_fails_within_the_timeout(tmp_path, family, payload):
+    """Before: ``screen --scheduler`` at a server that accepts and is not a Dask scheduler hung
+    past 120 s (Dask bounds the connection, not the handshake), or failed with an internal
+    error on its garbage."""
+    import contextlib
+    import socket
+    import threading
+    import time
+
+    import spatialmech.services.screening as bs
+
+    srv = socket.socket()
+    srv.bind(("127.0.0.1", 0))
+    srv.listen()
+    held = []
+
+    def serve():
+        while True:
+            try:
+                c, _ = srv.accept()
+            except OSError:
+                return
+            held.append(c)
+            with contextlib.suppress(OSError):
+                c.sendall(payload)
+
+    threading.Thread(target=serve, daemon=True).start()
+    try:
+        with pytest.MonkeyPatch.context() as mp:
+            mp.setattr(bs, "CONNECT_TIMEOUT", "1s")
+            t0 = time.perf_counter()
+            with pytest.raises(InputError, match="scheduler: "):
+                run_screen(five_cs_positions(), tmp_path / "s", candidates=2, family=family,
+                           scheduler=f"tcp://127.0.0.1:{srv.getsockname()[1]}")
+            assert time.perf_counter() - t0 < 10
+    finally:
+        srv.close()
+        for c in held:
+            c.close()

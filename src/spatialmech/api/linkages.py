@@ -512,6 +512,10 @@ def synth_cs(positions=None, *, pick: int = 5, starts: int = 60, seed: int = 0, 
 
 
 # ============================================================================ screening
+#: Largest ``seed`` of :func:`screen` (a random generator's seed, stored as a 64-bit integer).
+_SEED_MAX = 2**63 - 1
+
+
 @one_blas_thread
 def screen(task=None, out: str | os.PathLike = "screen.parquet", *, candidates: int = 1000, density: float = 0.5,
            workers: int | None = None, scheduler: str | None = None, top: int = 5, rank_by: str = "singularity",
@@ -587,7 +591,8 @@ def screen(task=None, out: str | os.PathLike = "screen.parquet", *, candidates: 
     if workers is not None:
         check_int(workers, "workers", minimum=0)
     summary = run_screen(poses, out, candidates=candidates, density=check_number(density, "density"),
-                         seed=check_int(seed, "seed"), starts=starts, separation=check_number(separation, "separation"),
+                         seed=check_int(seed, "seed", minimum=0, maximum=_SEED_MAX), starts=starts,
+                         separation=check_number(separation, "separation"),
                          chunk_size=chunk_size, workers=workers, scheduler=scheduler, top=top, rank_by=rank_by,
                          progress=optional_progress(progress))
     summary.positions_source = source

@@ -23,8 +23,8 @@ from .threads import one_blas_thread
 @dataclass(frozen=True, eq=False)
 class ReportResult:
     """A report written into ``out``: ``index.html`` (opens offline), ``results.json`` (every
-    number: :attr:`data`) and ``figures/``.  ``to_dict()`` is ``data`` without the model name
-    (the payload of ``spatialmech report --json``, whose envelope names the model)."""
+    number: :attr:`data`, with its JSON envelope) and ``figures/``.  ``to_dict()`` is ``data``
+    without the envelope (the payload of ``spatialmech report --json``, which adds its own)."""
 
     out: Path
     data: dict
@@ -38,7 +38,7 @@ class ReportResult:
         return self.out / "results.json"
 
     def to_dict(self) -> dict:
-        return {k: v for k, v in self.data.items() if k != "model"}
+        return {k: v for k, v in self.data.items() if k not in ("schema_version", "command", "model", "length_unit")}
 
 
 @one_blas_thread

@@ -343,6 +343,7 @@ def parasitic(model: ModelLike, over: Mapping, *, at: Mapping[str, float] | None
     (('x', 'y', 'a1'), {'x': 0.000747, 'y': 0.000375, 'a1': 0.005008})
     """
     from ..analysis.parasitic import parasitic_table
+    from ..geometry.rotations import check_sequence
     from ..kinematics.task import default_task
     from ..model.task import TASK_NAMES, TaskCoordinates
 
@@ -356,8 +357,17 @@ def parasitic(model: ModelLike, over: Mapping, *, at: Mapping[str, float] | None
     task = None
     if free is not None or euler is not None:
         seq = euler if euler is not None else (mech.task.euler if mech.task is not None else "ZYX")
+        try:
+            check_sequence(seq)
+        except InputError as e:
+            raise InputError(f"euler: {str(e).split(': ', 1)[-1]}") from None
         if free is None:
-            given = default_task(mech, seq).given  # the model's own task, else the default
+            try:
+                given = default_task(mech, seq).given  # the model's own task, else the default
+            except np.linalg.LinAlgError:
+                raise InputError(f"euler: the angles of {seq!r} are singular (gimbal lock) at the reference pose of "
+                                 f"{mech.name}: choose another sequence, or name the solved coordinates (free)"
+                                 ) from None
         else:
             names = check_names(free, "free") or []
             for n in names:

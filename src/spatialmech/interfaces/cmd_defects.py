@@ -9,7 +9,7 @@ import numpy as np
 
 from .. import api as sm
 from ..errors import InputError
-from .common import check_output_dir, emit_json, json_option, load_model
+from .common import SEED_MAX, check_output_dir, emit_json, json_option, load_model
 
 #: Largest --monte-carlo: each sample is a whole defect analysis (seconds to tens of seconds).
 MAX_MONTE_CARLO = 1000
@@ -25,7 +25,7 @@ MAX_MONTE_CARLO = 1000
 @click.option("--angle-tol-deg", type=float, default=1.0, show_default=True, help="Angle tolerance for circuit membership (deg).")
 @click.option("--monte-carlo", type=int, default=0, show_default=True, help="Samples of a perturbation check of the verdicts.")
 @click.option("--precision", type=float, default=5e-4, show_default=True, help="Printed precision of lengths for --monte-carlo.")
-@click.option("--seed", type=int, default=0, show_default=True, help="Seed of the Monte-Carlo check.")
+@click.option("--seed", type=click.IntRange(0, SEED_MAX), default=0, show_default=True, help="Seed of the Monte-Carlo check.")
 @click.option("--plot", "plot_dir", type=click.Path(file_okay=False, path_type=Path), default=None,
               help="Write the figures into this directory.")
 @json_option

@@ -367,7 +367,7 @@ def _fk_text(r: sm.FKResult) -> None:
                    + ("" if not a.all_solutions else f"; {a.n_within_limits} within limits" if limited
                       else "; no joint limits in the model"))
         if a.all_solutions:
-            click.echo(f"  NOT proven complete: {a.completeness}")
+            click.echo(("  complete: " if a.complete else "  NOT proven complete: ") + a.completeness)
     for k, m in enumerate(modes):
         ang = matrix_euler("ZYX", m.pose.R, degrees=True)
         lim = ("outside limits: " + ", ".join(m.outside_limits) if not m.within_limits

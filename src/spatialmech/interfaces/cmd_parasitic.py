@@ -6,6 +6,7 @@ import click
 import numpy as np
 
 from .. import api as sm
+from ..errors import InputError
 from .common import check_output_file, emit_json, json_option, load_model
 from .task_args import parse_axes, parse_free, parse_task_at
 
@@ -38,8 +39,14 @@ def parasitic_cmd(model, over_text, at_text, free_text, euler, plot, as_json):
     over = parse_axes(over_text, "--over", min_axes=1, max_axes=2)
     at = parse_task_at(at_text)
     free = parse_free(free_text)
-    # --euler names the sequence of the task --free defines (without --free: the model's own task)
-    table = sm.parasitic(mech, over, at=at, free=free, euler=euler if free is not None else None, plot=plot_path)
+    # --euler names the sequence of the task's angles (with --free: of the task it defines; without: of the
+    # model's own task); the API checks the name
+    try:
+        table = sm.parasitic(mech, over, at=at, free=free, euler=euler, plot=plot_path)
+    except InputError as e:
+        if str(e).startswith("euler: "):  # the option's name
+            raise InputError(f"--{e}") from None
+        raise
     grid = table.grid
     solved = grid.solved
     n_ok = int(grid.converged.sum())

@@ -8,7 +8,7 @@ from pathlib import Path
 import click
 
 from .. import api as sm
-from .common import emit_json, json_option
+from .common import SEED_MAX, emit_json, json_option
 
 __all__ = ["screen"]
 
@@ -29,7 +29,8 @@ __all__ = ["screen"]
 @click.option("--rank-by", type=click.Choice(["singularity", "slide"]), default="singularity", show_default=True,
               help="singularity: the largest distance to a singularity along the task path first, then the smallest "
                    "C-slide stroke; slide: the smallest stroke first.")
-@click.option("--seed", type=int, default=0, show_default=True, help="Seed of the family's random starts and of the sample.")
+@click.option("--seed", type=click.IntRange(0, SEED_MAX), default=0, show_default=True,
+              help="Seed of the family's random starts and of the sample.")
 @click.option("--starts", type=click.IntRange(min=1, max=5000), default=60, show_default=True,
               help="Random starts of the family synthesis.")
 @click.option("--separation", type=click.FloatRange(min=0.0), default=0.5, show_default=True,

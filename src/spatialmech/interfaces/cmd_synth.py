@@ -13,7 +13,7 @@ import numpy as np
 
 from .. import api as sm
 from ..errors import InputError
-from .common import check_output_dir, check_output_file, emit_json
+from .common import SEED_MAX, check_output_dir, check_output_file, emit_json
 
 __all__ = ["synth"]
 
@@ -95,7 +95,7 @@ def rccc(task, as_json, plot_dir, save_file, pick, samples):
               help="Write the 5-CS of the five picked dyads as a model file (TOML); needs --pick 5.")
 @click.option("--starts", type=click.IntRange(min=1, max=5000), default=60, show_default=True,
               help="Random starts of the multi-start search for branches of the family.")
-@click.option("--seed", type=int, default=0, show_default=True, help="Seed of the random starts.")
+@click.option("--seed", type=click.IntRange(0, SEED_MAX), default=0, show_default=True, help="Seed of the random starts.")
 @click.option("--skip-defects", is_flag=True,
               help="Do not run the defect analysis of the 5-CS (faster; the result is then not a verified success).")
 def cs(positions_file, as_json, samples, pick, save_file, starts, seed, skip_defects):

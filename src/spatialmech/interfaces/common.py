@@ -146,6 +146,10 @@ def parse_numbers(text: str, option: str, *, count: int | None = None, what: str
     return out
 
 
+#: Largest ``--seed`` (a random generator's seed: a non-negative integer, stored as a 64-bit one).
+SEED_MAX = 2**63 - 1
+
+
 # ------------------------------------------------------------------ tolerances
 _TOL_MEANING = {
     "rank": "relative singular-value threshold of the rank decisions",

@@ -198,8 +198,9 @@ def mechanism_from_graph(name: str, links, joints, *, output: str | None = None,
     links with two joints are the chains' intermediate links.  A chain is traversed in the
     direction most of its joints were described in (a joint traversed backwards is
     :meth:`~spatialmech.model.joints.Joint.flipped`, so its variables keep their meaning).
-    Errors name the field: unknown or duplicate links, a joint from a link to itself, links
-    not connected to the ground, a link held by one joint only (it would move freely).
+    Errors name the field: unknown, duplicate or empty link names, a joint from a link to
+    itself, two joints between the same two links, links not connected to the ground, a link
+    held by one joint only (it would move freely).
     """
     names = _link_names(links)
     output = _output_link(names, output)
@@ -223,8 +224,11 @@ def _link_names(links) -> list[str]:
         raise TypeError(f"links: expected a sequence of link names, got {type(links).__name__}")
     names = list(links)
     for k, ln in enumerate(names):
-        if not (isinstance(ln, str) and ln):
+        if not isinstance(ln, str):
             raise TypeError(f"links[{k}]: expected a link name (str), got {ln!r}")
+        if not ln.strip() or ln != ln.strip():
+            raise InputError(f"links[{k}]: a link name must be non-empty, without leading or trailing spaces; "
+                             f"got {ln!r}")
     if len(set(names)) != len(names):
         dup = sorted({x for x in names if names.count(x) > 1})
         raise InputError(f"links: duplicate link names {dup}")
@@ -264,6 +268,11 @@ def _graph_edges(joints, names: list[str]) -> list[_Edge]:
             raise InputError(f"joints[{k}].links: joint {j.name!r} connects link {a!r} to itself")
         if j.name in seen:
             raise InputError(f"joints[{k}].name: duplicate joint name {j.name!r}")
+        twin = next((e[0].name for e in edges if {e[1], e[2]} == {a, b}), None)
+        if twin is not None:
+            raise InputError(f"joints[{k}].links: joint {j.name!r} joins links {a!r} and {b!r}, already joined by "
+                             f"joint {twin!r}: two joints between the same two links make a loop with no link in it "
+                             "(one joint between two links; check the links of both)")
         seen.add(j.name)
         edges.append((j, a, b))
     if not edges:

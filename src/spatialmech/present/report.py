@@ -27,6 +27,7 @@ between runs.  Example::
 
 from __future__ import annotations
 
+import contextlib
 import html
 import importlib
 import json
@@ -374,19 +375,23 @@ def render_html(title: str, sections: Sequence[Section], data: dict) -> str:
             + "".join(parts) + "</body></html>\n")
 
 
-def write_report(out, title: str, sections: Sequence[Section], elapsed: float, extra: dict | None = None) -> dict:
-    """Write ``out/results.json``, ``out/index.html`` and ``out/figures/*.png``; return the data."""
+def write_report(out, title: str, sections: Sequence[Section], elapsed: float, extra: dict | None = None, *,
+                 command: str = "demo", length_unit: str | None = None) -> dict:
+    """Write ``out/results.json``, ``out/index.html`` and ``out/figures/*.png``; return the
+    document written to ``results.json``: the JSON envelope of ``command`` (docs/json.md; its
+    ``model`` is ``extra["model"]``, else ``None``) around the report's data.
+
+    Atomic: everything is written into a new folder next to ``out``, which then replaces
+    ``out``'s report files; an interrupted run leaves no partial report behind (other files in
+    an existing ``out`` are kept)."""
     from .. import __version__
+    from ..serialize import envelope
 
     out = Path(out)
-    (out / "figures").mkdir(parents=True, exist_ok=True)
     names = [f.name for sec in sections for f in sec.figures]
     dup = {n for n in names if names.count(n) > 1}
     if dup:
         raise InputError(f"figures: duplicate file names {sorted(dup)}")
-    for sec in sections:
-        for f in sec.figures:
-            (out / "figures" / f.name).write_bytes(f.png)
     data = {
         "title": title,
         "version": __version__,
@@ -397,11 +402,52 @@ def write_report(out, title: str, sections: Sequence[Section], elapsed: float, e
         "sections": [sec.to_dict() for sec in sections],
         **(extra or {}),
     }
-    text = json.dumps(data, indent=1, default=json_default, allow_nan=False)
-    (out / "results.json").write_text(text, encoding="utf-8")
-    data = json.loads(text)
-    (out / "index.html").write_text(render_html(title, sections, data), encoding="utf-8")
-    return data
+    model = data.pop("model", None)
+    doc = envelope(command, model, data, length_unit=length_unit)
+    text = json.dumps(doc, indent=1, default=json_default, allow_nan=False)
+    doc = json.loads(text)
+    with _staged(out) as tmp:
+        (tmp / "figures").mkdir()
+        for sec in sections:
+            for f in sec.figures:
+                (tmp / "figures" / f.name).write_bytes(f.png)
+        (tmp / "results.json").write_text(text, encoding="utf-8")
+        (tmp / "index.html").write_text(render_html(title, sections, doc), encoding="utf-8")
+    return doc
+
+
+#: The entries of a report folder (:func:`write_report`), replaced together.
+REPORT_ENTRIES = ("figures", "results.json", "index.html")
+
+
+@contextlib.contextmanager
+def _staged(out: Path):
+    """A new, hidden folder next to ``out`` to write a report into; on success its entries
+    replace :data:`REPORT_ENTRIES` of ``out`` (renames in one file system), on any failure or
+    interrupt it is removed and ``out`` is untouched."""
+    import shutil
+    import uuid
+
+    parent = out.parent
+    parent.mkdir(parents=True, exist_ok=True)
+    tmp = parent / f".{out.name}.partial-{uuid.uuid4().hex[:12]}"
+    tmp.mkdir()
+    try:
+        yield tmp
+        if not out.exists():
+            tmp.rename(out)
+            return
+        old = parent / f".{out.name}.old-{uuid.uuid4().hex[:12]}"
+        old.mkdir()
+        for name in REPORT_ENTRIES:  # the previous report's entries aside, the new ones in
+            if (out / name).exists() or (out / name).is_symlink():
+                (out / name).rename(old / name)
+        for name in REPORT_ENTRIES:
+            (tmp / name).rename(out / name)
+        shutil.rmtree(old, ignore_errors=True)
+    finally:
+        if tmp.exists():
+            shutil.rmtree(tmp, ignore_errors=True)
 
 
 # ------------------------------------------------------------------------------ entry points
@@ -456,6 +502,7 @@ def build_model_report(model, out, *, progress: bool | ProgressCallback = True, 
     mech = catalog.resolve(model)
     sink, bar = _reporter(progress, models.MODEL_STEPS, f"spatialmech report {mech.name}")
     sec = models.model_section(mech, sink, trace=trace)
-    data = write_report(out, f"spatialmech report: {mech.name}", [sec], bar.elapsed, {"model": mech.name})
+    data = write_report(out, f"spatialmech report: {mech.name}", [sec], bar.elapsed, {"model": mech.name},
+                        command="report", length_unit=mech.length_unit)
     bar.close()
     return data

@@ -235,6 +235,46 @@ class _Reporter:
                                              f"{self.usable} usable so far")
 
 
+def _connect(client_type, scheduler: str):
+    """A Dask client of the scheduler at ``scheduler``, or :class:`InputError` within about
+    :data:`CONNECT_TIMEOUT`: Dask bounds the connection, not the handshake, so a server that
+    accepts and then says nothing (or garbage) would hang it; the attempt runs in a thread
+    that is abandoned at the deadline (a client it makes later is closed)."""
+    import threading
+
+    from dask.utils import parse_timedelta
+
+    limit = float(parse_timedelta(CONNECT_TIMEOUT, default="s"))
+    box: dict = {}
+    lock = threading.Lock()
+
+    def attempt() -> None:
+        try:
+            c = client_type(scheduler, timeout=CONNECT_TIMEOUT)
+        except Exception as e:  # any failure of the handshake is the address's fault
+            box["error"] = e
+            return
+        with lock:
+            box["client"] = c
+            late = box.get("abandoned", False)
+        if late:
+            c.close()
+
+    t = threading.Thread(target=attempt, name="spatialmech-dask-connect", daemon=True)
+    t.start()
+    t.join(limit + 2.0)
+    with lock:
+        box["abandoned"] = "client" not in box and "error" not in box
+    if box["abandoned"]:
+        raise InputError(f"scheduler: no Dask scheduler answered at {scheduler!r} within {CONNECT_TIMEOUT} "
+                         "(the server accepts connections but does not speak Dask's protocol)")
+    if "error" in box:
+        e = box["error"]
+        raise InputError(f"scheduler: cannot reach a Dask scheduler at {scheduler!r} within "
+                         f"{CONNECT_TIMEOUT} ({type(e).__name__}: {str(e)[:200]})")
+    return box["client"]
+
+
 def _local_cluster(workers: int):
     import logging
 
@@ -355,11 +395,7 @@ def run_screen(
             from distributed import Client
 
             if scheduler is not None:
-                try:
-                    cluster, client = None, Client(str(scheduler), timeout=CONNECT_TIMEOUT)
-                except (OSError, TimeoutError, ValueError) as e:
-                    raise InputError(f"scheduler: cannot reach a Dask scheduler at {scheduler!r} within "
-                                     f"{CONNECT_TIMEOUT} ({type(e).__name__}: {e})") from None
+                cluster, client = None, _connect(Client, str(scheduler))
                 where = str(scheduler)
             else:
                 cluster, client = _local_cluster(int(workers or os.cpu_count() or 1))
