@@ -199,3 +199,20 @@ def test_json_and_text_show_the_singular_reference(tmp_path):
     text = CliRunner().invoke(cli, ["mobility", str(path)], catch_exceptions=False).output
     assert "reference configuration is singular (instantaneous mobility 3 there" in text
     assert "branches through it: 2 of dimension 1" in text
+
+
+def test_a_singular_reference_with_no_second_order_quadric_is_not_an_internal_error(tmp_path):
+    """Found by the fuzzer: three-sps-smpu with its Sm joint moved 1e5 m away: the reference is
+    flagged singular and the tangent cone has no quadric (an empty array); the mobility is still
+    computed (no reshape error)."""
+    import tomllib
+
+    import tomli_w
+
+    path = tmp_path / "far-sm.toml"
+    sm.export("three-sps-smpu", path)
+    d = tomllib.loads(path.read_text())
+    d["limbs"][3]["joints"][0]["point"][0] = 1.0e5
+    path.write_text(tomli_w.dumps(d))
+    r = sm.mobility(str(path), mode="R1+R4+R7")   # the mode of the failing run: mobility 6 (3R3T)
+    assert r.dof_instantaneous == 6

@@ -139,7 +139,9 @@ def _cone(prob: MotionProblem, x0, K: np.ndarray, C: np.ndarray, rng, zero: floa
     H = _quadrics(prob, x0, K, C) if C.shape[1] else np.zeros((0, k, k))
     if not np.all(np.isfinite(H)):
         return [], np.nan
-    scale = float(np.max(np.linalg.norm(H.reshape(H.shape[0], -1), axis=1), initial=0.0))
+    # (no quadric -- no constraint left on the kernel -- or an empty kernel: no obstruction)
+    scale = float(np.max(np.abs(H), initial=0.0)) if H.size == 0 else float(np.max(np.linalg.norm(
+        H.reshape(H.shape[0], -1), axis=1), initial=0.0))
     if scale <= zero:  # no second-order obstruction: every kernel direction is a candidate
         return [K @ (a / np.linalg.norm(a)) for a in starts], 0.0
     found, best = [], np.inf
