@@ -234,7 +234,11 @@ def test_report_and_view_write_their_files(tmp_path):
                     progress=lambda done, total, msg: steps.append((done, total)))
     assert rep.index_html.exists() and rep.results_json.exists()
     written = json.loads(rep.results_json.read_text(encoding="utf-8"))
-    assert written["model"] == "planar-4r" and strict_json(rep) == {k: v for k, v in written.items() if k != "model"}
+    # results.json is the JSON envelope (docs/json.md: schema_version, command, model, length_unit)
+    # around the report's payload, which is what to_dict() gives
+    envelope = ("schema_version", "command", "model", "length_unit")
+    assert written["model"] == "planar-4r" and written["command"] == "report"
+    assert strict_json(rep) == {k: v for k, v in written.items() if k not in envelope}
     assert steps and all(t == steps[0][1] for _, t in steps) and steps[-1][0] <= steps[0][1]
     page = sm.view("rssr", tmp_path / "rssr.html", motion="demo", frames=6)
     assert page.frames == 6 and Path(page.out).stat().st_size == page.bytes
