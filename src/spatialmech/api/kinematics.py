@@ -4,7 +4,7 @@
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -21,7 +21,6 @@ from ..kinematics.position import InverseResult, PoseFit, configuration_at_pose,
 from ..kinematics.task import TaskJacobian, TaskSolution, default_task, task_jacobian_at, task_solution_dict
 from ..model.mechanism import Mechanism, Pose
 from ..model.task import TaskCoordinates
-from ..model.topology import link_graph
 from ..results import Progress
 from ..serialize import pose_dict
 
@@ -354,30 +353,9 @@ def fk(model: ModelLike, actuators, *, all_solutions: bool = False, seeds: int |
     if seed is not None:
         seed = check_int(seed, "seed")
     method = check_choice(method, "method", ("auto", "closed-form", "homotopy", "multistart"))
-    if all_solutions and link_graph(mech).n_loops == 0:
-        return FKResult(mech, values, _serial_forward(mech, values, method, seeds, seed))
     ans = solve_forward(mech, values, all_solutions=all_solutions, method=method, seeds=seeds, seed=seed,
                         progress=optional_progress(progress))
     return FKResult(mech, values, ans)
-
-
-def _serial_forward(mech: Mechanism, values: np.ndarray, method: str, seeds, seed) -> ForwardAnswer:
-    """``fk(all_solutions=True)`` of a serial chain (no closed loop): with every freedom
-    actuated or locked it has exactly one pose, the chain's forward kinematics; with a passive
-    freedom the pose is not determined by the actuators (refused)."""
-    passive = [r.id for r in mech.freedom_refs if not (r.freedom.actuated or r.freedom.locked)]
-    if passive:
-        raise InputError(f"all_solutions: {mech.name} is a serial chain (no closed loop) with passive freedoms "
-                         f"({', '.join(passive)}): the actuators do not determine its pose")
-    given = [n for n, v in (("method", method != "auto"), ("seeds", seeds is not None), ("seed", seed is not None))
-             if v]
-    if given:
-        raise InputError(f"{', '.join(given)}: {mech.name} is a serial chain (no closed loop): with its actuators "
-                         "given it has one pose, nothing to search")
-    ans = solve_forward(mech, values)
-    return replace(ans, all_solutions=True, complete=bool(ans.modes),
-                   completeness="a serial chain (no closed loop): with its actuators given it has one pose, "
-                                "its forward kinematics")
 
 
 # ============================================================================ Jacobian, velocity

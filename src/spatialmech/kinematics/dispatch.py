@@ -29,7 +29,7 @@ every limb's joints) or the general engine (:func:`.position.inverse_position`).
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Literal
 
 import numpy as np
@@ -37,6 +37,7 @@ import numpy as np
 from ..errors import InputError
 from ..geometry.tolerances import Tolerances
 from ..model.mechanism import Mechanism, Pose
+from ..model.topology import link_graph
 from ..results import Progress
 from .assembly import AssemblyKind, SelfMotion
 from .closed_forms.four_sps_cu_forward import ForwardAllResult
@@ -330,6 +331,8 @@ def solve_forward(mech: Mechanism, values, *, all_solutions: bool = False, metho
             raise InputError(f"{', '.join(given)}: only with all_solutions (without it, one Newton solve from the "
                              "reference configuration: no engine to choose, no starts)")
         return _general_answer(mech, values, forward_position(mech, values), False)
+    if link_graph(mech).n_loops == 0:
+        return _serial_answer(mech, values, method, seeds, seed)
     engine = forward_engine(mech, method)
     if engine == "closed-form":
         solver = _closed_form(FORWARD_CLOSED_FORMS, mech)
@@ -342,6 +345,25 @@ def solve_forward(mech: Mechanism, values, *, all_solutions: bool = False, metho
     res = forward_position(mech, values, all_solutions=True, n_seeds=DEFAULT_SEEDS if seeds is None else seeds,
                            seed=0 if seed is None else seed, progress=progress, method=method)
     return _general_answer(mech, values, res, True)
+
+
+def _serial_answer(mech: Mechanism, values, method: str, seeds: int | None, seed: int | None) -> ForwardAnswer:
+    """``all_solutions`` on a serial chain (no closed loop): with every freedom
+    actuated or locked it has exactly one pose, the chain's forward kinematics; with a passive
+    freedom the pose is not determined by the actuators (refused)."""
+    passive = [r.id for r in mech.freedom_refs if not (r.freedom.actuated or r.freedom.locked)]
+    if passive:
+        raise InputError(f"all_solutions: {mech.name} is a serial chain (no closed loop) with passive freedoms "
+                         f"({', '.join(passive)}): the actuators do not determine its pose")
+    given = [n for n, v in (("method", method != "auto"), ("seeds", seeds is not None), ("seed", seed is not None))
+             if v]
+    if given:
+        raise InputError(f"{', '.join(given)}: {mech.name} is a serial chain (no closed loop): with its actuators "
+                         "given it has one pose, nothing to search")
+    ans = solve_forward(mech, values)
+    return replace(ans, all_solutions=True, complete=bool(ans.modes),
+                   completeness="a serial chain (no closed loop): with its actuators given it has one pose, "
+                                "its forward kinematics")
 
 
 # ============================================================================ inverse position
