@@ -54,7 +54,15 @@ def _budget(tolerances) -> ErrorBudget:
 
 
 def _comp(v) -> dict:
-    return {c: (None if not np.isfinite(x) else float(x)) for c, x in zip(COMPONENTS, v, strict=True)}
+    """``{position_len: [dx, dy, dz], rotation_deg: [rx, ry, rz]}`` (``null`` where not finite)."""
+    v = np.asarray(v, dtype=float)
+    out = np.concatenate([v[:3], np.degrees(v[3:])])
+    vals = [None if not np.isfinite(x) else float(x) for x in out]
+    return {"position_len": vals[:3], "rotation_deg": vals[3:]}
+
+
+def _tolerance(p) -> dict:
+    return {"tolerance_len": p.tolerance} if p.unit == "m" else {"tolerance_deg": float(np.degrees(p.tolerance))}
 
 
 @dataclass(frozen=True, eq=False)
@@ -88,39 +96,45 @@ class AccuracyResult:
         return bool(b is not None and b.loses_mobility)
 
     def to_dict(self) -> dict:
-        """JSON (``spatialmech accuracy --json``): per output component (``dx_m`` ... ``rz_rad``) the
-        first-order standard deviation, the worst case over the box and the exact model at its
-        vertex, the Monte-Carlo statistics; the sensitivities by parameter; the mobility check."""
+        """JSON (``spatialmech accuracy --json``, docs/json.md): each estimate as ``position_len``
+        (the output point's dx, dy, dz) and ``rotation_deg`` (the rotation vector): the first-order
+        standard deviation, the worst case over the box and the exact model at its vertex, the
+        Monte-Carlo statistics; each parameter's effect at its tolerance; ``residual``: the relative
+        inconsistency of the first-order solve (redundant constraints); the mobility check (``k``:
+        the tolerance scale that removes a freedom, ``loss_rate``: the deciding singular value per
+        unit scale, ``tol``: the rank tolerance)."""
         a, mech = self.analysis, self.mechanism
         P = platform_pose(mech, self.config)
         mc = a.mc_errors
         n_ok = int(mc.shape[0])
         within = (np.all(np.abs(mc) <= a.worst_case[None, :] * (1 + 1e-9) + 1e-15, axis=0) if n_ok else
                   np.zeros(6, bool))
-        with np.errstate(invalid="ignore", divide="ignore"):
-            ratio = np.where(a.worst_case > 0, a.exact_at_worst / a.worst_case, np.nan)
+        bd = a.breakdown
         return {
             "result": "accuracy",
             "pose": pose_dict(P.R, P.p),
-            "output_point_m": [float(v) for v in P.p],
+            "output_point_len": [float(v) for v in P.p],
             "error_model": ERROR_MODEL,
-            "components": list(COMPONENTS),
-            "parameters": [{"name": p.name, "kind": p.kind, "tolerance": p.tolerance, "unit": p.unit}
-                           for p in a.params],
-            "first_order": {"std": _comp(a.std_first_order),
-                            "distribution": "independent, uniform over each tolerance interval (variance t^2 / 3)",
-                            "sensitivity": {p.name: _comp(a.G[:, i]) for i, p in enumerate(a.params)},
-                            "inconsistency": a.inconsistency},
-            "worst_case": {"bound": _comp(a.worst_case), "method": "sum_i |G_ci| t_i per component (exact for the "
-                           "linearisation: the box vertex t sign(G_c))", "exact_at_vertex": _comp(a.exact_at_worst),
-                           "exact_over_linear": _comp(ratio),
-                           "position_norm_bound_m": float(np.linalg.norm(a.worst_case[:3]))},
-            "monte_carlo": {"samples": a.samples, "assembled": n_ok, "failures": a.mc_failures, "seed": a.seed,
+            "parameters": [{"name": p.name, "kind": p.kind, **_tolerance(p)} for p in a.params],
+            "std_first_order": _comp(a.std_first_order),
+            "first_order_distribution": "independent, uniform over each tolerance interval (variance t^2 / 3)",
+            "worst_case": _comp(a.worst_case),
+            "worst_case_method": "sum_i |G_ci| t_i per component: exact for the linearisation (box vertex t sign(G_c))",
+            "exact_at_worst_vertex": _comp(a.exact_at_worst),
+            "position_norm_bound_len": float(np.linalg.norm(a.worst_case[:3])),
+            "effect_at_tolerance": {p.name: _comp(a.G[:, i] * p.tolerance) for i, p in enumerate(a.params)},
+            "residual": a.inconsistency,
+            "monte_carlo": {"samples": a.samples, "n_converged": n_ok, "failed": a.mc_failures, "seed": a.seed,
                             "mean": _comp(mc.mean(axis=0) if n_ok else np.full(6, np.nan)),
                             "std": _comp(self.std_monte_carlo),
                             "max_abs": _comp(np.abs(mc).max(axis=0) if n_ok else np.full(6, np.nan)),
-                            "within_worst_case": {c: bool(w) for c, w in zip(COMPONENTS, within, strict=True)}},
-            "mobility_under_tolerances": None if a.breakdown is None else a.breakdown.to_dict(),
+                            "within_worst_case": bool(np.all(within))},
+            "mobility_under_tolerances": None if bd is None else {
+                "dof": bd.nominal_dof, "dof_instantaneous": bd.perturbed_dof, "loses_mobility": bd.loses_mobility,
+                "k": bd.breaks_at_scale,
+                "breaks_at_point_len": bd.breaks_at_point_m,
+                "breaks_at_axis_deg": None if bd.breaks_at_axis_rad is None else float(np.degrees(bd.breaks_at_axis_rad)),
+                "loss_rate": bd.rate, "tol": bd.rank_tolerance, "seed": bd.seed, "method": bd.method},
             "pose_fit": None if self.pose_fit is None else self.pose_fit.to_dict(),
         }
 
@@ -184,7 +198,7 @@ def accuracy(model: ModelLike, pose=None, *, tolerances, config: Configuration |
     if mode is not None:
         mech = mech.in_mode(mode)
     elif mech.is_metamorphic:
-        raise InputError(f"mode: {mech.name} is metamorphic with modes {', '.join(m.name for m in mech.all_modes)}; "
+        raise InputError(f"mode: {mech.name} is metamorphic with modes {', '.join(m.name for m in mech.all_modes())}; "
                          "name one")
     degrees = check_bool(degrees, "degrees")
     budget = _budget(tolerances)
