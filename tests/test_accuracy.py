@@ -90,7 +90,7 @@ def test_designs_that_are_not_overconstrained_keep_their_mobility(name):
 
 
 def test_bad_tolerances_are_refused():
-    with pytest.raises(sm.InputError, match="tolerances.geometry"):
+    with pytest.raises(sm.InputError, match=r"tolerances\.geometry"):
         sm.accuracy("stewart-6sps", tolerances={"geometry": -1.0})
     with pytest.raises(sm.InputError, match="unknown key"):
         sm.accuracy("stewart-6sps", tolerances={"points": 1e-5})

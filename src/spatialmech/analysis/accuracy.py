@@ -74,7 +74,6 @@ from ..kinematics.closure import (
     limb_chains,
     limb_slices,
 )
-from ..kinematics.forward import actuator_q
 from ..kinematics.jacobian import complete_jacobian
 from ..model.mechanism import Mechanism
 

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..analysis.accuracy import COMPONENTS, AccuracyAnalysis, ErrorBudget, accuracy_analysis
+from ..analysis.accuracy import AccuracyAnalysis, ErrorBudget, accuracy_analysis
 from ..errors import InputError
 from ..kinematics.closure import Configuration
 from ..kinematics.position import PoseFit, platform_pose
@@ -128,7 +128,7 @@ class AccuracyResult:
                             "mean": _comp(mc.mean(axis=0) if n_ok else np.full(6, np.nan)),
                             "std": _comp(self.std_monte_carlo),
                             "max_abs": _comp(np.abs(mc).max(axis=0) if n_ok else np.full(6, np.nan)),
-                            "within_worst_case": bool(np.all(within))},
+                            "within_worst_case": bool(np.all(within)) if n_ok else None},
             "mobility_under_tolerances": None if bd is None else {
                 "dof": bd.nominal_dof, "dof_instantaneous": bd.perturbed_dof, "loses_mobility": bd.loses_mobility,
                 "k": bd.breaks_at_scale,

@@ -32,8 +32,9 @@ def _text(r) -> list[str]:
     if a.mc_errors.shape[0]:
         lines.append(_row(f"Monte-Carlo std ({a.mc_errors.shape[0]} assembled)", r.std_monte_carlo, u))
         lines.append(_row("Monte-Carlo largest |error|", np.abs(a.mc_errors).max(axis=0), u))
-    lines.append(f"  Monte-Carlo: {a.samples} samples, {a.mc_failures} did not assemble; within the worst case: "
-                 f"{d['monte_carlo']['within_worst_case']}")
+    if a.samples:
+        lines.append(f"  Monte-Carlo: {a.samples} samples, {a.mc_failures} did not assemble; within the worst case: "
+                     f"{d['monte_carlo']['within_worst_case']}")
     if a.inconsistency > 1e-9:
         lines.append(f"  note: redundant constraints: the first-order errors cannot all be absorbed (relative residual "
                      f"{a.inconsistency:.3g}); the design deforms or does not assemble")
