@@ -112,3 +112,18 @@ def test_command_line_text_json_and_plot(tmp_path):
     d = json.loads(r.output)
     assert d["command"] == "accuracy" and d["monte_carlo"]["n_converged"] == 10
     assert {p["kind"] for p in d["parameters"]} == {"actuator", "clearance"}
+
+
+def test_worst_case_equals_the_linear_programme_over_the_box():
+    """sum |G_ci| t_i is the maximum of the linearised error over the box: scipy's LP agrees."""
+    from scipy.optimize import linprog
+
+    r = sm.accuracy("three-rps", ([0, 0, 0.33], None), samples=0, mobility_check=False,
+                    tolerances={"actuator": 1e-5, "geometry": 2e-5, "clearance": 1e-5})
+    a = r.analysis
+    t = np.array([p.tolerance for p in a.params])
+    for c in range(6):
+        lp = linprog(-a.G[c], bounds=list(zip(-t, t, strict=True)), method="highs")
+        assert lp.status == 0
+        assert -lp.fun == pytest.approx(a.worst_case[c], rel=1e-9, abs=1e-18)
+        assert a.G[c] @ a.worst_vertex[c] == pytest.approx(a.worst_case[c], rel=1e-12, abs=1e-18)
