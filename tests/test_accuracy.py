@@ -100,6 +100,7 @@ def test_bad_tolerances_are_refused():
         sm.accuracy("three-rrr-sm", tolerances={"geometry": 1e-5})
 
 
+@pytest.mark.slow
 def test_command_line_text_json_and_plot(tmp_path):
     r = CliRunner().invoke(cli, ["accuracy", "bennett", "--geometry-tolerance", "1e-5", "--samples", "0"],
                            catch_exceptions=False)
