@@ -128,3 +128,15 @@ def test_worst_case_equals_the_linear_programme_over_the_box():
         assert lp.status == 0
         assert -lp.fun == pytest.approx(a.worst_case[c], rel=1e-9, abs=1e-18)
         assert a.G[c] @ a.worst_vertex[c] == pytest.approx(a.worst_case[c], rel=1e-12, abs=1e-18)
+
+
+@pytest.mark.slow
+def test_to_dict_is_the_payload_of_the_command():
+    r = CliRunner().invoke(cli, ["accuracy", "three-rps", "--xyz", "0", "0", "0.33", "--actuator-error", "1e-5",
+                                 "--geometry-tolerance", "1e-5", "--samples", "6", "--seed", "2", "--json"],
+                           catch_exceptions=False)
+    doc = json.loads(r.output)
+    payload = {k: v for k, v in doc.items() if k not in ("schema_version", "command", "model", "length_unit", "plot")}
+    facade = sm.accuracy("three-rps", ([0, 0, 0.33], None), samples=6, seed=2,
+                         tolerances={"actuator": 1e-5, "geometry": 1e-5, "clearance": 0.0})
+    assert json.loads(json.dumps(facade.to_dict(), allow_nan=False)) == payload
