@@ -273,9 +273,10 @@ def sensitivity(mech: Mechanism, config: Configuration, params: list[Parameter])
     L = mech.characteristic_length
     scale = np.concatenate([np.full(3, 1.0), np.full(3, L)])  # solve for (omega ; v / L): scale-free
     Ms = M * scale[None, :]
-    if Ms.shape[0] < 6 or np.linalg.matrix_rank(Ms) < 6:
-        raise InputError(f"{mech.name}: the complete Jacobian has rank < 6 here (a singular pose, or fewer constraint "
-                         "and actuation wrenches than 6): the output error is not determined")
+    if Ms.shape[0] < 6 or jac.sigma_min < current().singular:
+        raise InputError(f"{mech.name}: the complete Jacobian is singular here (scale-free sigma_min "
+                         f"{jac.sigma_min:.3g} < {current().singular:g}, or fewer constraint and actuation wrenches "
+                         "than 6): the output error is not determined")
     X, *_ = np.linalg.lstsq(Ms, rhs, rcond=None)
     inconsistency = 0.0
     if Ms.shape[0] > 6:
@@ -429,6 +430,7 @@ class AccuracyAnalysis:
     mc_failures: int
     seed: int
     breakdown: MobilityBreakdown | None
+    inconsistent: bool = False  # inconsistency above the rank tolerance: errors the design cannot absorb
 
 
 def _mc(mech: Mechanism, config: Configuration, params: list[Parameter], G: np.ndarray, n: int, seed: int):
@@ -481,4 +483,4 @@ def accuracy_analysis(mech: Mechanism, config: Configuration, budget: ErrorBudge
     mc, fails = _mc(mech, config, params, G, samples, seed) if samples else (np.zeros((0, 6)), 0)
     bd = mobility_breakdown(mech, params, seed=seed) if breakdown else None
     return AccuracyAnalysis(tuple(params), G, inc, wc, vert, exact, np.sqrt(np.diag(cov)), cov, samples, mc, fails,
-                            seed, bd)
+                            seed, bd, inc > current().rank)

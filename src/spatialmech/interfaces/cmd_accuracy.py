@@ -35,7 +35,7 @@ def _text(r) -> list[str]:
     if a.samples:
         lines.append(f"  Monte-Carlo: {a.samples} samples, {a.mc_failures} did not assemble; within the worst case: "
                      f"{d['monte_carlo']['within_worst_case']}")
-    if a.inconsistency > 1e-9:
+    if a.inconsistent:
         lines.append(f"  note: redundant constraints: the first-order errors cannot all be absorbed (relative residual "
                      f"{a.inconsistency:.3g}); the design deforms or does not assemble")
     b = a.breakdown
