@@ -21,13 +21,13 @@ print(f"reference pose, leg errors +-{t:g} m: worst z error {r.worst_case[2]:.4g
 
 # 2. a tilted pose, every source: legs, clearances of the R and S joints, joint points and axes
 pose = ([0, 0, 0.33], ("ZYX", 0, 5, 5))  # pitch and roll 5 deg; the parasitic x, y, yaw are fitted
-r = sm.accuracy("three-rps", pose, degrees=True, samples=150, seed=1,
+r = sm.accuracy("three-rps", pose, degrees=True, samples=100, seed=1,
                 tolerances={"actuator": t, "clearance": t, "geometry": t})
 a = r.analysis
 kinds = sorted({p.kind for p in a.params})
 assert kinds == ["actuator", "axis", "clearance", "point"] and a.mc_failures == 0
 assert np.all(np.abs(a.mc_errors) <= r.worst_case)
-assert np.all(np.abs(r.std_monte_carlo / r.std_first_order - 1) < 0.3)  # 150 samples
+assert np.all(np.abs(r.std_monte_carlo / r.std_first_order - 1) < 0.3)  # 100 samples: about 7 % sampling error
 assert not r.loses_mobility  # a 3-RPS is not overconstrained
 print(f"tilted pose, {len(a.params)} error sources ({', '.join(kinds)}):")
 for name, wc, sd, mc in zip(("dx", "dy", "dz"), r.worst_case, r.std_first_order, r.std_monte_carlo, strict=False):
