@@ -95,6 +95,8 @@ CASES = [
     (["statics", "four-sps-cu", "--wrench", "0,0,-10,0,0,1", *POSE], "statics", "four-sps-cu"),
     (["statics", "four-sps-cu", "--wrench", "0,0,-10,0,0,1"], "statics", "four-sps-cu"),  # singular: unbalanced
     (["statics", "delta", "--wrench=-1,0,-10,0,0,0", "--xyz", "0.02", "0.01", "-0.33"], "statics", "delta"),  # graph
+    (["accuracy", "three-rps", "--xyz", "0", "0", "0.33", "--actuator-error", "1e-5", "--geometry-tolerance", "1e-5",
+      "--clearance", "1e-5", "--samples", "4"], "accuracy", "three-rps"),
     (["stiffness", "stewart-6sps", "--k", "2e6"], "stiffness", "stewart-6sps"),
     (["stiffness", "three-rps", "--k", "1e6", "--kc", "leg1=1e8", "--pose", "0,0,0.33,ZYX,0,5,5"], "stiffness", "three-rps"),
     (["stiffness", "four-sps-cu"], "stiffness", "four-sps-cu"),  # singular at the reference: compliance null

@@ -32,6 +32,7 @@ from .results import Progress, TrackStatus
 
 if TYPE_CHECKING:  # what mypy sees; at run time :func:`__getattr__` imports these on first use
     from .api import (
+        accuracy,
         announce_compilation,
         default_tolerance,
         defects,
@@ -95,6 +96,7 @@ __all__ = [
     "U",
     "UnknownNameError",
     "__version__",
+    "accuracy",
     "announce_compilation",
     "closed_forms",
     "default_tolerance",

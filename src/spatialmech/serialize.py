@@ -94,6 +94,7 @@ UNIT_FREE_KEYS: dict[str, str] = {
     "dof": "degrees of freedom",
     "dof_instantaneous": "instantaneous degrees of freedom (rank of the closure Jacobian)",
     "dof_at_reference": "instantaneous degrees of freedom at the reference configuration itself (mobility)",
+    "loss_rate": "accuracy: the singular value that removes a freedom, per unit tolerance scale (scale-free)",
     "local_dof": "largest dimension of the branches through the reference (mobility; null: undecided)",
     "dimension": "dimension of a branch of closed configurations (its degrees of freedom)",
     "expected_rank": "rank of a non-singular wrench system",

@@ -494,7 +494,7 @@ def performance_map(mech: Mechanism, *, kind: str = "position", over: Mapping, a
         out, va, fa, status = pose_loop(mech, R, p, checker)
         path = "python per-pose loop"
     else:
-        status, _ = _statuses(checker, R, p)
+        status, violated = _statuses(checker, R, p)
         plan = closed_form_plan(mech)
         if isinstance(plan, dict):
             out, va, fa = _batched_closed(mech, R, p, status, fast, plan)
@@ -503,11 +503,15 @@ def performance_map(mech: Mechanism, *, kind: str = "position", over: Mapping, a
             out, va, fa = _batched_general(mech, R, p, status, fast)
             path = "compiled indices, batched inverse position"
     seconds = time.perf_counter() - t0
-    violated = [""] * R.shape[0]
-    bad = np.flatnonzero(status >= OUTSIDE)
-    if bad.size:
-        for i, name in zip(bad, checker.violated(R[bad], p[bad]), strict=True):
-            violated[i] = name or "closure"
+    if method == "loop" or fast is None:
+        violated = [""] * R.shape[0]
+        bad = np.flatnonzero(status >= OUTSIDE)
+        if bad.size:
+            for i, name in zip(bad, checker.violated(R[bad], p[bad]), strict=True):
+                violated[i] = name or "closure"
+    else:  # the limits were named once by _statuses; cells the kernel found degenerate do not close
+        for i in np.flatnonzero(status >= OUTSIDE):
+            violated[i] = violated[i] or "closure"
     values = {name: out[:, k].reshape(shape) for k, name in enumerate(SCALARS)}
     values["velocity_axes"] = va.reshape(*shape, -1)
     values["force_axes"] = fa.reshape(*shape, -1)

@@ -59,6 +59,7 @@ if TYPE_CHECKING:  # what mypy (and a reader) sees; at run time __getattr__ impo
         WORKSPACE_COORDINATES as WORKSPACE_COORDINATES,
         WORKSPACE_MAX_POSES as WORKSPACE_MAX_POSES,
     )
+    from .accuracy import AccuracyResult, accuracy
     from .forces import StaticsResult, statics
     from .kinematics import (
         FKResult,
@@ -86,6 +87,7 @@ if TYPE_CHECKING:  # what mypy (and a reader) sees; at run time __getattr__ impo
 _LAZY: dict[str, str] = {
     **dict.fromkeys(("Mechanism", "Pose"), "..model.mechanism"),
     **dict.fromkeys(("ModelLike",), ".checks"),
+    **dict.fromkeys(("AccuracyResult", "accuracy"), ".accuracy"),
     **dict.fromkeys(("StaticsResult", "statics"), ".forces"),
     **dict.fromkeys(("FKResult", "IKResult", "JacobianResult", "VelocityResult", "fk", "ik", "jacobian", "velocity"),
                     ".kinematics"),
@@ -104,6 +106,7 @@ _LAZY: dict[str, str] = {
 }
 
 __all__ = [
+    "AccuracyResult",
     "CSSynthesisResult",
     "DefectAnalysis",
     "ExportResult",
@@ -121,6 +124,7 @@ __all__ = [
     "TraceResult",
     "VelocityResult",
     "ViewResult",
+    "accuracy",
     "announce_compilation",
     "default_tolerance",
     "defects",

@@ -279,6 +279,7 @@ def report(model, out, no_trace, as_json):
         click.echo(f"report written to {out / 'index.html'} and {out / 'results.json'}")
 
 
+from .cmd_accuracy import accuracy_cmd  # noqa: E402
 from .cmd_defects import defects  # noqa: E402
 from .cmd_kinematics import fk, ik, jacobian  # noqa: E402  (commands defined in their own modules)
 from .cmd_maps import maps_cmd  # noqa: E402
@@ -297,6 +298,7 @@ for _cmd in (ik, fk, jacobian, parasitic_cmd, synth, view, defects, workspace, s
              statics_cmd, maps_cmd):
     cli.add_command(_cmd)
 cli.add_command(stiffness_cmd)
+cli.add_command(accuracy_cmd)
 
 
 def main(argv=None):  # console-script entry point

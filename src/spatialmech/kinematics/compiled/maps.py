@@ -23,48 +23,59 @@ N_SCALARS = 7
 
 
 @njit(cache=True)
-def nb_singular_values(A, out):
-    """Singular values (descending) of ``A`` (m, n) into ``out`` (min(m, n)): one-sided Jacobi."""
+def nb_singular_values(A, B, out):
+    """Singular values (descending) of ``A`` (m, n), ``m <= n``, into ``out[:m]``: one-sided
+    (Hestenes) Jacobi rotations of its rows (sv(A) = sv(A^T): contiguous rows), in the scratch
+    ``B`` (at least (m, n)), no allocation; rows whose cosine is below 1e-15 count as orthogonal."""
     m, n = A.shape
-    B = A.copy() if m >= n else A.T.copy()
-    r, c = B.shape
-    nrm = np.empty(c)
+    for i in range(m):
+        for j in range(n):
+            B[i, j] = A[i, j]
     for _sweep in range(60):
-        for j in range(c):  # squared column norms, refreshed each sweep and updated by each rotation
-            s = 0.0
-            for i in range(r):
-                s += B[i, j] * B[i, j]
-            nrm[j] = s
-        rotated = False
-        for p in range(c - 1):
-            for q in range(p + 1, c):
-                alpha = nrm[p]
-                beta = nrm[q]
+        worst = 0.0  # the largest |cos| between two rows that this sweep rotated
+        for p in range(m - 1):
+            for q in range(p + 1, m):
+                alpha = 0.0
+                beta = 0.0
                 gamma = 0.0
-                for i in range(r):
-                    gamma += B[i, p] * B[i, q]
-                if gamma == 0.0 or abs(gamma) <= 1e-15 * np.sqrt(alpha * beta):
+                for j in range(n):
+                    bp = B[p, j]
+                    bq = B[q, j]
+                    alpha += bp * bp
+                    beta += bq * bq
+                    gamma += bp * bq
+                if gamma == 0.0:
                     continue
-                rotated = True
+                cosine = abs(gamma) / np.sqrt(alpha * beta)
+                if cosine <= 1e-15:
+                    continue
+                worst = max(worst, cosine)
                 zeta = (beta - alpha) / (2.0 * gamma)
                 t = (1.0 if zeta >= 0.0 else -1.0) / (abs(zeta) + np.sqrt(1.0 + zeta * zeta))
                 cs = 1.0 / np.sqrt(1.0 + t * t)
                 sn = cs * t
-                for i in range(r):
-                    bp = B[i, p]
-                    bq = B[i, q]
-                    B[i, p] = cs * bp - sn * bq
-                    B[i, q] = sn * bp + cs * bq
-                nrm[p] = alpha - t * gamma
-                nrm[q] = beta + t * gamma
-        if not rotated:
+                for j in range(n):
+                    bp = B[p, j]
+                    bq = B[q, j]
+                    B[p, j] = cs * bp - sn * bq
+                    B[q, j] = sn * bp + cs * bq
+        # a sweep whose rotations were all below 1e-8 leaves every pair orthogonal to ~1e-16 (each
+        # rotation zeroes its pair and moves the others by products of two such cosines): no
+        # confirming sweep needed
+        if worst < 1e-8:
             break
-    for j in range(c):
+    for i in range(m):
         s = 0.0
-        for i in range(r):
+        for j in range(n):
             s += B[i, j] * B[i, j]
-        out[j] = np.sqrt(s)
-    out[:c] = np.sort(out[:c])[::-1]
+        out[i] = np.sqrt(s)
+    for i in range(1, m):  # insertion sort, descending
+        v = out[i]
+        k = i - 1
+        while k >= 0 and out[k] < v:
+            out[k + 1] = out[k]
+            k -= 1
+        out[k + 1] = v
 
 
 @njit(cache=True)
@@ -106,46 +117,40 @@ def nb_power(W, T, L):
 
 
 @njit(cache=True)
-def nb_pivot(G, c):
-    """Swap into row ``c`` the row (from ``c`` down) with the largest ``|G[., c]|``; False if it is 0."""
-    piv = c
-    for i in range(c + 1, G.shape[0]):
-        if abs(G[i, c]) > abs(G[piv, c]):
-            piv = i
-    if G[piv, c] == 0.0:
-        return False
-    if piv != c:
-        for j in range(G.shape[1]):
-            tmp = G[c, j]
-            G[c, j] = G[piv, j]
-            G[piv, j] = tmp
-    return True
-
-
-@njit(cache=True)
-def nb_inverse6(A, X):
-    """``X = A^-1`` (6, 6) by Gauss-Jordan elimination with partial pivoting; False if a pivot is 0."""
+def nb_inverse6(A, G, X):
+    """``X = A^-1`` (6, 6) by Gauss-Jordan elimination with partial pivoting, ``G`` (6, 6) scratch
+    (ends as the identity); False if a pivot is 0."""
     n = 6
-    G = np.empty((n, 2 * n))
     for i in range(n):
         for j in range(n):
             G[i, j] = A[i, j]
-            G[i, n + j] = 1.0 if i == j else 0.0
+            X[i, j] = 1.0 if i == j else 0.0
     for c in range(n):
-        if not nb_pivot(G, c):
+        piv = c
+        for i in range(c + 1, n):
+            if abs(G[i, c]) > abs(G[piv, c]):
+                piv = i
+        if G[piv, c] == 0.0:
             return False
+        if piv != c:
+            for j in range(n):
+                tmp = G[c, j]
+                G[c, j] = G[piv, j]
+                G[piv, j] = tmp
+                tmp = X[c, j]
+                X[c, j] = X[piv, j]
+                X[piv, j] = tmp
         p = G[c, c]
-        for j in range(2 * n):
+        for j in range(n):
             G[c, j] /= p
+            X[c, j] /= p
         for i in range(n):
             if i != c:
                 f = G[i, c]
                 if f != 0.0:
-                    for j in range(2 * n):
+                    for j in range(n):
                         G[i, j] -= f * G[c, j]
-    for i in range(n):
-        for j in range(n):
-            X[i, j] = G[i, n + j]
+                        X[i, j] -= f * X[c, j]
     return True
 
 
@@ -162,26 +167,32 @@ def nb_project_out(x, Q, nq):
 
 
 @njit(cache=True)
-def nb_ellipsoids(Jn, Jr, nc, out, vaxes, faxes):
+def nb_ellipsoids(Jn, Jr, nc, out, vaxes, faxes, work, vec):
     """Velocity / force ellipsoids on the motion subspace: the actuation rows ``Jn[nc:]`` projected
-    off the constraint rows; ``out[2]`` the manipulability."""
+    off the constraint rows; ``out[2]`` the manipulability.  Scratch: ``work`` (>= 3, 6, 6),
+    ``vec`` (>= 1, 6)."""
     na = 6 - nc
-    Q = np.zeros((6, 6))
+    Q = work[0]
+    Kt = work[1]  # rows: the projected actuation rows (the columns of K)
     nq = 0
     for i in range(nc):
-        x = Jr[i].copy()
-        nb_project_out(x, Q, nq)
-        nx = np.sqrt(np.sum(x * x))
+        for c in range(6):
+            Q[nq, c] = Jr[i, c]
+        nb_project_out(Q[nq], Q, nq)
+        nx = 0.0
+        for c in range(6):
+            nx += Q[nq, c] * Q[nq, c]
+        nx = np.sqrt(nx)
         if nx > 1e-12:
-            Q[nq] = x / nx
+            for c in range(6):
+                Q[nq, c] /= nx
             nq += 1
-    K = np.empty((6, na))
     for a in range(na):
-        x = Jn[nc + a].copy()
-        nb_project_out(x, Q, nq)
-        K[:, a] = x
-    fs = np.empty(na)
-    nb_singular_values(K, fs)
+        for c in range(6):
+            Kt[a, c] = Jn[nc + a, c]
+        nb_project_out(Kt[a], Q, nq)
+    fs = vec[0]
+    nb_singular_values(Kt[:na], work[2], fs)
     prod = 1.0
     for a in range(na):
         faxes[a] = fs[a]
@@ -208,11 +219,14 @@ def nb_cofactor_twist(Jr, i, y):
 
 
 @njit(cache=True)
-def nb_transmission(M, Jr, sigma_min, nc, inputs, L, out):
+def nb_transmission(M, Jr, sigma_min, nc, inputs, L, out, work, vec):
     """ITI, OTI, LTI, LCI into ``out[3:7]``: power coefficients of each row's wrench with the
-    actuated joint's twist (ITI) and with the twist reciprocal to every other row (OTI, LCI)."""
+    actuated joint's twist (ITI) and with the twist reciprocal to every other row (OTI, LCI).
+    Scratch: ``work`` (>= 2, 6, 6), ``vec`` (>= 3, 6)."""
     na = 6 - nc
-    W = np.empty(6)
+    W = vec[0]
+    y = vec[1]
+    T = vec[2]
     iti = 1.0
     for a in range(na):
         for c in range(3):
@@ -221,24 +235,24 @@ def nb_transmission(M, Jr, sigma_min, nc, inputs, L, out):
         iti = min(iti, nb_power(W, inputs[a], L))
     oti = 1.0
     lci = 1.0
-    y = np.empty(6)
-    T = np.empty(6)
-    X = np.empty((6, 6))
+    X = work[0]
     # column i of Jr^-1 is the cofactor twist up to scale and sign (which the power coefficient
     # ignores); near a singularity the cofactors themselves
-    by_inverse = sigma_min > 1e-6 and nb_inverse6(Jr, X)
+    by_inverse = sigma_min > 1e-6 and nb_inverse6(Jr, work[1], X)
     for i in range(6):
         if by_inverse:
-            y[:] = X[:, i]
+            for c in range(6):
+                y[c] = X[c, i]
         else:
             nb_cofactor_twist(Jr, i, y)
-        ny = np.sqrt(np.sum(y * y))
+        ny = 0.0
         for c in range(3):
             W[c] = M[i, 3 + c]
             W[3 + c] = M[i, c]
             T[c] = y[c]
             T[3 + c] = y[3 + c] * L
-        z = nb_power(W, T, L) if ny > 1e-13 else 0.0
+            ny += y[c] * y[c] + y[3 + c] * y[3 + c]
+        z = nb_power(W, T, L) if np.sqrt(ny) > 1e-13 else 0.0
         if i < nc:
             lci = min(lci, z)
         else:
@@ -250,32 +264,38 @@ def nb_transmission(M, Jr, sigma_min, nc, inputs, L, out):
 
 
 @njit(cache=True)
-def nb_indices(M, nc, inputs, act_scale, L, out, vaxes, faxes):
+def nb_indices(M, nc, inputs, act_scale, L, out, vaxes, faxes, work, vec):
     """The indices of one square complete Jacobian ``M`` (6, 6) (rows ``(moment ; force)``, the
     first ``nc`` the constraints), the actuated joints' twists ``inputs`` (na, 6) and the rate
-    scale of each actuator (L for a slide, 1 for a rotation): :func:`..analysis.maps.pose_indices`."""
-    Jn = M.copy()
-    Jn[:, 3:] *= L
-    for a in range(6 - nc):
-        Jn[nc + a] /= act_scale[a]
-    Jr = Jn.copy()
+    scale of each actuator (L for a slide, 1 for a rotation): :func:`..analysis.maps.pose_indices`.
+    Scratch (allocated once by the caller): ``work`` (5, 6, 6), ``vec`` (4, 6)."""
+    Jn = work[3]
+    Jr = work[4]
     for i in range(6):
-        s = np.sqrt(np.sum(Jr[i] * Jr[i]))
-        if s > 0.0:
-            Jr[i] /= s
-    sv = np.empty(6)
-    nb_singular_values(Jr, sv)
+        s = 1.0 if i < nc else act_scale[i - nc]
+        nrm = 0.0
+        for c in range(6):
+            v = (M[i, c] if c < 3 else M[i, c] * L) / s
+            Jn[i, c] = v
+            nrm += v * v
+        nrm = np.sqrt(nrm)
+        for c in range(6):
+            Jr[i, c] = Jn[i, c] / nrm if nrm > 0.0 else Jn[i, c]
+    sv = vec[3]
+    nb_singular_values(Jr, work[0], sv)
     out[0] = sv[5]
     out[1] = sv[5] / sv[0] if sv[0] > 0.0 else 0.0
-    nb_ellipsoids(Jn, Jr, nc, out, vaxes, faxes)
-    nb_transmission(M, Jr, sv[5], nc, inputs, L, out)
+    nb_ellipsoids(Jn, Jr, nc, out, vaxes, faxes, work, vec)
+    nb_transmission(M, Jr, sv[5], nc, inputs, L, out, work, vec)
 
 
 @njit(cache=True)
 def nb_indices_many(Ms, nc, inputs, act_scale, L, out, vaxes, faxes):
     """:func:`nb_indices` of many Jacobians ``Ms`` (N, 6, 6) and inputs (N, na, 6)."""
+    work = np.empty((5, 6, 6))
+    vec = np.empty((4, 6))
     for s in range(Ms.shape[0]):
-        nb_indices(Ms[s], nc, inputs[s], act_scale, L, out[s], vaxes[s], faxes[s])
+        nb_indices(Ms[s], nc, inputs[s], act_scale, L, out[s], vaxes[s], faxes[s], work, vec)
 
 
 @njit(cache=True)
@@ -332,21 +352,21 @@ def nb_rref_rows(A, rank_tol, pivot_tol):
 
 
 @njit(cache=True)
-def nb_cu_rows(R, p, pb, e1, e2, L, rank_tol, pivot_tol, M, row):
+def nb_cu_rows(R, p, pb, e1, e2, L, rank_tol, pivot_tol, M, row, C):
     """The two constraint rows of a C-U column at ``M[row]``, ``M[row + 1]``: forces through the
-    U centre ``R pb + p`` perpendicular to the column, basis in reduced row-echelon form."""
-    C = np.empty((2, 6))
-    u = np.empty(3)
-    for c in range(3):
-        u[c] = R[c, 0] * pb[0] + R[c, 1] * pb[1] + R[c, 2] * pb[2] + p[c]
+    U centre ``R pb + p`` perpendicular to the column, basis in reduced row-echelon form
+    (``C`` (2, 6) scratch)."""
+    u0 = R[0, 0] * pb[0] + R[0, 1] * pb[1] + R[0, 2] * pb[2] + p[0]
+    u1 = R[1, 0] * pb[0] + R[1, 1] * pb[1] + R[1, 2] * pb[2] + p[1]
+    u2 = R[2, 0] * pb[0] + R[2, 1] * pb[1] + R[2, 2] * pb[2] + p[2]
     for b in range(2):
         e = e1 if b == 0 else e2
         C[b, 0] = e[0]
         C[b, 1] = e[1]
         C[b, 2] = e[2]
-        C[b, 3] = (u[1] * e[2] - u[2] * e[1]) / L
-        C[b, 4] = (u[2] * e[0] - u[0] * e[2]) / L
-        C[b, 5] = (u[0] * e[1] - u[1] * e[0]) / L
+        C[b, 3] = (u1 * e[2] - u2 * e[1]) / L
+        C[b, 4] = (u2 * e[0] - u0 * e[2]) / L
+        C[b, 5] = (u0 * e[1] - u1 * e[0]) / L
     good = nb_rref_rows(C, rank_tol, pivot_tol) == 2
     for b in range(2):
         for c in range(3):  # matrix row: (moment ; force)
@@ -363,16 +383,22 @@ def nb_maps_closed(R, p, kind, pa, pb, e1, e2, act_limb, act_scale, nc, L, rank_
     actuated along the leg) or 1 (a C-U column: constraint forces through ``R pb[k] + p``
     perpendicular to the column, spanned by ``e1[k]``, ``e2[k]``, basis put in reduced row-echelon
     form as :func:`..jacobian.limb_constraint_wrenches` does).  ``ok[s]`` False: a degenerate
-    pose (a leg of zero length, a constraint basis of the wrong rank); the caller decides."""
+    pose (a leg of zero length, a constraint basis of the wrong rank); the caller decides.
+    Every scratch array is allocated once, before the loop."""
     na = act_limb.shape[0]
     M = np.empty((6, 6))
     inp = np.zeros((na, 6))
+    C = np.empty((2, 6))
+    work = np.empty((5, 6, 6))
+    vec = np.empty((4, 6))
     for s in range(R.shape[0]):
         ok[s] = True
+        Rs = R[s]
+        ps = p[s]
         row = 0
         for k in range(kind.shape[0]):
             if kind[k] == 1:
-                if not nb_cu_rows(R[s], p[s], pb[k], e1[k], e2[k], L, rank_tol, pivot_tol, M, row):
+                if not nb_cu_rows(Rs, ps, pb[k], e1[k], e2[k], L, rank_tol, pivot_tol, M, row, C):
                     ok[s] = False
                 row += 2
         if row != nc:
@@ -381,23 +407,29 @@ def nb_maps_closed(R, p, kind, pa, pb, e1, e2, act_limb, act_scale, nc, L, rank_
         for a in range(na):
             k = act_limb[a]
             B = pa[k]
-            d = np.empty(3)
-            for c in range(3):
-                d[c] = R[s, c, 0] * pb[k, 0] + R[s, c, 1] * pb[k, 1] + R[s, c, 2] * pb[k, 2] + p[s, c] - B[c]
-            ln = np.sqrt(np.sum(d * d))
+            P = pb[k]
+            d0 = Rs[0, 0] * P[0] + Rs[0, 1] * P[1] + Rs[0, 2] * P[2] + ps[0] - B[0]
+            d1 = Rs[1, 0] * P[0] + Rs[1, 1] * P[1] + Rs[1, 2] * P[2] + ps[1] - B[1]
+            d2 = Rs[2, 0] * P[0] + Rs[2, 1] * P[1] + Rs[2, 2] * P[2] + ps[2] - B[2]
+            ln = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
             if not ln > 1e-12 * L:
                 ok[s] = False
                 break
-            u = d / ln
-            mom = np.cross(B, u)
-            for c in range(3):
-                M[nc + a, c] = mom[c]
-                M[nc + a, 3 + c] = u[c]
-                inp[a, c] = 0.0
-                inp[a, 3 + c] = u[c]
+            u0 = d0 / ln
+            u1 = d1 / ln
+            u2 = d2 / ln
+            M[nc + a, 0] = B[1] * u2 - B[2] * u1  # moment B x u
+            M[nc + a, 1] = B[2] * u0 - B[0] * u2
+            M[nc + a, 2] = B[0] * u1 - B[1] * u0
+            M[nc + a, 3] = u0
+            M[nc + a, 4] = u1
+            M[nc + a, 5] = u2
+            inp[a, 3] = u0
+            inp[a, 4] = u1
+            inp[a, 5] = u2
         if not ok[s]:
             continue
-        nb_indices(M, nc, inp, act_scale, L, out[s], vaxes[s], faxes[s])
+        nb_indices(M, nc, inp, act_scale, L, out[s], vaxes[s], faxes[s], work, vec)
 
 
 def indices_many(Ms, nc: int, inputs, act_scale, L: float):
