@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...errors import InputError
+from ...geometry.tolerances import INVERSE_SINGULAR, NEAR_INVERSE_SINGULAR
 from ...kinematics.closure import Configuration
 from ...kinematics.jacobian import complete_jacobian
 from ...kinematics.position import within_limits
@@ -37,7 +38,7 @@ from ...model.mechanism import Mechanism
 from ...model.task import TASK_NAMES, TaskCoordinates
 from ...results import DriveStatus
 
-__all__ = ["MAX_JOINT_STEP", "MIN_STEP", "PosePath", "pose_path"]
+__all__ = ["MAX_JOINT_STEP", "MIN_STEP", "PosePath", "pose_path", "transmission_readout"]
 
 #: Largest change of any joint in one continuation step (rad; slides in characteristic lengths).
 MAX_JOINT_STEP = 0.15
@@ -48,7 +49,7 @@ MAX_STEP = 0.05
 #: Largest number of continuation steps per request.
 MAX_STEPS = 400
 #: Actuation transmission below which a limb is called singular where the steps stop.
-LIMB_SINGULAR_TRANSMISSION = 0.05
+LIMB_SINGULAR_TRANSMISSION = INVERSE_SINGULAR
 
 
 @dataclass
@@ -165,3 +166,19 @@ def _edge(mech: Mechanism, cur: Configuration, passed: list, steps: int) -> Pose
                         f"{t:.2g}): the edge of the workspace of this branch; stopped there", cur, passed, steps=steps)
     return PosePath(DriveStatus.UNREACHABLE, "the requested pose is not reachable along this branch (no closed configuration "
                     "beyond this one); stopped at the last reachable pose", cur, passed, steps=steps)
+
+
+def transmission_readout(J) -> dict:
+    """The inverse (transmission) light of the studio beside the direct one (``sigma_min``):
+    each actuator's transmission index ``|W.$a| / (|W| |$a|)`` of the complete Jacobian ``J``
+    (0 where the actuation wrench does not exist: an inverse singularity), the smallest, which
+    actuator it is, and the colour class: ``inverse_singular`` below :data:`INVERSE_SINGULAR`
+    (the level where a pose drag reports ``limb_singular``), ``near_inverse_singular`` below
+    :data:`NEAR_INVERSE_SINGULAR`."""
+    trans = {a: 0.0 for a in J.inverse_singular}
+    trans.update((a, float(t)) for a, t in zip(J.actuators, J.transmission or (), strict=False) if a not in trans)
+    worst = min(trans.items(), key=lambda kv: kv[1]) if trans else (None, None)
+    low = worst[1] if worst[1] is not None else 1.0
+    return {"transmission": trans, "transmission_min": worst[1], "transmission_min_actuator": worst[0],
+            "inverse_singular": bool(low < INVERSE_SINGULAR), "near_inverse_singular": bool(low < NEAR_INVERSE_SINGULAR),
+            "near_inverse_singular_below": NEAR_INVERSE_SINGULAR, "inverse_singular_below": INVERSE_SINGULAR}
