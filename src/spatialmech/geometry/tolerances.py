@@ -201,7 +201,7 @@ NEAR_SINGULAR = 0.02
 #: singular where a studio pose drag cannot go on (``limb_singular``), and the studio's inverse
 #: light turns red; below :data:`NEAR_INVERSE_SINGULAR` it is amber (a reading aid, as above).
 INVERSE_SINGULAR = 0.05
-NEAR_INVERSE_SINGULAR = 0.2
+NEAR_INVERSE_SINGULAR = 0.1
 
 #: Points whose spread is below this, relative to their coordinates, are the same point (round-off).
 _SAME_POINT = 1e-13
