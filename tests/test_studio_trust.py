@@ -11,6 +11,8 @@
    with ``limb_singular`` shows it red while sigma_min is far from singular.
 """
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from fastapi.testclient import TestClient
@@ -100,8 +102,8 @@ def test_a_repeated_stop_is_logged_once_and_the_page_list_is_bounded():
     back = client.post("/api/drive", json={"actuators": [a0 - 250.0]}).json()
     assert [e["name"] for e in back["events"]].count("DJ (drivers)") == 1  # a new approach is logged again
     assert EVENT_LOG_MAX == 100
-    js = (sm.__path__[0] + "/interfaces/studio/static/studio.js")
-    assert "EVENT_LOG_MAX = 100" in open(js).read()
+    js = Path(sm.__path__[0]) / "interfaces" / "studio" / "static" / "studio.js"
+    assert "EVENT_LOG_MAX = 100" in js.read_text()
 
 
 def test_six_rus_pose_drag_shows_the_inverse_light_red_where_it_stops():

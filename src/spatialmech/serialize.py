@@ -256,7 +256,7 @@ UNIT_FREE_KEYS: dict[str, str] = {
     "limb_index": "index of a limb (from 0)",
     "mode_number": "assembly mode number (from 1)",
     "near_singular_below": "sigma_min below which the studio warns of a nearby singularity",
-    "dj_rate": "a single driver's share of its linkage's motion, |rate| along the unit tangent (scale-free, 0 where it loses control)",
+    "dj_rate": "a single driver's share of its linkage's motion: absolute rate along the unit tangent (0: no control)",
     "transmission_min": "the smallest transmission index of the actuators, in [0, 1] (studio inverse light)",
     "inverse_singular_below": "transmission index below which the studio calls a limb inversely singular",
     "near_inverse_singular_below": "transmission index below which the studio warns of a nearby inverse singularity",

@@ -175,7 +175,7 @@ def transmission_readout(J) -> dict:
     actuator it is, and the colour class: ``inverse_singular`` below :data:`INVERSE_SINGULAR`
     (the level where a pose drag reports ``limb_singular``), ``near_inverse_singular`` below
     :data:`NEAR_INVERSE_SINGULAR`."""
-    trans = {a: 0.0 for a in J.inverse_singular}
+    trans = dict.fromkeys(J.inverse_singular, 0.0)
     trans.update((a, float(t)) for a, t in zip(J.actuators, J.transmission or (), strict=False) if a not in trans)
     worst = min(trans.items(), key=lambda kv: kv[1]) if trans else (None, None)
     low = worst[1] if worst[1] is not None else 1.0

@@ -513,12 +513,10 @@ class Session:
         events = []
         step_of: dict[int, int] = {}  # event -> index of the tracked point its step starts from
         own_crossed = None
-        for e in r.events:
+        for e in _real_events(r.events, names, noise_scale):
             xe = cast(np.ndarray, e.x)  # the drag problem's points are vectors (the pose's x, lambda)
             if float(xe[1]) > ell:  # in the overshoot of the last step: not on the way to the target
                 continue
-            if e.name in names and is_noise(e.value_before, e.value_after, noise_scale):
-                continue  # a sign change of round-off (a rate or DJ that is zero on the whole path)
             a_e = a0 + (float(xe[1]) / ell) * delta
             ev = {"name": e.name, "kind": str(e.kind), **self._display(a_e)}
             if e.name == DEAD_POINT:
@@ -779,6 +777,12 @@ class Session:
         self.config = config
         self.fk_branch = object()
         self.history = [self._platform_point(self.config)]
+
+
+def _real_events(events, names: list[str], scale: float) -> list:
+    """The tracker's events without the sign changes of round-off among the monitors ``names``
+    (a rate or DJ that is zero on the whole path: both sides below ``singular`` x ``scale``)."""
+    return [e for e in events if e.name not in names or not is_noise(e.value_before, e.value_after, scale)]
 
 
 def _mode_configurations(ans: ForwardAnswer) -> list[Configuration | None]:
