@@ -29,6 +29,7 @@ from ..geometry.tolerances import current
 from ..kinematics.backend import joint_twists
 from ..kinematics.closure import Configuration
 from ..kinematics.position import configuration_at_pose
+from ..kinematics.task import joint_change
 from ..model.mechanism import Mechanism, Pose
 
 __all__ = ["FOLLOWED", "MAX_JOINT_JUMP", "SUBSTEPS", "SWITCHED", "UNREACHED", "follow_grid", "mode_signature"]
@@ -71,13 +72,6 @@ def _same_mode(a: tuple[int, ...], b: tuple[int, ...]) -> bool:
     return all(x == y or x == 0 or y == 0 for x, y in zip(a, b, strict=True))
 
 
-def _jump(mech: Mechanism, a: Configuration, b: Configuration) -> float:
-    rot = np.array([r.freedom.kind != "P" for r in mech.freedom_refs])
-    dq = b.q - a.q
-    dq = np.where(rot, (dq + np.pi) % (2 * np.pi) - np.pi, dq / mech.characteristic_length)
-    return float(np.max(np.abs(dq))) if dq.size else 0.0
-
-
 def _blend(p: Pose, q: Pose, s: float) -> Pose:
     """The pose a fraction ``s`` of the way from ``p`` to ``q`` (position linear, rotation along
     the geodesic)."""
@@ -98,13 +92,13 @@ def _follow(mech: Mechanism, p_from: Pose, c_from: Configuration, p_to: Pose, mo
     other = None
     c = _solve(mech, p_to, c_from)
     if c is not None:
-        if _same_mode(mode, mode_signature(mech, c)) and _jump(mech, c_from, c) <= MAX_JOINT_JUMP:
+        if _same_mode(mode, mode_signature(mech, c)) and joint_change(mech, c_from, c) <= MAX_JOINT_JUMP:
             return FOLLOWED, c
         other = c
     cur = c_from
     for k in range(1, SUBSTEPS + 1):
         nxt = _solve(mech, _blend(p_from, p_to, k / SUBSTEPS), cur)
-        if nxt is None or _jump(mech, cur, nxt) > MAX_JOINT_JUMP or not _same_mode(mode, mode_signature(mech, nxt)):
+        if nxt is None or joint_change(mech, cur, nxt) > MAX_JOINT_JUMP or not _same_mode(mode, mode_signature(mech, nxt)):
             return (SWITCHED, other) if other is not None else (UNREACHED, None)
         cur = nxt
     return FOLLOWED, cur
