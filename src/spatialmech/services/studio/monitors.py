@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ...errors import ConvergenceError
 from ...geometry.tolerances import current
 from ...kinematics.closure import Configuration, active_mask
 from ...kinematics.tracking import MotionProblem, conventional_sense
@@ -53,7 +54,10 @@ class MotionRates:
         """The unit joint-rate tangent at ``config``: oriented as ``ref`` (the previous point's)
         when given, else by the documented convention (``sense_order``: the first actuator
         increasing, ...)."""
-        t = np.asarray(self.problem.tangent(config), dtype=float)[: self.na]
+        try:
+            t = np.asarray(self.problem.tangent(config), dtype=float)[: self.na]
+        except ConvergenceError:  # rigid here (no tangent): every rate is zero
+            return np.zeros(self.na)
         n = float(np.linalg.norm(t))
         if not n > 0:
             return np.zeros(self.na)
