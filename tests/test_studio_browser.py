@@ -121,6 +121,11 @@ def test_dragging_a_slider_moves_the_mechanism(server, browser, tmp_path):
     assert ref.drive([40.0]).status == "reached"
     assert np.allclose(after["scene"]["platform_point_len"], ref.state()["scene"]["platform_point_len"], atol=1e-9)
     assert browser.find_element(By.ID, "readouts").text != readout
+    # the inverse (transmission) light beside the direct one, coloured by the state's verdict
+    light = browser.find_element(By.ID, "transmission")
+    want = "sing" if after["inverse_singular"] else "near" if after["near_inverse_singular"] else "ok"
+    assert light.get_attribute("class") == want and float(light.text) == pytest.approx(after["transmission_min"], rel=1e-3)
+    assert "transmission (inverse)" in browser.find_element(By.ID, "readouts").text
     assert "reached" in browser.find_element(By.ID, "status").text
     img1 = pixels(browser, tmp_path, "after.png")
     assert img0.shape == img1.shape and float(np.mean(np.any(np.abs(img0 - img1) > 0.05, axis=-1))) > 0.002

@@ -257,6 +257,13 @@ UNIT_FREE_KEYS: dict[str, str] = {
     "limb_index": "index of a limb (from 0)",
     "mode_number": "assembly mode number (from 1)",
     "near_singular_below": "sigma_min below which the studio warns of a nearby singularity",
+    "dj_rate": "a single driver's share of its linkage's motion: absolute rate along the unit tangent (0: no control)",
+    "transmission_min": "the smallest transmission index of the actuators, in [0, 1] (studio inverse light)",
+    "inverse_singular_below": "transmission index below which the studio calls a limb inversely singular",
+    "near_inverse_singular_below": "transmission index below which the studio warns of a nearby inverse singularity",
+    "branch": "per slice grid point: 0 on the given pose's branch, 1 on another branch, -1 not solved",
+    "n_branch_switched": "slice grid points on another branch than the given pose's (masked)",
+    "n_unreached": "slice grid points where no closed configuration was found on the branch",
     "port": "TCP port number",
     "tracker_steps": "accepted continuation steps",
     # defect screening (screen)

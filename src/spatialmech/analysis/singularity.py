@@ -27,6 +27,8 @@ parametrisation: the singularity loci are its zero contours (drawn by
 
 from __future__ import annotations
 
+from collections import deque
+
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -37,7 +39,7 @@ from ..geometry import screws as sc
 from ..geometry.line_geometry import classify_lines, json_dict
 from ..kinematics.closure import Configuration
 from ..kinematics.jacobian import CompleteJacobian, complete_jacobian
-from ..kinematics.position import configuration_at_pose
+from ..kinematics.position import configuration_at_pose, platform_pose
 from ..kinematics.forward import locked_actuators
 from ..kinematics.tracking import MotionProblem, track
 from ..geometry.tolerances import current as current_tolerances
@@ -238,15 +240,21 @@ class SliceResult:
     names: tuple[str, str]
     u: np.ndarray
     v: np.ndarray
-    det: np.ndarray  # (len(v), len(u)); nan where not reachable
+    det: np.ndarray  # (len(v), len(u)); nan where not reachable on the given pose's branch
     sigma_min: np.ndarray
     fixed: dict = field(default_factory=dict)
     units: tuple[str, str] = ("", "")
+    #: per grid point: 0 on the given pose's branch, 1 on another branch, -1 not solved
+    branch: np.ndarray | None = None
+    #: ``det J`` and ``sigma_min`` at the given pose itself (as ``sm.jacobian`` gives them)
+    at_pose: dict = field(default_factory=dict)
 
     def to_dict(self) -> dict:
         """JSON (docs/json.md): the two ``axes`` with their values (``values_deg`` for an
         angle, ``values_len`` for a length, by ``units``), ``det`` / ``sign`` / ``sigma_min``
-        over the grid (rows along v, columns along u; ``None`` where no pose closes)."""
+        over the grid (rows along v, columns along u; ``None`` where no pose closes on the given
+        pose's branch), ``branch`` (0 followed, 1 another branch, -1 not solved; masked in
+        ``det``), ``at_pose`` and ``sign_changes_along_u`` (between neighbours on the branch)."""
         def clean(a):
             return [[None if not np.isfinite(x) else float(x) for x in row] for row in a]
 
@@ -254,9 +262,17 @@ class SliceResult:
         for name, unit, vals in zip(self.names, self.units, (self.u, self.v), strict=True):
             key = "values_deg" if unit == "deg" else "values_len"
             axes.append({"name": name, key: [float(x) for x in vals]})
-        return {"axes": axes, "det": clean(self.det), "sign": clean(np.sign(self.det)), "sigma_min": clean(self.sigma_min),
-                "fixed": self.fixed,
-                "sign_changes_along_u": int(np.sum(np.abs(np.diff(np.sign(np.nan_to_num(self.det)), axis=1)) > 0))}
+        s = np.sign(self.det)
+        both = np.isfinite(s[:, 1:]) & np.isfinite(s[:, :-1])
+        out = {"axes": axes, "det": clean(self.det), "sign": clean(s), "sigma_min": clean(self.sigma_min),
+               "fixed": self.fixed, "sign_changes_along_u": int(np.sum((s[:, 1:] != s[:, :-1]) & both))}
+        if self.branch is not None:
+            out["branch"] = self.branch.astype(int).tolist()
+            out["n_branch_switched"] = int(np.sum(self.branch == 1))
+            out["n_unreached"] = int(np.sum(self.branch == -1))
+        if self.at_pose:
+            out["at_pose"] = self.at_pose
+        return out
 
 
 def singularity_slice(
@@ -270,30 +286,46 @@ def singularity_slice(
     actuators=None,
     fixed: dict | None = None,
     progress: Progress | None = None,
+    start: tuple[Pose, Configuration] | None = None,
 ) -> SliceResult:
-    """``det J`` and the scale-free ``sigma_min`` over a grid ``pose_of(u_i, v_j)``.
+    """``det J`` and the scale-free ``sigma_min`` over a grid ``pose_of(u_i, v_j)``, on the branch
+    (working mode) of ``start = (pose, configuration)``: the given pose and its closed
+    configuration (default: the reference's).
 
-    Each grid row is solved by continuation from its neighbour (so the assembly stays the same);
-    unreachable poses are ``nan``.  The singularity loci are the zero contours of ``det``.
-    ``progress(j, len(v), "slice")`` after each grid row.
+    The grid is solved neighbour to neighbour from the point nearest the given pose
+    (:func:`~spatialmech.analysis.pose_slice.follow_grid`), each Jacobian's constraint rows
+    oriented as its neighbour's, the given pose's Jacobian first: the sign of ``det`` there is
+    ``sm.jacobian``'s.  Points on another branch or not solved are ``nan`` (``branch`` says
+    which), so the zero contours of ``det`` are singularity loci of this branch only.
+    ``progress(j, len(v), "slice")`` as the grid fills.
     """
+    from .pose_slice import FOLLOWED, follow_grid
+    from .task_slice import row_orientation
+
     u = np.asarray(u, float)
     v = np.asarray(v, float)
+    if start is None:
+        c0 = Configuration.reference(mech)
+        start = (platform_pose(mech, c0), c0)
+    configs, code, root = follow_grid(mech, pose_of, u, v, start[0], start[1], progress)
     det = np.full((len(v), len(u)), np.nan)
     sig = np.full((len(v), len(u)), np.nan)
-    prev_row = None
-    for j, vj in enumerate(v):
-        prev = prev_row
-        for i, ui in enumerate(u):
-            fit = configuration_at_pose(mech, pose_of(ui, vj), start=prev)
-            if not (fit.converged and fit.exact):
-                continue
-            J = complete_jacobian(mech, fit.config, actuators)
-            det[j, i] = J.det if J.det is not None else np.nan
+    J0 = complete_jacobian(mech, start[1], actuators)
+    at_pose = {"det": None if J0.det is None else float(J0.det), "sigma_min": float(J0.sigma_min)}
+    # the Jacobians breadth first from the given pose, each referenced to its parent's
+    seen: dict[tuple[int, int], tuple] = {}
+    if code[root] == FOLLOWED:
+        queue = deque([(root, J0, 1.0)])
+        seen[root] = ()
+        while queue:
+            (j, i), ref, o = queue.popleft()
+            J = complete_jacobian(mech, configs[j, i], actuators, reference=ref)
+            o = o * row_orientation(J, ref)
+            det[j, i] = o * J.det if J.det is not None else np.nan
             sig[j, i] = J.sigma_min
-            prev = fit.config
-            if i == 0:
-                prev_row = fit.config
-        if progress:
-            progress(j + 1, len(v), "slice")
-    return SliceResult(tuple(names), u, v, det, sig, dict(fixed or {}), tuple(units))
+            for nb in ((j, i - 1), (j, i + 1), (j - 1, i), (j + 1, i)):
+                if nb in seen or not (0 <= nb[0] < len(v) and 0 <= nb[1] < len(u)) or code[nb] != FOLLOWED:
+                    continue
+                seen[nb] = ()
+                queue.append((nb, J, o))
+    return SliceResult(tuple(names), u, v, det, sig, dict(fixed or {}), tuple(units), code, at_pose)

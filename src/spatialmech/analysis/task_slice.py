@@ -30,7 +30,7 @@ from ..results import Progress
 from .singularity import SliceResult
 from .workspace.task import euler_convention
 
-__all__ = ["TaskSliceResult", "task_singularity_slice"]
+__all__ = ["TaskSliceResult", "row_orientation", "task_singularity_slice"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -95,7 +95,7 @@ class TaskSliceResult(SliceResult):
         return base
 
 
-def _orientation(J, ref) -> float:
+def row_orientation(J, ref) -> float:
     """+1 when the constraint rows of ``J`` are oriented as those of the neighbouring ``ref``,
     -1 when they are the opposite orientation of the same (nearly the same) space: the sign
     ``det J`` must be multiplied by to be continuous across the slice.  The constraint wrenches
@@ -151,7 +151,7 @@ def task_singularity_slice(
             ref = jac[nb] if nb is not None else None
             J = complete_jacobian(mech, config, actuators, reference=ref)
             jac[i, j] = J
-            orient[i, j] = (orient[nb] if nb is not None else 1.0) * _orientation(J, ref)
+            orient[i, j] = (orient[nb] if nb is not None else 1.0) * row_orientation(J, ref)
             det[j, i] = orient[i, j] * J.det if J.det is not None else np.nan
             sig[j, i] = J.sigma_min
     u0, u1 = ("rad" if task_unit(c) == "deg" else mech.length_unit for c in g.over)

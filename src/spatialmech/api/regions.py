@@ -140,6 +140,7 @@ def singularity_slice(model: ModelLike, over: Mapping[str, Any], *, pose: Sequen
 def _pose_slice(mech: Mechanism, axes, pose, acts, degrees: bool, progress) -> SliceResult:
     from ..analysis.singularity import singularity_slice as _slice
     from ..geometry.rotations import euler_matrix
+    from ..kinematics.position import configuration_at_pose
     from ..model.mechanism import Pose
 
     (n1, g1), (n2, g2) = axes
@@ -165,7 +166,12 @@ def _pose_slice(mech: Mechanism, axes, pose, acts, degrees: bool, progress) -> S
         return Pose(R, np.array([vals["x"], vals["y"], vals["z"]]))
 
     units = tuple("deg" if n.startswith("a") else mech.length_unit for n in (n1, n2))
-    return _slice(mech, pose_of, g1, g2, names=(n1, n2), units=units, actuators=acts,
+    given = Pose(euler_matrix(seq, [b1, b2, b3], degrees=True), np.array([x0, y0, z0]))
+    fit = configuration_at_pose(mech, given)  # the configuration sm.jacobian analyses at this pose
+    if not (fit.converged and fit.exact):
+        raise InputError(f"pose: not reachable exactly (nearest closed pose is {fit.position_error:.3g} away); the "
+                         "slice follows the given pose's working mode from its closed configuration")
+    return _slice(mech, pose_of, g1, g2, names=(n1, n2), units=units, actuators=acts, start=(given, fit.config),
                   fixed={"position_len": [x0, y0, z0], "euler_sequence": seq, "euler_deg": [b1, b2, b3]},
                   progress=progress)
 

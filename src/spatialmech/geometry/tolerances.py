@@ -69,6 +69,7 @@ __all__ = [
     "INPUT_PERTURBATIONS",
     "INPUT_PERTURBATION_SEED",
     "INPUT_PERTURBATION_STEPS",
+    "INVERSE_SINGULAR",
     "LOCAL_DIMENSION_STEP",
     "MONODROMY_DIVERGED",
     "MONODROMY_MAX_LOOPS",
@@ -77,6 +78,7 @@ __all__ = [
     "MONODROMY_PARALLEL",
     "MONODROMY_RESIDUAL",
     "MONODROMY_STALE_LOOPS",
+    "NEAR_INVERSE_SINGULAR",
     "NEAR_SINGULAR",
     "SINGULAR_LEFT",
     "TRACE_MAX_LOOPS",
@@ -195,6 +197,11 @@ DEFAULT = Tolerances()
 #: (``spatialmech studio``) warns that the configuration is near a singularity (colour warning);
 #: a reading aid, not a verdict (``singular`` above decides that).
 NEAR_SINGULAR = 0.02
+#: Actuation transmission index ``|W.$a| / (|W| |$a|)`` below which a limb is called inversely
+#: singular where a studio pose drag cannot go on (``limb_singular``), and the studio's inverse
+#: light turns red; below :data:`NEAR_INVERSE_SINGULAR` it is amber (a reading aid, as above).
+INVERSE_SINGULAR = 0.05
+NEAR_INVERSE_SINGULAR = 0.1
 
 #: Points whose spread is below this, relative to their coordinates, are the same point (round-off).
 _SAME_POINT = 1e-13

@@ -553,8 +553,12 @@ def joint_points(mech: Mechanism, config: Configuration) -> list[np.ndarray]:
 
     A joint's point moves with the link before it: it is displaced by every freedom that
     precedes the joint in its limb.  Together with the platform point ``D p0`` this is what a
-    drawing of the mechanism needs.
+    drawing of the mechanism needs.  The last answer is remembered (a drawing and its joint
+    solids ask for the same configuration, which is never changed in place).
     """
+    m0, c0, last = _LAST_JOINT_POINTS[0]
+    if m0 is mech and c0 is config:
+        return [p.copy() for p in last]
     out = []
     for li, (ch, sl) in enumerate(zip(limb_chains(mech), limb_slices(mech), strict=True)):
         _, _, pre = chain_forward(ch, config.q[sl], prefixes=True)
@@ -570,4 +574,8 @@ def joint_points(mech: Mechanism, config: Configuration) -> list[np.ndarray]:
                 p = mech.limbs[li].joints[r.joint].point
                 pts.append(pre[k, :3, :3] @ p + pre[k, :3, 3])
         out.append(np.array(pts))
+    _LAST_JOINT_POINTS[0] = (mech, config, [p.copy() for p in out])  # one tuple: read whole by any thread
     return out
+
+
+_LAST_JOINT_POINTS: list[tuple] = [(None, None, [])]

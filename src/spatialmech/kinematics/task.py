@@ -23,7 +23,7 @@ coordinates from the output link's twist space at the reference configuration.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, replace
 from itertools import combinations
 
@@ -41,10 +41,12 @@ from .velocity import euler_rate_matrix
 
 __all__ = [
     "TaskJacobian",
+    "TaskPath",
     "TaskSolution",
     "continue_task",
     "coordinate_map",
     "default_task",
+    "joint_change",
     "pose_from_task",
     "solve_pose",
     "solve_task",
@@ -263,45 +265,91 @@ CONTINUATION_MIN_STEP = 1e-4
 CONTINUATION_MAX_STEPS = 2000
 
 
+def joint_change(mech: Mechanism, a: Configuration, b: Configuration) -> float:
+    """The largest change of any joint from ``a`` to ``b``: rad (the short way round), slides in
+    characteristic lengths."""
+    dq = b.q - a.q
+    rot = np.array([r.freedom.kind != "P" for r in mech.freedom_refs])
+    dq = np.where(rot, (dq + np.pi) % (2 * np.pi) - np.pi, dq / mech.characteristic_length)
+    return float(np.max(np.abs(dq))) if dq.size else 0.0
+
+
+class TaskPath:
+    """The straight path of the given task coordinates from their values at ``start`` (default:
+    the reference) to ``given`` (angles the short way round), ``s`` in [0, 1]; ``length`` is its
+    nondimensional length (rad, characteristic lengths).  :meth:`walk` follows it by
+    natural-parameter continuation; :attr:`status` says how the last walk ended: ``"reached"``,
+    ``"stalled"`` (no step above the smallest converged: the edge of the branch) or
+    ``"max_steps"``."""
+
+    def __init__(self, mech: Mechanism, given: Mapping[str, float], *, task: TaskCoordinates,
+                 start: Configuration | None = None):
+        self.given = _check_given(task, given)
+        self.mech, self.task = mech, task
+        self.start = Configuration.reference(mech) if start is None else start
+        self.v0 = task_values(mech, self.start.D, task.euler)
+        gi = [TASK_NAMES.index(n) for n in self.given]
+        self.delta = np.zeros(6)
+        self.delta[gi] = np.array([self.given[n] for n in self.given]) - self.v0[gi]
+        self.delta[3:] = (self.delta[3:] + np.pi) % (2 * np.pi) - np.pi
+        L = mech.characteristic_length
+        self.length = float(np.linalg.norm(np.r_[self.delta[:3] / L, self.delta[3:]]))
+        self.status = ""
+        self.steps = 0
+
+    def values(self, s: float) -> np.ndarray:
+        """The six task values at ``s`` (the solved ones: the start's)."""
+        return self.v0 + s * self.delta
+
+    def at(self, s: float, seed: Configuration, max_iter: int = 12) -> TaskSolution:
+        """:func:`solve_task` at ``s`` from ``seed``."""
+        v = self.values(s)
+        return solve_task(self.mech, {n: float(v[TASK_NAMES.index(n)]) for n in self.given}, task=self.task,
+                          seed=seed, max_iter=max_iter)
+
+    def walk(self, *, step: float = CONTINUATION_STEP, min_step: float = CONTINUATION_MIN_STEP,
+             max_steps: int = CONTINUATION_MAX_STEPS,
+             max_joint_step: float | None = None) -> Iterator[tuple[float, TaskSolution]]:
+        """Yield ``(s, solution)`` for every accepted step from the start: each step (``step``
+        long at first and at most, nondimensional) solved from the previous configuration, kept
+        when it converges and no joint moves more than ``max_joint_step`` (see
+        :func:`joint_change`), else halved down to ``min_step``.  The caller may stop at any
+        step; :attr:`status` and :attr:`steps` tell how a finished walk ended."""
+        cur, s, h = self.start, 0.0, min(step, self.length)
+        self.steps, self.status = 0, "reached"
+        while s < 1.0 and self.length > 0.0:
+            if self.steps >= max_steps:
+                self.status = "max_steps"
+                return
+            nxt = min(1.0, s + h / self.length)
+            r = self.at(nxt, cur)
+            if not r.converged or (max_joint_step is not None and joint_change(self.mech, cur, r.config) > max_joint_step):
+                h *= 0.5
+                if h < min_step:
+                    self.status = "stalled"
+                    return
+                continue
+            self.steps += 1
+            yield nxt, r
+            cur, s, h = r.config, nxt, min(step, 1.5 * h)
+
+
 def continue_task(mech: Mechanism, given: Mapping[str, float], *, task: TaskCoordinates,
                   start: Configuration | None = None) -> tuple[TaskSolution | None, float]:
     """Natural-parameter continuation (a homotopy in the pose, as the studio's pose drag,
-    :mod:`spatialmech.services.studio.posing`): the given coordinates are moved along the straight
-    path from their values at ``start`` (default: the reference) to ``given`` (angles the short
-    way round), each step corrected by :func:`solve_task` from the previous configuration and
-    halved when it does not converge.  Returns ``(solution, s)``: the converged solve at the
-    target (its ``continuation`` 1.0) and ``s = 1``, or ``None`` and the path parameter ``s`` in
-    [0, 1) where the steps could not go on."""
-    g = _check_given(task, given)
-    start = Configuration.reference(mech) if start is None else start
-    L = mech.characteristic_length
-    v0 = task_values(mech, start.D, task.euler)
-    gi = [TASK_NAMES.index(n) for n in g]
-    delta = np.zeros(6)
-    delta[gi] = np.array([g[n] for n in g]) - v0[gi]
-    delta[3:] = (delta[3:] + np.pi) % (2 * np.pi) - np.pi
-    ell = float(np.linalg.norm(np.r_[delta[:3] / L, delta[3:]]))
-
-    def at(s: float, seed: Configuration, max_iter: int = 12) -> TaskSolution:
-        v = v0 + s * delta
-        return solve_task(mech, {n: float(v[TASK_NAMES.index(n)]) for n in g}, task=task, seed=seed,
-                          max_iter=max_iter)
-
-    cur, s, h = start, 0.0, min(CONTINUATION_STEP, ell)
-    for _ in range(CONTINUATION_MAX_STEPS):
-        if s >= 1.0 or ell == 0.0:
-            break
-        nxt = min(1.0, s + h / ell)
-        r = at(nxt, cur)
-        if not r.converged:
-            h *= 0.5
-            if h < CONTINUATION_MIN_STEP:
-                break
-            continue
-        cur, s, h = r.config, nxt, min(CONTINUATION_STEP, 1.5 * h)
+    :mod:`spatialmech.services.studio.posing`; both walk a :class:`TaskPath`): the given
+    coordinates are moved along the straight path from their values at ``start`` (default: the
+    reference) to ``given`` (angles the short way round), each step corrected by
+    :func:`solve_task` from the previous configuration and halved when it does not converge.
+    Returns ``(solution, s)``: the converged solve at the target (its ``continuation`` 1.0) and
+    ``s = 1``, or ``None`` and the path parameter ``s`` in [0, 1) where the steps could not go on."""
+    path = TaskPath(mech, given, task=task, start=start)
+    cur, s = path.start, 0.0
+    for s_step, sol in path.walk():
+        s, cur = s_step, sol.config
     if s < 1.0:
         return None, float(s)
-    final = at(1.0, cur, 60)
+    final = path.at(1.0, cur, 60)
     return (replace(final, continuation=1.0) if final.converged else None), float(s)
 
 

@@ -29,15 +29,16 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...errors import InputError
+from ...geometry.tolerances import INVERSE_SINGULAR, NEAR_INVERSE_SINGULAR
 from ...kinematics.closure import Configuration
 from ...kinematics.jacobian import complete_jacobian
 from ...kinematics.position import within_limits
-from ...kinematics.task import solve_task, task_values
+from ...kinematics.task import TaskPath, joint_change
 from ...model.mechanism import Mechanism
 from ...model.task import TASK_NAMES, TaskCoordinates
 from ...results import DriveStatus
 
-__all__ = ["MAX_JOINT_STEP", "MIN_STEP", "PosePath", "pose_path"]
+__all__ = ["MAX_JOINT_STEP", "MIN_STEP", "PosePath", "pose_path", "transmission_readout"]
 
 #: Largest change of any joint in one continuation step (rad; slides in characteristic lengths).
 MAX_JOINT_STEP = 0.15
@@ -48,7 +49,7 @@ MAX_STEP = 0.05
 #: Largest number of continuation steps per request.
 MAX_STEPS = 400
 #: Actuation transmission below which a limb is called singular where the steps stop.
-LIMB_SINGULAR_TRANSMISSION = 0.05
+LIMB_SINGULAR_TRANSMISSION = INVERSE_SINGULAR
 
 
 @dataclass
@@ -65,62 +66,39 @@ class PosePath:
     steps: int = 0
 
 
-def _joint_change(mech: Mechanism, a: Configuration, b: Configuration) -> float:
-    dq = b.q - a.q
-    rot = np.array([r.freedom.kind != "P" for r in mech.freedom_refs])
-    dq = np.where(rot, (dq + np.pi) % (2 * np.pi) - np.pi, dq / mech.characteristic_length)
-    return float(np.max(np.abs(dq))) if dq.size else 0.0
-
-
 def pose_path(mech: Mechanism, start: Configuration, task: TaskCoordinates, target: np.ndarray,
               dj: Callable[[Configuration], float | None]) -> PosePath:
     """Move the given coordinates of ``task`` from their values at ``start`` to those of
     ``target`` (six task values, SI / rad; the solved ones are ignored); ``dj`` is the chosen
-    drivers' DJ (its sign is watched).  See the module docstring."""
-    L = mech.characteristic_length
-    gi = [TASK_NAMES.index(n) for n in task.given]
-    v0 = task_values(mech, start.D, task.euler)
-    delta = np.zeros(6)
-    delta[gi] = np.asarray(target, dtype=float)[gi] - v0[gi]
-    delta[3:] = (delta[3:] + np.pi) % (2 * np.pi) - np.pi  # angles the short way round
-    nd = np.r_[delta[:3] / L, delta[3:]]
-    ell = float(np.linalg.norm(nd))
+    drivers' DJ (its sign is watched).  The steps are a walk along a
+    :class:`~spatialmech.kinematics.task.TaskPath` (as ``continue_task``); see the module
+    docstring."""
+    target = np.asarray(target, dtype=float)
+    path = TaskPath(mech, {n: float(target[TASK_NAMES.index(n)]) for n in task.given}, task=task, start=start)
+    ell = path.length
     outside0 = set(within_limits(mech, start.q))  # already outside at the start: not watched
 
-    def at(lam: float, seed: Configuration):
-        v = v0 + (lam / ell) * delta
-        r = solve_task(mech, {n: float(v[TASK_NAMES.index(n)]) for n in task.given}, task=task, seed=seed, max_iter=12)
-        if not r.converged or _joint_change(mech, seed, r.config) > MAX_JOINT_STEP:
+    def at(s: float, seed: Configuration) -> Configuration | None:
+        r = path.at(s, seed)
+        if not r.converged or joint_change(mech, seed, r.config) > MAX_JOINT_STEP:
             return None
         return r.config
 
-    def task_at(lam: float, c: Configuration) -> dict:
-        return {"lambda": lam / ell, "values": v0 + (lam / ell) * delta, "config": c}
-
     own0 = dj(start)
-    cur, lam, h = start, 0.0, min(MAX_STEP, ell)
+    cur, s_cur = start, 0.0
     passed: list[Configuration] = []
-    steps = 0
-    while lam < ell:
-        if steps >= MAX_STEPS:
-            return PosePath(DriveStatus.STOPPED_TRACKER, f"moved part of the way ({steps} steps); request again to go on", cur,
-                            passed, steps=steps)
-        nxt_lam = min(ell, lam + h)
-        nxt = at(nxt_lam, cur)
-        if nxt is None:
-            h *= 0.5
-            if h < MIN_STEP * max(1.0, ell):
-                return _edge(mech, cur, passed, steps)
-            continue
-        steps += 1
+    walk = path.walk(step=MAX_STEP, min_step=MIN_STEP * max(1.0, ell), max_steps=MAX_STEPS,
+                     max_joint_step=MAX_JOINT_STEP)
+    for s, sol in walk:
+        nxt = sol.config
         bad = [b for b in within_limits(mech, nxt.q) if b not in outside0]
         if bad:
             lims = ", ".join(f"{b} {_show_limits(mech, b)}" for b in bad)
             return PosePath(DriveStatus.STOPPED_LIMIT, f"joints leave their limits ({lims}) before the requested pose; stopped "
-                            "just before", cur, passed, steps=steps)
+                            "just before", cur, passed, steps=path.steps)
         d1 = dj(nxt)
         if own0 is not None and d1 is not None and d1 != 0 and np.sign(d1) != np.sign(own0):
-            lo, hi, c_lo = lam, nxt_lam, cur
+            lo, hi, c_lo = s_cur, s, cur
             for _ in range(20):  # locate the DJ zero by bisection of the path parameter
                 mid = 0.5 * (lo + hi)
                 c_mid = at(mid, c_lo)
@@ -131,13 +109,19 @@ def pose_path(mech: Mechanism, start: Configuration, task: TaskCoordinates, targ
                     hi = mid
                 else:
                     lo, c_lo = mid, c_mid
+            event = {"lambda": 0.5 * (lo + hi), "values": path.values(0.5 * (lo + hi)), "config": c_lo}
             return PosePath(DriveStatus.STOPPED_SINGULAR, "the chosen drivers lose control before the requested pose (DJ of "
                             "the drivers changes sign: a direct singularity); stopped just before it (move back, or "
-                            "switch drivers)", cur, passed, event=task_at(0.5 * (lo + hi), c_lo), steps=steps)
-        cur, lam = nxt, nxt_lam
+                            "switch drivers)", cur, passed, event=event, steps=path.steps)
+        cur, s_cur = nxt, s
         passed.append(cur)
-        h = min(MAX_STEP, 1.5 * h)
-    return PosePath(DriveStatus.REACHED, "reached the requested pose along the current branch", cur, passed, steps=steps)
+    if path.status == "max_steps":
+        return PosePath(DriveStatus.STOPPED_TRACKER, f"moved part of the way ({path.steps} steps); request again to go on", cur,
+                        passed, steps=path.steps)
+    if path.status == "stalled":
+        return _edge(mech, cur, passed, path.steps)
+    return PosePath(DriveStatus.REACHED, "reached the requested pose along the current branch", cur, passed,
+                    steps=path.steps)
 
 
 def _show_limits(mech: Mechanism, fid: str) -> str:
@@ -165,3 +149,19 @@ def _edge(mech: Mechanism, cur: Configuration, passed: list, steps: int) -> Pose
                         f"{t:.2g}): the edge of the workspace of this branch; stopped there", cur, passed, steps=steps)
     return PosePath(DriveStatus.UNREACHABLE, "the requested pose is not reachable along this branch (no closed configuration "
                     "beyond this one); stopped at the last reachable pose", cur, passed, steps=steps)
+
+
+def transmission_readout(J) -> dict:
+    """The inverse (transmission) light of the studio beside the direct one (``sigma_min``):
+    each actuator's transmission index ``|W.$a| / (|W| |$a|)`` of the complete Jacobian ``J``
+    (0 where the actuation wrench does not exist: an inverse singularity), the smallest, which
+    actuator it is, and the colour class: ``inverse_singular`` below :data:`INVERSE_SINGULAR`
+    (the level where a pose drag reports ``limb_singular``), ``near_inverse_singular`` below
+    :data:`NEAR_INVERSE_SINGULAR`."""
+    trans = dict.fromkeys(J.inverse_singular, 0.0)
+    trans.update((a, float(t)) for a, t in zip(J.actuators, J.transmission or (), strict=False) if a not in trans)
+    worst = min(trans.items(), key=lambda kv: kv[1]) if trans else (None, None)
+    low = worst[1] if worst[1] is not None else 1.0
+    return {"transmission": trans, "transmission_min": worst[1], "transmission_min_actuator": worst[0],
+            "inverse_singular": bool(low < INVERSE_SINGULAR), "near_inverse_singular": bool(low < NEAR_INVERSE_SINGULAR),
+            "near_inverse_singular_below": NEAR_INVERSE_SINGULAR, "inverse_singular_below": INVERSE_SINGULAR}

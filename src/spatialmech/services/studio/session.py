@@ -47,11 +47,11 @@ from ...kinematics.task import default_task, task_values
 from ...kinematics.tracking import ActuatorPathProblem, conventional_sense, track
 from ...model.mechanism import Mechanism
 from ...model.task import TASK_NAMES, TaskCoordinates
-from ...present.shapes import joint_list, joint_meshes, mesh_json, platform_solid
-from ...present.viewer import LIMB_COLOURS, drawing
 from ...results import DriveStatus, TrackStatus
 from ...serialize import freedom_values_dict, pose_dict
-from .posing import pose_path
+from .monitors import MotionRates, is_noise, same_event
+from .posing import pose_path, transmission_readout
+from .scene import scene
 
 __all__ = ["DriveResult", "Session"]
 
@@ -126,6 +126,7 @@ class Session:
         self.fk_branch: object = object()  # a new object whenever the branch is changed on purpose
         self._circuit: dict = {}
         self.history: list[np.ndarray] = []  # platform-point path, for the page's trail
+        self.last_stop: dict | None = None  # the event of the last stop at a singularity
         c = Configuration.reference(mech)
         L = mech.characteristic_length
         if float(np.linalg.norm(closure_residual(mech, c))) > 1e-8 * max(1.0, L) or self._sigma(c) < NEAR_SINGULAR:
@@ -253,7 +254,30 @@ class Session:
         if not cands:
             return {}
         vals = self._driver_dets(c)
-        return {d: vals[d] for d in cands if np.isfinite(vals[d])}
+        if not all(np.isfinite(vals[d]) for d in cands):  # not square: each driver's |rate| on the motion
+            return dict(zip(cands, np.abs(self._rates().rates(c, cands)[0]).tolist(), strict=True))
+        return {d: vals[d] for d in cands}
+
+    def _rates(self) -> MotionRates:
+        """The motion's tangent-space rates of the current model (one-degree-of-freedom)."""
+        r = getattr(self, "_motion_rates", None)
+        if r is None or r.mech is not self.mech:
+            r = self._motion_rates = MotionRates(self.mech)
+        return r
+
+    def _dj_readout(self, c: Configuration, J) -> dict:
+        """``dj`` with ``dj_rate`` (one driver: its share of the motion, scale-free, 0 where it
+        loses control) and ``dj_note``, the reason when ``dj`` has no value."""
+        dj = self._dj(c, J)
+        out: dict = {"dj": dj, "dj_rate": None, "dj_note": ""}
+        if len(self.mech.actuators) == 1 and self._candidates():
+            out["dj_rate"] = float(abs(self._rates().rates(c, self.mech.actuators)[0][0]))
+        if dj is None:
+            shape = " x ".join(map(str, J.matrix.shape))
+            out["dj_note"] = (f"the complete Jacobian is {shape}, not square (common constraints): no determinant"
+                              + ("; the driver's rate along the motion (dj_rate) decides where it loses control"
+                                 if out["dj_rate"] is not None else "; sigma_min decides"))
+        return out
 
     # ------------------------------------------------------------------ readouts
     def state(self) -> dict:
@@ -276,9 +300,10 @@ class Session:
             "slider_ranges_len": {k: list(v) for k, v in lo.items() if not _is_rot(m, k)},
             **joints,
             "pose": pose_dict(pose.R, pose.p),
-            "dj": self._dj(c, J),
+            **self._dj_readout(c, J),
             "dj_by_driver": self._dj_by_driver(c),
             "sigma_min": sig,
+            **transmission_readout(J),
             "singular": bool(sig < current().singular),
             "near_singular": bool(sig < NEAR_SINGULAR),
             "near_singular_below": NEAR_SINGULAR,
@@ -350,34 +375,8 @@ class Session:
                                       for i, n in enumerate(TASK_NAMES[3:]) if n in t.given}}
 
     def scene(self) -> dict:
-        """What the page draws (model length unit): limb polylines, base and platform outlines,
-        every joint with its type, limb and axis directions, the platform point and frame,
-        the platform point's trail, and the task positions."""
-        m, c = self.mech, self.config
-        d = drawing(m, c)
-        jl = joint_list(m, c)
-        joints = [{"name": j["name"], "type": j["type"], "limb_index": j["limb_index"],
-                   "joint_axes": [v.tolist() for v in j["axes"]], "centre_len": j["centre"].tolist()} for j in jl]
-        solid = platform_solid(m, d.platform, d.limbs, d.platform_point)
-        hull = solid if solid is not None and solid["hull"] else None  # the platform mesh, when it is a hull
-        return {
-            "limbs_len": [l.tolist() for l in d.limbs],
-            "limb_names": [l.name for l in m.limbs],
-            "limb_colours": [LIMB_COLOURS[i % len(LIMB_COLOURS)] for i in range(len(m.limbs))],
-            "base_len": d.base.tolist(),
-            "platform_len": d.platform.tolist(),
-            "platform_hull_len": hull["vertices"].tolist() if hull is not None else [],
-            "hull_faces": hull["triangles"].tolist() if hull is not None else [],
-            "platform_mesh": mesh_json(solid),
-            "joint_meshes": [mesh_json(x) for x in joint_meshes(jl, len(m.limbs), float(d.scale))],
-            "bodies_len": d.bodies.tolist(),
-            "joints": joints,
-            "platform_point_len": d.platform_point.tolist(),
-            "platform_frame": d.platform_frame.tolist(),
-            "scale_len": float(d.scale),
-            "trail_len": [p.tolist() for p in self.history[-400:]],
-            "task_positions_len": [pz.p.tolist() for pz in m.positions],
-        }
+        """What the page draws (:func:`.scene.scene`)."""
+        return scene(self.mech, self.config, self.history)
 
     def model_info(self) -> dict:
         """The model: name, description, limbs, freedoms with their kinds, the ready-made models."""
@@ -459,7 +458,7 @@ class Session:
         monitors = {}
         if own0 is not None:
             monitors["DJ (drivers)"] = lambda x: float(own_dj(x) or 0.0)
-        vector = ((names, lambda x: [self._driver_dets(with_actuators(x))[d] for d in others]) if others else None)
+        vector, noise_scale, by_rate = self._other_monitors(others, names, with_actuators)
         why = {"reason": ""}
         lam_prev = [0.0]
         ref_t: dict = {}
@@ -514,7 +513,7 @@ class Session:
         events = []
         step_of: dict[int, int] = {}  # event -> index of the tracked point its step starts from
         own_crossed = None
-        for e in r.events:
+        for e in _real_events(r.events, names, noise_scale):
             xe = cast(np.ndarray, e.x)  # the drag problem's points are vectors (the pose's x, lambda)
             if float(xe[1]) > ell:  # in the overshoot of the last step: not on the way to the target
                 continue
@@ -533,7 +532,9 @@ class Session:
                 ev["meaning"] = "the chosen drivers lose control here (DJ = 0): a dead point / direct singularity"
             else:
                 ev["driver"] = e.name[3:]
-                ev["meaning"] = f"{e.name[3:]} could not drive through this point (its DJ changes sign)"
+                why_ = ("its rate along the motion passes zero: the reduced Jacobian without it is singular" if by_rate
+                        else "its DJ changes sign")
+                ev["meaning"] = f"{e.name[3:]} could not drive through this point ({why_})"
             events.append(ev)
             step_of[id(ev)] = e.step
         reason = why["reason"]
@@ -552,6 +553,7 @@ class Session:
                     reason = "dj"
                 else:
                     self._accept(res.config, r.points[1:])
+                    self.last_stop = None
                     return DriveResult(REACHED, "reached the requested values along the current branch",
                                        tuple(events), steps, elapsed(), requested)
             else:
@@ -572,6 +574,7 @@ class Session:
             if reason == "turned" and own_crossed is None:
                 msg = ("the path turns back in the actuator values (a dead point / direct singularity) before the "
                        "requested values; stopped just before it (drive back, or switch drivers)")
+            events, msg = self._once(own_crossed, events, msg)
             return self._stop_before(r, STOPPED_SINGULAR, msg, events, steps, elapsed, requested, with_actuators)
         if r.status == TrackStatus.MAX_ARC or steps >= MAX_STEPS:
             msg = (f"moved part of the way ({steps} steps): the mechanism moves fast for these actuator values (near a "
@@ -580,6 +583,25 @@ class Session:
             msg = f"the tracker stopped on this branch: {r.message}"
         return self._stop_before(r, STOPPED_TRACKER, msg, events, steps, elapsed,
                                  requested, with_actuators)
+
+    def _other_monitors(self, others: list[str], names: list[str], with_actuators) -> tuple:
+        """The vector monitor of the other candidate drivers along a drive and the scale of its
+        values, and whether they are rates: their DJ where the complete Jacobian is square (scale:
+        the largest |DJ| at the start), else their rates along the motion's tangent, oriented by
+        continuity (scale 1; see :mod:`.monitors`)."""
+        if not others:
+            return None, 1.0, False
+        dets = self._driver_dets(self.config)
+        if all(np.isfinite(dets[d]) for d in others):
+            scale = max(abs(v) for v in dets.values() if np.isfinite(v))
+            return (names, lambda x: [self._driver_dets(with_actuators(x))[d] for d in others]), scale, False
+        rates = self._rates()
+        ref = {"t": rates.tangent(self.config)}
+
+        def vec(x):
+            v, ref["t"] = rates.rates(with_actuators(x), others, ref["t"])
+            return v
+        return (names, vec), 1.0, True
 
     def parse_pose(self, task_len=None, task_deg=None, *, euler=None, relative=False) -> tuple[TaskCoordinates, np.ndarray]:
         """The task coordinates and the six target values (SI, rad) of a pose request:
@@ -648,7 +670,17 @@ class Session:
                            "task_deg": {n: float(np.degrees(r.event["values"][i + 3])) for i, n in enumerate(TASK_NAMES[3:])}})
         if r.passed:
             self._accept(r.config, [(c, None) for c in r.passed])
-        return DriveResult(r.status, r.message, tuple(events), r.steps, time.perf_counter() - t_start, requested)
+        events, msg = self._once(events[0] if events else None, events, r.message)
+        return DriveResult(r.status, msg, tuple(events), r.steps, time.perf_counter() - t_start, requested)
+
+    def _once(self, stop_event: dict | None, events: list, msg: str) -> tuple[list, str]:
+        """Drop the event of a stop that repeats the last one (the same place, met again by a
+        drive further on: the page logs it once) and remember it."""
+        if stop_event is not None and same_event(self.last_stop, stop_event, self.mech):
+            events = [ev for ev in events if ev is not stop_event]
+            msg += " (the same stop as before; its event is not repeated)"
+        self.last_stop = stop_event
+        return events, msg
 
     def _check_limits(self, a0: np.ndarray, a1: np.ndarray, delta: np.ndarray, name: str) -> None:
         """Refuse a drive whose path (the target and points on the way) leaves an actuator's
@@ -745,6 +777,12 @@ class Session:
         self.config = config
         self.fk_branch = object()
         self.history = [self._platform_point(self.config)]
+
+
+def _real_events(events, names: list[str], scale: float) -> list:
+    """The tracker's events without the sign changes of round-off among the monitors ``names``
+    (a rate or DJ that is zero on the whole path: both sides below ``singular`` x ``scale``)."""
+    return [e for e in events if e.name not in names or not is_noise(e.value_before, e.value_after, scale)]
 
 
 def _mode_configurations(ans: ForwardAnswer) -> list[Configuration | None]:

@@ -4,6 +4,7 @@
 // (no websockets).  window.studio exposes the last state for tests.
 "use strict";
 
+const EVENT_LOG_MAX = 100;  // services/studio/monitors.EVENT_LOG_MAX
 const S = { state: null, circuit: null, unit: "", inFlight: false, pending: null, range: null, drawn: 0, errors: [] };
 window.studio = S;
 
@@ -177,17 +178,25 @@ function logEvent(e) {
     .concat(Object.entries(e.actuators_len).map(([k, v]) => k + " = " + fmt(v, 6) + " " + S.unit));
   li.textContent = e.name + " (" + e.kind + ") at " + vals.join(", ") + ": " + e.meaning;
   const ol = document.getElementById("events"); ol.insertBefore(li, ol.firstChild);
+  while (ol.children.length > EVENT_LOG_MAX) ol.removeChild(ol.lastChild);  // a bounded list, newest first
 }
 
 function update(st) {
   S.state = st;
   const sig = st.sigma_min, cls = st.singular ? "sing" : (st.near_singular ? "near" : "ok");
+  const icls = st.transmission_min === null ? "" : st.inverse_singular ? "sing" : (st.near_inverse_singular ? "near" : "ok");
   const p = st.pose, rows = [
     ["output point [" + S.unit + "]", p.position_len.map(x => fmt(x, 5)).join(", ")],
     ["orientation " + p.euler_sequence + " [deg]", p.euler_deg.map(x => fmt(x, 5)).join(", ")],
-    ["DJ of the drivers", fmt(st.dj, 5)],
-    ["sigma_min (complete J)", `<span id="sigma" class="${cls}">${fmt(sig, 4)}</span>` +
+    ["DJ of the drivers", st.dj !== null ? fmt(st.dj, 5)
+      : `<span id="dj-note" title="${st.dj_note}">n/a</span>` + (st.dj_rate !== null ? "; driver rate " + fmt(st.dj_rate, 4) : "")
+        + `<div class="small">${st.dj_note}</div>`],
+    ["sigma_min (complete J, direct)", `<span id="sigma" class="${cls}">${fmt(sig, 4)}</span>` +
       (st.singular ? " singular" : st.near_singular ? " near a singularity (< " + st.near_singular_below + ")" : "")],
+    ["transmission (inverse)", `<span id="transmission" class="${icls}">${fmt(st.transmission_min, 4)}</span>` +
+      (st.transmission_min_actuator ? " " + st.transmission_min_actuator : "") +
+      (st.inverse_singular ? " inverse singular (< " + st.inverse_singular_below + ")"
+        : st.near_inverse_singular ? " near an inverse singularity (< " + st.near_inverse_singular_below + ")" : "")],
     ["closure residual", fmt(st.residual, 3)],
     ["outside joint limits", st.outside_limits.length ? st.outside_limits.join(", ") : "none"],
   ];
