@@ -76,6 +76,11 @@ UNIT_SUFFIXES: dict[str, str] = {
     "_len_per_N": "length_unit per newton (a linear compliance)",
     "_per_N": "per newton (a coupling compliance: length_unit per N length_unit, or rad per N)",
     "_per_N_len": "per newton length_unit (a rotational compliance: rad per N length_unit)",
+    "_deg_per_s": "degrees per second (an angular rate)",
+    "_deg_per_s2": "degrees per second squared (an angular acceleration)",
+    "_kg": "kilograms",
+    "_kg_len2": "kilograms times the square of the document's length_unit (an inertia; the metre for dynamics)",
+    "_kg_per_len3": "kilograms per cube of the document's length_unit (a density)",
 }
 
 #: Keys whose numbers have no unit, with their meaning: counts, indices, signs, nondimensional

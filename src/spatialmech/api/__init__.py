@@ -60,6 +60,7 @@ if TYPE_CHECKING:  # what mypy (and a reader) sees; at run time __getattr__ impo
         WORKSPACE_MAX_POSES as WORKSPACE_MAX_POSES,
     )
     from .forces import StaticsResult, statics
+    from .dynamics import DynamicsResult, StaticsPath, inverse_dynamics, statics_along
     from .kinematics import (
         FKResult,
         IKResult,
@@ -87,6 +88,7 @@ _LAZY: dict[str, str] = {
     **dict.fromkeys(("Mechanism", "Pose"), "..model.mechanism"),
     **dict.fromkeys(("ModelLike",), ".checks"),
     **dict.fromkeys(("StaticsResult", "statics"), ".forces"),
+    **dict.fromkeys(("DynamicsResult", "StaticsPath", "inverse_dynamics", "statics_along"), ".dynamics"),
     **dict.fromkeys(("FKResult", "IKResult", "JacobianResult", "VelocityResult", "fk", "ik", "jacobian", "velocity"),
                     ".kinematics"),
     **dict.fromkeys(("SingularityAnalysis", "parasitic", "singularity", "workspace"), ".spaces"),
@@ -106,6 +108,7 @@ _LAZY: dict[str, str] = {
 __all__ = [
     "CSSynthesisResult",
     "DefectAnalysis",
+    "DynamicsResult",
     "ExportResult",
     "FKResult",
     "IKResult",
@@ -114,6 +117,7 @@ __all__ = [
     "MobilityModes",
     "ReportResult",
     "SingularityAnalysis",
+    "StaticsPath",
     "StaticsResult",
     "StiffnessMap",
     "StiffnessResult",
@@ -129,6 +133,7 @@ __all__ = [
     "export",
     "fk",
     "ik",
+    "inverse_dynamics",
     "jacobian",
     "load_model",
     "maps",
@@ -141,6 +146,7 @@ __all__ = [
     "singularity",
     "singularity_slice",
     "statics",
+    "statics_along",
     "stiffness",
     "stiffness_map",
     "studio_session",
