@@ -37,9 +37,12 @@ def _split_efforts(K: np.ndarray, qfrc: np.ndarray, n_act: int) -> tuple[np.ndar
     return z[:n_act], _rel(K @ z, qfrc)
 
 
-def mujoco_efforts(mech: Mechanism, inertias: dict, res: InverseDynamics, gravity) -> tuple[np.ndarray, dict]:
+def mujoco_efforts(mech: Mechanism, inertias: dict, res: InverseDynamics, gravity, wrench=None
+                   ) -> tuple[np.ndarray, dict]:
     """The actuator efforts MuJoCo gives at the library's state ``res.state`` (module docstring),
-    and the residuals: ``qvel``, ``qacc`` (the body motions reproduced) and the split."""
+    and the residuals: ``qvel``, ``qacc`` (the body motions reproduced) and the split.  ``wrench``:
+    ``(f ; m about the origin)`` on the output body, its generalized force ``J^T (m ; f)`` taken
+    off the tree's."""
     import mujoco as mj
 
     tree = body_tree(mech)
@@ -84,7 +87,12 @@ def mujoco_efforts(mech: Mechanism, inertias: dict, res: InverseDynamics, gravit
     act = [int(m.jnt_dofadr[mj.mj_name2id(m, mj.mjtObj.mjOBJ_JOINT, a)]) for a in res.actuators]
     B = np.zeros((len(act), m.nv))
     B[np.arange(len(act)), act] = 1.0
-    tau, resid["split"] = _split_efforts(np.hstack([B.T, Jc.T]), d.qfrc_inverse.copy(), len(act))
+    qfrc = d.qfrc_inverse.copy()
+    if wrench is not None:
+        jp, jr = np.zeros((3, m.nv)), np.zeros((3, m.nv))
+        mj.mj_jac(m, d, jp, jr, np.zeros(3), mj.mj_name2id(m, mj.mjtObj.mjOBJ_BODY, tree.output))
+        qfrc -= jp.T @ np.asarray(wrench[:3]) + jr.T @ np.asarray(wrench[3:])
+    tau, resid["split"] = _split_efforts(np.hstack([B.T, Jc.T]), qfrc, len(act))
     return tau, resid
 
 
@@ -188,8 +196,9 @@ class PinocchioTree:
             rows.append(sum(blocks))
         return np.vstack(rows)
 
-    def efforts(self, res: InverseDynamics) -> tuple[np.ndarray, dict]:
-        """The actuator efforts Pinocchio gives at the library's state, and the residuals."""
+    def efforts(self, res: InverseDynamics, wrench=None) -> tuple[np.ndarray, dict]:
+        """The actuator efforts Pinocchio gives at the library's state, and the residuals;
+        ``wrench`` on the output body as in :func:`mujoco_efforts`."""
         pin = self.pin
         q = self.q_of(res.state.config)
         jac = self.body_jacobians(q)
@@ -203,6 +212,9 @@ class PinocchioTree:
         a, *_ = np.linalg.lstsq(J, Acc, rcond=None)
         resid["a"] = _rel(J @ a, Acc)
         qfrc = pin.rnea(self.model, self.data, q, v, a).copy()
+        if wrench is not None:
+            Jo = jac[self.tree.output][0]
+            qfrc -= Jo.T @ np.r_[np.asarray(wrench[3:]), np.asarray(wrench[:3])]
         Jc = self.closure_jacobian(q)
         act = [self.model.idx_vs[self.model.getJointId(name)] for name in res.actuators]
         B = np.zeros((len(act), self.model.nv))
