@@ -23,6 +23,7 @@ from .dynamics_engines import mujoco_efforts
 TRAJECTORIES = {
     "four-sps-cu": (([0, 0, 0.12], ("ZYX", 0.3, -0.4, 0.5)), [0.004, -0.003, 0.002, 0.005]),
     "delta-ruu": (None, [0.2, 0.1, -0.05]),
+    "delta": (None, [0.17, 0.09, 0.0]),  # the Clavel Delta: a graph with parallelograms, 6 idle spins
     "five-cs-3": (None, [0.15]),
 }
 

@@ -97,6 +97,8 @@ UNIT_FREE_KEYS: dict[str, str] = {
     "d": "order of the screw system (mobility formula)",
     "defects": "defect count or bit mask of a spherical four-bar (synth rccc)",
     "dof": "degrees of freedom",
+    "idle_motions": "number of idle motions (every actuator still: an SPS leg's spin) of inverse dynamics",
+    "max_residual": "largest relative residual of the virtual-power balance over the samples (dynamics)",
     "dof_instantaneous": "instantaneous degrees of freedom (rank of the closure Jacobian)",
     "dof_at_reference": "instantaneous degrees of freedom at the reference configuration itself (mobility)",
     "local_dof": "largest dimension of the branches through the reference (mobility; null: undecided)",
