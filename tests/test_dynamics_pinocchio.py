@@ -15,7 +15,7 @@ from .test_dynamics_mujoco import TRAJECTORIES, trajectory
 
 pytest.importorskip("pinocchio")
 
-from .dynamics_engines import PinocchioTree  # noqa: E402
+from .dynamics_engines import PinocchioTree
 
 
 @pytest.mark.parametrize("name", list(TRAJECTORIES))

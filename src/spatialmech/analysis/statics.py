@@ -251,22 +251,7 @@ def statics(mech: Mechanism, config: Configuration, wrench, drivers=None, loads=
     redundant = bool(n_live + rank_c > 6)
     unbalanced = unbalanced_direction(U[:, 5], L) if singular else None
     efforts = x[n_c:].copy()
-    notes: list[str] = []
-    if J.inverse_singular:
-        notes.append(f"inverse (serial) singular for {', '.join(J.inverse_singular)}: its actuation wrench does not "
-                     "exist here; that actuator cannot carry a load (effort 0)")
-    if singular:
-        notes.append("singular: the actuation and constraint wrenches span less than 6 directions; the efforts are "
-                     "the least-squares ones and the external wrench's component along unbalanced_wrench is not balanced"
-                     + ("" if balanced else " (residual)"))
-    if redundant:
-        notes.append(f"redundant actuation: {n_live} actuation wrenches where {6 - rank_c} suffice; the efforts are the "
-                     "minimum-norm ones (torques divided by the characteristic length)")
-    elif effort_free and not singular:
-        notes.append("the efforts are not unique here; the minimum-norm ones are given")
-    if indeterminate:
-        notes.append("overconstrained: the constraint wrenches are dependent; their share between the limbs (and the "
-                     "joint reactions) is statically indeterminate: the minimum-norm intensities are given")
+    notes = _notes(J, singular, balanced, redundant, effort_free, indeterminate, n_live, rank_c)
     # per limb: the wrench it exerts on the output link, and the reactions of its joints
     limb_w: np.ndarray | None = None
     reactions: tuple[JointReaction, ...] = ()
@@ -293,6 +278,28 @@ def statics(mech: Mechanism, config: Configuration, wrench, drivers=None, loads=
                    x[:n_c, None] * W[:n_c], limb_w, reactions, residual, balanced and transfer_residual <= tol.rank,
                    singular, redundant, indeterminate, float(sigma), unbalanced, J, tuple(notes),
                    None if not loads else dict(loads))
+
+
+def _notes(J: CompleteJacobian, singular: bool, balanced: bool, redundant: bool, effort_free: bool,
+           indeterminate: bool, n_live: int, rank_c: int) -> list[str]:
+    """What the flags of :func:`statics` mean for its answer, in words."""
+    notes: list[str] = []
+    if J.inverse_singular:
+        notes.append(f"inverse (serial) singular for {', '.join(J.inverse_singular)}: its actuation wrench does not "
+                     "exist here; that actuator cannot carry a load (effort 0)")
+    if singular:
+        notes.append("singular: the actuation and constraint wrenches span less than 6 directions; the efforts are "
+                     "the least-squares ones and the external wrench's component along unbalanced_wrench is not balanced"
+                     + ("" if balanced else " (residual)"))
+    if redundant:
+        notes.append(f"redundant actuation: {n_live} actuation wrenches where {6 - rank_c} suffice; the efforts are the "
+                     "minimum-norm ones (torques divided by the characteristic length)")
+    elif effort_free and not singular:
+        notes.append("the efforts are not unique here; the minimum-norm ones are given")
+    if indeterminate:
+        notes.append("overconstrained: the constraint wrenches are dependent; their share between the limbs (and the "
+                     "joint reactions) is statically indeterminate: the minimum-norm intensities are given")
+    return notes
 
 
 def _serial_limbs(mech: Mechanism) -> bool:

@@ -35,6 +35,7 @@ internal loops (a Delta's parallelograms) comes back in graph form, with the sam
 from __future__ import annotations
 
 import json
+from collections import Counter
 import os
 import xml.etree.ElementTree as ET
 
@@ -149,9 +150,7 @@ def mjcf_tree(tree: BodyTree, inertias: dict | None = None) -> ET.ElementTree:
     elements: dict[str | None, ET.Element] = {None: world}
     origins: dict[str | None, np.ndarray] = {None: np.zeros(3)}
     gyr = (0.2 * L) ** 2
-    copies: dict[str, int] = {}
-    for b in tree.bodies:
-        copies[b.link] = copies.get(b.link, 0) + 1
+    copies = dict(Counter(b.link for b in tree.bodies))
     for b in tree.bodies:
         el = ET.SubElement(elements[b.parent], "body", name=b.name, pos=_vec(b.origin - origins[b.parent]))
         _inertial(el, b, inertias, copies, gyr)
