@@ -17,7 +17,7 @@ def dynamics_figure(result):
     from matplotlib.figure import Figure
 
     mech = result.mechanism
-    groups = {"force": [], "torque": []}
+    groups: dict[str, list[int]] = {"force": [], "torque": []}
     for j, a in enumerate(result.actuators):
         groups["force" if mech.freedom(a).freedom.kind == "P" else "torque"].append(j)
     kinds = [k for k in ("force", "torque") if groups[k]]
