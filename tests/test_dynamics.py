@@ -139,3 +139,20 @@ def test_dynamics_plot(tmp_path):
                                    "2700", "--plot", str(path)], catch_exceptions=False)
     assert out.exit_code == 0, out.output
     assert path.stat().st_size > 1000 and "L1.slide [N]" in out.output
+
+
+def test_dynamics_masses_go_into_the_mujoco_export(tmp_path):
+    import mujoco
+
+    d = schema.to_dict(catalog.resolve("three-rps"))
+    d["density_kg_m3"] = 2700.0
+    path = tmp_path / "rps.toml"
+    path.write_text(schema.dumps(schema.from_dict(d)))
+    sm.export(path, tmp_path / "rps.xml")
+    m = mujoco.MjModel.from_xml_path(str(tmp_path / "rps.xml"))
+    masses, _ = dy.mass_properties(sm.load_model(path))
+    for name, li in masses.items():
+        bid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, name)
+        assert m.body_mass[bid] == pytest.approx(li.mass_kg, rel=1e-12)
+    sm.export("three-rps", tmp_path / "plain.xml")  # no masses in the model: the default inertias
+    assert "fullinertia" not in (tmp_path / "plain.xml").read_text()
