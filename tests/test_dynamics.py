@@ -202,3 +202,16 @@ def test_dynamics_do_not_depend_on_where_the_world_frame_is(q, p, rates, accs):
         state = dy.state_from_actuators(m, c, rates, accs)
         out.append(dy.inverse_dynamics(m, state, m.inertias or masses, g, w).efforts)
     np.testing.assert_allclose(out[1], out[0], rtol=0, atol=1e-9 * np.max(np.abs(out[0])))
+
+
+def test_dynamics_bad_input_is_named():
+    with pytest.raises(InputError, match=r"sample 0 \(t = 0 s\): a direct singularity"):
+        sm.inverse_dynamics("four-sps-cu", density=2700)  # the reference pose is singular
+    with pytest.raises(InputError, match="length_unit: dynamics needs a model in metres"):
+        sm.inverse_dynamics("five-cs-3", density=1)
+    with pytest.raises(InputError, match="values: expected one row of 3"):
+        sm.inverse_dynamics("three-rps", density=2700, values=[[1, 2]])
+    with pytest.raises(InputError, match="density"):
+        sm.inverse_dynamics("three-rps", density=-1)
+    with pytest.raises(InputError, match="to/values"):
+        sm.inverse_dynamics("three-rps", density=2700, to=[0.3] * 3, values=[[0.3] * 3])

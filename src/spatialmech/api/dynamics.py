@@ -204,8 +204,11 @@ def inverse_dynamics(model: ModelLike, pose=None, *, to=None, duration: float = 
     configs = dyn.follow_actuators(mech, start, V)
     serial = dyn.limb_base_ground(mech)
     out, reactions = [], []
-    for c, r, a, t in zip(configs, R, A, T, strict=True):
-        st = dyn.state_from_actuators(mech, c, r, a, t=float(t))
+    for i, (c, r, a, t) in enumerate(zip(configs, R, A, T, strict=True)):
+        try:
+            st = dyn.state_from_actuators(mech, c, r, a, t=float(t))
+        except InputError as e:
+            raise InputError(f"sample {i} (t = {t:g} s): {str(e).split(': ', 1)[-1]}") from None
         res = dyn.inverse_dynamics(mech, st, inertias, g, F)
         out.append(res)
         reactions.append(joint_reactions(mech, c, res.limb_wrenches, res.by_actuator, dyn.distal_wrenches(mech, res))
