@@ -215,3 +215,15 @@ def test_dynamics_bad_input_is_named():
         sm.inverse_dynamics("three-rps", density=-1)
     with pytest.raises(InputError, match="to/values"):
         sm.inverse_dynamics("three-rps", density=2700, to=[0.3] * 3, values=[[0.3] * 3])
+
+
+def test_statics_along_poses_is_the_statics_at_each_pose():
+    poses = [sm.Pose.from_euler("ZYX", [0, 5, 5], [0, 0, 0.33], degrees=True),
+             sm.Pose.from_euler("ZYX", [0, -5, 3], [0, 0, 0.31], degrees=True)]
+    F = [0, 0, -100, 0, 0, 0]
+    p = sm.statics_along("three-rps", poses=poses, wrench=F, gravity=G, density=2700)
+    for k, pose in enumerate(poses):
+        s = sm.statics("three-rps", pose, wrench=F, gravity=G, density=2700)
+        np.testing.assert_allclose(p.efforts[k], list(s.efforts.values()), rtol=1e-12)
+    with pytest.raises(InputError, match="exactly one"):
+        sm.statics_along("three-rps", poses=poses, to=[0.3] * 3)

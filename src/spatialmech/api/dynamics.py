@@ -16,7 +16,15 @@ from ..kinematics.position import platform_pose
 from ..model.inertia import LinkInertia
 from ..model.mechanism import Mechanism
 from ..serialize import freedom_values_dict, pose_dict
-from .checks import ModelLike, as_configuration, as_mechanism, check_int, check_number, check_numbers
+from .checks import (
+    ModelLike,
+    as_configuration,
+    as_mechanism,
+    as_positions,
+    check_int,
+    check_number,
+    check_numbers,
+)
 
 __all__ = ["DynamicsResult", "StaticsPath", "inverse_dynamics", "masses_for", "statics_along"]
 
@@ -256,7 +264,7 @@ class StaticsPath:
                 "masses": _masses_json(self.masses, self.mass_source), "samples": samples}
 
 
-def statics_along(model: ModelLike, pose=None, *, to=None, samples: int = 11, values=None,
+def statics_along(model: ModelLike, pose=None, *, to=None, samples: int = 11, values=None, poses=None,
                   config: Configuration | None = None, wrench=None, gravity=None, density: float | None = None,
                   degrees: bool = False) -> StaticsPath:
     """Statics at every sample of a motion: the actuator efforts that hold the mechanism against
@@ -275,6 +283,9 @@ def statics_along(model: ModelLike, pose=None, *, to=None, samples: int = 11, va
         Number of samples with ``to`` (both ends included).
     values : array (n, n_a), optional
         Instead of ``to``: the actuator values of each sample.
+    poses : sequence of Pose, or a TOML file of ``[[positions]]``, optional
+        Instead of ``to`` and ``values``: the output link's poses, each fitted onto the closure
+        (inverse position), in order.
     config : Configuration, optional
         The start as a configuration.
     wrench : sequence of 6 floats, optional
@@ -294,7 +305,8 @@ def statics_along(model: ModelLike, pose=None, *, to=None, samples: int = 11, va
     Raises
     ------
     InputError
-        Neither ``to`` nor ``values``; gravity without masses.
+        Not exactly one of ``to``, ``values``, ``poses``; gravity without masses; a pose with no
+        closed configuration near it.
     ConvergenceError
         The forward position does not follow the actuators.
 
@@ -309,18 +321,29 @@ def statics_along(model: ModelLike, pose=None, *, to=None, samples: int = 11, va
     F = np.zeros(6) if wrench is None else check_numbers(wrench, "wrench", shape=(6,))
     g = None if gravity is None else check_numbers(gravity, "gravity", shape=(3,))
     inertias, source = masses_for(mech, density) if g is not None else ({}, {})
+    if sum(x is not None for x in (to, values, poses)) != 1:
+        raise InputError("to/values/poses: give exactly one: target actuator values, actuator values per sample, or "
+                         "poses")
+    if poses is not None:
+        given = as_positions(poses) or ()
+        configs = [as_configuration(mech, P, None, degrees, pose_name=f"poses[{k}]")[0] for k, P in enumerate(given)]
+        if not configs:
+            raise InputError("poses: no pose given")
+        return _statics_at(mech, configs, np.array([dyn.actuator_values(mech, c) for c in configs]), F, g, inertias,
+                           source)
     start, _ = as_configuration(mech, pose, config, degrees)
     if to is not None:
         a0 = dyn.actuator_values(mech, start)
         n = check_int(samples, "samples", minimum=2)
         V = a0 + np.linspace(0.0, 1.0, n)[:, None] * (check_numbers(to, "to", shape=(len(a0),)) - a0)
-    elif values is not None:
+    else:
         V = check_numbers(values, "values")
         if V.ndim != 2 or V.shape[1] != len(mech.actuators):
             raise InputError(f"values: expected rows of {len(mech.actuators)} actuator values, got shape {V.shape}")
-    else:
-        raise InputError("to/values: give the target actuator values (to=) or the samples (values=)")
-    configs = dyn.follow_actuators(mech, start, V)
+    return _statics_at(mech, dyn.follow_actuators(mech, start, V), V, F, g, inertias, source)
+
+
+def _statics_at(mech: Mechanism, configs, V: np.ndarray, F: np.ndarray, g, inertias, source) -> StaticsPath:
     rows = []
     for c in configs:
         loads = dyn.gravity_loads(mech, c, inertias, g) if g is not None else None

@@ -73,9 +73,10 @@ def _text(r, unit: str) -> list[str]:
                    "file or --density.")
 @click.option("--density", type=float, default=None,
               help="kg/m^3 for the links without masses in the model file (solid cylinders along the links).")
-@click.option("--along", "along_text", default=None, metavar="V1,V2,...",
+@click.option("--along", "along_text", default=None, metavar="V1,V2,...|FILE.toml",
               help="Statics along a motion: the actuators moved in a straight line from the start to these values "
-                   "(m, or deg for revolute actuators); efforts per sample.")
+                   "(m, or deg for revolute actuators), or the poses of a TOML file of [[positions]]; efforts per "
+                   "sample.")
 @click.option("--samples", type=int, default=11, show_default=True, help="Samples with --along (both ends included).")
 @tol_option("singular")
 @json_option
@@ -116,10 +117,15 @@ def _along(mech, pose, along_text, samples, wrench, gravity, density, drivers, a
     """``statics --along``: the efforts at each sample of a straight path of actuator values."""
     if drivers:
         raise click.UsageError("--driver: not with --along (the path is in the model's actuators)")
-    vals = parse_numbers(along_text, "--along", count=len(mech.actuators), what="actuator values")
-    to = [v if mech.freedom(a).freedom.kind == "P" else float(np.radians(v))
-          for a, v in zip(mech.actuators, vals, strict=True)]
-    p = sm.statics_along(mech, pose, to=to, samples=samples, wrench=wrench, gravity=gravity, density=density)
+    if along_text.endswith(".toml"):
+        if pose is not None:
+            raise click.UsageError("--along FILE.toml: the file gives the poses; no --pose / --xyz / --position")
+        p = sm.statics_along(mech, poses=along_text, wrench=wrench, gravity=gravity, density=density)
+    else:
+        vals = parse_numbers(along_text, "--along", count=len(mech.actuators), what="actuator values")
+        to = [v if mech.freedom(a).freedom.kind == "P" else float(np.radians(v))
+              for a, v in zip(mech.actuators, vals, strict=True)]
+        p = sm.statics_along(mech, pose, to=to, samples=samples, wrench=wrench, gravity=gravity, density=density)
     if as_json:
         emit_json("statics along", mech, {"result": "statics along", **p.to_dict()})
         return
