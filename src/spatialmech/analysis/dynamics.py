@@ -36,7 +36,7 @@ on them): ``N^T (Q + M_x N alpha) = 0`` over a basis ``N`` of them.  The residua
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -292,6 +292,7 @@ class DynamicsState:
     values: np.ndarray | None = None
     rates: np.ndarray | None = None
     accelerations: np.ndarray | None = None
+    frame: _Frame | None = field(default=None, repr=False)  # the velocity maps at config (reused)
 
 
 def _solve_free(M: np.ndarray, rhs: np.ndarray, what: str) -> np.ndarray:
@@ -331,7 +332,7 @@ def state_from_actuators(mech: Mechanism, config: Configuration, rates, accelera
     xd = np.zeros(nx)
     xd[fr.act] = acc / fr.col[fr.act]
     xd[free] = _solve_free(M, -fr.row * beta - As[:, fr.act] @ xd[fr.act], "accelerations")
-    return DynamicsState(config, x, xd * fr.col, t, None, r, acc)
+    return DynamicsState(config, x, xd * fr.col, t, None, r, acc, fr if drivers is None else None)
 
 
 # ------------------------------------------------------------------ the balance
@@ -367,7 +368,7 @@ def inverse_dynamics(mech: Mechanism, state: DynamicsState, inertias: dict[str, 
     """Actuator efforts, loop multipliers and link wrenches at ``state`` (module docstring);
     ``wrench``: an external wrench ``(f ; m about the origin)`` on the output link."""
     config = state.config
-    fr = _frame(mech, config, drivers)
+    fr = state.frame if state.frame is not None and drivers is None else _frame(mech, config, drivers)
     g = np.asarray(gravity, float)
     F = np.zeros(6) if wrench is None else np.asarray(wrench, float)
     links = _links(mech)

@@ -16,6 +16,7 @@ from ..kinematics.position import platform_pose
 from ..model.inertia import LinkInertia
 from ..model.mechanism import Mechanism
 from ..serialize import freedom_values_dict, pose_dict
+from .threads import one_blas_thread
 from .checks import (
     ModelLike,
     as_configuration,
@@ -143,6 +144,7 @@ def _trajectory(mech: Mechanism, start: Configuration, to, duration, samples, va
     return T, V, R, A
 
 
+@one_blas_thread
 def inverse_dynamics(model: ModelLike, pose=None, *, to=None, duration: float = 1.0, samples: int = 11, values=None,
                      rates=None, accelerations=None, times=None, config: Configuration | None = None,
                      gravity=STANDARD_GRAVITY, wrench=None, density: float | None = None,
@@ -264,6 +266,7 @@ class StaticsPath:
                 "masses": _masses_json(self.masses, self.mass_source), "samples": samples}
 
 
+@one_blas_thread
 def statics_along(model: ModelLike, pose=None, *, to=None, samples: int = 11, values=None, poses=None,
                   config: Configuration | None = None, wrench=None, gravity=None, density: float | None = None,
                   degrees: bool = False) -> StaticsPath:
