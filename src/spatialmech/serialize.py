@@ -76,6 +76,11 @@ UNIT_SUFFIXES: dict[str, str] = {
     "_len_per_N": "length_unit per newton (a linear compliance)",
     "_per_N": "per newton (a coupling compliance: length_unit per N length_unit, or rad per N)",
     "_per_N_len": "per newton length_unit (a rotational compliance: rad per N length_unit)",
+    "_deg_per_s": "degrees per second (an angular rate)",
+    "_deg_per_s2": "degrees per second squared (an angular acceleration)",
+    "_kg": "kilograms",
+    "_kg_len2": "kilograms times the square of the document's length_unit (an inertia; the metre for dynamics)",
+    "_kg_per_len3": "kilograms per cube of the document's length_unit (a density)",
 }
 
 #: Keys whose numbers have no unit, with their meaning: counts, indices, signs, nondimensional
@@ -92,6 +97,8 @@ UNIT_FREE_KEYS: dict[str, str] = {
     "d": "order of the screw system (mobility formula)",
     "defects": "defect count or bit mask of a spherical four-bar (synth rccc)",
     "dof": "degrees of freedom",
+    "idle_motions": "number of idle motions (every actuator still: an SPS leg's spin) of inverse dynamics",
+    "max_residual": "largest relative residual of the virtual-power balance over the samples (dynamics)",
     "dof_instantaneous": "instantaneous degrees of freedom (rank of the closure Jacobian)",
     "dof_at_reference": "instantaneous degrees of freedom at the reference configuration itself (mobility)",
     "loss_rate": "accuracy: the singular value that removes a freedom, per unit tolerance scale (scale-free)",

@@ -45,6 +45,15 @@ joint's point): ``W_k - sum_f tau_f eta_f`` with ``eta_f . $_g = delta_fg`` over
 freedoms, so the reaction is reciprocal to every freedom of the joint (it does no work).
 Mechanisms with internal bodies (a link-and-joint graph) get the efforts; their joint reactions are
 not computed (:attr:`Statics.notes` says so).
+
+**Loads on the links** (``loads``: a wrench on each named link, e.g. its weight, see
+:func:`spatialmech.analysis.dynamics.gravity_loads`), for limbs from the ground to the output link.
+A load on the output link adds to ``F``.  In limb ``k`` a joint now transmits ``W_k`` plus
+``D_j``, the sum of ``-load`` over the limb's links beyond it, so ``W_k . $_f = tau_f - D_j . $_f``:
+``W_k = P0_k + (tau a + lambda c)`` with ``P0_k . $_f = -D_j . $_f`` for every freedom (a least-squares
+solve over the limb's twists; a residual means the loads drive a motion no actuator holds, e.g. a
+weight off an SPS leg's line spinning the leg, and is reported).  The platform's balance is then
+the massless one against ``F + load_output + sum_k P0_k``.
 """
 
 from __future__ import annotations
@@ -60,7 +69,7 @@ from ..kinematics.closure import Configuration, chain_forward, joint_twists, lim
 from ..kinematics.jacobian import CompleteJacobian, complete_jacobian
 from ..model.mechanism import GROUND, Mechanism
 
-__all__ = ["JointReaction", "Statics", "statics", "unbalanced_direction"]
+__all__ = ["JointReaction", "Statics", "joint_reactions", "statics", "unbalanced_direction"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -107,6 +116,7 @@ class Statics:
     unbalanced_wrench: np.ndarray | None  # (6,) the wrench direction that cannot be balanced (when singular)
     jacobian: CompleteJacobian
     notes: tuple[str, ...] = ()
+    loads: dict[str, np.ndarray] | None = None  # wrench (f ; m about the origin) on each loaded link
 
     @property
     def by_actuator(self) -> dict[str, float]:
@@ -149,18 +159,52 @@ def _lstsq(A: np.ndarray, b: np.ndarray, rtol: float) -> np.ndarray:
     return vt[:r].T @ ((u[:, :r].T @ b) / s[:r])
 
 
-def statics(mech: Mechanism, config: Configuration, wrench, drivers=None) -> Statics:
+def _limb_transfer(mech: Mechanism, config: Configuration, loads: dict[str, np.ndarray]
+                   ) -> tuple[np.ndarray, list[np.ndarray], float]:
+    """Per limb ``P0_k`` and the per-joint distal sums ``D_j`` of the loads (module docstring), and
+    the largest relative residual of the ``P0_k`` solves."""
+    L = mech.characteristic_length
+    twists = joint_twists(mech, config)
+    P0 = np.zeros((len(mech.limbs), 6))
+    distal = []
+    worst = 0.0
+    for k, limb in enumerate(mech.limbs):
+        n = len(limb.joints)
+        D = np.zeros((n, 6))
+        for j in range(n - 2, -1, -1):
+            D[j] = D[j + 1] - loads.get(limb.link_names[j], np.zeros(6))
+        distal.append(D)
+        joint_of = [j for j, joint in enumerate(limb.joints) for _ in joint.freedoms]
+        S = twists[k]
+        rhs = -np.array([float(sc.reciprocal_product(S[:, f], D[joint_of[f]])) for f in range(S.shape[1])]) / L
+        rows = np.hstack([S[3:].T / L, S[:3].T])  # . (f ; m / L)
+        z, *_ = np.linalg.lstsq(rows, rhs, rcond=None)
+        if np.any(rhs):
+            worst = max(worst, float(np.linalg.norm(rows @ z - rhs) / np.linalg.norm(rhs)))
+        P0[k] = np.r_[z[:3], z[3:] * L]
+    return P0, distal, worst
+
+
+def statics(mech: Mechanism, config: Configuration, wrench, drivers=None, loads=None) -> Statics:
     """Actuator efforts, constraint-wrench intensities and joint reactions that hold ``mech`` at
     ``config`` against the external ``wrench`` ``(f ; m)`` on its output link (``m`` about the
     origin; SI force, moment in force times the model's length unit).
 
     ``drivers``: the actuated freedoms (default: the mechanism's actuators).  Raises
     :class:`~spatialmech.errors.InputError` for a wrench that is not 6 finite numbers or a
-    mechanism with no actuator.
+    mechanism with no actuator.  ``loads``: wrenches on links by name (module docstring).
     """
-    F = np.asarray(wrench, dtype=float)
-    if F.shape != (6,) or not np.all(np.isfinite(F)):
-        raise InputError(f"wrench: expected 6 finite numbers (fx, fy, fz ; mx, my, mz), got shape {F.shape}")
+    F_given = np.asarray(wrench, dtype=float)
+    if F_given.shape != (6,) or not np.all(np.isfinite(F_given)):
+        raise InputError(f"wrench: expected 6 finite numbers (fx, fy, fz ; mx, my, mz), got shape {F_given.shape}")
+    F = F_given
+    P0, distal, transfer_residual = None, None, 0.0
+    if loads:
+        if not _serial_limbs(mech):
+            raise InputError("loads: loads on the links (gravity) are balanced for limbs from the ground to the output "
+                             f"link only; {mech.name} has other limbs (use sm.inverse_dynamics at rest)")
+        P0, distal, transfer_residual = _limb_transfer(mech, config, loads)
+        F = F_given + loads.get(mech.output, np.zeros(6)) + P0.sum(axis=0)
     J = complete_jacobian(mech, config, drivers)
     acts = J.actuators
     if not acts:
@@ -207,6 +251,38 @@ def statics(mech: Mechanism, config: Configuration, wrench, drivers=None) -> Sta
     redundant = bool(n_live + rank_c > 6)
     unbalanced = unbalanced_direction(U[:, 5], L) if singular else None
     efforts = x[n_c:].copy()
+    notes = _notes(J, singular, balanced, redundant, effort_free, indeterminate, n_live, rank_c)
+    # per limb: the wrench it exerts on the output link, and the reactions of its joints
+    limb_w: np.ndarray | None = None
+    reactions: tuple[JointReaction, ...] = ()
+    if mech.bodies:
+        notes.append(f"joint reactions are not computed for mechanisms with internal bodies ({', '.join(mech.bodies)}); "
+                     "the efforts are")
+    elif not _serial_limbs(mech):
+        notes.append("joint reactions are computed only for limbs from the ground to the output link")
+    else:
+        act_limb = [mech.freedom(a).limb for a in acts]
+        limb_w = np.zeros((len(mech.limbs), 6))
+        for i in range(n_c):
+            limb_w[J.constraint_limbs[i]] += x[i] * W[i]
+        for j, k in enumerate(act_limb):
+            limb_w[k] += x[n_c + j] * W[n_c + j]
+        if P0 is not None:
+            limb_w += P0
+        reactions = joint_reactions(mech, config, limb_w, dict(zip(acts, efforts, strict=True)), distal)
+    if transfer_residual > tol.rank:
+        notes.append(f"the loads on the limbs' links drive a motion no actuator holds (relative residual "
+                     f"{transfer_residual:.2e}, e.g. a weight off an SPS leg's line spinning the leg): not balanced")
+    kinds = tuple("force" if mech.freedom(a).freedom.kind == "P" else "torque" for a in acts)
+    return Statics(F_given, acts, kinds, efforts, tuple(J.constraint_limbs[:n_c]), y[:n_c].copy(),
+                   x[:n_c, None] * W[:n_c], limb_w, reactions, residual, balanced and transfer_residual <= tol.rank,
+                   singular, redundant, indeterminate, float(sigma), unbalanced, J, tuple(notes),
+                   None if not loads else dict(loads))
+
+
+def _notes(J: CompleteJacobian, singular: bool, balanced: bool, redundant: bool, effort_free: bool,
+           indeterminate: bool, n_live: int, rank_c: int) -> list[str]:
+    """What the flags of :func:`statics` mean for its answer, in words."""
     notes: list[str] = []
     if J.inverse_singular:
         notes.append(f"inverse (serial) singular for {', '.join(J.inverse_singular)}: its actuation wrench does not "
@@ -223,45 +299,34 @@ def statics(mech: Mechanism, config: Configuration, wrench, drivers=None) -> Sta
     if indeterminate:
         notes.append("overconstrained: the constraint wrenches are dependent; their share between the limbs (and the "
                      "joint reactions) is statically indeterminate: the minimum-norm intensities are given")
-    # per limb: the wrench it exerts on the output link, and the reactions of its joints
-    limb_w: np.ndarray | None = None
-    reactions: tuple[JointReaction, ...] = ()
-    if mech.bodies:
-        notes.append(f"joint reactions are not computed for mechanisms with internal bodies ({', '.join(mech.bodies)}); "
-                     "the efforts are")
-    elif any(limb.base != GROUND or mech.limb_tip(limb) != mech.output or any(j.reversed for j in limb.joints)
-             for limb in mech.limbs):
-        notes.append("joint reactions are computed only for limbs from the ground to the output link")
-    else:
-        act_limb = [mech.freedom(a).limb for a in acts]
-        limb_w = np.zeros((len(mech.limbs), 6))
-        for i in range(n_c):
-            limb_w[J.constraint_limbs[i]] += x[i] * W[i]
-        for j, k in enumerate(act_limb):
-            limb_w[k] += x[n_c + j] * W[n_c + j]
-        reactions = _reactions(mech, config, limb_w, dict(zip(acts, efforts, strict=True)))
-    kinds = tuple("force" if mech.freedom(a).freedom.kind == "P" else "torque" for a in acts)
-    return Statics(F, acts, kinds, efforts, tuple(J.constraint_limbs[:n_c]), y[:n_c].copy(),
-                   x[:n_c, None] * W[:n_c], limb_w, reactions, residual, balanced, singular, redundant,
-                   indeterminate, float(sigma), unbalanced, J, tuple(notes))
+    return notes
 
 
-def _reactions(mech: Mechanism, config: Configuration, limb_w: np.ndarray, efforts: dict[str, float]
-               ) -> tuple[JointReaction, ...]:
-    """Every joint's reaction, for limbs from the ground to the output link."""
+def _serial_limbs(mech: Mechanism) -> bool:
+    """Every limb a serial chain from the ground to the output link, joints in its direction."""
+    return not mech.bodies and not any(
+        limb.base != GROUND or mech.limb_tip(limb) != mech.output or any(j.reversed for j in limb.joints)
+        for limb in mech.limbs)
+
+
+def joint_reactions(mech: Mechanism, config: Configuration, limb_w: np.ndarray, efforts: dict[str, float],
+                    distal: list[np.ndarray] | None = None) -> tuple[JointReaction, ...]:
+    """Every joint's reaction, for limbs from the ground to the output link: the wrench limb ``k``
+    exerts on the output link ``limb_w[k]``, plus (``distal[k][j]``) what joint ``j`` carries for
+    the limb's links beyond it, without the actuator ``efforts`` along the joint's freedoms."""
     twists = joint_twists(mech, config)
     out = []
     for k, (limb, ch, sl) in enumerate(zip(mech.limbs, limb_chains(mech), limb_slices(mech), strict=True)):
         _, _, pre = chain_forward(ch, config.q[sl], prefixes=True, local=True)
         T = twists[k]
         i = 0
-        for joint in limb.joints:
+        for jj, joint in enumerate(limb.joints):
             m = len(joint.freedoms)
             P = pre[i]
             c = P[:3, :3] @ joint.point + P[:3, 3]
             ids = [f"{joint.name}.{f.name}" for f in joint.freedoms]
             tau = {fid: float(efforts[fid]) for fid in ids if fid in efforts}
-            w = limb_w[k].copy()
+            w = limb_w[k].copy() if distal is None else limb_w[k] + distal[k][jj]
             if tau:
                 S = T[:, i : i + m].T  # (m, 6) the joint's current twists
                 E = np.array([np.r_[S[g, 3:], np.cross(c, S[g, 3:])] if joint.freedoms[g].kind == "P"

@@ -61,6 +61,7 @@ if TYPE_CHECKING:  # what mypy (and a reader) sees; at run time __getattr__ impo
     )
     from .accuracy import AccuracyResult, accuracy
     from .forces import StaticsResult, statics
+    from .dynamics import DynamicsResult, StaticsPath, inverse_dynamics, statics_along
     from .kinematics import (
         FKResult,
         IKResult,
@@ -89,6 +90,7 @@ _LAZY: dict[str, str] = {
     **dict.fromkeys(("ModelLike",), ".checks"),
     **dict.fromkeys(("AccuracyResult", "accuracy"), ".accuracy"),
     **dict.fromkeys(("StaticsResult", "statics"), ".forces"),
+    **dict.fromkeys(("DynamicsResult", "StaticsPath", "inverse_dynamics", "statics_along"), ".dynamics"),
     **dict.fromkeys(("FKResult", "IKResult", "JacobianResult", "VelocityResult", "fk", "ik", "jacobian", "velocity"),
                     ".kinematics"),
     **dict.fromkeys(("SingularityAnalysis", "parasitic", "singularity", "workspace"), ".spaces"),
@@ -109,6 +111,7 @@ __all__ = [
     "AccuracyResult",
     "CSSynthesisResult",
     "DefectAnalysis",
+    "DynamicsResult",
     "ExportResult",
     "FKResult",
     "IKResult",
@@ -117,6 +120,7 @@ __all__ = [
     "MobilityModes",
     "ReportResult",
     "SingularityAnalysis",
+    "StaticsPath",
     "StaticsResult",
     "StiffnessMap",
     "StiffnessResult",
@@ -133,6 +137,7 @@ __all__ = [
     "export",
     "fk",
     "ik",
+    "inverse_dynamics",
     "jacobian",
     "load_model",
     "maps",
@@ -145,6 +150,7 @@ __all__ = [
     "singularity",
     "singularity_slice",
     "statics",
+    "statics_along",
     "stiffness",
     "stiffness_map",
     "studio_session",

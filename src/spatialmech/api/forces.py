@@ -9,6 +9,7 @@ import numpy as np
 
 from ..analysis.statics import JointReaction, Statics
 from ..analysis.statics import statics as _statics
+from ..errors import InputError
 from ..geometry.tolerances import current as current_tolerances
 from ..kinematics.closure import Configuration
 from ..kinematics.position import PoseFit, platform_pose
@@ -55,6 +56,9 @@ class StaticsResult:
     analysis: Statics  # the core result: constraint intensities, limb wrenches, the complete Jacobian
     pose_fit: PoseFit | None = None
     pose: Pose | None = None  # the requested pose (default: the configuration's)
+    gravity: np.ndarray | None = None  # m/s^2, when the links' weights are balanced too
+    masses: dict | None = None  # link -> LinkInertia used for the weights
+    mass_source: dict | None = None  # link -> "file" | "density" | "none"
 
     @property
     def notes(self) -> tuple[str, ...]:
@@ -97,11 +101,15 @@ class StaticsResult:
             "reactions": reactions,
             "notes": list(self.notes),
             "pose_fit": None if self.pose_fit is None else self.pose_fit.to_dict(),
+            **({} if self.gravity is None else {
+                "gravity_len_per_s2": [float(v) for v in self.gravity],
+                "masses": [{"link": n, "source": (self.mass_source or {}).get(n, "file"), "mass_kg": float(li.mass_kg)}
+                           for n, li in (self.masses or {}).items()]}),
         }
 
 
 def statics(model: ModelLike, pose=None, *, wrench, config: Configuration | None = None, drivers=None,
-            degrees: bool = False) -> StaticsResult:
+            degrees: bool = False, gravity=None, density: float | None = None) -> StaticsResult:
     """Statics at a pose (fitted onto the closure), a configuration or the reference
     configuration: the force or torque of every actuator, and every joint's reaction, that hold the
     mechanism against an external ``wrench`` on its output link (massless links, no friction).
@@ -122,6 +130,12 @@ def statics(model: ModelLike, pose=None, *, wrench, config: Configuration | None
         redundant actuation.
     degrees : bool
         Read a pose tuple's Euler angles in degrees.
+    gravity : sequence of 3 floats, optional
+        m/s^2: also balance the links' weights (limbs from the ground to the output link; the
+        model in metres).  The masses are the file's, or solid cylinders along the links of
+        ``density`` (docs/dynamics.md); ``masses`` and ``mass_source`` say which.
+    density : float, optional
+        kg/m^3 for the links without masses in the file (with ``gravity``).
 
     Returns
     -------
@@ -157,6 +171,16 @@ def statics(model: ModelLike, pose=None, *, wrench, config: Configuration | None
     drivers = check_names(drivers, "drivers")
     c, fit = as_configuration(mech, pose, config, degrees)
     requested = as_pose(mech, pose, degrees)[0] if pose is not None else None
-    s = _statics(mech, c, F, drivers)
+    g, loads, masses, source = None, None, None, None
+    if gravity is not None:
+        from ..analysis.dynamics import gravity_loads
+        from .dynamics import masses_for
+
+        g = check_numbers(gravity, "gravity", shape=(3,))
+        masses, source = masses_for(mech, density)
+        loads = gravity_loads(mech, c, masses, g)
+    elif density is not None:
+        raise InputError("density: only with gravity (the links' weights)")
+    s = _statics(mech, c, F, drivers, loads)
     return StaticsResult(mech, c, F, s.by_actuator, s.reactions, s.residual, s.balanced, s.singular, s.redundant,
-                         s.indeterminate, s.sigma_min, s.unbalanced_wrench, s, fit, requested)
+                         s.indeterminate, s.sigma_min, s.unbalanced_wrench, s, fit, requested, g, masses, source)

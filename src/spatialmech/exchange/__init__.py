@@ -59,15 +59,27 @@ def format_of(path, fmt: str | None = None) -> str:
                      f"use .toml, .xml (MJCF) or .urdf, or give --format {'|'.join(FORMATS)}")
 
 
+def _model_masses(mech: Mechanism) -> dict | None:
+    """The links' mass properties when the model gives them (``masses``, ``density_kg_m3``) for
+    every moving link, else ``None`` (the MJCF keeps its default inertias)."""
+    if not (mech.inertias or mech.density_kg_m3 is not None) or mech.length_unit != "m":
+        return None
+    from ..analysis.dynamics import mass_properties
+
+    masses, _ = mass_properties(mech)
+    return masses if all(li.mass_kg > 0 for li in masses.values()) else None
+
+
 def export_model(mech: Mechanism, path, fmt: str | None = None) -> str:
     """Write ``mech`` to ``path`` as TOML (the model file format), MJCF or URDF; returns the
-    format used (``fmt`` or the one the extension implies)."""
+    format used (``fmt`` or the one the extension implies).  An MJCF of a model whose file gives
+    every link a mass (``masses``, ``density_kg_m3``) carries those mass properties."""
     fmt = format_of(path, fmt)
     if fmt == "toml":
         from ..model.schema import dump
 
         dump(mech, path)
     else:
-        text = to_mjcf(mech) if fmt == "mjcf" else to_urdf(mech)
+        text = to_mjcf(mech, _model_masses(mech)) if fmt == "mjcf" else to_urdf(mech)
         Path(os.fspath(path)).write_text(text, encoding="utf-8")
     return fmt

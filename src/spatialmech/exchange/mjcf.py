@@ -17,6 +17,8 @@
   freedom, its ``ctrlrange`` the freedom's limits;
 - geometry to look at in the viewer: capsules for links, cylinders along hinge and slide axes
   (actuated ones red), spheres for spherical joints; they never collide;
+- with mass properties (``to_mjcf(model, inertias)``, by link name), each body's ``inertial`` is
+  its link's (shared equally by a link's body and its ghost copies);
 - ``custom/text name="spatialmech"``: JSON with what MJCF cannot say (model name, unit, output
   body, limb names and end links, internal bodies, joint types and described directions),
   read back by :func:`from_mjcf`.
@@ -33,6 +35,7 @@ internal loops (a Delta's parallelograms) comes back in graph form, with the sam
 from __future__ import annotations
 
 import json
+from collections import Counter
 import os
 import xml.etree.ElementTree as ET
 
@@ -106,8 +109,27 @@ def _joint(parent: ET.Element, ax: Axis, origin: np.ndarray, gyr: float) -> None
     ET.SubElement(parent, "joint", attrs)
 
 
-def mjcf_tree(tree: BodyTree) -> ET.ElementTree:
-    """The MJCF document (an ``ElementTree``) of a body tree; see the module docstring."""
+def _inertial(el: ET.Element, body: Body, inertias: dict | None, copies: dict[str, int], gyr: float) -> None:
+    """The body's ``inertial``: its link's mass properties (shared equally by the link's body and
+    its ghost copies, which a weld makes one rigid body) or the default mass 1."""
+    li = None if inertias is None else inertias.get(body.link)
+    if li is None:
+        ET.SubElement(el, "inertial", pos="0 0 0", mass="1", diaginertia=_vec([gyr, gyr, gyr]))
+        return
+    n = copies[body.link]
+    if li.mass_kg <= 0:
+        raise InputError(f"masses: link {body.link!r} has no mass; MuJoCo needs a positive mass for every moving body")
+    inertia = li.inertia_kg_m2 / n
+    ET.SubElement(el, "inertial", pos=_vec(li.com_m - body.origin), mass=_num(li.mass_kg / n),
+                  fullinertia=_vec([inertia[0, 0], inertia[1, 1], inertia[2, 2], inertia[0, 1], inertia[0, 2],
+                                    inertia[1, 2]]))
+
+
+def mjcf_tree(tree: BodyTree, inertias: dict | None = None) -> ET.ElementTree:
+    """The MJCF document (an ``ElementTree``) of a body tree; see the module docstring.
+    ``inertias``: mass properties by link name (:class:`~spatialmech.model.inertia.LinkInertia`,
+    world coordinates at the reference) written as each body's ``inertial`` instead of the
+    default (mass 1, radius of gyration 0.2 L)."""
     L = tree.characteristic_length
     root = ET.Element("mujoco", model=tree.name)
     ET.SubElement(root, "compiler", angle="radian", autolimits="true")
@@ -128,9 +150,10 @@ def mjcf_tree(tree: BodyTree) -> ET.ElementTree:
     elements: dict[str | None, ET.Element] = {None: world}
     origins: dict[str | None, np.ndarray] = {None: np.zeros(3)}
     gyr = (0.2 * L) ** 2
+    copies = dict(Counter(b.link for b in tree.bodies))
     for b in tree.bodies:
         el = ET.SubElement(elements[b.parent], "body", name=b.name, pos=_vec(b.origin - origins[b.parent]))
-        ET.SubElement(el, "inertial", pos="0 0 0", mass="1", diaginertia=_vec([gyr, gyr, gyr]))
+        _inertial(el, b, inertias, copies, gyr)
         if b.joint is not None:
             for ax in b.joint.axes:
                 _joint(el, ax, b.origin, gyr)
@@ -175,9 +198,10 @@ def mjcf_tree(tree: BodyTree) -> ET.ElementTree:
     return ET.ElementTree(root)
 
 
-def to_mjcf(model: Mechanism | BodyTree) -> str:
-    """The MJCF text of a mechanism (or of a body tree); it loads with ``mujoco.MjModel.from_xml_string``."""
-    root = mjcf_tree(as_body_tree(model)).getroot()
+def to_mjcf(model: Mechanism | BodyTree, inertias: dict | None = None) -> str:
+    """The MJCF text of a mechanism (or of a body tree); it loads with ``mujoco.MjModel.from_xml_string``.
+    ``inertias``: mass properties by link name (see :func:`mjcf_tree`)."""
+    root = mjcf_tree(as_body_tree(model), inertias).getroot()
     if root is None:  # pragma: no cover - the writer always builds a root
         raise RuntimeError("empty MJCF document")
     return ET.tostring(root, encoding="unicode") + "\n"

@@ -281,6 +281,7 @@ def report(model, out, no_trace, as_json):
 
 from .cmd_accuracy import accuracy_cmd  # noqa: E402
 from .cmd_defects import defects  # noqa: E402
+from .cmd_dynamics import dynamics_cmd  # noqa: E402
 from .cmd_kinematics import fk, ik, jacobian  # noqa: E402  (commands defined in their own modules)
 from .cmd_maps import maps_cmd  # noqa: E402
 from .cmd_parasitic import parasitic_cmd  # noqa: E402
@@ -299,6 +300,7 @@ for _cmd in (ik, fk, jacobian, parasitic_cmd, synth, view, defects, workspace, s
     cli.add_command(_cmd)
 cli.add_command(stiffness_cmd)
 cli.add_command(accuracy_cmd)
+cli.add_command(dynamics_cmd)
 
 
 def main(argv=None):  # console-script entry point

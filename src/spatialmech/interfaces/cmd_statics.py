@@ -50,6 +50,11 @@ def _text(r, unit: str) -> list[str]:
         for j in r.reactions:
             lines.append(f"    {j.limb}/{j.joint} at {_vec(j.point)} {unit}: force {_vec(j.force)} N, "
                          f"moment {_vec(j.moment_at_point)}")
+    if r.gravity is not None:
+        total = sum(li.mass_kg for li in (r.masses or {}).values())
+        used = " and ".join(sorted(set((r.mass_source or {}).values())))
+        lines.insert(2, f"  with the links' weights: gravity ({', '.join(f'{v:g}' for v in r.gravity)}) m/s^2, "
+                        f"{total:.6g} kg in all (masses from: {used})")
     if r.pose_fit is not None and not r.pose_fit.exact:
         lines.append(f"  note: the pose was fitted onto the closure (error {r.pose_fit.position_error:.3g} {unit}, "
                      f"{np.degrees(r.pose_fit.angle_error):.3g} deg)")
@@ -58,14 +63,24 @@ def _text(r, unit: str) -> list[str]:
 
 @click.command(name="statics")
 @click.argument("model")
-@click.option("--wrench", "wrench_text", required=True, metavar="FX,FY,FZ,MX,MY,MZ",
+@click.option("--wrench", "wrench_text", default=None, metavar="FX,FY,FZ,MX,MY,MZ",
               help="External wrench on the output link (screw convention: force in N, then its moment about the "
-                   "model's origin in N times the model's length unit).")
+                   "model's origin in N times the model's length unit); default none (then --gravity is needed).")
 @with_pose
 @click.option("--driver", "drivers", multiple=True, help="Actuated freedom(s) (repeatable; default: the model's actuators).")
+@click.option("--gravity", "gravity_text", default=None, metavar="GX,GY,GZ",
+              help="Also hold the links' weights under this gravity (m/s^2, e.g. 0,0,-9.81); masses from the model "
+                   "file or --density.")
+@click.option("--density", type=float, default=None,
+              help="kg/m^3 for the links without masses in the model file (solid cylinders along the links).")
+@click.option("--along", "along_text", default=None, metavar="V1,V2,...|FILE.toml",
+              help="Statics along a motion: the actuators moved in a straight line from the start to these values "
+                   "(m, or deg for revolute actuators), or the poses of a TOML file of [[positions]]; efforts per "
+                   "sample.")
+@click.option("--samples", type=int, default=11, show_default=True, help="Samples with --along (both ends included).")
 @tol_option("singular")
 @json_option
-def statics_cmd(model, wrench_text, xyz, euler, position, drivers, as_json):
+def statics_cmd(model, wrench_text, xyz, euler, position, drivers, gravity_text, density, along_text, samples, as_json):
     """Statics: every actuator's force or torque and every joint's reaction that hold the mechanism
     against an external wrench on its output link (at the reference configuration unless a pose is
     given).  Redundant actuation: minimum-norm efforts; a singular pose: least squares and the
@@ -76,13 +91,48 @@ def statics_cmd(model, wrench_text, xyz, euler, position, drivers, as_json):
       spatialmech statics stewart-6sps --wrench 0,0,-600,0,0,0
       spatialmech statics three-rps --wrench 0,0,-100,0,0,0 --pose 0,0,0.33,ZYX,0,5,5 --json
       spatialmech statics delta --wrench=0,0,-10,0,0,0 --xyz 0.02 0.01 -0.33
+      spatialmech statics three-rps --gravity 0,0,-9.81 --density 2700
+      spatialmech statics three-rps --wrench 0,0,-100,0,0,0 --gravity 0,0,-9.81 --density 2700 --along 0.36,0.34,0.35
     """
-    wrench = parse_numbers(wrench_text, "--wrench", count=6, what="components FX,FY,FZ,MX,MY,MZ")
+    if wrench_text is None and gravity_text is None:
+        raise click.UsageError("give --wrench, --gravity or both")
+    wrench = [0.0] * 6 if wrench_text is None else parse_numbers(wrench_text, "--wrench", count=6,
+                                                                 what="components FX,FY,FZ,MX,MY,MZ")
+    gravity = None if gravity_text is None else parse_numbers(gravity_text, "--gravity", count=3,
+                                                              what="components GX,GY,GZ")
     mech = sm.load_model(model)
     given = xyz is not None or euler is not None or position is not None
     pose = resolve_pose(mech, xyz, euler, position) if given else None
-    r = sm.statics(mech, pose, wrench=wrench, drivers=list(drivers) or None)
+    if along_text is not None:
+        _along(mech, pose, along_text, samples, wrench, gravity, density, drivers, as_json)
+        return
+    r = sm.statics(mech, pose, wrench=wrench, drivers=list(drivers) or None, gravity=gravity, density=density)
     if as_json:
         emit_json("statics", mech, r.to_dict())
         return
     click.echo("\n".join(_text(r, mech.length_unit)))
+
+
+def _along(mech, pose, along_text, samples, wrench, gravity, density, drivers, as_json) -> None:
+    """``statics --along``: the efforts at each sample of a straight path of actuator values."""
+    if drivers:
+        raise click.UsageError("--driver: not with --along (the path is in the model's actuators)")
+    if along_text.endswith(".toml"):
+        if pose is not None:
+            raise click.UsageError("--along FILE.toml: the file gives the poses; no --pose / --xyz / --position")
+        p = sm.statics_along(mech, poses=along_text, wrench=wrench, gravity=gravity, density=density)
+    else:
+        vals = parse_numbers(along_text, "--along", count=len(mech.actuators), what="actuator values")
+        to = [v if mech.freedom(a).freedom.kind == "P" else float(np.radians(v))
+              for a, v in zip(mech.actuators, vals, strict=True)]
+        p = sm.statics_along(mech, pose, to=to, samples=samples, wrench=wrench, gravity=gravity, density=density)
+    if as_json:
+        emit_json("statics along", mech, {"result": "statics along", **p.to_dict()})
+        return
+    units = ["N" if mech.freedom(a).freedom.kind == "P" else f"N {mech.length_unit}" for a in p.actuators]
+    click.echo(f"{mech.name}: statics along {len(p.configs)} samples, wrench {_vec(p.wrench)}"
+               + ("" if p.gravity is None else f", gravity {_vec(p.gravity)} m/s^2"))
+    click.echo("  sample  " + "  ".join(f"{a} [{u}]".rjust(16) for a, u in zip(p.actuators, units, strict=True)))
+    for i, row in enumerate(p.efforts):
+        flag = "" if p.balanced[i] else "  (NOT balanced)"
+        click.echo(f"  {i:<6d}  " + "  ".join(f"{v:+16.6g}" for v in row) + flag)

@@ -27,6 +27,7 @@ from ..geometry.tolerances import characteristic_length
 from ..geometry.tolerances import current as current_tolerances
 from ..geometry.validate import as_finite_array
 from .joints import Freedom, Joint
+from .inertia import LinkInertia
 from .task import TaskCoordinates
 
 __all__ = ["GROUND", "MAX_IMPLICIT_MODES", "OUTPUT", "FreedomRef", "Limb", "Mechanism", "Mode", "Pose"]
@@ -189,6 +190,10 @@ class Mechanism:
     #: The task coordinates a user gives to pose the output link (None: chosen from the
     #: mobility analysis, :func:`spatialmech.kinematics.task.default_task`).
     task: TaskCoordinates | None = None
+    #: Mass properties by link name (:mod:`spatialmech.model.inertia`); links not named here get
+    #: theirs from their shapes when ``density_kg_m3`` is given (docs/dynamics.md).
+    inertias: Mapping[str, LinkInertia] = field(default_factory=dict)
+    density_kg_m3: float | None = None
 
     def __post_init__(self):
         if not isinstance(self.name, str):
@@ -214,6 +219,7 @@ class Mechanism:
                     raise InputError(f"limbs[{i}].joints[{j}].name: duplicate joint name {joint.name!r}")
                 seen_j.add(joint.name)
         self._check_links()
+        self._check_inertias()
         if self.task is not None and not isinstance(self.task, TaskCoordinates):
             raise TypeError(f"task: expected a TaskCoordinates, got {describe(self.task)}")
         for target in self.aliases.values():
@@ -235,6 +241,19 @@ class Mechanism:
                 raise InputError(f"limbs[{r.limb}].joints[{r.joint}].pitch: {r.freedom.pitch:.3g} per rad is more than "
                                  f"{current_tolerances().max_ratio:g} characteristic lengths ({L:.3g}): to the rank "
                                  "tolerance it is a prismatic joint; use a P joint")
+
+    def _check_inertias(self) -> None:
+        """Mass properties name moving links; the density is a positive number or None."""
+        object.__setattr__(self, "inertias", dict(self.inertias))
+        moving = {self.output, *self.bodies, *(ln for limb in self.limbs for ln in limb.link_names)}
+        for name, li in self.inertias.items():
+            if not isinstance(li, LinkInertia):
+                raise TypeError(f"inertias[{name!r}]: expected a LinkInertia, got {describe(li)}")
+            if name not in moving:
+                raise InputError(f"masses: {name!r} is not a moving link; links: {', '.join(sorted(moving))}")
+        d = self.density_kg_m3
+        if d is not None and (isinstance(d, bool) or not isinstance(d, (int, float)) or not np.isfinite(d) or d <= 0):
+            raise InputError(f"density_kg_m3: expected a positive number, got {d!r}")
 
     def _check_links(self) -> None:
         """Limb ends name known hub links; link names are unique; every body is attached by at

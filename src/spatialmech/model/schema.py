@@ -23,6 +23,7 @@ from pydantic import BaseModel, ConfigDict, Field, PlainValidator, ValidationErr
 from ..errors import InputError
 from ..geometry.rotations import check_sequence
 from .joints import Joint, make_joint
+from .inertia import LinkInertia, check_inertia
 from .mechanism import Limb, Mechanism, Mode, Pose
 from .task import TaskCoordinates
 
@@ -161,6 +162,15 @@ class ModeSpec(_Strict):
     description: str = ""
 
 
+class MassSpec(_Strict):
+    """A link's mass properties, at the reference configuration in world coordinates (SI)."""
+
+    link: str
+    mass_kg: float
+    com_m: Vec3
+    inertia_kg_m2: Annotated[list[Vec3], Len(3, 3)] = Field(default_factory=lambda: [[0.0] * 3 for _ in range(3)])
+
+
 class MechanismSpec(_Strict):
     format: Annotated[Literal[1], PlainValidator(_format_version)] = 1
     name: str
@@ -179,6 +189,8 @@ class MechanismSpec(_Strict):
     aliases: dict[str, str] = Field(default_factory=dict)
     source: str = ""
     notes: str = ""
+    masses: list[MassSpec] = Field(default_factory=list)
+    density_kg_m3: float | None = None
 
 
 def _loc(loc) -> str:
@@ -271,6 +283,18 @@ def _pose(ps: PoseSpec, where: str) -> Pose:
         raise ModelFileError(f"{where}: {e}") from None
 
 
+def _masses(specs: list[MassSpec]) -> dict[str, LinkInertia]:
+    out: dict[str, LinkInertia] = {}
+    for i, ms in enumerate(specs):
+        if ms.link in out:
+            raise ModelFileError(f"masses[{i}].link: {ms.link!r} given twice")
+        try:
+            out[ms.link] = check_inertia(ms.mass_kg, ms.com_m, ms.inertia_kg_m2, f"masses[{i}]")
+        except InputError as e:
+            raise ModelFileError(str(e)) from None
+    return out
+
+
 def from_dict(data: dict[str, Any], *, source: str = "<dict>") -> Mechanism:
     """Validate a parsed file (a dict) and build the mechanism."""
     if not isinstance(data, dict):
@@ -303,6 +327,7 @@ def from_dict(data: dict[str, Any], *, source: str = "<dict>") -> Mechanism:
         platform_point=np.asarray(spec.platform_point, dtype=float),
         description=spec.description, modes=modes, positions=positions, aliases=spec.aliases,
         length_unit=spec.length_unit, source=spec.source or source, notes=spec.notes,
+        inertias=_masses(spec.masses), density_kg_m3=spec.density_kg_m3,
     )
     try:
         if graph:
@@ -458,6 +483,11 @@ def to_dict(mech: Mechanism) -> dict[str, Any]:
                       for l in mech.limbs]
     if mech.modes:
         d["modes"] = [{"name": m.name, "driven": list(m.driven), "description": m.description} for m in mech.modes]
+    if mech.density_kg_m3 is not None:
+        d["density_kg_m3"] = mech.density_kg_m3
+    if mech.inertias:
+        d["masses"] = [{"link": name, "mass_kg": li.mass_kg, "com_m": _vec(li.com_m),
+                        "inertia_kg_m2": [_vec(row) for row in li.inertia_kg_m2]} for name, li in mech.inertias.items()]
     if mech.positions:
         d["positions"] = [
             {"name": p.name, "point": _vec(p.p), "matrix": [_vec(row) for row in p.R]}
