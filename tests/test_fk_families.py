@@ -64,6 +64,37 @@ def test_delta_ruu_is_proven_complete_by_default_and_contains_the_multistart():
         assert _near(p, r.poses, 1e-6), "the multi-start found a mode the homotopy missed"
 
 
+def test_u_u_rod_quadrics_vanish_on_closed_configurations_and_refusals():
+    """The R-U-U limb's two quadrics (the sphere about the moving elbow, the U-P-U condition with
+    the arm's outer axis) hold at the assembly modes the multi-start finds (Newton on the full
+    closure, independent of the reduction), the platform turned in most of them; a U-U rod of
+    another axis layout is not reduced (the reason names the limb)."""
+    from scipy.spatial.transform import Rotation
+
+    mech = catalog.resolve("delta-ruu")
+    sysm = hc.pose_system(mech)
+    vals = np.radians([5.0, 10.0, 15.0])
+    ms = sm.fk(mech, vals, all_solutions=True, method="multistart", seeds=40)
+    turned = 0
+    Qv = sysm.coefficients(vals)
+    for pose in ms.poses:
+        D = pose.displacement(mech.platform_point)
+        q = Rotation.from_matrix(D[:3, :3]).as_quat()
+        e = np.r_[q[3], q[:3]]
+        p = D[:3, 3] / sysm.L
+        x = np.r_[e, np.array([-p @ e[1:], *(p * e[0] + np.cross(p, e[1:]))]) / 2]
+        assert max(abs(x @ Qv[i] @ x) for i in range(7)) < 1e-9
+        turned += np.linalg.norm(D[:3, :3] - np.eye(3)) > 1e-3
+    assert turned >= 1
+    z, x_ = [0, 0, 1], [1, 0, 0]
+    bent = sm.Mechanism("bent-ruu", limbs=[
+        sm.Limb(f"arm{i}", [sm.R(f"R{i}", [np.cos(t), np.sin(t), 0], [-np.sin(t), np.cos(t), 0], actuated=True),
+                            sm.U(f"E{i}", [1.2 * np.cos(t), 1.2 * np.sin(t), 0], [z, x_]),
+                            sm.U(f"W{i}", [0.3 * np.cos(t), 0.3 * np.sin(t), -1], [z, x_])])
+        for i, t in enumerate(np.radians([90, 210, 330]))], platform_point=[0, 0, -1])
+    assert "arm0" in hc.unsupported_reason(bent)
+
+
 @pytest.mark.parametrize(("name", "vals"), [
     ("delta", np.radians([5.73, 11.46, -5.73])),
     ("delta-ruu", np.radians([5.0, 10.0, 15.0])),
