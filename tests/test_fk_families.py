@@ -107,7 +107,10 @@ def test_translational_closed_form_is_the_identity_rotation_subset_of_the_comple
     t = translational_modes(mech, vals)
     assert (t.n_real, t.n_complex) == (2, 0) and t.residual < 1e-12 and "at most 2" in t.statement
     r = sm.fk(mech, vals, all_solutions=True)
-    assert r.complete
+    assert r.complete and r.completeness.endswith(
+        "2 of the real solutions keep the platform's reference orientation (the translational modes; the others "
+        "have it turned); the translational closed form (three spheres: at most 2, Bezout) gives 2 real and "
+        "0 complex, the same")
     turned_not = [p for p in r.poses if np.linalg.norm(p.R - np.eye(3)) < 1e-8]
     assert len(turned_not) == 2 and len(r.poses) > 2  # other modes have the platform turned
     for p in t.poses:
@@ -123,8 +126,11 @@ def test_translational_closed_form_complex_pair_and_refusals():
     assert (t.n_real, t.n_complex) == (0, 2) and t.points.shape == (0, 3)
     r = sm.fk(upu, [0.05, 0.06, 0.07], all_solutions=True)
     assert r.complete and not any(np.linalg.norm(p.R - np.eye(3)) < 1e-8 for p in r.poses)
+    assert r.completeness.endswith("gives 0 real and 2 complex, the same")
     prs = catalog.resolve("three-prs")
     assert "planes" in translational_reason(prs)
+    assert "6 distinct spheres" in translational_reason(catalog.resolve("stewart-6sps"))
+    assert "translational" not in sm.fk(prs, [0.0, 0.01, -0.01], all_solutions=True).completeness
     with pytest.raises(sm.InputError, match="three-prs"):
         translational_modes(prs, [0.0, 0.01, -0.01])
     with pytest.raises(sm.InputError, match="values"):

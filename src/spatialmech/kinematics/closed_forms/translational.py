@@ -36,7 +36,7 @@ import numpy as np
 from ...errors import InputError
 from ...model.mechanism import Mechanism, Pose
 
-__all__ = ["TranslationalModes", "translational_modes", "translational_reason"]
+__all__ = ["TranslationalModes", "translational_modes", "translational_note", "translational_reason"]
 
 #: Relative size below which a coefficient counts as zero (the quadrics are nondimensional, of order 1).
 _ZERO = 1e-10
@@ -106,7 +106,19 @@ def translational_reason(mech: Mechanism, values=None) -> str | None:
     why, spheres, linear = _spheres_and_planes(_rows(mech, v))
     if why is None and (not spheres or linear):
         why = "its limbs give planes, not only spheres, at the reference orientation (no translational family)"
+    if why is None and (n := _n_distinct(spheres)) != 3:
+        why = (f"its limbs give {n} distinct spheres at the reference orientation, not 3 (a translational family "
+               "has three: a Delta, a 3-UPU)")
     return why
+
+
+def _n_distinct(spheres) -> int:
+    """How many of the spheres ``(b, c)`` differ (a parallelogram's two rods give one)."""
+    kept: list = []
+    for b, c in spheres:
+        if not any(np.abs(b - b2).max() + abs(c - c2) < 1e-9 * (1.0 + np.abs(b).max() + abs(c)) for b2, c2 in kept):
+            kept.append((b, c))
+    return len(kept)
 
 
 def translational_modes(mech: Mechanism, values) -> TranslationalModes:
@@ -159,3 +171,27 @@ def translational_modes(mech: Mechanism, values) -> TranslationalModes:
                  "orientation held (three distinct spheres), two radical planes and a quadratic: at most 2 "
                  f"(Bezout 1 x 1 x 2); {n_real} real, {n_complex} complex")
     return TranslationalModes(pts, n_real, n_complex, float(res), statement)
+
+
+def translational_note(mech: Mechanism, values, poses) -> str | None:
+    """The sentence the complete forward position adds for a model with a translational family
+    (``None`` for the others, and where the spheres meet in no point at all): how many of its
+    real solutions ``poses`` keep the platform's reference orientation, and whether the closed
+    form (:func:`translational_modes`) gives the same ones."""
+    from ...geometry.tolerances import current
+
+    try:
+        if translational_reason(mech, values) is not None:
+            return None
+        t = translational_modes(mech, values)
+    except InputError:
+        return None
+    if t.n_real + t.n_complex == 0:
+        return None
+    L = mech.characteristic_length
+    tol = current().dedup
+    ident = [p for p in poses if np.linalg.norm(p.R - np.eye(3)) < tol]
+    same = len(ident) == t.n_real and all(any(np.linalg.norm(p.p - q.p) / L < tol for q in ident) for p in t.poses)
+    return (f"{len(ident)} of the real solutions keep the platform's reference orientation (the translational "
+            f"modes; the others have it turned); the translational closed form (three spheres: at most 2, Bezout) "
+            f"gives {t.n_real} real and {t.n_complex} complex, {'the same' if same else 'NOT the same (a defect)'}")
