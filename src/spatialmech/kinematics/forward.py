@@ -557,7 +557,7 @@ def _forward_homotopy(mech: Mechanism, targets: dict[int, float], seed: int, max
     from .closed_forms.translational import translational_note
 
     if (note := translational_note(mech, vals, [s.pose for s in sols])) is not None:
-        search["completeness"] += "; " + note
+        search["completeness"] = f"{search['completeness']}; {note}"
     return ForwardResult(tuple(sols), search)
 
 
