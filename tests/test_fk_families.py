@@ -17,6 +17,7 @@ from hypothesis import strategies as st
 import spatialmech as sm
 from spatialmech import catalog
 from spatialmech.catalog import classic
+from spatialmech.kinematics.closed_forms.three_prs_forward import prs_forward
 from spatialmech.kinematics.closed_forms.translational import translational_modes, translational_reason
 from spatialmech.kinematics.homotopy import study as hc
 from spatialmech.kinematics.motion import generic_configuration
@@ -137,6 +138,23 @@ def test_translational_closed_form_complex_pair_and_refusals():
         translational_modes(upu, [0.3, 0.3])
 
 
+@pytest.mark.parametrize("vals", [[0.02, -0.01, 0.03], [0.1, 0.05, -0.08]])
+def test_three_prs_elimination_of_degree_16_gives_the_homotopys_set(vals):
+    """The 3-PRS by elimination (a univariate polynomial of degree 16, the published count):
+    16 finite roots, as many real as the homotopy's proven set and the same poses, each
+    closing the three rigid distances to rounding."""
+    mech = catalog.resolve("three-prs")
+    e = prs_forward(mech, vals)
+    r = sm.fk(mech, vals, all_solutions=True)
+    d = r.to_dict()
+    assert r.complete and d["search"]["n_generic"] == 16 == e.n_real + e.n_complex and e.n_at_infinity == 0
+    assert e.n_real == d["n_real"] == len(r.poses) > 0 and e.residual < 1e-12 and "degree 16" in e.statement
+    for p in e.poses:
+        assert _near(p, r.poses, 1e-9)
+    with pytest.raises(sm.InputError, match=r"not a 3-PRS|not P-R-S"):
+        prs_forward(catalog.resolve("three-rps"), [0.3, 0.3, 0.3])
+
+
 _FAMILIES = {
     "delta": lambda g: classic.delta(rb=0.2 * g[0], arm=0.2 * g[1], rp=0.05 * g[2], h=-0.35 * g[3], width=0.06),
     "delta-ruu": lambda g: classic.delta_ruu(rb=0.2 * g[0], arm=0.2 * g[1], rp=0.05 * g[2], h=-0.35 * g[3]),
@@ -161,6 +179,9 @@ def test_random_geometry_fk_of_ik_contains_the_pose(family, g, seed):
     r = sm.fk(mech, list(inv.actuators.values()), all_solutions=True)
     assert r.complete and r.engine == "homotopy"
     assert _near(pose, r.poses, 1e-7)
+    if family == "three-prs":  # the elimination agrees on a random geometry too
+        e = prs_forward(mech, list(inv.actuators.values()))
+        assert e.n_real == len(r.poses) and all(_near(p, r.poses, 1e-7) for p in e.poses)
 
 
 @pytest.mark.slow
