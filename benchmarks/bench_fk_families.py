@@ -12,7 +12,9 @@ fresh process (imports and the compiled kernels' cache load included).  The base
 measured in the same run, is the 200-start multi-start on the same request (never a proof); the
 ratio says how many times faster the proven answer is.  Where the model has a translational
 family, the three-sphere closed form (:mod:`spatialmech.kinematics.closed_forms.translational`)
-is checked against the proven set's solutions with the reference orientation.  ``--phc`` also
+is checked against the proven set's solutions with the reference orientation, and the 3-PRS's
+degree-16 elimination (:mod:`spatialmech.kinematics.closed_forms.three_prs_forward`) against its
+whole real set.  ``--phc`` also
 runs PHCpack's blackbox (``phc -b``) on the same polynomial system of each case, in the same
 run (skipped where ``phc`` is missing): its count of regular solutions must equal the generic
 count and it must take at least 10 times as long as the first solve (issue 27's target).
@@ -35,6 +37,7 @@ import sys
 
 import spatialmech as sm
 from spatialmech import catalog
+from spatialmech.kinematics.closed_forms.three_prs_forward import prs_forward
 from spatialmech.kinematics.closed_forms.translational import translational_modes, translational_reason
 from spatialmech.kinematics.homotopy import study as hc
 
@@ -100,6 +103,15 @@ def case(name: str, values, degrees: bool, phc: bool) -> dict:
         row["translational"] = {"n_real": tm.n_real, "n_complex": tm.n_complex,
                                 "in_proven_set": len(ident) == tm.n_real and all(
                                     any(np.linalg.norm(p.p - q.p) < 1e-8 for q in ident) for p in tm.poses)}
+    if name == "three-prs":
+        t = time.perf_counter()
+        e = prs_forward(mech, vals)
+        row["elimination_ms"] = round(1e3 * (time.perf_counter() - t), 2)
+        row["elimination"] = {"degree": e.n_real + e.n_complex + e.n_at_infinity, "n_real": e.n_real,
+                              "n_complex": e.n_complex,
+                              "same_real_poses": e.n_real == len(r.poses) and all(
+                                  any(np.linalg.norm(p.p - q.p) + np.linalg.norm(p.R - q.R) < 1e-8 for q in r.poses)
+                                  for p in e.poses)}
     if phc:
         row.update(_phc_seconds(mech, vals))
         if row["phc_s"] is not None:
@@ -126,6 +138,10 @@ def main() -> None:
         extra = (f"; translational closed form {tr['n_real']} real + {tr['n_complex']} complex, "
                  f"{'the same as' if tr['in_proven_set'] else 'NOT the same as'} the proven set's R = I modes"
                  if tr else "")
+        el = r.get("elimination")
+        if el:
+            extra += (f"; degree-{el['degree']} elimination {r['elimination_ms']} ms: {el['n_real']} real + "
+                      f"{el['n_complex']} complex, {'the same' if el['same_real_poses'] else 'NOT the same'} real poses")
         phc = f"; PHCpack {r['phc_s']} s ({r['phc_regular']} regular)" if r.get("phc_s") is not None else ""
         print(f"{r['model']}: {r['engine']}, complete {r['complete']}, {r['n_real']} real of {r['n_generic']} generic "
               f"({r['n_listed']} listed); first solve {r['first_solve_s']} s (command line {r['cli_s']} s), "
