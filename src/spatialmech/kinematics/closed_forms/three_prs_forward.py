@@ -141,7 +141,8 @@ def prs_forward(mech: Mechanism, values) -> PrsForward:
     nz = np.flatnonzero(np.abs(coef) > 1e-12 * scale)
     deg = int(nz[-1]) if nz.size else 0
     roots = np.roots(coef[: deg + 1][::-1]) if deg > 0 else np.zeros(0, complex)
-    poses, res, n_real = [], 0.0, 0
+    poses: list[Pose] = []
+    res, n_real = 0.0, 0
     for t1 in roots:
         c2 = np.roots(_poly_y(C12, t1)[::-1])
         rt = _interpolate(lambda y, t1=t1: r_t2(t1, y), 4)[::-1]
@@ -155,7 +156,8 @@ def prs_forward(mech: Mechanism, values) -> PrsForward:
         th = 2.0 * np.arctan(t)
         A = np.array([feet[k] + lb[4] * (np.cos(th[k]) * lb[5] + np.sin(th[k]) * lb[6]) for k, lb in enumerate(limbs)])
         R, p = _rigid(np.array(b), A)
-        err = max(abs(np.linalg.norm(A[i] - A[j]) - np.linalg.norm(b[i] - b[j])) for i, j in ((0, 1), (1, 2), (2, 0)))
+        err = max(float(abs(np.linalg.norm(A[i] - A[j]) - np.linalg.norm(b[i] - b[j])))
+                  for i, j in ((0, 1), (1, 2), (2, 0)))
         res = max(res, err / L)
         poses.append(Pose(R, R @ mech.platform_point + p, f"mode {len(poses) + 1}"))
         n_real += 1
