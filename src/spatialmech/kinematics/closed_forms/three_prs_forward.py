@@ -149,8 +149,8 @@ def prs_forward(mech: Mechanism, values) -> PrsForward:
         t2 = c2[np.argmin([abs(np.polyval(rt, y)) for y in c2])]
         c3 = np.roots(_poly_y(C31.T, t1)[::-1])
         t3 = c3[np.argmin([abs(np.polyval(_poly_y(C23, t2)[::-1], y)) for y in c3])]
-        t = np.array([t1, t2, t3])
-        if np.abs(t.imag).max() > 1e-7 * (1.0 + np.abs(t).max()):
+        t = _polish(np.array([t1, t2, t3], dtype=complex), (C12, C23, C31))
+        if np.abs(t.imag).max() > 1e-9 * (1.0 + np.abs(t).max()):
             continue
         t = _polish(t.real, (C12, C23, C31))
         th = 2.0 * np.arctan(t)
@@ -169,12 +169,13 @@ def prs_forward(mech: Mechanism, values) -> PrsForward:
     return PrsForward(tuple(poses), n_real, deg - n_real, n_inf, float(res), statement)
 
 
-def _polish(t: np.ndarray, Cs: tuple, steps: int = 4) -> np.ndarray:
-    """A few Newton steps on the three pair conditions at a real root (the polynomial's roots
-    carry its conditioning: about 1e-8 here; after them the residual is rounding)."""
+def _polish(t: np.ndarray, Cs: tuple, steps: int = 6) -> np.ndarray:
+    """A few Newton steps on the three pair conditions (complex or real ``t``): the polynomial's
+    roots carry its conditioning (1e-8 to 1e-6 here, a real root of size 5 can come out with an
+    imaginary part of 1e-6); after them the residual is rounding and a real root is real."""
     pairs = ((0, 1), (1, 2), (2, 0))
     for _ in range(steps):
-        F, J = np.zeros(3), np.zeros((3, 3))
+        F, J = np.zeros(3, dtype=t.dtype), np.zeros((3, 3), dtype=t.dtype)
         for r, ((i, j), C) in enumerate(zip(pairs, Cs, strict=True)):
             xi, xj = np.array([1.0, t[i], t[i] ** 2]), np.array([1.0, t[j], t[j] ** 2])
             F[r] = xi @ C @ xj
