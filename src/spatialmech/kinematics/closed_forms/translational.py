@@ -97,19 +97,25 @@ def _spheres_and_planes(rows) -> tuple[str | None, list, list]:
 def translational_reason(mech: Mechanism, values=None) -> str | None:
     """``None`` when :func:`translational_modes` applies to ``mech`` (its limbs reduce to spheres
     for the translation, at least one, with the reference orientation held), else why not."""
-    from ..homotopy.systems import unsupported_reason
-
-    why = unsupported_reason(mech)
-    if why is not None:
-        return f"its limbs do not reduce to quadrics in the platform pose: {why}"
     v = np.array([mech.freedom(a).freedom.offset for a in mech.actuators]) if values is None else values
-    why, spheres, linear = _spheres_and_planes(_rows(mech, v))
+    return _spheres(mech, v)[0]
+
+
+def _spheres(mech: Mechanism, values) -> tuple[str | None, list]:
+    """(why not, the sphere conditions ``(b, c)``) of ``mech`` at ``values``, the rows computed once."""
+    from ..homotopy.systems import pose_system, unsupported_reason
+
+    try:
+        pose_system(mech)  # cached per model object
+    except InputError:
+        return f"its limbs do not reduce to quadrics in the platform pose: {unsupported_reason(mech)}", []
+    why, spheres, linear = _spheres_and_planes(_rows(mech, values))
     if why is None and (not spheres or linear):
         why = "its limbs give planes, not only spheres, at the reference orientation (no translational family)"
     if why is None and (n := _n_distinct(spheres)) != 3:
         why = (f"its limbs give {n} distinct spheres at the reference orientation, not 3 (a translational family "
                "has three: a Delta, a 3-UPU)")
-    return why
+    return why, spheres
 
 
 def _n_distinct(spheres) -> int:
@@ -131,10 +137,9 @@ def translational_modes(mech: Mechanism, values) -> TranslationalModes:
     if values.size != len(mech.actuators):
         raise InputError(f"values: expected {len(mech.actuators)} actuator values ({', '.join(mech.actuators)}), "
                          f"got {values.size}")
-    why = translational_reason(mech, values)
+    why, spheres = _spheres(mech, values)
     if why is not None:
         raise InputError(f"model: no translational closed form for {mech.name}: {why}")
-    _, spheres, _ = _spheres_and_planes(_rows(mech, values))
     b0, c0 = spheres[0]
     G = np.array([b - b0 for b, _ in spheres[1:]]).reshape(-1, 3)  # differences: G tau = h
     h = np.array([c0 - c for _, c in spheres[1:]])
@@ -181,8 +186,6 @@ def translational_note(mech: Mechanism, values, poses) -> str | None:
     from ...geometry.tolerances import current
 
     try:
-        if translational_reason(mech, values) is not None:
-            return None
         t = translational_modes(mech, values)
     except InputError:
         return None
