@@ -554,6 +554,10 @@ def _forward_homotopy(mech: Mechanism, targets: dict[int, float], seed: int, max
               "n_paths": hr.n_paths_total_degree, "elapsed_s": hr.seconds, "generic_elapsed_s": hr.seconds_generic,
               "generic_cached": hr.cached, "endpoints": [e.to_dict() for e in hr.solutions],
               "singular_below": singular_threshold()}
+    from .closed_forms.translational import translational_note
+
+    if (note := translational_note(mech, vals, [s.pose for s in sols])) is not None:
+        search["completeness"] = f"{search['completeness']}; {note}"
     return ForwardResult(tuple(sols), search)
 
 

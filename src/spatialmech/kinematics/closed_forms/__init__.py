@@ -1,7 +1,7 @@
 """Closed-form kinematics of particular limb and mechanism types: fast vectorised kernels for
 hot paths, each cross-checked in the tests against the general closure engine."""
 
-__all__ = ["four_sps_cu", "four_sps_cu_forward", "spherical_rrr", "sps"]
+__all__ = ["four_sps_cu", "four_sps_cu_forward", "spherical_rrr", "sps", "three_prs_forward", "translational"]
 
 
 def __getattr__(name: str):

@@ -362,41 +362,88 @@ def _is_rod(joints, L: float) -> bool:
     return all(j.type != "U" or np.linalg.norm(j.freedoms[0].point - j.freedoms[1].point) <= 1e-9 * L for j in joints)
 
 
+def _uu_rod(joints, L: float) -> tuple[np.ndarray, np.ndarray] | None:
+    """A U-U rod of the U-P-U's layout (each U's axes meeting, the two inner axes parallel and
+    normal to the rod and to the outer axes, as the ``delta-ruu``'s parallelogram equivalents):
+    ``(n1, n_p)``, the first U's outer axis (carried by the body before the rod) and the second
+    U's outer axis (carried by the platform), reference directions; else ``None``."""
+    if [j.type for j in joints] != ["U", "U"]:
+        return None
+    tol = 1e-9
+    if any(np.linalg.norm(j.freedoms[0].point - j.freedoms[1].point) > tol * L for j in joints):
+        return None
+    w = joints[1].point - joints[0].point
+    if np.linalg.norm(w) < tol * L:
+        return None
+    w = _unit(w)
+    n1, m = _unit(joints[0].freedoms[0].direction), _unit(joints[0].freedoms[1].direction)
+    m2, n_p = _unit(joints[1].freedoms[0].direction), _unit(joints[1].freedoms[1].direction)
+    if abs(m @ n1) > tol or abs(m @ w) > tol or np.linalg.norm(np.cross(m, m2)) > tol or abs(n_p @ m2) > tol:
+        return None
+    return n1, n_p
+
+
+def _rod_rows(D: np.ndarray, a, b, r: float, uu, L: float) -> list[np.ndarray]:
+    """A rod from the point ``a`` of a body displaced by ``D`` (the actuators fix it) to the
+    platform point ``b``: the sphere about the moving centre and, for a U-U rod (``uu`` =
+    ``(n1, n_p)``), the U-P-U condition with the first outer axis carried by the body."""
+    c = D[:3, :3] @ a + D[:3, 3]
+    rows = [_sphere_quadric(b, c, r, L)]
+    if uu is not None:
+        rows.append(_upu_quadric(b, c, D[:3, :3] @ uu[0], uu[1], L))
+    return rows
+
+
+def _driven_rod(limb, L: float, act_index: dict, hubs: dict) -> tuple[str | None, list, str] | None:
+    """(why not, builders, description) of a rod limb after a body the actuators fix: a limb from
+    a driven body that is a rod, or actuated joints from the ground then a rod (S-S, S-U, U-S:
+    a sphere about a moving centre; U-U of the U-P-U's layout: the sphere and the U-joint
+    condition); ``None`` when the limb is neither."""
+    types = [j.type for j in limb.joints]
+    if limb.base != "ground":
+        if limb.base not in hubs:
+            return f"limb {limb.name} starts on body {limb.base}, whose pose the actuators do not fix", [], ""
+        uu = _uu_rod(limb.joints, L)
+        if not _is_rod(limb.joints, L) and uu is None:
+            return (f"limb {limb.name} from body {limb.base} is {'-'.join(types)} (from a driven body the "
+                    "formulation covers S-S, S-U, U-S rods and U-U rods of the U-P-U's layout)"), [], ""
+        hub = hubs[limb.base]
+        a, b = limb.joints[0].point, limb.joints[1].point
+        r = float(np.linalg.norm(b - a))
+
+        def rod(v, hub=hub, a=a, b=b, r=r, uu=uu):
+            return _rod_rows(hub(v), a, b, r, uu, L)
+
+        return None, [rod], f"{limb.name} ({'-'.join(types)} rod from driven {limb.base}): sphere about a moving centre"
+    prefix = [f for j in limb.joints[:-2] for f in j.freedoms]
+    if len(types) <= 2 or not all(f.actuated and id(f) in act_index for f in prefix):
+        return None
+    uu = _uu_rod(limb.joints[-2:], L)
+    if not _is_rod(limb.joints[-2:], L) and uu is None:
+        return None
+    from ..closure import limb_forward
+
+    S = np.array([f.screw for f in prefix])
+    ks = [act_index[id(f)] for f in prefix]
+    offs = np.array([f.offset for f in prefix])
+    a, b = limb.joints[-2].point, limb.joints[-1].point
+    r = float(np.linalg.norm(b - a))
+
+    def crank(v, S=S, ks=ks, offs=offs, a=a, b=b, r=r, uu=uu):
+        return _rod_rows(limb_forward(S, np.asarray(v)[ks] - offs)[0], a, b, r, uu, L)
+
+    what = "sphere about a moving centre" + ("" if uu is None else " and the U-joint condition n1 . ((u - c) x R n_p) = 0")
+    return None, [crank], f"{limb.name} ({'-'.join(types)}): driven crank and rod, {what}"
+
+
 def _reduce_limb(limb, L: float, act_index: dict, hubs: dict) -> tuple[str | None, list, str]:
     """(why not, constraint builders ``values -> [quadrics]``, description) of one limb to the
     platform."""
     types = [j.type for j in limb.joints]
     tol = 1e-9
-    if limb.base != "ground":
-        if limb.base not in hubs:
-            return f"limb {limb.name} starts on body {limb.base}, whose pose the actuators do not fix", [], ""
-        if not _is_rod(limb.joints, L):
-            return (f"limb {limb.name} from body {limb.base} is {'-'.join(types)} (from a driven body the "
-                    "formulation covers S-S, S-U and U-S rods)"), [], ""
-        hub = hubs[limb.base]
-        a, b = limb.joints[0].point, limb.joints[1].point
-        r = float(np.linalg.norm(b - a))
-
-        def rod(v, hub=hub, a=a, b=b, r=r):
-            D = hub(v)
-            return [_sphere_quadric(b, D[:3, :3] @ a + D[:3, 3], r, L)]
-
-        return None, [rod], f"{limb.name} ({'-'.join(types)} rod from driven {limb.base}): sphere about a moving centre"
-    prefix = [f for j in limb.joints[:-2] for f in j.freedoms]
-    if len(types) > 2 and _is_rod(limb.joints[-2:], L) and all(f.actuated and id(f) in act_index for f in prefix):
-        from ..closure import limb_forward
-
-        S = np.array([f.screw for f in prefix])
-        ks = [act_index[id(f)] for f in prefix]
-        offs = np.array([f.offset for f in prefix])
-        a, b = limb.joints[-2].point, limb.joints[-1].point
-        r = float(np.linalg.norm(b - a))
-
-        def crank(v, S=S, ks=ks, offs=offs, a=a, b=b, r=r):
-            D = limb_forward(S, np.asarray(v)[ks] - offs)[0]
-            return [_sphere_quadric(b, D[:3, :3] @ a + D[:3, 3], r, L)]
-
-        return None, [crank], f"{limb.name} ({'-'.join(types)}): driven crank and rod, sphere about a moving centre"
+    driven = _driven_rod(limb, L, act_index, hubs)
+    if driven is not None:
+        return driven
     if types == ["P", "R", "S"]:
         sl, rj, sj = _slide(limb, 0), limb.joints[1].freedoms[0], limb.joints[2]
         if not sl.actuated or id(sl) not in act_index:
@@ -478,8 +525,8 @@ def _reduce_limb(limb, L: float, act_index: dict, hubs: dict) -> tuple[str | Non
 
         return None, [rps_rows], f"{limb.name} (R-P-S): leg sphere and the plane normal to the R axis"
     return (f"limb {limb.name} is {'-'.join(types)} (covered: S-P-S, U-P-S, S-P-U, U-P-U, R-P-S and P-R-S legs, "
-            "C-U / C-S limbs with the centre on the C axis, S-S / S-U / U-S rods after actuated joints or from a body "
-            "driven by actuated joints only)"), [], ""
+            "C-U / C-S limbs with the centre on the C axis, S-S / S-U / U-S rods and U-U rods of the U-P-U's layout "
+            "after actuated joints or from a body driven by actuated joints only)"), [], ""
 
 
 def _general(mech: Mechanism) -> tuple[str | None, PoseSystem | None]:
