@@ -242,6 +242,17 @@ def _four_sps_cu_forward(mech: Mechanism):
 #: 3-RRR's ``forward_orientation`` follows one assembly branch from a start and the 3-RPS's
 #: closed form is its parasitic motion: neither finds every assembly mode, none is registered.)
 FORWARD_CLOSED_FORMS: list[ClosedForm] = [ClosedForm("4-SPS/CU of paper B's layout", _four_sps_cu_forward)]
+
+
+def _spherical_rrr_forward(mech: Mechanism):
+    """A spherical 3-RRR wrist (nine R axes through one centre, one actuator per limb):
+    :func:`.closed_forms.spherical_rrr_forward.solve`, proven complete by Bezout's bound."""
+    from .closed_forms import spherical_rrr_forward as srf
+
+    return srf.recognise(mech)
+
+
+FORWARD_CLOSED_FORMS.append(ClosedForm("spherical 3-RRR wrist (3 quaternion quadrics)", _spherical_rrr_forward))
 #: Closed forms of inverse position, tried in order by :func:`solve_inverse`.  None yet: the
 #: closed forms (4-SPS/CU and S-P-S leg lengths, the spherical 3-RRR's actuator angles) give the
 #: actuator values only, where inverse position answers every limb's joint values.
