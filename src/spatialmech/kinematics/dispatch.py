@@ -253,6 +253,17 @@ def _spherical_rrr_forward(mech: Mechanism):
 
 
 FORWARD_CLOSED_FORMS.append(ClosedForm("spherical 3-RRR wrist (3 quaternion quadrics)", _spherical_rrr_forward))
+
+
+def _cs_forward(mech: Mechanism):
+    """A 5-CS guidance linkage with one C rotation driven: :func:`.closed_forms.cs_forward.solve`,
+    proven complete by a homotopy on SO(3) x C."""
+    from .closed_forms import cs_forward as csf
+
+    return csf.recognise(mech)
+
+
+FORWARD_CLOSED_FORMS.append(ClosedForm("5-CS linkage (4 quadrics on SO(3) x C)", _cs_forward))
 #: Closed forms of inverse position, tried in order by :func:`solve_inverse`.  None yet: the
 #: closed forms (4-SPS/CU and S-P-S leg lengths, the spherical 3-RRR's actuator angles) give the
 #: actuator values only, where inverse position answers every limb's joint values.

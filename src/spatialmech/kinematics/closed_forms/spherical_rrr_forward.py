@@ -38,7 +38,8 @@ from ...geometry.tolerances import HOMOTOPY_INFINITY, current
 from ...model.mechanism import Mechanism
 from .projective_quadrics import solve_projective_quadrics
 
-__all__ = ["SphericalWrist", "forward_rotations", "quaternion_quadric", "recognise", "solve", "wrist_of"]
+__all__ = ["SphericalWrist", "forward_rotations", "matrix_quadric", "quaternion_quadric", "quaternion_rotation", "recognise",
+           "solve", "wrist_of"]
 
 
 @dataclass(frozen=True)
@@ -99,7 +100,20 @@ _M = _rtilde_forms()
 def quaternion_quadric(u, v, k: float) -> np.ndarray:
     """The symmetric 4x4 matrix ``A`` with ``x^T A x = u . R~(x) v - k (x . x)``: the condition
     ``u . R v = k`` in quaternion coordinates."""
-    return np.einsum("a,b,abrs->rs", np.asarray(u, float), np.asarray(v, float), _M) - k * np.eye(4)
+    return matrix_quadric(np.outer(np.asarray(u, float), np.asarray(v, float)), k)
+
+
+def matrix_quadric(C, k) -> np.ndarray:
+    """The symmetric 4x4 matrix ``A`` with ``x^T A x = sum_ab C_ab R~(x)_ab - k (x . x)``: the
+    linear condition ``sum_ab C_ab R_ab = k`` on a rotation, in quaternion coordinates (``C``
+    (3, 3) and ``k`` real or complex)."""
+    return np.einsum("ab,abrs->rs", np.asarray(C), _M) - k * np.eye(4)
+
+
+def quaternion_rotation(x) -> np.ndarray:
+    """``R~(x) / (x . x)``: the (complex) rotation matrix of the quaternion ``x`` (``x . x != 0``)."""
+    x = np.asarray(x)
+    return _rtilde(x) / (x @ x)
 
 
 def _quaternion_matrix(x: np.ndarray) -> np.ndarray:
