@@ -264,6 +264,17 @@ def _cs_forward(mech: Mechanism):
 
 
 FORWARD_CLOSED_FORMS.append(ClosedForm("5-CS linkage (4 quadrics on SO(3) x C)", _cs_forward))
+
+
+def _r_loop_forward(mech: Mechanism):
+    """A single loop of 5 to 7 R joints, one driven: :func:`.closed_forms.r_loop_forward.solve`,
+    the complete inverse position of a 6R."""
+    from .closed_forms import r_loop_forward as rlf
+
+    return rlf.recognise(mech)
+
+
+FORWARD_CLOSED_FORMS.append(ClosedForm("single loop of 5-7 R joints (a 6R inverse position)", _r_loop_forward))
 #: Closed forms of inverse position, tried in order by :func:`solve_inverse`.  None yet: the
 #: closed forms (4-SPS/CU and S-P-S leg lengths, the spherical 3-RRR's actuator angles) give the
 #: actuator values only, where inverse position answers every limb's joint values.

@@ -26,13 +26,15 @@ __all__ = ["Counts", "answer_from_poses"]
 @dataclass(frozen=True)
 class Counts:
     """The end points of a closed form's polynomial system: real (the candidate poses), complex,
-    singular, at infinity (not a pose), and the number of paths (the bound they attain)."""
+    singular, at infinity (not a pose), the number of paths (the bound they attain) and the end
+    points of a larger system that are no solution (``n_spurious``, ``None`` where there is none)."""
 
     n_real: int
     n_complex: int
     n_singular: int
     n_at_infinity: int
     n_paths: int
+    n_spurious: int | None = None  # end points of a larger system that are no solution of the mechanism
 
 
 def answer_from_poses(mech: Mechanism, values, poses: list[tuple[np.ndarray, np.ndarray]], *, label: str,
@@ -82,7 +84,7 @@ def answer_from_poses(mech: Mechanism, values, poses: list[tuple[np.ndarray, np.
               "n_complex": counts.n_complex, "n_real": counts.n_real, "n_singular": counts.n_singular,
               "n_at_infinity": counts.n_at_infinity, "n_generic": counts.n_paths, "n_paths": counts.n_paths,
               "elapsed_s": seconds, "endpoints": [], "singular_below": singular_threshold()}
-    ends = EndPoints(counts.n_real, counts.n_complex, counts.n_singular, counts.n_at_infinity, counts.n_paths, None,
-                     seconds)
+    ends = EndPoints(counts.n_real, counts.n_complex, counts.n_singular, counts.n_at_infinity, counts.n_paths,
+                     counts.n_spurious, seconds)
     return ForwardAnswer("closed-form", label, True, tuple(modes), complete, completeness, 0, len(modes), ends, None,
                          ForwardResult(tuple(sols), search))
