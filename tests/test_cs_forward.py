@@ -92,7 +92,7 @@ def test_fk_of_ik_returns_the_pose_on_random_linkages(seed):
     assert complete, why
     assert sum(counts[:4]) == counts[4] == 128 and counts[0] % 2 == 0
     ts = [link.line(theta) + sig * link.u[0] - R @ link.s[0] for R, sig in sols]
-    assert min(np.linalg.norm(R - R0) + np.linalg.norm(t * link.L - t0) for (R, _), t in zip(sols, ts)) < 1e-8
+    assert min(np.linalg.norm(R - R0) + np.linalg.norm(t * link.L - t0) for (R, _), t in zip(sols, ts, strict=True)) < 1e-8
     for (R, _), t in zip(sols, ts, strict=True):  # every real solution keeps each S centre on its cylinder
         P = link.s @ R.T + t
         assert np.allclose(np.linalg.norm(np.cross(link.u, P - link.c), axis=1), link.r, atol=1e-9)

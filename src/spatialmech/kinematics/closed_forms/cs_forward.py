@@ -204,7 +204,7 @@ def solve_rotations(link: CsLinkage, theta: float, *, seed: int = 0):
         Ht = np.concatenate([np.zeros_like(P), F - gamma * Gv], axis=1)
         return H, Hx, Ht
 
-    X, T, reached, _ = track(fun, st.X)
+    X, _, reached, _ = track(fun, st.X)
     X = _refine(X, D, E, U, ua, r)
     with np.errstate(all="ignore"):
         P, JP = _orth(X)
