@@ -47,7 +47,7 @@ from ..homotopy.study import track
 from .projective_quadrics import solve_projective_quadrics
 from .spherical_rrr_forward import matrix_quadric, quaternion_rotation
 
-__all__ = ["CsLinkage", "linkage_of", "recognise", "solve", "solve_rotations"]
+__all__ = ["CsLinkage", "clear_cache", "linkage_of", "recognise", "solve", "solve_rotations"]
 
 _N = 10  # unknowns: the 9 entries of R (row-major), sigma
 _IU = np.triu_indices(3)
@@ -144,6 +144,12 @@ class _Start:
 
 
 _START: dict[int, _Start] = {}
+
+
+def clear_cache() -> None:
+    """Forget the start system's points (the next solve computes them again: benchmarks time
+    that first solve)."""
+    _START.clear()
 
 
 def _start_system(seed: int = 0) -> _Start:

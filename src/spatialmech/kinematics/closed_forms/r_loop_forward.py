@@ -89,7 +89,7 @@ def loop_of(mech: Mechanism) -> RLoop | None:
         v = rng.normal(size=3)
         extra.append((centre + rng.normal(size=3) * L, v / np.linalg.norm(v)))
     joints = [RJoint(f"K{k}", p, u) for k, (p, u) in enumerate([(c[0], c[1]) for c in cyc[1:]] + extra)]
-    aux = Mechanism(f"{mech.name}-cut", [Limb("chain", joints)], platform_point=centre)
+    aux = Mechanism(f"{mech.name}-cut", (Limb("chain", tuple(joints)),), platform_point=centre)
     return RLoop(np.array([c[0] for c in cyc]), np.array([c[1] for c in cyc]), tuple(c[2] for c in cyc),
                  cyc[0][3].offset, aux, n_extra)
 
