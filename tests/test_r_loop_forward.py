@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 import spatialmech as sm
 from spatialmech.kinematics.closed_forms import r_loop_forward as rlf
@@ -77,3 +79,33 @@ def test_a_general_7r_at_its_reference_input_has_its_reference_pose():
     assert all(m.residual < 1e-10 for m in r.modes)
     e = r.answer.endpoints
     assert e.n_spurious == 0 and (e.n_real + e.n_complex) % 2 == 0 and e.n_generic == 16
+
+
+# ------------------------------------------------------------------ four R joints: one trigonometric equation
+@pytest.mark.parametrize(("name", "deg", "n"), [("bennett", 40.0, 1), ("planar-4r", 20.0, 2)])
+def test_four_bar_loops_in_closed_form_agree_with_the_multistart(name, deg, n):
+    m = sm.load_model(name)
+    assert forward_engine(m) == "closed-form"
+    r = sm.fk(m, [np.radians(deg)], all_solutions=True)
+    assert r.engine == "closed-form" and r.complete and "at most 2 roots" in r.completeness
+    assert len(r.modes) == n and all(x.residual < 1e-10 for x in r.modes)
+    ms = sm.fk(m, [np.radians(deg)], all_solutions=True, method="multistart", seeds=40, seed=1)
+    assert len(ms.modes) == n
+    for x in ms.modes:
+        assert min(np.linalg.norm(x.pose.R - y.pose.R) + np.linalg.norm(x.pose.p - y.pose.p) for y in r.modes) < 1e-8
+
+
+@settings(max_examples=8, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.integers(0, 10**6))
+def test_fk_at_the_reference_input_lists_the_reference_on_random_planar_four_bars(seed):
+    """A random planar four-bar (pivots in the plane z = 0, axes along z), described at its
+    reference configuration: at the reference input that configuration is among the proven ones,
+    with at most 2 configurations in all."""
+    rng = np.random.default_rng(seed)
+    A0, A1, B1, B0 = (np.append(rng.normal(size=2), 0.0) for _ in range(4))
+    z = [0, 0, 1]
+    m = sm.Mechanism("my-4r", [sm.Limb("crank", [sm.R("A0", A0, z, actuated=True), sm.R("A1", A1, z)]),
+                               sm.Limb("rocker", [sm.R("B0", B0, z), sm.R("B1", B1, z)])], platform_point=A1)
+    r = sm.fk(m, [0.0], all_solutions=True)
+    assert r.engine == "closed-form" and r.complete and 1 <= len(r.modes) <= 2
+    assert any(np.allclose(x.pose.R, np.eye(3), atol=1e-9) and np.allclose(x.pose.p, A1, atol=1e-9) for x in r.modes)

@@ -275,6 +275,17 @@ def _r_loop_forward(mech: Mechanism):
 
 
 FORWARD_CLOSED_FORMS.append(ClosedForm("single loop of 5-7 R joints (a 6R inverse position)", _r_loop_forward))
+
+
+def _four_r_forward(mech: Mechanism):
+    """A single loop of four R joints, one driven (Bennett, four-bars):
+    :func:`.closed_forms.four_r_forward.solve`, one trigonometric equation."""
+    from .closed_forms import four_r_forward as frf
+
+    return frf.recognise(mech)
+
+
+FORWARD_CLOSED_FORMS.append(ClosedForm("single loop of 4 R joints (one trigonometric equation)", _four_r_forward))
 #: Closed forms of inverse position, tried in order by :func:`solve_inverse`.  None yet: the
 #: closed forms (4-SPS/CU and S-P-S leg lengths, the spherical 3-RRR's actuator angles) give the
 #: actuator values only, where inverse position answers every limb's joint values.

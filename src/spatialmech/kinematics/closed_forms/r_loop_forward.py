@@ -29,9 +29,10 @@ import numpy as np
 from ...errors import InputError
 from ...geometry.rotations import transform
 from ...model.joints import R as RJoint
+from ...model.joints import Freedom
 from ...model.mechanism import Limb, Mechanism
 
-__all__ = ["RLoop", "loop_of", "recognise", "solve"]
+__all__ = ["RLoop", "loop_cycle", "loop_of", "platform_pose_of", "recognise", "rotation_about", "solve"]
 
 #: Seed of the added joints' axes (the chain is then a general-enough 6R with probability one).
 EXTRA_SEED = 27
@@ -52,15 +53,19 @@ class RLoop:
     n_extra: int
 
 
-def _rotation_about(p: np.ndarray, u: np.ndarray, t: float) -> np.ndarray:
+def rotation_about(p: np.ndarray, u: np.ndarray, t: float) -> np.ndarray:
+    """The displacement (4x4) turning by ``t`` (rad, right-handed) about the line through ``p``
+    along the unit ``u``."""
     K = np.array([[0, -u[2], u[1]], [u[2], 0, -u[0]], [-u[1], u[0], 0]])
     R = np.eye(3) + np.sin(t) * K + (1 - np.cos(t)) * (K @ K)
     return transform(R, p - R @ p)
 
 
-def loop_of(mech: Mechanism) -> RLoop | None:
-    """The :class:`RLoop` of ``mech`` when it is a single loop of 5 to 7 R joints with one
-    driven (module docstring), else ``None``."""
+def loop_cycle(mech: Mechanism) -> list[tuple[np.ndarray, np.ndarray, int, Freedom]] | None:
+    """The joints of a single loop of R joints as a cycle starting at the driven one: per joint
+    its point, unit direction (reversed for the second limb's joints, whose variable is then the
+    limb's own), freedom index and freedom; ``None`` unless ``mech`` is two limbs of R joints
+    (no pitch, none locked) from the ground to the output link with one actuator."""
     if mech.is_graph or len(mech.limbs) != 2 or len(mech.actuators) != 1:
         return None
     refs = mech.freedom_refs
@@ -76,10 +81,29 @@ def loop_of(mech: Mechanism) -> RLoop | None:
             idx = next(k for k, r in enumerate(refs) if r.limb == li and r.joint == ji)
             d = np.asarray(f.direction, float) / np.linalg.norm(f.direction)
             cyc.append((np.asarray(f.point, float), d if li == 0 else -d, idx, f))
-    if not 5 <= len(cyc) <= 7:
-        return None
     a = next(k for k, c in enumerate(cyc) if c[3].actuated)
-    cyc = cyc[a:] + cyc[:a]
+    return cyc[a:] + cyc[:a]
+
+
+def platform_pose_of(mech: Mechanism, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The output link's rotation and platform point of a loop's joint variables ``q`` (every
+    freedom): the product of exponentials of the first limb."""
+    T = np.eye(4)
+    for i, r_ in enumerate(mech.freedom_refs):
+        if r_.limb == 0:
+            f = r_.freedom
+            T = T @ rotation_about(np.asarray(f.point, float), np.asarray(f.direction, float) /
+                                   np.linalg.norm(f.direction), q[i])
+    P0 = np.asarray(mech.platform_point, float)
+    return T[:3, :3], T[:3, :3] @ P0 + T[:3, 3]
+
+
+def loop_of(mech: Mechanism) -> RLoop | None:
+    """The :class:`RLoop` of ``mech`` when it is a single loop of 5 to 7 R joints with one
+    driven (module docstring), else ``None``."""
+    cyc = loop_cycle(mech)
+    if cyc is None or not 5 <= len(cyc) <= 7:
+        return None
     rng = np.random.default_rng(EXTRA_SEED)
     L = mech.characteristic_length
     centre = np.mean([c[0] for c in cyc], axis=0)
@@ -109,26 +133,17 @@ def solve(mech: Mechanism, values, *, seeds: int | None = None, seed: int | None
     loop = loop_of(mech)
     assert loop is not None
     theta = float(np.asarray(values, float).ravel()[0]) - loop.offset
-    D = _rotation_about(loop.points[0], loop.dirs[0], -theta)
+    D = rotation_about(loop.points[0], loop.dirs[0], -theta)
     r = limb_inverse(loop.aux, 0, D, seed=0 if seed is None else seed)
     n_rest = len(loop.points) - 1
     keep = [q for q in r.solutions if np.all(np.abs(np.angle(np.exp(1j * q[n_rest:]))) < 1e-6)]
-    # the platform pose: the first limb's joints, in the cycle's variables
-    refs = mech.freedom_refs
     poses = []
     for q in keep:
-        qq = np.zeros(len(refs))
+        qq = np.zeros(len(mech.freedom_refs))
         qq[loop.index[0]] = theta
         for k, i in enumerate(loop.index[1:]):
             qq[i] = q[k]
-        T = np.eye(4)
-        for i, r_ in enumerate(refs):
-            if r_.limb == 0:
-                f = r_.freedom
-                T = T @ _rotation_about(np.asarray(f.point, float), np.asarray(f.direction, float) /
-                                        np.linalg.norm(f.direction), qq[i])
-        P0 = np.asarray(mech.platform_point, float)
-        poses.append((T[:3, :3], T[:3, :3] @ P0 + T[:3, 3]))
+        poses.append(platform_pose_of(mech, qq))
     n = len(loop.points)
     added = (f" with {loop.n_extra} R joint(s) of random axes added (the loop's configurations are its solutions "
              f"with them at 0: {len(keep)} of its {r.n_real} real ones)") if loop.n_extra else ""
