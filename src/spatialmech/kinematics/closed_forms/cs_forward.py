@@ -41,7 +41,7 @@ from itertools import product
 import numpy as np
 
 from ...errors import InputError
-from ...geometry.tolerances import HOMOTOPY_REAL, HOMOTOPY_SINGULAR, MONODROMY_DIVERGED
+from ...geometry.tolerances import HOMOTOPY_NEAR_REAL, HOMOTOPY_REAL, HOMOTOPY_SINGULAR, MONODROMY_DIVERGED
 from ...model.mechanism import Mechanism
 from ..homotopy.study import track
 from .projective_quadrics import solve_projective_quadrics
@@ -235,8 +235,11 @@ def solve_rotations(link: CsLinkage, theta: float, *, seed: int = 0):
         G2 = np.linalg.norm(pts[:, None] - pts[None], axis=2)
         np.fill_diagonal(G2, np.inf)
         dup = int(np.sum(np.min(G2, axis=1) < 1e-8))
+    # near-real singular end points (a double root at a singular input) are listed too: the
+    # lifting polishes them, and the answer is then not proven
+    near = sing & ~inf & (np.linalg.norm(X.imag, axis=1) < HOMOTOPY_NEAR_REAL * np.maximum(1.0, nrm))
     out = []
-    for x in X[real]:
+    for x in X[real | near]:
         Uu, _, Vt = np.linalg.svd(x[:9].real.reshape(3, 3))
         out.append((Uu @ Vt, float(x[9].real)))
     counts = (int(real.sum()), int(cplx.sum()), int(sing.sum()), int(inf.sum()), len(st.X))

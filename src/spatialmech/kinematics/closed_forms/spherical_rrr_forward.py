@@ -34,7 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...geometry.tolerances import HOMOTOPY_INFINITY, current
+from ...geometry.tolerances import HOMOTOPY_INFINITY, HOMOTOPY_NEAR_REAL, current
 from ...model.mechanism import Mechanism
 from .projective_quadrics import solve_projective_quadrics
 
@@ -172,7 +172,8 @@ def forward_rotations(wrist: SphericalWrist, angles, *, seed: int = 0):
     inf = E < HOMOTOPY_INFINITY
     sing = ~sol.nonsingular & ~inf
     real = sol.real & ~inf & ~sing
-    rots = [_quaternion_matrix(np.real(y)) for y in sol.Y[real]]
+    near = sing & (np.linalg.norm(sol.Y.imag, axis=1) < HOMOTOPY_NEAR_REAL)  # listed too (polished by the lift)
+    rots = [_quaternion_matrix(np.real(y)) for y in sol.Y[real | near]]
     counts = (int(real.sum()), int((~sol.real & ~inf & ~sing).sum()), int(sing.sum()), int(inf.sum()), sol.n_paths)
     return rots, counts, sol.complete, sol.seconds
 
