@@ -7,8 +7,10 @@ Forward position, :func:`solve_forward` (actuator values -> platform pose(s)):
 - without ``all_solutions``: one Gauss-Newton solve from the reference configuration (engine
   ``"newton"``); ``method``, ``seeds`` and ``seed`` are refused (nothing to choose or to seed);
 - ``method="closed-form"``: the registered closed form that recognises the model
-  (:data:`FORWARD_CLOSED_FORMS`; today the 4-SPS/CU of paper B's layout), else ``InputError``;
-  its multi-seed search takes ``seeds`` (default 512) and ``seed`` (the quasi-random sequence's);
+  (:data:`FORWARD_CLOSED_FORMS`: the 4-SPS/CU of paper B's layout, whose multi-seed search takes
+  ``seeds`` (default 512) and ``seed`` (the quasi-random sequence's); the spherical 3-RRR wrist,
+  the 5-CS linkage and single loops of 4 to 7 R joints, proven complete, which refuse ``seeds``),
+  else ``InputError``;
 - ``method="homotopy"``: homotopy continuation, in Study parameters where the limbs reduce to
   them (engine ``"homotopy"``, proven complete; ``seeds`` refused: it tracks every path of a
   total-degree homotopy, a multi-start adds roots only at singular end points, with its default
