@@ -193,3 +193,11 @@ def test_phcpack_finds_the_same_eight_rotations(wrist, tmp_path):
     assert proven and len(phc) == len(rots) == counts[0] == 8
     for R in phc:
         assert min(np.linalg.norm(R - Q) for Q in rots) < 1e-8
+
+
+def test_a_continuum_is_not_proven():
+    """Two equal conics meet in a curve: the end points are singular or lost, never 'complete'."""
+    A = np.zeros((2, 3, 3))
+    A[0] = A[1] = np.diag([1.0, 1.0, -5.0])
+    s = solve_projective_quadrics(A)
+    assert not s.complete
