@@ -201,3 +201,22 @@ def test_a_continuum_is_not_proven():
     A[0] = A[1] = np.diag([1.0, 1.0, -5.0])
     s = solve_projective_quadrics(A)
     assert not s.complete
+
+
+@pytest.mark.parametrize("args", [["three-rrr-sm", "--actuators", "10,20,30"], ["bennett", "--actuators", "40"],
+                                  ["five-cs-3", "--actuators", "10"]])
+def test_closed_form_json_validates_against_the_schema(args):
+    from jsonschema import Draft202012Validator
+    from referencing import Registry, Resource
+
+    from spatialmech.interfaces.common import load_schema
+
+    common = load_schema("common")
+    registry = Registry().with_resource(common["$id"], Resource.from_contents(common))
+    r = CliRunner().invoke(cli, ["fk", *args, "--all", "--json"], catch_exceptions=False)
+    assert r.exit_code == 0, r.output
+    doc = json.loads(r.stdout)
+    errors = list(Draft202012Validator(load_schema("fk"), registry=registry).iter_errors(doc))
+    assert not errors, [(list(e.absolute_path), e.message[:300]) for e in errors[:5]]
+    assert doc["engine"] == "closed-form" and doc["complete"] is True
+    assert all(s["endpoint"] == "real" for s in doc["solutions"])
