@@ -89,8 +89,8 @@ def test_wrist_text_counts_and_flags(wrist):
 
 @pytest.mark.slow
 def test_wrist_default_engine_reports_the_same(wrist):
-    """The default engine (the loop formulation by monodromy, capped, gives up here and leaves it
-    to the multi-start) flags the same 4 input-independent poses."""
+    """The default engine (the wrist's closed form, proven complete:
+    tests/test_spherical_rrr_forward.py) flags the same 4 input-independent poses."""
     r = sm.fk(wrist, WRIST_INPUTS, all_solutions=True)
     assert r.answer.n_input_independent == 4
     assert sum(m.assembly_mode for m in r.modes) == 4

@@ -7,8 +7,10 @@ Forward position, :func:`solve_forward` (actuator values -> platform pose(s)):
 - without ``all_solutions``: one Gauss-Newton solve from the reference configuration (engine
   ``"newton"``); ``method``, ``seeds`` and ``seed`` are refused (nothing to choose or to seed);
 - ``method="closed-form"``: the registered closed form that recognises the model
-  (:data:`FORWARD_CLOSED_FORMS`; today the 4-SPS/CU of paper B's layout), else ``InputError``;
-  its multi-seed search takes ``seeds`` (default 512) and ``seed`` (the quasi-random sequence's);
+  (:data:`FORWARD_CLOSED_FORMS`: the 4-SPS/CU of paper B's layout, whose multi-seed search takes
+  ``seeds`` (default 512) and ``seed`` (the quasi-random sequence's); the spherical 3-RRR wrist,
+  the 5-CS linkage and single loops of 4 to 7 R joints, proven complete, which refuse ``seeds``),
+  else ``InputError``;
 - ``method="homotopy"``: homotopy continuation, in Study parameters where the limbs reduce to
   them (engine ``"homotopy"``, proven complete; ``seeds`` refused: it tracks every path of a
   total-degree homotopy, a multi-start adds roots only at singular end points, with its default
@@ -242,6 +244,50 @@ def _four_sps_cu_forward(mech: Mechanism):
 #: 3-RRR's ``forward_orientation`` follows one assembly branch from a start and the 3-RPS's
 #: closed form is its parasitic motion: neither finds every assembly mode, none is registered.)
 FORWARD_CLOSED_FORMS: list[ClosedForm] = [ClosedForm("4-SPS/CU of paper B's layout", _four_sps_cu_forward)]
+
+
+def _spherical_rrr_forward(mech: Mechanism):
+    """A spherical 3-RRR wrist (nine R axes through one centre, one actuator per limb):
+    :func:`.closed_forms.spherical_rrr_forward.solve`, proven complete by Bezout's bound."""
+    from .closed_forms import spherical_rrr_forward as srf
+
+    return srf.recognise(mech)
+
+
+FORWARD_CLOSED_FORMS.append(ClosedForm("spherical 3-RRR wrist (3 quaternion quadrics)", _spherical_rrr_forward))
+
+
+def _cs_forward(mech: Mechanism):
+    """A 5-CS guidance linkage with one C rotation driven: :func:`.closed_forms.cs_forward.solve`,
+    proven complete by a homotopy on SO(3) x C."""
+    from .closed_forms import cs_forward as csf
+
+    return csf.recognise(mech)
+
+
+FORWARD_CLOSED_FORMS.append(ClosedForm("5-CS linkage (4 quadrics on SO(3) x C)", _cs_forward))
+
+
+def _r_loop_forward(mech: Mechanism):
+    """A single loop of 5 to 7 R joints, one driven: :func:`.closed_forms.r_loop_forward.solve`,
+    the complete inverse position of a 6R."""
+    from .closed_forms import r_loop_forward as rlf
+
+    return rlf.recognise(mech)
+
+
+FORWARD_CLOSED_FORMS.append(ClosedForm("single loop of 5-7 R joints (a 6R inverse position)", _r_loop_forward))
+
+
+def _four_r_forward(mech: Mechanism):
+    """A single loop of four R joints, one driven (Bennett, four-bars):
+    :func:`.closed_forms.four_r_forward.solve`, one trigonometric equation."""
+    from .closed_forms import four_r_forward as frf
+
+    return frf.recognise(mech)
+
+
+FORWARD_CLOSED_FORMS.append(ClosedForm("single loop of 4 R joints (one trigonometric equation)", _four_r_forward))
 #: Closed forms of inverse position, tried in order by :func:`solve_inverse`.  None yet: the
 #: closed forms (4-SPS/CU and S-P-S leg lengths, the spherical 3-RRR's actuator angles) give the
 #: actuator values only, where inverse position answers every limb's joint values.
