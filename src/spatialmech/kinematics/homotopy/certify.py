@@ -1,0 +1,618 @@
+"""Certified solutions (issue 27): a Krawczyk test in ball arithmetic (python-flint's ``acb``)
+proves that a numerical end point is an approximate zero of the *exact* polynomial system, with
+its own root, and that distinct end points have distinct roots.
+
+The exact system.  The systems of the homotopies are evaluated from floating-point data: the
+quadrics of the Study formulation (:mod:`.study`), the twist matrices and the pose parameters of
+the limb formulation (:mod:`.inverse`).  Those floats are taken as the exact data of the stated
+model (each one is a binary rational, enclosed by a ball of radius zero); every operation on them
+is carried out in ball arithmetic, so the enclosures hold for the exact polynomials, not for
+their floating-point evaluation.
+
+The test (Krawczyk 1969; Moore 1977; Rump's verification method).  For a square system ``F`` of
+``n`` polynomials in ``n`` unknowns, a point ``y`` (exact floats), a box ``X = y + [-r, r]^n
+(1 + i)`` (each real and imaginary part within ``r``) and a floating-point inverse ``A`` of
+``F'(y)``, the Krawczyk operator
+
+    K(X) = y - A F(y) + (I - A F'(X)) (X - y)
+
+is enclosed in ball arithmetic.  If ``K(X)`` lies in the interior of ``X``, then ``X`` holds
+exactly one root of ``F`` (and ``F'`` is nonsingular there): the certificate.  The box is built
+around the numerical point with the smallest radius that works, from ``CERTIFY_MIN_RADIUS``
+(relative to the point's size) up by factors of ``CERTIFY_GROWTH`` to ``CERTIFY_MAX_RADIUS``; a
+point whose Newton correction exceeds the largest box is *not* certified (it is no accurate
+approximation of a root, however near one it may be), nor is a point where the test fails at
+every radius (a singular root, or roots closer than the point's accuracy).
+
+Distinct roots.  Two certified boxes that are disjoint hold two different roots.  When the
+box of a point lies inside the box of an earlier one, both hold the same (unique) root: the later
+point is a *duplicate* and not certified.  Boxes that overlap otherwise leave the question open:
+neither point is certified.
+
+Real roots.  For a system with real coefficients, a box with a real centre is its own complex
+conjugate, so the unique root in it equals its conjugate: it is real.  A box that misses the real
+space in some coordinate holds a non-real root (its conjugate is another root).
+
+This module is pure: :func:`certify` over a :class:`BallSystem` and points returns one
+:class:`Certificate` per point.  :func:`quadric_system` builds the ball system of the Study
+formulation (quadrics and linear equations), :func:`limb_system` that of a limb's inverse
+position.  HomotopyContinuation.jl's ``certify`` (Breiding, Rose and Timme 2020) uses the same
+test; this is an independent implementation.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
+from contextvars import ContextVar
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+from flint import acb, acb_mat, arb, arb_mat, ctx
+
+from ...geometry.tolerances import CERTIFY_GROWTH, CERTIFY_MAX_RADIUS, CERTIFY_MIN_RADIUS, CERTIFY_PRECISION
+
+__all__ = [
+    "BallSystem",
+    "Certificate",
+    "LimbBallSystem",
+    "QuadricBallSystem",
+    "certification",
+    "certify",
+    "certify_forward",
+    "certify_inverse",
+    "enabled",
+    "limb_point",
+    "limb_system",
+    "n_certified",
+    "quadric_system",
+    "statement",
+    "study_parameters",
+]
+
+
+class BallSystem(Protocol):
+    """A square polynomial system evaluated in ball arithmetic.
+
+    ``n``: the number of unknowns (and of equations); ``real``: whether its coefficients are real
+    (then the conjugate of a root is a root).  ``values(x)`` encloses ``F`` at the ball vector
+    ``x`` (an ``n x 1`` :class:`flint.acb_mat`); ``jacobian(x)`` encloses ``F'`` over it
+    (``n x n``)."""
+
+    n: int
+    real: bool
+
+    def values(self, x: acb_mat) -> acb_mat: ...
+
+    def jacobian(self, x: acb_mat) -> acb_mat: ...
+
+
+@dataclass(frozen=True)
+class Certificate:
+    """The verdict on one point.
+
+    ``certified``: the box of half-width ``radius`` about the point (each real and imaginary part)
+    holds exactly one root of the exact system, and no other point's certified box shares it.
+    ``radius``: the half-width of the smallest box that passed (in the system's coordinates);
+    ``None`` when no box passed.  ``real``: ``True`` when the root is proven real, ``False`` when
+    proven non-real, ``None`` when not decided.  ``duplicate_of``: the index of the earlier point
+    whose box holds the same root.  ``reason``: why not certified (empty when certified)."""
+
+    certified: bool
+    radius: float | None
+    real: bool | None
+    reason: str = ""
+    duplicate_of: int | None = None
+
+    def to_dict(self) -> dict:
+        return {"certified": self.certified, "box_radius": self.radius, "real": self.real,
+                "reason": self.reason or None, "duplicate_of": self.duplicate_of}
+
+
+def n_certified(certs: Sequence[Certificate]) -> int:
+    """The number of distinct roots certified."""
+    return sum(c.certified for c in certs)
+
+
+# ------------------------------------------------------------------------------ ball helpers
+def _ball(v: complex, r: float = 0.0) -> acb:
+    return acb(arb(float(v.real), r), arb(float(v.imag), r))
+
+
+_I = acb(0, 1)
+
+
+def _matrix(M: np.ndarray) -> acb_mat:
+    """An exact ball matrix of the floats ``M`` (real or complex; python floats convert exactly)."""
+    M = np.asarray(M)
+    if M.ndim == 1:
+        M = M[:, None]
+    out = acb_mat(arb_mat(np.ascontiguousarray(M.real, dtype=float).tolist()))
+    if np.iscomplexobj(M) and np.any(M.imag):
+        out += acb_mat(arb_mat(np.ascontiguousarray(M.imag, dtype=float).tolist())) * _I
+    return out
+
+
+def _column(v: np.ndarray, r: float = 0.0) -> acb_mat:
+    """The ball column of the floats ``v``, each real and imaginary part widened by ``r``."""
+    c = _matrix(np.asarray(v).ravel())
+    return c if r == 0.0 else c + _radius_column(len(c.entries()), r)
+
+
+_RADII: dict[tuple[int, float], acb_mat] = {}
+
+
+def _radius_column(n: int, r: float) -> acb_mat:
+    """Balls of centre zero and radius ``r`` (an exact power of two, rounded up), cached."""
+    key = (n, r)
+    hit = _RADII.get(key)
+    if hit is None:
+        if len(_RADII) > 4096:
+            _RADII.clear()
+        hit = _RADII[key] = acb_mat([[acb(arb(0, r), arb(0, r))] for _ in range(n)])
+    return hit
+
+
+def _pow2_up(r: float) -> float:
+    """The least power of two not below ``r``."""
+    m, e = np.frexp(r)
+    return float(np.ldexp(1.0, int(e) - (1 if m == 0.5 else 0)))
+
+
+def _identity(n: int) -> acb_mat:
+    return acb_mat(n, n, [1 if i == j else 0 for i in range(n) for j in range(n)])
+
+
+def _mid(M: acb_mat) -> np.ndarray:
+    return np.array([[complex(M[i, j].mid()) for j in range(M.ncols())] for i in range(M.nrows())])
+
+
+# ------------------------------------------------------------------------------ the test
+def _krawczyk(system: BallSystem, y: np.ndarray, A: acb_mat, AF: acb_mat, r: float) -> bool:
+    """Whether ``K(X)`` lies in the interior of the box ``X`` of half-width ``r`` about ``y``."""
+    n = system.n
+    yc = _column(y)
+    D = _radius_column(n, r)  # X - y
+    X = yc + D
+    K = yc - AF + (_identity(n) - A * system.jacobian(X)) * D
+    return all(X[i, 0].contains_interior(K[i, 0]) for i in range(n))
+
+
+def _inverses(system: BallSystem, Ys: list[np.ndarray]) -> list[np.ndarray | None]:
+    """Floating-point inverses of ``F'(y)`` (the preconditioners; ``None`` where singular)."""
+    jf = getattr(system, "jacobian_float", None)
+    Js = np.array([jf(y) if jf is not None else _mid(system.jacobian(_column(y))) for y in Ys])
+    with np.errstate(all="ignore"):
+        try:
+            inv = np.linalg.inv(Js)
+            return [a if np.all(np.isfinite(a)) else None for a in inv]
+        except np.linalg.LinAlgError:
+            pass
+    out: list[np.ndarray | None] = []
+    for J in Js:
+        try:
+            a = np.linalg.inv(J)
+            out.append(a if np.all(np.isfinite(a)) else None)
+        except np.linalg.LinAlgError:
+            out.append(None)
+    return out
+
+
+def _conjugate_partners(system: BallSystem, Ys: list[np.ndarray], real: list[bool]) -> dict[int, int]:
+    """``{j: i}``: the point ``j`` is (to 1e-8 relative) the conjugate of the point ``i < j``, for a
+    system with real coefficients: ``j`` is then certified by the conjugate of ``i``'s box."""
+    if not system.real or len(Ys) < 2:
+        return {}
+    Y = np.array(Ys)
+    scale = 1.0 + np.max(np.abs(Y), axis=1)
+    dist = np.max(np.abs(Y[None, :, :] - Y.conj()[:, None, :]), axis=2) / scale[None, :]  # [i, j]: |y_j - conj y_i|
+    out: dict[int, int] = {}
+    used: set[int] = set()
+    for i in range(len(Ys)):
+        if real[i] or i in out or i in used or not np.any(Y[i].imag):
+            continue
+        for j in np.flatnonzero(dist[i] < 1e-8):
+            j = int(j)
+            if j > i and not real[j] and j not in out and j not in used:
+                out[j] = i
+                used.add(i)
+                break
+    return out
+
+
+def _one(system: BallSystem, y: np.ndarray, Ainv: np.ndarray | None, max_radius: float) -> tuple[float | None, str]:
+    """(radius, reason) of one point: the smallest box that passes, or why none does."""
+    if Ainv is None:
+        return None, "the Jacobian is singular at the point"
+    A = _matrix(Ainv)
+    AF = A * system.values(_column(y))
+    step = float(np.max(np.abs(_mid(AF))))
+    scale = 1.0 + float(np.max(np.abs(y)))
+    r = _pow2_up(max(4.0 * step, CERTIFY_MIN_RADIUS * scale))
+    rmax = max_radius * scale
+    if r > rmax:
+        return None, (f"its Newton correction ({step:.1e}) exceeds the largest box ({rmax:.1e}): not an accurate "
+                      "approximation of a root")
+    while r <= rmax:
+        if _krawczyk(system, y, A, AF, r):
+            return r, ""
+        r *= CERTIFY_GROWTH
+    return None, ("the Krawczyk test failed in every box up to the largest (a singular root, or roots closer than the "
+                  "point's accuracy)")
+
+
+def _real_verdict(system: BallSystem, y: np.ndarray, r: float) -> bool | None:
+    if not system.real:
+        return None
+    if not np.any(y.imag):
+        return True  # a conjugation-symmetric box: its unique root is its own conjugate
+    if np.any(np.abs(y.imag) > 2.0 * r):
+        return False  # the box misses its conjugate: the conjugate root is another one
+    return None
+
+
+def _pairs(Y: np.ndarray, R: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(disjoint, inside)`` (m, m) of the boxes of centres ``Y`` (m, n) and half-widths ``R``
+    (m,): ``disjoint[i, j]`` when the boxes certainly do not meet, ``inside[i, j]`` when box ``i``
+    certainly lies inside box ``j`` (margins for the floats of the comparison)."""
+    a = np.abs(Y)
+    eps = 4e-16 * (a[:, None, :] + a[None, :, :])
+    dre = np.abs(Y.real[:, None, :] - Y.real[None, :, :])
+    dim = np.abs(Y.imag[:, None, :] - Y.imag[None, :, :])
+    gap = 1.01 * (R[:, None, None] + R[None, :, None]) + eps
+    disjoint = np.any((dre > gap) | (dim > gap), axis=2)
+    slack = R[None, :, None] - R[:, None, None] - eps
+    inside = np.all((dre < slack) & (dim < slack), axis=2)
+    return disjoint, inside
+
+
+def certify(system: BallSystem, points, *, real: Sequence[bool] | None = None,
+            max_radius: float = CERTIFY_MAX_RADIUS) -> tuple[Certificate, ...]:
+    """Certify each of ``points`` (m, n) as an approximate zero of ``system`` with its own root.
+
+    ``real[i]``: the point is meant to be real; its imaginary part is dropped and the box, real
+    centred, proves the root real (``system.real`` required).  ``max_radius``: the largest box
+    half-width tried, relative to ``1 + max |y|`` (default ``CERTIFY_MAX_RADIUS``).  Returns one
+    :class:`Certificate` per point (module docstring)."""
+    P = np.atleast_2d(np.asarray(points, dtype=complex))
+    if len(P) == 0:
+        return ()
+    flags = [False] * len(P) if real is None else [bool(v) for v in real]
+    prec = ctx.prec
+    ctx.prec = CERTIFY_PRECISION
+    try:
+        Ys = [y.real.astype(complex) if flags[i] and system.real else y for i, y in enumerate(P)]
+        bad = [y.shape != (system.n,) or not np.all(np.isfinite(y)) for y in Ys]
+        if any(bad):
+            raise ValueError(f"certify: points of {system.n} finite numbers expected")
+        partner = _conjugate_partners(system, Ys, flags)
+        todo = [i for i in range(len(Ys)) if i not in partner]
+        inv = _inverses(system, [Ys[i] for i in todo])
+        found: list = [None] * len(Ys)
+        for i, a in zip(todo, inv, strict=True):
+            found[i] = (Ys[i], *_one(system, Ys[i], a, max_radius), 0.0)
+        for j, i in partner.items():  # the conjugate of a certified box holds the conjugate root
+            yi, ri, why, _ = found[i]
+            yj = yi.conj()
+            found[j] = (yj, ri, why, float(np.max(np.abs(Ys[j] - yj))))
+    finally:
+        ctx.prec = prec
+    ok = [i for i, f in enumerate(found) if f[1] is not None]
+    disjoint, inside = _pairs(np.array([found[i][0] for i in ok]).reshape(len(ok), -1),
+                              np.array([found[i][1] for i in ok], dtype=float))
+    pos = {i: k for k, i in enumerate(ok)}
+    out: list[Certificate] = []
+    for i, (y, r, why, extra) in enumerate(found):
+        if r is None:
+            out.append(Certificate(False, None, None, why))
+            continue
+        a = pos[i]
+        dup = next((j for j in ok if j < i and inside[a, pos[j]]), None)
+        clash = next((j for j in ok if j != i and not disjoint[a, pos[j]] and not inside[a, pos[j]]
+                      and not (j > i and inside[pos[j], a])), None)
+        rv = _real_verdict(system, y, r)
+        r = r + extra  # from the point to its root: the box's half-width and the distance to its centre
+        if dup is not None:
+            out.append(Certificate(False, r, rv, f"the same root as point {dup} (its box lies inside that one)", dup))
+        elif clash is not None:
+            out.append(Certificate(False, r, rv, f"its box overlaps that of point {clash}: distinct roots not proven"))
+        else:
+            out.append(Certificate(True, r, rv))
+    return tuple(out)
+
+
+# ------------------------------------------------------------------------------ the systems
+class QuadricBallSystem:
+    """``x^T Q_k x`` for each quadric ``Q_k`` (m, n, n), then the linear equations ``B x = b``
+    ((n - m, n) and (n - m,)): the Study formulation (seven quadrics and an affine patch)."""
+
+    def __init__(self, Q, B, b) -> None:
+        Q = np.asarray(Q)
+        B = np.atleast_2d(np.asarray(B))
+        self.m, self.n = Q.shape[0], Q.shape[1]
+        if Q.shape[1:] != (self.n, self.n) or B.shape != (self.n - self.m, self.n):
+            raise ValueError("quadric_system: m quadrics (n x n) and n - m linear equations of n unknowns expected")
+        self.real = bool(not np.iscomplexobj(Q) or not np.any(Q.imag)) and bool(not np.any(np.imag(B)))
+        self.real &= bool(not np.any(np.imag(b)))
+        S = _matrix(np.concatenate([Qk for Qk in Q]))
+        St = _matrix(np.concatenate([Qk.T for Qk in Q]))
+        self._S = S + St  # the symmetric parts, doubled: exact in ball arithmetic
+        self._Sk = [_matrix(Qk) for Qk in Q]
+        self._Qf = np.asarray(Q, dtype=complex)
+        self._Bf = np.asarray(B, dtype=complex)
+        self._B = _matrix(B)
+        self._Brows = [[self._B[k, j] for j in range(self.n)] for k in range(self.n - self.m)]
+        self._b = _column(np.asarray(b, dtype=complex).ravel())
+
+    def _products(self, x: acb_mat) -> acb_mat:
+        return self._S * x
+
+    def values(self, x: acb_mat) -> acb_mat:
+        n, m = self.n, self.m
+        xt = x.transpose()
+        lin = self._B * x - self._b
+        rows = [[(xt * (Sk * x))[0, 0] * 0.5] for Sk in self._Sk]
+        return acb_mat(rows + [[lin[k, 0]] for k in range(n - m)])
+
+    def jacobian_float(self, y: np.ndarray) -> np.ndarray:
+        """``F'(y)`` in floating point (for the preconditioner only)."""
+        return np.vstack([np.einsum("kij,j->ki", self._Qf + self._Qf.transpose(0, 2, 1), y), self._Bf])
+
+    def jacobian(self, x: acb_mat) -> acb_mat:
+        n, m = self.n, self.m
+        SX = self._products(x)
+        return acb_mat([[SX[k * n + j, 0] for j in range(n)] for k in range(m)] + self._Brows)
+
+
+def quadric_system(Q, B, b) -> QuadricBallSystem:
+    """The ball system of quadrics ``Q`` (m, n, n) and linear equations ``B x = b``."""
+    return QuadricBallSystem(Q, B, b)
+
+
+class LimbBallSystem:
+    """The square system of a limb's inverse position (:class:`.inverse.LimbIK` of the *rigid*
+    family: as many equations as unknowns) at a real pose: the circles ``c^2 + s^2 = 1``, then
+    the closure equations of :meth:`.inverse.LimbIK.equations` with the quaternion ``q`` and the
+    translation ``t`` (over ``L``) as exact data."""
+
+    def __init__(self, sysm, q, t) -> None:
+        if not sysm.rigid:
+            raise ValueError("limb_system: the limb's equations are not square (a graph family)")
+        self.n = int(sysm.nx)
+        self.real = True
+        self.kind = sysm.kind
+        self.circles = tuple(sysm.circles)
+        self.left = [self._factor(f) for f in sysm.left]
+        self.right = [self._factor(f) for f in sysm.right]
+        w, i, j, k = (acb(float(v)) for v in np.real(q))
+        self.s = w * w + i * i + j * j + k * k
+        E = acb_mat(4, 4)
+        rows = [[w * w + i * i - j * j - k * k, 2 * (i * j - w * k), 2 * (i * k + w * j)],
+                [2 * (i * j + w * k), w * w - i * i + j * j - k * k, 2 * (j * k - w * i)],
+                [2 * (i * k - w * j), 2 * (j * k + w * i), w * w - i * i - j * j + k * k]]
+        for a in range(3):
+            for b in range(3):
+                E[a, b] = rows[a][b]
+        self.E = E
+        self.t = [acb(float(v)) for v in np.real(t)]
+        self.centre = _column(np.asarray(sysm.centre, dtype=complex))
+
+    @staticmethod
+    def _factor(f) -> tuple:
+        A = _matrix(f.sign * f.A)
+        return (f.kind, A, _matrix(f.A2), f.idx)
+
+    @staticmethod
+    def _chain(factors, x: acb_mat, want: bool):
+        """The product ``T`` and, with ``want``, its derivative in each unknown ``{index: dT}``
+        (prefix and suffix products)."""
+        eye = acb_mat(4, 4, [1 if a == b else 0 for a in range(4) for b in range(4)])
+        Ms, dMs = [], []
+        for kind, A, A2, idx in factors:
+            if kind == "R":
+                c, s = x[idx[0], 0], x[idx[1], 0]
+                Ms.append(eye + A * s + A2 * (1 - c))
+                dMs.append({idx[0]: -A2, idx[1]: A})
+            else:
+                Ms.append(eye + A * x[idx[0], 0])
+                dMs.append({idx[0]: A})
+        pre = [eye]
+        for M in Ms:
+            pre.append(pre[-1] * M)
+        if not want:
+            return pre[-1], {}
+        suf = [eye]
+        for M in reversed(Ms):
+            suf.append(M * suf[-1])
+        suf.reverse()  # suf[i] = M_i ... M_last
+        d = {}
+        for i, dm in enumerate(dMs):
+            for z, D in dm.items():
+                d[z] = pre[i] * D * suf[i + 1]
+        return pre[-1], d
+
+    def _rows(self, TL: acb_mat, TR: acb_mat) -> list:
+        """The closure equations of the halves ``TL``, ``TR`` (or of their derivatives: the
+        terms without ``T`` dropped by the callers)."""
+        E, s = self.E, self.s
+        if self.kind == "point":
+            u, v = TL * self.centre, E * (TR * self.centre)
+            return [s * u[a, 0] - v[a, 0] for a in range(3)]
+        P = TL.transpose() * E * TR
+        W = E * TR
+        return [P[0, 1], P[0, 2], P[1, 2]] + [s * TL[a, 3] - W[a, 3] for a in range(3)]
+
+    def _t_terms(self) -> list:
+        if self.kind == "point":
+            return [self.s * self.t[a] for a in range(3)]
+        return [acb(0)] * 3 + [self.s * self.t[a] for a in range(3)]
+
+    def values(self, x: acb_mat) -> acb_mat:
+        TL, _ = self._chain(self.left, x, False)
+        TR, _ = self._chain(self.right, x, False)
+        F = acb_mat(self.n, 1)
+        for i, (a, b) in enumerate(self.circles):
+            F[i, 0] = x[a, 0] * x[a, 0] + x[b, 0] * x[b, 0] - 1
+        k = len(self.circles)
+        for r, (val, tt) in enumerate(zip(self._rows(TL, TR), self._t_terms(), strict=True)):
+            F[k + r, 0] = val - tt
+        return F
+
+    def jacobian(self, x: acb_mat) -> acb_mat:
+        TL, dL = self._chain(self.left, x, True)
+        TR, dR = self._chain(self.right, x, True)
+        J = acb_mat(self.n, self.n)
+        for i, (a, b) in enumerate(self.circles):
+            J[i, a], J[i, b] = 2 * x[a, 0], 2 * x[b, 0]
+        k = len(self.circles)
+        E, s = self.E, self.s
+        if self.kind == "point":
+            for z, dT in dL.items():
+                u = dT * self.centre
+                for r in range(3):
+                    J[k + r, z] = s * u[r, 0]
+            for z, dT in dR.items():
+                v = E * (dT * self.centre)
+                for r in range(3):
+                    J[k + r, z] = -v[r, 0]
+            return J
+        ETR = E * TR
+        TLtE = TL.transpose() * E
+        for z, dT in dL.items():
+            P = dT.transpose() * ETR
+            for r, val in enumerate([P[0, 1], P[0, 2], P[1, 2]] + [s * dT[a, 3] for a in range(3)]):
+                J[k + r, z] = val
+        for z, dT in dR.items():
+            P = TLtE * dT
+            W = E * dT
+            for r, val in enumerate([P[0, 1], P[0, 2], P[1, 2]] + [-W[a, 3] for a in range(3)]):
+                J[k + r, z] = val
+        return J
+
+
+def limb_system(sysm, q, t) -> LimbBallSystem:
+    """The ball system of the limb ``sysm`` (:class:`.inverse.LimbIK`, rigid family) at the pose
+    of quaternion ``q`` (4, real) and translation ``t`` (3, over ``L``)."""
+    return LimbBallSystem(sysm, q, t)
+
+
+# ------------------------------------------------------------------------------ switch
+_ENABLED: ContextVar[bool] = ContextVar("spatialmech_certify", default=True)
+
+
+def enabled() -> bool:
+    """Whether the solvers certify their solutions (default ``True``; :func:`certification`)."""
+    return _ENABLED.get()
+
+
+@contextmanager
+def certification(on: bool) -> Iterator[None]:
+    """Certify (``on``) or not the solutions of the solvers called inside the block
+    (``sm.fk(..., certify=False)`` and ``sm.ik(..., certify=False)`` use it)."""
+    token = _ENABLED.set(bool(on))
+    try:
+        yield
+    finally:
+        _ENABLED.reset(token)
+
+
+# ------------------------------------------------------------------------------ the solvers' points
+def study_parameters(D: np.ndarray, L: float) -> np.ndarray:
+    """The Study parameters ``(e ; g)`` (8,) of a real displacement ``D`` (4x4, model units) in
+    the convention of :func:`.study.study_to_pose` (``e`` a unit quaternion, ``g = p e / 2``
+    with ``p`` over ``L``)."""
+    R = np.asarray(D, dtype=float)[:3, :3]
+    p = np.asarray(D, dtype=float)[:3, 3] / L
+    tr = R[0, 0] + R[1, 1] + R[2, 2]
+    cands = np.array([[1 + tr, R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]],
+                      [R[2, 1] - R[1, 2], 1 + R[0, 0] - R[1, 1] - R[2, 2], R[0, 1] + R[1, 0], R[0, 2] + R[2, 0]],
+                      [R[0, 2] - R[2, 0], R[0, 1] + R[1, 0], 1 - R[0, 0] + R[1, 1] - R[2, 2], R[1, 2] + R[2, 1]],
+                      [R[1, 0] - R[0, 1], R[0, 2] + R[2, 0], R[1, 2] + R[2, 1], 1 - R[0, 0] - R[1, 1] + R[2, 2]]])
+    e = cands[int(np.argmax(np.linalg.norm(cands, axis=1)))]
+    e = e / np.linalg.norm(e)
+    w, x, y, z = e
+    P = np.array([[0.0, -p[0], -p[1], -p[2]], [p[0], 0.0, -p[2], p[1]], [p[1], p[2], 0.0, -p[0]],
+                  [p[2], -p[1], p[0], 0.0]])  # left multiplication by the pure quaternion p
+    return np.concatenate([e, 0.5 * P @ np.array([w, x, y, z])])
+
+
+def _real_patch(points: np.ndarray, seed: int = 27) -> np.ndarray:
+    """A real affine patch ``c . x = 1`` far from every point's hyperplane at infinity (the best
+    of a few seeded random ``c``)."""
+    rng = np.random.default_rng(seed)
+    best, score = None, -1.0
+    norms = np.maximum(np.linalg.norm(points, axis=1), 1e-300) if len(points) else np.ones(0)
+    for _ in range(8):
+        c = rng.normal(size=points.shape[1] if len(points) else 8)
+        c /= np.linalg.norm(c)
+        s = float(np.min(np.abs(points @ c) / norms)) if len(points) else 1.0
+        if s > score:
+            best, score = c, s
+    assert best is not None
+    return best
+
+
+def certify_forward(Qt: np.ndarray, real_points: Sequence[np.ndarray | None],
+                    complex_points: np.ndarray) -> tuple[list[Certificate | None], list[Certificate]]:
+    """Certificates of the Study formulation's seven quadrics ``Qt`` (7, 8, 8, real: the
+    requested actuator values) for the listed real solutions (their Study parameters,
+    :func:`study_parameters`; ``None``: not attempted) and the complex end points (k, 8): all in
+    one real affine patch, so that they are told apart together and the real ones proven real."""
+    have = [i for i, x in enumerate(real_points) if x is not None]
+    R = np.array([np.asarray(real_points[i], dtype=complex) for i in have]).reshape(len(have), 8)
+    C = np.asarray(complex_points, dtype=complex).reshape(-1, 8)
+    P = np.vstack([R, C])
+    if len(P) == 0:
+        return [None] * len(real_points), []
+    c = _real_patch(P)
+    s = P @ c
+    P = P / np.where(np.abs(s) > 0, s, 1.0)[:, None]
+    certs = certify(quadric_system(np.real(Qt), c[None], [1.0]), P, real=[True] * len(R) + [False] * len(C))
+    out: list[Certificate | None] = [None] * len(real_points)
+    for k, i in enumerate(have):
+        out[i] = certs[k]
+    return out, list(certs[len(R):])
+
+
+def limb_point(sysm, q) -> np.ndarray:
+    """The unknowns ``x`` of a limb's :class:`.inverse.LimbIK` at its joint variables ``q``
+    (``(cos, sin)`` per revolute, slide over ``L``; an S joint's variables have none)."""
+    x = np.zeros(sysm.nx)
+    for k, s in enumerate(sysm.slots):
+        if s[0] == "R":
+            x[s[1]], x[s[2]] = np.cos(q[k]), np.sin(q[k])
+        elif s[0] == "P":
+            x[s[1]] = q[k] / sysm.L
+    return x
+
+
+def certify_inverse(sysm, D: np.ndarray, qs: Sequence[np.ndarray]) -> list[Certificate] | None:
+    """Certificates of a limb's solutions ``qs`` (joint variables) with its output link at ``D``
+    (4x4, model units); ``None`` when the limb's system is not square (a graph family: more
+    equations than unknowns, made square by random combinations; no certificate is attempted)."""
+    if not sysm.rigid:
+        return None
+    if not qs:
+        return []
+    P = np.real(sysm.pose_parameters(np.asarray(D, dtype=float)))
+    return list(certify(limb_system(sysm, P[:4], P[4:7]), np.array([limb_point(sysm, q) for q in qs]),
+                        real=[True] * len(qs)))
+
+
+def statement(certs: Sequence[Certificate | None], complex_certs: Sequence[Certificate] = ()) -> str:
+    """One sentence on what was certified (the ``certification`` field of fk and ik)."""
+    tried = [c for c in certs if c is not None]
+    if not tried and not complex_certs:
+        return "not attempted"
+    n_ok = n_certified(tried)
+    text = (f"{n_ok} of {len(tried)} solution(s) certified: a Krawczyk test in ball arithmetic proved a unique root "
+            "of the exact polynomial system (the floats of the model as exact data) within the stated box of each, "
+            "real, and every box disjoint from the others")
+    if complex_certs:
+        text += (f"; {n_certified(complex_certs)} of {len(complex_certs)} complex end point(s) certified (distinct "
+                 "non-real roots)")
+    bad = [c.reason for c in tried if not c.certified]
+    if bad:
+        text += f"; not certified: {bad[0]}"
+    return text
