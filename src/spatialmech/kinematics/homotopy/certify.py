@@ -116,42 +116,60 @@ def n_certified(certs: Sequence[Certificate]) -> int:
 
 
 # ------------------------------------------------------------------------------ ball helpers
-def _ball(v: complex, r: float = 0.0) -> acb:
-    return acb(arb(float(v.real), r), arb(float(v.imag), r))
-
-
 _I = acb(0, 1)
 
 
-def _matrix(M: np.ndarray) -> acb_mat:
-    """An exact ball matrix of the floats ``M`` (real or complex; python floats convert exactly)."""
-    M = np.asarray(M)
-    if M.ndim == 1:
-        M = M[:, None]
-    out = acb_mat(arb_mat(np.ascontiguousarray(M.real, dtype=float).tolist()))
-    if np.iscomplexobj(M) and np.any(M.imag):
-        out += acb_mat(arb_mat(np.ascontiguousarray(M.imag, dtype=float).tolist())) * _I
-    return out
+@dataclass(frozen=True)
+class _Field:
+    """Real (``arb``) or complex (``acb``) balls: exact matrices of floats, columns, boxes."""
+
+    real: bool
+
+    def mat(self, M) -> arb_mat | acb_mat:
+        """An exact ball matrix of the floats ``M`` (python floats convert exactly)."""
+        M = np.asarray(M)
+        if M.ndim == 1:
+            M = M[:, None]
+        re = arb_mat(np.ascontiguousarray(M.real, dtype=float).tolist())
+        if self.real:
+            return re
+        out = acb_mat(re)
+        if np.iscomplexobj(M) and np.any(M.imag):
+            out += acb_mat(arb_mat(np.ascontiguousarray(M.imag, dtype=float).tolist())) * _I
+        return out
+
+    def col(self, v) -> arb_mat | acb_mat:
+        return self.mat(np.asarray(v).ravel())
+
+    def scalar(self, x: float) -> arb | acb:
+        return arb(float(x)) if self.real else acb(float(x))
+
+    def radius_col(self, n: int, r: float) -> arb_mat | acb_mat:
+        """Balls of centre zero and radius ``r`` (each real and imaginary part), cached."""
+        key = (self.real, n, r)
+        hit = _RADII.get(key)
+        if hit is None:
+            if len(_RADII) > 4096:
+                _RADII.clear()
+            hit = _RADII[key] = (arb_mat([[arb(0, r)] for _ in range(n)]) if self.real
+                                 else acb_mat([[acb(arb(0, r), arb(0, r))] for _ in range(n)]))
+        return hit
+
+    def identity(self, n: int) -> arb_mat | acb_mat:
+        key = (self.real, -n, 0.0)
+        hit = _RADII.get(key)
+        if hit is None:
+            flat = [1 if i == j else 0 for i in range(n) for j in range(n)]
+            hit = _RADII[key] = arb_mat(n, n, flat) if self.real else acb_mat(n, n, flat)
+        return hit
 
 
-def _column(v: np.ndarray, r: float = 0.0) -> acb_mat:
-    """The ball column of the floats ``v``, each real and imaginary part widened by ``r``."""
-    c = _matrix(np.asarray(v).ravel())
-    return c if r == 0.0 else c + _radius_column(len(c.entries()), r)
+REAL, COMPLEX = _Field(True), _Field(False)
+_RADII: dict[tuple[bool, int, float], arb_mat | acb_mat] = {}
 
 
-_RADII: dict[tuple[int, float], acb_mat] = {}
-
-
-def _radius_column(n: int, r: float) -> acb_mat:
-    """Balls of centre zero and radius ``r`` (an exact power of two, rounded up), cached."""
-    key = (n, r)
-    hit = _RADII.get(key)
-    if hit is None:
-        if len(_RADII) > 4096:
-            _RADII.clear()
-        hit = _RADII[key] = acb_mat([[acb(arb(0, r), arb(0, r))] for _ in range(n)])
-    return hit
+def _field(x) -> _Field:
+    return REAL if isinstance(x, arb_mat) else COMPLEX
 
 
 def _pow2_up(r: float) -> float:
@@ -160,43 +178,26 @@ def _pow2_up(r: float) -> float:
     return float(np.ldexp(1.0, int(e) - (1 if m == 0.5 else 0)))
 
 
-def _identity(n: int) -> acb_mat:
-    return acb_mat(n, n, [1 if i == j else 0 for i in range(n) for j in range(n)])
-
-
-def _mid(M: acb_mat) -> np.ndarray:
-    return np.array([[complex(M[i, j].mid()) for j in range(M.ncols())] for i in range(M.nrows())])
+def _mid(M) -> np.ndarray:
+    """The midpoints of a ball matrix as floats."""
+    shape = (M.nrows(), M.ncols())
+    if isinstance(M, arb_mat):
+        return np.array([float(v) for v in M.mid().entries()], dtype=float).reshape(shape)
+    return np.array([complex(v) for v in M.mid().entries()], dtype=complex).reshape(shape)
 
 
 # ------------------------------------------------------------------------------ the test
-def _krawczyk(system: BallSystem, y: np.ndarray, A: acb_mat, AF: acb_mat, r: float) -> bool:
-    """Whether ``K(X)`` lies in the interior of the box ``X`` of half-width ``r`` about ``y``."""
-    n = system.n
-    yc = _column(y)
-    D = _radius_column(n, r)  # X - y
-    X = yc + D
-    K = yc - AF + (_identity(n) - A * system.jacobian(X)) * D
+def _contained(X, K, n: int) -> bool:
     return all(X[i, 0].contains_interior(K[i, 0]) for i in range(n))
 
 
-def _inverses(system: BallSystem, Ys: list[np.ndarray]) -> list[np.ndarray | None]:
-    """Floating-point inverses of ``F'(y)`` (the preconditioners; ``None`` where singular)."""
-    jf = getattr(system, "jacobian_float", None)
-    Js = np.array([jf(y) if jf is not None else _mid(system.jacobian(_column(y))) for y in Ys])
+def _inverse(J: np.ndarray) -> np.ndarray | None:
     with np.errstate(all="ignore"):
         try:
-            inv = np.linalg.inv(Js)
-            return [a if np.all(np.isfinite(a)) else None for a in inv]
+            A = np.linalg.inv(J)
         except np.linalg.LinAlgError:
-            pass
-    out: list[np.ndarray | None] = []
-    for J in Js:
-        try:
-            a = np.linalg.inv(J)
-            out.append(a if np.all(np.isfinite(a)) else None)
-        except np.linalg.LinAlgError:
-            out.append(None)
-    return out
+            return None
+    return A if np.all(np.isfinite(A)) else None
 
 
 def _conjugate_partners(system: BallSystem, Ys: list[np.ndarray], real: list[bool]) -> dict[int, int]:
@@ -221,28 +222,46 @@ def _conjugate_partners(system: BallSystem, Ys: list[np.ndarray], real: list[boo
     return out
 
 
-def _one(system: BallSystem, y: np.ndarray, Ainv: np.ndarray | None, max_radius: float) -> tuple[float | None, str]:
-    """(radius, reason) of one point: the smallest box that passes, or why none does."""
-    if Ainv is None:
-        return None, "the Jacobian is singular at the point"
-    A = _matrix(Ainv)
-    AF = A * system.values(_column(y))
-    step = float(np.max(np.abs(_mid(AF))))
+def _one(system: BallSystem, y: np.ndarray, max_radius: float) -> tuple[float | None, str, bool]:
+    """(radius, reason, real box) of one point: the smallest box that passes, or why none does.
+    A real point of a real system gets a real box (uniqueness among real points).
+
+    ``F'`` is enclosed once over the largest box (it encloses ``F'`` over every smaller one, so
+    one evaluation serves every radius tried; the preconditioner ``A`` is the inverse of its
+    midpoint); a radius that fails with it is tried again with ``F'`` over its own box."""
+    n = system.n
+    f = REAL if system.real and not np.any(y.imag) else COMPLEX
+    yc = f.col(y.real if f.real else y)
     scale = 1.0 + float(np.max(np.abs(y)))
-    r = _pow2_up(max(4.0 * step, CERTIFY_MIN_RADIUS * scale))
     rmax = max_radius * scale
-    if r > rmax:
+    J = system.jacobian(yc + f.radius_col(n, _pow2_up(rmax)))
+    Ainv = _inverse(_mid(J))
+    if Ainv is None:
+        return None, "the Jacobian is singular at the point", f.real
+    A = f.mat(Ainv.real if f.real else Ainv)
+    AF = A * system.values(yc)
+    step = float(np.max(np.abs(_mid(AF))))
+    r = _pow2_up(max(4.0 * step, CERTIFY_MIN_RADIUS * scale))
+    if not r <= rmax:
         return None, (f"its Newton correction ({step:.1e}) exceeds the largest box ({rmax:.1e}): not an accurate "
-                      "approximation of a root")
+                      "approximation of a root"), f.real
+    eye = f.identity(n)
+    M = eye - A * J
+    base = yc - AF
     while r <= rmax:
-        if _krawczyk(system, y, A, AF, r):
-            return r, ""
+        D = f.radius_col(n, r)
+        if _contained(yc + D, base + M * D, n):
+            return r, "", f.real
+        if _contained(yc + D, base + (eye - A * system.jacobian(yc + D)) * D, n):
+            return r, "", f.real
         r *= CERTIFY_GROWTH
     return None, ("the Krawczyk test failed in every box up to the largest (a singular root, or roots closer than the "
-                  "point's accuracy)")
+                  "point's accuracy)"), f.real
 
 
-def _real_verdict(system: BallSystem, y: np.ndarray, r: float) -> bool | None:
+def _real_verdict(system: BallSystem, y: np.ndarray, r: float, real_box: bool) -> bool | None:
+    if real_box:
+        return True  # a real box: its root is real
     if not system.real:
         return None
     if not np.any(y.imag):
@@ -252,18 +271,22 @@ def _real_verdict(system: BallSystem, y: np.ndarray, r: float) -> bool | None:
     return None
 
 
-def _pairs(Y: np.ndarray, R: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _pairs(Y: np.ndarray, R: np.ndarray, Rim: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``(disjoint, inside)`` (m, m) of the boxes of centres ``Y`` (m, n) and half-widths ``R``
-    (m,): ``disjoint[i, j]`` when the boxes certainly do not meet, ``inside[i, j]`` when box ``i``
-    certainly lies inside box ``j`` (margins for the floats of the comparison)."""
+    (real parts) and ``Rim`` (imaginary parts; 0 for a real box): ``disjoint[i, j]`` when the
+    boxes certainly do not meet, ``inside[i, j]`` when box ``i`` certainly lies inside box ``j``
+    (margins for the floats of the comparison)."""
     a = np.abs(Y)
     eps = 4e-16 * (a[:, None, :] + a[None, :, :])
     dre = np.abs(Y.real[:, None, :] - Y.real[None, :, :])
     dim = np.abs(Y.imag[:, None, :] - Y.imag[None, :, :])
-    gap = 1.01 * (R[:, None, None] + R[None, :, None]) + eps
-    disjoint = np.any((dre > gap) | (dim > gap), axis=2)
-    slack = R[None, :, None] - R[:, None, None] - eps
-    inside = np.all((dre < slack) & (dim < slack), axis=2)
+    gre = 1.01 * (R[:, None, None] + R[None, :, None]) + eps
+    gim = 1.01 * (Rim[:, None, None] + Rim[None, :, None]) + eps
+    disjoint = np.any((dre > gre) | (dim > gim), axis=2)
+    sre = R[None, :, None] - R[:, None, None] - eps
+    sim = Rim[None, :, None] - Rim[:, None, None] - eps
+    inside = np.all((dre < sre) & ((dim < sim) | ((Rim[:, None, None] == 0) & (Rim[None, :, None] == 0) & (dim == 0))),
+                    axis=2)
     return disjoint, inside
 
 
@@ -271,39 +294,40 @@ def certify(system: BallSystem, points, *, real: Sequence[bool] | None = None,
             max_radius: float = CERTIFY_MAX_RADIUS) -> tuple[Certificate, ...]:
     """Certify each of ``points`` (m, n) as an approximate zero of ``system`` with its own root.
 
-    ``real[i]``: the point is meant to be real; its imaginary part is dropped and the box, real
-    centred, proves the root real (``system.real`` required).  ``max_radius``: the largest box
-    half-width tried, relative to ``1 + max |y|`` (default ``CERTIFY_MAX_RADIUS``).  Returns one
-    :class:`Certificate` per point (module docstring)."""
+    ``real[i]``: the point is meant to be real; its imaginary part is dropped and a real box
+    about it proves a unique real root there (``system.real`` required).  ``max_radius``: the
+    largest box half-width tried, relative to ``1 + max |y|`` (default ``CERTIFY_MAX_RADIUS``).
+    Returns one :class:`Certificate` per point (module docstring)."""
     P = np.atleast_2d(np.asarray(points, dtype=complex))
-    if len(P) == 0:
+    if P.size == 0:
         return ()
     flags = [False] * len(P) if real is None else [bool(v) for v in real]
+    if len(flags) != len(P):
+        raise ValueError(f"certify: {len(P)} points but {len(flags)} real flags")
+    Ys = [y.real.astype(complex) if flags[i] and system.real else y for i, y in enumerate(P)]
+    if P.shape[1] != system.n or not np.all(np.isfinite(P)):
+        raise ValueError(f"certify: points of {system.n} finite numbers expected")
     prec = ctx.prec
     ctx.prec = CERTIFY_PRECISION
     try:
-        Ys = [y.real.astype(complex) if flags[i] and system.real else y for i, y in enumerate(P)]
-        bad = [y.shape != (system.n,) or not np.all(np.isfinite(y)) for y in Ys]
-        if any(bad):
-            raise ValueError(f"certify: points of {system.n} finite numbers expected")
         partner = _conjugate_partners(system, Ys, flags)
         todo = [i for i in range(len(Ys)) if i not in partner]
-        inv = _inverses(system, [Ys[i] for i in todo])
         found: list = [None] * len(Ys)
-        for i, a in zip(todo, inv, strict=True):
-            found[i] = (Ys[i], *_one(system, Ys[i], a, max_radius), 0.0)
+        for i in todo:
+            found[i] = (Ys[i], *_one(system, Ys[i], max_radius), 0.0)
         for j, i in partner.items():  # the conjugate of a certified box holds the conjugate root
-            yi, ri, why, _ = found[i]
+            yi, ri, why, rb, _ = found[i]
             yj = yi.conj()
-            found[j] = (yj, ri, why, float(np.max(np.abs(Ys[j] - yj))))
+            found[j] = (yj, ri, why, rb, float(np.max(np.abs(Ys[j] - yj))))
     finally:
         ctx.prec = prec
     ok = [i for i, f in enumerate(found) if f[1] is not None]
     disjoint, inside = _pairs(np.array([found[i][0] for i in ok]).reshape(len(ok), -1),
-                              np.array([found[i][1] for i in ok], dtype=float))
+                              np.array([found[i][1] for i in ok], dtype=float),
+                              np.array([0.0 if found[i][3] else found[i][1] for i in ok], dtype=float))
     pos = {i: k for k, i in enumerate(ok)}
     out: list[Certificate] = []
-    for i, (y, r, why, extra) in enumerate(found):
+    for i, (y, r, why, real_box, extra) in enumerate(found):
         if r is None:
             out.append(Certificate(False, None, None, why))
             continue
@@ -311,7 +335,7 @@ def certify(system: BallSystem, points, *, real: Sequence[bool] | None = None,
         dup = next((j for j in ok if j < i and inside[a, pos[j]]), None)
         clash = next((j for j in ok if j != i and not disjoint[a, pos[j]] and not inside[a, pos[j]]
                       and not (j > i and inside[pos[j], a])), None)
-        rv = _real_verdict(system, y, r)
+        rv = _real_verdict(system, y, r, real_box)
         r = r + extra  # from the point to its root: the box's half-width and the distance to its centre
         if dup is not None:
             out.append(Certificate(False, r, rv, f"the same root as point {dup} (its box lies inside that one)", dup))
@@ -330,39 +354,45 @@ class QuadricBallSystem:
     def __init__(self, Q, B, b) -> None:
         Q = np.asarray(Q)
         B = np.atleast_2d(np.asarray(B))
+        b = np.asarray(b).ravel()
         self.m, self.n = Q.shape[0], Q.shape[1]
-        if Q.shape[1:] != (self.n, self.n) or B.shape != (self.n - self.m, self.n):
+        if Q.shape[1:] != (self.n, self.n) or B.shape != (self.n - self.m, self.n) or b.shape != (self.n - self.m,):
             raise ValueError("quadric_system: m quadrics (n x n) and n - m linear equations of n unknowns expected")
-        self.real = bool(not np.iscomplexobj(Q) or not np.any(Q.imag)) and bool(not np.any(np.imag(B)))
-        self.real &= bool(not np.any(np.imag(b)))
-        S = _matrix(np.concatenate([Qk for Qk in Q]))
-        St = _matrix(np.concatenate([Qk.T for Qk in Q]))
-        self._S = S + St  # the symmetric parts, doubled: exact in ball arithmetic
-        self._Sk = [_matrix(Qk) for Qk in Q]
-        self._Qf = np.asarray(Q, dtype=complex)
-        self._Bf = np.asarray(B, dtype=complex)
-        self._B = _matrix(B)
-        self._Brows = [[self._B[k, j] for j in range(self.n)] for k in range(self.n - self.m)]
-        self._b = _column(np.asarray(b, dtype=complex).ravel())
+        self.real = not (np.any(np.imag(Q)) or np.any(np.imag(B)) or np.any(np.imag(b)))
+        self._Q, self._B, self._b = Q, B, b
+        self._consts: dict[bool, tuple] = {}
 
-    def _products(self, x: acb_mat) -> acb_mat:
-        return self._S * x
+    def _k(self, f: _Field) -> tuple:
+        hit = self._consts.get(f.real)
+        if hit is None:
+            Sk = [f.mat(Qk) + f.mat(Qk.T) for Qk in self._Q]  # the symmetric parts, doubled: exact balls
+            Bm = f.mat(self._B)
+            hit = self._consts[f.real] = (Sk, _stack(Sk, f), Bm, f.col(self._b),
+                                          [[Bm[k, j] for j in range(self.n)] for k in range(self.n - self.m)],
+                                          f.scalar(0.5))
+        return hit
 
-    def values(self, x: acb_mat) -> acb_mat:
-        n, m = self.n, self.m
+    def values(self, x):
+        Sk, _, Bm, bv, _, half = self._k(_field(x))
         xt = x.transpose()
-        lin = self._B * x - self._b
-        rows = [[(xt * (Sk * x))[0, 0] * 0.5] for Sk in self._Sk]
-        return acb_mat(rows + [[lin[k, 0]] for k in range(n - m)])
+        lin = Bm * x - bv
+        rows = [[(xt * (S * x))[0, 0] * half] for S in Sk]
+        rows += [[lin[k, 0]] for k in range(self.n - self.m)]
+        return arb_mat(rows) if isinstance(x, arb_mat) else acb_mat(rows)
 
-    def jacobian_float(self, y: np.ndarray) -> np.ndarray:
-        """``F'(y)`` in floating point (for the preconditioner only)."""
-        return np.vstack([np.einsum("kij,j->ki", self._Qf + self._Qf.transpose(0, 2, 1), y), self._Bf])
+    def jacobian(self, x):
+        _, S, _, _, Brows, _ = self._k(_field(x))
+        SX = S * x
+        n = self.n
+        rows = [[SX[k * n + j, 0] for j in range(n)] for k in range(self.m)] + Brows
+        return arb_mat(rows) if isinstance(x, arb_mat) else acb_mat(rows)
 
-    def jacobian(self, x: acb_mat) -> acb_mat:
-        n, m = self.n, self.m
-        SX = self._products(x)
-        return acb_mat([[SX[k * n + j, 0] for j in range(n)] for k in range(m)] + self._Brows)
+
+
+def _stack(mats: list, f: _Field):
+    """The matrices stacked vertically (exact: entries copied)."""
+    rows = [[M[i, j] for j in range(M.ncols())] for M in mats for i in range(M.nrows())]
+    return arb_mat(rows) if f.real else acb_mat(rows)
 
 
 def quadric_system(Q, B, b) -> QuadricBallSystem:
@@ -383,112 +413,131 @@ class LimbBallSystem:
         self.real = True
         self.kind = sysm.kind
         self.circles = tuple(sysm.circles)
-        self.left = [self._factor(f) for f in sysm.left]
-        self.right = [self._factor(f) for f in sysm.right]
-        w, i, j, k = (acb(float(v)) for v in np.real(q))
-        self.s = w * w + i * i + j * j + k * k
-        E = acb_mat(4, 4)
+        self._sysm = sysm
+        self._q = np.real(np.asarray(q)).astype(float)
+        self._t = np.real(np.asarray(t)).astype(float)
+        self._consts: dict[bool, dict] = {}
+
+    def _k(self, f: _Field) -> dict:
+        hit = self._consts.get(f.real)
+        if hit is not None:
+            return hit
+        w, i, j, k = (f.scalar(v) for v in self._q)
         rows = [[w * w + i * i - j * j - k * k, 2 * (i * j - w * k), 2 * (i * k + w * j)],
                 [2 * (i * j + w * k), w * w - i * i + j * j - k * k, 2 * (j * k - w * i)],
                 [2 * (i * k - w * j), 2 * (j * k + w * i), w * w - i * i - j * j + k * k]]
-        for a in range(3):
-            for b in range(3):
-                E[a, b] = rows[a][b]
-        self.E = E
-        self.t = [acb(float(v)) for v in np.real(t)]
-        self.centre = _column(np.asarray(sysm.centre, dtype=complex))
+        zero = f.scalar(0.0)
+        Erows = [rows[a] + [zero] for a in range(3)] + [[zero] * 4]
+        E = arb_mat(Erows) if f.real else acb_mat(Erows)
+
+        hit = self._consts[f.real] = {"E": E, "s": w * w + i * i + j * j + k * k, "t": [f.scalar(v) for v in self._t],
+                                      "one": f.scalar(1.0), **_limb_constants(self._sysm, f)}
+        return hit
 
     @staticmethod
-    def _factor(f) -> tuple:
-        A = _matrix(f.sign * f.A)
-        return (f.kind, A, _matrix(f.A2), f.idx)
-
-    @staticmethod
-    def _chain(factors, x: acb_mat, want: bool):
-        """The product ``T`` and, with ``want``, its derivative in each unknown ``{index: dT}``
-        (prefix and suffix products)."""
-        eye = acb_mat(4, 4, [1 if a == b else 0 for a in range(4) for b in range(4)])
+    def _chain(factors, x, K: dict, want: bool):
+        """The product ``T``, and with ``want`` its prefix and suffix products and per factor the
+        derivatives of its matrix ``{unknown: dM}``."""
+        eye, one = K["eye"], K["one"]
         Ms, dMs = [], []
         for kind, A, A2, idx in factors:
             if kind == "R":
                 c, s = x[idx[0], 0], x[idx[1], 0]
-                Ms.append(eye + A * s + A2 * (1 - c))
-                dMs.append({idx[0]: -A2, idx[1]: A})
+                Ms.append(eye + A * s + A2 * (one - c))
+                dMs.append(((idx[0], -A2), (idx[1], A)))
             else:
                 Ms.append(eye + A * x[idx[0], 0])
-                dMs.append({idx[0]: A})
+                dMs.append(((idx[0], A),))
         pre = [eye]
         for M in Ms:
             pre.append(pre[-1] * M)
         if not want:
-            return pre[-1], {}
+            return pre[-1], pre, [], dMs
         suf = [eye]
         for M in reversed(Ms):
             suf.append(M * suf[-1])
         suf.reverse()  # suf[i] = M_i ... M_last
-        d = {}
-        for i, dm in enumerate(dMs):
-            for z, D in dm.items():
-                d[z] = pre[i] * D * suf[i + 1]
-        return pre[-1], d
+        return pre[-1], pre, suf, dMs
 
-    def _rows(self, TL: acb_mat, TR: acb_mat) -> list:
-        """The closure equations of the halves ``TL``, ``TR`` (or of their derivatives: the
-        terms without ``T`` dropped by the callers)."""
-        E, s = self.E, self.s
+    def values(self, x):
+        K = self._k(_field(x))
+        TL, _, _, _ = self._chain(K["left"], x, K, False)
+        TR, _, _, _ = self._chain(K["right"], x, K, False)
+        E, s, t = K["E"], K["s"], K["t"]
+        out = [[x[a, 0] * x[a, 0] + x[b, 0] * x[b, 0] - K["one"]] for a, b in self.circles]
         if self.kind == "point":
-            u, v = TL * self.centre, E * (TR * self.centre)
-            return [s * u[a, 0] - v[a, 0] for a in range(3)]
-        P = TL.transpose() * E * TR
-        W = E * TR
-        return [P[0, 1], P[0, 2], P[1, 2]] + [s * TL[a, 3] - W[a, 3] for a in range(3)]
+            u, v = TL * K["centre"], E * (TR * K["centre"])
+            out += [[s * u[a, 0] - v[a, 0] - s * t[a]] for a in range(3)]
+        else:
+            Q = (E * TR).transpose() * TL  # P^T with P = TL^T E TR
+            W = E * TR
+            out += [[Q[1, 0]], [Q[2, 0]], [Q[2, 1]]] + [[s * TL[a, 3] - W[a, 3] - s * t[a]] for a in range(3)]
+        return arb_mat(out) if isinstance(x, arb_mat) else acb_mat(out)
 
-    def _t_terms(self) -> list:
-        if self.kind == "point":
-            return [self.s * self.t[a] for a in range(3)]
-        return [acb(0)] * 3 + [self.s * self.t[a] for a in range(3)]
-
-    def values(self, x: acb_mat) -> acb_mat:
-        TL, _ = self._chain(self.left, x, False)
-        TR, _ = self._chain(self.right, x, False)
-        F = acb_mat(self.n, 1)
+    def jacobian(self, x):
+        f = _field(x)
+        K = self._k(f)
+        TL, preL, sufL, dL = self._chain(K["left"], x, K, True)
+        TR, preR, sufR, dR = self._chain(K["right"], x, K, True)
+        E, s = K["E"], K["s"]
+        zero = f.scalar(0.0)
+        J = [[zero] * self.n for _ in range(self.n)]
         for i, (a, b) in enumerate(self.circles):
-            F[i, 0] = x[a, 0] * x[a, 0] + x[b, 0] * x[b, 0] - 1
+            J[i][a], J[i][b] = 2 * x[a, 0], 2 * x[b, 0]
         k = len(self.circles)
-        for r, (val, tt) in enumerate(zip(self._rows(TL, TR), self._t_terms(), strict=True)):
-            F[k + r, 0] = val - tt
-        return F
-
-    def jacobian(self, x: acb_mat) -> acb_mat:
-        TL, dL = self._chain(self.left, x, True)
-        TR, dR = self._chain(self.right, x, True)
-        J = acb_mat(self.n, self.n)
-        for i, (a, b) in enumerate(self.circles):
-            J[i, a], J[i, b] = 2 * x[a, 0], 2 * x[b, 0]
-        k = len(self.circles)
-        E, s = self.E, self.s
         if self.kind == "point":
-            for z, dT in dL.items():
-                u = dT * self.centre
-                for r in range(3):
-                    J[k + r, z] = s * u[r, 0]
-            for z, dT in dR.items():
-                v = E * (dT * self.centre)
-                for r in range(3):
-                    J[k + r, z] = -v[r, 0]
-            return J
-        ETR = E * TR
-        TLtE = TL.transpose() * E
-        for z, dT in dL.items():
-            P = dT.transpose() * ETR
-            for r, val in enumerate([P[0, 1], P[0, 2], P[1, 2]] + [s * dT[a, 3] for a in range(3)]):
-                J[k + r, z] = val
-        for z, dT in dR.items():
-            P = TLtE * dT
-            W = E * dT
-            for r, val in enumerate([P[0, 1], P[0, 2], P[1, 2]] + [-W[a, 3] for a in range(3)]):
-                J[k + r, z] = val
-        return J
+            c = K["centre"]
+            for i, dm in enumerate(dL):
+                tail = sufL[i + 1] * c
+                for z, dM in dm:
+                    u = preL[i] * (dM * tail)
+                    for r in range(3):
+                        J[k + r][z] = s * u[r, 0]
+            for i, dm in enumerate(dR):
+                tail = sufR[i + 1] * c
+                for z, dM in dm:
+                    v = E * (preR[i] * (dM * tail))
+                    for r in range(3):
+                        J[k + r][z] = -v[r, 0]
+        else:
+            ETRt = (E * TR).transpose()
+            TLtE = TL.transpose() * E
+            for i, dm in enumerate(dL):
+                for z, dM in dm:
+                    dT = preL[i] * dM * sufL[i + 1]
+                    Q = ETRt * dT  # (E TR)^T dTL = P_z^T
+                    vals = [Q[1, 0], Q[2, 0], Q[2, 1]] + [s * dT[a, 3] for a in range(3)]
+                    for r, val in enumerate(vals):
+                        J[k + r][z] = val
+            for i, dm in enumerate(dR):
+                for z, dM in dm:
+                    dT = preR[i] * dM * sufR[i + 1]
+                    P = TLtE * dT
+                    W = E * dT
+                    vals = [P[0, 1], P[0, 2], P[1, 2]] + [-W[a, 3] for a in range(3)]
+                    for r, val in enumerate(vals):
+                        J[k + r][z] = val
+        return arb_mat(J) if f.real else acb_mat(J)
+
+
+
+_LIMBS: dict[tuple[bytes, bool], dict] = {}
+
+
+def _limb_constants(sysm, f: _Field) -> dict:
+    """The ball matrices of a limb's factors (cached per limb geometry and field)."""
+    key = (sysm.key, f.real)
+    hit = _LIMBS.get(key)
+    if hit is None:
+        if len(_LIMBS) > 256:
+            _LIMBS.clear()
+
+        def factor(fa):
+            return (fa.kind, f.mat(fa.sign * fa.A), f.mat(fa.A2), fa.idx)
+
+        hit = _LIMBS[key] = {"centre": f.col(np.asarray(sysm.centre, dtype=float)), "eye": f.identity(4),
+                             "left": [factor(fa) for fa in sysm.left], "right": [factor(fa) for fa in sysm.right]}
+    return hit
 
 
 def limb_system(sysm, q, t) -> LimbBallSystem:
@@ -579,10 +628,13 @@ def limb_point(sysm, q) -> np.ndarray:
     """The unknowns ``x`` of a limb's :class:`.inverse.LimbIK` at its joint variables ``q``
     (``(cos, sin)`` per revolute, slide over ``L``; an S joint's variables have none)."""
     x = np.zeros(sysm.nx)
+    q = np.asarray(q, dtype=float)
+    rot = [(k, s[1], s[2]) for k, s in enumerate(sysm.slots) if s[0] == "R"]
+    if rot:
+        k, ic, js = (np.array(v) for v in zip(*rot, strict=True))
+        x[ic], x[js] = np.cos(q[k]), np.sin(q[k])
     for k, s in enumerate(sysm.slots):
-        if s[0] == "R":
-            x[s[1]], x[s[2]] = np.cos(q[k]), np.sin(q[k])
-        elif s[0] == "P":
+        if s[0] == "P":
             x[s[1]] = q[k] / sysm.L
     return x
 
