@@ -582,7 +582,8 @@ def _certify_solutions(mech: Mechanism, vals, sols: list, hr) -> tuple[list, dic
     pts = [hcert.study_parameters(s.config.D, sysm.L) if s.converged else None for s in sols]
     cx = np.array([e.study for e in hr.solutions if e.status == EndPointStatus.COMPLEX]).reshape(-1, 8)
     certs, ccerts = hcert.certify_forward(sysm.coefficients(np.asarray(vals, dtype=float)), pts, cx)
-    out = [s if c is None else replace(s, certified=c.certified, certificate=c.to_dict()) for s, c in zip(sols, certs, strict=True)]
+    out = [s if c is None else replace(s, certified=c.certified, certificate=c.to_dict())
+           for s, c in zip(sols, certs, strict=True)]
     return out, {"n_certified": hcert.n_certified([c for c in certs if c is not None]),
                  "n_certified_complex": hcert.n_certified(ccerts), "certification": hcert.statement(certs, ccerts),
                  "certify_elapsed_s": perf_counter() - t0}

@@ -322,7 +322,7 @@ def certify(system: BallSystem, points, *, real: Sequence[bool] | None = None,
     finally:
         ctx.prec = prec
     ok = [i for i, f in enumerate(found) if f[1] is not None]
-    disjoint, inside = _pairs(np.array([found[i][0] for i in ok]).reshape(len(ok), -1),
+    disjoint, inside = _pairs(np.array([found[i][0] for i in ok]).reshape(len(ok), system.n),
                               np.array([found[i][1] for i in ok], dtype=float),
                               np.array([0.0 if found[i][3] else found[i][1] for i in ok], dtype=float))
     pos = {i: k for k, i in enumerate(ok)}
