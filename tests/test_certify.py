@@ -108,6 +108,7 @@ def test_fk_no_certify_and_text(stewart):
     assert doc["n_certified"] is None and doc["solutions"][0]["certified"] is None
 
 
+@pytest.mark.slow
 def test_multistart_and_closed_form_are_not_certified():
     r = sm.fk("four-sps-cu", [0.216745, 0.23896, 0.227321, 0.206933], all_solutions=True, seeds=32)
     d = r.to_dict()
@@ -230,3 +231,19 @@ def test_general_6r_real_solutions_certified():
     q = np.array(r.result.limbs[0].solutions[0], dtype=float)
     q[2] += 1e-3
     assert C.certify_inverse(sysm, D, [q])[0].certified is False
+
+
+def test_certify_benchmark_reports_its_target(stewart):
+    """benchmarks/bench_homotopy.py: ``certify_overhead_fraction`` and a verdict (quick: one
+    re-solve each of the Stewart forward and the PUMA inverse)."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "benchmarks" / "bench_homotopy.py"
+    spec = importlib.util.spec_from_file_location("bench_homotopy", path)
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    out = bench.certify_case(1, quick=True)
+    assert set(out["cases"]) == {"stewart-6sps fk", "PUMA 560 ik"}
+    assert all(c["all_certified"] and c["fraction"] > 0 for c in out["cases"].values())
+    assert isinstance(out["certify_met"], bool) and out["certify_overhead_fraction"] > 0
