@@ -46,7 +46,7 @@ from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from contextvars import ContextVar
 from dataclasses import dataclass
-from typing import Protocol
+from typing import Any, Protocol
 
 import numpy as np
 from flint import acb, acb_mat, arb, arb_mat, ctx
@@ -72,6 +72,10 @@ __all__ = [
 ]
 
 
+#: A ball matrix: :class:`flint.arb_mat` (real balls) or :class:`flint.acb_mat` (complex balls).
+Ball = Any
+
+
 class BallSystem(Protocol):
     """A square polynomial system evaluated in ball arithmetic.
 
@@ -83,9 +87,9 @@ class BallSystem(Protocol):
     n: int
     real: bool
 
-    def values(self, x: acb_mat) -> acb_mat: ...
+    def values(self, x: Ball) -> Ball: ...
 
-    def jacobian(self, x: acb_mat) -> acb_mat: ...
+    def jacobian(self, x: Ball) -> Ball: ...
 
 
 @dataclass(frozen=True)
@@ -213,8 +217,8 @@ def _conjugate_partners(system: BallSystem, Ys: list[np.ndarray], real: list[boo
     for i in range(len(Ys)):
         if real[i] or i in out or i in used or not np.any(Y[i].imag):
             continue
-        for j in np.flatnonzero(dist[i] < 1e-8):
-            j = int(j)
+        for jj in np.flatnonzero(dist[i] < 1e-8):
+            j = int(jj)
             if j > i and not real[j] and j not in out and j not in used:
                 out[j] = i
                 used.add(i)
@@ -376,7 +380,7 @@ class QuadricBallSystem:
         Sk, _, Bm, bv, _, half = self._k(_field(x))
         xt = x.transpose()
         lin = Bm * x - bv
-        rows = [[(xt * (S * x))[0, 0] * half] for S in Sk]
+        rows: Any = [[(xt * (S * x))[0, 0] * half] for S in Sk]
         rows += [[lin[k, 0]] for k in range(self.n - self.m)]
         return arb_mat(rows) if isinstance(x, arb_mat) else acb_mat(rows)
 
@@ -384,14 +388,14 @@ class QuadricBallSystem:
         _, S, _, _, Brows, _ = self._k(_field(x))
         SX = S * x
         n = self.n
-        rows = [[SX[k * n + j, 0] for j in range(n)] for k in range(self.m)] + Brows
+        rows: Any = [[SX[k * n + j, 0] for j in range(n)] for k in range(self.m)] + Brows
         return arb_mat(rows) if isinstance(x, arb_mat) else acb_mat(rows)
 
 
 
 def _stack(mats: list, f: _Field):
     """The matrices stacked vertically (exact: entries copied)."""
-    rows = [[M[i, j] for j in range(M.ncols())] for M in mats for i in range(M.nrows())]
+    rows: Any = [[M[i, j] for j in range(M.ncols())] for M in mats for i in range(M.nrows())]
     return arb_mat(rows) if f.real else acb_mat(rows)
 
 
@@ -427,7 +431,7 @@ class LimbBallSystem:
                 [2 * (i * j + w * k), w * w - i * i + j * j - k * k, 2 * (j * k - w * i)],
                 [2 * (i * k - w * j), 2 * (j * k + w * i), w * w - i * i - j * j + k * k]]
         zero = f.scalar(0.0)
-        Erows = [rows[a] + [zero] for a in range(3)] + [[zero] * 4]
+        Erows: Any = [rows[a] + [zero] for a in range(3)] + [[zero] * 4]
         E = arb_mat(Erows) if f.real else acb_mat(Erows)
 
         hit = self._consts[f.real] = {"E": E, "s": w * w + i * i + j * j + k * k, "t": [f.scalar(v) for v in self._t],
@@ -439,7 +443,8 @@ class LimbBallSystem:
         """The product ``T``, and with ``want`` its prefix and suffix products and per factor the
         derivatives of its matrix ``{unknown: dM}``."""
         eye, one = K["eye"], K["one"]
-        Ms, dMs = [], []
+        Ms: list[Any] = []
+        dMs: list[tuple] = []
         for kind, A, A2, idx in factors:
             if kind == "R":
                 c, s = x[idx[0], 0], x[idx[1], 0]
@@ -464,7 +469,7 @@ class LimbBallSystem:
         TL, _, _, _ = self._chain(K["left"], x, K, False)
         TR, _, _, _ = self._chain(K["right"], x, K, False)
         E, s, t = K["E"], K["s"], K["t"]
-        out = [[x[a, 0] * x[a, 0] + x[b, 0] * x[b, 0] - K["one"]] for a, b in self.circles]
+        out: Any = [[x[a, 0] * x[a, 0] + x[b, 0] * x[b, 0] - K["one"]] for a, b in self.circles]
         if self.kind == "point":
             u, v = TL * K["centre"], E * (TR * K["centre"])
             out += [[s * u[a, 0] - v[a, 0] - s * t[a]] for a in range(3)]
@@ -481,7 +486,7 @@ class LimbBallSystem:
         TR, preR, sufR, dR = self._chain(K["right"], x, K, True)
         E, s = K["E"], K["s"]
         zero = f.scalar(0.0)
-        J = [[zero] * self.n for _ in range(self.n)]
+        J: Any = [[zero] * self.n for _ in range(self.n)]
         for i, (a, b) in enumerate(self.circles):
             J[i][a], J[i][b] = 2 * x[a, 0], 2 * x[b, 0]
         k = len(self.circles)
@@ -631,8 +636,8 @@ def limb_point(sysm, q) -> np.ndarray:
     q = np.asarray(q, dtype=float)
     rot = [(k, s[1], s[2]) for k, s in enumerate(sysm.slots) if s[0] == "R"]
     if rot:
-        k, ic, js = (np.array(v) for v in zip(*rot, strict=True))
-        x[ic], x[js] = np.cos(q[k]), np.sin(q[k])
+        kk, ic, js = (np.array(v) for v in zip(*rot, strict=True))
+        x[ic], x[js] = np.cos(q[kk]), np.sin(q[kk])
     for k, s in enumerate(sysm.slots):
         if s[0] == "P":
             x[s[1]] = q[k] / sysm.L
