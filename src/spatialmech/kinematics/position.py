@@ -12,6 +12,7 @@ Actuator values are physical values (``offset + q``: a leg length, an angle in r
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -461,6 +462,9 @@ def _homotopy_limb(mech: Mechanism, li: int, D: np.ndarray, q_all: np.ndarray, h
     return LimbSolutions(mech.limbs[li].name, tuple(sols), tuple(float(r) for r in res), bool(sols), 0, viol)
 
 
+_LIMB_SYSTEMS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # per model: {(limb, seed): LimbIK}
+
+
 def _certify_limb(mech: Mechanism, li: int, D: np.ndarray, ls: LimbSolutions, seed: int) -> tuple[LimbSolutions, dict]:
     """The homotopy's polished solutions of limb ``li`` certified as roots of its exact system
     (:func:`.homotopy.certify.certify_inverse`), and the report's ``n_certified`` and
@@ -474,7 +478,11 @@ def _certify_limb(mech: Mechanism, li: int, D: np.ndarray, ls: LimbSolutions, se
     if not hcert.enabled():
         return ls, {"n_certified": None, "certification": "not attempted (certification off)"}
     t0 = perf_counter()
-    certs = hcert.certify_inverse(limb_ik_system(mech, li, seed), D, ls.solutions)
+    key = (li, seed)
+    systems = _LIMB_SYSTEMS.setdefault(mech, {})
+    if key not in systems:
+        systems[key] = limb_ik_system(mech, li, seed)
+    certs = hcert.certify_inverse(systems[key], D, ls.solutions)
     if certs is None:
         return ls, {"n_certified": None, "certification": ("not attempted: the limb has more equations than unknowns "
                                                            "(its square system is a random combination of them)")}

@@ -196,11 +196,12 @@ def _contained(X, K, n: int) -> bool:
 
 
 def _inverse(J: np.ndarray) -> np.ndarray | None:
-    with np.errstate(all="ignore"):
-        try:
-            A = np.linalg.inv(J)
-        except np.linalg.LinAlgError:
-            return None
+    if not np.all(np.isfinite(J)):
+        return None
+    try:
+        A = np.linalg.inv(J)
+    except np.linalg.LinAlgError:
+        return None
     return A if np.all(np.isfinite(A)) else None
 
 
@@ -369,34 +370,29 @@ class QuadricBallSystem:
     def _k(self, f: _Field) -> tuple:
         hit = self._consts.get(f.real)
         if hit is None:
-            Sk = [f.mat(Qk) + f.mat(Qk.T) for Qk in self._Q]  # the symmetric parts, doubled: exact balls
+            Qk = [f.mat(Q) for Q in self._Q]
+            # the Jacobian's rows Q_k + Q_k^T, stacked: exact balls (the sum is taken in ball arithmetic)
+            S = f.mat(np.concatenate(list(self._Q))) + f.mat(np.concatenate([Q.T for Q in self._Q]))
             Bm = f.mat(self._B)
-            hit = self._consts[f.real] = (Sk, _stack(Sk, f), Bm, f.col(self._b),
-                                          [[Bm[k, j] for j in range(self.n)] for k in range(self.n - self.m)],
-                                          f.scalar(0.5))
+            hit = self._consts[f.real] = (Qk, S, Bm, f.col(self._b),
+                                          [[Bm[k, j] for j in range(self.n)] for k in range(self.n - self.m)])
         return hit
 
     def values(self, x):
-        Sk, _, Bm, bv, _, half = self._k(_field(x))
+        Qk, _, Bm, bv, _ = self._k(_field(x))
         xt = x.transpose()
         lin = Bm * x - bv
-        rows: Any = [[(xt * (S * x))[0, 0] * half] for S in Sk]
+        rows: Any = [[(xt * (Q * x))[0, 0]] for Q in Qk]
         rows += [[lin[k, 0]] for k in range(self.n - self.m)]
         return arb_mat(rows) if isinstance(x, arb_mat) else acb_mat(rows)
 
     def jacobian(self, x):
-        _, S, _, _, Brows, _ = self._k(_field(x))
+        _, S, _, _, Brows = self._k(_field(x))
         SX = S * x
         n = self.n
         rows: Any = [[SX[k * n + j, 0] for j in range(n)] for k in range(self.m)] + Brows
         return arb_mat(rows) if isinstance(x, arb_mat) else acb_mat(rows)
 
-
-
-def _stack(mats: list, f: _Field):
-    """The matrices stacked vertically (exact: entries copied)."""
-    rows: Any = [[M[i, j] for j in range(M.ncols())] for M in mats for i in range(M.nrows())]
-    return arb_mat(rows) if f.real else acb_mat(rows)
 
 
 def quadric_system(Q, B, b) -> QuadricBallSystem:
@@ -506,19 +502,21 @@ class LimbBallSystem:
                         J[k + r][z] = -v[r, 0]
         else:
             ETRt = (E * TR).transpose()
-            TLtE = TL.transpose() * E
+            TLt = TL.transpose()
+            nL, nR = len(dL), len(dR)
             for i, dm in enumerate(dL):
                 for z, dM in dm:
-                    dT = preL[i] * dM * sufL[i + 1]
+                    dT = dM if i + 1 == nL else dM * sufL[i + 1]
+                    dT = dT if i == 0 else preL[i] * dT
                     Q = ETRt * dT  # (E TR)^T dTL = P_z^T
                     vals = [Q[1, 0], Q[2, 0], Q[2, 1]] + [s * dT[a, 3] for a in range(3)]
                     for r, val in enumerate(vals):
                         J[k + r][z] = val
             for i, dm in enumerate(dR):
+                lead = E * preR[i]
                 for z, dM in dm:
-                    dT = preR[i] * dM * sufR[i + 1]
-                    P = TLtE * dT
-                    W = E * dT
+                    W = lead * dM if i + 1 == nR else lead * dM * sufR[i + 1]  # E dTR
+                    P = TLt * W
                     vals = [P[0, 1], P[0, 2], P[1, 2]] + [-W[a, 3] for a in range(3)]
                     for r, val in enumerate(vals):
                         J[k + r][z] = val
@@ -632,16 +630,22 @@ def certify_forward(Qt: np.ndarray, real_points: Sequence[np.ndarray | None],
 def limb_point(sysm, q) -> np.ndarray:
     """The unknowns ``x`` of a limb's :class:`.inverse.LimbIK` at its joint variables ``q``
     (``(cos, sin)`` per revolute, slide over ``L``; an S joint's variables have none)."""
-    x = np.zeros(sysm.nx)
+    idx = _SLOTS.get(sysm.key)
+    if idx is None:
+        rot = [(k, s[1], s[2]) for k, s in enumerate(sysm.slots) if s[0] == "R"]
+        lin = [(k, s[1]) for k, s in enumerate(sysm.slots) if s[0] == "P"]
+        idx = _SLOTS[sysm.key] = (np.array([r[0] for r in rot], dtype=np.int64), np.array([r[1] for r in rot], dtype=np.int64),
+                                  np.array([r[2] for r in rot], dtype=np.int64), np.array([r[0] for r in lin], dtype=np.int64),
+                                  np.array([r[1] for r in lin], dtype=np.int64))
+    kr, ic, js, kp, ip = idx
     q = np.asarray(q, dtype=float)
-    rot = [(k, s[1], s[2]) for k, s in enumerate(sysm.slots) if s[0] == "R"]
-    if rot:
-        kk, ic, js = (np.array(v) for v in zip(*rot, strict=True))
-        x[ic], x[js] = np.cos(q[kk]), np.sin(q[kk])
-    for k, s in enumerate(sysm.slots):
-        if s[0] == "P":
-            x[s[1]] = q[k] / sysm.L
+    x = np.zeros(sysm.nx)
+    x[ic], x[js] = np.cos(q[kr]), np.sin(q[kr])
+    x[ip] = q[kp] / sysm.L
     return x
+
+
+_SLOTS: dict[bytes, tuple] = {}
 
 
 def certify_inverse(sysm, D: np.ndarray, qs: Sequence[np.ndarray]) -> list[Certificate] | None:
