@@ -147,6 +147,16 @@ def test_double_root_and_nearby_point_are_not_certified():
     assert C.certify(_square_root_system(1.0), np.array([[1.0, 1.0]]), real=[True])[0].certified
 
 
+def test_bad_points_are_refused_naming_the_field():
+    system = _square_root_system(2.0)
+    with pytest.raises(sm.InputError, match="points"):
+        C.certify(system, np.array([[np.nan, 1.0]]))
+    with pytest.raises(sm.InputError, match="points"):
+        C.certify(system, np.ones((1, 3)))
+    with pytest.raises(sm.InputError, match="real"):
+        C.certify(system, np.ones((2, 2)), real=[True])
+
+
 def test_real_and_non_real_verdicts():
     Q = np.zeros((1, 2, 2))
     Q[0, 0, 0], Q[0, 1, 1] = 1.0, 4.0  # x0^2 + 4 = 0: roots (+-2i, 1)

@@ -51,6 +51,7 @@ from typing import Any, Protocol
 import numpy as np
 from flint import acb, acb_mat, arb, arb_mat, ctx
 
+from ...errors import InputError
 from ...geometry.tolerances import CERTIFY_GROWTH, CERTIFY_MAX_RADIUS, CERTIFY_MIN_RADIUS, CERTIFY_PRECISION
 
 __all__ = [
@@ -308,10 +309,10 @@ def certify(system: BallSystem, points, *, real: Sequence[bool] | None = None,
         return ()
     flags = [False] * len(P) if real is None else [bool(v) for v in real]
     if len(flags) != len(P):
-        raise ValueError(f"certify: {len(P)} points but {len(flags)} real flags")
+        raise InputError(f"real: {len(flags)} flags for {len(P)} points")
     Ys = [y.real.astype(complex) if flags[i] and system.real else y for i, y in enumerate(P)]
     if P.shape[1] != system.n or not np.all(np.isfinite(P)):
-        raise ValueError(f"certify: points of {system.n} finite numbers expected")
+        raise InputError(f"points: expected rows of {system.n} finite numbers, got shape {P.shape}")
     prec = ctx.prec
     ctx.prec = CERTIFY_PRECISION
     try:
@@ -362,7 +363,8 @@ class QuadricBallSystem:
         b = np.asarray(b).ravel()
         self.m, self.n = Q.shape[0], Q.shape[1]
         if Q.shape[1:] != (self.n, self.n) or B.shape != (self.n - self.m, self.n) or b.shape != (self.n - self.m,):
-            raise ValueError("quadric_system: m quadrics (n x n) and n - m linear equations of n unknowns expected")
+            raise InputError(f"Q, B, b: expected m quadrics (n x n) and n - m linear equations of n unknowns, got shapes "
+                             f"{Q.shape}, {B.shape}, {b.shape}")
         self.real = not (np.any(np.imag(Q)) or np.any(np.imag(B)) or np.any(np.imag(b)))
         self._Q, self._B, self._b = Q, B, b
         self._consts: dict[bool, tuple] = {}
@@ -408,7 +410,7 @@ class LimbBallSystem:
 
     def __init__(self, sysm, q, t) -> None:
         if not sysm.rigid:
-            raise ValueError("limb_system: the limb's equations are not square (a graph family)")
+            raise InputError("sysm: the limb's equations are not square (a graph family): no certificate")
         self.n = int(sysm.nx)
         self.real = True
         self.kind = sysm.kind
