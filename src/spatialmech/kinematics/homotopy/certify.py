@@ -209,7 +209,7 @@ def _inverse(J: np.ndarray) -> np.ndarray | None:
 def _conjugate_partners(system: BallSystem, Ys: list[np.ndarray], real: list[bool]) -> dict[int, int]:
     """``{j: i}``: the point ``j`` is (to 1e-8 relative) the conjugate of the point ``i < j``, for a
     system with real coefficients: ``j`` is then certified by the conjugate of ``i``'s box."""
-    if not system.real or len(Ys) < 2:
+    if not system.real or len(Ys) < 2 or all(real):
         return {}
     Y = np.array(Ys)
     scale = 1.0 + np.max(np.abs(Y), axis=1)
