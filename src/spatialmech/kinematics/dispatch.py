@@ -185,6 +185,7 @@ class ForwardAnswer:
             m = next(modes, None) if s["converged"] else None
             f = m.flags if m is not None else None
             s.update(f.to_dict() if f is not None else dict.fromkeys(_FLAG_KEYS))
+            s.setdefault("certificate", None)  # the closed form's solutions have none
             if m is not None:
                 s["forward_singular"] = m.forward_singular
         return {"engine": self.engine, **d, "complete": self.complete, "completeness": self.completeness,
