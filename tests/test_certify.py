@@ -257,3 +257,23 @@ def test_certify_benchmark_reports_its_target(stewart):
     assert set(out["cases"]) == {"stewart-6sps fk", "PUMA 560 ik"}
     assert all(c["all_certified"] and c["fraction"] > 0 for c in out["cases"].values())
     assert isinstance(out["certify_met"], bool) and out["certify_overhead_fraction"] > 0
+
+
+def test_limb_float_jacobians_match_the_ball_system():
+    """The batched floating-point Jacobians (the preconditioners) equal the ball system's."""
+    m = serial_arm("puma560", PUMA560_DH)
+    D = dh_pose(PUMA560_DH, np.array([0.3, -0.7, 0.5, 0.9, 0.6, -0.4])).displacement(m.platform_point)
+    sysm = ikh.limb_ik_system(m, 0)
+    P = sysm.pose_parameters(np.asarray(D, float)).real
+    system = C.limb_system(sysm, P[:4], P[4:7])
+    Y = np.random.default_rng(8).normal(size=(3, sysm.nx))
+    Jf = system.jacobian_float_many(Y)
+    for y, J in zip(Y, Jf, strict=True):
+        assert np.allclose(C._mid(system.jacobian(C.REAL.col(y))), J, atol=1e-12)
+
+
+def test_quadric_float_jacobians_match_the_ball_system(stewart):
+    system = stewart["system"]
+    Y = stewart["Y"][:3] + 0.1j
+    for y, J in zip(Y, system.jacobian_float_many(Y), strict=True):
+        assert np.allclose(C._mid(system.jacobian(C.COMPLEX.col(y))), J, atol=1e-12)

@@ -228,20 +228,22 @@ def _conjugate_partners(system: BallSystem, Ys: list[np.ndarray], real: list[boo
     return out
 
 
-def _one(system: BallSystem, y: np.ndarray, max_radius: float) -> tuple[float | None, str, bool]:
+def _one(system: BallSystem, y: np.ndarray, max_radius: float,
+         Ainv: np.ndarray | None = None) -> tuple[float | None, str, bool]:
     """(radius, reason, real box) of one point: the smallest box that passes, or why none does.
     A real point of a real system gets a real box (uniqueness among real points).
 
     ``F'`` is enclosed once over the largest box (it encloses ``F'`` over every smaller one, so
     one evaluation serves every radius tried; the preconditioner ``A`` is the inverse of its
-    midpoint); a radius that fails with it is tried again with ``F'`` over its own box."""
+    midpoint, or ``Ainv`` when given: any matrix serves); a radius that fails with it is tried
+    again with ``F'`` over its own box."""
     n = system.n
     f = REAL if system.real and not np.any(y.imag) else COMPLEX
     yc = f.col(y.real if f.real else y)
     scale = 1.0 + float(np.max(np.abs(y)))
     rmax = max_radius * scale
     J = system.jacobian(yc + f.radius_col(n, _pow2_up(rmax)))
-    Ainv = _inverse(_mid(J))
+    Ainv = _inverse(_mid(J)) if Ainv is None else Ainv
     if Ainv is None:
         return None, "the Jacobian is singular at the point", f.real
     A = f.mat(Ainv.real if f.real else Ainv)
@@ -319,8 +321,12 @@ def certify(system: BallSystem, points, *, real: Sequence[bool] | None = None,
         partner = _conjugate_partners(system, Ys, flags)
         todo = [i for i in range(len(Ys)) if i not in partner]
         found: list = [None] * len(Ys)
-        for i in todo:
-            found[i] = (Ys[i], *_one(system, Ys[i], max_radius), 0.0)
+        many = getattr(system, "jacobian_float_many", None)
+        pre: list = [None] * len(todo)
+        if many is not None and todo:  # floating-point preconditioners, all points at once
+            pre = [_inverse(J) for J in many(np.array([Ys[i] for i in todo]))]
+        for i, Ainv in zip(todo, pre, strict=True):
+            found[i] = (Ys[i], *_one(system, Ys[i], max_radius, Ainv), 0.0)
         for j, i in partner.items():  # the conjugate of a certified box holds the conjugate root
             yi, ri, why, rb, _ = found[i]
             yj = yi.conj()
@@ -387,6 +393,12 @@ class QuadricBallSystem:
         rows: Any = [[(xt * (Q * x))[0, 0]] for Q in Qk]
         rows += [[lin[k, 0]] for k in range(self.n - self.m)]
         return arb_mat(rows) if isinstance(x, arb_mat) else acb_mat(rows)
+
+    def jacobian_float_many(self, Y: np.ndarray) -> np.ndarray:
+        """``F'`` in floating point at the points ``Y`` (k, n) (the preconditioners only)."""
+        Q = np.asarray(self._Q, dtype=complex)
+        Jq = np.einsum("kij,pj->pki", Q + Q.transpose(0, 2, 1), np.asarray(Y, dtype=complex))
+        return np.concatenate([Jq, np.broadcast_to(self._B, (len(Jq), *self._B.shape))], axis=1)
 
     def jacobian(self, x):
         _, S, _, _, Brows = self._k(_field(x))
@@ -462,6 +474,10 @@ class LimbBallSystem:
         suf.reverse()  # suf[i] = M_i ... M_last
         return pre[-1], pre, suf, dMs
 
+    def jacobian_float_many(self, Y: np.ndarray) -> np.ndarray:
+        """``F'`` in floating point at the points ``Y`` (k, n) (the preconditioners only)."""
+        return _limb_float_jacobians(self._sysm, self._q, self._t, Y)
+
     def values(self, x):
         K = self._k(_field(x))
         TL, _, _, _ = self._chain(K["left"], x, K, False)
@@ -527,6 +543,62 @@ class LimbBallSystem:
 
 
 _LIMBS: dict[tuple[bytes, bool], dict] = {}
+
+
+def _limb_float_jacobians(sysm, q: np.ndarray, t: np.ndarray, Y: np.ndarray) -> np.ndarray:
+    """``F'`` of the limb's square system in floating point at the points ``Y`` (k, n), batched
+    (the preconditioners only: the same formulas as :meth:`LimbBallSystem.jacobian`)."""
+    Y = np.asarray(Y, dtype=complex)
+    k, n = Y.shape
+    eye = np.broadcast_to(np.eye(4), (k, 4, 4))
+
+    def chain(factors):
+        Ms: list[np.ndarray] = []
+        dMs: list[tuple] = []
+        for fa in factors:
+            A = fa.sign * fa.A
+            if fa.kind == "R":
+                c, s = Y[:, fa.idx[0], None, None], Y[:, fa.idx[1], None, None]
+                Ms.append(eye + s * A + (1 - c) * fa.A2)
+                dMs.append(((fa.idx[0], -fa.A2), (fa.idx[1], A)))
+            else:
+                Ms.append(eye + Y[:, fa.idx[0], None, None] * A)
+                dMs.append(((fa.idx[0], A),))
+        pre = [eye]
+        for M in Ms:
+            pre.append(pre[-1] @ M)
+        suf = [eye]
+        for M in reversed(Ms):
+            suf.append(M @ suf[-1])
+        suf.reverse()
+        return pre, suf, dMs
+
+    w, i, j, kq = q
+    E = np.zeros((4, 4))
+    E[:3, :3] = [[w * w + i * i - j * j - kq * kq, 2 * (i * j - w * kq), 2 * (i * kq + w * j)],
+                 [2 * (i * j + w * kq), w * w - i * i + j * j - kq * kq, 2 * (j * kq - w * i)],
+                 [2 * (i * kq - w * j), 2 * (j * kq + w * i), w * w - i * i - j * j + kq * kq]]
+    s2 = float(q @ q)
+    preL, sufL, dL = chain(sysm.left)
+    preR, sufR, dR = chain(sysm.right)
+    TL, TR = preL[-1], preR[-1]
+    J = np.zeros((k, n, n), dtype=complex)
+    for r, (a, b) in enumerate(sysm.circles):
+        J[:, r, a], J[:, r, b] = 2 * Y[:, a], 2 * Y[:, b]
+    m = len(sysm.circles)
+    for side, (pre, suf, dm) in enumerate(((preL, sufL, dL), (preR, sufR, dR))):
+        for f_i, derivs in enumerate(dm):
+            for z, dM in derivs:
+                dT = pre[f_i] @ dM @ suf[f_i + 1]
+                if sysm.kind == "point":
+                    c = np.asarray(sysm.centre, dtype=float)
+                    J[:, m:m + 3, z] = s2 * (dT @ c)[:, :3] if side == 0 else -((E @ dT) @ c)[:, :3]
+                    continue
+                P = np.swapaxes(dT, 1, 2) @ E @ TR if side == 0 else np.swapaxes(TL, 1, 2) @ E @ dT
+                tr = s2 * dT[:, :3, 3] if side == 0 else -(E @ dT)[:, :3, 3]
+                J[:, m:m + 3, z] = np.stack([P[:, 0, 1], P[:, 0, 2], P[:, 1, 2]], axis=1)
+                J[:, m + 3:m + 6, z] = tr
+    return J
 
 
 def _limb_constants(sysm, f: _Field) -> dict:
