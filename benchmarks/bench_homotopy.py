@@ -16,6 +16,13 @@ under ``ik``: ``ik_6r_first_s`` (a random general 6R: the generic solve, monodro
 the root count, then the pose; target < 2 s; numba compilation excluded by a warm-up on another
 geometry), ``ik_6r_resolve_ms`` (median re-solve at new poses, the 16 cached paths; target
 < 50 ms) and ``ik_puma_solutions`` (the PUMA 560: 8).
+
+Certified solutions (kinematics/homotopy/certify.py, issue 27), reported under ``certify``:
+``certify_overhead_fraction``, the largest over the cases of the median of the certificates'
+time over the rest of the same solve (``sm.fk`` / ``sm.ik`` with ``all_solutions``, re-solves at
+new actuator values or poses, the generic solve cached: the smallest solves, so the largest
+fractions), target <= 0.25.  Cases: stewart-6sps forward (8 real solutions and 20 complex end
+points certified) and the inverse position of the PUMA 560 (8) and of a random general 6R.
 """
 
 from __future__ import annotations
@@ -38,6 +45,7 @@ TARGET_FIRST_S = 2.0
 TARGET_RESOLVE_MS = 50.0
 TARGET_IK_FIRST_S = 2.0
 TARGET_IK_RESOLVE_MS = 50.0
+TARGET_CERTIFY_FRACTION = 0.25
 
 
 def _dh_arm(dh):
@@ -99,6 +107,44 @@ def ik_case(resolves: int) -> dict:
             "ik_puma_met": len(rp.limbs[0].solutions) == 8}
 
 
+def certify_case(resolves: int, quick: bool = False) -> dict:
+    """The certificates' share of a solve: ``certify_elapsed_s`` (reported by the solve) over the
+    rest of the same call, median over re-solves, per case (``quick``: without the general 6R)."""
+    import spatialmech as sm
+
+    rng = np.random.default_rng(11)
+    out: dict = {"cases": {}}
+    mech = catalog.build("stewart-6sps")
+    sm.fk(mech, np.full(6, 1.2), all_solutions=True)  # the generic solve, cached
+    fr, ok = [], True
+    for _ in range(resolves):
+        t0 = time.perf_counter()
+        d = sm.fk(mech, 1.2 * (1 + 0.02 * rng.standard_normal(6)), all_solutions=True).answer.detail.search
+        total = time.perf_counter() - t0
+        fr.append(d["certify_elapsed_s"] / (total - d["certify_elapsed_s"]))
+        ok &= d["n_certified"] == d["distinct"] and d["n_certified_complex"] > 0
+    out["cases"]["stewart-6sps fk"] = {"fraction": float(np.median(fr)), "all_certified": bool(ok)}
+    puma = [(0.0, 0.0, np.pi / 2), (0.0, 0.4318, 0.0), (0.15005, 0.0203, -np.pi / 2), (0.4318, 0.0, np.pi / 2),
+            (0.0, 0.0, -np.pi / 2), (0.0, 0.0, 0.0)]
+    general = [(rng.uniform(-0.5, 0.5), rng.uniform(0.1, 0.6), rng.uniform(-np.pi, np.pi)) for _ in range(6)]
+    for name, dh in (("PUMA 560 ik", puma), ("general 6R ik", general))[: 1 if quick else 2]:
+        m, pose = _dh_arm(dh)
+        sm.ik(m, pose(np.zeros(6)), all_solutions=True)  # the generic solve, cached
+        fr, ok = [], True
+        for _ in range(resolves):
+            p = pose(rng.uniform(-np.pi, np.pi, 6))
+            t0 = time.perf_counter()
+            rep = sm.ik(m, p, all_solutions=True).result.search["limbs"][0]
+            total = time.perf_counter() - t0
+            fr.append(rep["certify_elapsed_s"] / (total - rep["certify_elapsed_s"]))
+            ok &= rep["n_certified"] == rep["n_real"]
+        out["cases"][name] = {"fraction": float(np.median(fr)), "all_certified": bool(ok)}
+    frac = max(c["fraction"] for c in out["cases"].values())
+    out["certify_overhead_fraction"] = frac
+    out["certify_met"] = frac <= TARGET_CERTIFY_FRACTION and all(c["all_certified"] for c in out["cases"].values())
+    return out
+
+
 def phc_blackbox(sysm, values, c) -> tuple[float, int] | None:
     """Seconds of ``phc -b`` on the system and its number of regular solutions (None: no phc)."""
     if shutil.which("phc") is None:
@@ -153,9 +199,11 @@ def main(argv=None) -> dict:
                                                                    or c["first_solve_s"] < c["phc_blackbox_s"])
         c["resolve_met"] = c["resolve_median_ms"] is not None and c["resolve_median_ms"] < TARGET_RESOLVE_MS
     ik = ik_case(3 if args.quick else 20)
+    cert = certify_case(3 if args.quick else 15, quick=args.quick)
     out = {"cases": cases, "targets": {"first_solve_s": TARGET_FIRST_S, "resolve_ms": TARGET_RESOLVE_MS,
                                        "ik_6r_first_s": TARGET_IK_FIRST_S, "ik_6r_resolve_ms": TARGET_IK_RESOLVE_MS,
-                                       "ik_puma_solutions": 8},
+                                       "ik_puma_solutions": 8, "certify_overhead_fraction": TARGET_CERTIFY_FRACTION},
+           "certify": cert, "certify_overhead_fraction": cert["certify_overhead_fraction"],
            "phc": shutil.which("phc") is not None, "ik": ik, **{k: ik[k] for k in
                                                                 ("ik_6r_first_s", "ik_6r_resolve_ms", "ik_puma_solutions")}}
     if args.json:
@@ -176,6 +224,9 @@ def main(argv=None) -> dict:
           f"first solve (target < {TARGET_IK_RESOLVE_MS:g} ms): {word[ik['ik_resolve_met']]}")
     print(f"limb IK PUMA   {ik['ik_puma_solutions']} solutions (target 8), complete {ik['ik_puma_complete']}: "
           f"{word[ik['ik_puma_met']]}")
+    print("certificates   share of a re-solve (median): " + ", ".join(
+        f"{k} {v['fraction']:.0%}{'' if v['all_certified'] else ' (NOT all certified)'}" for k, v in cert["cases"].items())
+          + f" (target <= {TARGET_CERTIFY_FRACTION:.0%}): {word[cert['certify_met']]}")
     return out
 
 

@@ -184,7 +184,8 @@ def test_ik_jacobian_workspace_give_the_same_fields_for_every_model():
     b = run_json("ik", "delta", "--xyz", "0.02", "0.01", "-0.33")
     assert keys(a) == keys(b)
     sa, sb = a["limbs"][0]["solutions"][0], b["limbs"][0]["solutions"][0]
-    assert keys(sa) == keys(sb) == {"joints_deg", "joints_len", "residual", "within_limits", "outside_limits"}
+    assert keys(sa) == keys(sb) == {"joints_deg", "joints_len", "residual", "within_limits", "outside_limits",
+                                    "certified", "certificate"}
     assert set(a["actuators_len"]) == {"L1.slide", "L2.slide", "L3.slide", "L4.slide"} and a["actuators_deg"] == {}
     assert set(b["actuators_deg"]) == {"R1.rot", "R2.rot", "R3.rot"} and b["actuators_len"] == {}
 

@@ -117,7 +117,7 @@ class IKResult:
 
 @one_blas_thread
 def ik(model: ModelLike, pose, *, all_solutions: bool = False, n_seeds: int = 48, seed: int = 0,
-       degrees: bool = False, tol=None, free=None, method: str = "auto") -> IKResult:
+       degrees: bool = False, tol=None, free=None, method: str = "auto", certify: bool = True) -> IKResult:
     """Inverse position: the joint values of every limb for a platform pose.
 
     Parameters
@@ -151,6 +151,11 @@ def ik(model: ModelLike, pose, *, all_solutions: bool = False, n_seeds: int = 48
         proves it complete, else the multi-start, labelled not proven), ``"homotopy"`` (every
         limb it covers, proven by a root count or the trace test) or ``"multistart"``.  The
         result's ``to_dict()["search"]`` says per limb the method and its completeness.
+    certify : bool
+        Certify each solution the homotopy returns (a Krawczyk test in ball arithmetic: a unique
+        real root of the limb's exact system near it, distinct from the others; ``certified`` per
+        solution and ``n_certified`` in ``to_dict()``, docs/homotopy.md); ``False`` skips it
+        (``certified`` is then ``None``, as for the multi-start).
 
     Returns
     -------
@@ -185,9 +190,12 @@ def ik(model: ModelLike, pose, *, all_solutions: bool = False, n_seeds: int = 48
     all_solutions = check_bool(all_solutions, "all_solutions")
     P, position = as_pose(mech, pose, degrees)
     names = None if free is None else (check_names(free, "free") or [])
-    ans = solve_inverse(mech, P, all_solutions=all_solutions, n_seeds=check_int(n_seeds, "n_seeds", minimum=1),
-                        seed=check_int(seed, "seed"), tol=tol, free=names, euler=pose_sequence(pose),
-                        method=check_choice(method, "method", ("auto", "homotopy", "multistart")))
+    from ..kinematics.homotopy.certify import certification
+
+    with certification(check_bool(certify, "certify")):
+        ans = solve_inverse(mech, P, all_solutions=all_solutions, n_seeds=check_int(n_seeds, "n_seeds", minimum=1),
+                            seed=check_int(seed, "seed"), tol=tol, free=names, euler=pose_sequence(pose),
+                            method=check_choice(method, "method", ("auto", "homotopy", "multistart")))
     return IKResult(mech, ans.pose, ans.result, position, resolve_tolerances(tol, "closure").reachability, ans.task)
 
 
@@ -256,7 +264,7 @@ class FKResult:
 
 @one_blas_thread
 def fk(model: ModelLike, actuators, *, all_solutions: bool = False, seeds: int | None = None, seed: int | None = None,
-       degrees: bool = False, progress: Progress | None = None, method: str = "auto") -> FKResult:
+       degrees: bool = False, progress: Progress | None = None, method: str = "auto", certify: bool = True) -> FKResult:
     """Forward position: platform pose(s) for actuator values.
 
     Without ``all_solutions``: one Newton solve from the reference configuration (``method``,
@@ -290,6 +298,12 @@ def fk(model: ModelLike, actuators, *, all_solutions: bool = False, seeds: int |
         else the multi-start search; ``"closed-form"``: the registered closed form;
         ``"homotopy"``: homotopy continuation or the loop formulation, uncapped;
         ``"multistart"``: the general multi-start search (never a proof).
+    certify : bool
+        Certify each solution of homotopy continuation in Study parameters (a Krawczyk test in
+        ball arithmetic: a unique real root of the exact system near it, distinct from the others
+        and from the complex end points; ``certified`` per solution and ``n_certified`` in
+        ``to_dict()``, docs/homotopy.md); ``False`` skips it (``certified`` is then ``None``, as
+        for the other engines).
 
     Returns
     -------
@@ -353,8 +367,11 @@ def fk(model: ModelLike, actuators, *, all_solutions: bool = False, seeds: int |
     if seed is not None:
         seed = check_int(seed, "seed")
     method = check_choice(method, "method", ("auto", "closed-form", "homotopy", "multistart"))
-    ans = solve_forward(mech, values, all_solutions=all_solutions, method=method, seeds=seeds, seed=seed,
-                        progress=optional_progress(progress))
+    from ..kinematics.homotopy.certify import certification
+
+    with certification(check_bool(certify, "certify")):
+        ans = solve_forward(mech, values, all_solutions=all_solutions, method=method, seeds=seeds, seed=seed,
+                            progress=optional_progress(progress))
     return FKResult(mech, values, ans)
 
 

@@ -296,6 +296,16 @@ HOMOTOPY_INFINITY = 1e-7
 HOMOTOPY_REAL = 1e-7
 HOMOTOPY_NEAR_REAL = 1e-3
 
+#: Certified solutions (kinematics/homotopy/certify.py), nondimensional (relative to ``1 + max |y|``,
+#: ``y`` the point in the system's coordinates): the half-width of the first Krawczyk box (or four
+#: times the point's Newton correction, if larger), the factor between the boxes tried, and the
+#: largest box: a point whose root lies farther away is not certified.  The ball arithmetic's
+#: working precision in bits.
+CERTIFY_MIN_RADIUS = 1e-13
+CERTIFY_GROWTH = 100.0
+CERTIFY_MAX_RADIUS = 1e-8
+CERTIFY_PRECISION = 53
+
 #: Forward-position solution flags (kinematics/solution_flags.py).  A solution is
 #: *input-independent* (it persists for every actuator value: the actuators move without moving
 #: the platform) when the same platform pose still closes after each of ``INPUT_PERTURBATIONS``

@@ -157,9 +157,11 @@ def _fmt_value(mech: Mechanism, fid: str, v: float) -> str:
               help="Task coordinates to SOLVE (parasitic), comma-separated from x,y,z,a1,a2,a3 (a1..a3: the --euler "
                    "sequence's angles, default ZYX); the others are held at the pose's values. For lower-mobility "
                    "mechanisms, e.g. --free x,y,a1 for a 3-RPS.")
+@click.option("--no-certify", "no_certify", is_flag=True,
+              help="With --all: skip the certificates of the homotopy's solutions (Krawczyk test in ball arithmetic).")
 @tol_option("reachability")
 @json_option
-def ik(model, xyz, euler, position, all_solutions, method, free, as_json):
+def ik(model, xyz, euler, position, all_solutions, method, free, no_certify, as_json):
     """Inverse position: joint values of every limb for a platform pose.
 
     \b
@@ -173,7 +175,7 @@ def ik(model, xyz, euler, position, all_solutions, method, free, as_json):
     """
     mech = sm.load_model(model)
     r = sm.ik(mech, pose_argument(mech, xyz, euler, position), all_solutions=all_solutions, degrees=True,
-              free=None if free is None else free_names(free), method=method)
+              free=None if free is None else free_names(free), method=method, certify=not no_certify)
     if as_json:
         emit_json("ik", mech, r.to_dict())
         return
@@ -222,6 +224,8 @@ def _ik_text(r: sm.IKResult) -> None:
     d = r.to_dict()
     order = {f.id: i for i, f in enumerate(mech.freedom_refs)}
     searched = _completeness_lines(d.get("search") or {})
+    certified = {str(rep.get("limb")): rep["certification"] for rep in (d.get("search") or {}).get("limbs") or ()
+                 if rep.get("certification") is not None}
     fitted = (f" (fitted onto the closure: off by {fit.position_error:.3g} {mech.length_unit} and "
               f"{np.degrees(fit.angle_error):.3g} deg, within the tolerance {reach_tol:g})"
               ) if res.fitted and fit is not None else ""  # fitted: the pose has a fit
@@ -240,11 +244,15 @@ def _ik_text(r: sm.IKResult) -> None:
         how = searched.get(limb["limb"])
         if how is not None:
             click.echo(f"    {how}")
+        cert = certified.get(limb["limb"])
+        if cert is not None:
+            click.echo(f"    certificates: {cert}")
         for k, sol in enumerate(limb["solutions"]):
             values = sorted({**sol["joints_deg"], **sol["joints_len"]}.items(), key=lambda kv: order[kv[0]])
             shown = ", ".join(f"{fid}={v:.6g}" for fid, v in values)
             lim = f"  outside limits: {', '.join(sol['outside_limits'])}" if sol["outside_limits"] else ""
-            click.echo(f"    [{k + 1}] {shown}  (residual {sol['residual']:.1e}){lim}")
+            cert = {True: ", certified", False: ", NOT certified"}.get(sol.get("certified"), "")
+            click.echo(f"    [{k + 1}] {shown}  (residual {sol['residual']:.1e}{cert}){lim}")
     if r.config is not None:
         head = "  actuators: " if r.reachable else "  actuators (of the limbs' solutions, not of the pose asked for): "
         click.echo(head + ", ".join(f"{k} = {_fmt_value(mech, k, v)}" for k, v in r.actuators.items()))
@@ -277,9 +285,11 @@ def _ik_text(r: sm.IKResult) -> None:
 @click.option("--seeds", type=click.IntRange(min=1, max=MAX_SEEDS), default=None,
               help=f"Number of starts of a multi-start search with --all (default: 200; 512 on the 4-SPS/CU closed "
                    f"form; at most {MAX_SEEDS}); refused where homotopy continuation answers.")
+@click.option("--no-certify", "no_certify", is_flag=True,
+              help="With --all: skip the certificates of the homotopy's solutions (Krawczyk test in ball arithmetic).")
 @tol_option("newton")
 @json_option
-def fk(model, values, all_solutions, method, seeds, as_json):
+def fk(model, values, all_solutions, method, seeds, no_certify, as_json):
     """Forward position: platform pose(s) for actuator values.
 
     \b
@@ -301,7 +311,8 @@ def fk(model, values, all_solutions, method, seeds, as_json):
             why = f" (1e6 times the size of {mech.name})" if slide else ""
             raise InputError(f"--actuators: item {k} ({a} = {v:g} {unit}) is out of range: at most {top:.3g} {unit}{why}")
     with _progress_bar(enabled=all_solutions and not as_json) as progress:
-        r = sm.fk(mech, raw, all_solutions=all_solutions, method=method, seeds=seeds, degrees=True, progress=progress)
+        r = sm.fk(mech, raw, all_solutions=all_solutions, method=method, seeds=seeds, degrees=True, progress=progress,
+                  certify=not no_certify)
     if as_json:
         emit_json("fk", mech, r.to_dict())
         return
@@ -354,6 +365,10 @@ def _fk_text(r: sm.FKResult) -> None:
         if a.complete and how.startswith("complete (trace test): "):  # say "complete" once
             how = "by the trace test: " + how[len("complete (trace test): "):]
         click.echo(("  complete (proven): " if a.complete else "  NOT proven complete: ") + how)
+        search = getattr(a.detail, "search", None)
+        cert = search.get("certification") if isinstance(search, dict) else None
+        if cert is not None:
+            click.echo(f"  certificates: {cert}")
     else:
         if not modes:
             if a.all_solutions:
@@ -388,6 +403,7 @@ def _fk_flag_lines(m) -> None:
     yn = {True: "yes", False: "no"}
     click.echo(f"      flags: forward singular {yn[m.forward_singular]}, inverse singular {yn[f.inverse_singular]}, "
                f"input-independent {yn[f.input_independent]}"
+               + (f", certified {yn[f.certified]}" if f.certified is not None else "")
                + (f"; from a {f.endpoint} end point of the homotopy" if f.endpoint is not None else ""))
     for w in f.words():
         click.echo(f"      {w}")

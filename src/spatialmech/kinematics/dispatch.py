@@ -166,12 +166,18 @@ class ForwardAnswer:
         """Solutions that hold for every actuator value (:attr:`AssemblyMode.input_independent`)."""
         return sum(m.input_independent for m in self.modes)
 
+    @property
+    def n_certified(self) -> int | None:
+        """Solutions certified (:mod:`.homotopy.certify`); ``None`` when none was attempted."""
+        tried = [m.flags.certified for m in self.modes if m.flags is not None and m.flags.certified is not None]
+        return sum(tried) if tried else None
+
     def to_dict(self, mech: Mechanism) -> dict:
         """JSON (docs/json.md, ``spatialmech fk --json``): the engine's fields and, for every
-        engine, ``engine``, ``complete``, ``completeness``, ``n_input_independent`` and, on every
-        solution, its flags (``forward_singular``, ``inverse_singular``,
-        ``inverse_singular_actuators``, ``input_independent``, ``endpoint``; ``None`` on a
-        failed attempt)."""
+        engine, ``engine``, ``complete``, ``completeness``, ``n_input_independent``,
+        ``n_certified`` and, on every solution, its flags (``forward_singular``, ``inverse_singular``,
+        ``inverse_singular_actuators``, ``input_independent``, ``endpoint``, ``certified``; ``None``
+        on a failed attempt)."""
         if isinstance(self.detail, ForwardAllResult):
             d = self.detail.to_dict(actuators=mech.actuators)
         else:
@@ -181,14 +187,16 @@ class ForwardAnswer:
             m = next(modes, None) if s["converged"] else None
             f = m.flags if m is not None else None
             s.update(f.to_dict() if f is not None else dict.fromkeys(_FLAG_KEYS))
+            s.setdefault("certificate", None)  # the closed form's solutions have none
             if m is not None:
                 s["forward_singular"] = m.forward_singular
         return {"engine": self.engine, **d, "complete": self.complete, "completeness": self.completeness,
-                "n_input_independent": self.n_input_independent}
+                "n_input_independent": self.n_input_independent, "n_certified": self.n_certified}
 
 
 #: The flags of every solution in JSON (:meth:`.solution_flags.SolutionFlags.to_dict`).
-_FLAG_KEYS = ("forward_singular", "inverse_singular", "inverse_singular_actuators", "input_independent", "endpoint")
+_FLAG_KEYS = ("forward_singular", "inverse_singular", "inverse_singular_actuators", "input_independent", "endpoint",
+              "certified")
 
 
 # ============================================================================ the registry of closed forms
@@ -305,7 +313,8 @@ def _closed_form(registry: Sequence[ClosedForm], mech: Mechanism) -> Callable | 
 # ============================================================================ forward position
 def _mode(mech: Mechanism, s, targets: dict[int, float]) -> AssemblyMode:
     c = s.conditioning
-    flags = solution_flags(mech, s.config, targets, forward_singular=c.singular, endpoint=s.endpoint)
+    flags = solution_flags(mech, s.config, targets, forward_singular=c.singular, endpoint=s.endpoint,
+                           certified=s.certified)
     return AssemblyMode(s.pose, s.kind, float(s.residual), tuple(s.outside_limits), c.sigma_min, c.condition,
                         c.threshold, s.members, s.self_motion, c.free_dim, flags)
 

@@ -83,6 +83,8 @@ class ForwardSolution:
     members: int = 1  # converged runs that this result stands for
     self_motion: SelfMotion | None = None  # the continuum traced through a self-motion result
     endpoint: str | None = None  # homotopy: status of the end point it came from (None: found by a multi-start)
+    certified: bool | None = None  # homotopy: its certificate's verdict (None: not attempted; homotopy/certify.py)
+    certificate: dict | None = None  # the certificate (box radius, real, reason)
 
     @property
     def singular(self) -> bool:
@@ -112,6 +114,7 @@ class ForwardSolution:
             "kind": str(self.kind) if self.kind is not None else None,
             "members": self.members,
             "self_motion": self.self_motion.to_dict() if self.self_motion is not None else None,
+            "certificate": self.certificate,
         }
 
 
@@ -540,6 +543,7 @@ def _forward_homotopy(mech: Mechanism, targets: dict[int, float], seed: int, max
         # and a singular root is followed along its self-motion and reported as one continuum
         runs += _multistart_runs(mech, targets, mask, n_seeds, seed, max_iter)
     sols, conv = _group_runs(mech, runs, origins)
+    sols, cert = _certify_solutions(mech, vals, sols, hr)
     kinds = [s.kind for s in sols]
     extra = len(runs) - n_endpoint_runs
     search = {"method": "homotopy continuation (Study parameters), real end points polished by Newton"
@@ -553,12 +557,36 @@ def _forward_homotopy(mech: Mechanism, targets: dict[int, float], seed: int, max
               "n_at_infinity": hr.count(EndPointStatus.AT_INFINITY), "n_generic": hr.n_generic,
               "n_paths": hr.n_paths_total_degree, "elapsed_s": hr.seconds, "generic_elapsed_s": hr.seconds_generic,
               "generic_cached": hr.cached, "endpoints": [e.to_dict() for e in hr.solutions],
-              "singular_below": singular_threshold()}
+              "singular_below": singular_threshold(), **cert}
     from .closed_forms.translational import translational_note
 
     if (note := translational_note(mech, vals, [s.pose for s in sols])) is not None:
         search["completeness"] = f"{search['completeness']}; {note}"
     return ForwardResult(tuple(sols), search)
+
+
+def _certify_solutions(mech: Mechanism, vals, sols: list, hr) -> tuple[list, dict]:
+    """Each converged solution certified as a root of the Study formulation's exact system at
+    ``vals`` (its polished pose's Study parameters), together with the complex end points
+    (:func:`.homotopy.certify.certify_forward`); the search fields ``n_certified``,
+    ``certification``, ``certify_elapsed_s``.  Nothing when certification is off."""
+    from time import perf_counter
+
+    from .homotopy import certify as hcert
+    from .homotopy.systems import pose_system
+
+    if not hcert.enabled():
+        return sols, {"n_certified": None, "certification": "not attempted (certification off)"}
+    t0 = perf_counter()
+    sysm = pose_system(mech)
+    pts = [hcert.study_parameters(s.config.D, sysm.L) if s.converged else None for s in sols]
+    cx = np.array([e.study for e in hr.solutions if e.status == EndPointStatus.COMPLEX]).reshape(-1, 8)
+    certs, ccerts = hcert.certify_forward(sysm.coefficients(np.asarray(vals, dtype=float)), pts, cx)
+    out = [s if c is None else replace(s, certified=c.certified, certificate=c.to_dict())
+           for s, c in zip(sols, certs, strict=True)]
+    return out, {"n_certified": hcert.n_certified([c for c in certs if c is not None]),
+                 "n_certified_complex": hcert.n_certified(ccerts), "certification": hcert.statement(certs, ccerts),
+                 "certify_elapsed_s": perf_counter() - t0}
 
 
 def _group_runs(mech: Mechanism, runs: list, origins: list[str] | None = None) -> tuple[list, list]:
@@ -634,5 +662,8 @@ def _forward_general(mech: Mechanism, targets: dict[int, float], seed: int, max_
               "trace_deviation": _json_float(hr.trace.deviation) if hr.trace else None,
               "n_witness": hr.trace.n_witness if hr.trace else 0,
               "trace_elapsed_s": hr.trace.seconds if hr.trace else 0.0,
-              "endpoints": [e.to_dict() for e in hr.solutions], "singular_below": singular_threshold()}
+              "endpoints": [e.to_dict() for e in hr.solutions], "singular_below": singular_threshold(),
+              "n_certified": None, "certification": ("not attempted: the loop formulation has no evaluation in ball "
+                                                     "arithmetic (only the Study formulation and limbs' inverse position "
+                                                     "are certified)")}
     return ForwardResult(tuple(sols), search)

@@ -12,6 +12,7 @@ Actuator values are physical values (``offset + q``: a leg length, an angle in r
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -186,16 +187,22 @@ class LimbSolutions:
     reachable: bool
     passive_dim: int  # dimension of the solution set (0: finitely many)
     violations: tuple[tuple[str, ...], ...]  # per solution, freedoms outside their limits
+    #: per solution, its certificate (homotopy/certify.py: ``certified``, ``box_radius``, ...);
+    #: empty when none was attempted
+    certificates: tuple[dict, ...] = ()
 
     def to_dict(self, mech: Mechanism, first: int) -> dict:
         """JSON (docs/json.md): per solution the joint values by freedom id, rotations in
-        ``joints_deg`` and slides in ``joints_len``; ``first`` is the limb's first freedom index."""
+        ``joints_deg`` and slides in ``joints_len``; ``first`` is the limb's first freedom index;
+        ``certified`` and ``certificate`` (``None`` when not attempted)."""
         refs = mech.freedom_refs
         sols = []
-        for q, res, bad in zip(self.solutions, self.residuals, self.violations, strict=True):
+        certs = self.certificates or (None,) * len(self.solutions)
+        for q, res, bad, cert in zip(self.solutions, self.residuals, self.violations, certs, strict=True):
             vals = {refs[first + j].id: refs[first + j].freedom.offset + qj for j, qj in enumerate(q)}
             sols.append({**freedom_values_dict(mech, vals, "joints"), "residual": float(res),
-                         "within_limits": not bad, "outside_limits": list(bad)})
+                         "within_limits": not bad, "outside_limits": list(bad),
+                         "certified": None if cert is None else cert["certified"], "certificate": cert})
         return {"limb": self.limb, "reachable": bool(self.reachable), "passive_dim": int(self.passive_dim),
                 "solutions": sols}
 
@@ -235,8 +242,10 @@ class InverseResult:
         acts = (freedom_values_dict(mech, self.actuator_values(mech), "actuators") if self.config is not None
                 else {"actuators_deg": None, "actuators_len": None})
         # the same fields for every pose: pose_fit is None unless fit=True and the pose does not close exactly
+        tried = [c["certified"] for limb in self.limbs for c in limb.certificates]
         return {"reachable": bool(self.reachable), "pose": pose_dict(self.pose.R, self.pose.p),
                 "limbs": [l.to_dict(mech, f) for l, f in zip(self.limbs, firsts, strict=True)], **acts,
+                "n_certified": sum(tried) if tried else None,
                 "search": dict(self.search), "fitted": bool(self.fitted),
                 "pose_fit": None if self.pose_fit is None else self.pose_fit.to_dict()}
 
@@ -408,7 +417,8 @@ def _solve_limb(mech: Mechanism, li: int, D: np.ndarray, q_start: np.ndarray, q_
             refused = (auto_reason(mech, li, seed) if method == "auto" else None) or ""
             if not refused:
                 hres = limb_inverse(mech, li, D, seed=seed)
-                return _homotopy_limb(mech, li, D, q_all, hres, t), {"limb": name, **hres.report()}
+                ls, cert = _certify_limb(mech, li, D, _homotopy_limb(mech, li, D, q_all, hres, t), seed)
+                return ls, {"limb": name, **hres.report(), **cert}
         except InputError as exc:
             refused = str(exc)
     res = _inverse_limb(mech, li, D, q_start, q_all, all_solutions, n_seeds, rng, t)
@@ -450,6 +460,35 @@ def _homotopy_limb(mech: Mechanism, li: int, D: np.ndarray, q_all: np.ndarray, h
         q_all[sl] = sols[0]
     viol = tuple(tuple(within_limits(mech, np.r_[q_all[: sl.start], s, q_all[sl.stop :]], indices=idx_l)) for s in sols)
     return LimbSolutions(mech.limbs[li].name, tuple(sols), tuple(float(r) for r in res), bool(sols), 0, viol)
+
+
+_LIMB_SYSTEMS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # per model: {(limb, seed): LimbIK}
+
+
+def _certify_limb(mech: Mechanism, li: int, D: np.ndarray, ls: LimbSolutions, seed: int) -> tuple[LimbSolutions, dict]:
+    """The homotopy's polished solutions of limb ``li`` certified as roots of its exact system
+    (:func:`.homotopy.certify.certify_inverse`), and the report's ``n_certified`` and
+    ``certification``; nothing attempted when certification is off or the limb's system is not
+    square."""
+    from time import perf_counter
+
+    from .homotopy import certify as hcert
+    from .homotopy.inverse import limb_ik_system
+
+    if not hcert.enabled():
+        return ls, {"n_certified": None, "certification": "not attempted (certification off)"}
+    t0 = perf_counter()
+    key = (li, seed)
+    systems = _LIMB_SYSTEMS.setdefault(mech, {})
+    if key not in systems:
+        systems[key] = limb_ik_system(mech, li, seed)
+    certs = hcert.certify_inverse(systems[key], D, ls.solutions)
+    if certs is None:
+        return ls, {"n_certified": None, "certification": ("not attempted: the limb has more equations than unknowns "
+                                                           "(its square system is a random combination of them)")}
+    ls = replace(ls, certificates=tuple(c.to_dict() for c in certs))
+    return ls, {"n_certified": hcert.n_certified(certs), "certification": hcert.statement(certs),
+                "certify_elapsed_s": round(perf_counter() - t0, 4)}
 
 
 def random_joint_values(mech: Mechanism, rng: np.random.Generator, sl: slice, keep: np.ndarray, held) -> np.ndarray:

@@ -20,7 +20,10 @@ Every forward solution carries three flags next to its conditioning:
 Homotopy engines also say which end point a solution came from (``endpoint``: ``"real"``, or
 ``"singular"`` for a near-real singular end point polished by Newton; ``None`` when only the
 multi-start search that the engine added found it); complex end points and those at infinity
-are counted by the engine, never listed as solutions.
+are counted by the engine, never listed as solutions.  Homotopy in Study parameters also says
+whether the solution is ``certified`` (a Krawczyk test in ball arithmetic proved a unique real
+root of the exact system near it, distinct from the others: :mod:`.homotopy.certify`; ``None``
+when not attempted).
 """
 
 from __future__ import annotations
@@ -54,11 +57,13 @@ class SolutionFlags:
     input_independent: bool
     inverse_singular_actuators: tuple[str, ...] = ()
     endpoint: str | None = None  # homotopy: the status of the end point it came from
+    certified: bool | None = None  # homotopy: certified (homotopy/certify.py); None: not attempted
 
     def to_dict(self) -> dict:
         return {"forward_singular": bool(self.forward_singular), "inverse_singular": bool(self.inverse_singular),
                 "inverse_singular_actuators": list(self.inverse_singular_actuators),
-                "input_independent": bool(self.input_independent), "endpoint": self.endpoint}
+                "input_independent": bool(self.input_independent), "endpoint": self.endpoint,
+                "certified": self.certified}
 
     def words(self) -> list[str]:
         """The flags that are set, in a few words each (the text of ``fk``)."""
@@ -109,7 +114,7 @@ def input_independent(mech: Mechanism, config: Configuration, targets: dict[int,
 
 
 def solution_flags(mech: Mechanism, config: Configuration, targets: dict[int, float], *, forward_singular: bool,
-                   endpoint: str | None = None) -> SolutionFlags:
+                   endpoint: str | None = None, certified: bool | None = None) -> SolutionFlags:
     """The flags of the forward solution ``config`` (module docstring); ``forward_singular`` is
     the engine's conditioning verdict, ``targets`` the actuators' joint variables held."""
     J = complete_jacobian(mech, config)
@@ -123,7 +128,7 @@ def solution_flags(mech: Mechanism, config: Configuration, targets: dict[int, fl
     ii = nearly and input_independent(mech, config, targets)
     if ii and len(inv) < len(J.actuators):  # the perturbations moved every actuator: all of them are free
         inv = tuple(J.actuators)
-    return SolutionFlags(bool(forward_singular), bool(inv), ii, inv, endpoint)
+    return SolutionFlags(bool(forward_singular), bool(inv), ii, inv, endpoint, certified)
 
 
 def configuration_at_pose(mech: Mechanism, pose: Pose, targets: dict[int, float]) -> Configuration:
