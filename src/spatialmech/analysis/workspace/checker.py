@@ -197,6 +197,12 @@ def _cone_margins(seg_a, seg_b, R, cones):
     return cols
 
 
+def _cone_specs(cones) -> list[tuple]:
+    """The cone (limit, link) pairs as the compiled margins take them: ``(axis, in the platform
+    frame, max_angle, link)``."""
+    return [(c.axis, c.frame == "platform", c.max_angle, k) for c, k in cones]
+
+
 def _pair_margins(seg_a, seg_b, pairs):
     """Capsule margins ``distance - (d_i + d_j) / 2`` (m) of the link pairs."""
     return [segment_distance(seg_a[:, i], seg_b[:, i], seg_a[:, j], seg_b[:, j]) - clearance for i, j, clearance in pairs]
@@ -409,11 +415,7 @@ class _GeneralKernel:
         k = self.k
         cols = [_freedom_margins(k.offs[k.fl] + q[:, k.fl], k.los, k.his, k.rot)] if k.fl else []
         if k.cones or k.pairs:
-            n_links = len(k.links)
-            pts = compiled.joint_points_many(k.mech, q, self.link_points)
-            seg_a, seg_b = pts[:, :n_links], pts[:, n_links:]
-            cols += [c[:, None] for c in _cone_margins(seg_a, seg_b, R, k.cones)]
-            cols += [c[:, None] for c in _pair_margins(seg_a, seg_b, k.pairs)]
+            cols.append(compiled.link_margins_many(k.mech, q, R, self.link_points, _cone_specs(k.cones), k.pairs))
         cols.append(np.full((q.shape[0], 1), 1e-9 * k.L))
         return np.concatenate(cols, axis=1)
 
@@ -548,10 +550,29 @@ class ConfigurationChecker:
     names: tuple[str, ...]
     scales: np.ndarray
     _fn: Callable = field(repr=False)
+    _many: Callable | None = field(default=None, repr=False)
 
     def margins(self, config) -> np.ndarray:
         """The (m,) margins at ``config`` (a closed :class:`~spatialmech.kinematics.closure.Configuration`)."""
+        if self._many is not None:
+            from ...kinematics import backend
+
+            if backend.enabled():
+                return self._many(np.asarray(config.q, dtype=float)[None], np.asarray(config.D, dtype=float)[None])[0]
         return self._fn(config)
+
+    def margins_many(self, configs) -> np.ndarray:
+        """The (N, m) margins at the closed configurations ``configs``: in one batch (the joint
+        points by the compiled kernel) when every limb starts on the ground and the compiled
+        engine is in use, else one by one (:meth:`margins`)."""
+        configs = list(configs)
+        if self._many is not None and configs:
+            from ...kinematics import backend
+
+            if backend.enabled():
+                return self._many(np.array([c.q for c in configs], dtype=float).reshape(len(configs), -1),
+                                  np.array([c.D for c in configs], dtype=float).reshape(-1, 4, 4))
+        return np.array([self._fn(c) for c in configs]).reshape(len(configs), len(self.names))
 
     def violated(self, config) -> str:
         """The most violated limit (scaled margins) at ``config``, ``""`` when within every limit."""
@@ -590,4 +611,16 @@ def configuration_checker(mech: Mechanism, limits: WorkspaceLimits | None = None
             cols += [c[:, None] for c in _pair_margins(seg_a, seg_b, pairs)]
         return np.concatenate(cols, axis=1)[0] if cols else np.zeros(0)
 
-    return ConfigurationChecker(mech, limits, tuple(names), np.asarray(scale, dtype=float), fn)
+    link_points = [(lk.limb, lk.ends[0]) for lk in links] + [(lk.limb, lk.ends[1]) for lk in links]
+
+    def many(q: np.ndarray, D: np.ndarray) -> np.ndarray:
+        """``fn`` for a stack of configurations (joint variables ``q`` (N, n), platforms ``D``)."""
+        from ...kinematics import compiled
+
+        cols = [_freedom_margins(offs[fl] + q[:, fl], los, his, rot)] if fl else []
+        if cones or pairs:
+            cols.append(compiled.link_margins_many(mech, q, D[:, :3, :3], link_points, _cone_specs(cones), pairs))
+        return np.concatenate(cols, axis=1) if cols else np.zeros((q.shape[0], 0))
+
+    ground = all(a is None for a, _ in mech.limb_ends)
+    return ConfigurationChecker(mech, limits, tuple(names), np.asarray(scale, dtype=float), fn, many if ground else None)

@@ -404,9 +404,15 @@ def _cell_limits(probe: _Probe, g: TaskGrid) -> tuple[np.ndarray, dict[tuple, np
     the scaled margins of every closed cell."""
     cell_limits = np.full(g.shape, CLOSURE, dtype=object)
     cell_margins: dict[tuple, np.ndarray] = {}
-    for idx in zip(*np.nonzero(g.converged), strict=True):
-        cell_margins[idx] = probe.margins(g.configs[idx])
-        cell_limits[idx] = probe.limit(cell_margins[idx])
+    cells = list(zip(*np.nonzero(g.converged), strict=True))
+    checker = probe.checker
+    if checker.names and cells:
+        scaled = checker.margins_many([g.configs[idx] for idx in cells]) / checker.scales
+    else:
+        scaled = np.zeros((len(cells), 0))
+    for idx, m in zip(cells, scaled, strict=True):
+        cell_margins[idx] = m
+        cell_limits[idx] = probe.limit(m)
     return cell_limits, cell_margins
 
 

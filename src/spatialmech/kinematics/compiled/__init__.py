@@ -8,7 +8,8 @@ the kernels are plain-array ``@njit(cache=True)`` functions in :mod:`.kernels_se
 Study formulation's parameter homotopy) and :mod:`.kernels_loops` (the loop formulation's square
 system), :mod:`.kernels_ik` (one limb's inverse position),
 :mod:`.kernels_four_sps_cu` (the 4-SPS/CU closed-form leg lengths), :mod:`.kernels_limits`
-(with its entry :mod:`.limits`: joint points of many configurations, for the workspace limits); :mod:`.jit` is numba's ``njit`` or its
+(with its entry :mod:`.limits`: joint points of many configurations, for the workspace limits),
+:mod:`.kernels_task` (with its entry :mod:`.tasks`: the task-coordinate solve); :mod:`.jit` is numba's ``njit`` or its
 stand-in.
 
 Callers do not choose between this package and the Python reference themselves:
@@ -48,7 +49,8 @@ from .kernels_ik import ik_pack, ik_track
 from .kernels_loops import pack as pack_loop_system
 from .kernels_loops import square_batch as loop_square_batch
 from .legs import correct_legs
-from .limits import joint_points_many
+from .limits import joint_points_many, link_margins_many
+from .tasks import task_solve
 from . import maps as maps  # performance-map kernels (analysis/maps.py)
 
 __all__ = [
@@ -72,6 +74,7 @@ __all__ = [
     "ik_pack",
     "ik_track",
     "joint_points_many",
+    "link_margins_many",
     "limb_gn",
     "limb_inverse_many",
     "loop_square_batch",
@@ -80,6 +83,7 @@ __all__ = [
     "pack_loop_system",
     "retract",
     "sps_leg_lengths",
+    "task_solve",
     "track_parameter",
     "warm_up",
 ]

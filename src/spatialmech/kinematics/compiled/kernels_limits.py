@@ -13,7 +13,7 @@ import numpy as np
 from .jit import njit
 from .kernels_se3 import nb_rodrigues, nb_screw_shift
 
-__all__ = ["nb_joint_points"]
+__all__ = ["nb_joint_points", "nb_link_margins", "nb_segment_distance"]
 
 
 @njit(cache=True)
@@ -88,3 +88,82 @@ def nb_joint_points(S, ball_of, ball_axes, ball_centre, limb_start, qs, pt_freed
             x = pt_local[k]
             for a in range(3):
                 out[s, k, a] = pre[f, a, 0] * x[0] + pre[f, a, 1] * x[1] + pre[f, a, 2] * x[2] + pre[f, a, 3]
+
+
+@njit(cache=True)
+def nb_clip01(x):
+    return 0.0 if x < 0.0 else 1.0 if x > 1.0 else x
+
+
+@njit(cache=True)
+def nb_segment_distance(p1, q1, p2, q2):
+    """Minimum distance between the segments ``p1 q1`` and ``p2 q2``: the same closest points
+    (Ericson 5.1.9, parallel and degenerate cases included) as
+    :func:`spatialmech.analysis.workspace.checker.segment_distance`."""
+    a = b = c = e = f = 0.0
+    for x in range(3):
+        d1 = q1[x] - p1[x]
+        d2 = q2[x] - p2[x]
+        r = p1[x] - p2[x]
+        a += d1 * d1
+        e += d2 * d2
+        b += d1 * d2
+        c += d1 * r
+        f += d2 * r
+    tiny = 1e-300
+    a_ = max(a, tiny)
+    e_ = max(e, tiny)
+    denom = a * e - b * b
+    s = nb_clip01((b * f - c * e) / max(denom, tiny)) if denom > 1e-12 * a_ * e_ else 0.0
+    t = (b * s + f) / e_
+    if t < 0.0:
+        s = nb_clip01(-c / a_)
+    elif t > 1.0:
+        s = nb_clip01((b - c) / a_)
+    t = nb_clip01(t)
+    deg_a = a <= 1e-300
+    deg_e = e <= 1e-300
+    if deg_e and not deg_a:
+        s = nb_clip01(-c / a_)
+    if deg_e:
+        t = 0.0
+    if deg_a and not deg_e:
+        t = nb_clip01(f / e_)
+    if deg_a:
+        s = 0.0
+    sq = 0.0
+    for x in range(3):
+        g = (p1[x] + s * (q1[x] - p1[x])) - (p2[x] + t * (q2[x] - p2[x]))
+        sq += g * g
+    return np.sqrt(sq)
+
+
+@njit(cache=True)
+def nb_link_margins(pts, n_links, R, cone_link, cone_axis, cone_platform, cone_max, pair_i, pair_j, pair_clear, out):
+    """Cone and interference margins from the link ends ``pts`` (N, 2 n_links, 3): every link's
+    start, then every link's end.  Cone ``c`` (column ``c``): ``cone_max[c]`` minus the angle
+    ``atan2(|d x a|, d . a)`` between link ``cone_link[c]``'s direction ``d`` and the axis ``a``
+    (``R[s] cone_axis[c]`` when ``cone_platform[c]``); pair ``k`` (column ``n_cones + k``): the
+    distance of links ``pair_i[k]`` and ``pair_j[k]`` minus ``pair_clear[k]``."""
+    nc = cone_link.shape[0]
+    ax = np.empty(3)
+    d = np.empty(3)
+    for s in range(pts.shape[0]):
+        for c in range(nc):
+            k = cone_link[c]
+            for x in range(3):
+                d[x] = pts[s, n_links + k, x] - pts[s, k, x]
+                if cone_platform[c]:
+                    ax[x] = R[s, x, 0] * cone_axis[c, 0] + R[s, x, 1] * cone_axis[c, 1] + R[s, x, 2] * cone_axis[c, 2]
+                else:
+                    ax[x] = cone_axis[c, x]
+            c0 = d[1] * ax[2] - d[2] * ax[1]
+            c1 = d[2] * ax[0] - d[0] * ax[2]
+            c2 = d[0] * ax[1] - d[1] * ax[0]
+            out[s, c] = cone_max[c] - np.arctan2(np.sqrt(c0 * c0 + c1 * c1 + c2 * c2),
+                                                 d[0] * ax[0] + d[1] * ax[1] + d[2] * ax[2])
+        for k in range(pair_i.shape[0]):
+            i = pair_i[k]
+            j = pair_j[k]
+            out[s, nc + k] = nb_segment_distance(pts[s, i], pts[s, n_links + i], pts[s, j], pts[s, n_links + j]) \
+                - pair_clear[k]

@@ -12,9 +12,9 @@ import numpy as np
 from ...errors import InputError
 from ...model.mechanism import Mechanism
 from .engine import compile_mechanism
-from .kernels_limits import nb_joint_points
+from .kernels_limits import nb_joint_points, nb_link_margins
 
-__all__ = ["joint_point_spec", "joint_points_many"]
+__all__ = ["joint_point_spec", "joint_points_many", "link_margins_many"]
 
 _SPECS: weakref.WeakKeyDictionary[Mechanism, list[list[tuple[int, np.ndarray]]]] = weakref.WeakKeyDictionary()
 
@@ -55,4 +55,25 @@ def joint_points_many(mech: Mechanism, q, points: Sequence[tuple[int, int]]) -> 
     out = np.empty((qs.shape[0], len(points), 3))
     if qs.shape[0] and len(points):
         nb_joint_points(cm.screws, cm.ball_of, cm.ball_axes, cm.ball_centre, cm.limb_start, qs, fr, loc, out)
+    return out
+
+
+def link_margins_many(mech: Mechanism, q, R, link_points: Sequence[tuple[int, int]], cones, pairs) -> np.ndarray:
+    """Cone and interference margins at the joint variables ``q`` (N, n) and platform
+    orientations ``R`` (N, 3, 3): ``link_points`` the link ends (every link's start, then every
+    link's end, as :func:`joint_points_many` takes them); ``cones`` ``(axis, in the platform
+    frame, max_angle (rad), link index)`` per cone limit; ``pairs`` ``(link i, link j,
+    clearance)`` per capsule pair.  Returns (N, len(cones) + len(pairs)): ``max_angle`` minus
+    the link's angle to the axis (rad), then the links' distance minus the clearance."""
+    pts = joint_points_many(mech, q, link_points)
+    n = pts.shape[0]
+    Rs = np.ascontiguousarray(R, dtype=float).reshape(n, 3, 3)
+    out = np.empty((n, len(cones) + len(pairs)))
+    if n and out.shape[1]:
+        nb_link_margins(pts, len(link_points) // 2, Rs, np.array([c[3] for c in cones], dtype=np.int64),
+                        np.array([c[0] for c in cones], dtype=float).reshape(-1, 3),
+                        np.array([bool(c[1]) for c in cones], dtype=np.bool_).reshape(-1),
+                        np.array([c[2] for c in cones], dtype=float).reshape(-1),
+                        np.array([p[0] for p in pairs], dtype=np.int64), np.array([p[1] for p in pairs], dtype=np.int64),
+                        np.array([p[2] for p in pairs], dtype=float).reshape(-1), out)
     return out

@@ -1,0 +1,272 @@
+"""Compiled kernel of the task-coordinate solve (:mod:`spatialmech.kinematics.compiled`): the same
+Gauss-Newton steps as :func:`spatialmech.kinematics.task.solve_task` (the given task coordinates
+held, the closure solved for the joint variables, the solved coordinates and the internal
+bodies), on the plain arrays of the compiled model.
+
+Euler sequences: ``axes`` holds the three axes (0 = x, 1 = y, 2 = z) of the named sequence and
+``intrinsic`` its case (upper case intrinsic ``R = R1(a1) R2(a2) R3(a3)``, lower case extrinsic
+``R = R3(a3) R2(a2) R1(a1)``), as :func:`spatialmech.geometry.rotations.euler_matrix` and
+:func:`spatialmech.kinematics.velocity.euler_rate_matrix`."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .jit import njit
+from .kernels_closure import (
+    RETRACT_WS,
+    nb_closure_system,
+    nb_closure_ws_size,
+    nb_colmap,
+    nb_norm,
+    nb_retract,
+    nb_scales,
+)
+from .kernels_se3 import nb_copy44, nb_lstsq
+
+__all__ = ["nb_euler", "nb_matrix_euler", "nb_task_solve"]
+
+
+@njit(cache=True)
+def nb_axis_rot(ax, t, out):
+    """Rotation by ``t`` about coordinate axis ``ax`` (0 = x, 1 = y, 2 = z) into ``out``."""
+    c = np.cos(t)
+    s = np.sin(t)
+    for i in range(3):
+        for j in range(3):
+            out[i, j] = 1.0 if i == j else 0.0
+    i = (ax + 1) % 3
+    j = (ax + 2) % 3
+    out[i, i] = c
+    out[j, j] = c
+    out[i, j] = -s
+    out[j, i] = s
+
+
+@njit(cache=True)
+def nb_euler(axes, intrinsic, a, R, E):
+    """The rotation ``R`` of Euler angles ``a`` (3,) and ``E`` (``omega = E da/dt``, the angular
+    velocity in the fixed frame), for the sequence ``axes`` / ``intrinsic``."""
+    Rk = np.empty((3, 3))
+    M = np.empty((3, 3))
+    T = np.empty((3, 3))
+    for i in range(3):
+        for j in range(3):
+            M[i, j] = 1.0 if i == j else 0.0
+    if intrinsic:  # R = R1 R2 R3: axis k moved by the rotations before it
+        for k in range(3):
+            for i in range(3):
+                E[i, k] = M[i, axes[k]]
+            nb_axis_rot(axes[k], a[k], Rk)
+            for i in range(3):
+                for j in range(3):
+                    T[i, j] = M[i, 0] * Rk[0, j] + M[i, 1] * Rk[1, j] + M[i, 2] * Rk[2, j]
+            for i in range(3):
+                for j in range(3):
+                    M[i, j] = T[i, j]
+        for i in range(3):
+            for j in range(3):
+                R[i, j] = M[i, j]
+        return
+    # extrinsic: R = R3 R2 R1; axis k moved by the rotations after it
+    for k in range(2, -1, -1):
+        for i in range(3):
+            E[i, k] = M[i, axes[k]]
+        nb_axis_rot(axes[k], a[k], Rk)
+        for i in range(3):
+            for j in range(3):
+                T[i, j] = M[i, 0] * Rk[0, j] + M[i, 1] * Rk[1, j] + M[i, 2] * Rk[2, j]
+        for i in range(3):
+            for j in range(3):
+                M[i, j] = T[i, j]
+    for i in range(3):
+        for j in range(3):
+            R[i, j] = M[i, j]
+
+
+@njit(cache=True)
+def nb_matrix_euler(axes, intrinsic, R, out):
+    """The Euler angles ``out`` (3,) of the rotation ``R`` in the sequence ``axes`` /
+    ``intrinsic``: :func:`spatialmech.geometry.rotations.matrix_euler` (SciPy's
+    ``Rotation.from_matrix(R).as_euler(seq)``: the quaternion by the largest of the trace and the
+    diagonal, then Bernardes and Viollet's angles, each angle wrapped to [-pi, pi); at a gimbal
+    lock the third angle is 0) for an orthonormal ``R``."""
+    tr = R[0, 0] + R[1, 1] + R[2, 2]
+    choice = 0
+    best = R[0, 0]
+    for c in range(1, 4):
+        v = tr if c == 3 else R[c, c]
+        if v > best:
+            best = v
+            choice = c
+    q = np.empty(4)
+    if choice == 0:
+        q[0], q[1], q[2], q[3] = 1 - tr + 2 * R[0, 0], R[1, 0] + R[0, 1], R[2, 0] + R[0, 2], R[2, 1] - R[1, 2]
+    elif choice == 1:
+        q[0], q[1], q[2], q[3] = R[1, 0] + R[0, 1], 1 - tr + 2 * R[1, 1], R[2, 1] + R[1, 2], R[0, 2] - R[2, 0]
+    elif choice == 2:
+        q[0], q[1], q[2], q[3] = R[2, 0] + R[0, 2], R[2, 1] + R[1, 2], 1 - tr + 2 * R[2, 2], R[1, 0] - R[0, 1]
+    else:
+        q[0], q[1], q[2], q[3] = R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1], 1 + tr
+    nq = np.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+    for t in range(4):
+        q[t] /= nq
+    extrinsic = not intrinsic
+    if extrinsic:
+        i, j, k = axes[0], axes[1], axes[2]
+    else:
+        i, j, k = axes[2], axes[1], axes[0]
+    symmetric = i == k
+    if symmetric:
+        k = 3 - i - j
+    sign = float((i - j) * (j - k) * (k - i) // 2)
+    if symmetric:
+        a, b, c, d = q[3], q[i], q[j], q[k] * sign
+    else:
+        a, b, c, d = q[3] - q[j], q[i] + q[k] * sign, q[j] + q[3], q[k] * sign - q[i]
+    half_sum = np.arctan2(b, a)
+    half_diff = np.arctan2(d, c)
+    out[0] = 0.0
+    out[1] = 2 * np.arctan2(np.hypot(c, d), np.hypot(a, b))
+    out[2] = 0.0
+    first = 0 if extrinsic else 2
+    third = 2 if extrinsic else 0
+    case1 = abs(out[1]) <= 1e-7
+    case2 = abs(out[1] - np.pi) <= 1e-7
+    case0 = not (case1 or case2)
+    out[0] = 2 * half_sum if case1 else 2 * half_diff * (-1.0 if extrinsic else 1.0)
+    if case0:
+        out[first] = half_sum - half_diff
+    a3 = half_sum + half_diff if case0 else out[third]
+    if not symmetric:
+        a3 = a3 * sign
+        out[1] = out[1] - np.pi / 2
+    out[third] = a3
+    for t in range(3):
+        out[t] = (out[t] + np.pi) % (2 * np.pi) - np.pi
+
+
+@njit(cache=True)
+def nb_pose_from_task(axes, intrinsic, values, p0, D, E):
+    """The output displacement ``D`` of task coordinates ``values`` (6,) (the output link's
+    reference point ``p0``), and the Euler rate matrix ``E`` there."""
+    R = np.empty((3, 3))
+    nb_euler(axes, intrinsic, values[3:], R, E)
+    for i in range(3):
+        for j in range(3):
+            D[i, j] = R[i, j]
+        D[i, 3] = values[i] - (R[i, 0] * p0[0] + R[i, 1] * p0[1] + R[i, 2] * p0[2])
+        D[3, i] = 0.0
+    D[3, 3] = 1.0
+
+
+@njit(cache=True)
+def nb_task_solve(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends, linear, L, active, p0, axes,
+                  intrinsic, seeded, free, values, q, D, B, tol, max_iter, info):
+    """``solve_task`` from the configuration ``q``, ``D``, ``B`` (updated in place, with
+    ``values``): the task coordinates marked ``seeded`` (6,) start at the seed's (``D``'s), the
+    others at ``values``; those marked ``free`` (6,) are solved, and end in ``values``.  ``info``: status (1 converged, 2
+    stalled, 0 not converged), the iterations, the residual."""
+    start = np.empty(3)
+    nb_matrix_euler(axes, intrinsic, D, start)
+    for i in range(3):
+        if seeded[i]:
+            values[i] = D[i, 0] * p0[0] + D[i, 1] * p0[1] + D[i, 2] * p0[2] + D[i, 3]
+        if seeded[3 + i]:
+            values[3 + i] = start[i]
+    K = len(limb_start) - 1
+    h = 1 + B.shape[0]
+    n = q.shape[0]
+    colmap, na = nb_colmap(active)
+    row, col = nb_scales(linear, active, K, h, L)
+    nc = na + 6 * h
+    nf = 0
+    for i in range(6):
+        if free[i]:
+            nf += 1
+    fidx = np.empty(nf, dtype=np.int64)
+    j = 0
+    for i in range(6):
+        if free[i]:
+            fidx[j] = i
+            j += 1
+    ng = na + nf + 6 * (h - 1)
+    scales = np.empty(ng)
+    for c in range(na):
+        scales[c] = col[c]
+    for k in range(nf):
+        scales[na + k] = L if fidx[k] < 3 else 1.0
+    for c in range(6 * (h - 1)):
+        scales[na + nf + c] = col[na + 6 + c]
+    A = np.zeros((6 * K, nc))
+    r = np.zeros(6 * K)
+    G = np.empty((6 * K, ng))
+    rhs = np.empty(6 * K)
+    step = np.zeros(nc)
+    C = np.zeros((6, 6))
+    E = np.empty((3, 3))
+    q2 = np.empty(n)
+    D2 = np.empty((4, 4))
+    B2 = np.empty((h - 1, 4, 4))
+    cws = np.empty(nb_closure_ws_size(limb_start))
+    rws = np.empty(n + RETRACT_WS)
+    nb_pose_from_task(axes, intrinsic, values, p0, D, E)
+    st = 0
+    rn = np.inf
+    it = 0
+    for it in range(max_iter + 1):
+        nb_closure_system(S, ball_of, ball_axes, ball_centre, limb_start, ends, q, D, B, colmap, na, A, r, cws)
+        sq = 0.0
+        for i in range(6 * K):
+            rhs[i] = -row[i] * r[i]
+            sq += rhs[i] * rhs[i]
+        rn = np.sqrt(sq)
+        if rn < tol:
+            st = 1
+            break
+        if it == max_iter or not np.isfinite(rn):
+            break
+        # C: V = C d(values)/dt (coordinate_map): [[0, E], [I, skew(P) E]]
+        for i in range(6):
+            for k in range(6):
+                C[i, k] = 0.0
+        for i in range(3):
+            C[3 + i, i] = 1.0
+            for k in range(3):
+                C[i, 3 + k] = E[i, k]
+        P = values[:3]
+        for k in range(3):
+            C[3, 3 + k] = P[1] * E[2, k] - P[2] * E[1, k]
+            C[4, 3 + k] = P[2] * E[0, k] - P[0] * E[2, k]
+            C[5, 3 + k] = P[0] * E[1, k] - P[1] * E[0, k]
+        for i in range(6 * K):
+            for c in range(na):
+                G[i, c] = row[i] * A[i, c] * scales[c]
+            for k in range(nf):
+                s = 0.0
+                for m in range(6):
+                    s += A[i, na + m] * C[m, fidx[k]]
+                G[i, na + k] = row[i] * s * scales[na + k]
+            for c in range(6 * (h - 1)):
+                G[i, na + nf + c] = row[i] * A[i, na + 6 + c] * scales[na + nf + c]
+        x = nb_lstsq(G, rhs)
+        if nb_norm(x) < 1e-13 * max(1.0, rn):
+            st = 2
+            break
+        for c in range(na):
+            step[c] = scales[c] * x[c]
+        for c in range(6):
+            step[na + c] = 0.0
+        for c in range(6 * (h - 1)):
+            step[na + 6 + c] = scales[na + nf + c] * x[na + nf + c]
+        for k in range(nf):
+            values[fidx[k]] += scales[na + k] * x[na + k]
+        nb_retract(ball_first, ball_axes, q, D, B, active, step, na, np.bool_(True), q2, D2, B2, rws)
+        for i in range(n):
+            q[i] = q2[i]
+        for b in range(h - 1):
+            nb_copy44(B2[b], B[b])
+        nb_pose_from_task(axes, intrinsic, values, p0, D, E)
+    info[0] = st
+    info[1] = it
+    info[2] = rn
