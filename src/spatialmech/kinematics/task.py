@@ -185,13 +185,10 @@ def solve_task(mech: Mechanism, given: Mapping[str, float], *, task: TaskCoordin
     tol = current_tolerances().newton if tol is None else float(tol)
     config = Configuration.reference(mech) if seed is None else seed
     if (fast := backend.engine()) is not None:  # the same steps, compiled
-        values = np.zeros(6)
-        for k, v in g.items():
-            values[TASK_NAMES.index(k)] = v
-        solved = task.solved
-        free = np.array([n in solved for n in TASK_NAMES])
-        config, values, code, it, rn = fast.task_solve(mech, config, values, free | np.array([n not in g for n in TASK_NAMES]),
-                                                       free, task.euler, tol, max_iter)
+        values = np.array([g.get(n, 0.0) for n in TASK_NAMES])
+        free = np.array([n not in task.given for n in TASK_NAMES])
+        seeded = np.array([n not in g for n in TASK_NAMES]) | free
+        config, values, code, it, rn = fast.task_solve(mech, config, values, seeded, free, task.euler, tol, max_iter)
         return TaskSolution(config, dict(zip(TASK_NAMES, map(float, values), strict=True)), task, code == 1, rn, it,
                             _STATUS[code])
     values = task_values(mech, config.D, task.euler)

@@ -154,7 +154,11 @@ def predict(cur: Configuration, prev: Configuration) -> Configuration:
     """Secant predictor on the closure manifold: one more step ``prev -> cur`` from ``cur``
     (joint variables extrapolated linearly, displacements by ``cur prev^-1 cur``)."""
     q = 2.0 * np.asarray(cur.q) - np.asarray(prev.q)
-    D = cur.D @ inverse_transform(prev.D) @ cur.D
+    Rt = prev.D[:3, :3].T
+    inv = np.eye(4)  # prev.D^-1, written out (inverse_transform's stacks cost more than the step)
+    inv[:3, :3] = Rt
+    inv[:3, 3] = -(Rt @ prev.D[:3, 3])
+    D = cur.D @ inv @ cur.D
     B = np.array([c @ inverse_transform(p) @ c for c, p in zip(cur.B, prev.B, strict=True)]) if len(cur.B) else cur.B
     return Configuration(q, D, B)
 

@@ -4,6 +4,8 @@ statuses; the reference hands its solve to this entry when the compiled engine i
 
 from __future__ import annotations
 
+import weakref
+
 import numpy as np
 
 from ...model.mechanism import Mechanism
@@ -24,14 +26,35 @@ def task_solve(mech: Mechanism, config: Configuration, values: np.ndarray, seede
     Returns ``(config, values, status, iterations, residual)``, status 1 converged, 2 stalled, 0
     not converged (iteration limit, or a residual that is not finite)."""
     cm = compile_mechanism(mech)
-    q = np.array(config.q, dtype=np.float64)
+    q = np.array(config.q, dtype=np.float64)  # copies: the kernel works in place
     B = np.array(config.B, dtype=np.float64).reshape(-1, 4, 4)
     vals = np.array(values, dtype=np.float64)
     D = np.array(config.D, dtype=np.float64)
-    axes = np.array([_AXES[c] for c in euler.lower()], dtype=np.int64)
+    axes = _axes(euler)
     info = np.empty(3)
     nb_task_solve(cm.screws, cm.ball_of, cm.ball_first, cm.ball_axes, cm.ball_centre, cm.limb_start, cm.ends,
-                  cm.linear, cm.length, cm.active, np.asarray(mech.platform_point, dtype=np.float64), axes,
-                  np.bool_(euler.isupper()), np.asarray(seeded, dtype=np.bool_), np.asarray(free, dtype=np.bool_), vals, q, D, B, float(tol),
+                  cm.linear, cm.length, cm.active, _point(mech), axes, np.bool_(euler.isupper()), np.asarray(seeded, dtype=np.bool_), np.asarray(free, dtype=np.bool_), vals, q, D, B, float(tol),
                   int(max_iter), info)
     return Configuration.of(q, D, B), vals, int(info[0]), int(info[1]), float(info[2])
+
+
+_AXES_OF: dict[str, np.ndarray] = {}
+_POINTS: weakref.WeakKeyDictionary[Mechanism, np.ndarray] = weakref.WeakKeyDictionary()
+
+
+def _axes(euler: str) -> np.ndarray:
+    """The axis indices (0 = x, 1 = y, 2 = z) of a named Euler sequence (cached)."""
+    try:
+        return _AXES_OF[euler]
+    except KeyError:
+        out = _AXES_OF[euler] = np.array([_AXES[c] for c in euler.lower()], dtype=np.int64)
+        return out
+
+
+def _point(mech: Mechanism) -> np.ndarray:
+    """The output link's reference point as a float64 array (cached per mechanism)."""
+    try:
+        return _POINTS[mech]
+    except KeyError:
+        out = _POINTS[mech] = np.ascontiguousarray(mech.platform_point, dtype=np.float64).reshape(3)
+        return out
