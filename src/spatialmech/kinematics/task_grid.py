@@ -32,10 +32,12 @@ import numpy as np
 
 from ..errors import ConvergenceError, InputError, SearchTooLargeError
 from ..geometry.rotations import inverse_transform
+from ..geometry.tolerances import current as current_tolerances
 from ..geometry.validate import as_finite_array
 from ..model.mechanism import Mechanism
 from ..model.task import TASK_NAMES, TaskCoordinates
 from ..results import Progress, check_progress
+from . import backend
 from .closure import Configuration
 from .task import default_task, solve_task, task_values
 
@@ -251,6 +253,14 @@ def solve_task_grid(
     _check_range(mech, {**dict(zip(names, axes, strict=True)), **fixed}, start_values)
     d = len(names)
 
+    # cells by distance (in grid steps) from the seed's task values: the start, then the islands
+    centre = [float(np.interp(start_values[c], a, np.arange(a.size))) if a.size > 1 else 0.0
+              for c, a in zip(names, axes, strict=True)]
+    grid_idx = np.indices(shape).reshape(d, -1).T
+    order = np.argsort(np.sum((grid_idx - np.array(centre)) ** 2, axis=1), kind="stable")
+    if (fast := backend.engine()) is not None:  # the same sweep, compiled
+        return _compiled_grid(fast, mech, task, names, axes, fixed, order, seed, islands, progress, t0)
+
     converged = np.zeros(shape, dtype=bool)
     attempts = np.zeros(shape, dtype=np.int8)
     values = np.full((*shape, 6), np.nan)
@@ -285,11 +295,6 @@ def solve_task_grid(
             return [predict(configs[cur], configs[prev]), configs[cur]]
         return [configs[cur]]
 
-    # cells by distance (in grid steps) from the seed's task values: the start, then the islands
-    centre = [float(np.interp(start_values[c], a, np.arange(a.size))) if a.size > 1 else 0.0
-              for c, a in zip(names, axes, strict=True)]
-    grid_idx = np.indices(shape).reshape(d, -1).T
-    order = np.argsort(np.sum((grid_idx - np.array(centre)) ** 2, axis=1), kind="stable")
     found = False
     for flat in order:
         start = tuple(int(i) for i in grid_idx[flat])
@@ -317,3 +322,18 @@ def solve_task_grid(
                         queue.append(nbt)
     return TaskGrid(mech, task, names, axes, fixed, converged, values, configs, residuals, n_solves,
                     time.perf_counter() - t0)
+
+
+def _compiled_grid(fast, mech: Mechanism, task: TaskCoordinates, names: tuple[str, ...], axes: tuple[np.ndarray, ...],
+                   fixed: dict, order: np.ndarray, seed: Configuration, islands: bool, progress: Progress,
+                   t0: float) -> TaskGrid:
+    """:func:`solve_task_grid`'s sweep by the compiled engine (``fast``): the same cells, seeds
+    and order, each solve :func:`.task.solve_task`'s steps."""
+    shape = tuple(a.size for a in axes)
+    conv, vals, q, D, B, res, n_solves = fast.task_grid(mech, task, names, axes, fixed, order, seed, islands,
+                                                         current_tolerances().newton, 60, progress)
+    configs = np.empty(len(conv), dtype=object)
+    for i in np.flatnonzero(conv):
+        configs[i] = Configuration.of(q[i], D[i], B[i])
+    return TaskGrid(mech, task, names, axes, fixed, conv.reshape(shape), vals.reshape((*shape, 6)),
+                    configs.reshape(shape), res.reshape(shape), n_solves, time.perf_counter() - t0)

@@ -50,7 +50,7 @@ from .kernels_loops import pack as pack_loop_system
 from .kernels_loops import square_batch as loop_square_batch
 from .legs import correct_legs
 from .limits import joint_points_many, link_margins_many
-from .tasks import task_solve
+from .tasks import task_grid, task_solve
 from . import maps as maps  # performance-map kernels (analysis/maps.py)
 
 __all__ = [
@@ -83,6 +83,7 @@ __all__ = [
     "pack_loop_system",
     "retract",
     "sps_leg_lengths",
+    "task_grid",
     "task_solve",
     "track_parameter",
     "warm_up",

@@ -24,7 +24,7 @@ from .kernels_closure import (
 )
 from .kernels_se3 import nb_copy44, nb_lstsq
 
-__all__ = ["nb_euler", "nb_matrix_euler", "nb_task_solve"]
+__all__ = ["nb_euler", "nb_matrix_euler", "nb_predict", "nb_task_grid", "nb_task_solve"]
 
 
 @njit(cache=True)
@@ -270,3 +270,145 @@ def nb_task_solve(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, en
     info[0] = st
     info[1] = it
     info[2] = rn
+
+
+@njit(cache=True)
+def nb_predict(qc, Dc, Bc, qp, Dp, Bp, q, D, B):
+    """``task_grid.predict``: one more secant step ``prev -> cur`` from ``cur`` (joint variables
+    extrapolated linearly, displacements by ``cur prev^-1 cur``) into ``q``, ``D``, ``B``."""
+    inv = np.empty((4, 4))
+    T = np.empty((4, 4))
+    for i in range(q.shape[0]):
+        q[i] = 2.0 * qc[i] - qp[i]
+    for b in range(-1, B.shape[0]):
+        P = Dp if b < 0 else Bp[b]
+        C = Dc if b < 0 else Bc[b]
+        out = D if b < 0 else B[b]
+        for i in range(3):
+            for j in range(3):
+                inv[i, j] = P[j, i]
+            inv[i, 3] = -(P[0, i] * P[0, 3] + P[1, i] * P[1, 3] + P[2, i] * P[2, 3])
+            inv[3, i] = 0.0
+        inv[3, 3] = 1.0
+        for i in range(4):
+            for j in range(4):
+                T[i, j] = C[i, 0] * inv[0, j] + C[i, 1] * inv[1, j] + C[i, 2] * inv[2, j] + C[i, 3] * inv[3, j]
+        for i in range(4):
+            for j in range(4):
+                out[i, j] = T[i, 0] * C[0, j] + T[i, 1] * C[1, j] + T[i, 2] * C[2, j] + T[i, 3] * C[3, j]
+
+
+@njit(cache=True)
+def nb_task_grid(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends, linear, L, active, p0, axes,
+                 intrinsic, free, base, grid, coord, shape, order, q0, D0, B0, islands, tol, max_iter, budget, state,
+                 attempts, converged, parents, queue, q_out, D_out, B_out, values_out, residuals):
+    """``task_grid.solve_task_grid``'s sweep: the cells in ``order`` (flat, C order over ``shape``)
+    each start a breadth-first sweep unless already attempted (only the first unless
+    ``islands``), solved from the seed ``q0, D0, B0``; each neighbour (coordinate by coordinate,
+    the step -1 then +1) not converged and attempted fewer than twice is solved from the secant
+    prediction (when its parent's parent is in line) then from the parent's solution.  Cell
+    values: ``base`` (6,) with grid coordinate ``k`` (task coordinate ``coord[k]``) at
+    ``grid[k, i_k]``.  Resumable: ``state`` = (position in ``order``, queue head, queue tail,
+    a sweep found, solves so far, finished); returns after the step in which the solves reach
+    ``budget``."""
+    d = shape.shape[0]
+    n = q0.shape[0]
+    stride = np.empty(d, dtype=np.int64)
+    s_ = 1
+    for k in range(d - 1, -1, -1):
+        stride[k] = s_
+        s_ *= shape[k]
+    qs = np.empty((2, n))
+    Ds = np.empty((2, 4, 4))
+    Bs = np.empty((2, B0.shape[0], 4, 4))
+    q = np.empty(n)
+    D = np.empty((4, 4))
+    B = np.empty((B0.shape[0], 4, 4))
+    vals = np.empty(6)
+    info = np.empty(3)
+    cur_i = np.empty(d, dtype=np.int64)
+    while state[5] == 0 and state[4] < budget:
+        if state[2] > state[1]:  # the sweep goes on: the next cell of the queue
+            cur = queue[state[1]]
+            state[1] += 1
+            rem = cur
+            for k in range(d):
+                cur_i[k] = rem // stride[k]
+                rem -= cur_i[k] * stride[k]
+            prev = parents[cur]
+            for k in range(d):
+                for step in (-1, 1):
+                    if not 0 <= cur_i[k] + step < shape[k]:
+                        continue
+                    nb = cur + step * stride[k]
+                    if converged[nb] or attempts[nb] >= 2:
+                        continue
+                    ns = np.int64(1)
+                    if prev >= 0 and cur - prev == step * stride[k]:
+                        nb_predict(q_out[cur], D_out[cur], B_out[cur], q_out[prev], D_out[prev], B_out[prev],
+                                   qs[0], Ds[0], Bs[0])
+                        ns = np.int64(2)
+                    qs[ns - 1] = q_out[cur]
+                    Ds[ns - 1] = D_out[cur]
+                    Bs[ns - 1] = B_out[cur]
+                    if _attempt(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends, linear, L, active,
+                                p0, axes, intrinsic, free, base, grid, coord, stride, nb, qs, Ds, Bs, ns, tol,
+                                max_iter, state, attempts, converged, q, D, B, vals, info, q_out, D_out, B_out,
+                                values_out, residuals):
+                        parents[nb] = cur
+                        queue[state[2]] = nb
+                        state[2] += 1
+            continue
+        # a new start
+        while state[0] < order.shape[0] and attempts[order[state[0]]] > 0:
+            state[0] += 1
+        if state[0] >= order.shape[0] or (state[3] == 1 and not islands):
+            state[5] = 1
+            break
+        start = order[state[0]]
+        state[0] += 1
+        qs[0] = q0
+        Ds[0] = D0
+        Bs[0] = B0
+        if _attempt(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends, linear, L, active, p0, axes,
+                    intrinsic, free, base, grid, coord, stride, start, qs, Ds, Bs, np.int64(1), tol, max_iter, state, attempts,
+                    converged, q, D, B, vals, info, q_out, D_out, B_out, values_out, residuals):
+            state[3] = 1
+            queue[state[2]] = start
+            state[2] += 1
+
+
+@njit(cache=True)
+def _attempt(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends, linear, L, active, p0, axes, intrinsic,
+             free, base, grid, coord, stride, cell, qs, Ds, Bs, ns, tol, max_iter, state, attempts, converged, q, D, B,
+             vals, info, q_out, D_out, B_out, values_out, residuals):
+    """One attempt of grid cell ``cell`` from the seeds ``qs[:ns], Ds[:ns], Bs[:ns]`` in turn,
+    until one converges; its solution stored (``task_grid``'s ``attempt``)."""
+    attempts[cell] += 1
+    rem = cell
+    for k in range(stride.shape[0]):
+        i = rem // stride[k]
+        rem -= i * stride[k]
+    for j in range(ns):
+        state[4] += 1
+        for t in range(6):
+            vals[t] = base[t]
+        rem = cell
+        for k in range(stride.shape[0]):
+            i = rem // stride[k]
+            rem -= i * stride[k]
+            vals[coord[k]] = grid[k, i]
+        q[:] = qs[j]
+        D[:, :] = Ds[j]
+        B[:, :, :] = Bs[j]
+        nb_task_solve(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends, linear, L, active, p0, axes,
+                      intrinsic, free, free, vals, q, D, B, tol, max_iter, info)
+        residuals[cell] = info[2]
+        if info[0] == 1:
+            converged[cell] = True
+            q_out[cell] = q
+            D_out[cell] = D
+            B_out[cell] = B
+            values_out[cell] = vals
+            return True
+    return False
