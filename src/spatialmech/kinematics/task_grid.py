@@ -231,13 +231,7 @@ def solve_task_grid(
     """
     t0 = time.perf_counter()
     names, axes = _axes(over)
-    at = {} if at is None else at
-    if not isinstance(at, Mapping):
-        raise InputError(f"at: expected a mapping of task coordinate -> value (SI, rad), got {type(at).__name__}")
-    for c in at:
-        if c in names:
-            raise InputError(f"at.{c}: {c} is a grid coordinate (over); hold it or sweep it, not both")
-    held = {str(c): float(as_finite_array(v, f"at.{c}", shape=())) for c, v in at.items()}
+    held = _held(at, names)
     task = resolve_task(mech, [*names, *held], task)
     limit = MAX_CELLS if max_cells is None else int(max_cells)
     shape = tuple(a.size for a in axes)
@@ -253,11 +247,7 @@ def solve_task_grid(
     _check_range(mech, {**dict(zip(names, axes, strict=True)), **fixed}, start_values)
     d = len(names)
 
-    # cells by distance (in grid steps) from the seed's task values: the start, then the islands
-    centre = [float(np.interp(start_values[c], a, np.arange(a.size))) if a.size > 1 else 0.0
-              for c, a in zip(names, axes, strict=True)]
-    grid_idx = np.indices(shape).reshape(d, -1).T
-    order = np.argsort(np.sum((grid_idx - np.array(centre)) ** 2, axis=1), kind="stable")
+    order, grid_idx = _start_order(names, axes, start_values)
     if (fast := backend.engine()) is not None:  # the same sweep, compiled
         return _compiled_grid(fast, mech, task, names, axes, fixed, order, seed, islands, progress, t0)
 
@@ -322,6 +312,28 @@ def solve_task_grid(
                         queue.append(nbt)
     return TaskGrid(mech, task, names, axes, fixed, converged, values, configs, residuals, n_solves,
                     time.perf_counter() - t0)
+
+
+def _held(at: Mapping[str, float] | None, names: tuple[str, ...]) -> dict[str, float]:
+    """The held coordinates ``at`` (SI, rad), checked: a mapping, finite values, none of them a
+    grid coordinate."""
+    at = {} if at is None else at
+    if not isinstance(at, Mapping):
+        raise InputError(f"at: expected a mapping of task coordinate -> value (SI, rad), got {type(at).__name__}")
+    for c in at:
+        if c in names:
+            raise InputError(f"at.{c}: {c} is a grid coordinate (over); hold it or sweep it, not both")
+    return {str(c): float(as_finite_array(v, f"at.{c}", shape=())) for c, v in at.items()}
+
+
+def _start_order(names: tuple[str, ...], axes: tuple[np.ndarray, ...],
+                 start_values: Mapping[str, float]) -> tuple[np.ndarray, np.ndarray]:
+    """The cells (flat, C order) by distance in grid steps from the seed's task values (the
+    first start, then the islands'), and every cell's multi-index."""
+    centre = [float(np.interp(start_values[c], a, np.arange(a.size))) if a.size > 1 else 0.0
+              for c, a in zip(names, axes, strict=True)]
+    grid_idx = np.indices(tuple(a.size for a in axes)).reshape(len(axes), -1).T
+    return np.argsort(np.sum((grid_idx - np.array(centre)) ** 2, axis=1), kind="stable"), grid_idx
 
 
 def _compiled_grid(fast, mech: Mechanism, task: TaskCoordinates, names: tuple[str, ...], axes: tuple[np.ndarray, ...],

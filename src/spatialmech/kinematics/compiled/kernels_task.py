@@ -22,7 +22,7 @@ from .kernels_closure import (
     nb_retract,
     nb_scales,
 )
-from .kernels_se3 import nb_copy44, nb_lstsq
+from .kernels_se3 import nb_lstsq
 
 __all__ = ["nb_euler", "nb_matrix_euler", "nb_predict", "nb_task_grid", "nb_task_solve"]
 
@@ -44,44 +44,29 @@ def nb_axis_rot(ax, t, out):
 
 
 @njit(cache=True)
+def nb_rotate_by(M, ax, t, Rk, T):
+    """``M <- M R_ax(t)`` (scratch ``Rk``, ``T``)."""
+    nb_axis_rot(ax, t, Rk)
+    for i in range(3):
+        for j in range(3):
+            T[i, j] = M[i, 0] * Rk[0, j] + M[i, 1] * Rk[1, j] + M[i, 2] * Rk[2, j]
+    M[:, :] = T
+
+
+@njit(cache=True)
 def nb_euler(axes, intrinsic, a, R, E):
     """The rotation ``R`` of Euler angles ``a`` (3,) and ``E`` (``omega = E da/dt``, the angular
-    velocity in the fixed frame), for the sequence ``axes`` / ``intrinsic``."""
+    velocity in the fixed frame), for the sequence ``axes`` / ``intrinsic``: intrinsic
+    ``R = R1 R2 R3``, axis ``k`` moved by the rotations before it; extrinsic ``R = R3 R2 R1``,
+    axis ``k`` moved by the rotations after it."""
     Rk = np.empty((3, 3))
-    M = np.empty((3, 3))
     T = np.empty((3, 3))
-    for i in range(3):
-        for j in range(3):
-            M[i, j] = 1.0 if i == j else 0.0
-    if intrinsic:  # R = R1 R2 R3: axis k moved by the rotations before it
-        for k in range(3):
-            for i in range(3):
-                E[i, k] = M[i, axes[k]]
-            nb_axis_rot(axes[k], a[k], Rk)
-            for i in range(3):
-                for j in range(3):
-                    T[i, j] = M[i, 0] * Rk[0, j] + M[i, 1] * Rk[1, j] + M[i, 2] * Rk[2, j]
-            for i in range(3):
-                for j in range(3):
-                    M[i, j] = T[i, j]
-        for i in range(3):
-            for j in range(3):
-                R[i, j] = M[i, j]
-        return
-    # extrinsic: R = R3 R2 R1; axis k moved by the rotations after it
-    for k in range(2, -1, -1):
-        for i in range(3):
-            E[i, k] = M[i, axes[k]]
-        nb_axis_rot(axes[k], a[k], Rk)
-        for i in range(3):
-            for j in range(3):
-                T[i, j] = M[i, 0] * Rk[0, j] + M[i, 1] * Rk[1, j] + M[i, 2] * Rk[2, j]
-        for i in range(3):
-            for j in range(3):
-                M[i, j] = T[i, j]
-    for i in range(3):
-        for j in range(3):
-            R[i, j] = M[i, j]
+    M = np.eye(3)
+    for j in range(3):
+        k = j if intrinsic else 2 - j
+        E[:, k] = M[:, axes[k]]
+        nb_rotate_by(M, axes[k], a[k], Rk, T)
+    R[:, :] = M
 
 
 @njit(cache=True)
@@ -161,12 +146,8 @@ def nb_pose_from_task(axes, intrinsic, values, p0, D, E):
 
 
 @njit(cache=True)
-def nb_task_solve(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends, linear, L, active, p0, axes,
-                  intrinsic, seeded, free, values, q, D, B, tol, max_iter, info):
-    """``solve_task`` from the configuration ``q``, ``D``, ``B`` (updated in place, with
-    ``values``): the task coordinates marked ``seeded`` (6,) start at the seed's (``D``'s), the
-    others at ``values``; those marked ``free`` (6,) are solved, and end in ``values``.  ``info``: status (1 converged, 2
-    stalled, 0 not converged), the iterations, the residual."""
+def nb_task_seed(axes, intrinsic, seeded, p0, D, values):
+    """The task coordinates marked ``seeded`` (6,) set to those of the displacement ``D``."""
     start = np.empty(3)
     nb_matrix_euler(axes, intrinsic, D, start)
     for i in range(3):
@@ -174,12 +155,13 @@ def nb_task_solve(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, en
             values[i] = D[i, 0] * p0[0] + D[i, 1] * p0[1] + D[i, 2] * p0[2] + D[i, 3]
         if seeded[3 + i]:
             values[3 + i] = start[i]
-    K = len(limb_start) - 1
-    h = 1 + B.shape[0]
-    n = q.shape[0]
-    colmap, na = nb_colmap(active)
-    row, col = nb_scales(linear, active, K, h, L)
-    nc = na + 6 * h
+
+
+@njit(cache=True)
+def nb_task_scales(free, col, na, h, L):
+    """The indices of the solved coordinates (``free``) and the column scales of the task system:
+    the active joints' (``col[:na]``), ``L`` for a solved length and 1 for an angle, the internal
+    bodies' (``col[na + 6:]``)."""
     nf = 0
     for i in range(6):
         if free[i]:
@@ -190,19 +172,73 @@ def nb_task_solve(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, en
         if free[i]:
             fidx[j] = i
             j += 1
-    ng = na + nf + 6 * (h - 1)
-    scales = np.empty(ng)
-    for c in range(na):
-        scales[c] = col[c]
+    scales = np.empty(na + nf + 6 * (h - 1))
+    scales[:na] = col[:na]
     for k in range(nf):
         scales[na + k] = L if fidx[k] < 3 else 1.0
-    for c in range(6 * (h - 1)):
-        scales[na + nf + c] = col[na + 6 + c]
-    A = np.zeros((6 * K, nc))
+    scales[na + nf :] = col[na + 6 :]
+    return fidx, scales
+
+
+@njit(cache=True)
+def nb_task_system(A, row, E, values, fidx, scales, na, C, G):
+    """The scaled task system ``row G scales`` with ``G = [A_joints, A_output C_free, A_bodies]``,
+    ``C = [[0, E], [I, skew(P) E]]`` the coordinate map at ``values`` (``V = C d(values)/dt``)."""
+    nf = fidx.shape[0]
+    C[:, :] = 0.0
+    for i in range(3):
+        C[3 + i, i] = 1.0
+        for k in range(3):
+            C[i, 3 + k] = E[i, k]
+    for k in range(3):
+        C[3, 3 + k] = values[1] * E[2, k] - values[2] * E[1, k]
+        C[4, 3 + k] = values[2] * E[0, k] - values[0] * E[2, k]
+        C[5, 3 + k] = values[0] * E[1, k] - values[1] * E[0, k]
+    for i in range(A.shape[0]):
+        for c in range(na):
+            G[i, c] = row[i] * A[i, c] * scales[c]
+        for k in range(nf):
+            acc = 0.0
+            for m in range(6):
+                acc += A[i, na + m] * C[m, fidx[k]]
+            G[i, na + k] = row[i] * acc * scales[na + k]
+        for c in range(na + nf, G.shape[1]):
+            G[i, c] = row[i] * A[i, c - nf + 6] * scales[c]
+
+
+@njit(cache=True)
+def nb_task_step(x, scales, fidx, na, step, values):
+    """The retraction step (joints, no platform twist, bodies) and the solved coordinates moved by
+    the scaled solution ``x``."""
+    nf = fidx.shape[0]
+    for c in range(na):
+        step[c] = scales[c] * x[c]
+    step[na : na + 6] = 0.0
+    for c in range(na + nf, x.shape[0]):
+        step[c - nf + 6] = scales[c] * x[c]
+    for k in range(nf):
+        values[fidx[k]] += scales[na + k] * x[na + k]
+
+
+@njit(cache=True)
+def nb_task_solve(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends, linear, L, active, p0, axes,
+                  intrinsic, seeded, free, values, q, D, B, tol, max_iter, info):
+    """``solve_task`` from the configuration ``q``, ``D``, ``B`` (updated in place, with
+    ``values``): the task coordinates marked ``seeded`` (6,) start at the seed's (``D``'s), the
+    others at ``values``; those marked ``free`` (6,) are solved, and end in ``values``.
+    ``info``: status (1 converged, 2 stalled, 0 not converged), the iterations, the residual."""
+    nb_task_seed(axes, intrinsic, seeded, p0, D, values)
+    K = len(limb_start) - 1
+    h = 1 + B.shape[0]
+    n = q.shape[0]
+    colmap, na = nb_colmap(active)
+    row, col = nb_scales(linear, active, K, h, L)
+    fidx, scales = nb_task_scales(free, col, na, h, L)
+    A = np.zeros((6 * K, na + 6 * h))
     r = np.zeros(6 * K)
-    G = np.empty((6 * K, ng))
+    G = np.empty((6 * K, scales.shape[0]))
     rhs = np.empty(6 * K)
-    step = np.zeros(nc)
+    step = np.zeros(na + 6 * h)
     C = np.zeros((6, 6))
     E = np.empty((3, 3))
     q2 = np.empty(n)
@@ -226,46 +262,15 @@ def nb_task_solve(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, en
             break
         if it == max_iter or not np.isfinite(rn):
             break
-        # C: V = C d(values)/dt (coordinate_map): [[0, E], [I, skew(P) E]]
-        for i in range(6):
-            for k in range(6):
-                C[i, k] = 0.0
-        for i in range(3):
-            C[3 + i, i] = 1.0
-            for k in range(3):
-                C[i, 3 + k] = E[i, k]
-        P = values[:3]
-        for k in range(3):
-            C[3, 3 + k] = P[1] * E[2, k] - P[2] * E[1, k]
-            C[4, 3 + k] = P[2] * E[0, k] - P[0] * E[2, k]
-            C[5, 3 + k] = P[0] * E[1, k] - P[1] * E[0, k]
-        for i in range(6 * K):
-            for c in range(na):
-                G[i, c] = row[i] * A[i, c] * scales[c]
-            for k in range(nf):
-                s = 0.0
-                for m in range(6):
-                    s += A[i, na + m] * C[m, fidx[k]]
-                G[i, na + k] = row[i] * s * scales[na + k]
-            for c in range(6 * (h - 1)):
-                G[i, na + nf + c] = row[i] * A[i, na + 6 + c] * scales[na + nf + c]
+        nb_task_system(A, row, E, values, fidx, scales, na, C, G)
         x = nb_lstsq(G, rhs)
         if nb_norm(x) < 1e-13 * max(1.0, rn):
             st = 2
             break
-        for c in range(na):
-            step[c] = scales[c] * x[c]
-        for c in range(6):
-            step[na + c] = 0.0
-        for c in range(6 * (h - 1)):
-            step[na + 6 + c] = scales[na + nf + c] * x[na + nf + c]
-        for k in range(nf):
-            values[fidx[k]] += scales[na + k] * x[na + k]
+        nb_task_step(x, scales, fidx, na, step, values)
         nb_retract(ball_first, ball_axes, q, D, B, active, step, na, np.bool_(True), q2, D2, B2, rws)
-        for i in range(n):
-            q[i] = q2[i]
-        for b in range(h - 1):
-            nb_copy44(B2[b], B[b])
+        q[:] = q2
+        B[:, :, :] = B2
         nb_pose_from_task(axes, intrinsic, values, p0, D, E)
     info[0] = st
     info[1] = it

@@ -35,7 +35,8 @@ def task_solve(mech: Mechanism, config: Configuration, values: np.ndarray, seede
     axes = _axes(euler)
     info = np.empty(3)
     nb_task_solve(cm.screws, cm.ball_of, cm.ball_first, cm.ball_axes, cm.ball_centre, cm.limb_start, cm.ends,
-                  cm.linear, cm.length, cm.active, _point(mech), axes, np.bool_(euler.isupper()), np.asarray(seeded, dtype=np.bool_), np.asarray(free, dtype=np.bool_), vals, q, D, B, float(tol),
+                  cm.linear, cm.length, cm.active, _point(mech), axes, np.bool_(euler.isupper()),
+                  np.asarray(seeded, dtype=np.bool_), np.asarray(free, dtype=np.bool_), vals, q, D, B, float(tol),
                   int(max_iter), info)
     return Configuration.of(q, D, B), vals, int(info[0]), int(info[1]), float(info[2])
 
