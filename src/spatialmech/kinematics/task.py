@@ -186,9 +186,9 @@ def solve_task(mech: Mechanism, given: Mapping[str, float], *, task: TaskCoordin
     config = Configuration.reference(mech) if seed is None else seed
     if (fast := backend.engine()) is not None:  # the same steps, compiled
         values = np.array([g.get(n, 0.0) for n in TASK_NAMES])
-        free = np.array([n not in task.given for n in TASK_NAMES])
-        seeded = np.array([n not in g for n in TASK_NAMES]) | free
-        config, values, code, it, rn = fast.task_solve(mech, config, values, seeded, free, task.euler, tol, max_iter)
+        solved = np.array([n not in task.given for n in TASK_NAMES])
+        seeded = np.array([n not in g for n in TASK_NAMES]) | solved
+        config, values, code, it, rn = fast.task_solve(mech, config, values, seeded, solved, task.euler, tol, max_iter)
         return TaskSolution(config, dict(zip(TASK_NAMES, map(float, values), strict=True)), task, code == 1, rn, it,
                             _STATUS[code])
     values = task_values(mech, config.D, task.euler)
