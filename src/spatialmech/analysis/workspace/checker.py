@@ -443,6 +443,8 @@ class _GeneralKernel:
             qq = np.array([recentre_balls(mech, row) for row in qq]).reshape(qq.shape)
         out[idx] = self.rows(qq, R[idx])
         inside = np.all(out[idx] >= 0.0, axis=1)
+        if self.model_limits and not k.fl:  # limits the checker ignores, but the per-pose solve
+            inside &= self.within_model_limits(q[idx])  # retries a solution outside (other seeds)
         done[idx] = inside
         if not self.simple and not np.all(inside):
             out_idx = idx[~inside]
@@ -457,11 +459,17 @@ class _GeneralKernel:
         again (fewest violations, the first on a tie): the same row.  Not decided here (``False``):
         a limb the homotopy would answer, freedom limits of S joints (the search compares rows of
         joint values not re-centred), a solution outside a freedom limit of the model."""
+        if self.s_limits or not self.multistart_only():
+            return np.zeros(q.shape[0], dtype=bool)
+        return self.within_model_limits(q)
+
+    def within_model_limits(self, q) -> np.ndarray:
+        """Whether each row of joint variables ``q`` (N, n), rotations wrapped as the per-pose
+        solve wraps them, is within every freedom limit of the model (whatever the checker's
+        ``freedom_limits``)."""
         from ...kinematics.distinct import wrap_rotations
         from ...kinematics.position import within_limits
 
-        if self.s_limits or not self.multistart_only():
-            return np.zeros(q.shape[0], dtype=bool)
         if not self.model_limits:
             return np.ones(q.shape[0], dtype=bool)
         return np.array([not within_limits(self.k.mech, wrap_rotations(self.k.mech, row)) for row in q], dtype=bool)
