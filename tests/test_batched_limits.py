@@ -266,3 +266,18 @@ def test_compiled_task_grid_sweep_equals_the_reference(case):
     for idx in zip(*np.nonzero(a.converged), strict=True):
         assert np.max(np.abs(a.configs[idx].D - b.configs[idx].D)) <= 1e-10
     assert seen and seen[-1][0] == a.n_solves and seen[-1][2] == "solving task coordinates"
+
+
+@pytest.mark.slow
+def test_bench_limits_quick_reports_every_key_and_agrees():
+    """benchmarks/bench_limits.py --quick (tiny sizes): a verdict per target, both paths agree."""
+    import importlib.util
+
+    path = Path(__file__).resolve().parents[1] / "benchmarks" / "bench_limits.py"
+    spec = importlib.util.spec_from_file_location("bench_limits", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    out = mod.run(quick=True)
+    assert set(out["met"]) == set(mod.TARGETS)
+    assert out["checker_cones_three_rps_agree"] and out["checker_cones_stewart_agree"]
+    assert out["task_workspace_three_rps_agree"]
