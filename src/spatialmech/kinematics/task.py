@@ -36,6 +36,7 @@ from ..model.mechanism import Mechanism
 from ..model.task import TASK_NAMES, TaskCoordinates
 from ..results import SolveStatus
 from .closure import Configuration, active_mask, closure_scales
+from . import backend
 from .backend import closure_jacobian, retract
 from .velocity import euler_rate_matrix
 
@@ -152,6 +153,10 @@ class TaskSolution:
         return self.config.D
 
 
+#: The compiled solve's status codes (:func:`.compiled.tasks.task_solve`).
+_STATUS = {1: SolveStatus.CONVERGED, 2: SolveStatus.STALLED, 0: SolveStatus.MAX_ITER}
+
+
 def _check_given(task: TaskCoordinates, given: Mapping[str, float]) -> dict[str, float]:
     if not isinstance(given, Mapping):
         raise InputError(f"given: expected a mapping of task coordinate -> value, got {type(given).__name__}")
@@ -181,6 +186,13 @@ def solve_task(mech: Mechanism, given: Mapping[str, float], *, task: TaskCoordin
     g = _check_given(task, given)
     tol = current_tolerances().newton if tol is None else float(tol)
     config = Configuration.reference(mech) if seed is None else seed
+    if (fast := backend.engine()) is not None:  # the same steps, compiled
+        values = np.array([g.get(n, 0.0) for n in TASK_NAMES])
+        solved = np.array([n not in task.given for n in TASK_NAMES])
+        seeded = np.array([n not in g for n in TASK_NAMES]) | solved
+        config, values, code, it, rn = fast.task_solve(mech, config, values, seeded, solved, task.euler, tol, max_iter)
+        return TaskSolution(config, dict(zip(TASK_NAMES, map(float, values), strict=True)), task, code == 1, rn, it,
+                            _STATUS[code])
     values = task_values(mech, config.D, task.euler)
     for k, v in g.items():
         values[TASK_NAMES.index(k)] = v

@@ -32,10 +32,12 @@ import numpy as np
 
 from ..errors import ConvergenceError, InputError, SearchTooLargeError
 from ..geometry.rotations import inverse_transform
+from ..geometry.tolerances import current as current_tolerances
 from ..geometry.validate import as_finite_array
 from ..model.mechanism import Mechanism
 from ..model.task import TASK_NAMES, TaskCoordinates
 from ..results import Progress, check_progress
+from . import backend
 from .closure import Configuration
 from .task import default_task, solve_task, task_values
 
@@ -154,7 +156,11 @@ def predict(cur: Configuration, prev: Configuration) -> Configuration:
     """Secant predictor on the closure manifold: one more step ``prev -> cur`` from ``cur``
     (joint variables extrapolated linearly, displacements by ``cur prev^-1 cur``)."""
     q = 2.0 * np.asarray(cur.q) - np.asarray(prev.q)
-    D = cur.D @ inverse_transform(prev.D) @ cur.D
+    Rt = prev.D[:3, :3].T
+    inv = np.eye(4)  # prev.D^-1, written out (inverse_transform's stacks cost more than the step)
+    inv[:3, :3] = Rt
+    inv[:3, 3] = -(Rt @ prev.D[:3, 3])
+    D = cur.D @ inv @ cur.D
     B = np.array([c @ inverse_transform(p) @ c for c, p in zip(cur.B, prev.B, strict=True)]) if len(cur.B) else cur.B
     return Configuration(q, D, B)
 
@@ -225,13 +231,7 @@ def solve_task_grid(
     """
     t0 = time.perf_counter()
     names, axes = _axes(over)
-    at = {} if at is None else at
-    if not isinstance(at, Mapping):
-        raise InputError(f"at: expected a mapping of task coordinate -> value (SI, rad), got {type(at).__name__}")
-    for c in at:
-        if c in names:
-            raise InputError(f"at.{c}: {c} is a grid coordinate (over); hold it or sweep it, not both")
-    held = {str(c): float(as_finite_array(v, f"at.{c}", shape=())) for c, v in at.items()}
+    held = _held(at, names)
     task = resolve_task(mech, [*names, *held], task)
     limit = MAX_CELLS if max_cells is None else int(max_cells)
     shape = tuple(a.size for a in axes)
@@ -246,6 +246,10 @@ def solve_task_grid(
     fixed = {c: held.get(c, start_values[c]) for c in task.given if c not in names}
     _check_range(mech, {**dict(zip(names, axes, strict=True)), **fixed}, start_values)
     d = len(names)
+
+    order, grid_idx = _start_order(names, axes, start_values)
+    if (fast := backend.engine()) is not None:  # the same sweep, compiled
+        return _compiled_grid(fast, mech, task, names, axes, fixed, order, seed, islands, progress, t0)
 
     converged = np.zeros(shape, dtype=bool)
     attempts = np.zeros(shape, dtype=np.int8)
@@ -281,11 +285,6 @@ def solve_task_grid(
             return [predict(configs[cur], configs[prev]), configs[cur]]
         return [configs[cur]]
 
-    # cells by distance (in grid steps) from the seed's task values: the start, then the islands
-    centre = [float(np.interp(start_values[c], a, np.arange(a.size))) if a.size > 1 else 0.0
-              for c, a in zip(names, axes, strict=True)]
-    grid_idx = np.indices(shape).reshape(d, -1).T
-    order = np.argsort(np.sum((grid_idx - np.array(centre)) ** 2, axis=1), kind="stable")
     found = False
     for flat in order:
         start = tuple(int(i) for i in grid_idx[flat])
@@ -313,3 +312,40 @@ def solve_task_grid(
                         queue.append(nbt)
     return TaskGrid(mech, task, names, axes, fixed, converged, values, configs, residuals, n_solves,
                     time.perf_counter() - t0)
+
+
+def _held(at: Mapping[str, float] | None, names: tuple[str, ...]) -> dict[str, float]:
+    """The held coordinates ``at`` (SI, rad), checked: a mapping, finite values, none of them a
+    grid coordinate."""
+    at = {} if at is None else at
+    if not isinstance(at, Mapping):
+        raise InputError(f"at: expected a mapping of task coordinate -> value (SI, rad), got {type(at).__name__}")
+    for c in at:
+        if c in names:
+            raise InputError(f"at.{c}: {c} is a grid coordinate (over); hold it or sweep it, not both")
+    return {str(c): float(as_finite_array(v, f"at.{c}", shape=())) for c, v in at.items()}
+
+
+def _start_order(names: tuple[str, ...], axes: tuple[np.ndarray, ...],
+                 start_values: Mapping[str, float]) -> tuple[np.ndarray, np.ndarray]:
+    """The cells (flat, C order) by distance in grid steps from the seed's task values (the
+    first start, then the islands'), and every cell's multi-index."""
+    centre = [float(np.interp(start_values[c], a, np.arange(a.size))) if a.size > 1 else 0.0
+              for c, a in zip(names, axes, strict=True)]
+    grid_idx = np.indices(tuple(a.size for a in axes)).reshape(len(axes), -1).T
+    return np.argsort(np.sum((grid_idx - np.array(centre)) ** 2, axis=1), kind="stable"), grid_idx
+
+
+def _compiled_grid(fast, mech: Mechanism, task: TaskCoordinates, names: tuple[str, ...], axes: tuple[np.ndarray, ...],
+                   fixed: dict, order: np.ndarray, seed: Configuration, islands: bool, progress: Progress,
+                   t0: float) -> TaskGrid:
+    """:func:`solve_task_grid`'s sweep by the compiled engine (``fast``): the same cells, seeds
+    and order, each solve :func:`.task.solve_task`'s steps."""
+    shape = tuple(a.size for a in axes)
+    conv, vals, q, D, B, res, n_solves = fast.task_grid(mech, task, names, axes, fixed, order, seed, islands,
+                                                         current_tolerances().newton, 60, progress)
+    configs = np.empty(len(conv), dtype=object)
+    for i in np.flatnonzero(conv):
+        configs[i] = Configuration.of(q[i], D[i], B[i])
+    return TaskGrid(mech, task, names, axes, fixed, conv.reshape(shape), vals.reshape((*shape, 6)),
+                    configs.reshape(shape), res.reshape(shape), n_solves, time.perf_counter() - t0)

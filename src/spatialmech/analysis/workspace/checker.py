@@ -197,6 +197,12 @@ def _cone_margins(seg_a, seg_b, R, cones):
     return cols
 
 
+def _cone_specs(cones) -> list[tuple]:
+    """The cone (limit, link) pairs as the compiled margins take them: ``(axis, in the platform
+    frame, max_angle, link)``."""
+    return [(c.axis, c.frame == "platform", c.max_angle, k) for c, k in cones]
+
+
 def _pair_margins(seg_a, seg_b, pairs):
     """Capsule margins ``distance - (d_i + d_j) / 2`` (m) of the link pairs."""
     return [segment_distance(seg_a[:, i], seg_b[:, i], seg_a[:, j], seg_b[:, j]) - clearance for i, j, clearance in pairs]
@@ -380,6 +386,9 @@ class _GeneralKernel:
         self.batchable = all(ends == (None, 0) for ends in mech.limb_ends)
         self.s_limits = any(mech.limbs[refs[f].limb].joints[refs[f].joint].type == "S" for f in k.fl)
         self.simple = not k.cones and not k.pairs
+        self.model_limits = any(r.freedom.limits is not None for r in refs)
+        # the link ends, as joint points (limb, k): every link's start, then every link's end
+        self.link_points = [(lk.limb, lk.ends[0]) for lk in k.links] + [(lk.limb, lk.ends[1]) for lk in k.links]
 
     def row(self, config, R1):
         """The margins at a closed configuration (platform orientation ``R1``, (1, 3, 3))."""
@@ -397,12 +406,27 @@ class _GeneralKernel:
         cols.append(np.array([[1e-9 * k.L]]))  # reachable: the same closure margin as the closed form
         return np.concatenate(cols, axis=1)[0]
 
+    def rows(self, q, R) -> np.ndarray:
+        """The margins (one row per pose) at closed configurations of joint variables ``q`` (N, n)
+        whose every limb starts on the ground (platform orientations ``R`` (N, 3, 3)): the rows
+        :meth:`row` gives one by one, the joint points by the compiled kernel."""
+        from ...kinematics import compiled
+
+        k = self.k
+        cols = [_freedom_margins(k.offs[k.fl] + q[:, k.fl], k.los, k.his, k.rot)] if k.fl else []
+        if k.cones or k.pairs:
+            cols.append(compiled.link_margins_many(k.mech, q, R, self.link_points, _cone_specs(k.cones), k.pairs))
+        cols.append(np.full((q.shape[0], 1), 1e-9 * k.L))
+        return np.concatenate(cols, axis=1)
+
     def batch(self, R, p) -> tuple[np.ndarray, np.ndarray]:
         """Rows of the poses whose every limb closes from the reference (compiled, batched) and
-        which violate no limit: exactly the rows the per-pose path gives them (its first attempt
-        is this one); ``done`` marks them, the rest go through the per-pose path."""
+        which the per-pose path would give the same row: those within every limit (its first
+        attempt is this one), and those that break only limits its search of other assemblies
+        cannot change (:meth:`final`); ``done`` marks them, the rest go through the per-pose
+        path."""
         from ...kinematics import compiled
-        from ...kinematics.closure import Configuration, hub_displacements, recentre_balls
+        from ...kinematics.closure import recentre_balls
 
         k, mech = self.k, self.k.mech
         n = R.shape[0]
@@ -414,19 +438,55 @@ class _GeneralKernel:
         q, _res, ok = compiled.limb_inverse_many(mech, D)
         done = np.all(ok, axis=1)
         idx = np.flatnonzero(done)
-        if self.simple:
-            qq = q[idx]
-            if self.s_limits:
-                qq = np.array([recentre_balls(mech, row) for row in qq]).reshape(qq.shape)
-            cols = [_freedom_margins(k.offs[k.fl] + qq[:, k.fl], k.los, k.his, k.rot)] if k.fl else []
-            cols.append(np.full((idx.size, 1), 1e-9 * k.L))
-            out[idx] = np.concatenate(cols, axis=1)
-        else:
-            for i in idx:
-                qi = recentre_balls(mech, q[i])
-                out[i] = self.row(Configuration(qi, D[i], hub_displacements(mech, qi, D[i])), R[i : i + 1])
-        done[idx] = np.all(out[idx] >= 0.0, axis=1)
+        qq = q[idx]
+        if self.s_limits:
+            qq = np.array([recentre_balls(mech, row) for row in qq]).reshape(qq.shape)
+        out[idx] = self.rows(qq, R[idx])
+        inside = np.all(out[idx] >= 0.0, axis=1)
+        if self.model_limits and not k.fl:  # limits the checker ignores, but the per-pose solve
+            inside &= self.within_model_limits(q[idx])  # retries a solution outside (other seeds)
+        done[idx] = inside
+        if not self.simple and not np.all(inside):
+            out_idx = idx[~inside]
+            done[out_idx] = self.final(q[out_idx])
         return out, done
+
+    def final(self, q) -> np.ndarray:
+        """Whether the per-pose path keeps the reference assembly's row at each closed
+        configuration ``q`` (N, n) that breaks a cone or interference limit: its search
+        (:meth:`other_assemblies`) solves every limb by the multi-start, whose first start is the
+        reference and, when that solution breaks none of the model's freedom limits, chooses it
+        again (fewest violations, the first on a tie): the same row.  Not decided here (``False``):
+        a limb the homotopy would answer, freedom limits of S joints (the search compares rows of
+        joint values not re-centred), a solution outside a freedom limit of the model."""
+        if self.s_limits or not self.multistart_only():
+            return np.zeros(q.shape[0], dtype=bool)
+        return self.within_model_limits(q)
+
+    def within_model_limits(self, q) -> np.ndarray:
+        """Whether each row of joint variables ``q`` (N, n), rotations wrapped as the per-pose
+        solve wraps them, is within every freedom limit of the model (whatever the checker's
+        ``freedom_limits``)."""
+        from ...kinematics.distinct import wrap_rotations
+        from ...kinematics.position import within_limits
+
+        if not self.model_limits:
+            return np.ones(q.shape[0], dtype=bool)
+        return np.array([not within_limits(self.k.mech, wrap_rotations(self.k.mech, row)) for row in q], dtype=bool)
+
+    def multistart_only(self) -> bool:
+        """Every limb of the mechanism is solved by the multi-start in :meth:`other_assemblies`
+        (``method="auto"`` of :func:`..kinematics.position.inverse_position` takes the homotopy
+        for none; asked at each call: a cached homotopy solve changes the answer)."""
+        from ...kinematics.homotopy.inverse import auto_reason
+
+        for li in range(len(self.k.mech.limbs)):
+            try:
+                if auto_reason(self.k.mech, li, 0) is None:
+                    return False
+            except InputError:  # the homotopy does not cover the limb
+                continue
+        return True
 
     def margins(self, R, p):
         from ...kinematics import backend
@@ -498,10 +558,29 @@ class ConfigurationChecker:
     names: tuple[str, ...]
     scales: np.ndarray
     _fn: Callable = field(repr=False)
+    _many: Callable | None = field(default=None, repr=False)
 
     def margins(self, config) -> np.ndarray:
         """The (m,) margins at ``config`` (a closed :class:`~spatialmech.kinematics.closure.Configuration`)."""
+        if self._many is not None:
+            from ...kinematics import backend
+
+            if backend.enabled():
+                return self._many(np.asarray(config.q, dtype=float)[None], np.asarray(config.D, dtype=float)[None])[0]
         return self._fn(config)
+
+    def margins_many(self, configs) -> np.ndarray:
+        """The (N, m) margins at the closed configurations ``configs``: in one batch (the joint
+        points by the compiled kernel) when every limb starts on the ground and the compiled
+        engine is in use, else one by one (:meth:`margins`)."""
+        configs = list(configs)
+        if self._many is not None and configs:
+            from ...kinematics import backend
+
+            if backend.enabled():
+                return self._many(np.array([c.q for c in configs], dtype=float).reshape(len(configs), -1),
+                                  np.array([c.D for c in configs], dtype=float).reshape(-1, 4, 4))
+        return np.array([self._fn(c) for c in configs]).reshape(len(configs), len(self.names))
 
     def violated(self, config) -> str:
         """The most violated limit (scaled margins) at ``config``, ``""`` when within every limit."""
@@ -540,4 +619,16 @@ def configuration_checker(mech: Mechanism, limits: WorkspaceLimits | None = None
             cols += [c[:, None] for c in _pair_margins(seg_a, seg_b, pairs)]
         return np.concatenate(cols, axis=1)[0] if cols else np.zeros(0)
 
-    return ConfigurationChecker(mech, limits, tuple(names), np.asarray(scale, dtype=float), fn)
+    link_points = [(lk.limb, lk.ends[0]) for lk in links] + [(lk.limb, lk.ends[1]) for lk in links]
+
+    def many(q: np.ndarray, D: np.ndarray) -> np.ndarray:
+        """``fn`` for a stack of configurations (joint variables ``q`` (N, n), platforms ``D``)."""
+        from ...kinematics import compiled
+
+        cols = [_freedom_margins(offs[fl] + q[:, fl], los, his, rot)] if fl else []
+        if cones or pairs:
+            cols.append(compiled.link_margins_many(mech, q, D[:, :3, :3], link_points, _cone_specs(cones), pairs))
+        return np.concatenate(cols, axis=1) if cols else np.zeros((q.shape[0], 0))
+
+    ground = all(a is None for a, _ in mech.limb_ends)
+    return ConfigurationChecker(mech, limits, tuple(names), np.asarray(scale, dtype=float), fn, many if ground else None)

@@ -227,7 +227,7 @@ class _Probe:
         """The most violated limit of the scaled margins ``m``, ``""`` when within every limit."""
         if m.size == 0:
             return ""
-        k = int(np.argmin(m))
+        k = _first_least(m)
         return self.checker.names[k] if m[k] < 0 else ""
 
     def __call__(self, x: np.ndarray, seed: Configuration):
@@ -238,6 +238,17 @@ class _Probe:
             return None, None, None, CLOSURE
         m = self.margins(config)
         return config, vals, m, self.limit(m)
+
+
+#: Relative difference below which two margins, or two extents, count as a tie (the first wins):
+#: limits equal by symmetry (two legs of a 3-RPS) then get one name, not one picked by rounding.
+TIE = 1e-12
+
+
+def _first_least(v: np.ndarray) -> int:
+    """The index of the least of ``v``, the first of those within :data:`TIE` of it."""
+    lo = float(np.min(v))
+    return int(np.flatnonzero(v <= lo + TIE * max(1.0, abs(lo)))[0])
 
 
 def _bracket(probe: _Probe, k: int, x_in: np.ndarray, c_in: Configuration, v_in: np.ndarray, m_in: np.ndarray,
@@ -404,9 +415,15 @@ def _cell_limits(probe: _Probe, g: TaskGrid) -> tuple[np.ndarray, dict[tuple, np
     the scaled margins of every closed cell."""
     cell_limits = np.full(g.shape, CLOSURE, dtype=object)
     cell_margins: dict[tuple, np.ndarray] = {}
-    for idx in zip(*np.nonzero(g.converged), strict=True):
-        cell_margins[idx] = probe.margins(g.configs[idx])
-        cell_limits[idx] = probe.limit(cell_margins[idx])
+    cells = list(zip(*np.nonzero(g.converged), strict=True))
+    checker = probe.checker
+    if checker.names and cells:
+        scaled = checker.margins_many([g.configs[idx] for idx in cells]) / checker.scales
+    else:
+        scaled = np.zeros((len(cells), 0))
+    for idx, m in zip(cells, scaled, strict=True):
+        cell_margins[idx] = m
+        cell_limits[idx] = probe.limit(m)
     return cell_limits, cell_margins
 
 
@@ -497,7 +514,7 @@ def _extent_end(g: TaskGrid, k: int, sign: float, cells: np.ndarray, cell_idx: n
     best, lim = float(best_cell), BOX
     along = np.flatnonzero(ba == k)  # boundary points refined along this coordinate
     if along.size:
-        j = int(along[np.argmin(bp[along, k])]) if sign < 0 else int(along[np.argmax(bp[along, k])])
+        j = int(along[_first_least(sign * -bp[along, k])])
         if sign * (bp[j, k] - best) >= 0:
             best, lim = float(bp[j, k]), blims[j]
     if lim == BOX:

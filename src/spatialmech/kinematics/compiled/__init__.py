@@ -7,7 +7,9 @@ the kernels are plain-array ``@njit(cache=True)`` functions in :mod:`.kernels_se
 (with its entry :mod:`.legs`: six S-P-S legs in pose coordinates), :mod:`.kernels_homotopy` (the
 Study formulation's parameter homotopy) and :mod:`.kernels_loops` (the loop formulation's square
 system), :mod:`.kernels_ik` (one limb's inverse position),
-:mod:`.kernels_four_sps_cu` (the 4-SPS/CU closed-form leg lengths); :mod:`.jit` is numba's ``njit`` or its
+:mod:`.kernels_four_sps_cu` (the 4-SPS/CU closed-form leg lengths), :mod:`.kernels_limits`
+(with its entry :mod:`.limits`: joint points of many configurations, for the workspace limits),
+:mod:`.kernels_task` (with its entry :mod:`.tasks`: the task-coordinate solve); :mod:`.jit` is numba's ``njit`` or its
 stand-in.
 
 Callers do not choose between this package and the Python reference themselves:
@@ -47,6 +49,8 @@ from .kernels_ik import ik_pack, ik_track
 from .kernels_loops import pack as pack_loop_system
 from .kernels_loops import square_batch as loop_square_batch
 from .legs import correct_legs
+from .limits import joint_points_many, link_margins_many
+from .tasks import task_grid, task_solve
 from . import maps as maps  # performance-map kernels (analysis/maps.py)
 
 __all__ = [
@@ -69,14 +73,18 @@ __all__ = [
     "four_sps_cu_legs",
     "ik_pack",
     "ik_track",
+    "joint_points_many",
     "limb_gn",
     "limb_inverse_many",
+    "link_margins_many",
     "loop_square_batch",
     "lstsq",
     "minnorm_blocks",
     "pack_loop_system",
     "retract",
     "sps_leg_lengths",
+    "task_grid",
+    "task_solve",
     "track_parameter",
     "warm_up",
 ]
