@@ -63,6 +63,7 @@ __all__ = [
     "certify",
     "certify_forward",
     "certify_inverse",
+    "certify_projective",
     "enabled",
     "limb_point",
     "limb_system",
@@ -684,17 +685,29 @@ def certify_forward(Qt: np.ndarray, real_points: Sequence[np.ndarray | None],
     """Certificates of the Study formulation's seven quadrics ``Qt`` (7, 8, 8, real: the
     requested actuator values) for the listed real solutions (their Study parameters,
     :func:`study_parameters`; ``None``: not attempted) and the complex end points (k, 8): all in
-    one real affine patch, so that they are told apart together and the real ones proven real."""
+    one real affine patch, so that they are told apart together and the real ones proven real
+    (:func:`certify_projective`)."""
+    return certify_projective(Qt, real_points, complex_points)
+
+
+def certify_projective(Q: np.ndarray, real_points: Sequence[np.ndarray | None],
+                       complex_points: np.ndarray = ()) -> tuple[list[Certificate | None], list[Certificate]]:
+    """Certificates of ``k`` homogeneous quadrics ``x^T Q_j x = 0`` (``Q`` (k, k + 1, k + 1), real)
+    for points of ``P^k``: the listed real points (``None``: not attempted) and the complex ones
+    (m, k + 1), all scaled onto one real affine patch ``c . x = 1`` (:func:`_real_patch`), so that
+    they are told apart together and the real ones proven real.  Used by the Study formulation
+    and the closed forms' quadrics (the wrist's quaternion, the 5-CS's rotation entries)."""
+    n = np.asarray(Q).shape[1]
     have = [i for i, x in enumerate(real_points) if x is not None]
-    R = np.array([np.asarray(real_points[i], dtype=complex) for i in have]).reshape(len(have), 8)
-    C = np.asarray(complex_points, dtype=complex).reshape(-1, 8)
+    R = np.array([np.asarray(real_points[i], dtype=complex) for i in have]).reshape(len(have), n)
+    C = np.asarray(complex_points, dtype=complex).reshape(-1, n)
     P = np.vstack([R, C])
     if len(P) == 0:
         return [None] * len(real_points), []
     c = _real_patch(P)
     s = P @ c
     P = P / np.where(np.abs(s) > 0, s, 1.0)[:, None]
-    certs = certify(quadric_system(np.real(Qt), c[None], [1.0]), P, real=[True] * len(R) + [False] * len(C))
+    certs = certify(quadric_system(np.real(Q), c[None], [1.0]), P, real=[True] * len(R) + [False] * len(C))
     out: list[Certificate | None] = [None] * len(real_points)
     for k, i in enumerate(have):
         out[i] = certs[k]
