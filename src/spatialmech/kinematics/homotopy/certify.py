@@ -234,17 +234,17 @@ def _one(system: BallSystem, y: np.ndarray, max_radius: float,
     """(radius, reason, real box) of one point: the smallest box that passes, or why none does.
     A real point of a real system gets a real box (uniqueness among real points).
 
-    ``F'`` is enclosed once over the largest box (it encloses ``F'`` over every smaller one, so
-    one evaluation serves every radius tried; the preconditioner ``A`` is the inverse of its
-    midpoint, or ``Ainv`` when given: any matrix serves); a radius that fails with it is tried
-    again with ``F'`` over its own box."""
+    ``F'`` is enclosed once over a box ``CERTIFY_GROWTH`` times wider than the first one tried
+    (it encloses ``F'`` over every box inside it, so one evaluation serves those radii; the
+    preconditioner ``A`` is the inverse of its midpoint, or ``Ainv`` when given: any matrix
+    serves); a radius beyond it is tried with ``F'`` over its own box."""
     n = system.n
     f = REAL if system.real and not np.any(y.imag) else COMPLEX
     yc = f.col(y.real if f.real else y)
     scale = 1.0 + float(np.max(np.abs(y)))
     rmax = max_radius * scale
-    J = system.jacobian(yc + f.radius_col(n, _pow2_up(rmax)))
-    Ainv = _inverse(_mid(J)) if Ainv is None else Ainv
+    if Ainv is None:
+        Ainv = _inverse(_mid(system.jacobian(yc)))
     if Ainv is None:
         return None, "the Jacobian is singular at the point", f.real
     A = f.mat(Ainv.real if f.real else Ainv)
@@ -254,14 +254,14 @@ def _one(system: BallSystem, y: np.ndarray, max_radius: float,
     if not r <= rmax:
         return None, (f"its Newton correction ({step:.1e}) exceeds the largest box ({rmax:.1e}): not an accurate "
                       "approximation of a root"), f.real
+    rJ = min(_pow2_up(rmax), r * CERTIFY_GROWTH)  # the box of the shared enclosure of F'
     eye = f.identity(n)
-    M = eye - A * J
+    M = eye - A * system.jacobian(yc + f.radius_col(n, rJ))
     base = yc - AF
     while r <= rmax:
         D = f.radius_col(n, r)
-        if _contained(yc + D, base + M * D, n):
-            return r, "", f.real
-        if _contained(yc + D, base + (eye - A * system.jacobian(yc + D)) * D, n):
+        Mr = M if r <= rJ else eye - A * system.jacobian(yc + D)
+        if _contained(yc + D, base + Mr * D, n):
             return r, "", f.real
         r *= CERTIFY_GROWTH
     return None, ("the Krawczyk test failed in every box up to the largest (a singular root, or roots closer than the "
@@ -466,12 +466,12 @@ class LimbBallSystem:
                 dMs.append(((idx[0], A),))
         pre = [eye]
         for M in Ms:
-            pre.append(pre[-1] * M)
+            pre.append(M if len(pre) == 1 else pre[-1] * M)  # no product with the identity
         if not want:
             return pre[-1], pre, [], dMs
         suf = [eye]
         for M in reversed(Ms):
-            suf.append(M * suf[-1])
+            suf.append(M if len(suf) == 1 else M * suf[-1])
         suf.reverse()  # suf[i] = M_i ... M_last
         return pre[-1], pre, suf, dMs
 
@@ -510,13 +510,13 @@ class LimbBallSystem:
             for i, dm in enumerate(dL):
                 tail = sufL[i + 1] * c
                 for z, dM in dm:
-                    u = preL[i] * (dM * tail)
+                    u = dM * tail if i == 0 else preL[i] * (dM * tail)
                     for r in range(3):
                         J[k + r][z] = s * u[r, 0]
             for i, dm in enumerate(dR):
                 tail = sufR[i + 1] * c
                 for z, dM in dm:
-                    v = E * (preR[i] * (dM * tail))
+                    v = E * (dM * tail if i == 0 else preR[i] * (dM * tail))
                     for r in range(3):
                         J[k + r][z] = -v[r, 0]
         else:
