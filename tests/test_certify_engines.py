@@ -58,8 +58,8 @@ def test_the_5cs_homogeneous_quadrics_are_its_float_system():
     D, E, U, ua, r = link.s[o] - link.s[a], g[None] - link.c[o], link.u[o], link.u[a], link.r[o]
     Q = csf.homogeneous_quadrics(D, E, U, ua, r)
     X = np.random.default_rng(3).normal(size=(5, 10)) + 1j * np.random.default_rng(4).normal(size=(5, 10))
-    P, _ = csf._orth(X)  # noqa: SLF001 - the float system itself
-    F, _ = csf._target(X, D, E, U, ua.astype(complex), r)  # noqa: SLF001
+    P, _ = csf._orth(X)
+    F, _ = csf._target(X, D, E, U, ua.astype(complex), r)
     Z = np.hstack([X, np.ones((5, 1))])
     hom = np.einsum("ni,kij,nj->nk", Z, Q, Z)
     assert np.allclose(hom, np.hstack([P, F]), rtol=1e-12, atol=1e-12)
@@ -121,3 +121,32 @@ def test_a_perturbed_loop_configuration_is_not_certified(rssr):
     X[0, 0] += 1e-6
     bad = C.certify(LoopBallSystem(sysm, p), X)
     assert not bad[0].certified and bad[1].certified
+
+
+# ------------------------------------------------------------------ 3-UPU, equal short legs (issue 27)
+def _endpoint(e, g, status):
+    from spatialmech.kinematics.homotopy.study import HomotopySolution
+
+    y = np.concatenate([e, g]).astype(complex)
+    return HomotopySolution(status, y, 1e-13, 1.5e-7, float(np.linalg.norm(y.imag) / np.linalg.norm(y)), 1e-12)
+
+
+def test_singular_end_points_near_the_exceptional_generator_are_described():
+    from spatialmech.kinematics.homotopy.study import _near_infinity_note
+    from spatialmech.results import EndPointStatus
+
+    # the end point of the 3-UPU at legs 0.05 m: e ~ 4e-4 |x|, g isotropic (g.g = 0), far from real
+    near = _endpoint([-1.1e-4 + 3.5e-4j, 0, 0, -1.7e-4], [-1.1e-4, 0.568j, 0.568, 4.8e-5], EndPointStatus.SINGULAR)
+    finite = _endpoint([0.7, 0.1, 0.0, 0.7j], [0.1, 0.2, 0.3, 0.1], EndPointStatus.SINGULAR)
+    note = _near_infinity_note([near, finite])
+    assert "1 of the singular end point(s) lie near the exceptional generator e = 0" in note
+    assert "g isotropic" in note and "none is near a real pose" in note
+    assert _near_infinity_note([finite]) == ""
+
+
+@pytest.mark.slow
+def test_three_upu_equal_short_legs_says_why_not_proven():
+    fk = sm.fk("three-upu", [0.05, 0.05, 0.05], all_solutions=True)
+    assert fk.engine == "homotopy" and not fk.complete and len(fk.modes) == 0
+    assert "lie near the exceptional generator e = 0" in fk.completeness
+    assert "the translational closed form (three spheres: at most 2, Bezout) gives 0 real" in fk.completeness

@@ -280,7 +280,8 @@ def _ik_text(r: sm.IKResult) -> None:
                    "continuation (proven complete) where it covers the model, else multi-start.")
 @click.option("--method", type=click.Choice(["auto", "closed-form", "homotopy", "multistart"]), default="auto",
               show_default=True,
-              help="Method of --all (closed-form: the registered closed forms of --all; homotopy: proven complete for S-P-S and R-P-S legs, "
+              help="Method of --all (closed-form: the registered closed forms of --all; homotopy: proven complete for "
+                   "S-P-S and R-P-S legs, "
                    "passive C-U limbs, ...; by monodromy, not proven, for other limbs of R, P, C, U, S joints; "
                    "multistart: the general multi-start search on any model; see docs/homotopy.md).")
 @click.option("--seeds", type=click.IntRange(min=1, max=MAX_SEEDS), default=None,
