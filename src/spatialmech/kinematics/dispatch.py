@@ -244,7 +244,9 @@ def _four_sps_cu_forward(mech: Mechanism):
                                       float(s.condition), float(s.singular_below), s.members, s.self_motion,
                                       flags=flags))
         return ForwardAnswer("closed-form", "closed-form multi-start", True, tuple(modes), False,
-                             "multi-seed search of the closed form: not a proof; assembly modes may be missing",
+                             "multi-seed search of the closed form: not a proof; assembly modes may be missing "
+                             "(method='homotopy', fk --method homotopy, proves the set complete in the Study "
+                             "formulation)",
                              fa.search.n_seeds, fa.search.n_converged, None, None, fa)
 
     return solve
