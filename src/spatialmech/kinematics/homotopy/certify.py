@@ -691,7 +691,7 @@ def certify_forward(Qt: np.ndarray, real_points: Sequence[np.ndarray | None],
 
 
 def certify_projective(Q: np.ndarray, real_points: Sequence[np.ndarray | None],
-                       complex_points: np.ndarray = ()) -> tuple[list[Certificate | None], list[Certificate]]:
+                       complex_points: np.ndarray | None = None) -> tuple[list[Certificate | None], list[Certificate]]:
     """Certificates of ``k`` homogeneous quadrics ``x^T Q_j x = 0`` (``Q`` (k, k + 1, k + 1), real)
     for points of ``P^k``: the listed real points (``None``: not attempted) and the complex ones
     (m, k + 1), all scaled onto one real affine patch ``c . x = 1`` (:func:`_real_patch`), so that
@@ -700,7 +700,7 @@ def certify_projective(Q: np.ndarray, real_points: Sequence[np.ndarray | None],
     n = np.asarray(Q).shape[1]
     have = [i for i, x in enumerate(real_points) if x is not None]
     R = np.array([np.asarray(real_points[i], dtype=complex) for i in have]).reshape(len(have), n)
-    C = np.asarray(complex_points, dtype=complex).reshape(-1, n)
+    C = np.asarray(() if complex_points is None else complex_points, dtype=complex).reshape(-1, n)
     P = np.vstack([R, C])
     if len(P) == 0:
         return [None] * len(real_points), []

@@ -188,7 +188,7 @@ class LoopSystem:
     # -------------------------------------------------------------------------- evaluation
     def _chain(self, factors, Z):
         n, nz = Z.shape
-        T = np.broadcast_to(_I4, (n, 4, 4)).astype(_dt(Z))
+        T: np.ndarray = np.broadcast_to(_I4, (n, 4, 4)).astype(_dt(Z))
         dT = np.zeros((n, nz, 4, 4), _dt(Z))
         for f in factors:
             sg = -1.0 if f.inverse else 1.0
