@@ -282,7 +282,8 @@ def _ik_text(r: sm.IKResult) -> None:
               show_default=True,
               help="Method of --all (closed-form: the registered closed forms of --all; homotopy: proven complete for "
                    "S-P-S and R-P-S legs, "
-                   "passive C-U limbs, ...; by monodromy, not proven, for other limbs of R, P, C, U, S joints; "
+                   "passive C-U limbs, ...; by monodromy, proven when its trace test passes, for other limbs of R, P, C, U, S "
+                   "joints; "
                    "multistart: the general multi-start search on any model; see docs/homotopy.md).")
 @click.option("--seeds", type=click.IntRange(min=1, max=MAX_SEEDS), default=None,
               help=f"Number of starts of a multi-start search with --all (default: 200; 512 on the 4-SPS/CU closed "
