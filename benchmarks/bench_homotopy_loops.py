@@ -16,6 +16,11 @@ noisy, compare the ratios.
 
 ``--loop-formulation`` also runs the loop formulation alone (kinematics/homotopy/general.py) on
 rssr, planar-4r, bennett and (unless --quick) a general 6R limb, as before.
+
+Certificates (issue 27): every case reports ``n_certified`` (the regular solutions certified by
+the Krawczyk test: the closed forms' systems, the loop formulation's square system) and
+``certify_fraction``: the certificates' time (``certify_elapsed_s`` of the second solve) over
+the rest of that solve; target <= 25 % (``certify_verdict``).
 """
 
 from __future__ import annotations
@@ -37,6 +42,7 @@ from spatialmech.kinematics.homotopy import study as hs
 
 TARGET_WRIST_S = 5.0
 TARGET_LOOP_S = 10.0
+TARGET_CERTIFY_FRACTION = 0.25
 
 
 def bricard_6r() -> sm.Mechanism:
@@ -90,7 +96,14 @@ def fk_case(mech: sm.Mechanism, x, x2, target: float) -> dict:
     found = sum(min(np.linalg.norm(m.pose.R - o.pose.R) + np.linalg.norm(m.pose.p - o.pose.p) / L
                     for o in r.modes) < 1e-7 for m in ms.modes) if r.modes else 0
     met = r.complete and r2.complete and first < target
-    return {"model": mech.name, "engine": r.engine, "complete": r.complete, "complete_again": r2.complete,
+    cert_s = float(r2.answer.detail.search.get("certify_elapsed_s") or 0.0)
+    frac = cert_s / max(again - cert_s, 1e-9)
+    n_reg = sum(str(m.kind) == "regular" for m in r.modes)
+    n_cert = r.to_dict()["n_certified"]
+    return {"n_regular": n_reg, "n_certified": n_cert, "certify_s": round(cert_s, 4),
+            "certify_fraction": round(frac, 3),
+            "certify_verdict": "met" if n_cert == n_reg and frac <= TARGET_CERTIFY_FRACTION else "NOT met",
+            "model": mech.name, "engine": r.engine, "complete": r.complete, "complete_again": r2.complete,
             "completeness": r.completeness, "n_modes": sum(m.assembly_mode for m in r.modes),
             "n_input_independent": r.answer.n_input_independent, "n_real": e.n_real if e else None,
             "n_complex": e.n_complex if e else None, "n_at_infinity": e.n_at_infinity if e else None,
@@ -152,7 +165,9 @@ def main() -> None:
               f"modes {r['n_modes']:2d} (+{r['n_input_independent']} input-independent)  paths {r['n_paths']}  "
               f"first {r['first_s']:6.2f} s  again {r['again_s']:6.2f} s  multistart {r['multistart_s']:6.2f} s "
               f"({r['multistart_modes']} found, {r['multistart_found_by_ours']} among ours)  ratio "
-              f"{r['ratio_first_over_multistart']:.2f}  target proven < {r['target_s']:g} s: {r['verdict']}")
+              f"{r['ratio_first_over_multistart']:.2f}  target proven < {r['target_s']:g} s: {r['verdict']}; "
+              f"certified {r['n_certified']} of {r['n_regular']} regular, certificates {r['certify_fraction']:.1%} "
+              f"of a re-solve (target <= {TARGET_CERTIFY_FRACTION:.0%}): {r['certify_verdict']}")
     for r in loops:
         print(f"loop formulation {r['model']:10s} generic {r['n_generic']:4d} real {r['n_real']:2d} "
               f"{r['seconds']:.2f} s trace test {r['trace_test']}: {'complete' if r['complete'] else 'NOT proven'}")

@@ -109,11 +109,13 @@ def test_fk_no_certify_and_text(stewart):
 
 
 @pytest.mark.slow
-def test_multistart_and_closed_form_are_not_certified():
+def test_the_closed_form_multistart_poses_are_certified_in_the_study_formulation():
+    # the 4-SPS/CU closed form's search proves nothing about completeness, but each pose it
+    # found is certified as a real root of the Study formulation (tests/test_certify_engines.py)
     r = sm.fk("four-sps-cu", [0.216745, 0.23896, 0.227321, 0.206933], all_solutions=True, seeds=32)
     d = r.to_dict()
-    assert r.engine == "closed-form" and d["n_certified"] is None
-    assert all(s["certified"] is None for s in d["solutions"])
+    assert r.engine == "closed-form" and not r.complete and d["n_certified"] == len(r.modes) == 4
+    assert all(s["certified"] is True for s in d["solutions"])
 
 
 # ------------------------------------------------------------------ the exact system

@@ -53,6 +53,7 @@ def test_the_6r_loop_configurations_proven(bricard_all):
     assert e.n_generic == 16 and e.n_real == len(r.modes) == 2
     assert e.n_real + e.n_complex + e.n_spurious + e.n_singular + e.n_at_infinity == 16
     assert all(m.residual < 1e-10 and m.assembly_mode for m in r.modes)
+    assert r.to_dict()["n_certified"] == 2  # certified as roots of the padded 6R's limb system
 
 
 @pytest.mark.slow

@@ -292,18 +292,21 @@ def fk(model: ModelLike, actuators, *, all_solutions: bool = False, seeds: int |
         ``progress(done, total_or_None, message)``, called as the work goes on.
     method : {"auto", "closed-form", "homotopy", "multistart"}
         With ``all_solutions``: ``"auto"``: a registered closed form where one recognises the model
-        (the 4-SPS/CU of paper B's layout), else homotopy continuation where it covers the model
+        (the 4-SPS/CU of paper B's layout, a multi-seed search, not a proof; a spherical 3-RRR
+        wrist, a 5-CS linkage, a single loop of 4 to 7 R joints: proven complete), else homotopy
+        continuation where it covers the model
         (S-P-S and R-P-S legs, passive C-U limbs: proven complete), else the loop formulation by
         monodromy (limbs of R, P, C, U, Sm and S joints; complete when its trace test passes),
         else the multi-start search; ``"closed-form"``: the registered closed form;
         ``"homotopy"``: homotopy continuation or the loop formulation, uncapped;
         ``"multistart"``: the general multi-start search (never a proof).
     certify : bool
-        Certify each solution of homotopy continuation in Study parameters (a Krawczyk test in
-        ball arithmetic: a unique real root of the exact system near it, distinct from the others
-        and from the complex end points; ``certified`` per solution and ``n_certified`` in
-        ``to_dict()``, docs/homotopy.md); ``False`` skips it (``certified`` is then ``None``, as
-        for the other engines).
+        Certify each solution of ``all_solutions`` (a Krawczyk test in ball arithmetic: a unique
+        root of the engine's exact polynomial system near it, distinct from the others: the Study
+        formulation, real and also distinct from the complex end points; the closed forms'
+        systems; the loop formulation's square system; ``certified`` per solution and
+        ``n_certified`` in ``to_dict()``, docs/homotopy.md); ``False`` skips it (``certified`` is
+        then ``None``, as for the multi-start).
 
     Returns
     -------

@@ -275,18 +275,22 @@ def _ik_text(r: sm.IKResult) -> None:
 @click.option("--actuators", "values", required=True,
               help="Comma-separated actuator values in mechanism order (degrees / length).")
 @click.option("--all", "all_solutions", is_flag=True,
-              help="All real assembly modes: a closed form where one recognises the model (4-SPS/CU), else homotopy "
+              help="All real assembly modes: a closed form where one recognises the model (the 4-SPS/CU of paper B, "
+                   "a spherical 3-RRR wrist, a 5-CS linkage, a single loop of 4 to 7 R joints), else homotopy "
                    "continuation (proven complete) where it covers the model, else multi-start.")
 @click.option("--method", type=click.Choice(["auto", "closed-form", "homotopy", "multistart"]), default="auto",
               show_default=True,
-              help="Method of --all (closed-form: the 4-SPS/CU's; homotopy: proven complete for S-P-S and R-P-S legs, "
-                   "passive C-U limbs, ...; by monodromy, not proven, for other limbs of R, P, C, U, S joints; "
+              help="Method of --all (closed-form: the registered closed forms of --all; homotopy: proven complete for "
+                   "S-P-S and R-P-S legs, "
+                   "passive C-U limbs, ...; by monodromy, proven when its trace test passes, for other limbs of R, P, C, U, S "
+                   "joints; "
                    "multistart: the general multi-start search on any model; see docs/homotopy.md).")
 @click.option("--seeds", type=click.IntRange(min=1, max=MAX_SEEDS), default=None,
               help=f"Number of starts of a multi-start search with --all (default: 200; 512 on the 4-SPS/CU closed "
                    f"form; at most {MAX_SEEDS}); refused where homotopy continuation answers.")
 @click.option("--no-certify", "no_certify", is_flag=True,
-              help="With --all: skip the certificates of the homotopy's solutions (Krawczyk test in ball arithmetic).")
+              help="With --all: skip the certificates of the solutions (Krawczyk test in ball arithmetic; homotopy, "
+                   "closed forms, loop formulation).")
 @tol_option("newton")
 @json_option
 def fk(model, values, all_solutions, method, seeds, no_certify, as_json):
@@ -357,7 +361,8 @@ def _fk_text(r: sm.FKResult) -> None:
         click.echo(f"{mech.name}: {n_real} real assembly mode{'s' if n_real != 1 else ''}"
                    + (f" ({n_sm} of them self-motion sets)" if n_sm else "") + ii
                    + f"; end points: {e.n_real} real, {e.n_complex} complex, {e.n_singular} singular, "
-                   f"{e.n_at_infinity} at infinity, of {e.n_generic} generic solutions"
+                   f"{e.n_at_infinity} at infinity, of {e.n_generic} "
+                   + ("paths (the closed form's root bound)" if a.engine == "closed-form" else "generic solutions")
                    + (f" ({e.n_spurious} spurious end points of the square system discarded)" if e.n_spurious is not None
                       else "")
                    + f" ({a.label}, {e.elapsed_s:.2f} s)")

@@ -230,22 +230,38 @@ def _four_sps_cu_forward(mech: Mechanism):
         fa = k4f.forward_all(np.asarray(values, float), geometry=geom, qmc_seed=0 if seed is None else seed, **kw)
         modes = []
         targets = actuator_targets(mech, values)
-        for n, s in enumerate(fa.solutions):
-            if not s.converged:
-                continue
+        conv = [(n, s, Pose(k4.rotation(s.phi), k4.pose_transform(s.phi)[:3, 3], f"mode {n + 1}"))
+                for n, s in enumerate(fa.solutions) if s.converged]
+        cfgs = [configuration_at_pose(mech, pose, targets) for _, _, pose in conv]
+        certs = _closed_form_certificates(mech, values, [c.D for c in cfgs])
+        for (_n, s, pose), cfg, cert in zip(conv, cfgs, certs, strict=True):
             d = s.to_dict(actuators=mech.actuators)
             assert s.kind is not None
-            pose = Pose(k4.rotation(s.phi), k4.pose_transform(s.phi)[:3, 3], f"mode {n + 1}")
-            flags = solution_flags(mech, configuration_at_pose(mech, pose, targets), targets,
-                                   forward_singular=bool(s.sigma_min < s.singular_below))
+            flags = solution_flags(mech, cfg, targets,
+                                   forward_singular=bool(s.sigma_min < s.singular_below),
+                                   certified=None if cert is None else cert.certified)
             modes.append(AssemblyMode(pose, s.kind, d["residual"], tuple(d["outside_limits"]), float(s.sigma_min),
                                       float(s.condition), float(s.singular_below), s.members, s.self_motion,
                                       flags=flags))
         return ForwardAnswer("closed-form", "closed-form multi-start", True, tuple(modes), False,
-                             "multi-seed search of the closed form: not a proof; assembly modes may be missing",
+                             "multi-seed search of the closed form: not a proof; assembly modes may be missing "
+                             "(method='homotopy', fk --method homotopy, proves the set complete in the Study "
+                             "formulation)",
                              fa.search.n_seeds, fa.search.n_converged, None, None, fa)
 
     return solve
+
+
+def _closed_form_certificates(mech: Mechanism, values, displacements: list) -> list:
+    """The certificates of a closed form's platform displacements as roots of the Study
+    formulation's system (:func:`.forward.study_certificates`); ``None`` each when certification
+    is off."""
+    from .forward import study_certificates
+    from .homotopy.certify import enabled
+
+    if not enabled() or not displacements:
+        return [None] * len(displacements)
+    return study_certificates(mech, values, displacements)
 
 
 #: Closed forms of forward position, tried in order by :func:`solve_forward`.  (The spherical

@@ -12,6 +12,7 @@ Inverse position and poses onto the manifold: :mod:`.position`.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -589,6 +590,19 @@ def _certify_solutions(mech: Mechanism, vals, sols: list, hr) -> tuple[list, dic
                  "certify_elapsed_s": perf_counter() - t0}
 
 
+def study_certificates(mech: Mechanism, vals, displacements: Sequence[np.ndarray | None]) -> list:
+    """Certificates (:class:`.homotopy.certify.Certificate`, ``None`` where the displacement is
+    ``None``) of platform displacements (4x4, model units) as real roots of the Study
+    formulation's exact system at the actuator values ``vals`` (a model it covers): the
+    certificates of a closed form's poses (the 4-SPS/CU's)."""
+    from .homotopy import certify as hcert
+    from .homotopy.systems import pose_system
+
+    sysm = pose_system(mech)
+    pts = [None if D is None else hcert.study_parameters(D, sysm.L) for D in displacements]
+    return hcert.certify_forward(sysm.coefficients(np.asarray(vals, dtype=float)), pts, np.zeros((0, 8)))[0]
+
+
 def _group_runs(mech: Mechanism, runs: list, origins: list[str] | None = None) -> tuple[list, list]:
     """The converged runs grouped into results (distinct poses, self-motions), in the order found;
     ``origins[i]`` the status of the homotopy end point that run ``i`` polished (the runs past
@@ -642,6 +656,7 @@ def _forward_general(mech: Mechanism, targets: dict[int, float], seed: int, max_
     if hr.count(EndPointStatus.SINGULAR) or not hr.complete:
         runs += _multistart_runs(mech, targets, mask, n_seeds, seed, max_iter)
     sols, conv = _group_runs(mech, runs, origins)
+    sols, cert = _certify_loop_solutions(mech, targets, sols)
     kinds = [s.kind for s in sols]
     extra = len(runs) - n_endpoint_runs
     why_more = "singular end points" if hr.count(EndPointStatus.SINGULAR) else "not proven complete"
@@ -662,8 +677,31 @@ def _forward_general(mech: Mechanism, targets: dict[int, float], seed: int, max_
               "trace_deviation": _json_float(hr.trace.deviation) if hr.trace else None,
               "n_witness": hr.trace.n_witness if hr.trace else 0,
               "trace_elapsed_s": hr.trace.seconds if hr.trace else 0.0,
-              "endpoints": [e.to_dict() for e in hr.solutions], "singular_below": singular_threshold(),
-              "n_certified": None, "certification": ("not attempted: the loop formulation has no evaluation in ball "
-                                                     "arithmetic (only the Study formulation and limbs' inverse position "
-                                                     "are certified)")}
+              "endpoints": [e.to_dict() for e in hr.solutions], "singular_below": singular_threshold(), **cert}
     return ForwardResult(tuple(sols), search)
+
+
+def _certify_loop_solutions(mech: Mechanism, targets: dict[int, float], sols: list) -> tuple[list, dict]:
+    """Each converged solution certified as a root of the loop formulation's square system at
+    ``targets`` (:func:`.homotopy.certify_loops.certify_loop`); the search fields ``n_certified``,
+    ``certification``, ``certify_elapsed_s``.  Nothing when certification is off."""
+    from time import perf_counter
+
+    from .homotopy import certify as hcert
+    from .homotopy.certify_loops import certify_loop
+    from .homotopy.loop_system import loop_system
+
+    if not hcert.enabled():
+        return sols, {"n_certified": None, "certification": "not attempted (certification off)"}
+    t0 = perf_counter()
+    sysm = loop_system(mech)
+    idx = [i for i, s in enumerate(sols) if s.converged]
+    certs = certify_loop(sysm, sysm.parameters(targets), [sols[i].config for i in idx])
+    out = list(sols)
+    for i, c in zip(idx, certs, strict=True):
+        out[i] = replace(sols[i], certified=c.certified, certificate=c.to_dict())
+    text = hcert.statement(certs).replace("root of the exact polynomial system", "root of the loop formulation's exact "
+                                          "square system").replace(" of each, real, and", " of each (complex "
+                                                                   "coefficients: not proven real), and")
+    return out, {"n_certified": hcert.n_certified(certs), "certification": text,
+                 "certify_elapsed_s": perf_counter() - t0}

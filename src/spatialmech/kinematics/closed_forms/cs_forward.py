@@ -47,7 +47,7 @@ from ..homotopy.study import track
 from .projective_quadrics import solve_projective_quadrics
 from .spherical_rrr_forward import matrix_quadric, quaternion_rotation
 
-__all__ = ["CsLinkage", "clear_cache", "linkage_of", "recognise", "solve", "solve_rotations"]
+__all__ = ["CsLinkage", "clear_cache", "homogeneous_quadrics", "linkage_of", "recognise", "solve", "solve_rotations"]
 
 _N = 10  # unknowns: the 9 entries of R (row-major), sigma
 _IU = np.triu_indices(3)
@@ -184,6 +184,35 @@ def solve_rotations(link: CsLinkage, theta: float, *, seed: int = 0):
     homotopy on ``SO(3) x C`` (module docstring).  Returns ``(real, counts, complete, why)``:
     the real solutions (rotation, slide / L), the counts ``(real, complex, singular, at_infinity,
     paths)`` and whether every path is accounted for (``why``: what is not)."""
+    out, counts, complete, why, _ = _solve(link, theta, seed)
+    return out, counts, complete, why
+
+
+def homogeneous_quadrics(D, E, U, ua, r) -> np.ndarray:
+    """The system of :func:`solve_rotations` as 10 homogeneous quadrics ``z^T Q z`` (10, 11, 11,
+    real) in ``z = (R entries, sigma, h)`` (``h = 1``): ``R^T R - h^2 I`` (upper triangle), then
+    each dyad's ``|M z|^2 - (u_i . M z)^2 - r_i^2 h^2`` with ``W_i = M z = R D_i + sigma u_a + E_i h``
+    (the exact data of its certificates, :mod:`.certificates`)."""
+    Q = np.zeros((_N, _N + 1, _N + 1))
+    for m, (i, j) in enumerate(zip(*_IU, strict=True)):
+        for k in range(3):
+            Q[m, 3 * k + i, 3 * k + j] += 0.5
+            Q[m, 3 * k + j, 3 * k + i] += 0.5
+        Q[m, _N, _N] = -1.0 if i == j else 0.0
+    for d in range(len(D)):
+        M = np.zeros((3, _N + 1))
+        for a in range(3):
+            M[a, 3 * a:3 * a + 3] = D[d]
+        M[:, 9], M[:, _N] = np.real(ua), E[d]
+        P = np.eye(3) - np.outer(U[d], U[d])
+        Q[6 + d] = M.T @ P @ M
+        Q[6 + d, _N, _N] -= r[d] ** 2
+    return Q
+
+
+def _solve(link: CsLinkage, theta: float, seed: int):
+    """:func:`solve_rotations` and, last, ``(Q, Z)``: :func:`homogeneous_quadrics` and the
+    listed solutions' points ``z`` (real parts, ``h = 1``), for their certificates."""
     st = _start_system(seed)
     a, o = link.driven, link.others()
     g = link.line(theta)
@@ -247,7 +276,8 @@ def solve_rotations(link: CsLinkage, theta: float, *, seed: int = 0):
     why = ("" if complete else
            f"{int(sing.sum())} path(s) end at singular points (a multiple root or a continuum)" if sing.any() else
            f"{dup} paths end at one point (a path jump)" if dup else "the start system was not solved completely")
-    return out, counts, complete, why
+    Z = np.hstack([np.real(X[real | near]), np.ones((int(np.sum(real | near)), 1))])
+    return out, counts, complete, why, (homogeneous_quadrics(D, E, U, ua, r), Z)
 
 
 def _refine(X, D, E, U, ua, r, iters: int = 3) -> np.ndarray:
@@ -277,6 +307,7 @@ def solve(mech: Mechanism, values, *, seeds: int | None = None, seed: int | None
     configuration of the 5-CS linkage at the driven rotation ``values`` (rad), a
     :class:`..dispatch.ForwardAnswer`.  ``seeds`` is refused (no search); ``seed`` draws the
     start system and ``gamma``."""
+    from . import certificates
     from .forward_answer import Counts, answer_from_poses
 
     if seeds is not None:
@@ -286,7 +317,8 @@ def solve(mech: Mechanism, values, *, seeds: int | None = None, seed: int | None
     link = linkage_of(mech)
     assert link is not None
     theta = float(np.asarray(values, float).ravel()[0]) - link.offset
-    sols, (nr, nc, ns, ni, npaths), complete, why = solve_rotations(link, theta, seed=0 if seed is None else seed)
+    sols, (nr, nc, ns, ni, npaths), complete, why, (Q, Z) = _solve(link, theta, 0 if seed is None else seed)
+    certs = certificates.run(lambda: certificates.affine(Q, list(Z)))
     a = link.driven
     g = link.line(theta)
     p0 = np.asarray(mech.platform_point, float) / link.L
@@ -303,7 +335,7 @@ def solve(mech: Mechanism, values, *, seeds: int | None = None, seed: int | None
         how = f"NOT proven: of the {npaths} paths of the homotopy on SO(3) x C, {why}"
     return answer_from_poses(mech, values, poses, label=f"5-CS closed form (4 quadrics on SO(3) x C, {npaths} paths)",
                              complete=complete, completeness=how, counts=Counts(nr, nc, ns, ni, npaths),
-                             seconds=time.perf_counter() - t0)
+                             seconds=time.perf_counter() - t0, certified=certs)
 
 
 def recognise(mech: Mechanism):

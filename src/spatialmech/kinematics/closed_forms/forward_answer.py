@@ -8,6 +8,7 @@ their solution set complete (:mod:`.spherical_rrr_forward`)."""
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -19,6 +20,9 @@ from ..dispatch import AssemblyMode, EndPoints, ForwardAnswer
 from ..forward import ForwardResult, ForwardSolution, forward_conditioning
 from ..position import platform_pose, within_limits
 from ..solution_flags import actuator_targets, configuration_at_pose, solution_flags
+
+if TYPE_CHECKING:
+    from .certificates import Certified
 
 __all__ = ["Counts", "answer_from_poses"]
 
@@ -39,10 +43,12 @@ class Counts:
 
 def answer_from_poses(mech: Mechanism, values, poses: list[tuple[np.ndarray, np.ndarray]], *, label: str,
                       complete: bool, completeness: str, counts: Counts, seconds: float,
-                      max_iter: int = 30) -> ForwardAnswer:
+                      max_iter: int = 30, certified: Certified | None = None) -> ForwardAnswer:
     """The :class:`ForwardAnswer` (engine ``"closed-form"``) of the candidate platform poses
     ``poses`` (rotation, position of the platform point), each lifted and polished (module
-    docstring); a pose whose limbs do not close is dropped and ``complete`` withdrawn."""
+    docstring); a pose whose limbs do not close is dropped and ``complete`` withdrawn.
+    ``certified``: the certificates of the closed form's points, one per pose
+    (:mod:`.certificates`; ``None``: not attempted)."""
     targets = actuator_targets(mech, values)
     mask = active_mask(mech)
     for i in targets:
@@ -68,9 +74,11 @@ def answer_from_poses(mech: Mechanism, values, poses: list[tuple[np.ndarray, np.
         cond = forward_conditioning(mech, c)
         kind = AssemblyKind.SINGULAR if cond.singular else AssemblyKind.REGULAR
         outside = tuple(within_limits(mech, c.q))
-        flags = solution_flags(mech, c, targets, forward_singular=cond.singular, endpoint="real")
+        cert = certified.certificates[n] if certified is not None else None
+        ok = None if cert is None else cert.certified
+        flags = solution_flags(mech, c, targets, forward_singular=cond.singular, endpoint="real", certified=ok)
         sols.append(ForwardSolution(c, pose, True, float(res.residual), int(getattr(res, "iterations", 0)), outside,
-                                    cond, kind, 1, None, "real"))
+                                    cond, kind, 1, None, "real", ok, None if cert is None else cert.to_dict()))
         modes.append(AssemblyMode(pose, kind, float(res.residual), outside, cond.sigma_min, cond.condition,
                                   cond.threshold, 1, None, cond.free_dim, flags))
     if dropped:
@@ -83,7 +91,10 @@ def answer_from_poses(mech: Mechanism, values, poses: list[tuple[np.ndarray, np.
               "n_self_motion_sets": 0, "complete": complete, "completeness": completeness,
               "n_complex": counts.n_complex, "n_real": counts.n_real, "n_singular": counts.n_singular,
               "n_at_infinity": counts.n_at_infinity, "n_generic": counts.n_paths, "n_paths": counts.n_paths,
-              "elapsed_s": seconds, "endpoints": [], "singular_below": singular_threshold()}
+              "elapsed_s": seconds, "endpoints": [], "singular_below": singular_threshold(),
+              "n_certified": None if certified is None else certified.n_certified,
+              "certification": "not attempted" if certified is None else certified.statement,
+              "certify_elapsed_s": None if certified is None else certified.seconds}
     ends = EndPoints(counts.n_real, counts.n_complex, counts.n_singular, counts.n_at_infinity, counts.n_paths,
                      counts.n_spurious, seconds)
     return ForwardAnswer("closed-form", label, True, tuple(modes), complete, completeness, 0, len(modes), ends, None,

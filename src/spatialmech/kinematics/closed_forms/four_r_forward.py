@@ -85,6 +85,7 @@ def solve(mech: Mechanism, values, *, seeds: int | None = None, seed: int | None
     configuration of the four-bar loop at the driven joint's ``values`` (rad), a
     :class:`..dispatch.ForwardAnswer`.  ``seeds`` and ``seed`` are refused (nothing to search or
     draw)."""
+    from . import certificates
     from .forward_answer import Counts, answer_from_poses
 
     given = [n for n, v in (("seeds", seeds), ("seed", seed)) if v is not None]
@@ -121,8 +122,10 @@ def solve(mech: Mechanism, values, *, seeds: int | None = None, seed: int | None
            f"computed in closed form ({len(roots)} real, {n_complex} complex); {len(poses)} satisfy all five conditions "
            f"of the rigid coupler" + (f", {spurious} do not" if spurious else ""))
     double = len(roots) == 2 and abs(roots[0] - roots[1]) < 1e-9
+    kept = [phi for phi in roots if np.max(np.abs(alpha * np.cos(phi) + beta * np.sin(phi) + gamma)) <= 1e-9]
+    certs = certificates.run(lambda: certificates.four_bar(alpha[k], beta[k], gamma[k], kept[:1] if double else kept))
     return answer_from_poses(mech, values, poses[:1] if double else poses, label="four-bar closed form (2 roots)",
-                             complete=True, completeness=how,
+                             complete=True, completeness=how, certified=certs,
                              counts=Counts(len(poses), n_complex, int(double), 0, 2, spurious), seconds=time.perf_counter() - t0)
 
 

@@ -123,7 +123,9 @@ def solve(mech: Mechanism, values, *, seeds: int | None = None, seed: int | None
     configuration of the loop at the driven joint's ``values`` (rad), a
     :class:`..dispatch.ForwardAnswer` (module docstring).  ``seeds`` is refused (no search);
     ``seed`` is the 6R solve's."""
-    from ..homotopy.inverse import limb_inverse
+    from ..homotopy import certify as hcert
+    from ..homotopy.inverse import limb_ik_system, limb_inverse
+    from . import certificates
     from .forward_answer import Counts, answer_from_poses
 
     if seeds is not None:
@@ -151,11 +153,13 @@ def solve(mech: Mechanism, values, *, seeds: int | None = None, seed: int | None
            f"{n - 1}{added}, a 6R: {r.completeness}")
     if not r.complete:
         how = "NOT proven: " + how
+    certs = certificates.run(lambda: hcert.certify_inverse(limb_ik_system(loop.aux, 0, 0 if seed is None else seed), D,
+                                                           keep))
     return answer_from_poses(mech, values, poses, label=f"single {n}R loop as a 6R inverse position",
                              complete=r.complete, completeness=how,
                              counts=Counts(len(keep), r.n_complex, r.n_singular, r.n_infinity, r.n_paths,
                                            r.n_real - len(keep)),
-                             seconds=time.perf_counter() - t0)
+                             seconds=time.perf_counter() - t0, certified=certs)
 
 
 def recognise(mech: Mechanism):

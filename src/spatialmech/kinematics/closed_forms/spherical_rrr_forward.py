@@ -165,6 +165,13 @@ def forward_rotations(wrist: SphericalWrist, angles, *, seed: int = 0):
     Returns ``(rotations, counts, complete, seconds)``: the real rotations, the counts
     ``(real, complex, singular, at_infinity, paths)`` of the end points, and whether Bezout's
     bound proves the set complete."""
+    rots, counts, complete, seconds, _ = _forward_quaternions(wrist, angles, seed=seed)
+    return rots, counts, complete, seconds
+
+
+def _forward_quaternions(wrist: SphericalWrist, angles, *, seed: int = 0):
+    """:func:`forward_rotations` and, last, ``(A, Y)``: the three quadrics (3, 4, 4) and the
+    quaternions (unit, real) of the listed rotations, for their certificates."""
     U, V, K = wrist.conditions(angles)
     A = np.array([quaternion_quadric(U[i], V[i], K[i]) for i in range(3)])
     sol = solve_projective_quadrics(A, seed=seed)
@@ -175,7 +182,7 @@ def forward_rotations(wrist: SphericalWrist, angles, *, seed: int = 0):
     near = sing & (np.linalg.norm(sol.Y.imag, axis=1) < HOMOTOPY_NEAR_REAL)  # listed too (polished by the lift)
     rots = [_quaternion_matrix(np.real(y)) for y in sol.Y[real | near]]
     counts = (int(real.sum()), int((~sol.real & ~inf & ~sing).sum()), int(sing.sum()), int(inf.sum()), sol.n_paths)
-    return rots, counts, sol.complete, sol.seconds
+    return rots, counts, sol.complete, sol.seconds, (A, np.real(sol.Y[real | near]))
 
 
 def solve(mech: Mechanism, values, *, seeds: int | None = None, seed: int | None = None):
@@ -184,6 +191,7 @@ def solve(mech: Mechanism, values, *, seeds: int | None = None, seed: int | None
     :class:`..dispatch.ForwardAnswer`.  ``seeds`` is refused (no search); ``seed`` draws the
     homotopy's random patch and ``gamma``."""
     from ...errors import InputError
+    from . import certificates
     from .forward_answer import Counts, answer_from_poses
 
     if seeds is not None:
@@ -196,7 +204,9 @@ def solve(mech: Mechanism, values, *, seeds: int | None = None, seed: int | None
     order = [mech.freedom(a).limb for a in mech.actuators]
     angles = np.empty(3)
     angles[order] = vals - wrist.offsets[order]
-    rots, (nr, nc, ns, ni, npaths), proven, _ = forward_rotations(wrist, angles, seed=0 if seed is None else seed)
+    rots, (nr, nc, ns, ni, npaths), proven, _, (A, Y) = _forward_quaternions(wrist, angles,
+                                                                            seed=0 if seed is None else seed)
+    certs = certificates.run(lambda: certificates.projective(A, list(Y)))
     o, p0 = wrist.centre, np.asarray(mech.platform_point, float)
     poses = [(R, o + R @ (p0 - o)) for R in rots]
     if proven:
@@ -209,7 +219,7 @@ def solve(mech: Mechanism, values, *, seeds: int | None = None, seed: int | None
                "points at infinity, not 8 distinct nonsingular points")
     return answer_from_poses(mech, vals, poses, label="spherical 3-RRR closed form (3 quaternion quadrics, 8 paths)",
                              complete=proven, completeness=how, counts=Counts(nr, nc, ns, ni, npaths),
-                             seconds=time.perf_counter() - t0)
+                             seconds=time.perf_counter() - t0, certified=certs)
 
 
 def recognise(mech: Mechanism):

@@ -63,6 +63,7 @@ __all__ = [
     "certify",
     "certify_forward",
     "certify_inverse",
+    "certify_projective",
     "enabled",
     "limb_point",
     "limb_system",
@@ -233,17 +234,17 @@ def _one(system: BallSystem, y: np.ndarray, max_radius: float,
     """(radius, reason, real box) of one point: the smallest box that passes, or why none does.
     A real point of a real system gets a real box (uniqueness among real points).
 
-    ``F'`` is enclosed once over the largest box (it encloses ``F'`` over every smaller one, so
-    one evaluation serves every radius tried; the preconditioner ``A`` is the inverse of its
-    midpoint, or ``Ainv`` when given: any matrix serves); a radius that fails with it is tried
-    again with ``F'`` over its own box."""
+    ``F'`` is enclosed once over a box ``CERTIFY_GROWTH`` times wider than the first one tried
+    (it encloses ``F'`` over every box inside it, so one evaluation serves those radii; the
+    preconditioner ``A`` is the inverse of its midpoint, or ``Ainv`` when given: any matrix
+    serves); a radius beyond it is tried with ``F'`` over its own box."""
     n = system.n
     f = REAL if system.real and not np.any(y.imag) else COMPLEX
     yc = f.col(y.real if f.real else y)
     scale = 1.0 + float(np.max(np.abs(y)))
     rmax = max_radius * scale
-    J = system.jacobian(yc + f.radius_col(n, _pow2_up(rmax)))
-    Ainv = _inverse(_mid(J)) if Ainv is None else Ainv
+    if Ainv is None:
+        Ainv = _inverse(_mid(system.jacobian(yc)))
     if Ainv is None:
         return None, "the Jacobian is singular at the point", f.real
     A = f.mat(Ainv.real if f.real else Ainv)
@@ -253,14 +254,14 @@ def _one(system: BallSystem, y: np.ndarray, max_radius: float,
     if not r <= rmax:
         return None, (f"its Newton correction ({step:.1e}) exceeds the largest box ({rmax:.1e}): not an accurate "
                       "approximation of a root"), f.real
+    rJ = min(_pow2_up(rmax), r * CERTIFY_GROWTH)  # the box of the shared enclosure of F'
     eye = f.identity(n)
-    M = eye - A * J
+    M = eye - A * system.jacobian(yc + f.radius_col(n, rJ))
     base = yc - AF
     while r <= rmax:
         D = f.radius_col(n, r)
-        if _contained(yc + D, base + M * D, n):
-            return r, "", f.real
-        if _contained(yc + D, base + (eye - A * system.jacobian(yc + D)) * D, n):
+        Mr = M if r <= rJ else eye - A * system.jacobian(yc + D)
+        if _contained(yc + D, base + Mr * D, n):
             return r, "", f.real
         r *= CERTIFY_GROWTH
     return None, ("the Krawczyk test failed in every box up to the largest (a singular root, or roots closer than the "
@@ -465,12 +466,12 @@ class LimbBallSystem:
                 dMs.append(((idx[0], A),))
         pre = [eye]
         for M in Ms:
-            pre.append(pre[-1] * M)
+            pre.append(M if len(pre) == 1 else pre[-1] * M)  # no product with the identity
         if not want:
             return pre[-1], pre, [], dMs
         suf = [eye]
         for M in reversed(Ms):
-            suf.append(M * suf[-1])
+            suf.append(M if len(suf) == 1 else M * suf[-1])
         suf.reverse()  # suf[i] = M_i ... M_last
         return pre[-1], pre, suf, dMs
 
@@ -509,13 +510,13 @@ class LimbBallSystem:
             for i, dm in enumerate(dL):
                 tail = sufL[i + 1] * c
                 for z, dM in dm:
-                    u = preL[i] * (dM * tail)
+                    u = dM * tail if i == 0 else preL[i] * (dM * tail)
                     for r in range(3):
                         J[k + r][z] = s * u[r, 0]
             for i, dm in enumerate(dR):
                 tail = sufR[i + 1] * c
                 for z, dM in dm:
-                    v = E * (preR[i] * (dM * tail))
+                    v = E * (dM * tail if i == 0 else preR[i] * (dM * tail))
                     for r in range(3):
                         J[k + r][z] = -v[r, 0]
         else:
@@ -684,17 +685,29 @@ def certify_forward(Qt: np.ndarray, real_points: Sequence[np.ndarray | None],
     """Certificates of the Study formulation's seven quadrics ``Qt`` (7, 8, 8, real: the
     requested actuator values) for the listed real solutions (their Study parameters,
     :func:`study_parameters`; ``None``: not attempted) and the complex end points (k, 8): all in
-    one real affine patch, so that they are told apart together and the real ones proven real."""
+    one real affine patch, so that they are told apart together and the real ones proven real
+    (:func:`certify_projective`)."""
+    return certify_projective(Qt, real_points, complex_points)
+
+
+def certify_projective(Q: np.ndarray, real_points: Sequence[np.ndarray | None],
+                       complex_points: np.ndarray | None = None) -> tuple[list[Certificate | None], list[Certificate]]:
+    """Certificates of ``k`` homogeneous quadrics ``x^T Q_j x = 0`` (``Q`` (k, k + 1, k + 1), real)
+    for points of ``P^k``: the listed real points (``None``: not attempted) and the complex ones
+    (m, k + 1), all scaled onto one real affine patch ``c . x = 1`` (:func:`_real_patch`), so that
+    they are told apart together and the real ones proven real.  Used by the Study formulation
+    and the closed forms' quadrics (the wrist's quaternion, the 5-CS's rotation entries)."""
+    n = np.asarray(Q).shape[1]
     have = [i for i, x in enumerate(real_points) if x is not None]
-    R = np.array([np.asarray(real_points[i], dtype=complex) for i in have]).reshape(len(have), 8)
-    C = np.asarray(complex_points, dtype=complex).reshape(-1, 8)
+    R = np.array([np.asarray(real_points[i], dtype=complex) for i in have]).reshape(len(have), n)
+    C = np.asarray(() if complex_points is None else complex_points, dtype=complex).reshape(-1, n)
     P = np.vstack([R, C])
     if len(P) == 0:
         return [None] * len(real_points), []
     c = _real_patch(P)
     s = P @ c
     P = P / np.where(np.abs(s) > 0, s, 1.0)[:, None]
-    certs = certify(quadric_system(np.real(Qt), c[None], [1.0]), P, real=[True] * len(R) + [False] * len(C))
+    certs = certify(quadric_system(np.real(Q), c[None], [1.0]), P, real=[True] * len(R) + [False] * len(C))
     out: list[Certificate | None] = [None] * len(real_points)
     for k, i in enumerate(have):
         out[i] = certs[k]

@@ -62,6 +62,12 @@ __all__ = [
 _I4 = np.eye(4)
 
 
+def _dt(Z: np.ndarray) -> type:
+    """The dtype of the evaluation at ``Z``: complex, or ``object`` for ball arithmetic (python-flint
+    ``acb`` entries: the certificates of :mod:`.certify_loops` evaluate the same formulas)."""
+    return object if Z.dtype == object else complex
+
+
 @dataclass(frozen=True, eq=False)
 class _Factor:
     kind: str  # "R" or "P"
@@ -182,8 +188,8 @@ class LoopSystem:
     # -------------------------------------------------------------------------- evaluation
     def _chain(self, factors, Z):
         n, nz = Z.shape
-        T = np.broadcast_to(_I4, (n, 4, 4)).astype(complex)
-        dT = np.zeros((n, nz, 4, 4), complex)
+        T: np.ndarray = np.broadcast_to(_I4, (n, 4, 4)).astype(_dt(Z))
+        dT = np.zeros((n, nz, 4, 4), _dt(Z))
         for f in factors:
             sg = -1.0 if f.inverse else 1.0
             if f.kind == "R":
@@ -205,10 +211,10 @@ class LoopSystem:
         n, nz = Z.shape
         X = Z[:, k : k + 8]
         Dn = np.einsum("ni,abij,nj->nab", X, _STUDY_Q, X)
-        dDn = np.zeros((n, nz, 4, 4), complex)
+        dDn = np.zeros((n, nz, 4, 4), _dt(Z))
         dDn[:, k : k + 8] = np.einsum("abij,nj->niab", _STUDY_Q + _STUDY_Q.transpose(0, 1, 3, 2), X)
         E = np.einsum("ni,ni->n", X[:, :4], X[:, :4])
-        dE = np.zeros((n, nz), complex)
+        dE = np.zeros((n, nz), _dt(Z))
         dE[:, k : k + 4] = 2 * X[:, :4]
         return Dn, dDn, E, dE
 
@@ -217,8 +223,8 @@ class LoopSystem:
         of the ``e.e`` of the Study hubs it hangs from) and its derivative: ``{hub: (Hn, dHn, E,
         dE)}``, the ground (``None``) included."""
         n, nz = Z.shape
-        out: dict = {None: (np.broadcast_to(_I4, (n, 4, 4)).astype(complex), np.zeros((n, nz, 4, 4), complex),
-                            np.ones(n, complex), np.zeros((n, nz), complex))}
+        out: dict = {None: (np.broadcast_to(_I4, (n, 4, 4)).astype(_dt(Z)), np.zeros((n, nz, 4, 4), _dt(Z)),
+                            np.ones(n, _dt(Z)), np.zeros((n, nz), _dt(Z)))}
         for h in self.hubs:
             if h.study >= 0:
                 out[h.hub] = self._study_hub(Z, h.study)
@@ -321,7 +327,7 @@ class LoopSystem:
                 rows.append((np.einsum("na,na->n", w, w) - EE**2 * l2)[:, None])
                 jac.append((2 * np.einsum("na,nza->nz", w, dw) - 2 * (EE * l2)[:, None] * dEE)[:, None])
         if not rows:
-            return np.zeros((len(Z), 0), complex), np.zeros((len(Z), 0, Z.shape[1]), complex)
+            return np.zeros((len(Z), 0), _dt(Z)), np.zeros((len(Z), 0, Z.shape[1]), _dt(Z))
         return np.concatenate(rows, axis=1), np.concatenate(jac, axis=1)
 
     def side(self, Z):
@@ -329,8 +335,8 @@ class LoopSystem:
         n, nz = Z.shape
         st = self.studies
         k = len(self.circles) + 2 * len(st)
-        F = np.zeros((n, k), complex)
-        J = np.zeros((n, k, nz), complex)
+        F = np.zeros((n, k), _dt(Z))
+        J = np.zeros((n, k, nz), _dt(Z))
         for i, (a, b) in enumerate(self.circles):
             F[:, i] = Z[:, a] ** 2 + Z[:, b] ** 2 - 1
             J[:, i, a] = 2 * Z[:, a]

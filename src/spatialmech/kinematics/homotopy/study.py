@@ -254,6 +254,35 @@ def _classify(Qc, c, X):
     return out
 
 
+#: A singular end point is *near the exceptional generator* when ``|e| / |x|`` is below this
+#: (its ``e.e / |x|^2`` is then below its square, a few times ``HOMOTOPY_INFINITY`` at most).
+NEAR_GENERATOR = 1e-2
+
+
+def _near_infinity_note(sols) -> str:
+    """What the singular end points that did not reach ``e = 0`` are, when they are near it: the
+    paths run to the exceptional generator (no pose) through a continuum of solutions at infinity,
+    where an end game cannot converge; said precisely, with how near and how far from real."""
+    near = []
+    for s in sols:
+        if s.status != EndPointStatus.SINGULAR:
+            continue
+        y = np.asarray(s.study, dtype=complex)
+        ratio = float(np.linalg.norm(y[:4]) / max(float(np.linalg.norm(y)), 1e-300))
+        g = y[4:]
+        iso = float(abs(g @ g) / max(float(np.linalg.norm(g)) ** 2, 1e-300))
+        if ratio < NEAR_GENERATOR:
+            near.append((ratio, iso, s.imag_ratio))
+    if not near:
+        return ""
+    return (f"; {len(near)} of the singular end point(s) lie near the exceptional generator e = 0 (|e| / |x| <= "
+            f"{max(r for r, _, _ in near):.0e}, e.e / |x|^2 just above the {HOMOTOPY_INFINITY:g} that counts a point at "
+            f"infinity) with g isotropic (|g.g| / |g|^2 <= {max(i for _, i, _ in near):.0e}): paths running to "
+            "solutions at infinity (no pose) that form a continuum there, where the end game cannot converge; none is "
+            f"near a real pose (imaginary part >= {min(m for _, _, m in near):.0%} of the point); not proven only "
+            "because a numerical end point near infinity is no proof that the path ends there")
+
+
 def study_to_pose(x, L: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
     """Rotation and translation (model units, ``L`` the length scale) of real Study parameters."""
     x = np.real(np.asarray(x))
@@ -475,6 +504,7 @@ def homotopy_forward(mech: Mechanism | StewartSystem | PoseSystem, actuator_valu
         how += (f"; but {n_sing} end point(s) are singular and not all isolated multiple roots (a continuum of "
                 "solutions, or an end game that did not converge): not proven complete there; real points near them "
                 "polished, the multi-start roots added, and a continuum reported as one self-motion set")
+        how += _near_infinity_note(sols)
     if not accounted:
         how = (f"NOT complete: {gen.n_paths - len(gen.X) - gen.n_at_infinity} of the {gen.n_paths} total-degree paths "
                f"ended neither at a finite nonsingular point nor at infinity after {gen.attempts} attempts")
