@@ -603,7 +603,8 @@ def html_summary(title: str, doc: Mapping, records: str | None = None, columns: 
         def cell(r, c):
             v = r.get(c) if isinstance(r, dict) else None
             if c == "pose" and isinstance(v, dict):
-                return f"{html_cell(v.get('position_len'))}; {escape(str(v.get('euler_sequence')))} {html_cell(v.get('euler_deg'))} deg"
+                seq = escape(str(v.get("euler_sequence")))
+                return f"{html_cell(v.get('position_len'))}; {seq} {html_cell(v.get('euler_deg'))} deg"
             return html_cell(v)
         head = "".join(f"<th>{escape(c)}</th>" for c in ["#", *cols])
         body = "".join("<tr>" + f"<td>{k + 1}</td>" + "".join(f"<td>{cell(r, c)}</td>" for c in cols) + "</tr>"

@@ -65,7 +65,8 @@ def figure(state: dict, unit: str) -> dict:
         "type": "scatter3d", "mode": "lines", **_xyz(pts), "line": {"color": colour, "width": width}, "name": name, **kw}
     data = [line(sc["base_len"], "#555555", 5, "base (ground)"),
             line(sc["platform_len"], "#ff7f0e", 6, "platform")]
-    data += [line(pl, sc["limb_colours"][k], 8, name) for k, (pl, name) in enumerate(zip(sc["limbs_len"], sc["limb_names"]))]
+    limbs = zip(sc["limbs_len"], sc["limb_names"], strict=True)
+    data += [line(pl, sc["limb_colours"][k], 8, name) for k, (pl, name) in enumerate(limbs)]
     joints = sc["joints"]
     data.append({"type": "scatter3d", "mode": "markers", **_xyz([j["centre_len"] for j in joints]),
                  "marker": {"size": 3, "color": "#222222"}, "text": [f"{j['name']} ({j['type']})" for j in joints],
