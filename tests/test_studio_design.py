@@ -84,7 +84,7 @@ def test_a_sweep_stops_at_the_dead_points_and_puts_the_session_back(rssr):
     assert np.allclose(sw["joints_deg"]["A0.rot"], x, atol=1e-9)
     with pytest.raises(sm.InputError, match="samples: expected a whole number from 5 to 721"):
         s.desk.sweep(samples=2)
-    with pytest.raises(sm.InputError, match="driver: expected one of the drivers A0.rot"):
+    with pytest.raises(sm.InputError, match=r"driver: expected one of the drivers A0\.rot"):
         s.desk.sweep("nope")
 
 

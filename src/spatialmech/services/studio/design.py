@@ -180,7 +180,7 @@ class Desk:
         lo, hi = s.slider_range(aid, s.start_values[k], s.actuator_values()[k])
         v0 = _display(s)[k]
         kept = self._keep()
-        n_up = max(1, int(round((samples - 1) * (hi - v0) / max(hi - lo, 1e-300))))
+        n_up = max(1, round((samples - 1) * (hi - v0) / max(hi - lo, 1e-300)))
         try:
             here = self._sample(point)
             up, x_up, stop_up = self._walk(k, np.linspace(v0, hi, n_up + 1)[1:], point)
