@@ -191,6 +191,19 @@ def create_app(session) -> FastAPI:
             session.load(data["model"])
             return _json(doc({"model_info": session.model_info(), "state": session.state()}))
 
+    app.add_api_route("/api/circuit", guarded(circuit), methods=["GET"])
+    add_desk_routes(app, session, lock, doc, body, guarded)
+    for path, fn in (("/api/drive", drive), ("/api/pose", pose),
+                     ("/api/drivers", drivers), ("/api/fk_all", fk_all), ("/api/mode", mode),
+                     ("/api/load", load)):
+        app.add_api_route(path, guarded(fn), methods=["POST"])
+    return app
+
+
+def add_desk_routes(app: FastAPI, session, lock, doc, body, guarded) -> None:
+    """The design tools' routes (``session.desk``: snapshots, undo, coupler curve, sweep, the
+    driven path as CSV) on ``app``, with the helpers of :func:`create_app`."""
+
     async def snapshot(request: Request):
         data = await body(request, None)
         with lock:
@@ -223,16 +236,10 @@ def create_app(session) -> FastAPI:
             return Response(session.desk.path_csv(), media_type="text/csv",
                             headers={"Content-Disposition": f'attachment; filename="{name}-path.csv"'})
 
-    app.add_api_route("/api/circuit", guarded(circuit), methods=["GET"])
     app.add_api_route("/api/path.csv", guarded(path_csv), methods=["GET"])
     for path, fn in (("/api/snapshot", snapshot), ("/api/undo", undo), ("/api/restore", restore),
                      ("/api/coupler", coupler), ("/api/sweep", sweep)):
         app.add_api_route(path, guarded(fn), methods=["POST"])
-    for path, fn in (("/api/drive", drive), ("/api/pose", pose),
-                     ("/api/drivers", drivers), ("/api/fk_all", fk_all), ("/api/mode", mode),
-                     ("/api/load", load)):
-        app.add_api_route(path, guarded(fn), methods=["POST"])
-    return app
 
 
 def studio_app(model: sm.ModelLike = "five-cs-3") -> FastAPI:
