@@ -101,7 +101,7 @@ class StudioWidget(anywidget.AnyWidget):
     #: The last bad input or failed computation ("" when the last operation went through).
     error = traitlets.Unicode("").tag(sync=True)
     #: The assembly modes of the last ``fk_all``.
-    modes = traitlets.List().tag(sync=True)
+    modes: traitlets.List[dict] = traitlets.List().tag(sync=True)
 
     def __init__(self, session, **kwargs):
         super().__init__(_esm=esm_bundle(), **kwargs)

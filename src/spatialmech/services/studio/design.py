@@ -147,7 +147,9 @@ class Desk:
         """Drive driver ``k`` through ``values`` (display units) from the current configuration."""
         s = self.session
         base = _display(s)
-        out, inputs, stop = [], [], ""
+        out: list[dict] = []
+        inputs: list[float] = []
+        stop = ""
         for v in values:
             target = list(base)
             target[k] = float(v)
