@@ -77,7 +77,8 @@ async function sweepPlots() {
   Plotly.newPlot(box, data, { height: 420, margin: { l: 50, r: 50, t: 10, b: 40 }, showlegend: true,
     legend: { orientation: "h", x: 0, y: -0.25, font: { size: 9 } },
     xaxis: { title: { text: d.driver + " [" + d.input_unit + "]" } }, yaxis: { title: { text: "joint values" } },
-    yaxis2: { title: { text: "transmission" }, overlaying: "y", side: "right", range: [0, 1] } }, { displaylogo: false });
+    yaxis2: { title: { text: "transmission" }, overlaying: "y", side: "right", range: [0, 1], autorange: false, tickmode: "auto" } },
+    { displaylogo: false });
 }
 
 function designPanel() {
