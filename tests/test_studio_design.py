@@ -121,3 +121,18 @@ def test_the_desk_is_documented():
     text = (Path(__file__).parent.parent / "docs" / "studio.md").read_text(encoding="utf-8")
     for path in ("/api/snapshot", "/api/undo", "/api/coupler", "/api/sweep", "/api/path.csv"):
         assert path in text, path
+
+
+def test_switching_drivers_updates_the_readout_at_the_same_configuration():
+    """The readout's Jacobian belongs to the drivers: after set_drivers at the same configuration
+    the transmission indices are those of the new drivers (the cache was keyed on the
+    configuration only), and so after an undo across a driver switch."""
+    s = sm.studio_session("stewart-6sps")
+    assert "L1.slide" in s.state()["transmission"]
+    s.desk.snapshot("legs")
+    new = ["B1.rot1", "L2.slide", "L3.slide", "L4.slide", "L5.slide", "L6.slide"]
+    s.set_drivers(new)
+    st = s.state()
+    assert st["drivers"] == new and set(st["transmission"]) == set(new)
+    s.desk.undo()
+    assert set(s.state()["transmission"]) == {f"L{k}.slide" for k in range(1, 7)}

@@ -167,10 +167,10 @@ class Session:
         evaluates it at its end, and the readout that follows, and the next drive's start, at
         the same configuration object)."""
         last = getattr(self, "_last_jacobian", None)
-        if last is not None and last[0] is c:
+        if last is not None and last[0] is c and last[2] is self.mech:  # the drivers are part of J
             return last[1]
         J = complete_jacobian(self.mech, c)
-        self._last_jacobian = (c, J)
+        self._last_jacobian = (c, J, self.mech)
         return J
 
     def _platform_point(self, c: Configuration) -> np.ndarray:
@@ -234,12 +234,12 @@ class Session:
         (one evaluation shared by the readout, the drive's stop test and its monitors; the last
         configuration asked is remembered)."""
         last = getattr(self, "_last_dets", None)
-        if last is not None and last[0] is c:
+        if last is not None and last[0] is c and last[2] is self.mech:
             return last[1]
         names = list(dict.fromkeys([*self._candidates(), *self.mech.actuators]))
         vals = driver_determinants(self.mech, c, names)
         out = {d: float(v) for d, v in zip(names, vals, strict=True)}
-        self._last_dets = (c, out)
+        self._last_dets = (c, out, self.mech)
         return out
 
     def _dj(self, c: Configuration, J=None) -> float | None:
