@@ -111,3 +111,24 @@ def test_html_cell_escapes_and_shortens():
     assert html_cell(1.234567891) == "1.2346"
     assert html_cell("x" * 200).endswith("...") and len(html_cell("x" * 200)) == 120
     assert html_cell([[1, 2, 3], [4, 5, 6]]) == "2 x 3 matrix"
+
+
+def test_snapshot_and_undo_messages():
+    w = sm.studio("rssr")
+    send(w, {"type": "drive", "actuators": [20.0]})
+    send(w, {"type": "snapshot", "label": "twenty"})
+    assert [x["label"] for x in w.snapshots] == ["twenty"]
+    send(w, {"type": "drive", "actuators": [50.0]})
+    send(w, {"type": "undo"})
+    assert w.error == "" and w.snapshots == [] and abs(w.state["actuators_deg"]["A0.rot"] - 20.0) < 1e-9
+    assert w.last_drive == {"status": "undone", "message": "back at twenty"}
+    send(w, {"type": "undo"})
+    assert w.error.startswith("undo: no snapshot")
+
+
+def test_pose_message_moves_the_output_link():
+    w = sm.studio("rssr")
+    a3 = w.state["task"]["values_deg"]["a3"]
+    send(w, {"type": "pose", "task_deg": {"a3": a3 + 5.0}, "euler": w.state["task"]["euler"]})
+    assert w.error == "" and w.last_drive["status"] == "reached"
+    assert abs(w.state["task"]["values_deg"]["a3"] - (a3 + 5.0)) < 1e-6

@@ -25,7 +25,7 @@ from test_studio_browser import browser, missing  # noqa: F401  (the Chromium fi
 pytestmark = pytest.mark.slow  # a browser start and software WebGL take seconds
 pytest.importorskip("anywidget")
 
-TRAITS = ("state", "figure", "unit", "last_drive", "answered", "error", "modes")
+TRAITS = ("state", "figure", "unit", "last_drive", "answered", "error", "modes", "snapshots")
 
 HARNESS = """<!DOCTYPE html><html><head><meta charset="utf-8"><title>widget harness</title><link rel="icon" href="data:,"></head>
 <body style="width: 900px"><div id="w"></div>
@@ -87,6 +87,7 @@ def test_the_widget_renders_and_a_slider_drives_the_session(page, browser):  # n
     n_traces = browser.execute_script("return document.querySelector('.sm-plot').data.length")
     assert n_traces == len(w.figure["data"])
     assert browser.execute_script("return document.querySelectorAll('.sm-sliders input').length") == 1
+    assert browser.execute_script("return document.querySelectorAll('.sm-pose input').length") == 1  # a3
     # the user moves the slider: the page sends one drive message
     browser.execute_script("const el = document.querySelector('.sm-sliders input'); el.value = 35;"
                            "el.dispatchEvent(new Event('input'));")
@@ -101,6 +102,13 @@ def test_the_widget_renders_and_a_slider_drives_the_session(page, browser):  # n
         "arguments[0]", repr(x0[0])))
     text = browser.execute_script("return document.querySelector('.sm-readouts').textContent")
     assert "reached" in text and "sigma_min" in text
+    # the snapshot button sends its message once the drive has been answered
+    browser.execute_script("document.querySelector('.sm-snap').click()")
+    snap = wait_for(browser, "return window.sent.length > 1 ? window.sent[1] : null")
+    assert snap == {"type": "snapshot"}
+    w._handle_custom_msg(snap, [])
+    browser.execute_script("window.harness.set(arguments[0])", traits(w))
+    wait_for(browser, "return document.querySelector('.sm-snaps').textContent === 'snapshot 1'")
     assert browser.execute_script("return window.jsErrors") == []
     severe = [e for e in browser.get_log("browser") if e["level"] == "SEVERE"]
     assert not severe, severe

@@ -8,6 +8,7 @@ trait and the readouts of :attr:`StudioWidget.state`, and sends one message per 
     {"type": "drive", "actuators": [...]}          # model units, degrees for rotations
     {"type": "pose", "task_len": {...}, "task_deg": {...}}
     {"type": "fk_all"} / {"type": "mode", "mode_number": k}
+    {"type": "snapshot", "label": "..."} / {"type": "undo"}   # the session's desk
 
 Each message runs the session's operation (the same code as ``POST /api/drive`` and the others)
 and answers by setting :attr:`~StudioWidget.last_drive` (status, message, events),
@@ -102,6 +103,8 @@ class StudioWidget(anywidget.AnyWidget):
     error = traitlets.Unicode("").tag(sync=True)
     #: The assembly modes of the last ``fk_all``.
     modes: traitlets.List[dict] = traitlets.List().tag(sync=True)
+    #: The snapshots kept (``session.desk.listing()``).
+    snapshots: traitlets.List[dict] = traitlets.List().tag(sync=True)
 
     def __init__(self, session, **kwargs):
         super().__init__(_esm=esm_bundle(), **kwargs)
@@ -130,6 +133,21 @@ class StudioWidget(anywidget.AnyWidget):
         self._refresh()
         self.answered += 1
 
+    def snapshot(self, label=None) -> list[dict]:
+        """Keep the current configuration (``session.desk.snapshot``)."""
+        self.snapshots = _plain(self.session.desk.snapshot(label))
+        self.answered += 1
+        return self.snapshots
+
+    def undo(self) -> str:
+        """Back to the last snapshot, which is dropped (``session.desk.undo``); its label."""
+        label = self.session.desk.undo()
+        self.snapshots = _plain(self.session.desk.listing())
+        self.last_drive = {"status": "undone", "message": f"back at {label}"}
+        self._refresh()
+        self.answered += 1
+        return label
+
     def _run(self, op):
         r = op()
         self.last_drive = _plain(r.to_dict())
@@ -151,7 +169,8 @@ class StudioWidget(anywidget.AnyWidget):
         ops = {"drive": lambda c: self.drive(c.get("actuators")),
                "pose": lambda c: self.drive_pose(c.get("task_len"), c.get("task_deg"), euler=c.get("euler")),
                "fk_all": lambda c: self.fk_all(c.get("seeds")),
-               "mode": lambda c: self.pick_mode(c.get("mode_number"))}
+               "mode": lambda c: self.pick_mode(c.get("mode_number")),
+               "snapshot": lambda c: self.snapshot(c.get("label")), "undo": lambda c: self.undo()}
         try:
             if kind not in ops:
                 raise InputError(f"type: unknown message {kind!r}; expected one of {', '.join(ops)}")

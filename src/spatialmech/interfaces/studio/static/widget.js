@@ -11,6 +11,22 @@ function actuatorEntries(st, unit) {
     : { name: d, value: st.actuators_len[d], unit: unit, range: st.slider_ranges_len[d] });
 }
 
+function poseEntries(st, unit) {  // the output link's given task coordinates (pose sliders)
+  const t = st.task;
+  if (!t) return [];
+  return t.given.map(n => (n in t.slider_ranges_len)
+    ? { name: n, value: t.values_len[n], unit: unit, range: t.slider_ranges_len[n], key: "task_len" }
+    : { name: n, value: t.values_deg[n], unit: "deg", range: t.slider_ranges_deg[n], key: "task_deg" });
+}
+
+function sliderRow(a, onInput) {
+  const step = a.unit === "deg" ? 0.1 : (a.range[1] - a.range[0]) / 2000, div = document.createElement("div");
+  div.innerHTML = `<label style="font: 12px sans-serif">${a.name} [${a.unit}] <input type="range" ` +
+    `min="${a.range[0]}" max="${a.range[1]}" step="${step}" value="${a.value}" style="width: 60%"> <span></span></label>`;
+  div.querySelector("input").addEventListener("input", onInput);
+  return div;
+}
+
 function readoutRows(st, unit, model) {
   const p = st.pose, last = model.get("last_drive"), err = model.get("error");
   return [
@@ -25,9 +41,10 @@ function readoutRows(st, unit, model) {
 
 function render({ model, el }) {
   el.classList.add("spatialmech-studio");
-  el.innerHTML = '<div class="sm-sliders"></div><table class="sm-readouts" style="font: 12px sans-serif"></table>' +
+  el.innerHTML = '<div class="sm-sliders"></div><div class="sm-pose"></div><div class="sm-buttons" style="font: 12px sans-serif">' +
+    '<button class="sm-snap">snapshot</button> <button class="sm-undo">undo</button> <span class="sm-snaps"></span></div><table class="sm-readouts" style="font: 12px sans-serif"></table>' +
     '<div class="sm-plot" style="width: 100%"></div>';
-  const box = el.querySelector(".sm-sliders"), table = el.querySelector(".sm-readouts"), plot = el.querySelector(".sm-plot");
+  const box = el.querySelector(".sm-sliders"), pbox = el.querySelector(".sm-pose"), table = el.querySelector(".sm-readouts"), plot = el.querySelector(".sm-plot");
   let inFlight = false, pending = null, built = "";
 
   function send() {
@@ -37,27 +54,32 @@ function render({ model, el }) {
   function build() {
     const st = model.get("state"), unit = model.get("unit");
     const entries = actuatorEntries(st, unit), key = st.mechanism + ":" + st.drivers.join(",");
+    const poses = poseEntries(st, unit);
     if (key !== built) {
-      built = key; box.innerHTML = "";
-      entries.forEach((a, k) => {
-        const step = a.unit === "deg" ? 0.1 : (a.range[1] - a.range[0]) / 2000, div = document.createElement("div");
-        div.innerHTML = `<label style="font: 12px sans-serif">${a.name} [${a.unit}] <input type="range" data-index="${k}" ` +
-          `min="${a.range[0]}" max="${a.range[1]}" step="${step}" value="${a.value}" style="width: 60%"> <span></span></label>`;
-        div.querySelector("input").addEventListener("input", () => {
-          pending = { type: "drive", actuators: [...box.querySelectorAll("input")].map(x => Number(x.value)) }; send();
-        });
-        box.appendChild(div);
-      });
+      built = key; box.innerHTML = ""; pbox.innerHTML = "";
+      entries.forEach(a => box.appendChild(sliderRow(a, () => {
+        pending = { type: "drive", actuators: [...box.querySelectorAll("input")].map(x => Number(x.value)) }; send();
+      })));
+      poses.forEach(a => pbox.appendChild(sliderRow(a, () => {
+        const msg = { type: "pose", task_len: {}, task_deg: {}, euler: st.task.euler };
+        [...pbox.querySelectorAll("input")].forEach((x, k) => { msg[poses[k].key][poses[k].name] = Number(x.value); });
+        pending = msg; send();
+      })));
     }
-    box.querySelectorAll("input").forEach((x, k) => {
-      if (pending === null && !inFlight) x.value = entries[k].value;
-      x.nextElementSibling.textContent = fmt(entries[k].value, 6) + " " + entries[k].unit;
+    const sync = (b, list) => b.querySelectorAll("input").forEach((x, k) => {
+      if (pending === null && !inFlight) x.value = list[k].value;
+      x.nextElementSibling.textContent = fmt(list[k].value, 6) + " " + list[k].unit;
     });
+    sync(box, entries); sync(pbox, poses);
+    el.querySelector(".sm-snaps").textContent = model.get("snapshots").map(x => x.label).join(", ");
     table.innerHTML = readoutRows(st, unit, model).map(([k, v]) => `<tr><th style="text-align: left">${k}</th><td>${v}</td></tr>`).join("");
   }
   function draw() { const f = model.get("figure"); Plotly.react(plot, f.data, f.layout, { displaylogo: false, responsive: true }); }
 
+  el.querySelector(".sm-snap").addEventListener("click", () => { pending = { type: "snapshot" }; send(); });
+  el.querySelector(".sm-undo").addEventListener("click", () => { pending = { type: "undo" }; send(); });
   model.on("change:state", build);
+  model.on("change:snapshots", build);
   model.on("change:figure", draw);
   model.on("change:answered", () => { inFlight = false; build(); send(); });
   build(); draw();
