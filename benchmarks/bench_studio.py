@@ -20,6 +20,13 @@ is inflated by the other jobs; read it with the ratio), beside the wall times, o
 through FastAPI's TestClient.  The ratio is against the monitor the studio had
 before (the other drivers' DJ signs, ``nan`` where the Jacobian is not square), measured in the
 same run on the same model.
+
+``--browser`` (issue 30, "Also build"): the frame time of a slider drag in headless Chromium on
+planar-4r, bennett and five-cs-3 (``performance.now()`` in the page, from the slider's input
+event to the second animation frame after the answer is drawn: the server, the JSON and the
+drawing), with the page's smaller redraw (``Plotly.restyle`` of the traces that moved,
+static/design.js) and with the full ``Plotly.react`` of studio.js, in the same run; target
+50 ms per frame (printed met / NOT met on the median).  Needs chromium, chromedriver, selenium.
 """
 
 from __future__ import annotations
@@ -135,12 +142,100 @@ def run_pose(model: str, coord: str, step: float, n: int) -> dict:
     return timed_updates(f"{model} pose {coord}", n, lambda: client.post("/api/pose", json=body))
 
 
+BROWSER_JS = """
+const [n, step, fast, done] = [arguments[0], arguments[1], arguments[2], arguments[arguments.length - 1]];
+(async () => {
+  const S = window.studio; S.fastRedraw = fast; S.drawTimes = [];
+  const el = document.getElementById("slider-0"), frames = [];
+  const idle = () => new Promise(res => { const f = () => (!S.inFlight && S.pending === null) ? res() : setTimeout(f, 1); f(); });
+  const paint = () => new Promise(res => requestAnimationFrame(() => requestAnimationFrame(res)));
+  for (let k = 0; k < n; k++) {
+    const t0 = performance.now();
+    el.value = Number(el.value) + step; el.dispatchEvent(new Event("input"));
+    await idle(); await paint();
+    frames.push(performance.now() - t0);
+  }
+  done({ frames: frames, draws: S.drawTimes.slice(), errors: S.errors.slice() });
+})();
+"""
+
+
+def browser_frames(model: str, step: float, n: int) -> dict:
+    """Frame and draw times of a slider drag in headless Chromium (the page's performance.now():
+    from the slider's input event to the second animation frame after the answer is drawn),
+    with the smaller redraw (Plotly.restyle) and with the full one (Plotly.react), same run."""
+    import os
+    import socket
+    import tempfile
+    import threading
+
+    import uvicorn
+    from selenium import webdriver
+    from selenium.webdriver.chrome.service import Service
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    srv = uvicorn.Server(uvicorn.Config(sm.studio_app(model), host="127.0.0.1", port=port, log_level="warning"))
+    th = threading.Thread(target=srv.run, daemon=True)
+    th.start()
+    while not srv.started:
+        time.sleep(0.05)
+    os.environ["SE_OFFLINE"] = "true"
+    opts = webdriver.ChromeOptions()
+    opts.binary_location = os.environ.get("SPATIALMECH_CHROMIUM", "/usr/bin/chromium")
+    for f in ("--headless", "--no-sandbox", "--disable-gpu", "--enable-unsafe-swiftshader", "--window-size=1200,800",
+              f"--user-data-dir={tempfile.mkdtemp(prefix='bench-studio-')}"):
+        opts.add_argument(f)
+    drv = webdriver.Chrome(service=Service(os.environ.get("SPATIALMECH_CHROMEDRIVER", "/usr/bin/chromedriver")), options=opts)
+    try:
+        drv.set_script_timeout(600)
+        drv.get(f"http://127.0.0.1:{port}/")
+        t0 = time.time()
+        while not drv.execute_script("return !!(window.studio && window.studio.state && window.studio.drawn > 0)"):
+            if time.time() - t0 > 60:
+                raise RuntimeError("the studio page did not load")
+            time.sleep(0.1)
+        drv.execute_async_script(BROWSER_JS, 3, step, True)  # warm up (compilation, first draws)
+        out = {}
+        for label, fast in (("restyle", True), ("react", False), ("restyle_again", True)):
+            r = drv.execute_async_script(BROWSER_JS, n, step, fast)
+            out[label] = {"frame_median_ms": float(np.median(r["frames"])), "frame_p95_ms": float(np.percentile(r["frames"], 95)),
+                          "draw_median_ms": float(np.median(r["draws"])) if r["draws"] else None, "errors": r["errors"]}
+            step = -step  # drag back and forth
+        return out
+    finally:
+        drv.quit()
+        srv.should_exit = True
+        th.join(10)
+
+
+#: (model, crank step in degrees) of the browser drag; the frame target in ms.
+BROWSER_CASES = [("planar-4r", 1.0), ("bennett", 1.0), ("five-cs-3", -1.0)]
+FRAME_TARGET_MS = 50.0
+
+
 def main(argv=None) -> dict:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--json", action="store_true")
     ap.add_argument("--quick", action="store_true", help="10 updates per model")
     ap.add_argument("--drag", action="store_true", help="only issue 30's drag steps")
+    ap.add_argument("--browser", action="store_true", help="only the frame times in headless Chromium")
     args = ap.parse_args(argv)
+    if args.browser:
+        res = {m: browser_frames(m, st, 10 if args.quick else 30) for m, st in BROWSER_CASES}
+        for r in res.values():
+            r["met"] = bool(r["restyle"]["frame_median_ms"] < FRAME_TARGET_MS)
+        if args.json:
+            print(json.dumps({"browser": res, "frame_target_ms": FRAME_TARGET_MS}, indent=2))
+        else:
+            for m, r in res.items():
+                a, b = r["restyle"], r["react"]
+                print(f"browser drag {m:<10} frame median {a['frame_median_ms']:.0f} ms (p95 {a['frame_p95_ms']:.0f}), "
+                      f"draw {a['draw_median_ms']:.1f} ms; full react: frame {b['frame_median_ms']:.0f} ms, draw "
+                      f"{b['draw_median_ms']:.1f} ms (ratio restyle/react {a['frame_median_ms'] / b['frame_median_ms']:.2f}); "
+                      f"target < {FRAME_TARGET_MS:.0f} ms: {'met' if r['met'] else 'NOT met'}")
+        return {"browser": res}
     drags = [run_drag(m, s, 10 if args.quick else n) for m, s, n in DRAG_CASES]
     rows = [] if args.drag else [run(m, s, 10 if args.quick else n) for m, s, n in CASES]
     rows += [] if args.drag else [run_pose(m, c, s, 10 if args.quick else n) for m, c, s, n in POSE_CASES]

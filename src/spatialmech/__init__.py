@@ -10,7 +10,8 @@ Every analysis by a short name (one page: docs/api.md; the functions are in
 ``sm.jacobian``, ``sm.velocity``, ``sm.statics``, ``sm.stiffness``, ``sm.singularity``, ``sm.workspace``, ``sm.parasitic``,
 ``sm.track``,
 ``sm.defects``, ``sm.synth_rccc``, ``sm.synth_cs``, ``sm.screen``, ``sm.report``, ``sm.demo``, ``sm.view``,
-``sm.export``, ``sm.validate``, ``sm.singularity_slice``, ``sm.studio_session``, ``sm.studio_app``.  Each takes a
+``sm.export``, ``sm.validate``, ``sm.singularity_slice``, ``sm.studio_session``, ``sm.studio_app``,
+``sm.studio`` (the studio as a Jupyter widget).  Each takes a
 :class:`Mechanism`, a ready-made model name or a TOML file path, checks its arguments
 (``TypeError``, :class:`InputError`) and returns a result whose ``to_dict()`` is its JSON.
 
@@ -69,6 +70,7 @@ if TYPE_CHECKING:  # what mypy sees; at run time :func:`__getattr__` imports the
         workspace,
     )
     from .interfaces.studio.app import studio_app
+    from .interfaces.studio.widget import studio
     from .kinematics import closed_forms
     from .kinematics.closure import Configuration
     from .model import C, H, Joint, Limb, Mechanism, Mode, ModelFileError, P, Pose, R, S, Sm, U, dump, dumps, load, loads
@@ -129,6 +131,7 @@ __all__ = [
     "statics_along",
     "stiffness",
     "stiffness_map",
+    "studio",
     "studio_app",
     "studio_session",
     "suggest_task_grid",
@@ -152,9 +155,10 @@ _LAZY: dict[str, str] = {
     "Configuration": ".kinematics.closure",
     "closed_forms": ".kinematics.closed_forms",  # the closed-form kernels (a module; they load scipy.stats)
     "studio_app": ".interfaces.studio.app",  # the studio's web app, a driver (FastAPI) above the API
+    "studio": ".interfaces.studio.widget",  # the studio as a Jupyter widget (anywidget), a driver too
     **{name: ".api" for name in __all__ if name[0].islower() and name not in {"__version__", "closed_forms",
                                                                                "dump", "dumps", "load", "loads",
-                                                                               "results", "studio_app"}},
+                                                                               "results", "studio", "studio_app"}},
 }
 
 

@@ -36,6 +36,7 @@ import numpy as np
 
 __all__ = [
     "EMBEDDED_KEYS",
+    "HTML_MAX_ROWS",
     "JSON_EULER_SEQUENCE",
     "SCHEMA_VERSION",
     "SCREW_KEYS",
@@ -45,6 +46,8 @@ __all__ = [
     "envelope",
     "fields_dict",
     "freedom_values_dict",
+    "html_cell",
+    "html_summary",
     "json_default",
     "json_value",
     "pose_dict",
@@ -552,3 +555,60 @@ def unit_rule_violations(doc) -> list[str]:
         problems.append(f"length_unit: *_len fields ({', '.join(fields[:3])}{' ...' if len(fields) > 3 else ''}) "
                         "without a length_unit declared at the top level or on an enclosing object")
     return problems
+
+
+# ---------------------------------------------------------------------------- notebook display
+#: Most rows of a list of records (solutions, limbs) that :func:`html_summary` shows.
+HTML_MAX_ROWS = 12
+
+
+def html_cell(v: Any) -> str:
+    """One value of a JSON document as short HTML text: numbers to 5 significant digits, short
+    vectors inline, a matrix by its shape, long text cut; escaped."""
+    from html import escape
+
+    if isinstance(v, bool) or v is None:
+        return escape(str(v))
+    if isinstance(v, float):
+        return f"{v:.5g}"
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, str):
+        return escape(v if len(v) <= 120 else v[:117] + "...")
+    if isinstance(v, dict):
+        inner = [f"{escape(str(k))}: {html_cell(x)}" for k, x in v.items() if not isinstance(x, (dict, list))]
+        return ", ".join(inner) if inner else f"{{{len(v)} fields}}"
+    if isinstance(v, (list, tuple)):
+        if v and all(isinstance(x, (list, tuple)) for x in v):
+            return f"{len(v)} x {len(v[0])} matrix"
+        if len(v) <= 8 and not any(isinstance(x, (dict, list, tuple)) for x in v):
+            return "[" + ", ".join(html_cell(x) for x in v) + "]"
+        return f"{len(v)} items"
+    return escape(str(v))
+
+
+def html_summary(title: str, doc: Mapping, records: str | None = None, columns: Iterable[str] = ()) -> str:
+    """A compact HTML table of a result's JSON document ``doc`` (``to_dict()``: units in the
+    field names) for a notebook's ``_repr_html_``: one row per top-level field, and the list of
+    records under ``records`` (e.g. the solutions) as a table of ``columns`` (a pose field shows
+    its position and Euler angles)."""
+    from html import escape
+
+    cols = list(columns)
+    rows = "".join(f"<tr><th style='text-align:left'>{escape(str(k))}</th><td style='text-align:left'>{html_cell(v)}</td></tr>"
+                   for k, v in doc.items() if k != records)
+    out = [f"<div class='spatialmech-result'><b>{escape(title)}</b><table>{rows}</table>"]
+    recs = doc.get(records) if records else None
+    if isinstance(recs, list) and recs and cols:
+        def cell(r, c):
+            v = r.get(c) if isinstance(r, dict) else None
+            if c == "pose" and isinstance(v, dict):
+                seq = escape(str(v.get("euler_sequence")))
+                return f"{html_cell(v.get('position_len'))}; {seq} {html_cell(v.get('euler_deg'))} deg"
+            return html_cell(v)
+        head = "".join(f"<th>{escape(c)}</th>" for c in ["#", *cols])
+        body = "".join("<tr>" + f"<td>{k + 1}</td>" + "".join(f"<td>{cell(r, c)}</td>" for c in cols) + "</tr>"
+                       for k, r in enumerate(recs[:HTML_MAX_ROWS]))
+        more = f"<div>... {len(recs) - HTML_MAX_ROWS} more</div>" if len(recs) > HTML_MAX_ROWS else ""
+        out.append(f"<b>{escape(records or '')}</b><table><tr>{head}</tr>{body}</table>{more}")
+    return "".join(out) + "</div>"

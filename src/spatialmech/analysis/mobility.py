@@ -47,7 +47,7 @@ from ..kinematics.motion import generic_configuration
 from ..kinematics.tracking import MotionProblem
 from .branches import Branch, Exploration, explore
 from ..model.mechanism import Mechanism, Mode
-from ..serialize import fields_dict
+from ..serialize import fields_dict, html_summary
 
 __all__ = ["ELEMENTARY_MOTIONS", "SCAN_RANGE", "MobilityResult", "ToleranceStep", "mobility", "mobility_modes", "motion_type"]
 
@@ -195,6 +195,9 @@ class MobilityResult:
         d["branches"] = [b.to_dict() for b in self.branches]
         d["dof_at_tolerance"] = [{"tolerance": t, "dof": self.dof_at(t)} for t in _DECADES]
         return d
+
+    def _repr_html_(self) -> str:  # a notebook's display
+        return html_summary(f"mobility: {self.mechanism}", self.to_dict())
 
     def formula(self) -> str:
         return (

@@ -22,7 +22,7 @@ from ..kinematics.task import TaskJacobian, TaskSolution, default_task, task_jac
 from ..model.mechanism import Mechanism, Pose
 from ..model.task import TaskCoordinates
 from ..results import Progress
-from ..serialize import pose_dict
+from ..serialize import html_summary, pose_dict
 
 if TYPE_CHECKING:  # the analyses are imported where they run (lazily): their types only here
     pass
@@ -113,6 +113,9 @@ class IKResult:
         d["reachable"] = bool(self.reachable)
         d["warnings"] = self.warnings
         return d
+
+    def _repr_html_(self) -> str:  # a notebook's display: the fields and one row per limb
+        return html_summary(f"ik: {self.mechanism.name}", self.to_dict(), "limbs", ("limb", "reachable", "passive_dim"))
 
 
 @one_blas_thread
@@ -261,6 +264,10 @@ class FKResult:
     def to_dict(self) -> dict:
         return {**self.answer.to_dict(self.mechanism), "warnings": self.warnings}
 
+    def _repr_html_(self) -> str:  # a notebook's display: the fields and one row per solution
+        return html_summary(f"fk: {self.mechanism.name}", self.to_dict(), "solutions",
+                            ("status", "pose", "kind", "sigma_min", "within_limits", "residual"))
+
 
 @one_blas_thread
 def fk(model: ModelLike, actuators, *, all_solutions: bool = False, seeds: int | None = None, seed: int | None = None,
@@ -406,6 +413,9 @@ class JacobianResult:
         return {"result": "complete_jacobian", "pose": pose_dict(P.R, P.p), **self.jacobian.to_dict(),
                 "pose_fit": None if self.pose_fit is None else self.pose_fit.to_dict(),
                 "task_jacobian": None if self.task is None else self.task.to_dict(self.mechanism)}
+
+    def _repr_html_(self) -> str:  # a notebook's display (matrices by their shape)
+        return html_summary(f"jacobian: {self.mechanism.name}", self.to_dict())
 
 
 def jacobian(model: ModelLike, pose=None, *, config: Configuration | None = None, drivers=None,

@@ -21,6 +21,14 @@ and units in the field names; bad input answers 4xx with ``{"error": "<field>: .
 ``POST /api/fk_all``   ``{"seeds": n}`` (optional): every assembly mode at the current values
 ``POST /api/mode``     ``{"mode_number": k}``: move to mode k of the last ``fk_all``
 ``POST /api/load``     ``{"model": "name or path"}``: another model
+``POST /api/snapshot`` ``{"label": "..."}`` (optional): keep the configuration; ``snapshots``
+``POST /api/undo``     back to the last snapshot (dropped); ``POST /api/restore``
+                       ``{"number": k}``: back to snapshot k (kept)
+``POST /api/coupler``  ``{"point_len": [x, y, z]}`` (output-link frame, optional): the path of
+                       that point (``curve_len``) over the circuit or the driver's range
+``POST /api/sweep``    ``{"driver": name, "samples": n}`` (optional): joint values,
+                       ``transmission_min`` and ``sigma_min`` against one driver's ``input``
+``GET /api/path.csv``  the driven path as the CSV of ``validate --actuators-path``
 =====================  ==================================================================
 
 Updates are answered by POST (the page sends the next slider value when the previous answer
@@ -117,7 +125,7 @@ def create_app(session) -> FastAPI:
 
     @app.get("/static/{name}")
     def static(name: str):
-        types = {"studio.js": "text/javascript", "studio.css": "text/css"}
+        types = {"studio.js": "text/javascript", "design.js": "text/javascript", "studio.css": "text/css"}
         if name == "plotly.min.js":
             return Response(plotly_js_path().read_bytes(), media_type="text/javascript",
                             headers={"Cache-Control": "max-age=86400"})
@@ -184,11 +192,54 @@ def create_app(session) -> FastAPI:
             return _json(doc({"model_info": session.model_info(), "state": session.state()}))
 
     app.add_api_route("/api/circuit", guarded(circuit), methods=["GET"])
+    add_desk_routes(app, session, lock, doc, body, guarded)
     for path, fn in (("/api/drive", drive), ("/api/pose", pose),
                      ("/api/drivers", drivers), ("/api/fk_all", fk_all), ("/api/mode", mode),
                      ("/api/load", load)):
         app.add_api_route(path, guarded(fn), methods=["POST"])
     return app
+
+
+def add_desk_routes(app: FastAPI, session, lock, doc, body, guarded) -> None:
+    """The design tools' routes (``session.desk``: snapshots, undo, coupler curve, sweep, the
+    driven path as CSV) on ``app``, with the helpers of :func:`create_app`."""
+
+    async def snapshot(request: Request):
+        data = await body(request, None)
+        with lock:
+            return _json(doc({"snapshots": session.desk.snapshot(data.get("label"))}))
+
+    async def undo(request: Request):
+        with lock:
+            label = session.desk.undo()
+            return _json(doc({"restored": label, "snapshots": session.desk.listing(), "state": session.state()}))
+
+    async def restore(request: Request):
+        data = await body(request, "number")
+        with lock:
+            session.desk.restore(data["number"])
+            return _json(doc({"snapshots": session.desk.listing(), "state": session.state()}))
+
+    async def coupler(request: Request):
+        data = await body(request, None)
+        with lock:
+            return _json(doc(session.desk.coupler_curve(data.get("point_len"), data.get("frames", 240))))
+
+    async def sweep(request: Request):
+        data = await body(request, None)
+        with lock:
+            return _json(doc(session.desk.sweep(data.get("driver"), data.get("samples", 61))))
+
+    async def path_csv(request: Request):
+        with lock:
+            name = session.mech.name
+            return Response(session.desk.path_csv(), media_type="text/csv",
+                            headers={"Content-Disposition": f'attachment; filename="{name}-path.csv"'})
+
+    app.add_api_route("/api/path.csv", guarded(path_csv), methods=["GET"])
+    for path, fn in (("/api/snapshot", snapshot), ("/api/undo", undo), ("/api/restore", restore),
+                     ("/api/coupler", coupler), ("/api/sweep", sweep)):
+        app.add_api_route(path, guarded(fn), methods=["POST"])
 
 
 def studio_app(model: sm.ModelLike = "five-cs-3") -> FastAPI:

@@ -51,6 +51,7 @@ from ...results import DriveStatus, TrackStatus
 from ...serialize import freedom_values_dict, pose_dict
 from .monitors import MotionRates, is_noise, same_event
 from .posing import pose_path, transmission_readout
+from .design import Desk
 from .scene import scene
 
 __all__ = ["DriveResult", "Session"]
@@ -149,6 +150,8 @@ class Session:
         self.config = c
         self.start_values = self.actuator_values()
         self.history = [self._platform_point(c)]
+        self.driven = [self.start_values]  # the actuator values at the end of each drive (desk.path_csv)
+        self.desk = Desk(self)  # snapshots, coupler curve, sweeps (design.py)
         self._tasks: dict[str, TaskCoordinates | None] = {}
         self.euler = mech.task.euler if mech.task is not None else "ZYX"
         self.start_task = task_values(mech, c.D, self.euler)
@@ -164,10 +167,10 @@ class Session:
         evaluates it at its end, and the readout that follows, and the next drive's start, at
         the same configuration object)."""
         last = getattr(self, "_last_jacobian", None)
-        if last is not None and last[0] is c:
+        if last is not None and last[0] is c and last[2] is self.mech:  # the drivers are part of J
             return last[1]
         J = complete_jacobian(self.mech, c)
-        self._last_jacobian = (c, J)
+        self._last_jacobian = (c, J, self.mech)
         return J
 
     def _platform_point(self, c: Configuration) -> np.ndarray:
@@ -231,12 +234,12 @@ class Session:
         (one evaluation shared by the readout, the drive's stop test and its monitors; the last
         configuration asked is remembered)."""
         last = getattr(self, "_last_dets", None)
-        if last is not None and last[0] is c:
+        if last is not None and last[0] is c and last[2] is self.mech:
             return last[1]
         names = list(dict.fromkeys([*self._candidates(), *self.mech.actuators]))
         vals = driver_determinants(self.mech, c, names)
         out = {d: float(v) for d, v in zip(names, vals, strict=True)}
-        self._last_dets = (c, out)
+        self._last_dets = (c, out, self.mech)
         return out
 
     def _dj(self, c: Configuration, J=None) -> float | None:
@@ -289,7 +292,7 @@ class Session:
         pose = platform_pose(m, c)
         vals = freedom_values(m, c.q)
         joints = freedom_values_dict(m, {r.id: v for r, v in zip(m.freedom_refs, vals, strict=True)}, "joints")
-        lo = {aid: self._slider_range(aid, v0, v) for aid, v0, v in
+        lo = {aid: self.slider_range(aid, v0, v) for aid, v0, v in
               zip(m.actuators, self.start_values if len(self.start_values) == len(a) else a, a, strict=True)}
         return {
             "mechanism": m.name,
@@ -314,7 +317,7 @@ class Session:
             "scene": self.scene(),
         }
 
-    def _slider_range(self, aid: str, start: float, value: float) -> tuple[float, float]:
+    def slider_range(self, aid: str, start: float, value: float) -> tuple[float, float]:
         """The slider range of actuator ``aid`` (degrees / length unit): its joint limits where
         it has them (an angle's shifted by whole turns to hold ``value``), else a half-width
         around the start value ``start``."""
@@ -409,6 +412,7 @@ class Session:
                 raise InputError(f"drivers: {i} is locked")
         self.mech = self.base.with_actuators(ids)
         self.start_values = self.actuator_values()
+        self.driven = [self.start_values]
 
     def drive(self, values, *, name: str = "actuators") -> DriveResult:
         """Move the actuators to ``values`` (model units, degrees for rotations) along the
@@ -716,6 +720,7 @@ class Session:
         self.history.extend(self._platform_point(p[0]) for p in passed[-20:])
         self.history.append(self._platform_point(config))
         del self.history[:-400]
+        self.driven.append(self.actuator_values(config))
 
     def circuit(self, frames: int = 240) -> dict:
         """The whole circuit through the current configuration of a one-degree-of-freedom model
@@ -776,7 +781,7 @@ class Session:
             config = fit.config
         self.config = config
         self.fk_branch = object()
-        self.history = [self._platform_point(self.config)]
+        self.history, self.driven = [self._platform_point(self.config)], [self.actuator_values()]
 
 
 def _real_events(events, names: list[str], scale: float) -> list:

@@ -1,0 +1,89 @@
+// spatialmech studio in Jupyter (anywidget): draws the `figure` trait, shows the readouts of the
+// `state` trait and sends one message per slider move ({type: "drive", actuators: [...]}); the
+// next value goes when `answered` grows (one request in flight).  Plotly is defined by the
+// bundle this file is appended to (interfaces/studio/widget.py).
+
+function fmt(x, d = 5) { return (x === null || x === undefined) ? "-" : Number(x).toPrecision(d); }
+
+function actuatorEntries(st, unit) {
+  return st.drivers.map(d => (d in st.actuators_deg)
+    ? { name: d, value: st.actuators_deg[d], unit: "deg", range: st.slider_ranges_deg[d] }
+    : { name: d, value: st.actuators_len[d], unit: unit, range: st.slider_ranges_len[d] });
+}
+
+function poseEntries(st, unit) {  // the output link's given task coordinates (pose sliders)
+  const t = st.task;
+  if (!t) return [];
+  return t.given.map(n => (n in t.slider_ranges_len)
+    ? { name: n, value: t.values_len[n], unit: unit, range: t.slider_ranges_len[n], key: "task_len" }
+    : { name: n, value: t.values_deg[n], unit: "deg", range: t.slider_ranges_deg[n], key: "task_deg" });
+}
+
+function sliderRow(a, onInput) {
+  const step = a.unit === "deg" ? 0.1 : (a.range[1] - a.range[0]) / 2000, div = document.createElement("div");
+  div.innerHTML = `<label style="font: 12px sans-serif">${a.name} [${a.unit}] <input type="range" ` +
+    `min="${a.range[0]}" max="${a.range[1]}" step="${step}" value="${a.value}" style="width: 60%"> <span></span></label>`;
+  div.querySelector("input").addEventListener("input", onInput);
+  return div;
+}
+
+function readoutRows(st, unit, model) {
+  const p = st.pose, last = model.get("last_drive"), err = model.get("error");
+  return [
+    ["output point [" + unit + "]", p.position_len.map(x => fmt(x)).join(", ")],
+    ["orientation " + p.euler_sequence + " [deg]", p.euler_deg.map(x => fmt(x)).join(", ")],
+    ["DJ of the drivers", st.dj !== null ? fmt(st.dj) : "n/a (" + st.dj_note + ")"],
+    ["sigma_min (direct)", fmt(st.sigma_min, 4) + (st.singular ? " singular" : st.near_singular ? " near a singularity" : "")],
+    ["transmission (inverse)", fmt(st.transmission_min, 4) + (st.inverse_singular ? " inverse singular" : "")],
+    ["last drive", err ? "error: " + err : (last.status ? last.status + ": " + last.message : "-")],
+  ];
+}
+
+function render({ model, el }) {
+  el.classList.add("spatialmech-studio");
+  el.innerHTML = '<div class="sm-sliders"></div><div class="sm-pose"></div><div class="sm-buttons" style="font: 12px sans-serif">' +
+    '<button class="sm-snap">snapshot</button> <button class="sm-undo">undo</button> <span class="sm-snaps"></span></div><table class="sm-readouts" style="font: 12px sans-serif"></table>' +
+    '<div class="sm-plot" style="width: 100%"></div>';
+  const box = el.querySelector(".sm-sliders"), pbox = el.querySelector(".sm-pose"), table = el.querySelector(".sm-readouts"), plot = el.querySelector(".sm-plot");
+  let inFlight = false, pending = null, built = "";
+
+  function send() {
+    if (inFlight || pending === null) return;
+    inFlight = true; model.send(pending); pending = null;
+  }
+  function build() {
+    const st = model.get("state"), unit = model.get("unit");
+    const entries = actuatorEntries(st, unit), key = st.mechanism + ":" + st.drivers.join(",");
+    const poses = poseEntries(st, unit);
+    if (key !== built) {
+      built = key; box.innerHTML = ""; pbox.innerHTML = "";
+      entries.forEach(a => box.appendChild(sliderRow(a, () => {
+        pending = { type: "drive", actuators: [...box.querySelectorAll("input")].map(x => Number(x.value)) }; send();
+      })));
+      poses.forEach(a => pbox.appendChild(sliderRow(a, () => {
+        const msg = { type: "pose", task_len: {}, task_deg: {}, euler: st.task.euler };
+        [...pbox.querySelectorAll("input")].forEach((x, k) => { msg[poses[k].key][poses[k].name] = Number(x.value); });
+        pending = msg; send();
+      })));
+    }
+    const sync = (b, list) => b.querySelectorAll("input").forEach((x, k) => {
+      if (pending === null && !inFlight) x.value = list[k].value;
+      x.nextElementSibling.textContent = fmt(list[k].value, 6) + " " + list[k].unit;
+    });
+    sync(box, entries); sync(pbox, poses);
+    el.querySelector(".sm-snaps").textContent = model.get("snapshots").map(x => x.label).join(", ");
+    table.innerHTML = readoutRows(st, unit, model).map(([k, v]) => `<tr><th style="text-align: left">${k}</th><td>${v}</td></tr>`).join("");
+  }
+  function draw() { const f = model.get("figure"); Plotly.react(plot, f.data, f.layout, { displaylogo: false, responsive: true }); }
+
+  el.querySelector(".sm-snap").addEventListener("click", () => { pending = { type: "snapshot" }; send(); });
+  el.querySelector(".sm-undo").addEventListener("click", () => { pending = { type: "undo" }; send(); });
+  model.on("change:state", build);
+  model.on("change:snapshots", build);
+  model.on("change:figure", draw);
+  model.on("change:answered", () => { inFlight = false; build(); send(); });
+  build(); draw();
+  return () => Plotly.purge(plot);
+}
+
+export default { render };

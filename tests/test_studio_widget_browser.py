@@ -1,0 +1,118 @@
+"""The notebook widget's frontend (``sm.studio``: static/widget.js appended to plotly.js) in
+headless Chromium, without Jupyter: a static page imports the widget's ES module and renders it
+on a small stand-in for the anywidget model (``get``, ``on``, ``send``) that holds the traits of
+a real :class:`~spatialmech.interfaces.studio.widget.StudioWidget`.  A slider moved in the page
+sends a drive message; the test hands it to the Python widget (as the Jupyter kernel would) and
+pushes the new traits back: the readouts and the 3-D view follow, and the console has no errors.
+
+Skipped without Chromium, chromedriver or selenium (failed instead when ``CI`` is set), as
+tests/test_studio_browser.py.  ``SPATIALMECH_SCREENSHOTS=DIR`` keeps a screenshot in DIR.
+"""
+
+import functools
+import http.server
+import json
+import os
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+import spatialmech as sm
+from test_studio_browser import browser, missing  # noqa: F401  (the Chromium fixture, shared)
+
+pytestmark = pytest.mark.slow  # a browser start and software WebGL take seconds
+pytest.importorskip("anywidget")
+
+TRAITS = ("state", "figure", "unit", "last_drive", "answered", "error", "modes", "snapshots")
+
+HARNESS = """<!DOCTYPE html><html><head><meta charset="utf-8"><title>widget harness</title><link rel="icon" href="data:,"></head>
+<body style="width: 900px"><div id="w"></div>
+<script type="module">
+const values = await (await fetch("traits.json")).json(), listeners = {};
+window.sent = []; window.jsErrors = [];
+window.addEventListener("error", e => window.jsErrors.push(String(e.message)));
+const model = { get: k => values[k], send: m => window.sent.push(m),
+  on: (ev, f) => { (listeners[ev] = listeners[ev] || []).push(f); } };
+window.harness = { set(patch) { Object.assign(values, patch);
+  Object.keys(patch).forEach(k => (listeners["change:" + k] || []).forEach(f => f())); } };
+const widget = (await import("./bundle.js")).default;
+widget.render({ model, el: document.getElementById("w") });
+window.rendered = true;
+</script></body></html>"""
+
+
+class Quiet(http.server.SimpleHTTPRequestHandler):
+    def log_message(self, *args) -> None:  # no access log on stderr
+        pass
+
+
+def traits(w) -> dict:
+    return {k: getattr(w, k) for k in TRAITS}
+
+
+@pytest.fixture(scope="module")
+def page(tmp_path_factory):
+    from spatialmech.interfaces.studio.widget import esm_bundle
+
+    w = sm.studio("rssr")
+    root = tmp_path_factory.mktemp("widget-harness")
+    (root / "index.html").write_text(HARNESS, encoding="utf-8")
+    (root / "bundle.js").write_text(esm_bundle(), encoding="utf-8")
+    (root / "traits.json").write_text(json.dumps(traits(w)), encoding="utf-8")
+    handler = functools.partial(Quiet, directory=str(root))
+    srv = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
+    th = threading.Thread(target=srv.serve_forever, daemon=True)
+    th.start()
+    yield w, f"http://127.0.0.1:{srv.server_address[1]}/index.html"
+    srv.shutdown()
+    th.join(10)
+
+
+def wait_for(driver, script, timeout=60.0):
+    t0 = time.time()
+    while time.time() - t0 < timeout:
+        v = driver.execute_script(script)
+        if v:
+            return v
+        time.sleep(0.1)
+    raise AssertionError(f"timed out waiting for: {script}")
+
+
+def test_the_widget_renders_and_a_slider_drives_the_session(page, browser):  # noqa: F811
+    w, url = page
+    browser.get(url)
+    wait_for(browser, "return window.rendered === true && document.querySelector('.js-plotly-plot') !== null")
+    n_traces = browser.execute_script("return document.querySelector('.sm-plot').data.length")
+    assert n_traces == len(w.figure["data"])
+    assert browser.execute_script("return document.querySelectorAll('.sm-sliders input').length") == 1
+    assert browser.execute_script("return document.querySelectorAll('.sm-pose input').length") == 1  # a3
+    # the user moves the slider: the page sends one drive message
+    browser.execute_script("const el = document.querySelector('.sm-sliders input'); el.value = 35;"
+                           "el.dispatchEvent(new Event('input'));")
+    msg = wait_for(browser, "return window.sent.length ? window.sent[0] : null")
+    assert msg == {"type": "drive", "actuators": [35.0]}
+    # the kernel runs it on the session and the new traits reach the page
+    w._handle_custom_msg(msg, [])
+    assert w.last_drive["status"] == "reached"
+    browser.execute_script("window.harness.set(arguments[0])", traits(w))
+    x0 = w.figure["data"][1]["x"]
+    wait_for(browser, "return document.querySelector('.sm-plot').data[1].x[0] === arguments[0]".replace(
+        "arguments[0]", repr(x0[0])))
+    text = browser.execute_script("return document.querySelector('.sm-readouts').textContent")
+    assert "reached" in text and "sigma_min" in text
+    # the snapshot button sends its message once the drive has been answered
+    browser.execute_script("document.querySelector('.sm-snap').click()")
+    snap = wait_for(browser, "return window.sent.length > 1 ? window.sent[1] : null")
+    assert snap == {"type": "snapshot"}
+    w._handle_custom_msg(snap, [])
+    browser.execute_script("window.harness.set(arguments[0])", traits(w))
+    wait_for(browser, "return document.querySelector('.sm-snaps').textContent === 'snapshot 1'")
+    assert browser.execute_script("return window.jsErrors") == []
+    severe = [e for e in browser.get_log("browser") if e["level"] == "SEVERE"]
+    assert not severe, severe
+    out = os.environ.get("SPATIALMECH_SCREENSHOTS")
+    if out:
+        browser.set_window_size(1000, 900)
+        assert browser.find_element("css selector", "#w").screenshot(str(Path(out) / "studio-widget-rssr.png"))
