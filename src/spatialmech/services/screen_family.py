@@ -20,6 +20,7 @@ import hashlib
 import json
 import os
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -59,7 +60,7 @@ def save_family(family: CSFamily, path: Path, key: str) -> None:
     meta = {"format": _FORMAT, "key": key, "starts": family.starts, "extent": family.extent,
             "branches": [{"closed": bool(b.closed), "ends": [str(e) for e in b.ends], "residual": float(b.residual)}
                          for b in family.branches]}
-    arrays = {"meta": np.array(json.dumps(meta))}
+    arrays: dict[str, Any] = {"meta": np.array(json.dumps(meta))}
     for k, b in enumerate(family.branches):
         arrays[f"points_{k}"] = np.asarray(b.points, dtype=np.float64)
         arrays[f"arc_{k}"] = np.asarray(b.arc, dtype=np.float64)
