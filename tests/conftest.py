@@ -179,3 +179,12 @@ def pytest_collection_modifyitems(config, items):
     if late:
         ids = {id(item) for item in late}
         items[:] = [item for item in items if id(item) not in ids] + late
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _screen_family_cache(tmp_path_factory):
+    """Screens synthesise their CS dyad family once and cache it (services/screen_family.py): in
+    the tests, in a session directory rather than the user's ~/.cache."""
+    with pytest.MonkeyPatch.context() as m:
+        m.setenv("SPATIALMECH_CACHE_DIR", str(tmp_path_factory.mktemp("spatialmech-cache")))
+        yield

@@ -76,7 +76,8 @@ def screen(task, out, candidates, density, workers, scheduler, top, rank_by, see
     rate = summary.rate
     lines = [
         f"screen of 5-CS linkages for the 7 positions of {source}",
-        f"  family: {summary.family['n_branches']} branches, {summary.family['n_points']} points; pool: "
+        f"  family: {summary.family['n_branches']} branches, {summary.family['n_points']} points "
+        f"({summary.family.get('source', 'synthesised')}); pool: "
         f"{summary.pool['dyads']} dyads; candidates: {summary.candidates} ({summary.mode})",
         f"  judged {summary.judged} ({summary.judged_this_run} by this run, {summary.chunks_resumed} of "
         f"{summary.chunks} chunks resumed) in {summary.seconds:.1f} s"
@@ -90,5 +91,7 @@ def screen(task, out, candidates, density, workers, scheduler, top, rank_by, see
         lines.append(f"  #{t['place']}: candidate {t['candidate']} (dyads {t['dyads']}), drivers "
                      f"{', '.join(t['usable_drivers'])}; min sigma on the path {t['min_sigma_on_path']:.3g} "
                      f"({t['best_driver']}), slide stroke {t['stroke_len']:.4g} -> {t['model_file']}")
+    if summary.note:
+        lines.append(f"  note: {summary.note}")
     lines.append(f"  dataset: {summary.out} (Parquet; read it with pyarrow.parquet.read_table)")
     click.echo("\n".join(lines))

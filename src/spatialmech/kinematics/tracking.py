@@ -250,6 +250,29 @@ def _orientation(A: np.ndarray, t: np.ndarray, frame) -> float:
     return float(sign)
 
 
+def _step_tangent(problem, xn, t: np.ndarray, frame) -> tuple[np.ndarray, np.ndarray, float | None]:
+    """The unit tangent at the trial point ``xn`` in the sense of ``t``, the Jacobian there, and
+    Keller's orientation ``sign det [A; tangent]`` when the compiled step test
+    (:func:`.compiled.kernels_tracking.bordered_tangent`: one LU of ``[A; t]``, no SVD) applies
+    and certifies that ``A`` has full row rank under the reference's rank test (``None``: the
+    caller computes the orientation as the reference does).  The compiled test runs for the
+    mechanism problems whose tangent is the Jacobian's null vector, while the frame of the last
+    accepted point is the full-rank one; the same tangent and sign as the reference's SVD to
+    rounding (``tests/test_tracking_compiled.py``)."""
+    A_n = problem.jacobian(xn)
+    fast = backend.engine() if frame[0] is None and getattr(problem, "null_tangent", False) else None
+    if fast is not None and A_n.ndim == 2 and A_n.shape[1] == A_n.shape[0] + 1:
+        got = fast.bordered_tangent(A_n, t)
+        # sigma_n(A) >= smin and sigma_1(A) <= |A|_F: a margin of 10 over the rank test's threshold
+        if got is not None and got[2] > 10.0 * current_tolerances().rank * max(1.0, got[3]):
+            return got[0], A_n, got[1]
+    tn = problem.tangent(xn)
+    tn = tn / np.linalg.norm(tn)
+    if float(tn @ t) < 0:
+        tn = -tn
+    return tn, A_n, None
+
+
 def correct_on_hyperplane(problem, xp, t, tol, max_iter, contraction=0.6):
     """Newton on ``F(x) = 0`` with every correction orthogonal to ``t`` (the pseudo-arclength
     corrector; also used to land on a curve at a given distance along a tangent).  Returns
@@ -364,15 +387,12 @@ def track(
         total_iters += iters
         tn: np.ndarray | None = None
         A_n: np.ndarray | None = None
+        o_n: float | None = None  # the orientation at xn when the compiled step test certified it
         if ok and moved < 0.5 * h:
-            tn = problem.tangent(xn)
-            tn = tn / np.linalg.norm(tn)
-            if float(tn @ t) < 0:
-                tn = -tn
-            A_n = problem.jacobian(xn)
+            tn, A_n, o_n = _step_tangent(problem, xn, t, frame)
             if float(tn @ t) < cos_max:
                 ok = False
-            elif orient != 0.0 and _orientation(A_n, tn, frame) != orient:
+            elif orient != 0.0 and (o_n if o_n is not None else _orientation(A_n, tn, frame)) != orient:
                 ok = False  # the step crossed to another branch
                 flips += 1
         else:
@@ -423,8 +443,11 @@ def track(
         for k in monitors:
             mon[k].append(vals[k])
         x, t, s = xn, tn, s_new
-        frame = _frame(A_n, tn)
-        orient = _orientation(A_n, tn, frame)
+        if o_n is not None:  # full row rank certified: the reference's frame is (None, None)
+            frame, orient = (None, None), o_n
+        else:
+            frame = _frame(A_n, tn)
+            orient = _orientation(A_n, tn, frame)
         steps += 1
         if progress is not None:
             progress(s, max_arc, "tracing")
@@ -478,6 +501,9 @@ def _locate(problem, x, t, h, f, name, fa, fb, s, step, tol, event_tol):
 
 # --------------------------------------------------------------------------- mechanisms
 class _MechanismBase:
+    #: The tangent is the null vector of the Jacobian wherever it has full row rank (the
+    #: compiled step test of :func:`_step_tangent` applies).
+    null_tangent: bool = True
     #: ``+1``: the traced motion starts in the conventional sense (:func:`conventional_sense`
     #: over ``sense_order``); ``-1``: the opposite one.
     sense: float = 1.0

@@ -304,12 +304,11 @@ def _claims_html(claims: Sequence[Claim]) -> str:
 
 
 def _viewer_html(v: Viewer, div_id: str) -> str:
-    from .viewer import viewer_figure
+    from .viewer import viewer_html
 
-    fig = viewer_figure(v.mech, list(v.configs), title=v.title, task_positions=v.task_positions,
-                        singular_points=v.singular_points)
-    div = fig.to_html(include_plotlyjs=False, full_html=False, auto_play=False, div_id=div_id,
-                      default_height="640px", config={"displaylogo": False, "responsive": True})
+    div = viewer_html(v.mech, list(v.configs), title=v.title, task_positions=v.task_positions,
+                      singular_points=v.singular_points, full_html=False, include_plotlyjs=False, div_id=div_id,
+                      default_height="640px")
     note = f"<p class='small'>{html.escape(v.note)}</p>" if v.note else ""
     return f"<div class='viewer'>{div}</div>{note}"
 

@@ -41,6 +41,7 @@ angles.  Example::
 
 from __future__ import annotations
 
+import base64
 import html as _html
 import weakref
 from collections.abc import Sequence
@@ -60,7 +61,7 @@ from ..serialize import fields_dict
 from .shapes import joint_list, joint_meshes, platform_solid
 
 __all__ = ["DIV_ID", "LIMB_COLOURS", "PLOTLY_MODES", "SINGULAR_SYMBOL", "Drawing", "ViewerFile", "drawing", "viewer_figure",
-           "viewer_html", "write_viewer"]
+           "viewer_figure_dict", "viewer_html", "write_viewer"]
 
 #: ``id`` of the plotly graph ``<div>`` in the page (the browser test reads it).
 DIV_ID = "spatialmech-viewer"
@@ -309,38 +310,66 @@ def _solids(mech: Mechanism, config: Configuration, d: Drawing) -> tuple[dict | 
     return solid, joint_meshes(joint_list(mech, config), len(mech.limbs), d.scale)
 
 
-def _mesh3d(mesh: dict | None, faces: bool) -> go.Mesh3d:
+_TYPED = {"float32": "f4", "float64": "f8", "int32": "i4", "int16": "i2", "int8": "i1", "uint8": "u1"}
+
+
+def _typed(v):
+    """A NumPy vector as plotly.js's base64 typed array (what plotly's validated figures write),
+    anything else unchanged; int64 is written as int32 (plotly.js has no 64-bit integers)."""
+    if not isinstance(v, np.ndarray) or v.size == 0:
+        return v
+    a = v.astype(np.int32) if v.dtype == np.int64 else v
+    code = _TYPED.get(str(a.dtype))
+    if code is None or a.ndim != 1:
+        return v
+    return {"dtype": code, "bdata": base64.b64encode(np.ascontiguousarray(a).tobytes()).decode("ascii")}
+
+
+def _plain(kind: str):
+    """A trace maker like ``go.Scatter3d``, giving a plain dict (arrays typed): animation frames
+    built without plotly's validated setters (issue 29: 3-4 s of the demo for 564 frames)."""
+    return lambda **kw: {"type": kind, **{k: _typed(v) for k, v in kw.items()}}
+
+
+_GO = {"scatter3d": lambda **kw: go.Scatter3d(**kw), "mesh3d": lambda **kw: go.Mesh3d(**kw)}
+_PLAIN = {"scatter3d": _plain("scatter3d"), "mesh3d": _plain("mesh3d")}
+
+
+def _mesh3d(mesh: dict | None, faces: bool, make=_GO):
     """A mesh as a plotly trace, compact in the page: float32 vertices and int32 triangles
     (plotly writes NumPy arrays as base64 typed arrays); ``faces=False`` leaves the triangles
     out (an animation frame of a mesh whose topology does not change)."""
     if mesh is None:
-        return go.Mesh3d(x=[], y=[], z=[])
+        return make["mesh3d"](x=[], y=[], z=[])
     V = np.asarray(mesh["vertices"], np.float32)
     kw: dict[str, np.ndarray] = {"x": V[:, 0], "y": V[:, 1], "z": V[:, 2]}
     if faces:
         T = np.asarray(mesh["triangles"], np.int32)
         kw.update(i=T[:, 0], j=T[:, 1], k=T[:, 2])
-    return go.Mesh3d(**kw)
+    return make["mesh3d"](**kw)
 
 
-def _animated(d: Drawing, fill: bool, solids: tuple[dict | None, list[dict]], first: bool = False) -> list:
+def _animated(d: Drawing, fill: bool, solids: tuple[dict | None, list[dict]], first: bool = False,
+              make=_GO) -> list:
     """The traces that move, in a fixed order; styles (and the joint solids' triangles, the same
-    in every frame) are given only in the first frame."""
-    out = [go.Scatter3d(**_xyz(d.platform))]
+    in every frame) are given only in the first frame.  ``make``: plotly objects (``_GO``) or
+    plain dicts (``_PLAIN``, the frames of a page)."""
+    sc = make["scatter3d"]
+    out = [sc(**_xyz(d.platform))]
     x, y, z = _segments(np.array([[d.platform_point, q] for q in d.platform[: max(1, len(d.platform) - 1)]]))
-    out.append(go.Scatter3d(x=x, y=y, z=z))
+    out.append(sc(x=x, y=y, z=z))
     solid, joints = solids
     if fill:  # the platform body: its polygon, or the hull of a non-planar one (triangles may change)
-        out.append(_mesh3d(solid, True))
-    out += [go.Scatter3d(**_xyz(l)) for l in d.limbs]
-    out += [_mesh3d(m, first) for m in joints]
+        out.append(_mesh3d(solid, True, make))
+    out += [sc(**_xyz(l)) for l in d.limbs]
+    out += [_mesh3d(m, first, make) for m in joints]
     if len(d.bodies):
         x, y, z = _segments(d.bodies)
-        out.append(go.Scatter3d(x=x, y=y, z=z))
-    out.append(go.Scatter3d(**_xyz(d.joints)))
+        out.append(sc(x=x, y=y, z=z))
+    out.append(sc(**_xyz(d.joints)))
     for k in range(3):
         x, y, z = _segments(_frame_segments(d.platform_point, d.platform_frame, FRAME_LEN * d.scale, k))
-        out.append(go.Scatter3d(x=x, y=y, z=z))
+        out.append(sc(x=x, y=y, z=z))
     return out
 
 
@@ -399,6 +428,29 @@ def viewer_figure(
     point is drawn).  Pure: builds the figure, writes nothing.  Raises ``ValueError`` on an
     empty or mismatched ``configs`` and on NaN anywhere.
     """
+    fig, frames = _viewer_parts(mech, configs, title, task_positions, singular_points, _GO)
+    fig.frames = frames
+    return fig
+
+
+def viewer_figure_dict(
+    mech: Mechanism,
+    configs: Sequence[Configuration],
+    *,
+    title: str | None = None,
+    task_positions: Sequence[Pose] = (),
+    singular_points: Sequence = (),
+) -> dict:
+    """:func:`viewer_figure` as the plain dict plotly writes into a page (``Figure.to_dict()``:
+    arrays as base64 typed arrays), its animation frames built as dicts without plotly's
+    validated setters (the static traces and the layout still go through them).  For writing a
+    page: ``plotly.io.to_html(d, validate=False, ...)``."""
+    fig, frames = _viewer_parts(mech, configs, title, task_positions, singular_points, _PLAIN)
+    return {**fig.to_dict(), "frames": frames}
+
+
+def _viewer_parts(mech, configs, title, task_positions, singular_points, make):
+    """The figure without its frames, and the frames (``make``: plotly objects or plain dicts)."""
     if not isinstance(mech, Mechanism):
         raise InputError(f"mech: expected a Mechanism, got {type(mech).__name__}")
     configs = list(configs)
@@ -449,7 +501,7 @@ def viewer_figure(
     first = _animated(d0, fill, solids[0], first=True)
     _style_animated(first, d0, mech, fill)
     anim_idx = list(range(len(static), len(static) + len(first)))
-    frames = [go.Frame(data=_animated(d, fill, so), traces=anim_idx, name=str(k))
+    frames = [(go.Frame if make is _GO else dict)(data=_animated(d, fill, so, make=make), traces=anim_idx, name=str(k))
               for k, (d, so) in enumerate(zip(draws, solids, strict=True))]
 
     meshes = [m["vertices"] for so in solids for m in ([so[0]] if so[0] is not None else []) + so[1]]
@@ -462,7 +514,7 @@ def viewer_figure(
         scene[f"{ax}axis"] = dict(range=[c - half, c + half], title=f"{ax} [{unit}]", autorange=False)
 
     anim = dict(mode="immediate", frame=dict(duration=0, redraw=True), transition=dict(duration=0))
-    fig = go.Figure(data=static + first, frames=frames)
+    fig = go.Figure(data=static + first)
     fig.update_layout(
         title=title if title is not None else f"{mech.name}: {len(configs)} configurations",
         scene=scene,
@@ -485,7 +537,7 @@ def viewer_figure(
             steps=[dict(label=str(k), method="animate", args=[[str(k)], anim]) for k in range(len(configs))],
         )],
     )
-    return fig
+    return fig, frames
 
 
 def viewer_html(
@@ -497,15 +549,22 @@ def viewer_html(
     singular_points: Sequence = (),
     full_html: bool = True,
     include_plotlyjs: bool | str = True,
+    div_id: str = DIV_ID,
+    default_height: str = "92vh",
 ) -> str:
     """The viewer page as a string: plotly.min.js inlined (``include_plotlyjs=True``, works
-    offline), the figure of :func:`viewer_figure` in a ``<div id="spatialmech-viewer">``, not
-    auto-playing.  ``full_html=False`` gives an embeddable ``<div>`` (for a report that embeds
-    several viewers, inline the JavaScript once and pass ``include_plotlyjs=False`` after)."""
-    fig = viewer_figure(mech, configs, title=title, task_positions=task_positions, singular_points=singular_points)
-    page = fig.to_html(
-        include_plotlyjs=include_plotlyjs, full_html=full_html, auto_play=False, div_id=DIV_ID,
-        default_height="92vh", config={"displaylogo": False, "responsive": True},
+    offline), the figure of :func:`viewer_figure` in a ``<div id="spatialmech-viewer">``
+    (``div_id``), not auto-playing.  ``full_html=False`` gives an embeddable ``<div>`` (for a
+    report that embeds several viewers, inline the JavaScript once and pass
+    ``include_plotlyjs=False`` after).  Written from :func:`viewer_figure_dict` (the same page
+    content, its frames without plotly's validated setters)."""
+    import plotly.io as pio
+
+    fig = viewer_figure_dict(mech, configs, title=title, task_positions=task_positions,
+                             singular_points=singular_points)
+    page = pio.to_html(
+        fig, validate=False, include_plotlyjs=include_plotlyjs, full_html=full_html, auto_play=False, div_id=div_id,
+        default_height=default_height, config={"displaylogo": False, "responsive": True},
     )
     if full_html:
         name = _html.escape(title if title is not None else mech.name)

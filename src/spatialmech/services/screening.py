@@ -8,6 +8,7 @@ The dataset directory (``OUT``, e.g. ``screen.parquet``)::
     OUT/part-00000.parquet ...   one file per chunk of candidates (the verdict rows)
     OUT/_screen.json             the arguments, the task, the candidate fingerprint, the summary
     OUT/_pool.parquet            the sampled dyads (the candidates' limbs)
+    OUT/_family.npz              the CS dyad family (reused by a rerun; also cached: screen_family.py)
     OUT/_top/rank-01.toml ...    the best usable linkages as model files
 
 Files and folders whose names start with ``_`` are skipped by Parquet readers, so
@@ -35,7 +36,8 @@ import numpy as np
 from ..errors import InputError
 from ..model.mechanism import Pose
 from ..results import Progress, check_progress
-from ..synthesis.cs_dyads import CSFamily, cs_task, synthesize_cs
+from ..synthesis.cs_dyads import CSFamily, cs_task
+from .screen_family import FAMILY_FILE, obtain_family, save_family
 from ..synthesis.screening import (
     RANKINGS,
     STAGES,
@@ -48,12 +50,17 @@ from ..synthesis.screening import (
     rank_key,
 )
 
-__all__ = ["CONNECT_TIMEOUT", "MANIFEST", "ScreenSummary", "read_rows", "row_schema", "run_screen"]
+__all__ = ["CONNECT_TIMEOUT", "MANIFEST", "MIN_CANDIDATES_PER_WORKER", "TASKS_PER_WORKER", "ScreenSummary",
+           "chunk_runs", "judge_chunks", "read_rows", "row_schema", "run_screen", "too_small_note"]
 
 #: The dataset's description file.
 MANIFEST = "_screen.json"
 #: How long to wait for an existing Dask scheduler (``scheduler=``) to answer.
 CONNECT_TIMEOUT = "20s"
+#: Dask tasks per worker: each task judges a run of chunks (fewer, larger tasks; some balance).
+TASKS_PER_WORKER = 4
+#: Below this many candidates per worker, a run on workers says it would be faster serially.
+MIN_CANDIDATES_PER_WORKER = 250
 _POOL = "_pool.parquet"
 _TOP = "_top"
 _FORMAT = "spatialmech-screen/1"
@@ -107,6 +114,8 @@ class ScreenSummary:
     rank_by: str = "singularity"
     #: Where the seven task positions came from (set by ``sm.screen``; listed by ``to_dict`` when set).
     positions_source: str | None = None
+    #: Advice about this run (e.g. too few candidates to gain from workers); listed when set.
+    note: str = ""
 
     @property
     def rate(self) -> float | None:
@@ -123,7 +132,8 @@ class ScreenSummary:
             "pool": dict(self.pool), "family": dict(self.family), "top": list(self.top),
             "ranking": ("min_sigma_on_path (larger first), then stroke_len (smaller first)" if self.rank_by == "singularity"
                         else "stroke_len (smaller first), then min_sigma_on_path (larger first)"),
-        } | ({} if self.positions_source is None else {"positions_source": self.positions_source})
+        } | ({} if self.positions_source is None else {"positions_source": self.positions_source}) \
+          | ({"note": self.note} if self.note else {})
 
 
 # ------------------------------------------------------------------------------ helpers
@@ -285,19 +295,58 @@ def _local_cluster(workers: int):
     return cluster, Client(cluster)
 
 
-def _run_distributed(client, pool, todo, report, write) -> None:
+def judge_chunks(pool: DyadPool, todo: list) -> list[tuple[int, list[dict]]]:
+    """The verdict rows of several chunks ``(k, first, sets)`` in one task (runs on a worker):
+    ``[(k, rows), ...]``.  Fewer, larger tasks hide the scheduler's per-task cost."""
+    return [(k, judge_chunk(pool, sets, first, k)) for k, first, sets in todo]
+
+
+def chunk_runs(todo: list, n_workers: int) -> list[list]:
+    """``todo`` cut into about :data:`TASKS_PER_WORKER` tasks per worker (each a run of chunks)."""
+    n = max(1, min(len(todo), TASKS_PER_WORKER * max(1, n_workers)))
+    size = math.ceil(len(todo) / n)
+    return [todo[i:i + size] for i in range(0, len(todo), size)]
+
+
+def _run_distributed(client, pool, todo, report, write, n_workers: int) -> None:
     from distributed import as_completed
 
     pool_f = client.scatter(pool, broadcast=True)
-    futures = {client.submit(judge_chunk, pool_f, sets, first, k, pure=False): k for k, first, sets in todo}
+    futures = [client.submit(judge_chunks, pool_f, b, pure=False) for b in chunk_runs(todo, n_workers)]
     try:
         for fut in as_completed(futures):
-            rows = fut.result()  # a worker's exception is raised here, with its traceback
-            write(futures[fut], rows)
-            report(len(rows), sum(r["usable"] for r in rows))
+            for k, rows in fut.result():  # a worker's exception is raised here, with its traceback
+                write(k, rows)
+                report(len(rows), sum(r["usable"] for r in rows))
     except BaseException:
-        client.cancel(list(futures))
+        client.cancel(futures)
         raise
+
+
+def too_small_note(n: int, workers: int) -> str:
+    """A note when ``n`` candidates are too few to gain from ``workers`` worker processes (their
+    start-up, several seconds, exceeds what they save), else ``""``."""
+    if workers >= 2 and n < MIN_CANDIDATES_PER_WORKER * workers:
+        return (f"{n} candidates are too few to gain from {workers} workers (starting them takes several seconds); "
+                f"workers=0 (--workers 0) judges them serially, faster; workers pay off from about "
+                f"{MIN_CANDIDATES_PER_WORKER * workers} candidates")
+    return ""
+
+
+def _local_workers(workers: int | None) -> int:
+    """The worker processes of a local cluster (``None``: one per core; ``0``: serial)."""
+    return int(os.cpu_count() or 1) if workers is None else int(workers)
+
+
+def _family_for(task, family: CSFamily | None, starts: int, seed: int, out: Path, say):
+    """``(family, source, key)``: the given family (checked against the task; key ``None``), or
+    the one stored with the dataset, cached or synthesised (:func:`.screen_family.obtain_family`)."""
+    if family is None:
+        say(0, None, "the CS dyad family of the seven positions (stored with the dataset and cached)")
+        return obtain_family(task, starts, seed, out)
+    if family.task.D.shape != task.D.shape or not np.allclose(family.task.D, task.D, atol=1e-12):
+        raise InputError("family: it was synthesised for other positions")
+    return family, "given", None
 
 
 # ------------------------------------------------------------------------------ the screen
@@ -354,11 +403,7 @@ def run_screen(
     arguments = {"candidates": int(candidates), "density": float(density), "seed": int(seed), "starts": int(starts),
                  "separation": float(separation), "chunk_size": int(chunk_size)}
     _refuse_other_screen(out, arguments, _poses_json(task.poses))  # before the work, not after the family
-    if family is None:
-        say(0, None, "synthesising the CS dyad family of the seven positions")
-        family = synthesize_cs(task, n_starts=int(starts), seed=seed, pick=0)
-    elif family.task.D.shape != task.D.shape or not np.allclose(family.task.D, task.D, atol=1e-12):
-        raise InputError("family: it was synthesised for other positions")
+    family, family_source, family_key = _family_for(task, family, int(starts), seed, out, say)
     pool = dyad_pool(family, density)
     sets, mode = candidate_sets(pool, int(candidates), seed=seed, separation=separation)
     if len(sets) == 0:
@@ -375,6 +420,8 @@ def run_screen(
     resumed = _check_out(out, manifest)
     if not (out / _POOL).exists():
         _write_pool(out, pool)
+    if family_key is not None and not (out / FAMILY_FILE).exists():
+        save_family(family, out / FAMILY_FILE, family_key)
     todo = [(k, k * chunk_size, sets[k * chunk_size:(k + 1) * chunk_size]) for k in range(n_chunks)
             if not _part(out, k).exists()]
     done_before = len(sets) - sum(len(s) for _, _, s in todo)
@@ -385,6 +432,9 @@ def run_screen(
 
     t0 = time.perf_counter()
     n_workers, where = 0, "serial (this process)"
+    note = too_small_note(len(sets) - done_before, _local_workers(workers) if scheduler is None else 0)
+    if note:
+        say(done_before, len(sets), note)
     if todo:
         if scheduler is None and workers == 0:
             for k, first, s in todo:
@@ -398,12 +448,12 @@ def run_screen(
                 cluster, client = None, _connect(Client, str(scheduler))
                 where = str(scheduler)
             else:
-                cluster, client = _local_cluster(int(workers or os.cpu_count() or 1))
+                cluster, client = _local_cluster(_local_workers(workers))
                 where = "local cluster (127.0.0.1)"
             try:
                 n_workers = len(client.scheduler_info().get("workers", {}))
                 say(done_before, len(sets), f"judging {len(sets) - done_before} candidates on {n_workers} workers")
-                _run_distributed(client, pool, todo, report, write)
+                _run_distributed(client, pool, todo, report, write, n_workers)
             finally:
                 client.close()
                 if cluster is not None:
@@ -434,7 +484,9 @@ def run_screen(
         chunks=n_chunks, chunks_resumed=resumed, rejected_by_stage=counts, usable=len(usable), seconds=seconds,
         workers=n_workers, scheduler=where,
         pool={"dyads": len(pool), "density": float(density), "separation": float(separation)},
-        family={"n_branches": len(family.branches), "n_points": family.n_points}, top=top_rows, rank_by=rank_by,
+        family={"n_branches": len(family.branches), "n_points": family.n_points, "source": family_source},
+        top=top_rows, rank_by=rank_by,
+        note=note,
     )
     doc = {**manifest, "summary": summary.to_dict()}
     (out / MANIFEST).write_text(json.dumps(doc, indent=2, default=float), encoding="utf-8")

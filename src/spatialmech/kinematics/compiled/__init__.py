@@ -9,7 +9,8 @@ Study formulation's parameter homotopy) and :mod:`.kernels_loops` (the loop form
 system), :mod:`.kernels_ik` (one limb's inverse position),
 :mod:`.kernels_four_sps_cu` (the 4-SPS/CU closed-form leg lengths), :mod:`.kernels_limits`
 (with its entry :mod:`.limits`: joint points of many configurations, for the workspace limits),
-:mod:`.kernels_task` (with its entry :mod:`.tasks`: the task-coordinate solve); :mod:`.jit` is numba's ``njit`` or its
+:mod:`.kernels_task` (with its entry :mod:`.tasks`: the task-coordinate solve), :mod:`.kernels_tracking` (the
+continuation tracker's tangent and orientation test); :mod:`.jit` is numba's ``njit`` or its
 stand-in.
 
 Callers do not choose between this package and the Python reference themselves:
@@ -48,6 +49,7 @@ from .kernels_homotopy import track_parameter
 from .kernels_ik import ik_pack, ik_track
 from .kernels_loops import pack as pack_loop_system
 from .kernels_loops import square_batch as loop_square_batch
+from .kernels_tracking import bordered_tangent
 from .legs import correct_legs
 from .limits import joint_points_many, link_margins_many
 from .tasks import task_grid, task_solve
@@ -57,6 +59,7 @@ __all__ = [
     "AVAILABLE",
     "UNAVAILABLE_REASON",
     "CompiledMechanism",
+    "bordered_tangent",
     "closure_jacobian",
     "closure_jacobians",
     "closure_residual",

@@ -1,0 +1,99 @@
+"""Screening that scales (issue 29): the CS dyad family stored with the dataset and cached
+(services/screen_family.py), reused by later screens with the same rows; workers fed runs of
+chunks; a note when a run is too small to gain from workers."""
+
+import dataclasses
+import warnings
+
+import numpy as np
+import pytest
+
+from spatialmech.catalog.papers import five_cs_positions
+from spatialmech.services import screen_family as sf
+from spatialmech.services.screening import (
+    MIN_CANDIDATES_PER_WORKER,
+    TASKS_PER_WORKER,
+    chunk_runs,
+    judge_chunks,
+    read_rows,
+    run_screen,
+    too_small_note,
+)
+from spatialmech.synthesis.cs_dyads import cs_task
+from spatialmech.synthesis.screening import candidate_sets, dyad_pool
+
+
+def strip(rows):
+    return [{k: v for k, v in r.items() if k not in ("seconds", "worker")} for r in rows]
+
+
+def test_a_run_too_small_for_its_workers_says_so():
+    assert too_small_note(MIN_CANDIDATES_PER_WORKER * 2, 2) == ""
+    assert too_small_note(1000, 0) == "" and too_small_note(10, 1) == ""
+    note = too_small_note(200, 2)
+    assert "too few to gain from 2 workers" in note and "--workers 0" in note
+
+
+def test_workers_get_a_few_runs_of_chunks_covering_every_chunk_once():
+    todo = [(k, 20 * k, None) for k in range(50)]
+    for w in (1, 2, 3, 8):
+        b = chunk_runs(todo, w)
+        assert len(b) <= TASKS_PER_WORKER * w
+        assert [c for run in b for c in run] == todo
+    assert chunk_runs(todo[:3], 2) == [[t] for t in todo[:3]]
+
+
+@pytest.fixture(scope="module")
+def family(paper_a_cs_family):
+    return dataclasses.replace(paper_a_cs_family, picks=())
+
+
+@pytest.mark.slow
+def test_the_stored_family_round_trips_exactly(family, tmp_path):
+    task = cs_task(five_cs_positions())
+    key = sf.family_key(task, 60, 0)
+    path = tmp_path / "f.npz"
+    sf.save_family(family, path, key)
+    got = sf.load_family(path, task, key)
+    assert got is not None and len(got.branches) == len(family.branches)
+    for a, b in zip(got.branches, family.branches, strict=True):
+        assert np.array_equal(a.points, b.points) and np.array_equal(a.arc, b.arc)
+        assert (a.closed, a.ends, a.residual) == (b.closed, b.ends, b.residual)
+    assert got.starts == family.starts and got.extent == family.extent
+    pa, pb = dyad_pool(got, 0.5), dyad_pool(family, 0.5)
+    assert np.array_equal(pa.vectors, pb.vectors)
+    assert np.array_equal(candidate_sets(pa, 50)[0], candidate_sets(pb, 50)[0])
+    # another task, seed or number of starts: another key, nothing read
+    assert sf.family_key(task, 60, 1) != key and sf.family_key(task, 59, 0) != key
+    assert sf.load_family(path, task, sf.family_key(task, 60, 1)) is None
+    # a damaged file is ignored (and said so), never half read
+    path.write_bytes(b"not a family")
+    with warnings.catch_warnings(record=True) as w:
+        warnings.simplefilter("always")
+        assert sf.load_family(path, task, key) is None
+    assert any("ignoring the stored CS family" in str(x.message) for x in w)
+
+
+@pytest.mark.slow
+def test_a_screen_reuses_the_cached_then_the_stored_family_with_the_same_rows(family, tmp_path, monkeypatch):
+    cache = tmp_path / "cache"
+    monkeypatch.setenv(sf.CACHE_ENV, str(cache))
+    task = cs_task(five_cs_positions())
+    key = sf.family_key(task, 60, 0)
+    sf.save_family(family, cache / "cs-families" / f"{key}.npz", key)  # as a first screen would have
+    ref = run_screen(five_cs_positions(), tmp_path / "given", candidates=6, chunk_size=3, workers=0, family=family,
+                     top=0)
+    a = run_screen(five_cs_positions(), tmp_path / "a", candidates=6, chunk_size=3, workers=0, top=0)
+    assert a.family["source"] == "cache" and ref.family["source"] == "given"
+    assert (tmp_path / "a" / sf.FAMILY_FILE).is_file()
+    assert strip(read_rows(tmp_path / "a")) == strip(read_rows(tmp_path / "given"))
+    # the same screen again into the same dataset, the cache gone: the dataset's own copy
+    (cache / "cs-families" / f"{key}.npz").unlink()
+    b = run_screen(five_cs_positions(), tmp_path / "a", candidates=6, chunk_size=3, workers=0, top=0)
+    assert b.family["source"] == "dataset" and b.judged_this_run == 0 and b.chunks_resumed == 2
+    # a run of chunks judged in one task gives the rows of the chunks judged one by one
+    pool = dyad_pool(family, 0.5)
+    sets = candidate_sets(pool, 6)[0]
+    runs = judge_chunks(pool, [(0, 0, sets[:3]), (1, 3, sets[3:])])
+    assert [k for k, _ in runs] == [0, 1]
+    assert strip([r for _, rows in runs for r in rows]) == strip(read_rows(tmp_path / "given"))

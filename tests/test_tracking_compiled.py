@@ -1,0 +1,98 @@
+"""The tracker's compiled step test (issue 29): one LU of the bordered Jacobian ``[A; t]``
+instead of a full SVD per step gives the same tangents, orientation signs, statuses and events
+as the reference's SVD path, and steps aside (to the SVD) wherever the rank is in doubt."""
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from spatialmech import catalog
+from spatialmech.analysis import defect_circuits
+from spatialmech.analysis.defects import defect_analysis
+from spatialmech.kinematics import backend, tracking
+from spatialmech.kinematics.compiled import bordered_tangent
+from spatialmech.kinematics.tracking import MotionProblem
+
+TRACE_TOL = 1e-10  # arc lengths, tangents and event positions: compiled step test against the SVD path
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), n=st.integers(1, 40))
+def test_bordered_tangent_is_the_svd_null_vector_with_keller_sign(seed, n):
+    rng = np.random.default_rng(seed)
+    A = rng.standard_normal((n, n + 1))
+    t_prev = rng.standard_normal(n + 1)
+    t_prev /= np.linalg.norm(t_prev)
+    got = bordered_tangent(A, t_prev)
+    assert got is not None
+    z, sign, smin, anorm = got
+    _, sv, vt = np.linalg.svd(A)
+    ref = vt[-1] if vt[-1] @ t_prev > 0 else -vt[-1]  # oriented as the tracker does
+    assert np.linalg.norm(z) == pytest.approx(1.0, abs=1e-12)
+    assert z @ t_prev > 0
+    scale = 1.0 / max(sv[-1], 1e-300)
+    assert np.max(np.abs(z - ref)) < 1e-12 * max(1.0, scale)
+    assert sign == np.linalg.slogdet(np.vstack([A, ref]))[0]
+    assert smin <= sv[-1] * (1 + 1e-12)  # a lower bound of sigma_n(A) (interlacing)
+    assert anorm >= sv[0] * (1 - 1e-12)
+
+
+def test_bordered_tangent_of_a_rank_deficient_jacobian_is_not_certified():
+    rng = np.random.default_rng(3)
+    A = rng.standard_normal((6, 7))
+    A[5] = A[4] + 1e-13 * rng.standard_normal(7)  # rank 5 to working precision
+    got = bordered_tangent(A, np.eye(7)[0])
+    assert got is None or got[2] < 1e-9 * got[3]
+
+
+def _traces(mech, fast, monkeypatch):
+    """The TrackResults of a defect analysis, with the compiled step test on or off."""
+    rec = []
+
+    def recording(*a, **k):
+        r = tracking.track(*a, **k)
+        rec.append(r)
+        return r
+
+    with monkeypatch.context() as m:
+        m.setattr(defect_circuits, "track", recording)
+        m.setattr(MotionProblem, "null_tangent", fast)
+        res = defect_analysis(mech)
+    return res, rec
+
+
+def _assert_same_traces(a, b):
+    assert len(a) == len(b)
+    for ra, rb in zip(a, b, strict=True):
+        assert ra.status == rb.status and ra.closed == rb.closed
+        assert len(ra.s) == len(rb.s) and ra.rejected == rb.rejected
+        assert np.max(np.abs(ra.s - rb.s)) < TRACE_TOL
+        assert max(float(np.max(np.abs(x - y))) for x, y in zip(ra.tangents, rb.tangents, strict=True)) < TRACE_TOL
+        assert [e.name for e in ra.events] == [e.name for e in rb.events]
+        assert all(abs(x.s - y.s) < TRACE_TOL for x, y in zip(ra.events, rb.events, strict=True))
+
+
+@pytest.mark.parametrize("name", ["five-cs-1", "five-cs-2", pytest.param("five-cs-3", marks=pytest.mark.slow)])
+def test_compiled_step_test_traces_the_same_circuits_as_the_svd_path(name, monkeypatch):
+    if not backend.enabled():
+        pytest.skip("the compiled engine is not in use")
+    mech = catalog.build(name)
+    ra, fast = _traces(mech, True, monkeypatch)
+    rb, ref = _traces(mech, False, monkeypatch)
+    _assert_same_traces(fast, ref)
+    assert ra.usable_drivers == rb.usable_drivers
+    assert len(ra.circuits) == len(rb.circuits)
+    assert (ra.circuit_defect, ra.order_defect) == (rb.circuit_defect, rb.order_defect)
+
+
+@pytest.mark.slow
+def test_compiled_step_test_agrees_with_the_python_reference_on_five_cs_1(monkeypatch):
+    if not backend.enabled():
+        pytest.skip("the compiled engine is not in use")
+    mech = catalog.build("five-cs-1")
+    ra, fast = _traces(mech, True, monkeypatch)
+    with backend.python_reference():
+        rb, ref = _traces(mech, True, monkeypatch)  # null_tangent on, but no engine: the SVD path
+    _assert_same_traces(fast, ref)
+    assert ra.usable_drivers == rb.usable_drivers
