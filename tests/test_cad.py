@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -135,6 +136,13 @@ def test_glb_is_metres_and_cli(tmp_path):
     assert res.exit_code == 0, res.output
     d = json.loads(res.output)
     assert d["file_length_unit"] == "m" and len(d["files"]) == 1 + len(d["links"])
+    import jsonschema
+
+    from spatialmech.serialize import unit_rule_violations
+
+    schema = json.loads((Path(sm.__file__).parent / "interfaces" / "schemas" / "export.schema.json").read_text())
+    jsonschema.validate(d, schema)
+    assert unit_rule_violations(d) == []
 
 
 def test_missing_cad_extra_names_it(tmp_path, monkeypatch):

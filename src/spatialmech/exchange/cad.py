@@ -99,7 +99,8 @@ class LinkSolid:
 @dataclass(frozen=True)
 class CadExport:
     """What :func:`export_cad` wrote: the assembly file, one file per link, the sidecar (STL),
-    the format and the unit of the files."""
+    the format and the unit of the files; ``joints``: per link its file, diameter and joints
+    placed in the world (model length unit)."""
 
     assembly: Path
     links: dict[str, Path]
@@ -298,7 +299,11 @@ def export_cad(mech: Mechanism, out, fmt: str, *, config: Configuration | None =
                                  "joints": _features_dict(k, s, None)}
     writer = {"step": _write_step, "stl": _write_stl, "glb": _write_glb}[fmt]
     sidecar = writer(links, s, assembly, paths, meta)
-    return CadExport(assembly, paths, fmt, unit, sidecar, per_link)
+    summary = {k.link: {"file": paths[k.link].name, "diameter_len": k.diameter,
+                        "joints": [{("centre_len" if key == "centre" else key): v for key, v in f.items()}
+                                   for f in _features_dict(k, 1.0, k.placement)]}
+               for k in links}
+    return CadExport(assembly, paths, fmt, unit, sidecar, summary)
 
 
 # ------------------------------------------------------------------ STEP (build123d)
