@@ -16,7 +16,8 @@ import spatialmech as sm
 angles = np.radians(np.linspace(-40, 40, 33))
 s = sm.singularity_slice("three-rps", {"a2": angles, "a3": angles}, at={"z": 0.33})
 ok = np.isfinite(s.sigma_min)
-print(f"{int(ok.sum())} of {ok.size} cells closed (x, y, yaw solved: {s.solved}); smallest sigma_min {np.nanmin(s.sigma_min):.3g}")
+print(f"{int(ok.sum())} of {ok.size} cells closed ({', '.join(s.solved)} solved); "
+      f"smallest sigma_min {np.nanmin(s.sigma_min):.3g}")
 
 fig, ax = plt.subplots(figsize=(5.5, 4.5))
 U, V = np.degrees(s.u), np.degrees(s.v)
