@@ -18,7 +18,11 @@ from spatialmech.model.topology import link_graph
 
 pytest.importorskip("trimesh", reason="the cad extra (trimesh, manifold3d) is not installed")
 pytest.importorskip("manifold3d", reason="the cad extra (trimesh, manifold3d) is not installed")
-from spatialmech.exchange.cad import read_joint_frames
+from spatialmech.exchange.cad import cad_links, housing_mesh, housing_solid, read_joint_frames
+
+#: Cone half-angles and the fraction of the sphere a housing keeps: outside a cone of half-angle
+#: a the solid angle left is 1 - (1 - cos a) / 2 of the sphere's.
+HOUSINGS = [(np.pi / 3, 0.75), (np.pi / 2, 0.5), (2 * np.pi / 3, 0.25)]
 
 
 def _model_joints(mech, config):
@@ -143,6 +147,35 @@ def test_glb_is_metres_and_cli(tmp_path):
     schema = json.loads((Path(sm.__file__).parent / "interfaces" / "schemas" / "export.schema.json").read_text())
     jsonschema.validate(d, schema)
     assert unit_rule_violations(d) == []
+
+
+@pytest.mark.parametrize("alpha,kept", HOUSINGS)
+def test_housing_opening_is_the_cone_limit(alpha, kept):
+    """A ball housing keeps the sphere outside the cone the leg may sweep (mesh: within the
+    tessellation's 2 %)."""
+    import trimesh
+
+    w = np.array([0.0, 0.6, 0.8])
+    m = housing_mesh(trimesh, np.array([0.1, 0.2, 0.3]), 0.5, w, alpha)
+    full = 4 / 3 * np.pi * 0.5**3
+    assert m.is_watertight and m.volume / full == pytest.approx(kept, abs=0.02)
+    v = m.vertices - [0.1, 0.2, 0.3]
+    far = np.linalg.norm(v, axis=1) > 0.45  # on the sphere: none inside the open cone
+    assert np.all(v[far] @ w / np.linalg.norm(v[far], axis=1) <= np.cos(alpha) + 0.03)
+
+
+@pytest.mark.slow
+def test_housing_solid_and_paper_b_cones():
+    """The STEP housing's volume is the solid-angle fraction exactly; paper B's 90 deg cones
+    open the ground's housings upwards and the platform's downwards."""
+    b3d = pytest.importorskip("build123d", reason="the cad extra (build123d) is not installed")
+    for alpha, kept in HOUSINGS:
+        h = housing_solid(b3d, np.zeros(3), 2.0, np.array([0.0, 0.0, 1.0]), alpha)
+        assert h.volume / (4 / 3 * np.pi * 8.0) == pytest.approx(kept, rel=1e-6)
+    links = {k.link: k for k in cad_links(sm.load_model("four-sps-cu"))}
+    for link, w in (("ground", [0, 0, 1]), ("platform", [0, 0, -1])):
+        hs = [p for p in links[link].primitives if p[0] == "housing"]
+        assert len(hs) == 4 and all(np.allclose(p[3], w) and p[4] == pytest.approx(np.pi / 2) for p in hs)
 
 
 def test_missing_cad_extra_names_it(tmp_path, monkeypatch):

@@ -5,8 +5,10 @@ tree's, :mod:`.bodies`) with the link diameter the model gives (its workspace li
 ``link_diameter``; otherwise 4 % of the characteristic length, the MJCF export's capsules), and
 joint geometry on both links a joint connects: an R joint is a hub on one link and a longer,
 thinner pin on the other; a U joint two crossed pins; an S joint a housing sphere on one link
-and a smaller ball on the other; a P or C joint a sleeve on one link and a rod as long as the
-slide's stroke (its limits; otherwise 0.3 L) on the other.
+and a smaller ball on the other (with a cone limit in the model's workspace limits, the housing
+is on the link the cone's axis is fixed in and open over the cone the leg may sweep); a P or C
+joint a sleeve on one link and a rod as long as the slide's stroke (its limits; otherwise
+0.3 L) on the other.
 
 Each link is written in its own frame (the body tree's: world-aligned at the reference
 configuration, at the point of the joint that leads to it) and the assembly with every link
@@ -46,7 +48,7 @@ from ..model.topology import link_graph
 from .bodies import body_tree
 
 __all__ = ["CAD_FORMATS", "CAD_UNITS", "CadExport", "JointFeature", "LinkSolid", "cad_links", "export_cad",
-           "link_displacements", "read_joint_frames"]
+           "housing_mesh", "housing_solid", "link_displacements", "read_joint_frames"]
 
 #: The CAD formats and their file extensions.
 CAD_FORMATS = {"step": (".step", ".stp"), "stl": (".stl",), "glb": (".glb",)}
@@ -77,9 +79,10 @@ class JointFeature:
 
 @dataclass(frozen=True)
 class LinkSolid:
-    """One link: its primitives in its own frame (``("cyl", a, b, r)``, ``("sph", c, r)``, model
-    length unit), its joints, its frame ``origin`` (world, reference configuration) and its
-    displacement ``D`` (4x4, world) at the exported configuration."""
+    """One link: its primitives in its own frame (``("cyl", a, b, r)``, ``("sph", c, r)``,
+    ``("housing", c, r, opening direction, cone half-angle)``, model length unit), its joints,
+    its frame ``origin`` (world, reference configuration) and its displacement ``D`` (4x4,
+    world) at the exported configuration."""
 
     link: str
     origin: np.ndarray
@@ -150,10 +153,18 @@ def _diameters(mech: Mechanism) -> tuple[dict[str, float], float]:
     return per, hub
 
 
-def _cone_limits(mech: Mechanism) -> dict[str, float]:
+def _openings(mech: Mechanism) -> dict[str, tuple[str, np.ndarray, float]]:
+    """Per S joint with a cone limit (the model's workspace limits): the link its housing is on
+    (the one the cone's axis is fixed in: the ground for a ``base`` cone, the output link for a
+    ``platform`` one), the direction the housing opens to (the leg leaves a base-side joint along
+    ``+axis``, a platform-side one along ``-axis``) and the cone's half-angle (rad)."""
     from ..analysis.workspace.limits import default_limits
 
-    return {c.joint: c.max_angle for c in default_limits(mech).cones}
+    out = {}
+    for c in default_limits(mech).cones:
+        w = np.asarray(c.axis, float)
+        out[c.joint] = (GROUND, w, c.max_angle) if c.frame == "base" else (mech.output, -w, c.max_angle)
+    return out
 
 
 def _stroke(joint, L: float) -> float:
@@ -161,17 +172,24 @@ def _stroke(joint, L: float) -> float:
     return max([abs(hi - lo) for lo, hi in lims] or [0.3 * L])
 
 
-def _joint_parts(gj, side: str, d: float, L: float, o: np.ndarray) -> tuple[list[tuple], list[JointFeature]]:
+def _joint_parts(gj, side: str, d: float, L: float, o: np.ndarray, opening: tuple[str, np.ndarray, float] | None
+                 ) -> tuple[list[tuple], list[JointFeature]]:
     """The primitives and features of joint ``gj`` on the link at its ``side`` (``"a"`` or
-    ``"b"``), in the frame at ``o``."""
+    ``"b"``), in the frame at ``o``; ``opening``: the S joint's cone (:func:`_openings`)."""
     j = gj.joint
     c = j.point - o
     t = gj.type
     prims: list[tuple] = []
     if t in ("S", "Sm"):
-        role = "housing" if side == "a" else "ball"
-        prims.append(("sph", c, 1.1 * d if side == "a" else 0.8 * d))
-        return prims, [JointFeature(gj.name, t, c, np.zeros(3), role)]
+        on = opening[0] if opening is not None and opening[0] in (gj.a, gj.b) else gj.a
+        here = gj.a if side == "a" else gj.b
+        if here != on:
+            prims.append(("sph", c, 0.8 * d))
+        elif opening is not None and on == opening[0]:  # a housing open over the cone the leg may sweep
+            prims.append(("housing", c, 1.1 * d, opening[1], opening[2]))
+        else:
+            prims.append(("sph", c, 1.1 * d))
+        return prims, [JointFeature(gj.name, t, c, np.zeros(3), "ball" if here != on else "housing")]
     axes = [f.direction for f in j.freedoms if f.kind != "P"] or [j.freedoms[0].direction]
     if t in ("P", "C"):
         u = j.freedoms[0].direction
@@ -197,6 +215,7 @@ def cad_links(mech: Mechanism, config: Configuration | None = None) -> list[Link
     tree = body_tree(mech)
     graph = link_graph(mech)
     per, hub_d = _diameters(mech)
+    openings = _openings(mech)
     D = link_displacements(mech, config)
     origins = {GROUND: np.zeros(3)}
     segments: dict[str, list] = {GROUND: list(tree.ground_segments)}
@@ -215,7 +234,7 @@ def cad_links(mech: Mechanism, config: Configuration | None = None) -> list[Link
         for gj in graph.joints:
             for side, end in (("a", gj.a), ("b", gj.b)):
                 if end == link:
-                    p, f = _joint_parts(gj, side, d, L, o)
+                    p, f = _joint_parts(gj, side, d, L, o, openings.get(gj.name))
                     prims += p
                     feats += f
         out.append(LinkSolid(link, o.copy(), D[link], _distinct(prims, L), tuple(feats), d))
@@ -223,11 +242,12 @@ def cad_links(mech: Mechanism, config: Configuration | None = None) -> list[Link
 
 
 def _distinct(prims: list[tuple], L: float) -> tuple[tuple, ...]:
-    """The primitives less the spheres inside a larger one at the same centre (coincident
-    spheres make the CAD kernel's boolean union slow)."""
+    """The primitives less the spheres inside a larger one or a housing at the same centre
+    (coincident spheres make the CAD kernel's boolean union slow; a capsule's end would fill a
+    housing's opening)."""
     out = []
     for k, p in enumerate(prims):
-        if p[0] == "sph" and any(q[0] == "sph" and np.linalg.norm(q[1] - p[1]) <= 1e-12 * L
+        if p[0] == "sph" and any(q[0] in ("sph", "housing") and np.linalg.norm(q[1] - p[1]) <= 1e-12 * L
                                  and (q[2] > p[2] or (q[2] == p[2] and i < k)) for i, q in enumerate(prims)):
             continue
         out.append(p)
@@ -317,12 +337,40 @@ def _b3d_solid(b3d, prims, s: float):
                 continue
             plane = b3d.Plane(origin=tuple(a), z_dir=tuple((b - a) / h))
             parts.append(b3d.Solid.make_cylinder(r, h, plane))
+        elif p[0] == "housing":
+            parts.append(housing_solid(b3d, s * p[1], s * p[2], p[3], p[4]))
         else:
             parts.append(b3d.Solid.make_sphere(s * p[2]).moved(b3d.Location(tuple(s * p[1]))))
     # a fuzzy union (1e-5 of the largest radius): exact unions of tangent or coaxial primitives
     # are ten times slower in OpenCascade and give the same solid within that size
-    tol = 1e-5 * s * max(p[-1] for p in prims)
+    tol = 1e-5 * s * max(p[3] if p[0] == "cyl" else p[2] for p in prims)
     return parts[0].fuse(*parts[1:], tol=tol) if len(parts) > 1 else parts[0]
+
+
+def _cone_size(R: float, alpha: float) -> tuple[float, float]:
+    """Height and base radius of the cone (apex at the centre) that cuts a housing of radius
+    ``R`` with the half-angle ``alpha`` < pi/2: it reaches beyond the sphere."""
+    H = 1.5 * R
+    return H, H * float(np.tan(alpha))
+
+
+def housing_solid(b3d, c: np.ndarray, R: float, w: np.ndarray, alpha: float):
+    """A ball-joint housing as a build123d solid (``b3d``: the module): the sphere of radius
+    ``R`` at ``c`` less the cone of half-angle ``alpha`` about ``w`` where the leg may swing
+    (pi/2: a hemisphere; more: the sphere kept only inside the cone of pi - alpha about ``-w``)."""
+    sphere = b3d.Solid.make_sphere(R).moved(b3d.Location(tuple(c)))
+    if abs(alpha - np.pi / 2) < 1e-9:
+        out = sphere.cut(b3d.Solid.make_cylinder(1.5 * R, 1.5 * R, b3d.Plane(origin=tuple(c), z_dir=tuple(w))))
+    else:
+        beta, sign = (alpha, 1.0) if alpha < np.pi / 2 else (np.pi - alpha, -1.0)
+        H, r = _cone_size(R, beta)
+        cone = b3d.Solid.make_cone(0.0, r, H, b3d.Plane(origin=tuple(c), z_dir=tuple(sign * w)))
+        out = sphere.cut(cone) if sign > 0 else sphere.intersect(cone)
+    if isinstance(out, list):  # build123d gives a list of the pieces: a housing is one
+        if len(out) != 1:
+            raise RuntimeError(f"a ball housing cut into {len(out)} pieces (alpha = {alpha} rad)")
+        out = out[0]
+    return out
 
 
 def _b3d_edges(b3d, link: LinkSolid, s: float, L: float, T: np.ndarray) -> list:
@@ -415,11 +463,32 @@ def _mesh(tm, prims, s: float):
             a, b = s * p[1], s * p[2]
             if np.linalg.norm(b - a) > 0:
                 parts.append(tm.creation.cylinder(radius=s * p[3], segment=np.array([a, b]), sections=_SECTIONS))
+        elif p[0] == "housing":
+            parts.append(housing_mesh(tm, s * p[1], s * p[2], p[3], p[4]))
         else:
             sph = tm.creation.icosphere(subdivisions=2, radius=s * p[2])
             sph.apply_translation(s * p[1])
             parts.append(sph)
     return tm.boolean.union(parts, engine="manifold") if len(parts) > 1 else parts[0]
+
+
+def housing_mesh(tm, c: np.ndarray, R: float, w: np.ndarray, alpha: float):
+    """:func:`housing_solid` as a trimesh mesh (``tm``: the trimesh module; manifold3d booleans)."""
+    sphere = tm.creation.icosphere(subdivisions=3, radius=R)
+    if abs(alpha - np.pi / 2) < 1e-9:
+        cutter = tm.creation.cylinder(radius=1.5 * R, segment=np.array([np.zeros(3), 1.5 * R * w]), sections=_SECTIONS)
+        keep = False
+    else:
+        beta, sign = (alpha, 1.0) if alpha < np.pi / 2 else (np.pi - alpha, -1.0)
+        H, r = _cone_size(R, beta)
+        cutter = tm.creation.cone(radius=r, height=H, sections=_SECTIONS)  # base at z = 0, apex at z = H
+        cutter.apply_transform(tm.transformations.rotation_matrix(np.pi, [1.0, 0.0, 0.0]) @
+                               tm.transformations.translation_matrix([0.0, 0.0, -H]))  # apex at 0, base at z = H
+        cutter.apply_transform(tm.geometry.align_vectors([0.0, 0.0, 1.0], sign * w))
+        keep = sign < 0
+    out = (tm.boolean.intersection if keep else tm.boolean.difference)([sphere, cutter], engine="manifold")
+    out.apply_translation(c)
+    return out
 
 
 def _write_stl(links: list[LinkSolid], s: float, assembly: Path, paths: dict[str, Path], meta: dict) -> Path:
