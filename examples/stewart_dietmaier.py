@@ -53,7 +53,9 @@ closes = [np.abs(np.linalg.norm(s.pose.p + platform @ s.pose.R.T - base, axis=1)
           for s in res.result.solutions]
 print(f"largest leg-length error over the {len(closes)} poses: {max(closes):.1e} m")
 
-file_mech = sm.load(Path(__file__).parent / "models" / "stewart-dietmaier.toml")   # the shipped file: the same legs
+# the shipped file: the same legs (examples/models/; a gallery build runs the script without __file__)
+here = Path(__file__).parent if "__file__" in globals() else Path(sm.__file__).parents[2] / "examples"
+file_mech = sm.load(here / "models" / "stewart-dietmaier.toml")
 for mine, theirs in zip(mech.limbs, file_mech.limbs, strict=True):
     for j, k in zip(mine.joints, theirs.joints, strict=True):
         assert j.type == k.type and np.allclose(j.point, k.point, atol=1e-12)

@@ -7,7 +7,8 @@ import pytest
 
 EXAMPLES = sorted((Path(__file__).parent.parent / "examples").glob("*.py"))
 #: Examples that take more than ~2 s (deselected by the quick loop, pytest -m "not slow").
-SLOW_EXAMPLES = {"stewart_forward_all.py", "rssr_from_file.py", "rccc_synthesis.py", "screen_five_cs.py"}
+SLOW_EXAMPLES = {"stewart_forward_all.py", "rssr_from_file.py", "rccc_synthesis.py", "screen_five_cs.py", "singularity_map.py",
+                 "cad_parts.py"}
 
 
 @pytest.mark.parametrize("path", [pytest.param(p, id=p.name, marks=[pytest.mark.slow] if p.name in SLOW_EXAMPLES else [])

@@ -7,11 +7,14 @@ from __future__ import annotations
 
 from ..model.task import TASK_NAMES
 
-__all__ = ["EXPORT_FORMATS", "TASK_COORDINATES", "VALIDATION_METHODS", "VALIDATION_TOL", "VIEW_MOTIONS",
-           "WORKSPACE_COORDINATES", "WORKSPACE_MAX_POSES"]
+__all__ = ["CAD_FORMATS", "CAD_UNITS", "EXPORT_FORMATS", "TASK_COORDINATES", "VALIDATION_METHODS", "VALIDATION_TOL",
+           "VIEW_MOTIONS", "WORKSPACE_COORDINATES", "WORKSPACE_MAX_POSES"]
 
 #: The formats :func:`~spatialmech.api.export` writes.
-EXPORT_FORMATS = ("toml", "mjcf", "urdf")
+EXPORT_FORMATS = ("toml", "mjcf", "urdf", "step", "stl", "glb")
+#: The CAD formats among them (the ``cad`` extra) and the units a CAD file may be in.
+CAD_FORMATS = ("step", "stl", "glb")
+CAD_UNITS = ("m", "mm")
 #: The ways :func:`~spatialmech.api.validate` drives the simulator, and the largest error that
 #: passes by default (a fraction of the characteristic length, and radians).
 VALIDATION_METHODS = ("project", "settle")

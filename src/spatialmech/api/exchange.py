@@ -8,13 +8,15 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from ..errors import InputError, describe
+from ..errors import ConvergenceError, InputError, describe
 from ..model.mechanism import Mechanism
 if TYPE_CHECKING:  # imported where it runs (it loads the simulator's bindings lazily)
     from ..analysis.validation import ValidationResult
 
-from .checks import ModelLike, as_mechanism, as_pose, check_bool, check_choice, check_int, check_number, check_path
+from .checks import (ModelLike, as_configuration, as_mechanism, as_pose, check_bool, check_choice, check_int,
+                     check_number, check_numbers, check_path)
 
+from .constants import CAD_FORMATS, CAD_UNITS
 from .constants import EXPORT_FORMATS as EXPORT_FORMATS  # the formats export() writes
 from .constants import VALIDATION_METHODS as VALIDATION_METHODS  # validate()'s methods and default tolerance
 from .constants import VALIDATION_TOL as VALIDATION_TOL
@@ -22,26 +24,37 @@ from .constants import VALIDATION_TOL as VALIDATION_TOL
 
 @dataclass(frozen=True, eq=False)
 class ExportResult:
-    """A model written to :attr:`out` in :attr:`format` (``"toml"``, ``"mjcf"`` or ``"urdf"``);
-    ``to_dict()`` is the payload of ``spatialmech export --json``."""
+    """A model written to :attr:`out` in :attr:`format` (``"toml"``, ``"mjcf"``, ``"urdf"``,
+    ``"step"``, ``"stl"`` or ``"glb"``); ``to_dict()`` is the payload of ``spatialmech export
+    --json``.  A CAD export also lists every file written (:attr:`files`: the assembly, one file
+    per link, the STL sidecar), its length :attr:`unit` and the joint features of every link."""
 
     mechanism: Mechanism
     out: Path
     format: str
+    files: tuple[Path, ...] = ()
+    unit: str | None = None
+    joints: dict | None = None
 
     @property
     def bytes(self) -> int:
         return self.out.stat().st_size
 
     def to_dict(self) -> dict:
-        return {"out": str(self.out), "format": self.format, "bytes": self.bytes}
+        d = {"out": str(self.out), "format": self.format, "bytes": self.bytes}
+        if self.unit is not None:
+            d.update(files=[str(f) for f in self.files], file_length_unit=self.unit, links=self.joints)
+        return d
 
 
-def export(model: ModelLike, file, *, format: str | None = None, mode: str | None = None) -> ExportResult:
-    """Write a model as a TOML model file, a MuJoCo model (MJCF) or a URDF.
+def export(model: ModelLike, file, *, format: str | None = None, mode: str | None = None, pose=None,
+           actuators=None, degrees: bool = False, unit: str | None = None) -> ExportResult:
+    """Write a model as a TOML model file, a MuJoCo model (MJCF), a URDF or CAD parts.
 
     A TOML file to start your own from; MJCF and URDF for other tools (URDF: loop closures in an
-    extension block; docs/validation.md).
+    extension block; docs/validation.md).  CAD (STEP, STL, GLB; the ``cad`` extra): one solid per
+    link with its joint geometry, the assembly at a configuration and one file per link in its
+    own frame, the unit written into the files (docs/cad.md).
 
     Parameters
     ----------
@@ -49,10 +62,19 @@ def export(model: ModelLike, file, *, format: str | None = None, mode: str | Non
         The mechanism, a ready-made model name (``sm.models()``) or a TOML model file.
     file : str or path
         The file written.
-    format : {"toml", "mjcf", "urdf"}, optional
-        Default: from the extension of ``file`` (.toml, .xml, .urdf).
+    format : {"toml", "mjcf", "urdf", "step", "stl", "glb"}, optional
+        Default: from the extension of ``file`` (.toml, .xml, .urdf, .step, .stl, .glb).
     mode : str, optional
         Write a metamorphic mechanism in that motion mode (its other lockable freedoms locked).
+    pose : Pose, tuple or int, optional
+        CAD: place the links at the configuration nearest this pose (a pose as in :func:`ik`).
+    actuators : array of shape (n_actuators,), optional
+        CAD: place the links at the forward-position solution for these actuator values (SI, or
+        degrees with ``degrees``).  Neither: the reference configuration.
+    degrees : bool
+        Angles of ``pose`` and rotary ``actuators`` in degrees.
+    unit : {"m", "mm"}, optional
+        CAD: the files' length unit (default ``"mm"``; a GLB is always in metres).
 
     Returns
     -------
@@ -90,7 +112,30 @@ def export(model: ModelLike, file, *, format: str | None = None, mode: str | Non
         if not isinstance(mode, str):
             raise TypeError(f"mode: expected a mode name (str) or None, got {describe(mode)}")
         mech = mech.in_mode(mode)
+    if fmt in CAD_FORMATS:
+        return _export_cad(mech, out, fmt, pose, actuators, check_bool(degrees, "degrees"), unit)
+    if pose is not None or actuators is not None or unit is not None:
+        raise InputError(f"pose/actuators/unit: only for a CAD export (step, stl, glb), not {fmt}")
     return ExportResult(mech, out, export_model(mech, out, fmt))
+
+
+def _export_cad(mech: Mechanism, out: Path, fmt: str, pose, actuators, degrees: bool, unit: str | None) -> ExportResult:
+    """The CAD branch of :func:`export`: the configuration, then the files."""
+    from ..exchange.cad import export_cad
+    from .kinematics import fk
+
+    unit = check_choice(unit, "unit", CAD_UNITS) if unit is not None else ("m" if fmt == "glb" else "mm")
+    if pose is not None and actuators is not None:
+        raise InputError("pose/actuators: give a pose or actuator values, not both")
+    if actuators is not None:
+        values = check_numbers(actuators, "actuators", shape=(len(mech.actuators),))
+        r = fk(mech, values, degrees=degrees)
+        if not r.converged:
+            raise ConvergenceError(f"actuators: no assembly found for {', '.join(f'{v:g}' for v in values)}")
+        pose = r.poses[0]
+    config, _ = as_configuration(mech, pose, None, degrees)
+    w = export_cad(mech, out, fmt, config=config, unit=unit)
+    return ExportResult(mech, w.assembly, fmt, tuple(w.files), w.unit, w.joints)
 
 
 def validate(model: ModelLike, motion: str | None = None, *, mode: str | None = None, start=None,

@@ -41,7 +41,8 @@ __all__ = [
 ]
 
 #: Export formats and the file extensions that imply them.
-FORMATS = {"toml": (".toml",), "mjcf": (".xml", ".mjcf"), "urdf": (".urdf",)}
+FORMATS = {"toml": (".toml",), "mjcf": (".xml", ".mjcf"), "urdf": (".urdf",),
+           "step": (".step", ".stp"), "stl": (".stl",), "glb": (".glb",)}
 
 
 def format_of(path, fmt: str | None = None) -> str:
@@ -56,7 +57,7 @@ def format_of(path, fmt: str | None = None) -> str:
         if suffix in suffixes:
             return name
     raise InputError(f"FILE: cannot tell the format from the extension {suffix or '(none)'!r} of {os.fspath(path)}; "
-                     f"use .toml, .xml (MJCF) or .urdf, or give --format {'|'.join(FORMATS)}")
+                     f"use .toml, .xml (MJCF), .urdf, .step, .stl or .glb, or give --format {'|'.join(FORMATS)}")
 
 
 def _model_masses(mech: Mechanism) -> dict | None:
@@ -71,11 +72,15 @@ def _model_masses(mech: Mechanism) -> dict | None:
 
 
 def export_model(mech: Mechanism, path, fmt: str | None = None) -> str:
-    """Write ``mech`` to ``path`` as TOML (the model file format), MJCF or URDF; returns the
+    """Write ``mech`` to ``path`` as TOML (the model file format), MJCF, URDF or CAD; returns the
     format used (``fmt`` or the one the extension implies).  An MJCF of a model whose file gives
     every link a mass (``masses``, ``density_kg_m3``) carries those mass properties."""
     fmt = format_of(path, fmt)
-    if fmt == "toml":
+    if fmt in ("step", "stl", "glb"):  # CAD parts at the reference configuration (.cad.export_cad)
+        from .cad import export_cad
+
+        export_cad(mech, path, fmt, unit="m" if fmt == "glb" else "mm")
+    elif fmt == "toml":
         from ..model.schema import dump
 
         dump(mech, path)

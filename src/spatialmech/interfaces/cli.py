@@ -17,8 +17,9 @@ from pathlib import Path
 import click
 
 from .. import api as sm
-from ..errors import ConvergenceError, SpatialmechError
-from .common import UserError, check_output_dir, check_output_file, emit_json, json_option, load_model, tol_option
+from ..errors import ConvergenceError, InputError, SpatialmechError
+from .common import (UserError, check_output_dir, check_output_file, emit_json, json_option, load_model, parse_numbers,
+                     tol_option)
 
 
 def _one_line_usage(e: click.UsageError) -> UserError:
@@ -204,26 +205,48 @@ def mobility_cmd(model, mode, as_json):
 @cli.command()
 @click.argument("model")
 @click.argument("file", type=click.Path(dir_okay=False, writable=True, path_type=Path))
-@click.option("--format", "fmt", type=click.Choice(["toml", "mjcf", "urdf"]), default=None,
-              help="toml (the model file format), mjcf (MuJoCo) or urdf; default: from FILE's extension "
-                   "(.toml, .xml, .urdf).")
+@click.option("--format", "fmt", type=click.Choice(["toml", "mjcf", "urdf", "step", "stl", "glb"]), default=None,
+              help="toml (the model file format), mjcf (MuJoCo), urdf, or CAD parts: step, stl, glb; default: from "
+                   "FILE's extension (.toml, .xml, .urdf, .step, .stl, .glb).")
 @click.option("--mode", default=None, help="Export a metamorphic mechanism in this motion mode (the other "
                                            "lockable freedoms locked).")
+@click.option("--pose", "pose_text", default=None,
+              help="CAD: place the links at this pose, X,Y,Z,SEQ,A1,A2,A3 (length, degrees).")
+@click.option("--position", type=int, default=None, help="CAD: place the links at built-in task position N.")
+@click.option("--actuators", "values", default=None,
+              help="CAD: place the links at these actuator values (comma-separated, degrees / length).")
+@click.option("--unit", type=click.Choice(["m", "mm"]), default=None,
+              help="CAD: the files' length unit (default mm; GLB is always m).")
 @json_option
-def export(model, file, fmt, mode, as_json):
-    """Write a model (e.g. a ready-made one) as a TOML file to start your own from, or as a
-    MuJoCo model (MJCF) or URDF to carry it to a simulator (docs/validation.md).
+def export(model, file, fmt, mode, pose_text, position, values, unit, as_json):
+    """Write a model (e.g. a ready-made one) as a TOML file to start your own from, as a
+    MuJoCo model (MJCF) or URDF to carry it to a simulator (docs/validation.md), or as CAD
+    parts: one solid per link, an assembly and one file per link (docs/cad.md).
 
     \b
     Examples:
       spatialmech export rssr my-rssr.toml
       spatialmech export four-sps-cu four-sps-cu.xml     # MJCF: python -m mujoco.viewer --mjcf=four-sps-cu.xml
       spatialmech export stewart-6sps stewart.urdf       # URDF, loop closures in an extension block
+      spatialmech export rssr part.step --unit mm        # STEP assembly + part.LINK.step per link
+      spatialmech export stewart-6sps part.stl --position 1   # part.mm.stl, part.LINK.mm.stl, part.mm.json
     """
     check_output_file(file, "FILE")
-    r = sm.export(load_model(model), file, format=fmt, mode=mode)
+    mech = load_model(model)
+    pose = None
+    if pose_text is not None or position is not None:
+        if pose_text is not None and position is not None:
+            raise InputError("--pose/--position: give one of them")
+        from .cmd_kinematics import parse_pose
+
+        pose = position if pose_text is None else parse_pose(pose_text)
+    acts = None if values is None else parse_numbers(values, "--actuators")
+    r = sm.export(mech, file, format=fmt, mode=mode, pose=pose, actuators=acts, degrees=True, unit=unit)
     if as_json:
         emit_json("export", r.mechanism, r.to_dict())
+    elif r.unit is not None:
+        click.echo(f"wrote {r.out} ({r.format}, {r.unit}) and {len(r.files) - 1} more: "
+                   f"{', '.join(f.name for f in r.files[1:])}")
     else:
         click.echo(f"wrote {file} ({r.format})")
 
