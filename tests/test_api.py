@@ -431,7 +431,9 @@ def test_export_writes_each_format_and_checks_first(tmp_path):
     with pytest.raises(sm.InputError, match="format"):
         sm.export("no-such-model", tmp_path / "r.png")  # the file's format is refused before the model is loaded
     with pytest.raises(sm.InputError, match="format: expected one of"):
-        sm.export("rssr", tmp_path / "r.toml", format="step")
+        sm.export("rssr", tmp_path / "r.toml", format="iges")
+    with pytest.raises(sm.InputError, match="format: 'step' contradicts the extension '.toml'"):
+        sm.export("rssr", tmp_path / "r.toml", format="step")  # a STEP file named .toml is refused
 
 
 def test_tolerances_apply_inside_the_block_only():

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from test_studio_browser import TIMEOUT, browser, server  # noqa: F401  (shared fixtures)
+from .test_studio_browser import TIMEOUT, browser, server  # noqa: F401  (shared fixtures)
 
 pytestmark = pytest.mark.slow  # a browser start and software WebGL take seconds
 

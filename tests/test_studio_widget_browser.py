@@ -20,7 +20,7 @@ from pathlib import Path
 import pytest
 
 import spatialmech as sm
-from test_studio_browser import browser, missing  # noqa: F401  (the Chromium fixture, shared)
+from .test_studio_browser import browser, missing  # noqa: F401  (the Chromium fixture, shared)
 
 pytestmark = pytest.mark.slow  # a browser start and software WebGL take seconds
 pytest.importorskip("anywidget")

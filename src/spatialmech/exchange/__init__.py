@@ -46,13 +46,18 @@ FORMATS = {"toml": (".toml",), "mjcf": (".xml", ".mjcf"), "urdf": (".urdf",),
 
 
 def format_of(path, fmt: str | None = None) -> str:
-    """The export format: ``fmt`` if given (``toml``, ``mjcf``, ``urdf``), else from the file's
-    extension (``.toml``; ``.xml`` / ``.mjcf``; ``.urdf``)."""
+    """The export format: ``fmt`` if given (one of :data:`FORMATS`; refused when the file's
+    extension names another format), else from the file's extension (``.toml``; ``.xml`` /
+    ``.mjcf``; ``.urdf``; ``.step``; ``.stl``; ``.glb``)."""
+    suffix = Path(os.fspath(path)).suffix.lower()
     if fmt is not None:
         if fmt not in FORMATS:
             raise InputError(f"--format: expected one of {', '.join(FORMATS)}, got {fmt!r}")
+        named = [name for name, suffixes in FORMATS.items() if suffix in suffixes]
+        if named and fmt not in named:
+            raise InputError(f"--format: {fmt!r} contradicts the extension {suffix!r} of {os.fspath(path)} "
+                             f"(a {named[0]} file); drop --format or name the file for {fmt}")
         return fmt
-    suffix = Path(os.fspath(path)).suffix.lower()
     for name, suffixes in FORMATS.items():
         if suffix in suffixes:
             return name
