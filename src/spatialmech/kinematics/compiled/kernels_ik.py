@@ -49,14 +49,9 @@ def _aff_twist(A, B, out, sg):
 
 
 @njit(cache=True)
-def _chain(th, kinds, A, A2, idx, sg, T, dT, pre, suf, Ms, tmp):
-    """Rows 0-2 (the last rows are never read) of ``T`` = the product of the factors ``M_0 ...
-    M_(m-1)`` and of ``dT[idx[i]]`` = its derivative in their variables, ``sg pre_i A_i suf_i``
-    with ``pre_i = M_0 ... M_(i-1)`` and ``suf_i = M_i ... M_(m-1)`` (``A_i`` commutes with
-    ``M_i``: the first is ``sg A_0 T``, the last ``sg pre_m A``); the twist matrices ``A``,
-    ``A2 = A^2`` are real."""
-    m = kinds.shape[0]
-    for i in range(m):
+def _factors(th, kinds, A, A2, idx, sg, Ms):
+    """Rows 0-2 of every factor ``M_i = I + sg sin A + (1 - cos) A^2`` (or ``I + sg d A``)."""
+    for i in range(kinds.shape[0]):
         v = th[idx[i]]
         if kinds[i] == 0:
             sn = sg * np.sin(v)
@@ -69,6 +64,17 @@ def _chain(th, kinds, A, A2, idx, sg, T, dT, pre, suf, Ms, tmp):
             for a in range(3):
                 for b in range(4):
                     Ms[i, a, b] = (1.0 if a == b else 0.0) + d * A[i, a, b]
+
+
+@njit(cache=True)
+def _chain(th, kinds, A, A2, idx, sg, T, dT, pre, suf, Ms, tmp):
+    """Rows 0-2 (the last rows are never read) of ``T`` = the product of the factors ``M_0 ...
+    M_(m-1)`` and of ``dT[idx[i]]`` = its derivative in their variables, ``sg pre_i A_i suf_i``
+    with ``pre_i = M_0 ... M_(i-1)`` and ``suf_i = M_i ... M_(m-1)`` (``A_i`` commutes with
+    ``M_i``: the first is ``sg A_0 T``, the last ``sg pre_m A``); the twist matrices ``A``,
+    ``A2 = A^2`` are real."""
+    m = kinds.shape[0]
+    _factors(th, kinds, A, A2, idx, sg, Ms)
     if m == 0:
         for a in range(3):
             for b in range(4):
@@ -81,6 +87,13 @@ def _chain(th, kinds, A, A2, idx, sg, T, dT, pre, suf, Ms, tmp):
     suf[m - 1, :, :] = Ms[m - 1]
     for i in range(m - 2, 0, -1):  # suf_0 = T is not needed
         _aff(Ms[i], suf[i + 1], suf[i])
+    _derivatives(A, idx, sg, T, dT, pre, suf, tmp)
+
+
+@njit(cache=True)
+def _derivatives(A, idx, sg, T, dT, pre, suf, tmp):
+    """``dT[idx[i]] = sg pre_i A_i suf_i`` (rows 0-2; :func:`_chain`)."""
+    m = A.shape[0]
     for i in range(m):
         D = dT[idx[i]]
         if i == m - 1:  # pre_m A
