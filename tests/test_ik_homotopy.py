@@ -140,7 +140,9 @@ def test_helical_pitch_refused_to_multistart_with_a_label():
 
 
 def test_passive_spin_keeps_the_multistart():
-    m = sm.catalog.build("stewart-6sps") if "stewart-6sps" in sm.catalog.names() else None
+    from spatialmech import catalog  # the subpackage, not an attribute of the lazy facade
+
+    m = catalog.build("stewart-6sps") if "stewart-6sps" in catalog.names() else None
     if m is None:
         pytest.skip("no Stewart model in the catalogue")
     res = inverse_position(m, sm.kinematics.position.platform_pose(m, sm.kinematics.closure.Configuration.reference(m)),
