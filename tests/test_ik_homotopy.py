@@ -140,7 +140,9 @@ def test_helical_pitch_refused_to_multistart_with_a_label():
 
 
 def test_passive_spin_keeps_the_multistart():
-    m = sm.catalog.build("stewart-6sps") if "stewart-6sps" in sm.catalog.names() else None
+    from spatialmech import catalog  # the subpackage, not an attribute of the lazy facade
+
+    m = catalog.build("stewart-6sps") if "stewart-6sps" in catalog.names() else None
     if m is None:
         pytest.skip("no Stewart model in the catalogue")
     res = inverse_position(m, sm.kinematics.position.platform_pose(m, sm.kinematics.closure.Configuration.reference(m)),
@@ -184,3 +186,39 @@ def test_auto_takes_the_homotopy_only_where_a_root_count_proves_the_limb(tmp_pat
                                    *map(str, np.degrees(sm.api.matrix_euler("ZYX", pose.R))), "--all"])
     assert out.exit_code == 0, out.output
     assert "8 solution(s)" in out.output and "homotopy: complete (proven" in out.output
+
+
+def test_a_path_stopped_midway_is_re_tracked_through_a_waypoint(monkeypatch):
+    """A path of the re-solve that stops midway (a near miss of a branch point) sends every path
+    through a random complex waypoint near the pose: the same real solutions, still proven, and
+    the statement says so.  The stop is simulated on the straight segment's first path."""
+    dh, theta = random_6r(0)
+    m = serial_arm("random-6r", dh)
+    pose = dh_pose(dh, theta)
+    ref = inverse_position(m, pose, all_solutions=True, method="homotopy")
+    real = ikh._segment
+
+    def stalled(sysm, X, P0, P1, steps=None):
+        Xe, t, done = real(sysm, X, P0, P1, steps)
+        if np.ndim(P0) == 1 and np.allclose(P0, ikh._CACHE[sysm.key].P0) and np.allclose(P1[7:], 0) and not stalled.hit:
+            stalled.hit = True
+            t, done = t.copy(), done.copy()
+            t[0], done[0] = 0.4, False
+        return Xe, t, done
+
+    stalled.hit = False
+    monkeypatch.setattr(ikh, "_segment", stalled)
+    res = inverse_position(m, pose, all_solutions=True, method="homotopy")
+    rep = res.search["limbs"][0]
+    assert stalled.hit and rep["complete"] and "waypoint" in rep["completeness"]
+    _same_sets([np.asarray(q) for q in res.limbs[0].solutions], [np.asarray(q) for q in ref.limbs[0].solutions])
+
+
+def test_angles_of_far_complex_points_keep_their_digits():
+    """``c + i s`` is a difference of nearly equal large numbers when the angle is far from real:
+    :meth:`LimbIK.angles` takes ``c - i s`` there, so the angles round-trip to rounding."""
+    dh, _ = random_6r(0)
+    sysm = ikh.limb_ik_system(serial_arm("random-6r", dh), 0)
+    TH = np.array([[0.3 + 9j, -1.2 - 11j, 2.0 + 0.1j, 0.5 - 7j, -2.9 + 12j, 1.0]])
+    back = sysm.angles(sysm.from_angles(TH))
+    assert np.max(np.abs(np.angle(np.exp(1j * (back - TH)))) + np.abs((back - TH).imag)) < 1e-12

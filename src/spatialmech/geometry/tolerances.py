@@ -59,12 +59,15 @@ __all__ = [
     "ENDGAME_LOOPS",
     "ENDGAME_POINTS",
     "ENDGAME_RADIUS",
+    "HOMOTOPY_FLOOR",
     "HOMOTOPY_INFINITY",
     "HOMOTOPY_JUMP",
     "HOMOTOPY_NEAR_REAL",
     "HOMOTOPY_NEWTON",
     "HOMOTOPY_REAL",
     "HOMOTOPY_SINGULAR",
+    "IK_DETOURS",
+    "IK_DETOUR_SIZE",
     "INPUT_PERTURBATION",
     "INPUT_PERTURBATIONS",
     "INPUT_PERTURBATION_SEED",
@@ -291,6 +294,11 @@ def characteristic_length(points, *, tol: Tolerances | None = None, field: str =
 #: below which a singular end point (located to a few digits only) seeds a real Newton polish.
 HOMOTOPY_NEWTON = 1e-11
 HOMOTOPY_JUMP = 1e-3
+#: The limb inverse position's tracker (kinematics/compiled/kernels_ik.py) also accepts a step
+#: whose two Newton corrections are both below this (relative): the corrector's rounding floor at
+#: an ill-conditioned point (a complex angle far from real: cos and sin of about e^|Im theta|),
+#: where neither correction can contract further.
+HOMOTOPY_FLOOR = 1e-5
 HOMOTOPY_SINGULAR = 1e-7
 HOMOTOPY_INFINITY = 1e-7
 HOMOTOPY_REAL = 1e-7
@@ -346,6 +354,12 @@ MONODROMY_MAX_WORK = 250_000
 MONODROMY_DIVERGED = 1e4  # a path stopped short with |x| beyond this is at infinity (affine variables)
 MONODROMY_PARALLEL = 4  # loops tracked together in one batch
 MONODROMY_RESIDUAL = 1e-8
+#: A limb's inverse position (kinematics/homotopy/inverse.py): when a path of the re-solve stops
+#: midway (a near miss of a branch point), all paths are tracked again through a random complex
+#: waypoint near the pose (at this fraction of the parameters' distance from the generic instance),
+#: at most this many times.
+IK_DETOURS = 3
+IK_DETOUR_SIZE = 0.3
 
 #: Trace test (kinematics/homotopy/trace_test.py), nondimensional: the largest relative deviation of the
 #: traces from a line that passes (a complete set gives 1e-11 or less, a missing solution of the

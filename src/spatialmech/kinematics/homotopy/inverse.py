@@ -50,6 +50,7 @@ lost (stopped short away from infinity); else *NOT proven*, with the reason.
 from __future__ import annotations
 
 import time
+import weakref
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -64,6 +65,9 @@ from ...geometry.tolerances import (
     MONODROMY_MAX_LOOPS,
     MONODROMY_PARALLEL,
     MONODROMY_STALE_LOOPS,
+    ENDGAME_RADIUS,
+    IK_DETOURS,
+    IK_DETOUR_SIZE,
     TRACE_MAX_WORK_FULL,
     TRACE_TOL,
 )
@@ -238,11 +242,16 @@ class LimbIK:
         return F, J, Ft
 
     def angles(self, X: np.ndarray) -> np.ndarray:
-        """The angles (complex; ``c + i s = exp(i theta)``) and slides of the points ``X`` (n, nx)."""
+        """The angles (complex; ``c + i s = exp(i theta)``) and slides of the points ``X`` (n, nx).
+        Of ``c + i s`` and ``c - i s = exp(-i theta)`` (their product is 1) the larger is taken: the
+        smaller is a difference of nearly equal large numbers when ``theta`` is far from real."""
         facts = sorted(self.left + self.right, key=lambda f: f.theta)
+        cols = []
         with np.errstate(all="ignore"):
-            cols = [-1j * np.log(X[:, f.idx[0]] + 1j * X[:, f.idx[1]]) if f.kind == "R" else X[:, f.idx[0]]
-                    for f in facts]
+            for f in facts:
+                up, down = X[:, f.idx[0]] + 1j * X[:, f.idx[-1]], X[:, f.idx[0]] - 1j * X[:, f.idx[-1]]
+                cols.append(np.where(np.abs(up) >= np.abs(down), -1j * np.log(up), 1j * np.log(down))
+                            if f.kind == "R" else X[:, f.idx[0]])
         return np.array(cols, dtype=complex).T.reshape(len(X), len(facts))
 
     def from_angles(self, TH: np.ndarray) -> np.ndarray:
@@ -330,11 +339,28 @@ def _generic_rank(sysm: LimbIK, rng: np.random.Generator) -> int:
 
 
 _SYSTEMS: dict[bytes, LimbIK] = {}
+#: Per model object (immutable): ``(li, seed)`` -> its system, or why the homotopy refuses the limb.
+_BY_MECH: weakref.WeakKeyDictionary[Mechanism, dict[tuple[int, int], LimbIK | str]] = weakref.WeakKeyDictionary()
 
 
 def limb_ik_system(mech: Mechanism, li: int, seed: int = 0) -> LimbIK:
     """The :class:`LimbIK` of limb ``li`` of ``mech`` (a limb from the ground to the output
-    link); ``InputError`` saying why when the homotopy does not cover it (:func:`ik_reason`)."""
+    link); ``InputError`` saying why when the homotopy does not cover it (:func:`ik_reason`).
+    Kept per model object, so that a re-solve does not rebuild it."""
+    per = _BY_MECH.setdefault(mech, {})
+    hit = per.get((li, seed))
+    if hit is None:
+        try:
+            hit = _build_system(mech, li, seed)
+        except InputError as exc:
+            hit = str(exc)
+        per[(li, seed)] = hit
+    if isinstance(hit, str):
+        raise InputError(hit)
+    return hit
+
+
+def _build_system(mech: Mechanism, li: int, seed: int) -> LimbIK:
     if mech.limb_ends[li] != (None, 0):
         raise InputError(f"limb {mech.limbs[li].name}: does not run from the ground to the output link")
     balls = _ball_joints(mech, li)
@@ -507,6 +533,7 @@ def clear_cache() -> None:
     """Forget the cached generic solves (benchmarks time the first solve)."""
     _CACHE.clear()
     _SYSTEMS.clear()
+    _BY_MECH.clear()
     _PACKED.clear()
 
 
@@ -649,12 +676,21 @@ def _classify(sysm: LimbIK, X, P1, done) -> tuple[list[np.ndarray], dict[str, in
     cnt = {"complex": 0, "singular": 0, "infinity": 0, "spurious": 0, "lost": 0}
     real: list[np.ndarray] = []
     kept = np.zeros((0, sysm.nx), complex)
+    Pn = np.broadcast_to(P1, (len(X), sysm.n_params))
     with np.errstate(all="ignore"):
-        res = sysm.residual(X, np.broadcast_to(P1, (len(X), sysm.n_params)))
-        _, J, _ = sysm.square(X, np.broadcast_to(P1, (len(X), sysm.n_params)))
+        finite = np.all(np.isfinite(X), axis=1) & ~(np.linalg.norm(X, axis=1) > MONODROMY_DIVERGED)
+        res = np.full(len(X), np.inf)
+        res[finite] = sysm.residual(X[finite], Pn[finite])
+        imag = np.max(np.abs(X.imag), axis=1) / (1 + np.max(np.abs(X.real), axis=1))
+        # the conditioning only where it decides (closing, near real): one batched SVD
+        near = np.flatnonzero(finite & (res < 1e-8) & ~(imag > HOMOTOPY_NEAR_REAL))
+        regular = np.zeros(len(X), bool)
+        if len(near):
+            _, J, _ = sysm.square(X[near], Pn[near])
+            sv = np.linalg.svd(J / np.maximum(np.linalg.norm(J, axis=2, keepdims=True), 1e-300), compute_uv=False)
+            regular[near] = sv[:, -1] >= HOMOTOPY_SINGULAR * sv[:, 0]
     for n, x in enumerate(X):
-        finite = bool(np.all(np.isfinite(x)))
-        if not finite or np.linalg.norm(x) > MONODROMY_DIVERGED:
+        if not finite[n]:
             cnt["infinity"] += 1
             continue
         if not res[n] < 1e-8:
@@ -663,16 +699,13 @@ def _classify(sysm: LimbIK, X, P1, done) -> tuple[list[np.ndarray], dict[str, in
         if len(kept) and np.min(np.linalg.norm(kept - x, axis=1) / (1 + np.linalg.norm(x))) < 1e-6:
             continue  # two paths to one (singular) end point
         kept = np.vstack([kept, x[None]])
-        imag = np.max(np.abs(x.imag)) / (1 + np.max(np.abs(x.real)))
-        if imag > HOMOTOPY_NEAR_REAL:  # far from real (however ill-conditioned: large complex angles)
+        if imag[n] > HOMOTOPY_NEAR_REAL:  # far from real (however ill-conditioned: large complex angles)
             cnt["complex"] += 1
             continue
-        rows = J[n] / np.maximum(np.linalg.norm(J[n], axis=1, keepdims=True), 1e-300)
-        sv = np.linalg.svd(rows, compute_uv=False)
-        if not sv[-1] >= HOMOTOPY_SINGULAR * sv[0]:
+        if not regular[n]:
             cnt["singular"] += 1
             continue
-        if imag < HOMOTOPY_REAL:
+        if imag[n] < HOMOTOPY_REAL:
             real.append(x.real.copy())
         else:
             cnt["complex"] += 1
@@ -687,7 +720,8 @@ def _statement(sysm: LimbIK, g: _Generic, cnt: dict[str, int], n_real: int) -> t
     head = f"monodromy over {fam}: {n} generic solution(s) after {g.loops} loops"
     tail = (f"; a parameter homotopy tracked the {n} paths to the pose: {n_real} real, {cnt['complex']} complex, "
             f"{cnt['infinity']} at infinity" + (f", {cnt['spurious']} that do not close discarded" if cnt["spurious"] else "")
-            + (f", {cnt['singular']} singular" if cnt["singular"] else ""))
+            + (f", {cnt['singular']} singular" if cnt["singular"] else "")
+            + (" (through a random complex waypoint: a path had stopped midway)" if cnt.get("detour") else ""))
     if g.bound_reached:
         proof = f"root count: {n} generic solutions = {sysm.bound_source}"
     elif g.trace is not None and g.trace.passed:
@@ -708,6 +742,32 @@ def _statement(sysm: LimbIK, g: _Generic, cnt: dict[str, int], n_real: int) -> t
     return True, f"complete (proven, with probability one): {proof}; {head}{tail}"
 
 
+def _to_pose(sysm: LimbIK, g: _Generic, P1: np.ndarray, seed: int):
+    """Every generic solution tracked to ``P1``: ``(X, done, PA, XA, detours)``.  When a path stops
+    midway (a near miss of a branch point), all are tracked again through a random complex waypoint
+    ``B`` near the pose (:data:`IK_DETOUR_SIZE`; ``P0 -> B`` gives every solution at ``B``, ``B -> P1``
+    misses the branch points with probability one), at most :data:`IK_DETOURS` times; ``PA``, ``XA``:
+    the last segment's start and points (for the end game)."""
+
+    def midway(X, t, done):
+        with np.errstate(all="ignore"):
+            return int(np.sum(~done & (np.linalg.norm(X, axis=1) < MONODROMY_DIVERGED) & (t < 1.0 - ENDGAME_RADIUS)))
+
+    X, t, done = _segment(sysm, g.X, g.P0, P1)  # a finished path ends with two Newton corrections
+    PA, XA, detours = g.P0, g.X, 0
+    for k in range(IK_DETOURS):
+        if not (lost := midway(X, t, done)):
+            break
+        z = _crand(np.random.default_rng([seed, 2727, k]), sysm.n_params)
+        z[7:] *= not sysm.rigid  # the rigid family has no offset
+        B = P1 + IK_DETOUR_SIZE * np.linalg.norm(P1 - g.P0) * z / np.linalg.norm(z)
+        XB, _, okB = _segment(sysm, g.X, g.P0, B)
+        X2, t2, done2 = _segment(sysm, XB, B, P1) if okB.all() else (X, t, done)
+        if midway(X2, t2, done2) < lost:
+            X, t, done, PA, XA, detours = X2, t2, done2, B, XB, k + 1
+    return X, done, PA, XA, detours
+
+
 def limb_inverse(mech: Mechanism, li: int, D: np.ndarray, *, seed: int = 0) -> LimbIKResult:
     """Every real solution of limb ``li`` (from the ground to the output link) with the output
     link at the displacement ``D`` (4x4, model units): joint variables of its freedoms, closing
@@ -718,19 +778,20 @@ def limb_inverse(mech: Mechanism, li: int, D: np.ndarray, *, seed: int = 0) -> L
     g, cached = _generic(sysm, seed)
     P1 = sysm.pose_parameters(np.asarray(D, float))
     P1[:4] *= P1[:4] @ g.P0[:4]  # the same rotation; the quaternion nearest P0's (a shorter path)
-    X, _, done = _segment(sysm, g.X, g.P0, P1)  # a finished path ends with two Newton corrections
+    X, done, PA, XA, detour = _to_pose(sysm, g, P1, seed)
     cand = np.flatnonzero(~done & np.all(np.isfinite(X), axis=1) & (np.linalg.norm(X, axis=1) < MONODROMY_DIVERGED))
     if len(cand):  # stopped short, not diverging: the Cauchy end game
 
         def trk(PA, PB, _c, Xs):
             return _segment(sysm, Xs, PA, PB)
 
-        eg = cauchy_endgame(trk, g.P0, P1, np.zeros(0), g.X[cand])
+        eg = cauchy_endgame(trk, PA, P1, np.zeros(0), XA[cand])
         X[cand[eg.converged]] = eg.X[eg.converged]
         done = done.copy()
         done[cand[eg.converged]] = True
         X[cand] = _refine(sysm, X[cand], P1)
     real, cnt = _classify(sysm, X, P1, done)
+    cnt["detour"] = detour  # re-tracked through a waypoint (_to_pose)
     chain = limb_chains(mech)[li]
     axes = chain.balls[0][2] if chain.balls else None
     sols = tuple(_to_q(sysm, x, np.asarray(D, float), axes) for x in real)
