@@ -16,7 +16,8 @@ async function api(path, body) {
   return doc;
 }
 
-function fmt(x, d = 4) { return (x === null || x === undefined) ? "-" : Number(x).toPrecision(d); }
+// round-off (|x| < 1e-13, and -0) prints as 0, as present/numbers.py does for the text outputs
+function fmt(x, d = 4) { return (x === null || x === undefined) ? "-" : (Math.abs(Number(x)) < 1e-13 ? "0" : Number(x).toPrecision(d)); }
 
 // ------------------------------------------------------------------ shapes
 function add(a, b) { return [a[0] + b[0], a[1] + b[1], a[2] + b[2]]; }
