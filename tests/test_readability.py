@@ -37,3 +37,44 @@ def test_jacobian_text_prints_no_roundoff_and_no_unit_placeholder():
     rows = [ln for ln in out.splitlines() if ln.strip().startswith("[") or "slide [m]" in ln]
     assert rows and not any(re.search(r"e-1[5-9]", ln) for ln in rows)
     assert "-0.00000e+00" not in out and "[unit]" not in out
+
+
+def _rocker_driven_4r():
+    import spatialmech as sm
+    from spatialmech.catalog import build
+
+    m0, z = build("planar-4r"), [0, 0, 1.0]
+    (a0, a1), (b0, b1) = (j.point for j in m0.limbs[0].joints), (j.point for j in m0.limbs[1].joints)
+    return sm.Mechanism("rocker-driven-4r", limbs=[
+        sm.Limb("crank", [sm.R("A0", a0, z), sm.R("A1", a1, z)]),
+        sm.Limb("rocker", [sm.R("B0", b0, z, actuated=True), sm.R("B1", b1, z)])], platform_point=m0.platform_point)
+
+
+def test_four_bar_class_reference_values():
+    import numpy as np
+
+    from spatialmech.analysis.four_bar import four_bar_class
+    from spatialmech.catalog import build
+
+    cr = four_bar_class(build("planar-4r"))  # ground 4, crank 1, coupler 3.5, rocker 3
+    assert cr is not None and cr.kind.startswith("Grashof crank-rocker") and cr.input_range_deg == (0.0, 360.0)
+    # d in [3, 5]: mu = acos((3^2 + 3.5^2 - d^2) / (2 3 3.5)), to 1e-9 deg
+    mu = np.degrees(np.arccos([(9 + 12.25 - 9) / 21, (9 + 12.25 - 25) / 21]))
+    assert np.allclose(cr.transmission_range_deg, mu, atol=1e-9)
+    rk = four_bar_class(_rocker_driven_4r())
+    assert rk is not None and rk.kind.startswith("Grashof rocker-crank")
+    # the rocker (3) swings while the rocker-to-crank-pivot distance stays in [2.5, 4.5]
+    lo = np.degrees(np.arccos((9 + 16 - 2.5**2) / 24))
+    hi = np.degrees(np.arccos((9 + 16 - 4.5**2) / 24))
+    assert np.allclose(rk.input_range_deg, (lo, hi), atol=1e-9) and np.allclose(rk.transmission_range_deg, (0, 180))
+    assert four_bar_class(build("bennett")) is None
+
+
+def test_report_counts_the_dead_points_of_a_rocker_driven_four_bar():
+    from spatialmech.present.models import model_section
+
+    sec = model_section(_rocker_driven_4r())
+    zeros = [e for e in sec.data["trace"]["events"] if e["kind"] == "zero"]
+    assert len(zeros) == 2 and "red: 2 zeros" in " ".join(f.caption for f in sec.figures)
+    assert sec.data["four_bar"]["kind"].startswith("Grashof rocker-crank")
+    assert any(t.title == "Linkage class (planar four-bar)" for t in sec.tables)
