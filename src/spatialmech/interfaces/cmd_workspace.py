@@ -65,10 +65,12 @@ def _text(res, length_unit: str = "m") -> str:
                 continue
             lo_l, hi_l = ext[f"{key}_active_limits"]
             lines.append(f"  {c:5s} {label:9s}: [{ext[key][0]:.4f}, {ext[key][1]:.4f}] {u}   limits: {lo_l} / {hi_l}")
-    vkey = next(k for k in d if k.startswith("volume_") and k != "volume_note")
+    vkey = next(k for k in d if k.startswith("volume_") and k != "volume_note" and not k.startswith("volume_error"))
     power = vkey[-1] if vkey[-1].isdigit() else ""
     vunit = ("deg" if "_deg" in vkey else length_unit) + (f"^{power}" if power else "")
-    lines.append(f"volume: {d[vkey]:.6g} {vunit} ({d['volume_note']})")
+    err = d.get(vkey.replace("volume_", "volume_error_", 1))
+    pm = "" if err is None else f" +- {err:.2g} (grid estimate |V_h - V_2h| + bisection tolerance)"
+    lines.append(f"volume: {d[vkey]:.6g}{pm} {vunit} ({d['volume_note']})")
     lines.append("active limits (boundary points): " + ", ".join(f"{k} {v}" for k, v in res.active_limits.items()))
     lines.append(f"{res.n_poses} poses checked in {res.seconds:.2f} s; tolerance "
                  + ", ".join(_with_unit(k, v, ".3g", length_unit) for k, v in d["boundary_tol"].items()))
