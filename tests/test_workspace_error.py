@@ -28,3 +28,20 @@ def test_grid_volumes_at_two_steps_agree_within_their_estimates():
     assert abs(fine.volume - coarse.volume) <= coarse.volume_error + fine.volume_error
     d = fine.to_dict()
     assert d["volume_error_deg3"] == fine.volume_error * np.degrees(1.0) ** 3
+
+
+@pytest.mark.slow
+def test_max_poses_advice_works():
+    import re
+
+    from click.testing import CliRunner
+
+    from spatialmech.interfaces.cli import cli
+
+    args = ["workspace", "three-rps", "--task", "--over", "a2:-40:40:201,a3:-40:40:201", "--at", "z=0.33"]
+    first = CliRunner().invoke(cli, args)
+    assert first.exit_code == 2
+    m = re.search(r"raise --max-poses to at least (\d+)", first.output)
+    assert m is not None, first.output
+    again = CliRunner().invoke(cli, [*args, "--max-poses", m.group(1), "--json"])
+    assert again.exit_code == 0, again.output

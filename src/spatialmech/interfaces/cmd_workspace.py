@@ -273,7 +273,8 @@ def workspace(model, orientation_flag, position_flag, at, step_deg, tol_deg, ste
     except InputError as e:  # not ConvergenceError (exit 1) nor a bug (exit 3): see cli._Group
         msg = str(e)
         # the library names its arguments; say which command-line option to change
-        msg = msg.replace("max_poses =", "--max-poses =").replace("max_cells =", "--max-poses =")
+        for lib in ("max_poses", "max_cells"):  # "raise --max-poses to at least N" is advice that works
+            msg = msg.replace(f"{lib} =", "--max-poses =").replace(f"raise {lib}", "raise --max-poses")
         for arg, opt in (("step", "--step-deg" if kind == "orientation" else "--step"),
                          ("tol", "--tol-deg" if kind == "orientation" else "--tol")):
             if msg.startswith(arg + ":"):

@@ -398,10 +398,11 @@ def _check_grid_size(free, values, bounds, step, path: str, max_poses) -> None:
     e = float((max(log10_n, np.log10(n) if np.isfinite(n) else 0.0) - np.log10(limit)) / len(free))
     factor = f"{10.0**e:.3g}" if e < 300 else f"1e{e:.0f}"
     size = f"about {n:.3g}" if np.isfinite(n) else f"about 1e{log10_n:.0f}"
+    or_raise = f", or raise max_poses to at least {n:.0f}" if np.isfinite(n) and n < 1e12 else ""
     raise SearchTooLargeError(
         f"step: the grid has {size} poses ({' x '.join(f'{c:.3g}' for c in counts)} plus the lines through the "
         f"centre), more than max_poses = {limit} for the {path} kernel; multiply the step by at least "
-        f"{factor} or narrow the bounds")
+        f"{factor} or narrow the bounds{or_raise}")
 
 
 def _analyse(mech, kind, free, values, bounds, step, tol, limits, method, chunk, progress, max_poses, polish):
