@@ -78,3 +78,14 @@ def test_report_counts_the_dead_points_of_a_rocker_driven_four_bar():
     assert len(zeros) == 2 and "red: 2 zeros" in " ".join(f.caption for f in sec.figures)
     assert sec.data["four_bar"]["kind"].startswith("Grashof rocker-crank")
     assert any(t.title == "Linkage class (planar four-bar)" for t in sec.tables)
+
+
+def test_studio_axis_titles_use_title_text_and_roundoff_prints_zero():
+    from fastapi.testclient import TestClient
+
+    import spatialmech as sm
+
+    js = TestClient(sm.studio_app("planar-4r")).get("/static/studio.js").text
+    # the bundled plotly ignores a bare string axis title: the units would vanish
+    assert 'title: { text: n + " [" + S.unit + "]" }' in js and "title: { text: S.state.mechanism }" in js
+    assert 'Math.abs(Number(x)) < 1e-13 ? "0"' in js

@@ -84,8 +84,8 @@ function sceneRange(sc) {
 function draw() {
   const sc = S.state.scene;
   if (!S.range) S.range = sceneRange(sc);
-  const ax = (r, n) => ({ range: r, autorange: false, title: n + " [" + S.unit + "]" });
-  const layout = { uirevision: "studio", margin: { l: 0, r: 0, t: 30, b: 0 }, title: S.state.mechanism,
+  const ax = (r, n) => ({ range: r, autorange: false, title: { text: n + " [" + S.unit + "]" } });  // the bundled plotly needs title.text
+  const layout = { uirevision: "studio", margin: { l: 0, r: 0, t: 30, b: 0 }, title: { text: S.state.mechanism },
     scene: { aspectmode: "cube", xaxis: ax(S.range[0], "x"), yaxis: ax(S.range[1], "y"), zaxis: ax(S.range[2], "z") },
     legend: { itemsizing: "constant" } };
   Plotly.react("plot", traces(sc), layout, { displaylogo: false, responsive: true });
