@@ -89,3 +89,9 @@ def test_studio_axis_titles_use_title_text_and_roundoff_prints_zero():
     # the bundled plotly ignores a bare string axis title: the units would vanish
     assert 'title: { text: n + " [" + S.unit + "]" }' in js and "title: { text: S.state.mechanism }" in js
     assert 'Math.abs(Number(x)) < 1e-13 ? "0"' in js
+
+
+def test_legends_do_not_say_limb_twice():
+    from spatialmech.present.viewer import limb_label
+
+    assert limb_label("limb1") == "limb1" and limb_label("Limb_a") == "Limb_a" and limb_label("leg1") == "limb leg1"

@@ -47,7 +47,7 @@ function traces(sc) {
     hoverinfo: "skip", showlegend: true });
   out.push({ type: "scatter3d", mode: "lines", ...xyz(sc.platform_len), line: { color: "#ff7f0e", width: 6 }, name: "platform outline", showlegend: false });
   sc.limbs_len.forEach((pl, li) => out.push({ type: "scatter3d", mode: "lines", ...xyz(pl), line: { color: sc.limb_colours[li], width: 9 },
-    name: "limb " + sc.limb_names[li] }));
+    name: /^limb/i.test(sc.limb_names[li]) ? sc.limb_names[li] : "limb " + sc.limb_names[li] }));  // not "limb limb1"
   if (sc.bodies_len.length) {
     const pts = []; sc.bodies_len.forEach(sg => { pts.push(sg[0], sg[1], [null, null, null]); });
     out.push({ type: "scatter3d", mode: "lines", ...xyz(pts), line: { color: "#7f7f7f", width: 9 }, name: "internal bodies" });
