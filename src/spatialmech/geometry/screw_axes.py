@@ -68,9 +68,10 @@ def _signed(v: np.ndarray) -> np.ndarray:
     return -v if v[k] < 0 else v
 
 
-def _clean(v, scale: float) -> tuple[float, ...]:
-    """Round-off (relative to ``scale``) printed as 0."""
-    return tuple(0.0 if abs(x) <= 1e-12 * scale else float(x) for x in v)
+def _clean(v, scale: float) -> tuple[float, float, float]:
+    """A 3-vector with round-off (relative to ``scale``) set to 0."""
+    a, b, c = (0.0 if abs(x) <= 1e-12 * scale else float(x) for x in v)
+    return (a, b, c)
 
 
 def _axis(w, v, pitch_h: float, mult: int, length_scale: float) -> ScrewAxis:
