@@ -82,6 +82,17 @@ def _check_diameter(link_diameter) -> None:
         raise InputError(f"--link-diameter: expected a non-negative number of metres, got {link_diameter}")
 
 
+def _option_message(msg: str, kind: str) -> str:
+    """A library error with its argument names replaced by the command-line options to change."""
+    for lib in ("max_poses", "max_cells"):  # "raise --max-poses to at least N" is advice that works
+        msg = msg.replace(f"{lib} =", "--max-poses =").replace(f"raise {lib}", "raise --max-poses")
+    for arg, opt in (("step", "--step-deg" if kind == "orientation" else "--step"),
+                     ("tol", "--tol-deg" if kind == "orientation" else "--tol")):
+        if msg.startswith(arg + ":"):
+            msg = f"{opt} ({arg})" + msg[len(arg):]
+    return msg
+
+
 def _progress_bar():
     """A progress callback drawing a bar on stderr (opened at the first report) and its closer."""
     bars: list = []
@@ -271,15 +282,7 @@ def workspace(model, orientation_flag, position_flag, at, step_deg, tol_deg, ste
 
             write_workspace_plot(res, plot)
     except InputError as e:  # not ConvergenceError (exit 1) nor a bug (exit 3): see cli._Group
-        msg = str(e)
-        # the library names its arguments; say which command-line option to change
-        for lib in ("max_poses", "max_cells"):  # "raise --max-poses to at least N" is advice that works
-            msg = msg.replace(f"{lib} =", "--max-poses =").replace(f"raise {lib}", "raise --max-poses")
-        for arg, opt in (("step", "--step-deg" if kind == "orientation" else "--step"),
-                         ("tol", "--tol-deg" if kind == "orientation" else "--tol")):
-            if msg.startswith(arg + ":"):
-                msg = f"{opt} ({arg})" + msg[len(arg):]
-        raise UserError(msg) from None
+        raise UserError(_option_message(str(e), kind)) from None
     if as_json:
         emit_json("workspace", mech, {**res.to_dict(), "plot": str(plot) if plot else None})
         return
