@@ -82,7 +82,7 @@ EXPECTED = {
     "delta-ruu": (3, "TxTyTz", 0),
     "spatial-six-bar": (1, "Ry", 2),
     "planar-4r": (1, "1R", 0),
-    "bennett": (1, "1R", 0),
+    "bennett": (1, "1H", 0),  # the coupler screws about the ground (non-zero pitch)
     "rssr": (1, "1R", 1),
 }
 

@@ -89,7 +89,7 @@ def test_the_folded_6r_is_mobile_with_two_branches_of_dimension_one():
     assert [b.dimension for b in r.branches] == [1, 1] and r.undecided == ""
     assert ("reference configuration is singular (instantaneous mobility 3 there" in r.singular_note
             and "branches through it: 2 of dimension 1" in r.singular_note)
-    assert r.motion_class == "1R" and not r.agrees
+    assert r.motion_class == "1H" and not r.agrees  # a branch moves the output on a screw
     d0, d1 = (np.array(b.direction) for b in r.branches)
     assert abs(np.linalg.norm(d0) - 1) < 1e-9 and abs(d0 @ d1) < 0.99  # two distinct tangents
     for b in r.branches:  # each sample closes and lies on the line-symmetric motion, off the plane

@@ -358,7 +358,7 @@ def test_cli_view_json(tmp_path):
     assert r.exit_code == 0, r.output
     d = json.loads(r.output)
     assert d == {"schema_version": "2", "command": "view", "model": "three-rrr-sm", "length_unit": "m",
-                 "out": str(out), "frames": 6, "bytes": out.stat().st_size, "plotly": "inline", "motion": "demo"}
+                 "out": str(out), "frames": 6, "bytes": out.stat().st_size, "plotly": "inline", "motion": "demo", "note": ""}
 
 
 @pytest.mark.slow

@@ -40,6 +40,7 @@ import numpy as np
 
 from ..errors import ConvergenceError, InputError
 from ..geometry import screws as sc
+from ..geometry.screw_axes import ScrewAxis, principal_screws
 from ..geometry.tolerances import SINGULAR_LEFT, Tolerances, current, resolve, use
 from ..kinematics.closure import Configuration, active_mask, closure_scales, hub_count, limb_slices
 from ..kinematics.backend import closure_jacobian, joint_twists
@@ -73,6 +74,8 @@ ELEMENTARY_MOTIONS = {
 def motion_type(twists, point, *, length_scale: float = 1.0, rtol: float | None = None) -> tuple[str, str]:
     """Name a platform twist system at ``point``: ``("RxRyRzTz", "3R1T")``.
 
+    Screws of non-zero pitch (the principal screws of :func:`~spatialmech.geometry.screw_axes.principal_screws`)
+    are named ``H``: a 3-system of pitch 1.74 m/rad is ``"3H"``, not ``"3R"``.
     The first name lists the elementary motions (rotations about axes through ``point``
     parallel to x, y, z; translations along x, y, z) when they span the system; otherwise it is
     the class name alone (e.g. a coupled screw motion, or rotation axes not through the point).
@@ -94,6 +97,11 @@ def motion_type(twists, point, *, length_scale: float = 1.0, rtol: float | None 
     tdim = dim - r
     cls = (f"{r}R" if r else "") + (f"{tdim}T" if tdim else "")
     ctol = max(current().contains, rtol)  # a looser rank tolerance loosens membership too
+    axes = principal_screws(T, length_scale=length_scale, rtol=rtol)
+    helical = sum(a.multiplicity for a in axes if a.kind == "H")
+    if helical:  # screws of non-zero pitch are not rotations: "3H", "1R2H", "2H1T"
+        cls = (f"{r - helical}R" if r > helical else "") + f"{helical}H" + (f"{tdim}T" if tdim else "")
+        return cls, cls
     members = [k for k, e in ELEMENTARY_MOTIONS.items() if sc.contains(at_p, e, length_scale=length_scale, rtol=ctol)]
     if len(members) == dim:
         return "".join(members), cls
@@ -167,6 +175,10 @@ class MobilityResult:
     singular_note: str = ""
     #: Why the branches through a singular reference could not be decided (empty when they were).
     undecided: str = ""
+    #: The principal screws of the output link's free twist system where the motion is named
+    #: (world frame): for a 1-DOF mechanism its instantaneous screw (axis point, direction,
+    #: pitch).  ``kind`` "H" marks a screw of non-zero pitch.
+    screw_axes: tuple[ScrewAxis, ...] = field(default=())
 
     def dof_at(self, tolerance: float) -> int | None:
         """The count at another rank tolerance (within the scanned range; else ``None``)."""
@@ -193,6 +205,7 @@ class MobilityResult:
         d["constraint_wrenches"] = [list(w) for w in self.constraint_wrenches]
         d["dof_by_tolerance"] = [s.to_dict() for s in self.dof_by_tolerance]
         d["branches"] = [b.to_dict() for b in self.branches]
+        d["screw_axes"] = [a.to_dict() for a in self.screw_axes]
         d["dof_at_tolerance"] = [{"tolerance": t, "dof": self.dof_at(t)} for t in _DECADES]
         return d
 
@@ -557,10 +570,12 @@ def _mobility(mech: Mechanism, mode, seed: int, tols: Tolerances) -> MobilityRes
                              "reference's own branch was followed instead)")
     if Vref.shape[0] == dof_inst and not sing.singular:
         motion, mclass = motion_type(Vref, m.platform_point, length_scale=L, rtol=rtol)
+        axes = principal_screws(Vref, length_scale=L, rtol=rtol)
         where = "at the reference configuration"
     else:
         p_now = gen.D[:3, :3] @ m.platform_point + gen.D[:3, 3]
         motion, mclass = motion_type(Vgen, p_now, length_scale=L, rtol=rtol)
+        axes = principal_screws(Vgen, length_scale=L, rtol=rtol)
 
     notes = []
     if gk != M:
@@ -615,6 +630,7 @@ def _mobility(mech: Mechanism, mode, seed: int, tols: Tolerances) -> MobilityRes
         branches=sing.exploration.branches if sing.exploration is not None and sing.singular else (),
         singular_note=sing.note(),
         undecided=sing.exploration.undecided if sing.exploration is not None else "",
+        screw_axes=tuple(axes),
     )
 
 

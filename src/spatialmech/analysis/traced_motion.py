@@ -7,6 +7,8 @@ animates.  Numerics only; the viewer (:mod:`spatialmech.present.viewer`) draws t
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from ..errors import ConvergenceError
@@ -15,7 +17,20 @@ from ..kinematics.tracking import trace_motion
 from ..model.mechanism import Mechanism
 from .defects import dj_function
 
-__all__ = ["traced_motion"]
+__all__ = ["TracedMotion", "traced_motion", "traced_part"]
+
+
+@dataclass(frozen=True)
+class TracedMotion:
+    """A traced motion: ``configs`` (subsampled frames), ``singular`` (the configurations where
+    DJ of the first actuator vanishes), ``stops`` (the configurations where the tracker could not
+    go on: a bifurcation or a crossing branch; empty when the circuit closed) and ``note`` (why
+    it stopped, empty when it closed)."""
+
+    configs: list
+    singular: tuple
+    stops: tuple = ()
+    note: str = ""
 
 
 def traced_motion(mech: Mechanism, *, frames: int = 60, start: Configuration | None = None):
@@ -37,3 +52,34 @@ def traced_motion(mech: Mechanism, *, frames: int = 60, start: Configuration | N
     configs = [tr.points[i] for i in idx]
     sing = tuple(e.x for e in tr.events if e.kind == "zero")
     return configs, sing
+
+
+def _frames(points: list, frames: int) -> list:
+    idx = np.unique(np.linspace(0, len(points) - 1, min(frames, len(points))).round().astype(int))
+    return [points[i] for i in idx]
+
+
+def traced_part(mech: Mechanism, *, frames: int = 60, start: Configuration | None = None) -> TracedMotion:
+    """Like :func:`traced_motion`, but a tracker that stops (at a bifurcation point or a crossing
+    branch: a Sarrus linkage folded flat) does not lose what it traced: the motion is followed
+    from ``start`` in both senses, up to the stop in each, and the stops are returned as points to
+    mark.  Raises :class:`~spatialmech.errors.ConvergenceError` only when neither sense got off
+    the start."""
+    start = start if start is not None else Configuration.reference(mech)
+    acts = list(mech.actuators[:1])
+    mon = (acts, dj_function(mech, acts, start)[0]) if acts else None
+    first = acts[0] if acts else None
+    fwd = trace_motion(mech, start, increasing=first, vector_monitor=mon, max_arc=400)
+    if fwd.ok:
+        return TracedMotion(_frames(fwd.points, frames), tuple(e.x for e in fwd.events if e.kind == "zero"))
+    back = trace_motion(mech, start, increasing=first, sense=-1, vector_monitor=mon, max_arc=400)
+    parts = [t for t in (back, fwd) if len(t.points) > 1]
+    if not parts:
+        raise ConvergenceError(f"the tracker stopped at the start: {fwd.message}")
+    points = list(reversed(back.points[1:])) + list(fwd.points) if len(back.points) > 1 else list(fwd.points)
+    stops = tuple(t.points[-1] for t in (back, fwd) if not t.ok and len(t.points) > 1)
+    sing = tuple(e.x for t in (back, fwd) for e in t.events if e.kind == "zero")
+    why = "; ".join(dict.fromkeys(t.message for t in (back, fwd) if not t.ok))
+    note = (f"traced {len(points)} configurations between {len(stops)} stop(s) of the tracker ({why}); "
+            "the stops are marked")
+    return TracedMotion(_frames(points, frames), sing, stops, note)

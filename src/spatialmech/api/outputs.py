@@ -157,6 +157,9 @@ class ViewResult:
 
     file: ViewerFile
     motion: str
+    #: Why a traced motion is only part of a circuit (the tracker stopped at a bifurcation; the
+    #: stops are marked in the page); empty when the circuit closed or for a demonstration loop.
+    note: str = ""
 
     @property
     def out(self) -> str:
@@ -171,7 +174,7 @@ class ViewResult:
         return self.file.bytes
 
     def to_dict(self) -> dict:
-        return {**self.file.to_dict(), "motion": self.motion}
+        return {**self.file.to_dict(), "motion": self.motion, "note": self.note}
 
 
 def view(model: ModelLike, out, *, motion: str = "auto", frames: int = 60, plotly: str = "inline") -> ViewResult:
@@ -219,7 +222,7 @@ def view(model: ModelLike, out, *, motion: str = "auto", frames: int = 60, plotl
     ...     v.frames, v.bytes > 100_000
     (12, True)
     """
-    from ..analysis.traced_motion import traced_motion
+    from ..analysis.traced_motion import traced_part
     from ..kinematics.motion import sample_motion
     from ..present.viewer import PLOTLY_MODES, write_viewer
 
@@ -232,19 +235,23 @@ def view(model: ModelLike, out, *, motion: str = "auto", frames: int = 60, plotl
         raise InputError(f"out: {out} is a directory; give a file name")
     if not out.parent.is_dir():
         raise InputError(f"out: cannot write {out}: the directory {out.parent} does not exist")
-    singular = ()
+    singular: tuple = ()
+    stops: tuple = ()
+    note = ""
     if motion == "auto":
         motion = "trace" if (not mech.is_metamorphic and _mobility(mech).dof_instantaneous == 1) else "demo"
     if motion == "trace":
-        configs, singular = traced_motion(mech, frames=frames)
-        title = (f"{mech.name}: the traced circuit ({len(configs)} frames); +: DJ zeros of "
+        tr = traced_part(mech, frames=frames)
+        configs, singular, stops, note = tr.configs, tr.singular, tr.stops, tr.note
+        what = f"the traced part up to {len(stops)} bifurcation(s) (open squares)" if stops else "the traced circuit"
+        title = (f"{mech.name}: {what} ({len(configs)} frames); +: DJ zeros of "
                  f"{', '.join(mech.actuators[:1]) or '-'}")
     else:
         configs = sample_motion(mech, n=frames)
         title = f"{mech.name}: a demonstration loop, {len(configs)} configurations (not the tracker)"
     written = write_viewer(out, mech, configs, title=title, task_positions=mech.positions, singular_points=singular,
-                           plotly=plotly)
-    return ViewResult(written, motion)
+                           plotly=plotly, stop_points=stops)
+    return ViewResult(written, motion, note)
 
 
 # ============================================================================ design studio

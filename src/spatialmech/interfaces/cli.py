@@ -167,6 +167,10 @@ def _mobility_text(r) -> str:
         f"  instantaneous mobility (closure-Jacobian rank, generic configuration): {r.dof_instantaneous}",
         f"  motion: {r.motion}  ({r.motion_class})",
     ]
+    if r.screw_axes:  # the free twists' principal screws; a 1-DOF output's instantaneous screw
+        lines.append("  instantaneous screw:" if len(r.screw_axes) == 1 and r.screw_axes[0].multiplicity == 1
+                     else "  principal screws of the free twists:")
+        lines += [f"    {a.describe()}" for a in r.screw_axes]
     if r.constraint_wrenches:
         lines.append("  platform constraint wrenches (f ; m):")
         for w in r.constraint_wrenches:

@@ -22,6 +22,7 @@ import numpy as np
 from .. import api as sm
 from ..api import Mechanism, Pose, matrix_euler
 from ..errors import InputError
+from ..present.numbers import fmt_numbers
 from .common import emit_json, json_option, parse_numbers, tol_option
 
 if TYPE_CHECKING:
@@ -503,8 +504,9 @@ def jacobian(model, xyz, euler, position, drivers, dj_table, free, as_json):
     J, fit = jr.jacobian, jr.pose_fit
     click.echo(f"{mech.name}: complete Jacobian (rows: {J.constraint_rows} constraint, {len(J.actuators)} actuation"
                f" [{', '.join(J.actuators)}]); J $p = (0, qdot)")
-    for row in J.matrix:
-        click.echo("  [" + " ".join(f"{x:+.5e}" for x in row) + "]")
+    big = float(np.max(np.abs(J.matrix))) if np.size(J.matrix) else 1.0
+    for row in J.matrix:  # round-off against the matrix's largest entry prints as 0
+        click.echo("  [" + fmt_numbers(row, "+.5e", scale=big) + "]")
     if J.det is not None:
         click.echo(f"  det J = {J.det:+.6e}")
     click.echo(f"  scale-free sigma_min = {J.sigma_min:.4g}, 1/condition = {J.condition:.4g}")
@@ -531,11 +533,11 @@ def _echo_task_jacobian(jr: sm.JacobianResult) -> None:
                      for n in tj.solved)
     click.echo(f"  input-output Jacobian over the task ({sol.task.euler}: given {', '.join(tj.given)}; solved "
                f"{', '.join(tj.solved)}, here {vals}):")
-    click.echo("  d actuator / d given coordinate (actuator in [unit], per unit of the coordinate):")
+    click.echo("  d actuator / d given coordinate (each actuator in the unit after its name, per unit of the coordinate):")
     cols = [f"{n} (per {u})" if n in ("x", "y", "z") else f"{n} (per deg)" for n in tj.given]
     click.echo(" " * 20 + "".join(f"{c:>16s}" for c in cols))
     for a, row in zip(tj.actuators, tj.matrix, strict=True):
         slide = mech.freedom(a).freedom.kind == "P"
         cells = [(x if slide else np.degrees(x)) * (1.0 if n in ("x", "y", "z") else np.pi / 180.0)
                  for x, n in zip(row, tj.given, strict=True)]
-        click.echo(f"  {a + (f' [{u}]' if slide else ' [deg]'):>18s}" + "".join(f"{c:+16.6e}" for c in cells))
+        click.echo(f"  {a + (f' [{u}]' if slide else ' [deg]'):>18s}" + fmt_numbers(cells, "+16.6e", sep=""))

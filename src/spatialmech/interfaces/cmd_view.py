@@ -13,7 +13,7 @@ import click
 
 from .. import api as sm
 from ..errors import ConvergenceError, InputError
-from .common import UserError, check_output_file, emit_json, load_model
+from .common import UserError, check_output_file, emit_json, load_model, tol_option
 
 #: Largest number of frames (each is a configuration drawn into the page).
 MAX_FRAMES = 2000
@@ -47,8 +47,9 @@ class _Failed(UserError):
 @click.option("--plotly", "plotly", type=click.Choice(["inline", "cdn", "directory"]), default="inline", show_default=True,
               help="How the page gets plotly.js: inline (self-contained, ~4.8 MB, offline), cdn (small, needs the "
                    "network), directory (small; plotly.min.js written once next to the page, offline).")
+@tol_option("rank")
 @click.option("--json", "as_json", is_flag=True,
-              help="Print what was written (out, frames, bytes, plotly, motion) as JSON (docs/json.md).")
+              help="Print what was written (out, frames, bytes, plotly, motion, note) as JSON (docs/json.md).")
 def view(model, motion, out, frames, plotly, as_json):
     """Write an interactive 3-D viewer of MODEL (base, platform, limbs, joint axes, task
     positions) animated along a motion, with a slider and play / pause buttons.
@@ -59,6 +60,7 @@ def view(model, motion, out, frames, plotly, as_json):
       spatialmech view five-cs-1 --frames 120 --out five-cs-1.html --json
       spatialmech view bennett --motion trace --out bennett.html
       spatialmech view rssr --out pages/rssr.html --plotly directory
+      spatialmech view my-rounded-linkage.toml --tol 1e-4 --out linkage.html
     """
     try:
         check_output_file(out, "--out")
@@ -77,3 +79,5 @@ def view(model, motion, out, frames, plotly, as_json):
         emit_json("view", mech, written.to_dict())
     else:
         click.echo(f"wrote {written.out} ({written.frames} frames, {written.bytes} bytes)")
+        if written.note:
+            click.echo(f"note: {written.note}")

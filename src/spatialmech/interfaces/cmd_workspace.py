@@ -65,10 +65,12 @@ def _text(res, length_unit: str = "m") -> str:
                 continue
             lo_l, hi_l = ext[f"{key}_active_limits"]
             lines.append(f"  {c:5s} {label:9s}: [{ext[key][0]:.4f}, {ext[key][1]:.4f}] {u}   limits: {lo_l} / {hi_l}")
-    vkey = next(k for k in d if k.startswith("volume_") and k != "volume_note")
+    vkey = next(k for k in d if k.startswith("volume_") and k != "volume_note" and not k.startswith("volume_error"))
     power = vkey[-1] if vkey[-1].isdigit() else ""
     vunit = ("deg" if "_deg" in vkey else length_unit) + (f"^{power}" if power else "")
-    lines.append(f"volume: {d[vkey]:.6g} {vunit} ({d['volume_note']})")
+    err = d.get(vkey.replace("volume_", "volume_error_", 1))
+    pm = "" if err is None else f" +- {err:.2g} (grid estimate |V_h - V_2h| + bisection tolerance)"
+    lines.append(f"volume: {d[vkey]:.6g}{pm} {vunit} ({d['volume_note']})")
     lines.append("active limits (boundary points): " + ", ".join(f"{k} {v}" for k, v in res.active_limits.items()))
     lines.append(f"{res.n_poses} poses checked in {res.seconds:.2f} s; tolerance "
                  + ", ".join(_with_unit(k, v, ".3g", length_unit) for k, v in d["boundary_tol"].items()))
@@ -78,6 +80,17 @@ def _text(res, length_unit: str = "m") -> str:
 def _check_diameter(link_diameter) -> None:
     if link_diameter is not None and not (np.isfinite(link_diameter) and link_diameter >= 0):
         raise InputError(f"--link-diameter: expected a non-negative number of metres, got {link_diameter}")
+
+
+def _option_message(msg: str, kind: str) -> str:
+    """A library error with its argument names replaced by the command-line options to change."""
+    for lib in ("max_poses", "max_cells"):  # "raise --max-poses to at least N" is advice that works
+        msg = msg.replace(f"{lib} =", "--max-poses =").replace(f"raise {lib}", "raise --max-poses")
+    for arg, opt in (("step", "--step-deg" if kind == "orientation" else "--step"),
+                     ("tol", "--tol-deg" if kind == "orientation" else "--tol")):
+        if msg.startswith(arg + ":"):
+            msg = f"{opt} ({arg})" + msg[len(arg):]
+    return msg
 
 
 def _progress_bar():
@@ -269,14 +282,7 @@ def workspace(model, orientation_flag, position_flag, at, step_deg, tol_deg, ste
 
             write_workspace_plot(res, plot)
     except InputError as e:  # not ConvergenceError (exit 1) nor a bug (exit 3): see cli._Group
-        msg = str(e)
-        # the library names its arguments; say which command-line option to change
-        msg = msg.replace("max_poses =", "--max-poses =").replace("max_cells =", "--max-poses =")
-        for arg, opt in (("step", "--step-deg" if kind == "orientation" else "--step"),
-                         ("tol", "--tol-deg" if kind == "orientation" else "--tol")):
-            if msg.startswith(arg + ":"):
-                msg = f"{opt} ({arg})" + msg[len(arg):]
-        raise UserError(msg) from None
+        raise UserError(_option_message(str(e), kind)) from None
     if as_json:
         emit_json("workspace", mech, {**res.to_dict(), "plot": str(plot) if plot else None})
         return

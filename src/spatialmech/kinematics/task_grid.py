@@ -238,7 +238,8 @@ def solve_task_grid(
     n_cells = int(np.prod(shape))
     if n_cells > limit:
         raise SearchTooLargeError(f"over: the grid has {n_cells} cells ({' x '.join(map(str, shape))}), more than "
-                                  f"max_cells = {limit}; use fewer points per coordinate")
+                                  f"max_cells = {limit}; use fewer points per coordinate or raise max_cells to at least "
+                                  f"{n_cells}")
     progress = check_progress(progress)
     seed = Configuration.reference(mech) if seed is None else seed
     v0 = task_values(mech, seed.D, task.euler)

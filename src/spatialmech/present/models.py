@@ -18,6 +18,8 @@ import numpy as np
 
 from .. import catalog
 from ..analysis.mobility import mobility_modes
+from ..analysis.defects import dj_function
+from ..analysis.four_bar import four_bar_class
 from ..kinematics.closure import Configuration
 from ..kinematics.jacobian import CompleteJacobian, complete_jacobian
 from ..kinematics.position import PoseFit, configuration_at_pose, freedom_values
@@ -67,6 +69,34 @@ def _jacobian_row(label, J):
             ", ".join(J.inverse_singular) or "-")
 
 
+def _dj_vector_monitor(mech: Mechanism, ref: Configuration, square: bool):
+    """DJ of the first actuator as the tracker's vector monitor when J is not square (``None``
+    when it is, or without actuators)."""
+    if square or not mech.actuators:
+        return None
+    acts = list(mech.actuators[:1])
+    return acts, dj_function(mech, acts, ref)[0]
+
+
+def _four_bar_table(mech: Mechanism, data: dict) -> list[Table]:
+    """The linkage class of a planar four-bar (no table for anything else); its JSON in ``data``."""
+    fb = four_bar_class(mech)
+    if fb is None:
+        return []
+    unit = mech.length_unit
+    data["four_bar"] = fb.to_dict()
+    lo, hi = fb.input_range_deg
+    return [Table(
+        "Linkage class (planar four-bar)",
+        (f"ground [{unit}]", f"input [{unit}]", f"coupler [{unit}]", f"output [{unit}]", "type",
+         "input range [deg]", "transmission angle range [deg]"),
+        ((fb.ground, fb.input, fb.coupler, fb.output, fb.kind,
+          "full turn" if (lo, hi) == (0.0, 360.0) else f"{lo:.2f} to {hi:.2f} (and its mirror)",
+          f"{fb.transmission_range_deg[0]:.2f} to {fb.transmission_range_deg[1]:.2f}"),),
+        "Input angle from the ground line (the input's base pivot towards the output's); the transmission "
+        "angle is between coupler and output, 0 or 180 at a dead point (closed form, analysis/four_bar.py).")]
+
+
 def model_section(mech: Mechanism, progress: Progress | None = None, *, trace: bool = True) -> Section:
     """Every analysis that applies to ``mech`` (see the module docstring)."""
     say = Steps(progress, MODEL_STEPS)
@@ -82,6 +112,7 @@ def model_section(mech: Mechanism, progress: Progress | None = None, *, trace: b
     tables.append(Table("Mobility (modified Kutzbach-Grübler, checked numerically)", _MOB_COLS,
                         tuple(_mob_row(mech.name, r) for r in mob), "; ".join(dict.fromkeys(r.explanation for r in mob))))
     dof = mob[0].dof if len(mob) == 1 else None
+    tables += _four_bar_table(mech, data)  # the linkage class of a planar four-bar
 
     say(f"{mech.name}: complete Jacobian at the reference configuration")
     ref = Configuration.reference(mech)
@@ -153,8 +184,12 @@ def model_section(mech: Mechanism, progress: Progress | None = None, *, trace: b
             return 0.0 if J.det is None else J.det
 
         mons: dict[str, Callable[[Configuration], float]] | None = {"DJ": dj} if square else None
+        # a linkage with common constraints (a planar 4-bar) has no square J: DJ of the first
+        # actuator from the closure Jacobian's cofactor (as `view` and the studio), so that its
+        # dead points are counted, not reported as "0 zeros"
+        vmon = _dj_vector_monitor(mech, ref, square)
         tr = trace_motion(mech, ref, increasing=mech.actuators[0] if mech.actuators else None, monitors=mons,
-                          max_arc=200, max_steps=TRACE_MAX_STEPS)
+                          vector_monitor=vmon, max_arc=200, max_steps=TRACE_MAX_STEPS)
         q = np.array([freedom_values(mech, c.q) for c in tr.points])
         ids = [r.id for r in mech.freedom_refs]
         show = [i for i, r in enumerate(mech.freedom_refs) if r.id in mech.actuators] or list(range(min(3, len(ids))))

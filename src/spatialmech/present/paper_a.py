@@ -113,7 +113,7 @@ def section(progress: Progress | None = None) -> Section:
             rows.append((f"five-cs-{k}", P, f.position_error, float(np.degrees(f.angle_error)), f.exact))
     tables.append(Table(
         "Printed task positions (table 9) fitted onto each linkage's closure", ("linkage", "position",
-        "platform-point error [unit]", "orientation error [deg]", "exact"), tuple(rows),
+        "platform-point error (paper A lengths: no unit given)", "orientation error [deg]", "exact"), tuple(rows),
         "The printed tables are rounded to 3 decimals, so the printed poses do not close exactly; the nearest "
         "closed configuration is used and its distance reported (largest: "
         + ", ".join(f"linkage {k} {max(f.position_error for f in t.fits):.3g}" for k, t in tabs.items()) + ")."))
@@ -196,8 +196,8 @@ def _mujoco_table(mechs: dict, res: dict) -> Table:
                      "; ".join(r.notes[1:])))
     return Table(
         "Validated in MuJoCo: the linkage driven by rot1 along the path from P1 to P7",
-        ("linkage", "poses", "largest position error [unit]", "largest orientation error [deg]", "validated in MuJoCo",
-         "note"), tuple(rows),
+        ("linkage", "poses", "largest position error (paper A lengths: no unit given)", "largest orientation error [deg]",
+         "validated in MuJoCo", "note"), tuple(rows),
         "Each linkage exported as a MuJoCo model (MJCF) and solved by MuJoCo with rot1 held at the library's value "
         "(method 'project', docs/validation.md); the errors are the simulated platform poses against the library's "
         "forward position, passing at 1e-8 of the characteristic length. Where rot1 turns back (a branch point) a "

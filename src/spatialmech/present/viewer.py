@@ -385,7 +385,7 @@ def _style_animated(traces: list, d: Drawing, mech: Mechanism, fill: bool) -> No
                          hoverinfo="skip")
         i += 1
     for li, limb in enumerate(mech.limbs):
-        traces[i].update(mode="lines", name=f"limb {limb.name}", line=dict(color=_PALETTE[li % len(_PALETTE)], width=7))
+        traces[i].update(mode="lines", name=limb_label(limb.name), line=dict(color=_PALETTE[li % len(_PALETTE)], width=7))
         i += 1
     for li in range(len(mech.limbs)):
         traces[i].update(color=_PALETTE[li % len(_PALETTE)], opacity=1.0, flatshading=True, hoverinfo="skip",
@@ -405,6 +405,12 @@ def _style_animated(traces: list, d: Drawing, mech: Mechanism, fill: bool) -> No
         i += 1
 
 
+def limb_label(name: str) -> str:
+    """A limb's legend entry: ``"limb leg1"``, but ``"limb1"`` (not ``"limb limb1"``) when the
+    name already says it is a limb."""
+    return name if name.lower().startswith("limb") else f"limb {name}"
+
+
 def _singular_point(mech: Mechanism, item, k: int) -> np.ndarray:
     if isinstance(item, Configuration):
         _check_config(mech, item, f"singular_points[{k}]")
@@ -419,16 +425,18 @@ def viewer_figure(
     title: str | None = None,
     task_positions: Sequence[Pose] = (),
     singular_points: Sequence = (),
+    stop_points: Sequence = (),
 ) -> go.Figure:
     """The animated plotly figure of ``mech`` along ``configs`` (one frame per configuration).
 
     ``task_positions``: platform poses (:class:`Pose`, e.g. ``mech.positions``) shown as the
     platform point and a small frame each, labelled with the pose name.  ``singular_points``:
     platform points (3-vectors, world frame) or :class:`Configuration` objects (their platform
-    point is drawn).  Pure: builds the figure, writes nothing.  Raises ``ValueError`` on an
+    point is drawn).  ``stop_points``: the same, where a traced motion stopped (a bifurcation
+    point or a crossing branch), drawn as open squares.  Pure: builds the figure, writes nothing.  Raises ``ValueError`` on an
     empty or mismatched ``configs`` and on NaN anywhere.
     """
-    fig, frames = _viewer_parts(mech, configs, title, task_positions, singular_points, _GO)
+    fig, frames = _viewer_parts(mech, configs, title, task_positions, singular_points, _GO, stop_points)
     fig.frames = frames
     return fig
 
@@ -440,16 +448,17 @@ def viewer_figure_dict(
     title: str | None = None,
     task_positions: Sequence[Pose] = (),
     singular_points: Sequence = (),
+    stop_points: Sequence = (),
 ) -> dict:
     """:func:`viewer_figure` as the plain dict plotly writes into a page (``Figure.to_dict()``:
     arrays as base64 typed arrays), its animation frames built as dicts without plotly's
     validated setters (the static traces and the layout still go through them).  For writing a
     page: ``plotly.io.to_html(d, validate=False, ...)``."""
-    fig, frames = _viewer_parts(mech, configs, title, task_positions, singular_points, _PLAIN)
+    fig, frames = _viewer_parts(mech, configs, title, task_positions, singular_points, _PLAIN, stop_points)
     return {**fig.to_dict(), "frames": frames}
 
 
-def _viewer_parts(mech, configs, title, task_positions, singular_points, make):
+def _viewer_parts(mech, configs, title, task_positions, singular_points, make, stop_points=()):
     """The figure without its frames, and the frames (``make``: plotly objects or plain dicts)."""
     if not isinstance(mech, Mechanism):
         raise InputError(f"mech: expected a Mechanism, got {type(mech).__name__}")
@@ -463,6 +472,7 @@ def _viewer_parts(mech, configs, title, task_positions, singular_points, make):
         if not isinstance(pz, Pose):
             raise InputError(f"task_positions[{k}]: expected a Pose, got {type(pz).__name__}")
     sing = np.array([_singular_point(mech, x, k) for k, x in enumerate(singular_points)]).reshape(-1, 3)
+    stops = np.array([_singular_point(mech, x, k) for k, x in enumerate(stop_points)]).reshape(-1, 3)
 
     order = _platform_order(mech)
     draws = [drawing(mech, c) for c in configs]
@@ -496,6 +506,10 @@ def _viewer_parts(mech, configs, title, task_positions, singular_points, make):
         static.append(go.Scatter3d(**_xyz(sing), mode="markers", name="singular points",
                                    marker=dict(size=9, color="#d62728", symbol=SINGULAR_SYMBOL)))
         extra.append(sing)
+    if len(stops):
+        static.append(go.Scatter3d(**_xyz(stops), mode="markers", name="bifurcation (the tracker stopped here)",
+                                   marker=dict(size=11, color="#9467bd", symbol="square-open")))
+        extra.append(stops)
 
     solids = [_solids(mech, c, d) for c, d in zip(configs, draws, strict=True)]
     first = _animated(d0, fill, solids[0], first=True)
@@ -547,6 +561,7 @@ def viewer_html(
     title: str | None = None,
     task_positions: Sequence[Pose] = (),
     singular_points: Sequence = (),
+    stop_points: Sequence = (),
     full_html: bool = True,
     include_plotlyjs: bool | str = True,
     div_id: str = DIV_ID,
@@ -561,7 +576,7 @@ def viewer_html(
     import plotly.io as pio
 
     fig = viewer_figure_dict(mech, configs, title=title, task_positions=task_positions,
-                             singular_points=singular_points)
+                             singular_points=singular_points, stop_points=stop_points)
     page = pio.to_html(
         fig, validate=False, include_plotlyjs=include_plotlyjs, full_html=full_html, auto_play=False, div_id=div_id,
         default_height=default_height, config={"displaylogo": False, "responsive": True},
@@ -581,6 +596,7 @@ def write_viewer(
     task_positions: Sequence[Pose] = (),
     singular_points: Sequence = (),
     plotly: str = "inline",
+    stop_points: Sequence = (),
 ) -> ViewerFile:
     """Write :func:`viewer_html` (a full page) to ``path`` (UTF-8); ``plotly`` says how the page
     gets plotly.js (:data:`PLOTLY_MODES`; ``directory`` also writes ``plotly.min.js`` next to
@@ -590,7 +606,7 @@ def write_viewer(
     configs = list(configs)
     include: bool | str = True if plotly == "inline" else plotly
     page = viewer_html(mech, configs, title=title, task_positions=task_positions, singular_points=singular_points,
-                       include_plotlyjs=include)
+                       stop_points=stop_points, include_plotlyjs=include)
     data = page.encode("utf-8")
     p = Path(path)
     p.write_bytes(data)

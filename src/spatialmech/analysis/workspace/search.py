@@ -85,6 +85,11 @@ class WorkspaceResult:
     n_poses: int
     seconds: float
     limits: WorkspaceLimits
+    #: Estimated error of :attr:`volume` (same unit): ``|V_h - V_2h|``, the volume again from
+    #: every second grid line in the coordinates the rule integrates over (first-order
+    #: Richardson: the lines resolve the set's edge across them to a grid step), plus the
+    #: bisection tolerance at every refined run end.  See :func:`volume_error`.
+    volume_error: float = 0.0
 
     @property
     def active_limits(self) -> dict[str, int]:
@@ -145,6 +150,8 @@ class WorkspaceResult:
             "fixed": {key(c): conv(c, v) for c, v in self.fixed.items()},
             "extents": extents,
             f"volume_{code}{power if power > 1 else ''}": volume,
+            f"volume_error_{code}{power if power > 1 else ''}": float(self.volume_error) * (
+                float(np.degrees(1.0)) ** power if code == "deg" else 1.0),
             "volume_note": ("Euler-angle coordinates (alpha, beta, gamma), not the Haar measure of SO(3)"
                             if code == "deg" else "volume of the platform point's positions"),
             "active_limits": self.active_limits,
@@ -292,6 +299,29 @@ def _refine_runs(ev, F, grid, axis, tol):
     return lines, lo, hi, lo_lim, hi_lim, xin_lo, xin_hi
 
 
+def volume_error(grid, lines: np.ndarray, lengths: np.ndarray, k: int, tol: float) -> float:
+    """Error estimate of the volume ``sum w * lengths`` over refined runs along coordinate ``k``
+    (``lines``: each run's grid indices in the other coordinates): ``|V_h - V_2h|`` with
+    ``V_2h`` the trapezoid rule over every second grid line (the last one kept) in each other
+    coordinate, plus ``tol`` times the weight of every run end (the bisection's resolution)."""
+    others = [m for m in range(len(grid)) if m != k]
+    w_h = np.ones(lines.shape[0])
+    w_2h = np.ones(lines.shape[0])
+    keep = np.ones(lines.shape[0], dtype=bool)
+    for j, kk in enumerate(others):
+        g = np.asarray(grid[kk])
+        w_h *= trapezoid_weights(g)[lines[:, j]]
+        sub = np.unique(np.r_[np.arange(0, g.size, 2), g.size - 1])
+        w_sub = np.zeros(g.size)
+        w_sub[sub] = trapezoid_weights(g[sub])
+        w_2h *= w_sub[lines[:, j]]
+        keep &= np.isin(lines[:, j], sub)
+    v_h = float(np.sum(w_h * lengths))
+    v_2h = float(np.sum(np.where(keep, w_2h, 0.0) * lengths))
+    rich = abs(v_h - v_2h) if others else 0.0
+    return rich + float(np.sum(w_h)) * 2.0 * abs(float(tol))
+
+
 def trapezoid_weights(v: np.ndarray) -> np.ndarray:
     """Trapezoid-rule weights of the grid values ``v`` (a single value weighs 1)."""
     if v.size == 1:
@@ -368,10 +398,11 @@ def _check_grid_size(free, values, bounds, step, path: str, max_poses) -> None:
     e = float((max(log10_n, np.log10(n) if np.isfinite(n) else 0.0) - np.log10(limit)) / len(free))
     factor = f"{10.0**e:.3g}" if e < 300 else f"1e{e:.0f}"
     size = f"about {n:.3g}" if np.isfinite(n) else f"about 1e{log10_n:.0f}"
+    or_raise = f", or raise max_poses to at least {n:.0f}" if np.isfinite(n) and n < 1e12 else ""
     raise SearchTooLargeError(
         f"step: the grid has {size} poses ({' x '.join(f'{c:.3g}' for c in counts)} plus the lines through the "
         f"centre), more than max_poses = {limit} for the {path} kernel; multiply the step by at least "
-        f"{factor} or narrow the bounds")
+        f"{factor} or narrow the bounds{or_raise}")
 
 
 def _analyse(mech, kind, free, values, bounds, step, tol, limits, method, chunk, progress, max_poses, polish):
@@ -427,7 +458,7 @@ def _analyse(mech, kind, free, values, bounds, step, tol, limits, method, chunk,
     bpts, blims = [], []
     extents: dict[str, Extent | None] = {}
     method_used: dict[str, str] = {}
-    volume = 0.0
+    volume = volume_err = 0.0
     for k, c in enumerate(free):
         lines, lo, hi, lo_lim, hi_lim, xin_lo, xin_hi = _refine_runs(ev, F, grid, k, tolv)
         for X, lim, a in ((xin_lo, lo_lim, lo), (xin_hi, hi_lim, hi)):
@@ -440,6 +471,7 @@ def _analyse(mech, kind, free, values, bounds, step, tol, limits, method, chunk,
             for j, kk in enumerate([m for m in range(d) if m != k]):
                 w *= trapezoid_weights(grid[kk])[lines[:, j]]
             volume = float(np.sum(w * (hi - lo)))
+            volume_err = volume_error(grid, lines, hi - lo, k, tolv[k] if np.ndim(tolv) else float(tolv))
         if lo.size == 0:
             extents[c] = None
             continue
@@ -472,7 +504,7 @@ def _analyse(mech, kind, free, values, bounds, step, tol, limits, method, chunk,
         fixed={c: values[c] for c in COORDINATES if c not in free},
         center={c: values[c] for c in free}, bounds={c: tuple(bounds[c]) for c in free},
         grid=grid, feasible=F, alone=alone, alone_intervals=alone_int, extents=extents,
-        extent_method=method_used, volume=volume, volume_unit=volume_unit, boundary_points=bp,
+        extent_method=method_used, volume=volume, volume_unit=volume_unit, boundary_points=bp, volume_error=volume_err,
         boundary_limits=tuple(blims),
         step={c: float(g[1] - g[0]) if g.size > 1 else 0.0 for c, g in zip(free, grid, strict=True)},
         tol={c: tol[c] for c in free}, n_poses=ev.count, seconds=time.perf_counter() - t0, limits=checker.limits,

@@ -16,7 +16,8 @@ async function api(path, body) {
   return doc;
 }
 
-function fmt(x, d = 4) { return (x === null || x === undefined) ? "-" : Number(x).toPrecision(d); }
+// round-off (|x| < 1e-13, and -0) prints as 0, as present/numbers.py does for the text outputs
+function fmt(x, d = 4) { return (x === null || x === undefined) ? "-" : (Math.abs(Number(x)) < 1e-13 ? "0" : Number(x).toPrecision(d)); }
 
 // ------------------------------------------------------------------ shapes
 function add(a, b) { return [a[0] + b[0], a[1] + b[1], a[2] + b[2]]; }
@@ -46,7 +47,7 @@ function traces(sc) {
     hoverinfo: "skip", showlegend: true });
   out.push({ type: "scatter3d", mode: "lines", ...xyz(sc.platform_len), line: { color: "#ff7f0e", width: 6 }, name: "platform outline", showlegend: false });
   sc.limbs_len.forEach((pl, li) => out.push({ type: "scatter3d", mode: "lines", ...xyz(pl), line: { color: sc.limb_colours[li], width: 9 },
-    name: "limb " + sc.limb_names[li] }));
+    name: /^limb/i.test(sc.limb_names[li]) ? sc.limb_names[li] : "limb " + sc.limb_names[li] }));  // not "limb limb1"
   if (sc.bodies_len.length) {
     const pts = []; sc.bodies_len.forEach(sg => { pts.push(sg[0], sg[1], [null, null, null]); });
     out.push({ type: "scatter3d", mode: "lines", ...xyz(pts), line: { color: "#7f7f7f", width: 9 }, name: "internal bodies" });
@@ -83,8 +84,8 @@ function sceneRange(sc) {
 function draw() {
   const sc = S.state.scene;
   if (!S.range) S.range = sceneRange(sc);
-  const ax = (r, n) => ({ range: r, autorange: false, title: n + " [" + S.unit + "]" });
-  const layout = { uirevision: "studio", margin: { l: 0, r: 0, t: 30, b: 0 }, title: S.state.mechanism,
+  const ax = (r, n) => ({ range: r, autorange: false, title: { text: n + " [" + S.unit + "]" } });  // the bundled plotly needs title.text
+  const layout = { uirevision: "studio", margin: { l: 0, r: 0, t: 30, b: 0 }, title: { text: S.state.mechanism },
     scene: { aspectmode: "cube", xaxis: ax(S.range[0], "x"), yaxis: ax(S.range[1], "y"), zaxis: ax(S.range[2], "z") },
     legend: { itemsizing: "constant" } };
   Plotly.react("plot", traces(sc), layout, { displaylogo: false, responsive: true });

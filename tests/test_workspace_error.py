@@ -1,0 +1,47 @@
+"""Workspace volumes carry an error estimate (issue 30 item 10)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import spatialmech as sm
+from spatialmech.analysis.workspace.search import trapezoid_weights, volume_error
+
+
+def test_disc_area_lies_within_the_estimate():
+    # the unit disc as runs along x at grid lines y: exact runs, so only the y rule errs
+    for n in (9, 17, 33):
+        y = np.linspace(-1.0, 1.0, n)
+        lines = np.arange(n)[:, None]
+        lengths = 2.0 * np.sqrt(np.clip(1.0 - y**2, 0.0, None))
+        area = float(np.sum(trapezoid_weights(y) * lengths))
+        err = volume_error((np.zeros(1), y), lines, lengths, 0, 0.0)
+        assert abs(area - np.pi) <= err and err < 0.5
+
+
+@pytest.mark.slow
+def test_grid_volumes_at_two_steps_agree_within_their_estimates():
+    coarse = sm.workspace("four-sps-cu", kind="orientation", at={"z": 0.1}, step=np.radians(8.0))
+    fine = sm.workspace("four-sps-cu", kind="orientation", at={"z": 0.1}, step=np.radians(4.0))
+    assert 0.0 < fine.volume_error < coarse.volume_error
+    assert abs(fine.volume - coarse.volume) <= coarse.volume_error + fine.volume_error
+    d = fine.to_dict()
+    assert d["volume_error_deg3"] == fine.volume_error * np.degrees(1.0) ** 3
+
+
+@pytest.mark.slow
+def test_max_poses_advice_works():
+    import re
+
+    from click.testing import CliRunner
+
+    from spatialmech.interfaces.cli import cli
+
+    args = ["workspace", "three-rps", "--task", "--over", "a2:-40:40:201,a3:-40:40:201", "--at", "z=0.33"]
+    first = CliRunner().invoke(cli, args)
+    assert first.exit_code == 2
+    m = re.search(r"raise --max-poses to at least (\d+)", first.output)
+    assert m is not None, first.output
+    again = CliRunner().invoke(cli, [*args, "--max-poses", m.group(1), "--json"])
+    assert again.exit_code == 0, again.output
