@@ -432,7 +432,7 @@ def test_export_writes_each_format_and_checks_first(tmp_path):
         sm.export("no-such-model", tmp_path / "r.png")  # the file's format is refused before the model is loaded
     with pytest.raises(sm.InputError, match="format: expected one of"):
         sm.export("rssr", tmp_path / "r.toml", format="iges")
-    with pytest.raises(sm.InputError, match="format: 'step' contradicts the extension '.toml'"):
+    with pytest.raises(sm.InputError, match=r"format: 'step' contradicts the extension '\.toml'"):
         sm.export("rssr", tmp_path / "r.toml", format="step")  # a STEP file named .toml is refused
 
 
