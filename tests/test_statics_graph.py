@@ -63,7 +63,7 @@ def test_graph_statics_reactions_do_no_work_and_match_the_dynamics_at_rest(name,
     """Every joint's reaction is reciprocal to all its freedoms (a ball joint: a pure force through
     its centre); the efforts and reactions equal sm.inverse_dynamics at zero velocity and
     acceleration with the same masses and gravity (1e-10 relative)."""
-    mech, c, masses = _setup(name, pose)
+    mech, _, _ = _setup(name, pose)
     F = np.array([1.0, 2.0, -30.0, 0.1, 0.2, 0.3])
     r = sm.statics(mech, pose, wrench=F, gravity=G, density=2700.0)
     assert r.balanced and len(r.reactions) == sum(len(limb.joints) for limb in mech.limbs)
