@@ -71,6 +71,7 @@ from ..kinematics.closure import (
     chain_forward,
     closure_jacobian,
     closure_scales,
+    hub_count,
     limb_chains,
     limb_slices,
 )
@@ -243,7 +244,8 @@ def _source_twists(mech: Mechanism, config: Configuration, params: list[Paramete
         r = mech.limbs[p.limb].joints[p.joint].point
         eta = np.concatenate([np.zeros(3), p.direction]) if p.kind == "point" else \
             np.concatenate([p.direction, np.cross(r, p.direction)])
-        S[:, i] = adjoint(before) @ eta - adjoint(through) @ eta
+        # the limb's chain is placed on its base hub (identity for the ground)
+        S[:, i] = adjoint(config.hub(mech.limb_ends[p.limb][0])) @ (adjoint(before) @ eta - adjoint(through) @ eta)
     return S
 
 
@@ -254,7 +256,7 @@ def sensitivity(mech: Mechanism, config: Configuration, params: list[Parameter])
     Jacobian has more than 6 rows (redundant constraints: the errors cannot all be absorbed, the
     perturbed design deforms or does not assemble), 0 otherwise."""
     if mech.bodies:
-        raise InputError(f"{mech.name}: accuracy needs limbs from the ground to the output link (no internal bodies)")
+        return _closure_sensitivity(mech, config, params)
     jac = complete_jacobian(mech, config)
     M = jac.matrix
     if jac.inverse_singular:
@@ -291,6 +293,46 @@ def sensitivity(mech: Mechanism, config: Configuration, params: list[Parameter])
     return G, inconsistency, int(M.shape[0])
 
 
+def _closure_sensitivity(mech: Mechanism, config: Configuration, params: list[Parameter]) -> tuple[np.ndarray, float, int]:
+    """:func:`sensitivity` for a graph mechanism (internal bodies), from the loop closures: per
+    limb ``V_base + J_k dq_k + s_k - V_tip = 0`` with the actuators' ``dq`` the actuator errors,
+    solved (nondimensional least squares) for the passive rates and the hubs' twists; the output
+    link's twist is the error.  Raises :class:`InputError` where the actuators do not determine it
+    (a direct singularity)."""
+    active = active_mask(mech)
+    A, _ = closure_jacobian(mech, config, active=active)
+    row, col = closure_scales(mech, active)
+    pos = np.cumsum(active) - 1
+    acts = [int(pos[mech.freedom_refs.index(mech.freedom(a))]) for a in mech.actuators]
+    nx = A.shape[1]
+    B = np.zeros((len(acts), nx))
+    B[np.arange(len(acts)), acts] = 1.0
+    M = np.vstack([row[:, None] * A * col[None, :], B])
+    S = _source_twists(mech, config, params)
+    rhs = np.zeros((M.shape[0], len(params)))
+    for i, p in enumerate(params):
+        if p.kind == "actuator":
+            rhs[A.shape[0] + acts.index(int(pos[p.freedom])), i] = 1.0 / col[int(pos[p.freedom])]
+        else:
+            rhs[6 * p.limb : 6 * p.limb + 6, i] = -row[6 * p.limb : 6 * p.limb + 6] * S[:, i]
+    _, sv, vt = np.linalg.svd(M)
+    rank = int(np.sum(sv > current().rank * max(1.0, float(sv[0]))))
+    n_q = int(active.sum())
+    if vt[rank:].size and np.max(np.abs(vt[rank:, n_q : n_q + 6])) > 1e-7:
+        raise InputError(f"{mech.name}: a direct singularity here: the actuators do not determine the output link's "
+                         "motion, so the output error is not determined")
+    X, *_ = np.linalg.lstsq(M, rhs, rcond=None)
+    res = M @ X - rhs
+    big = np.maximum(np.linalg.norm(rhs, axis=0), 1e-300)
+    inconsistency = float(np.max(np.linalg.norm(res, axis=0) / big)) if len(params) else 0.0
+    tw = X[n_q : n_q + 6] * col[n_q : n_q + 6, None]  # (omega ; v) at the origin
+    p_out = config.D[:3, :3] @ mech.platform_point + config.D[:3, 3]
+    G = np.empty_like(tw)
+    G[3:] = tw[:3]
+    G[:3] = tw[3:] + np.cross(tw[:3].T, p_out).T
+    return G, inconsistency, int(M.shape[0])
+
+
 # ------------------------------------------------------------------------------ mobility under tolerances
 def _reference_closure(mech: Mechanism, params: list[Parameter], values) -> np.ndarray:
     """The nondimensional closure Jacobian at the reference configuration of ``mech`` with the
@@ -306,7 +348,8 @@ def _reference_closure(mech: Mechanism, params: list[Parameter], values) -> np.n
     active = active_mask(mech)
     n = len(mech.freedom_refs)
     K = len(mech.limbs)
-    A = np.zeros((6 * K, n + 6))
+    h = hub_count(mech)
+    A = np.zeros((6 * K, n + 6 * h))
     i = 0
     for k, limb in enumerate(mech.limbs):
         for j, jt in enumerate(limb.joints):
@@ -315,9 +358,13 @@ def _reference_closure(mech: Mechanism, params: list[Parameter], values) -> np.n
             for f in jt.freedoms:
                 A[6 * k : 6 * k + 6, i] = f.screw
                 i += 1
-        A[6 * k : 6 * k + 6, n:] = -np.eye(6)
+        a, b = mech.limb_ends[k]  # at the reference every hub is at the identity
+        if a is not None:
+            A[6 * k : 6 * k + 6, n + 6 * a : n + 6 * a + 6] += np.eye(6)
+        if b is not None:
+            A[6 * k : 6 * k + 6, n + 6 * b : n + 6 * b + 6] -= np.eye(6)
     row, col = closure_scales(mech, active)
-    return row[:, None] * A[:, np.concatenate([active, np.ones(6, bool)])] * col[None, :]
+    return row[:, None] * A[:, np.concatenate([active, np.ones(6 * h, bool)])] * col[None, :]
 
 
 def _dof(As: np.ndarray, mech: Mechanism, rtol: float) -> tuple[int, np.ndarray]:

@@ -66,6 +66,7 @@ __all__ = [
     "link_placements",
     "mass_properties",
     "quintic",
+    "rest_state",
     "state_from_actuators",
 ]
 
@@ -363,10 +364,42 @@ def _crf(V: np.ndarray, h: np.ndarray) -> np.ndarray:
     return np.r_[np.cross(w, h[:3]), np.cross(v, h[:3]) + np.cross(w, h[3:])]
 
 
+def rest_state(mech: Mechanism, config: Configuration) -> DynamicsState:
+    """The mechanism at rest at ``config``: zero velocity state and zero derivative (no
+    singularity check: the statics at a singular configuration is a least-squares balance)."""
+    nx = int(active_mask(mech).sum()) + 6 * hub_count(mech)
+    return DynamicsState(config, np.zeros(nx), np.zeros(nx))
+
+
+def _solve_balance(fr: _Frame, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+    """``Q = B^T tau + A^T lambda`` for the efforts ``tau`` and the multipliers ``lambda``, and the
+    relative residual.  Redundant actuation: the efforts of the least norm with torques divided by
+    the characteristic length (forces as they are) -- the definition of :mod:`.statics` -- then
+    the least multipliers in the scaled coordinates."""
+    n_a = fr.act.size
+    B = np.zeros((n_a, Q.size))
+    B[np.arange(n_a), fr.act] = 1.0
+    K = np.hstack([B.T, fr.col[:, None] * fr.A.T * fr.row[None, :]])
+    rhs = fr.col * Q
+    U, s, vt = np.linalg.svd(K, full_matrices=True)
+    rtol = current().rank * max(1.0, float(s[0]) if s.size else 0.0)
+    r = int(np.sum(s > rtol))
+    z = vt[:r].T @ ((U[:, :r].T @ rhs) / s[:r])
+    N = vt[r:].T  # combinations that balance nothing
+    if N.shape[1] and n_a:
+        # z[:n_a] = tau * col: a force times L, a torque as it is: uniformly the statics' weights times L
+        u, s2, v2 = np.linalg.svd(N[:n_a], full_matrices=True)
+        r2 = int(np.sum(s2 > rtol))
+        z = z + N @ (v2[:r2].T @ ((u[:, :r2].T @ -z[:n_a]) / s2[:r2]))
+    res = float(np.linalg.norm(K @ z - rhs)) / max(float(np.linalg.norm(rhs)), 1e-300)
+    return z[:n_a] / fr.col[fr.act], fr.row * z[n_a:], res if np.any(rhs) else 0.0
+
+
 def inverse_dynamics(mech: Mechanism, state: DynamicsState, inertias: dict[str, LinkInertia], gravity=(0.0, 0.0, -9.81),
-                     wrench=None, drivers=None) -> InverseDynamics:
+                     wrench=None, drivers=None, loads=None) -> InverseDynamics:
     """Actuator efforts, loop multipliers and link wrenches at ``state`` (module docstring);
-    ``wrench``: an external wrench ``(f ; m about the origin)`` on the output link."""
+    ``wrench``: an external wrench ``(f ; m about the origin)`` on the output link; ``loads``:
+    further wrenches on links, by name (added to their weights)."""
     config = state.config
     fr = state.frame if state.frame is not None and drivers is None else _frame(mech, config, drivers)
     g = np.asarray(gravity, float)
@@ -381,13 +414,18 @@ def inverse_dynamics(mech: Mechanism, state: DynamicsState, inertias: dict[str, 
         Ms.append(np.zeros((6, 6)) if li is None or li.mass_kg == 0 else spatial_inertia_matrix(li.moved(place[link.name])))
         Vs.append(E @ x)
         As_.append(E @ state.xdot + b)
-    loads = gravity_loads(mech, config, inertias, g)
+    weights = gravity_loads(mech, config, inertias, g)
+    extra_loads = {} if loads is None else loads
+    unknown = sorted(set(extra_loads) - {lk.name for lk in links})
+    if unknown:
+        raise InputError(f"loads: no moving link named {', '.join(unknown)}")
+    total = {n: weights.get(n, np.zeros(6)) + extra_loads.get(n, np.zeros(6)) for n in set(weights) | set(extra_loads)}
 
     def balance(xdot_extra: np.ndarray) -> tuple[np.ndarray, list[np.ndarray]]:
         Q = np.zeros(x.size)
         Ws = []
         for link, E, M, V, Acc in zip(links, fr.E, Ms, Vs, As_, strict=True):
-            W = M @ (Acc + E @ xdot_extra) + _crf(V, M @ V) - loads.get(link.name, np.zeros(6))
+            W = M @ (Acc + E @ xdot_extra) + _crf(V, M @ V) - total.get(link.name, np.zeros(6))
             if link.hub == 0:
                 W = W - F
             Ws.append(W)
@@ -408,20 +446,14 @@ def inverse_dynamics(mech: Mechanism, state: DynamicsState, inertias: dict[str, 
         alpha, *_ = np.linalg.lstsq(N.T @ Mx @ N, -(N.T @ Q0), rcond=None)
         extra = N @ alpha
     Q, Ws = balance(extra)
-    # Q = B^T tau + A^T lambda, in the scaled coordinates
-    K = np.hstack([B.T, fr.col[:, None] * fr.A.T * fr.row[None, :]])
-    rhs = fr.col * Q
-    z, *_ = np.linalg.lstsq(K, rhs, rcond=None)
-    res = float(np.linalg.norm(K @ z - rhs)) / max(float(np.linalg.norm(rhs)), 1e-300)
-    tau = z[: fr.act.size] / fr.col[fr.act]
-    lam = fr.row * z[fr.act.size :]
+    tau, lam, res = _solve_balance(fr, Q)
     P = np.array([-_swap(lam[6 * k : 6 * k + 6]) for k in range(len(mech.limbs))])
     acts = mech.actuators if drivers is None else tuple(mech.freedom(d).id for d in drivers)
     names = [lk.name for lk in links]
     return InverseDynamics(state, tuple(acts), tau, dict(zip(names, Ws, strict=True)),
                            dict(zip(names, Vs, strict=True)),
                            {n: a + E @ extra for n, a, E in zip(names, As_, fr.E, strict=True)},
-                           P, lam, int(N.shape[1]), res if np.any(rhs) else 0.0, state.xdot + extra)
+                           P, lam, int(N.shape[1]), res, state.xdot + extra)
 
 
 def distal_wrenches(mech: Mechanism, result: InverseDynamics) -> list[np.ndarray]:

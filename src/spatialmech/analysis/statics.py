@@ -43,8 +43,15 @@ the ground) exerts on its distal body.  A joint's reaction is ``W_k`` without th
 its actuated freedoms (a torque about a revolute axis, a force along a prismatic axis through the
 joint's point): ``W_k - sum_f tau_f eta_f`` with ``eta_f . $_g = delta_fg`` over the joint's
 freedoms, so the reaction is reciprocal to every freedom of the joint (it does no work).
-Mechanisms with internal bodies (a link-and-joint graph) get the efforts; their joint reactions are
-not computed (:attr:`Statics.notes` says so).
+**Graph mechanisms** (internal bodies, limbs between any two hubs, reversed joints: the Delta's
+parallelograms, the spatial six-bar): the efforts, the wrench each limb exerts on its tip link and
+the joint reactions come from the virtual-power balance at rest of
+:func:`spatialmech.analysis.dynamics.inverse_dynamics` (massless links, the loads as given): the
+same equilibrium written in the loop closures' multipliers, with the same minimum-norm rule for
+redundant actuation.  A joint of a limb transmits the limb's wrench on its tip link plus what the
+limb's links beyond it need (``-load``); its reaction is that minus the efforts along its
+freedoms, as for serial limbs.  The flags (singular, ``unbalanced_wrench``, ``residual`` of the
+external wrench alone) come from the complete Jacobian as above.
 
 **Loads on the links** (``loads``: a wrench on each named link, e.g. its weight, see
 :func:`spatialmech.analysis.dynamics.gravity_loads`), for limbs from the ground to the output link.
@@ -199,10 +206,8 @@ def statics(mech: Mechanism, config: Configuration, wrench, drivers=None, loads=
         raise InputError(f"wrench: expected 6 finite numbers (fx, fy, fz ; mx, my, mz), got shape {F_given.shape}")
     F = F_given
     P0, distal, transfer_residual = None, None, 0.0
-    if loads:
-        if not _serial_limbs(mech):
-            raise InputError("loads: loads on the links (gravity) are balanced for limbs from the ground to the output "
-                             f"link only; {mech.name} has other limbs (use sm.inverse_dynamics at rest)")
+    serial = _serial_limbs(mech)
+    if loads and serial:
         P0, distal, transfer_residual = _limb_transfer(mech, config, loads)
         F = F_given + loads.get(mech.output, np.zeros(6)) + P0.sum(axis=0)
     J = complete_jacobian(mech, config, drivers)
@@ -255,11 +260,15 @@ def statics(mech: Mechanism, config: Configuration, wrench, drivers=None, loads=
     # per limb: the wrench it exerts on the output link, and the reactions of its joints
     limb_w: np.ndarray | None = None
     reactions: tuple[JointReaction, ...] = ()
-    if mech.bodies:
-        notes.append(f"joint reactions are not computed for mechanisms with internal bodies ({', '.join(mech.bodies)}); "
-                     "the efforts are")
-    elif not _serial_limbs(mech):
-        notes.append("joint reactions are computed only for limbs from the ground to the output link")
+    balanced = balanced and transfer_residual <= tol.rank
+    if not serial:
+        efforts, limb_w, reactions, balance_residual = _graph_balance(mech, config, F_given, drivers, loads)
+        balanced = bool(balanced and balance_residual <= tol.rank)
+        notes.append("a graph mechanism: the efforts and the joint reactions from the balance of the loop closures at rest"
+                     + (f" (relative residual {balance_residual:.2e}: not balanced)" if balance_residual > tol.rank else ""))
+        if loads:
+            notes.append("residual and unbalanced_wrench: of the external wrench alone (the loads on the links are in "
+                         "the efforts and reactions)")
     else:
         act_limb = [mech.freedom(a).limb for a in acts]
         limb_w = np.zeros((len(mech.limbs), 6))
@@ -275,9 +284,20 @@ def statics(mech: Mechanism, config: Configuration, wrench, drivers=None, loads=
                      f"{transfer_residual:.2e}, e.g. a weight off an SPS leg's line spinning the leg): not balanced")
     kinds = tuple("force" if mech.freedom(a).freedom.kind == "P" else "torque" for a in acts)
     return Statics(F_given, acts, kinds, efforts, tuple(J.constraint_limbs[:n_c]), y[:n_c].copy(),
-                   x[:n_c, None] * W[:n_c], limb_w, reactions, residual, balanced and transfer_residual <= tol.rank,
+                   x[:n_c, None] * W[:n_c], limb_w, reactions, residual, balanced,
                    singular, redundant, indeterminate, float(sigma), unbalanced, J, tuple(notes),
                    None if not loads else dict(loads))
+
+
+def _graph_balance(mech: Mechanism, config: Configuration, F: np.ndarray, drivers, loads
+                   ) -> tuple[np.ndarray, np.ndarray, tuple[JointReaction, ...], float]:
+    """Efforts, limb wrenches (on each limb's tip link), joint reactions and the relative residual
+    of the balance at rest of a graph mechanism (module docstring)."""
+    from .dynamics import distal_wrenches, inverse_dynamics, rest_state
+
+    d = inverse_dynamics(mech, rest_state(mech, config), {}, np.zeros(3), F, drivers, loads=loads)
+    reactions = joint_reactions(mech, config, d.limb_wrenches, d.by_actuator, distal_wrenches(mech, d))
+    return d.efforts.copy(), d.limb_wrenches, reactions, d.residual
 
 
 def _notes(J: CompleteJacobian, singular: bool, balanced: bool, redundant: bool, effort_free: bool,
@@ -311,18 +331,20 @@ def _serial_limbs(mech: Mechanism) -> bool:
 
 def joint_reactions(mech: Mechanism, config: Configuration, limb_w: np.ndarray, efforts: dict[str, float],
                     distal: list[np.ndarray] | None = None) -> tuple[JointReaction, ...]:
-    """Every joint's reaction, for limbs from the ground to the output link: the wrench limb ``k``
-    exerts on the output link ``limb_w[k]``, plus (``distal[k][j]``) what joint ``j`` carries for
-    the limb's links beyond it, without the actuator ``efforts`` along the joint's freedoms."""
+    """Every joint's reaction: the wrench limb ``k`` exerts on its tip link ``limb_w[k]``, plus
+    (``distal[k][j]``) what joint ``j`` carries for the limb's links beyond it, without the actuator
+    ``efforts`` along the joint's freedoms.  The reaction is the wrench of the joint's body towards
+    the limb's base on its body towards the limb's tip."""
     twists = joint_twists(mech, config)
     out = []
     for k, (limb, ch, sl) in enumerate(zip(mech.limbs, limb_chains(mech), limb_slices(mech), strict=True)):
         _, _, pre = chain_forward(ch, config.q[sl], prefixes=True, local=True)
+        base = config.hub(mech.limb_ends[k][0])
         T = twists[k]
         i = 0
         for jj, joint in enumerate(limb.joints):
             m = len(joint.freedoms)
-            P = pre[i]
+            P = base @ pre[i]
             c = P[:3, :3] @ joint.point + P[:3, 3]
             ids = [f"{joint.name}.{f.name}" for f in joint.freedoms]
             tau = {fid: float(efforts[fid]) for fid in ids if fid in efforts}

@@ -212,7 +212,6 @@ def inverse_dynamics(model: ModelLike, pose=None, *, to=None, duration: float = 
     start, _ = as_configuration(mech, pose, config, degrees)
     T, V, R, A = _trajectory(mech, start, to, duration, samples, values, rates, accelerations, times)
     configs = dyn.follow_actuators(mech, start, V)
-    serial = dyn.limb_base_ground(mech)
     out, reactions = [], []
     for i, (c, r, a, t) in enumerate(zip(configs, R, A, T, strict=True)):
         try:
@@ -221,11 +220,8 @@ def inverse_dynamics(model: ModelLike, pose=None, *, to=None, duration: float = 
             raise InputError(f"sample {i} (t = {t:g} s): {str(e).split(': ', 1)[-1]}") from None
         res = dyn.inverse_dynamics(mech, st, inertias, g, F)
         out.append(res)
-        reactions.append(joint_reactions(mech, c, res.limb_wrenches, res.by_actuator, dyn.distal_wrenches(mech, res))
-                         if serial else ())
+        reactions.append(joint_reactions(mech, c, res.limb_wrenches, res.by_actuator, dyn.distal_wrenches(mech, res)))
     notes = []
-    if not serial:
-        notes.append("joint reactions are computed only for limbs from the ground to the output link")
     if out and out[0].idle:
         notes.append(f"{out[0].idle} idle motion(s) (e.g. an SPS leg's spin): their accelerations follow from the "
                      "dynamics, their rates are the minimum-norm ones")

@@ -45,7 +45,7 @@ class StaticsResult:
     config: Configuration
     wrench: np.ndarray  # (6,) external wrench on the output link, (f ; m about the origin)
     efforts: dict[str, float]  # actuator -> force (P) or torque (R, H) it exerts along its freedom
-    reactions: tuple[JointReaction, ...]  # every joint of every serial limb (empty for graph mechanisms)
+    reactions: tuple[JointReaction, ...]  # every joint of every limb
     residual: np.ndarray  # (6,) the part of ``wrench`` left unbalanced (zero when balanced)
     balanced: bool
     singular: bool

@@ -501,7 +501,9 @@ def build_model_report(model, out, *, progress: bool | ProgressCallback = True, 
     mech = catalog.resolve(model)
     sink, bar = _reporter(progress, models.MODEL_STEPS, f"spatialmech report {mech.name}")
     sec = models.model_section(mech, sink, trace=trace)
-    data = write_report(out, f"spatialmech report: {mech.name}", [sec], bar.elapsed, {"model": mech.name},
+    from .report_forces import forces_section
+
+    data = write_report(out, f"spatialmech report: {mech.name}", [sec, forces_section(mech)], bar.elapsed, {"model": mech.name},
                         command="report", length_unit=mech.length_unit)
     bar.close()
     return data
