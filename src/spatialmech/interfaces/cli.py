@@ -17,7 +17,7 @@ from pathlib import Path
 import click
 
 from .. import api as sm
-from ..errors import ConvergenceError, SpatialmechError
+from ..errors import ConvergenceError, MissingExtraError, SpatialmechError, require
 from .common import UserError, check_output_dir, check_output_file, emit_json, json_option, load_model, tol_option
 
 
@@ -43,7 +43,11 @@ class _FailedComputation(UserError):
 
 def _user_error(e: BaseException) -> UserError | None:
     """The one-line error of a user error (exit 2; 1 for a computation that did not converge),
-    or ``None`` when ``e`` is a programming error."""
+    or ``None`` when ``e`` is a programming error.  An optional dependency that is not installed
+    is a user error that names the extra to install (exit 2)."""
+    missing = MissingExtraError.from_import_error(e)
+    if missing is not None:
+        return UserError(_one_line(missing))
     if isinstance(e, ConvergenceError):
         return _FailedComputation(f"the computation failed: {_one_line(e)}")
     if isinstance(e, SpatialmechError):
@@ -241,6 +245,7 @@ def demo(out, as_json):
     Example:
       spatialmech demo --out report
     """
+    require("plot", "matplotlib", "plotly", what="the report")
     check_output_dir(out, "--out")  # fail now on an unwritable --out, not after the work
     r = sm.demo(out, progress=not as_json)
     if as_json:
@@ -268,6 +273,7 @@ def report(model, out, no_trace, as_json):
       spatialmech report bennett --out bennett-report
       spatialmech report my-rssr.toml --json
     """
+    require("plot", "matplotlib", "plotly", what="the report")
     check_output_dir(out, "--out")  # fail now on an unwritable --out, not after the work
     mech = load_model(model)
     out = out if out is not None else Path(f"report-{mech.name}")

@@ -12,7 +12,7 @@ from pathlib import Path
 import click
 
 from .. import api as sm
-from ..errors import ConvergenceError, InputError
+from ..errors import ConvergenceError, InputError, require
 from .common import UserError, check_output_file, emit_json, load_model
 
 #: Largest number of frames (each is a configuration drawn into the page).
@@ -60,6 +60,7 @@ def view(model, motion, out, frames, plotly, as_json):
       spatialmech view bennett --motion trace --out bennett.html
       spatialmech view rssr --out pages/rssr.html --plotly directory
     """
+    require("plot", "plotly", what="the viewer")  # before any work: the extra to install, exit 2
     try:
         check_output_file(out, "--out")
         mech = load_model(model)
