@@ -136,6 +136,10 @@ def cli(debug):
     Example:
       spatialmech mobility four-sps-cu
     """
+    # A fresh install: compile the kernels in the background and answer this command on the
+    # pure-Python engine (one line on stderr says so); `models` computes nothing.
+    if click.get_current_context().invoked_subcommand != "models" and sm.first_run(sys.stderr):
+        return
     if sys.stderr.isatty():  # a person waiting: say when a kernel compiles (first use only)
         sm.announce_compilation(sys.stderr)
 
