@@ -50,8 +50,8 @@ __all__ = [
     "engine",
     "joint_twists",
     "python_reference",
-    "use_python_reference",
     "retract",
+    "use_python_reference",
 ]
 
 #: Set this environment variable to ``1`` to run the pure-Python engine (the reference).

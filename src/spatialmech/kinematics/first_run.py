@@ -52,10 +52,7 @@ def _key() -> str:
 def marker_path() -> Path:
     """The file whose presence says that the kernels were compiled here."""
     base = os.environ.get("NUMBA_CACHE_DIR")
-    if base:
-        root = Path(base)
-    else:
-        root = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "spatialmech"
+    root = Path(base) if base else Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "spatialmech"
     return root / f"spatialmech-kernels-{_key()}.done"
 
 
