@@ -16,7 +16,7 @@ from pathlib import Path
 import pytest
 
 import spatialmech as sm
-from spatialmech.kinematics import first_run
+from spatialmech.services import first_run
 
 ROOT = Path(__file__).resolve().parents[1]
 IK = ["ik", "four-sps-cu", "--xyz", "0", "0", "0.12", "--euler", "ZYX", "34.38", "-5.73", "11.46", "--json"]

@@ -156,7 +156,7 @@ def first_run(stream) -> bool:
     False
     """
     from ..kinematics import backend
-    from ..kinematics import first_run as fr
+    from ..services import first_run as fr
 
     if stream is not None and not callable(getattr(stream, "write", None)):
         raise TypeError(f"stream: expected a text stream (with a write method) or None, got {describe(stream)}")

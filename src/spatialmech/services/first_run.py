@@ -2,11 +2,11 @@
 
 numba compiles a kernel on its first use and keeps it in an on-disk cache; on a fresh install the
 first command waits for its kernels (15-17 s on a quiet machine, minutes on a busy one) although
-the pure-Python reference engine (:mod:`..backend`, same results) answers a single command in a
+the pure-Python reference engine (:mod:`..kinematics.backend`, same results) answers a single command in a
 few seconds.  So, when the kernels have never been compiled here, the command line:
 
 1. says so in one line (once: the line is printed by the process that starts the compilation);
-2. starts one detached background process (``python -m spatialmech.kinematics.first_run``) that
+2. starts one detached background process (``python -m spatialmech.services.first_run``) that
    compiles the common kernels into numba's cache and then writes a marker file;
 3. runs its own command on the Python reference engine.
 
@@ -87,7 +87,7 @@ def start(stream) -> bool:
     ``SPATIALMECH_BACKGROUND_COMPILE=0``."""
     import importlib.util
 
-    from .backend import PURE_ENV
+    from ..kinematics.backend import PURE_ENV
 
     pure = os.environ.get(PURE_ENV, "").strip() not in ("", "0")
     if not _enabled() or pure or importlib.util.find_spec("numba") is None:
@@ -99,7 +99,7 @@ def start(stream) -> bool:
     started = _take_lock(lock)
     if started:
         env = {**os.environ, BACKGROUND_ENV: "0"}
-        child = subprocess.Popen([sys.executable, "-m", "spatialmech.kinematics.first_run", str(marker)], env=env,
+        child = subprocess.Popen([sys.executable, "-m", "spatialmech.services.first_run", str(marker)], env=env,
                                  stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                                  start_new_session=True)
         lock.write_text(f"{child.pid}\n")  # who is compiling
@@ -115,7 +115,7 @@ def warm(marker: Path) -> None:
     marker and remove the lock."""
     import spatialmech as sm
 
-    from . import compiled
+    from ..kinematics import compiled
 
     try:
         compiled.warm_up()
