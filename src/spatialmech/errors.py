@@ -53,7 +53,7 @@ EXTRAS: dict[str, tuple[str, ...]] = {
     "studio": ("fastapi", "uvicorn", "starlette"),
     "sim": ("mujoco", "pinocchio"),
     "screen": ("dask", "distributed", "pyarrow"),
-    "cad": ("trimesh",),
+    "cad": ("build123d", "trimesh", "manifold3d"),
     "notebook": ("anywidget",),
 }
 
