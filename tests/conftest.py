@@ -16,6 +16,11 @@ settings.register_profile("spatialmech", deadline=None)
 settings.register_profile("spatialmech-ci", deadline=None, derandomize=True)
 settings.load_profile("spatialmech-ci" if os.environ.get("CI") else "spatialmech")
 
+# The tests' command lines compile in the foreground, as they always did (no background compile
+# and pure-Python first run on a fresh cache: spatialmech.services.first_run; the tests of that
+# path, tests/test_first_run.py, turn it on in their own subprocesses).
+os.environ.setdefault("SPATIALMECH_BACKGROUND_COMPILE", "0")
+
 
 def _lock_numba_cache_saves() -> None:
     """Make numba's on-disk cache safe for the two pytest-xdist workers (README: ``pytest -n 2``).

@@ -45,7 +45,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import ConvergenceError, InputError
+from ..errors import ConvergenceError, InputError, MissingExtraError
 from ..geometry.rotations import rotation_angle, rotvec_matrix
 from ..kinematics.closure import Configuration
 from ..kinematics.position import configuration_at_pose, freedom_values, platform_pose
@@ -91,7 +91,7 @@ def _mujoco():
     try:
         import mujoco  # type: ignore[import-untyped]
     except ImportError:
-        raise InputError("validation needs the 'mujoco' package: pip install 'mujoco>=3.2'") from None
+        raise MissingExtraError("sim", "mujoco", "validation") from None
     return mujoco
 
 

@@ -79,7 +79,7 @@ if TYPE_CHECKING:  # what mypy (and a reader) sees; at run time __getattr__ impo
     from .stiffness import StiffnessMap, StiffnessResult, stiffness, stiffness_map
     from .outputs import ReportResult, ViewResult, demo, report, studio_session, view
     from .regions import TaskGridSuggestion, singularity_slice, suggest_task_grid
-    from .settings import announce_compilation, default_tolerance, tolerances
+    from .settings import announce_compilation, default_tolerance, first_run, tolerances
     from .structure import MobilityModes, load_model, mobility, mobility_modes, models
 
 #: Name -> the module (relative to this package) that defines it: every function and result type
@@ -103,7 +103,7 @@ _LAZY: dict[str, str] = {
     **dict.fromkeys(("StiffnessMap", "StiffnessResult", "stiffness", "stiffness_map"), ".stiffness"),
     **dict.fromkeys(("ReportResult", "ViewResult", "demo", "report", "studio_session", "view"), ".outputs"),
     **dict.fromkeys(("TaskGridSuggestion", "singularity_slice", "suggest_task_grid"), ".regions"),
-    **dict.fromkeys(("announce_compilation", "default_tolerance", "tolerances"), ".settings"),
+    **dict.fromkeys(("announce_compilation", "default_tolerance", "first_run", "tolerances"), ".settings"),
     **dict.fromkeys(("MobilityModes", "load_model", "mobility", "mobility_modes", "models"), ".structure"),
 }
 
@@ -135,6 +135,7 @@ __all__ = [
     "demo",
     "dj_table",
     "export",
+    "first_run",
     "fk",
     "ik",
     "inverse_dynamics",

@@ -124,3 +124,43 @@ def announce_compilation(stream) -> bool:
     if stream is not None and not callable(getattr(stream, "write", None)):
         raise TypeError(f"stream: expected a text stream (with a write method) or None, got {describe(stream)}")
     return _announce(stream)
+
+
+def first_run(stream) -> bool:
+    """On a machine where the numba kernels were never compiled (a fresh install): start their
+    compilation in a background process, say so in one line on ``stream``, and run the rest of
+    this process on the pure-Python reference engine (same results), so that a first command
+    answers in seconds instead of waiting for the compiler.  Later processes find the kernels
+    compiled and run them.  ``SPATIALMECH_BACKGROUND_COMPILE=0`` turns this off.
+
+    Parameters
+    ----------
+    stream : text stream or None
+        Where the one line goes (the command line passes ``sys.stderr``); ``None``: silent.
+
+    Returns
+    -------
+    bool
+        True when this process now runs on the Python reference engine.
+
+    Raises
+    ------
+    TypeError
+        ``stream`` has no ``write`` method.
+
+    Examples
+    --------
+    >>> import os, spatialmech as sm
+    >>> os.environ["SPATIALMECH_BACKGROUND_COMPILE"] = "0"
+    >>> sm.first_run(None)
+    False
+    """
+    from ..kinematics import backend
+    from ..services import first_run as fr
+
+    if stream is not None and not callable(getattr(stream, "write", None)):
+        raise TypeError(f"stream: expected a text stream (with a write method) or None, got {describe(stream)}")
+    if not fr.start(stream):
+        return False
+    backend.use_python_reference()
+    return True

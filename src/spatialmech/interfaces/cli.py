@@ -17,9 +17,14 @@ from pathlib import Path
 import click
 
 from .. import api as sm
-from ..errors import ConvergenceError, InputError, SpatialmechError
+from ..errors import ConvergenceError, InputError, MissingExtraError, SpatialmechError, require
 from .common import (UserError, check_output_dir, check_output_file, emit_json, json_option, load_model, parse_numbers,
                      tol_option)
+
+
+#: Commands that never take the first-run path (services/first_run.py): `models` computes
+#: nothing; the others are long jobs that are faster compiled than on the Python engine.
+FOREGROUND_COMMANDS = frozenset({"models", "demo", "report", "screen", "studio"})
 
 
 def _one_line_usage(e: click.UsageError) -> UserError:
@@ -44,7 +49,11 @@ class _FailedComputation(UserError):
 
 def _user_error(e: BaseException) -> UserError | None:
     """The one-line error of a user error (exit 2; 1 for a computation that did not converge),
-    or ``None`` when ``e`` is a programming error."""
+    or ``None`` when ``e`` is a programming error.  An optional dependency that is not installed
+    is a user error that names the extra to install (exit 2)."""
+    missing = MissingExtraError.from_import_error(e)
+    if missing is not None:
+        return UserError(_one_line(missing))
     if isinstance(e, ConvergenceError):
         return _FailedComputation(f"the computation failed: {_one_line(e)}")
     if isinstance(e, SpatialmechError):
@@ -133,6 +142,12 @@ def cli(debug):
     Example:
       spatialmech mobility four-sps-cu
     """
+    # A fresh install: compile the kernels in the background and answer this command on the
+    # pure-Python engine (one line on stderr says so); `models` computes nothing.  The long jobs
+    # (the papers' report, a model's report, screening, the studio) compile in the foreground as
+    # before: on the Python engine, beside a compiling process, they would take longer.
+    if click.get_current_context().invoked_subcommand not in FOREGROUND_COMMANDS and sm.first_run(sys.stderr):
+        return
     if sys.stderr.isatty():  # a person waiting: say when a kernel compiles (first use only)
         sm.announce_compilation(sys.stderr)
 
@@ -268,6 +283,7 @@ def demo(out, as_json):
     Example:
       spatialmech demo --out report
     """
+    require("plot", "matplotlib", "plotly", what="the report")
     check_output_dir(out, "--out")  # fail now on an unwritable --out, not after the work
     r = sm.demo(out, progress=not as_json)
     if as_json:
@@ -295,6 +311,7 @@ def report(model, out, no_trace, as_json):
       spatialmech report bennett --out bennett-report
       spatialmech report my-rssr.toml --json
     """
+    require("plot", "matplotlib", "plotly", what="the report")
     check_output_dir(out, "--out")  # fail now on an unwritable --out, not after the work
     mech = load_model(model)
     out = out if out is not None else Path(f"report-{mech.name}")

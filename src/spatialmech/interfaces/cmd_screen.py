@@ -8,6 +8,7 @@ from pathlib import Path
 import click
 
 from .. import api as sm
+from ..errors import require
 from .common import SEED_MAX, emit_json, json_option
 
 __all__ = ["screen"]
@@ -56,6 +57,7 @@ def screen(task, out, candidates, density, workers, scheduler, top, rank_by, see
       spatialmech screen my-7-positions.toml --candidates 200 --workers 0 --out s.parquet --json
       spatialmech screen --candidates 100000 --scheduler tcp://10.0.0.5:8786 --out big.parquet
     """
+    require("screen", "distributed", "pyarrow", what="screening")
     def say(done, total, msg):
         click.echo(f"  ... {msg}", err=True)
 

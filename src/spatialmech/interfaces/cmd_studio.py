@@ -13,6 +13,7 @@ import webbrowser
 import click
 
 from .. import api as sm
+from ..errors import require
 from .common import UserError, emit_json, load_model
 
 __all__ = ["studio"]
@@ -46,6 +47,8 @@ def studio(model, port, no_browser, as_json):
       spatialmech studio five-cs-3
       spatialmech studio stewart-6sps --port 8800 --no-browser
     """
+    require("plot", "plotly", what="the studio")
+    require("studio", "fastapi", "uvicorn", what="the studio")
     import uvicorn
 
     from .studio.app import COMMAND, create_app

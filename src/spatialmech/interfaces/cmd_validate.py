@@ -20,8 +20,8 @@ import click
 import numpy as np
 
 from .. import api as sm
-from ..errors import InputError
 from .cmd_kinematics import resolve_pose, with_pose
+from ..errors import InputError, require
 from .common import check_output_file, emit_json, json_option, load_model
 
 
@@ -135,6 +135,7 @@ def validate_cmd(model, motion, actuators_path, mode, xyz, euler, position, to_p
       spatialmech validate three-rrr-sm --mode R1+R4 --json
       spatialmech validate four-sps-cu --pose 0,0,0.12,ZYX,17.19,17.19,17.19 --method settle
     """
+    require("sim", "mujoco", what="validation")
     check_output_file(mjcf_out, "--mjcf")
     model_mech = load_model(model)
     mech = model_mech.in_mode(mode) if mode is not None else model_mech

@@ -12,7 +12,7 @@ from pathlib import Path
 import click
 
 from .. import api as sm
-from ..errors import ConvergenceError, InputError
+from ..errors import ConvergenceError, InputError, require
 from .common import UserError, check_output_file, emit_json, load_model, tol_option
 
 #: Largest number of frames (each is a configuration drawn into the page).
@@ -62,6 +62,7 @@ def view(model, motion, out, frames, plotly, as_json):
       spatialmech view rssr --out pages/rssr.html --plotly directory
       spatialmech view my-rounded-linkage.toml --tol 1e-4 --out linkage.html
     """
+    require("plot", "plotly", what="the viewer")  # before any work: the extra to install, exit 2
     try:
         check_output_file(out, "--out")
         mech = load_model(model)

@@ -16,7 +16,7 @@ from pathlib import Path
 import click
 
 from .. import api as sm
-from ..errors import InputError
+from ..errors import InputError, require
 from ..serialize import envelope, json_default
 
 
@@ -74,6 +74,13 @@ def _writable(d: Path) -> bool:
     return os.access(d, os.W_OK | os.X_OK)
 
 
+def _require_plot(option: str, html: bool) -> None:
+    """``--plot`` needs the ``plot`` extra (Matplotlib; plotly for ``.html``): say so before any
+    work (:class:`~spatialmech.errors.MissingExtraError`, exit 2)."""
+    if option == "--plot":
+        require("plot", "plotly" if html else "matplotlib", what="--plot")
+
+
 def check_output_file(path, option: str, *, suffixes: tuple[str, ...] | None = None) -> Path | None:
     """Check a file the command will write (``--plot``, ``--out``, ``--save``) before any work:
     not a directory, its directory exists and is writable, an existing file is writable, and
@@ -82,6 +89,7 @@ def check_output_file(path, option: str, *, suffixes: tuple[str, ...] | None = N
     if path is None:
         return None
     p = Path(path)
+    _require_plot(option, p.suffix.lower() == ".html")
     if p.is_dir():
         raise InputError(f"{option}: {p} is a directory; give a file name")
     if suffixes is not None and p.suffix.lower() not in suffixes:
@@ -105,6 +113,7 @@ def check_output_dir(path, option: str) -> Path | None:
     if path is None:
         return None
     p = Path(path)
+    _require_plot(option, False)
     if p.exists() and not p.is_dir():
         raise InputError(f"{option}: {p} is a file, not a directory")
     base = p

@@ -51,6 +51,7 @@ __all__ = [
     "joint_twists",
     "python_reference",
     "retract",
+    "use_python_reference",
 ]
 
 #: Set this environment variable to ``1`` to run the pure-Python engine (the reference).
@@ -67,6 +68,8 @@ def _env_pure() -> bool:
 _ENV_PURE: bool = _env_pure()
 _PURE: ContextVar[bool] = ContextVar("spatialmech_pure", default=_ENV_PURE)
 _NOTED = False
+#: True for the rest of the process: the Python reference runs (:func:`use_python_reference`).
+_FORCED: list[bool] = []
 
 
 _COMPILED: list[ModuleType] = []  # the compiled package once imported (a hot path: no import statement per call)
@@ -87,7 +90,7 @@ def enabled() -> bool:
     ``0``) when spatialmech was imported, and no :func:`python_reference` block is open.  Without
     numba a one-time ``RuntimeWarning`` says that the Python path runs."""
     global _NOTED
-    if _PURE.get():
+    if _FORCED or _PURE.get():
         return False
     compiled = _compiled()
     if not compiled.AVAILABLE:
@@ -103,6 +106,13 @@ def engine() -> ModuleType | None:
     """The compiled package (:mod:`spatialmech.kinematics.compiled`) when it is in use
     (:func:`enabled`), else ``None``: the caller runs its Python reference."""
     return _compiled() if enabled() else None
+
+
+def use_python_reference() -> None:
+    """Run the Python reference for the rest of the process, in every thread (the first command
+    on a fresh install while the kernels compile in the background: :mod:`.first_run`)."""
+    _FORCED.append(True)
+    os.environ[PURE_ENV] = "1"  # and in the processes it starts
 
 
 @contextmanager

@@ -1,0 +1,108 @@
+"""The light core and its extras (issue 31): a command whose extra is not installed says which
+extra to install and exits with code 2; the core commands run with every extra hidden.
+
+An extra is "not installed" in a subprocess whose first meta-path finder raises ImportError for
+the extra's top-level modules (as a missing package does), so the test does not depend on what
+this environment has installed.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import tomllib
+from pathlib import Path
+
+import pytest
+
+from spatialmech.errors import EXTRAS, MissingExtraError, require
+
+ROOT = Path(__file__).resolve().parents[1]
+
+#: Runs the command line with the modules named in argv[1] (comma-separated) hidden.
+_HIDE = """
+import importlib.abc, runpy, sys
+hidden = set(sys.argv[1].split(","))
+class Hide(importlib.abc.MetaPathFinder):
+    def find_spec(self, name, path=None, target=None):
+        if name.split(".")[0] in hidden:
+            raise ModuleNotFoundError(f"No module named {name!r}", name=name)
+        return None
+sys.meta_path.insert(0, Hide())
+for m in [m for m in sys.modules if m.split(".")[0] in hidden]:
+    del sys.modules[m]
+sys.argv = ["spatialmech", *sys.argv[2:]]
+runpy.run_module("spatialmech", run_name="__main__")
+"""
+
+ALL_EXTRA_MODULES = sorted({m for mods in EXTRAS.values() for m in mods})
+
+
+def run_hidden(hidden, *args, cwd=None):
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "src") + os.pathsep + os.environ.get("PYTHONPATH", "")}
+    return subprocess.run([sys.executable, "-c", _HIDE, ",".join(hidden), *args], capture_output=True, text=True,
+                          env=env, cwd=cwd, timeout=600)
+
+
+# One command per extra (small arguments: each one fails before any work).
+CASES = [
+    ("plot", ["view", "four-sps-cu", "--out", "v.html"], "the viewer"),
+    ("plot", ["singularity", "four-sps-cu", "--position", "1", "--plot", "s.png"], "--plot"),
+    ("plot", ["demo", "--out", "report"], "the report"),
+    ("studio", ["studio", "--no-browser"], "the studio"),
+    ("sim", ["validate", "rssr"], "validation"),
+    ("screen", ["screen", "--out", "screen"], "screening"),
+]
+
+
+@pytest.mark.parametrize("extra, args, what", CASES, ids=[f"{c[0]}-{c[1][0]}" for c in CASES])
+def test_a_missing_extra_names_itself_and_exits_2(tmp_path, extra, args, what):
+    r = run_hidden(EXTRAS[extra], *args, cwd=tmp_path)
+    assert r.returncode == 2, (r.returncode, r.stderr[-2000:])
+    last = r.stderr.strip().splitlines()[-1]
+    assert last.startswith(f"error: {what} needs the optional extra '{extra}'"), last
+    assert f"pip install 'spatialmech[{extra}]'" in last
+    assert not list(tmp_path.iterdir()), "nothing is written when the extra is missing"
+
+
+def test_core_commands_run_with_every_extra_hidden(tmp_path):
+    r = run_hidden(ALL_EXTRA_MODULES, "mobility", "four-sps-cu", "--json", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr[-2000:]
+    assert json.loads(r.stdout)["modes"][0]["dof"] == 4
+    r = run_hidden(ALL_EXTRA_MODULES, "ik", "four-sps-cu", "--xyz", "0", "0", "0.12", "--euler", "ZYX", "34.38", "-5.73",
+                   "11.46", "--json", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr[-2000:]
+    assert json.loads(r.stdout)["reachable"] is True
+
+
+def test_an_import_error_of_an_extra_module_maps_to_its_extra():
+    e = MissingExtraError.from_import_error(ModuleNotFoundError("No module named 'plotly.graph_objects'",
+                                                                name="plotly.graph_objects"))
+    assert e is not None and (e.extra, e.module) == ("plot", "plotly")
+    assert isinstance(e, ImportError) and isinstance(e, ValueError)
+    assert MissingExtraError.from_import_error(ModuleNotFoundError("x", name="numpyy")) is None
+    assert MissingExtraError.from_import_error(ValueError("plotly")) is None
+
+
+def test_require_checks_the_named_modules(monkeypatch):
+    monkeypatch.setitem(sys.modules, "anywidget", None)  # import anywidget raises ImportError
+    with pytest.raises(MissingExtraError, match=r"pip install 'spatialmech\[notebook\]'"):
+        require("notebook", what="the widget")
+    with pytest.raises(KeyError, match="unknown extra"):
+        require("plots")
+
+
+def test_the_extras_table_matches_pyproject():
+    """errors.EXTRAS (what the messages name) and pyproject.toml's extras (what pip installs)
+    list the same extras; the core dependencies bring none of the extras' packages."""
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
+    extras = project["optional-dependencies"]
+    assert set(EXTRAS) <= set(extras)
+    assert set(extras) - set(EXTRAS) == {"all", "test", "docs"}  # docs: building the site, not a feature
+    assert extras["all"] == [f"spatialmech[{','.join(EXTRAS)}]"]
+    assert "spatialmech[all]" in extras["test"]
+    core = " ".join(project["dependencies"]).lower()
+    for heavy in ("matplotlib", "plotly", "mujoco", "fastapi", "uvicorn", "dask", "pyarrow", "anywidget", "trimesh"):
+        assert heavy not in core, heavy
