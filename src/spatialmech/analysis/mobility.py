@@ -33,7 +33,7 @@ they belong to), and says so when the count changes between 1e-12 and 1e-2.
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from itertools import pairwise
 
 import numpy as np
@@ -630,7 +630,7 @@ def _mobility(mech: Mechanism, mode, seed: int, tols: Tolerances) -> MobilityRes
         branches=sing.exploration.branches if sing.exploration is not None and sing.singular else (),
         singular_note=sing.note(),
         undecided=sing.exploration.undecided if sing.exploration is not None else "",
-        screw_axes=tuple(axes),
+        screw_axes=tuple(replace(a, length_unit=mech.length_unit) for a in axes),
     )
 
 

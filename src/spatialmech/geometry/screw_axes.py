@@ -42,21 +42,24 @@ class ScrewAxis:
     pitch_m_per_rad: float | None
     #: How many principal screws share this pitch (a repeated pitch: the axes are not unique).
     multiplicity: int = 1
+    #: The model's length unit: ``point_m`` and ``pitch_m_per_rad`` are in it (metres for SI models).
+    length_unit: str = "m"
 
     def to_dict(self) -> dict:
         """JSON fields (docs/json.md: lengths in the document's unit, the pitch per degree)."""
         return {"kind": self.kind, "direction": list(self.direction),
                 "point_len": None if self.point_m is None else list(self.point_m),
                 "pitch_len_per_deg": None if self.pitch_m_per_rad is None else float(np.deg2rad(self.pitch_m_per_rad)),
-                "multiplicity": self.multiplicity}
+                "multiplicity": self.multiplicity, "length_unit": self.length_unit}
 
     def describe(self, fmt=lambda x: f"{x:.4g}") -> str:
         """``"H(p = 1.74 m/rad) about the axis through (x, y, z) m along (dx, dy, dz)"``."""
         d = "(" + ", ".join(fmt(x) for x in self.direction) + ")"
         if self.kind == "T" or self.point_m is None:
             return f"T along {d}"
-        p = "(" + ", ".join(fmt(x) for x in self.point_m) + ") m"
-        head = "R" if self.kind == "R" else f"H(p = {fmt(self.pitch_m_per_rad)} m/rad)"
+        u = self.length_unit
+        p = "(" + ", ".join(fmt(x) for x in self.point_m) + f") {u}"
+        head = "R" if self.kind == "R" else f"H(p = {fmt(self.pitch_m_per_rad)} {u}/rad)"
         rep = (f" [x{self.multiplicity}: every direction in a plane has this pitch; one axis shown]"
                if self.multiplicity > 1 else "")
         return f"{head} about the axis through {p} along {d}{rep}"

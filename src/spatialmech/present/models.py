@@ -205,7 +205,7 @@ def model_section(mech: Mechanism, progress: Progress | None = None, *, trace: b
             F.curves(ax2, tr.s, {"sigma_min": sig}, xlabel="arc length (nondimensional)",
                      ylabel="scale-free sigma_min of J", title="distance to singularity", logy=bool(np.all(sig > 0)))
             data["trace_sigma_min"] = {"min": float(sig.min()), "max": float(sig.max())}
-        kinds = [{"driver": e.name, "s": float(e.s), "kind": e.kind} for e in tr.events]
+        kinds = [{"driver": e.name, "arc": float(e.s), "kind": e.kind} for e in tr.events]
         for ev in tr.events:
             ax.axvline(float(ev.s), color="#b3261e" if ev.kind == "zero" else "#555555", linestyle="--", linewidth=0.8)
         nz = sum(k["kind"] == "zero" for k in kinds)
