@@ -9,16 +9,15 @@ import numpy as np
 from ...geometry.tolerances import HOMOTOPY_JUMP, HOMOTOPY_NEWTON
 from .jit import njit
 
-__all__ = ["nb_lu_solve", "nb_param_system", "nb_param_vel", "nb_step_control", "nb_track_param", "track_parameter"]
+__all__ = ["nb_lu_solve", "nb_lu_solve_inplace", "nb_param_system", "nb_param_vel", "nb_step_control",
+           "nb_track_param", "track_parameter"]
 
 
 @njit(cache=True)
-def nb_lu_solve(A, b, out):
-    """``A x = b`` (complex, small) by LU with partial pivoting into ``out``; False when a pivot
-    is zero or not finite (the batched NumPy tracker's LinAlgError)."""
-    n = A.shape[0]
-    M = A.copy()
-    y = b.copy()
+def nb_lu_solve_inplace(M, y):
+    """``M x = y`` (complex, small) by LU with partial pivoting, in place: ``M`` is destroyed and
+    ``y`` becomes ``x``; False when a pivot is zero or not finite."""
+    n = M.shape[0]
     for k in range(n):
         p = k
         big = abs(M[k, k])
@@ -40,8 +39,19 @@ def nb_lu_solve(A, b, out):
     for i in range(n - 1, -1, -1):
         acc = y[i]
         for j in range(i + 1, n):
-            acc -= M[i, j] * out[j]
-        out[i] = acc / M[i, i]
+            acc -= M[i, j] * y[j]
+        y[i] = acc / M[i, i]
+    return True
+
+
+@njit(cache=True)
+def nb_lu_solve(A, b, out):
+    """``A x = b`` (complex, small) by LU with partial pivoting into ``out`` (``A`` and ``b`` are
+    kept); False when a pivot is zero or not finite (the batched NumPy tracker's LinAlgError)."""
+    y = b.copy()
+    if not nb_lu_solve_inplace(A.copy(), y):
+        return False
+    out[:] = y
     return True
 
 

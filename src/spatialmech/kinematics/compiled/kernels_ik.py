@@ -24,7 +24,7 @@ import numpy as np
 
 from ...geometry.tolerances import HOMOTOPY_FLOOR, HOMOTOPY_JUMP, HOMOTOPY_NEWTON
 from .jit import njit
-from .kernels_homotopy import nb_step_control
+from .kernels_homotopy import nb_lu_solve_inplace, nb_step_control
 
 __all__ = ["ik_pack", "ik_track", "nb_ik_system", "nb_ik_track", "nb_ik_workspace"]
 
@@ -265,38 +265,6 @@ def _compress(C, P, dP, r, rt, dr, F, J, Ft):
 
 
 @njit(cache=True)
-def _lu_solve(M, y):
-    """``M x = y`` (complex, small) by LU with partial pivoting, in place: ``M`` is destroyed and
-    ``y`` becomes ``x`` (:func:`.kernels_homotopy.nb_lu_solve`'s operations, without its copies);
-    False when a pivot is zero or not finite."""
-    n = M.shape[0]
-    for k in range(n):
-        p = k
-        big = abs(M[k, k])
-        for i in range(k + 1, n):
-            if abs(M[i, k]) > big:
-                big = abs(M[i, k])
-                p = i
-        if not big > 0.0 or not np.isfinite(big):
-            return False
-        if p != k:
-            for j in range(n):
-                M[k, j], M[p, j] = M[p, j], M[k, j]
-            y[k], y[p] = y[p], y[k]
-        for i in range(k + 1, n):
-            f = M[i, k] / M[k, k]
-            for j in range(k, n):
-                M[i, j] -= f * M[k, j]
-            y[i] -= f * y[k]
-    for i in range(n - 1, -1, -1):
-        acc = y[i]
-        for j in range(i + 1, n):
-            acc -= M[i, j] * y[j]
-        y[i] = acc / M[i, i]
-    return True
-
-
-@njit(cache=True)
 def _vel(th, P0, dP, t, sysargs, F, J, Ft, Pt, ws, out):
     for a in range(P0.shape[0]):
         Pt[a] = P0[a] + t * dP[a]
@@ -304,7 +272,7 @@ def _vel(th, P0, dP, t, sysargs, F, J, Ft, Pt, ws, out):
     nb_ik_system(th, Pt, dP, lk, lA, lA2, li, rk, rA, rA2, ri, point, centre, C, ident, F, J, Ft, ws)
     for i in range(out.shape[0]):
         out[i] = -Ft[i]
-    return _lu_solve(J, out)
+    return nb_lu_solve_inplace(J, out)
 
 
 @njit(cache=True)
@@ -334,7 +302,7 @@ def _step(x, P0, dP, t, hh, sysargs, F, J, Ft, Pt, ws, ks, xs, xc, dx):
         nb_ik_system(xc, Pt, dP, lk, lA, lA2, li, rk, rA, rA2, ri, point, centre, C, ident, F, J, Ft, ws)
         for i in range(n):
             dx[i] = F[i]
-        if not _lu_solve(J, dx):
+        if not nb_lu_solve_inplace(J, dx):
             return False, d0, d1
         sq = 0.0
         for i in range(n):
