@@ -284,6 +284,7 @@ def demo(out, as_json):
       spatialmech demo --out report
     """
     require("plot", "matplotlib", "plotly", what="the report")
+    require("sim", "mujoco", what="the papers' report (its MuJoCo validation tables)")
     check_output_dir(out, "--out")  # fail now on an unwritable --out, not after the work
     r = sm.demo(out, progress=not as_json)
     if as_json:
