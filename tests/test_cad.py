@@ -167,15 +167,19 @@ def test_housing_opening_is_the_cone_limit(alpha, kept):
 @pytest.mark.slow
 def test_housing_solid_and_paper_b_cones():
     """The STEP housing's volume is the solid-angle fraction exactly; paper B's 90 deg cones
-    open the ground's housings upwards and the platform's downwards."""
+    open the ground's housings upwards and the platform's downwards (its four S joints' and the
+    CU column's universal joint U5's, whose cone is in the platform's frame too)."""
     b3d = pytest.importorskip("build123d", reason="the cad extra (build123d) is not installed")
     for alpha, kept in HOUSINGS:
         h = housing_solid(b3d, np.zeros(3), 2.0, np.array([0.0, 0.0, 1.0]), alpha)
         assert h.volume / (4 / 3 * np.pi * 8.0) == pytest.approx(kept, rel=1e-6)
     links = {k.link: k for k in cad_links(sm.load_model("four-sps-cu"))}
-    for link, w in (("ground", [0, 0, 1]), ("platform", [0, 0, -1])):
+    for link, w, n in (("ground", [0, 0, 1], 4), ("platform", [0, 0, -1], 5)):
         hs = [p for p in links[link].primitives if p[0] == "housing"]
-        assert len(hs) == 4 and all(np.allclose(p[3], w) and p[4] == pytest.approx(np.pi / 2) for p in hs)
+        assert len(hs) == n and all(np.allclose(p[3], w) and p[4] == pytest.approx(np.pi / 2) for p in hs)
+    u5 = next(f for f in links["platform"].joints if f.name == "U5")
+    assert any(p[0] == "housing" and np.allclose(p[1], u5.centre) for p in links["platform"].primitives)
+    assert not any(p[0] == "housing" for p in links["cu.link1"].primitives)  # the column's side: its hubs only
 
 
 def test_missing_cad_extra_names_it(tmp_path, monkeypatch):

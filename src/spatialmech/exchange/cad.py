@@ -4,16 +4,20 @@ Every link of a mechanism becomes one solid: capsules along the link's segments 
 tree's, :mod:`.bodies`) with the link diameter the model gives (its workspace limits'
 ``link_diameter``; otherwise 4 % of the characteristic length, the MJCF export's capsules), and
 joint geometry on both links a joint connects: an R joint is a hub on one link and a longer,
-thinner pin on the other; a U joint two crossed pins; an S joint a housing sphere on one link
-and a smaller ball on the other (with a cone limit in the model's workspace limits, the housing
-is on the link the cone's axis is fixed in and open over the cone the leg may sweep); a P or C
+thinner pin on the other; a U joint two crossed pins (with a cone limit, also a housing on the
+link the cone's axis is fixed in, open over the cone, as an S joint's); an S joint a housing
+sphere on one link and a smaller ball on the other (with a cone limit in the model's workspace
+limits, the housing is on the link the cone's axis is fixed in and open over the cone the leg
+may sweep); a P or C
 joint a sleeve on one link and a rod as long as the slide's stroke (its limits; otherwise
 0.3 L) on the other.
 
 Each link is written in its own frame (the body tree's: world-aligned at the reference
 configuration, at the point of the joint that leads to it) and the assembly with every link
-placed at the chosen configuration.  The joints are features of the files that survive a round
-trip: the joint centres and axes of every link, in the link's frame, are
+placed at the chosen configuration; along a motion (:func:`export_cad_motion`), the link files
+once (links are rigid), one assembly per sample (``part.000.step``, ...) and a JSON file of
+every link's placement at every sample (``part.placements.json``, :func:`read_placements`).
+The joints are features of the files that survive a round trip: the joint centres and axes of every link, in the link's frame, are
 
 * STEP: a line edge per joint and link, from the centre along the axis, in the solid's
   compound, labelled ``J_<hex of the joint name>``; the unit is the STEP header's
@@ -41,14 +45,15 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, MissingExtraError
 from ..kinematics.closure import Configuration, chain_forward, limb_chains, limb_slices
 from ..model.mechanism import GROUND, Mechanism
 from ..model.topology import link_graph
 from .bodies import body_tree
 
-__all__ = ["CAD_FORMATS", "CAD_UNITS", "CadExport", "JointFeature", "LinkSolid", "cad_links", "export_cad",
-           "housing_mesh", "housing_solid", "link_displacements", "read_joint_frames"]
+__all__ = ["CAD_FORMATS", "CAD_UNITS", "CadExport", "CadMotion", "JointFeature", "LinkSolid", "cad_links", "export_cad",
+           "export_cad_motion", "housing_mesh", "housing_solid", "link_displacements", "read_joint_frames",
+           "read_placements"]
 
 #: The CAD formats and their file extensions.
 CAD_FORMATS = {"step": (".step", ".stp"), "stl": (".stl",), "glb": (".glb",)}
@@ -61,6 +66,7 @@ DEFAULT_LINK_DIAMETER = 0.04
 #: Segments of a mesh cylinder (STL, GLB).
 _SECTIONS = 32
 _FORMAT_TAG = "spatialmech cad 1"
+_MOTION_TAG = "spatialmech cad motion 1"
 
 
 @dataclass(frozen=True)
@@ -115,6 +121,25 @@ class CadExport:
     @property
     def files(self) -> list[Path]:
         out = [self.assembly, *self.links.values()]
+        return [*out, self.sidecar] if self.sidecar is not None else out
+
+
+@dataclass(frozen=True)
+class CadMotion:
+    """What :func:`export_cad_motion` wrote: one assembly per sample, one file per link (once),
+    the placements file (JSON: every link's placement at every sample), the STL sidecar, the
+    format and the unit of the files."""
+
+    assemblies: tuple[Path, ...]
+    links: dict[str, Path]
+    placements: Path
+    format: str
+    unit: str
+    sidecar: Path | None = None
+
+    @property
+    def files(self) -> list[Path]:
+        out = [*self.assemblies, *self.links.values(), self.placements]
         return [*out, self.sidecar] if self.sidecar is not None else out
 
 
@@ -199,6 +224,9 @@ def _joint_parts(gj, side: str, d: float, L: float, o: np.ndarray, opening: tupl
         return prims, [JointFeature(gj.name, t, c, u / np.linalg.norm(u), role)]
     role = "hub" if side == "a" else "pin"
     feats = []
+    here = gj.a if side == "a" else gj.b
+    if t == "U" and opening is not None and opening[0] == here:  # the yoke's swing: a housing open over the cone
+        prims.append(("housing", c, 1.1 * d, opening[1], opening[2]))
     for k, u in enumerate(axes[:2] if t == "U" else axes[:1]):
         u = u / np.linalg.norm(u)
         h = 1.0 * d if side == "a" else 2.0 * d
@@ -277,53 +305,145 @@ def _features_dict(link: LinkSolid, s: float, T: np.ndarray | None) -> list[dict
 
 
 def _need(module: str, what: str):
+    """Import ``module`` (of the ``cad`` extra, or OpenCascade's ``OCP`` that build123d brings) or
+    raise :class:`~spatialmech.errors.MissingExtraError` naming the extra."""
     import importlib
 
     try:
         return importlib.import_module(module)
     except ImportError:
-        raise InputError(f"{what} needs the {module!r} package, in the cad extra: pip install 'spatialmech[cad]'"
-                         ) from None
+        raise MissingExtraError("cad", module.split(".")[0], what) from None
 
 
-def _paths(out: Path, fmt: str, unit: str, links: list[LinkSolid]) -> tuple[Path, dict[str, Path]]:
-    """The assembly's path and each link's (``part.<link>.step``); STL names carry the unit
-    (``part.mm.stl``, ``part.<link>.mm.stl``)."""
+def _paths(out: Path, fmt: str, unit: str, links: list[LinkSolid], samples: int = 0
+           ) -> tuple[list[Path], dict[str, Path], Path, Path]:
+    """The assemblies' paths (one; along a motion of ``samples`` samples, ``part.000.step``, ...),
+    each link's (``part.<link>.step``), the placements file's (``part.placements.json``) and the
+    STL sidecar's (``part.mm.json``); STL names carry the unit (``part.mm.stl``,
+    ``part.<link>.mm.stl``, ``part.000.mm.stl``)."""
     stem, suffix = out.name[: -len(out.suffix)] if out.suffix else out.name, out.suffix or CAD_FORMATS[fmt][0]
     if fmt == "stl":
         stem = stem[: -len(f".{unit}")] if stem.endswith(f".{unit}") else stem
         tail = f".{unit}{suffix}"
     else:
         tail = suffix
-    assembly = out.with_name(stem + tail)
-    return assembly, {k.link: out.with_name(f"{stem}.{_safe(k.link)}{tail}") for k in links}
+    width = max(3, len(str(samples - 1)))
+    assemblies = ([out.with_name(f"{stem}.{i:0{width}d}{tail}") for i in range(samples)] if samples
+                  else [out.with_name(stem + tail)])
+    return (assemblies, {k.link: out.with_name(f"{stem}.{_safe(k.link)}{tail}") for k in links},
+            out.with_name(f"{stem}.placements.json"), out.with_name(f"{stem}.{unit}.json"))
+
+
+def _rows(T: np.ndarray, s: float) -> list[list[float]]:
+    """A 4x4 placement (model length unit) as rows, its translation in the file's unit."""
+    return [[float(v) * (s if c == 3 and r < 3 else 1.0) for c, v in enumerate(row)] for r, row in enumerate(T)]
+
+
+def _origin(o: np.ndarray) -> np.ndarray:
+    T = np.eye(4)
+    T[:3, 3] = o
+    return T
+
+
+def _prepare(mech: Mechanism, fmt: str, unit: str, config: Configuration | None) -> tuple[list[LinkSolid], float]:
+    if fmt not in CAD_FORMATS:
+        raise InputError(f"format: expected one of {', '.join(CAD_FORMATS)}, got {fmt!r}")
+    if fmt == "glb" and unit != "m":
+        raise InputError(f"unit: a GLB is in metres (the glTF specification), got {unit!r}; use unit='m'")
+    s = _scale(mech, unit)
+    return cad_links(mech, config), s
+
+
+def _meta(mech: Mechanism, unit: str, links: list[LinkSolid], paths: dict[str, Path], s: float,
+          placements: dict[str, np.ndarray]) -> dict[str, Any]:
+    """The files' metadata: per link its file, diameter, placement and joints (file unit)."""
+    per_link = {k.link: {"file": paths[k.link].name, "diameter": k.diameter * s, "placement": _rows(placements[k.link], s),
+                         "joints": _features_dict(k, s, None)} for k in links}
+    return {"format": _FORMAT_TAG, "model": mech.name, "unit": unit, "links": per_link}
+
+
+def _write(fmt: str, links: list[LinkSolid], s: float, paths: dict[str, Path],
+           scenes: list[tuple[Path, dict[str, np.ndarray]]], meta: dict, sidecar: Path) -> Path | None:
+    """Write the link files and one assembly per scene (its path and every link's placement);
+    the STL sidecar's path, or None."""
+    if fmt == "step":
+        _write_step(links, s, paths, scenes, meta)
+        return None
+    if fmt == "glb":
+        _write_glb(links, s, paths, scenes, meta)
+        return None
+    _write_stl(links, s, paths, scenes, meta, sidecar)
+    return sidecar
 
 
 def export_cad(mech: Mechanism, out, fmt: str, *, config: Configuration | None = None, unit: str = "mm") -> CadExport:
     """Write ``mech`` at ``config`` as CAD files (see the module docstring): the assembly at
     ``out`` and one file per link beside it, in ``unit`` (``"m"`` or ``"mm"``; a GLB is always in
     metres)."""
-    if fmt not in CAD_FORMATS:
-        raise InputError(f"format: expected one of {', '.join(CAD_FORMATS)}, got {fmt!r}")
-    if fmt == "glb" and unit != "m":
-        raise InputError(f"unit: a GLB is in metres (the glTF specification), got {unit!r}; use unit='m'")
-    s = _scale(mech, unit)
-    links = cad_links(mech, config)
-    assembly, paths = _paths(Path(os.fspath(out)), fmt, unit, links)
-    per_link: dict[str, dict[str, Any]] = {}
-    meta: dict[str, Any] = {"format": _FORMAT_TAG, "model": mech.name, "unit": unit, "links": per_link}
-    for k in links:
-        per_link[k.link] = {"file": paths[k.link].name, "diameter": k.diameter * s,
-                                 "placement": [[float(v) * (s if c == 3 and r < 3 else 1.0) for c, v in enumerate(row)]
-                                               for r, row in enumerate(k.placement)],
-                                 "joints": _features_dict(k, s, None)}
-    writer = {"step": _write_step, "stl": _write_stl, "glb": _write_glb}[fmt]
-    sidecar = writer(links, s, assembly, paths, meta)
+    links, s = _prepare(mech, fmt, unit, config)
+    (assembly,), paths, _, sidecar_path = _paths(Path(os.fspath(out)), fmt, unit, links)
+    placements = {k.link: k.placement for k in links}
+    meta = _meta(mech, unit, links, paths, s, placements)
+    sidecar = _write(fmt, links, s, paths, [(assembly, placements)], meta, sidecar_path)
     summary = {k.link: {"file": paths[k.link].name, "diameter_len": k.diameter,
                         "joints": [{("centre_len" if key == "centre" else key): v for key, v in f.items()}
                                    for f in _features_dict(k, 1.0, k.placement)]}
                for k in links}
     return CadExport(assembly, paths, fmt, unit, sidecar, summary)
+
+
+def export_cad_motion(mech: Mechanism, out, fmt: str, configs, *, unit: str = "mm",
+                      labels: list[dict] | None = None) -> CadMotion:
+    """Write ``mech`` along a motion (``configs``, the samples in order) as CAD files: one file per
+    link in its own frame (once: the links are rigid), one assembly per sample (``part.000.step``,
+    ...) and ``part.placements.json``, every link's placement at every sample (rotation and
+    origin, the origin in the files' unit), for a CAD user to animate the links; ``labels``: per
+    sample, what else to record with it (e.g. its actuator values)."""
+    configs = list(configs)
+    if not configs:
+        raise InputError("configs: no sample to export")
+    if labels is not None and len(labels) != len(configs):
+        raise InputError(f"labels: expected one per sample ({len(configs)}), got {len(labels)}")
+    links, s = _prepare(mech, fmt, unit, configs[0])
+    assemblies, paths, placements_path, sidecar_path = _paths(Path(os.fspath(out)), fmt, unit, links, len(configs))
+    scenes = []
+    for path, c in zip(assemblies, configs, strict=True):
+        D = link_displacements(mech, c)
+        scenes.append((path, {k.link: D[k.link] @ _origin(k.origin) for k in links}))
+    meta = _meta(mech, unit, links, paths, s, scenes[0][1])
+    sidecar = _write(fmt, links, s, paths, scenes, meta, sidecar_path)
+    samples = []
+    for i, (path, P) in enumerate(scenes):
+        samples.append({"sample": i, "assembly": path.name, **(labels[i] if labels is not None else {}),
+                        "links": {k: {"rotation": [[float(v) for v in row] for row in T[:3, :3]],
+                                      f"origin_{unit}": [float(v) * s for v in T[:3, 3]]} for k, T in P.items()}})
+    doc = {"format": _MOTION_TAG, "model": mech.name, "file_length_unit": unit, "file_format": fmt,
+           "link_files": {k.link: paths[k.link].name for k in links}, "samples": samples}
+    placements_path.write_text(json.dumps(doc, indent=1), encoding="utf-8")
+    return CadMotion(tuple(assemblies), paths, placements_path, fmt, unit, sidecar)
+
+
+def read_placements(path) -> dict[str, Any]:
+    """The placements file of :func:`export_cad_motion`, in metres: ``{"unit": the files' unit,
+    "link_files": {link: file}, "samples": [{"assembly": file, "links": {link: 4x4 array, metres}},
+    ...]}`` (the other fields of each sample as written)."""
+    path = Path(os.fspath(path))
+    doc = json.loads(path.read_text(encoding="utf-8"))
+    if doc.get("format") != _MOTION_TAG:
+        raise InputError(f"{path}: not a spatialmech placements file (format {doc.get('format')!r})")
+    unit = doc["file_length_unit"]
+    if unit not in CAD_UNITS:
+        raise InputError(f"{path}: file_length_unit: expected one of {', '.join(CAD_UNITS)}, got {unit!r}")
+    samples = []
+    for x in doc["samples"]:
+        links = {}
+        for k, v in x["links"].items():
+            T = np.eye(4)
+            T[:3, :3] = np.asarray(v["rotation"], float)
+            T[:3, 3] = CAD_UNITS[unit] * np.asarray(v[f"origin_{unit}"], float)
+            links[k] = T
+        samples.append({**x, "links": links})
+    return {"unit": unit, "link_files": doc["link_files"], "samples": samples}
 
 
 # ------------------------------------------------------------------ STEP (build123d)
@@ -399,7 +519,8 @@ def _step_part(b3d, link: LinkSolid, solid, s: float, L: float, T: np.ndarray | 
     return b3d.Compound(label="L_" + link.link.encode().hex(), children=[solid, *_b3d_edges(b3d, link, s, L, M)])
 
 
-def _write_step(links: list[LinkSolid], s: float, assembly: Path, paths: dict[str, Path], meta: dict) -> None:
+def _write_step(links: list[LinkSolid], s: float, paths: dict[str, Path],
+                scenes: list[tuple[Path, dict[str, np.ndarray]]], meta: dict) -> None:
     b3d = _need("build123d", "a STEP export")
     unit = b3d.Unit.MM if meta["unit"] == "mm" else b3d.Unit.M
     # OpenCascade writes STEP in its session unit (mm by default) whatever the document's unit:
@@ -408,13 +529,16 @@ def _write_step(links: list[LinkSolid], s: float, assembly: Path, paths: dict[st
     _need("OCP.STEPControl", "a STEP export").STEPControl_Controller.Init_s()
     static.SetCVal_s("write.step.unit", meta["unit"].upper())
     L = max(float(np.linalg.norm(p[2] - p[1])) for k in links for p in k.primitives if p[0] == "cyl") or 1.0
-    placed = []
     stamp = "2000-01-01T00:00:00"  # reproducible files
+    solids = {}
     for k in links:
-        solid = _b3d_solid(b3d, k.primitives, s)
-        b3d.export_step(_step_part(b3d, k, solid, s, L, None), os.fspath(paths[k.link]), unit=unit, timestamp=stamp)
-        placed.append(_step_part(b3d, k, solid, s, L, k.placement))
-    b3d.export_step(b3d.Compound(label=meta["model"], children=placed), os.fspath(assembly), unit=unit, timestamp=stamp)
+        solids[k.link] = _b3d_solid(b3d, k.primitives, s)
+        b3d.export_step(_step_part(b3d, k, solids[k.link], s, L, None), os.fspath(paths[k.link]), unit=unit,
+                        timestamp=stamp)
+    for assembly, placements in scenes:
+        placed = [_step_part(b3d, k, solids[k.link], s, L, placements[k.link]) for k in links]
+        b3d.export_step(b3d.Compound(label=meta["model"], children=placed), os.fspath(assembly), unit=unit,
+                        timestamp=stamp)
     return None
 
 
@@ -491,40 +615,53 @@ def housing_mesh(tm, c: np.ndarray, R: float, w: np.ndarray, alpha: float):
     return out
 
 
-def _write_stl(links: list[LinkSolid], s: float, assembly: Path, paths: dict[str, Path], meta: dict) -> Path:
+def _write_stl(links: list[LinkSolid], s: float, paths: dict[str, Path],
+               scenes: list[tuple[Path, dict[str, np.ndarray]]], meta: dict, sidecar: Path) -> None:
     tm = _need("trimesh", "an STL export")
     _need("manifold3d", "an STL export")
-    placed = []
+    meshes = {}
     for k in links:
-        m = _mesh(tm, k.primitives, s)
+        meshes[k.link] = m = _mesh(tm, k.primitives, s)
         m.export(os.fspath(paths[k.link]))
         meta["links"][k.link]["bounds"] = m.bounds.tolist()
-        T = k.placement.copy()
-        T[:3, 3] *= s
-        placed.append(m.copy().apply_transform(T))
-    whole = tm.util.concatenate(placed)
-    whole.export(os.fspath(assembly))
-    meta["assembly"] = {"file": assembly.name, "bounds": whole.bounds.tolist()}
-    sidecar = assembly.with_suffix(".json")
+    records = []
+    for assembly, placements in scenes:
+        placed = []
+        for k in links:
+            T = placements[k.link].copy()
+            T[:3, 3] *= s
+            placed.append(meshes[k.link].copy().apply_transform(T))
+        whole = tm.util.concatenate(placed)
+        whole.export(os.fspath(assembly))
+        records.append({"file": assembly.name, "bounds": whole.bounds.tolist(),
+                        "placements": {k.link: _rows(placements[k.link], s) for k in links}})
+    if len(scenes) == 1:
+        meta["assembly"] = {key: v for key, v in records[0].items() if key != "placements"}
+    else:
+        meta["assemblies"] = records
     sidecar.write_text(json.dumps(meta, indent=1), encoding="utf-8")
-    return sidecar
 
 
-def _write_glb(links: list[LinkSolid], s: float, assembly: Path, paths: dict[str, Path], meta: dict) -> None:
+def _write_glb(links: list[LinkSolid], s: float, paths: dict[str, Path],
+               scenes: list[tuple[Path, dict[str, np.ndarray]]], meta: dict) -> None:
     tm = _need("trimesh", "a GLB export")
     _need("manifold3d", "a GLB export")
-    scene = tm.Scene()
+    meshes = {}
     for k in links:
-        m = _mesh(tm, k.primitives, s)
+        meshes[k.link] = m = _mesh(tm, k.primitives, s)
         one = tm.Scene()
         one.add_geometry(m, node_name=_safe(k.link), geom_name=_safe(k.link))
         one.metadata.update({"format": _FORMAT_TAG, "unit": "m", "link": k.link, "joints": meta["links"][k.link]["joints"]})
         one.export(os.fspath(paths[k.link]))
-        T = k.placement.copy()
-        T[:3, 3] *= s
-        scene.add_geometry(m, node_name=_safe(k.link), geom_name=_safe(k.link), transform=T)
-    scene.metadata.update(meta)
-    scene.export(os.fspath(assembly))
+    for assembly, placements in scenes:
+        scene = tm.Scene()
+        for k in links:
+            T = placements[k.link].copy()
+            T[:3, 3] *= s
+            scene.add_geometry(meshes[k.link], node_name=_safe(k.link), geom_name=_safe(k.link), transform=T)
+        scene.metadata.update({**meta, "links": {k: {**v, "placement": _rows(placements[k], s)}
+                                                 for k, v in meta["links"].items()}})
+        scene.export(os.fspath(assembly))
     return None
 
 
@@ -584,6 +721,10 @@ def _read_stl(path: Path) -> tuple[str, dict[str, list[dict]]]:
         if meta.get("assembly", {}).get("file") == path.name:
             _check_bounds(path, mesh.bounds, meta["assembly"]["bounds"])
             return unit, {k: [_placed(x, v["placement"]) for x in v["joints"]] for k, v in meta["links"].items()}
+        for a in meta.get("assemblies", ()):  # a sample of a motion
+            if a["file"] == path.name:
+                _check_bounds(path, mesh.bounds, a["bounds"])
+                return unit, {k: [_placed(x, a["placements"][k]) for x in v["joints"]] for k, v in meta["links"].items()}
         for k, v in meta["links"].items():
             if v["file"] == path.name:
                 _check_bounds(path, mesh.bounds, v["bounds"])
