@@ -12,13 +12,14 @@ import numpy as np
 import pytest
 
 import spatialmech as sm
+from spatialmech.analysis.dynamics import actuator_values
 from spatialmech.errors import InputError
 from spatialmech.kinematics.closure import chain_forward, limb_chains, limb_slices
 from spatialmech.model.topology import link_graph
 
 pytest.importorskip("trimesh", reason="the cad extra (trimesh, manifold3d) is not installed")
 pytest.importorskip("manifold3d", reason="the cad extra (trimesh, manifold3d) is not installed")
-from spatialmech.exchange.cad import cad_links, housing_mesh, housing_solid, read_joint_frames
+from spatialmech.exchange.cad import cad_links, housing_mesh, housing_solid, read_joint_frames, read_placements
 
 #: Cone half-angles and the fraction of the sphere a housing keeps: outside a cone of half-angle
 #: a the solid angle left is 1 - (1 - cos a) / 2 of the sphere's.
@@ -90,6 +91,40 @@ def test_mesh_round_trip(tmp_path, fmt, unit):
     assert link == "ground" and feats == frames["links"]["ground"]
 
 
+def _placed(f, T):
+    return {**f, "centre": (T[:3, :3] @ np.asarray(f["centre"]) + T[:3, 3]).tolist(),
+            "axis": (T[:3, :3] @ np.asarray(f["axis"])).tolist()}
+
+
+def test_motion_round_trip(tmp_path):
+    """Along a motion: the placements file, re-read, puts every link's joints (from its own
+    file, in its frame) where the model's forward position at that sample's actuator value puts
+    them (the limb chains, independent of the exporter), to 1e-9 of the characteristic length;
+    each sample's assembly reads back the same; the link files are written once."""
+    mech = sm.load_model("rssr")
+    L = mech.characteristic_length
+    r = sm.export(mech, tmp_path / "part.stl", actuators=[10.0], along=[70.0], samples=4, degrees=True, unit="mm")
+    assert r.samples == 4 and r.out.name == "part.000.mm.stl" and r.to_dict()["samples"] == 4
+    motion = read_placements(r.placements)
+    assert motion["unit"] == "mm" and [s["assembly"] for s in motion["samples"]] == [
+        f"part.{i:03d}.mm.stl" for i in range(4)]
+    own = {}
+    for name in motion["link_files"].values():
+        own.update(read_joint_frames(tmp_path / name)["links"])  # metres, in the link's own frame
+    assert set(own) == set(motion["link_files"]) == {"ground", "input.link1", "input.link2", "platform"}
+    origin = next(k.origin for k in cad_links(mech) if k.link == mech.output)  # the output link's frame
+    for deg, sample in zip(np.linspace(10.0, 70.0, 4), motion["samples"], strict=True):
+        assert sample["actuators_deg"]["A0.rot"] == pytest.approx(deg, abs=1e-9)
+        placed = {k: [_placed(f, sample["links"][k]) for f in feats] for k, feats in own.items()}
+        # the model's closed configuration nearest the output link's placement: at the sample's
+        # actuator value (the forward position), and the limb chains put every joint there
+        T = sample["links"][mech.output]
+        config = _config(mech, sm.Pose(T[:3, :3], T[:3, :3] @ (mech.platform_point - origin) + T[:3, 3]))
+        assert np.degrees(actuator_values(mech, config)[0]) == pytest.approx(deg, abs=1e-7)
+        _check_round_trip(mech, config, {"links": placed}, L)
+        _check_round_trip(mech, config, read_joint_frames(tmp_path / sample["assembly"]), L)
+
+
 @pytest.mark.slow
 def test_step_round_trip_and_header_unit(tmp_path):
     """STEP: joint edges re-read from the assembly at a forward-position configuration, in mm
@@ -147,6 +182,12 @@ def test_glb_is_metres_and_cli(tmp_path):
     schema = json.loads((Path(sm.__file__).parent / "interfaces" / "schemas" / "export.schema.json").read_text())
     jsonschema.validate(d, schema)
     assert unit_rule_violations(d) == []
+    res = CliRunner().invoke(cli, ["export", "rssr", str(tmp_path / "a.glb"), "--along", "40", "--samples", "2", "--json"])
+    assert res.exit_code == 0, res.output
+    d = json.loads(res.output)
+    jsonschema.validate(d, schema)
+    assert unit_rule_violations(d) == [] and d["samples"] == 2 and d["out"].endswith("a.000.glb")
+    assert [s["assembly"] for s in read_placements(d["placements"])["samples"]] == ["a.000.glb", "a.001.glb"]
 
 
 @pytest.mark.parametrize("alpha,kept", HOUSINGS)

@@ -236,8 +236,14 @@ def mobility_cmd(model, mode, as_json):
               help="CAD: place the links at these actuator values (comma-separated, degrees / length).")
 @click.option("--unit", type=click.Choice(["m", "mm"]), default=None,
               help="CAD: the files' length unit (default mm; GLB is always m).")
+@click.option("--along", "along_text", default=None, metavar="V1,V2,...",
+              help="CAD along a motion: the actuators moved in a straight line from the start (--pose, --position, "
+                   "--actuators or the reference) to these values (deg / length, as statics --along); one assembly "
+                   "per sample (FILE.000.step, ...), the link files once and FILE.placements.json.")
+@click.option("--samples", type=click.IntRange(2, 1000), default=11, show_default=True,
+              help="Samples with --along (both ends included).")
 @json_option
-def export(model, file, fmt, mode, pose_text, position, values, unit, as_json):
+def export(model, file, fmt, mode, pose_text, position, values, unit, along_text, samples, as_json):
     """Write a model (e.g. a ready-made one) as a TOML file to start your own from, as a
     MuJoCo model (MJCF) or URDF to carry it to a simulator (docs/validation.md), or as CAD
     parts: one solid per link, an assembly and one file per link (docs/cad.md).
@@ -249,8 +255,10 @@ def export(model, file, fmt, mode, pose_text, position, values, unit, as_json):
       spatialmech export stewart-6sps stewart.urdf       # URDF, loop closures in an extension block
       spatialmech export rssr part.step --unit mm        # STEP assembly + part.LINK.step per link
       spatialmech export stewart-6sps part.stl --position 1   # part.mm.stl, part.LINK.mm.stl, part.mm.json
+      spatialmech export rssr part.glb --actuators 0 --along 60 --samples 7   # part.000.glb ... part.006.glb
     """
     check_output_file(file, "FILE")
+    _require_cad(file, fmt)  # before any work: the extra to install, exit 2
     mech = load_model(model)
     pose = None
     if pose_text is not None or position is not None:
@@ -260,14 +268,33 @@ def export(model, file, fmt, mode, pose_text, position, values, unit, as_json):
 
         pose = position if pose_text is None else parse_pose(pose_text)
     acts = None if values is None else parse_numbers(values, "--actuators")
-    r = sm.export(mech, file, format=fmt, mode=mode, pose=pose, actuators=acts, degrees=True, unit=unit)
+    along = None if along_text is None else parse_numbers(along_text, "--along", count=len(mech.actuators),
+                                                            what="actuator values")
+    r = sm.export(mech, file, format=fmt, mode=mode, pose=pose, actuators=acts, degrees=True, unit=unit, along=along,
+                  samples=samples)
     if as_json:
         emit_json("export", r.mechanism, r.to_dict())
+    elif r.placements is not None:
+        click.echo(f"wrote {r.samples} assemblies {r.files[0].name} .. {r.files[r.samples - 1].name} ({r.format}, "
+                   f"{r.unit}), the placements {r.placements.name} and {len(r.files) - r.samples - 1} more: "
+                   f"{', '.join(f.name for f in r.files[r.samples:] if f != r.placements)}")
     elif r.unit is not None:
         click.echo(f"wrote {r.out} ({r.format}, {r.unit}) and {len(r.files) - 1} more: "
                    f"{', '.join(f.name for f in r.files[1:])}")
     else:
         click.echo(f"wrote {file} ({r.format})")
+
+
+#: The packages of the ``cad`` extra that each CAD file extension needs.
+_CAD_NEEDS = {"step": ("build123d",), "stp": ("build123d",), "stl": ("trimesh", "manifold3d"),
+              "glb": ("trimesh", "manifold3d")}
+
+
+def _require_cad(file: Path, fmt: str | None) -> None:
+    """A CAD export (by --format or FILE's extension) needs the ``cad`` extra: say so first."""
+    kind = fmt or file.suffix.lower().lstrip(".")
+    if kind in _CAD_NEEDS:
+        require("cad", *_CAD_NEEDS[kind], what=f"a {kind.upper()} export")
 
 
 @cli.command()
