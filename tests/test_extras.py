@@ -54,6 +54,7 @@ CASES = [
     ("studio", ["studio", "--no-browser"], "the studio"),
     ("sim", ["validate", "rssr"], "validation"),
     ("screen", ["screen", "--out", "screen"], "screening"),
+    ("cad", ["export", "rssr", "part.stl", "--along", "30", "--samples", "3"], "the STL export"),
 ]
 
 
@@ -65,6 +66,26 @@ def test_a_missing_extra_names_itself_and_exits_2(tmp_path, extra, args, what):
     assert last.startswith(f"error: {what} needs the optional extra '{extra}'"), last
     assert f"pip install 'spatialmech[{extra}]'" in last
     assert not list(tmp_path.iterdir()), "nothing is written when the extra is missing"
+
+
+#: Runs Python code (argv[2]) with the modules named in argv[1] hidden (as _HIDE).
+_HIDE_CODE = _HIDE.split("sys.argv = ")[0] + "exec(sys.argv[2])\n"
+
+
+def test_the_notebook_widget_without_its_extra_names_it(tmp_path):
+    """``sm.studio`` (the Jupyter widget) without anywidget: a MissingExtraError naming the
+    ``notebook`` extra, raised by the call (``import spatialmech`` and ``sm.studio`` itself, the
+    attribute, work on the core install: ``from spatialmech import *`` does not break)."""
+    code = ("import spatialmech as sm\nfrom spatialmech import *\nfrom spatialmech.errors import MissingExtraError\n"
+            "try:\n    sm.studio('rssr')\nexcept MissingExtraError as e:\n"
+            "    print(type(e).__name__, isinstance(e, ImportError), e)\n")
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "src") + os.pathsep + os.environ.get("PYTHONPATH", "")}
+    r = subprocess.run([sys.executable, "-c", _HIDE_CODE, ",".join(EXTRAS["notebook"]), code], capture_output=True,
+                       text=True, env=env, cwd=tmp_path, timeout=600)
+    assert r.returncode == 0, r.stderr[-2000:]
+    assert r.stdout.startswith("MissingExtraError True sm.studio (the studio in Jupyter) needs the optional extra "
+                               "'notebook'"), r.stdout
+    assert "pip install 'spatialmech[notebook]'" in r.stdout
 
 
 def test_core_commands_run_with_every_extra_hidden(tmp_path):

@@ -156,8 +156,10 @@ _LAZY: dict[str, str] = {
                      "U", "dump", "dumps", "load", "loads"), ".model"),
     "Configuration": ".kinematics.closure",
     "closed_forms": ".kinematics.closed_forms",  # the closed-form kernels (a module; they load scipy.stats)
-    "studio_app": ".interfaces.studio.app",  # the studio's web app, a driver (FastAPI) above the API
-    "studio": ".interfaces.studio.widget",  # the studio as a Jupyter widget (anywidget), a driver too
+    # the studio's web app (FastAPI) and Jupyter widget (anywidget), drivers above the API: their entry
+    # points check the extra first (a MissingExtraError naming it) and import nothing optional themselves
+    "studio_app": ".interfaces.studio.entry",
+    "studio": ".interfaces.studio.entry",
     **{name: ".api" for name in __all__ if name[0].islower() and name not in {"__version__", "closed_forms",
                                                                                "dump", "dumps", "load", "loads",
                                                                                "results", "studio", "studio_app"}},

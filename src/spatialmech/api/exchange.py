@@ -133,7 +133,7 @@ def export(model: ModelLike, file, *, format: str | None = None, mode: str | Non
     out = check_path(file, "file")
     fmt = format_of(out, format)  # before any work: a file name whose format is unknown
     if fmt in CAD_FORMATS:  # before any work: the extra to install
-        require("cad", *CAD_MODULES[fmt], what=f"a {fmt.upper()} export")
+        require("cad", *CAD_MODULES[fmt], what=f"the {fmt.upper()} export")
     mech = as_mechanism(model)
     if mode is not None:
         if not isinstance(mode, str):

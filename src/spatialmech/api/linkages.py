@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .. import catalog
-from ..errors import InputError, describe
+from ..errors import InputError, describe, require
 from ..kinematics.closure import Configuration
 from ..kinematics.position import freedom_values, platform_pose
 from ..model.mechanism import Mechanism, Pose
@@ -314,6 +314,8 @@ def defects(model: ModelLike, positions=None, *, drivers=None, pose_tol: float |
     angle_tol_deg = check_number(angle_tol_deg, "angle_tol_deg", positive=True)
     precision = check_number(precision, "precision")
     plot = None if plot is None else check_path(plot, "plot")
+    if plot is not None:  # before any work: the extra to install
+        require("plot", "matplotlib", what="plot")
     res = defect_analysis(mech, positions, drivers=check_names(drivers, "drivers"), pose_tol=pose_tol,
                           angle_tol_deg=angle_tol_deg, monte_carlo=check_int(monte_carlo, "monte_carlo", minimum=0),
                           seed=check_int(seed, "seed"), precision=precision, progress=optional_progress(progress))
@@ -376,6 +378,8 @@ def synth_rccc(task="rccc-four-positions", *, pick: str = "best-rc", samples: in
     samples = check_int(samples, "samples", minimum=8)
     save = None if save is None else check_path(save, "save")
     plot = None if plot is None else check_path(plot, "plot")
+    if plot is not None:  # before any work: the extra to install
+        require("plot", "matplotlib", what="plot")
     res = synthesize_rccc(resolve_task(task), pick=pick, samples=samples)
     if save is not None:
         from ..model.schema import dump
@@ -582,6 +586,7 @@ def screen(task=None, out: str | os.PathLike = "screen.parquet", *, candidates: 
     >>> s.judged, sum(s.rejected_by_stage.values()) + s.usable
     (2, 2)
     """
+    require("screen", "distributed", "pyarrow", what="screening")  # before any work: the extra to install
     from ..services.screening import run_screen
 
     poses, source = seven_positions(task)

@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ..analysis.mobility import mobility as _mobility
-from ..errors import InputError
+from ..errors import InputError, require
 from ..results import Progress, check_progress
 if TYPE_CHECKING:
     from ..present.viewer import ViewerFile
@@ -84,6 +84,7 @@ def report(model: ModelLike, out=None, *, trace: bool = True, progress: bool | P
     ...     r.index_html.exists(), r.data["model"]
     (True, 'planar-4r')
     """
+    require("plot", "matplotlib", "plotly", what="the report")  # before any work: the extra to install
     from ..present.report import build_model_report
 
     mech = as_mechanism(model)
@@ -135,6 +136,8 @@ def demo(out="report", *, progress: bool | Progress | None = None) -> ReportResu
     ...
     TypeError: out: expected a path (str or os.PathLike), got int 42
     """
+    require("plot", "matplotlib", "plotly", what="the report")  # before any work: the extras to install
+    require("sim", "mujoco", what="the papers' report (its MuJoCo validation tables)")
     from ..present.report import build_demo
 
     out = check_path(out, "out")
@@ -224,6 +227,7 @@ def view(model: ModelLike, out, *, motion: str = "auto", frames: int = 60, plotl
     """
     from ..analysis.traced_motion import traced_part
     from ..kinematics.motion import sample_motion
+    require("plot", "plotly", what="the viewer")  # before any work: the extra to install
     from ..present.viewer import PLOTLY_MODES, write_viewer
 
     mech = as_mechanism(model)
@@ -292,6 +296,7 @@ def studio_session(model: ModelLike = "five-cs-3") -> Session:
     >>> str(r.status), round(s.state()["actuators_deg"]["A0.rot"], 9)
     ('reached', 10.0)
     """
+    require("plot", "plotly", what="the studio")  # its scene is drawn with plotly
     from ..services.studio.session import Session
 
     return Session(as_mechanism(model))

@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import InputError, describe
+from ..errors import InputError, describe, require
 from ..kinematics.closure import Configuration
 from ..kinematics.position import PoseFit
 from ..model.mechanism import Mechanism
@@ -378,6 +378,8 @@ def parasitic(model: ModelLike, over: Mapping, *, at: Mapping[str, float] | None
     path = None if plot is None else check_path(plot, "plot")
     if path is not None and path.suffix.lower() not in (".png", ".pdf", ".svg"):
         raise InputError(f"plot: expected a .png, .pdf or .svg file, got {str(path)!r}")
+    if path is not None:  # before any work: the extra to install
+        require("plot", "matplotlib", what="plot")
     table = parasitic_table(mech, over, at=at, task=task, progress=optional_progress(progress))
     if path is not None:
         from ..present.parasitic import parasitic_figure

@@ -294,7 +294,7 @@ def _require_cad(file: Path, fmt: str | None) -> None:
     """A CAD export (by --format or FILE's extension) needs the ``cad`` extra: say so first."""
     kind = fmt or file.suffix.lower().lstrip(".")
     if kind in _CAD_NEEDS:
-        require("cad", *_CAD_NEEDS[kind], what=f"a {kind.upper()} export")
+        require("cad", *_CAD_NEEDS[kind], what=f"the {kind.upper()} export")
 
 
 @cli.command()

@@ -9,7 +9,7 @@ import click
 import numpy as np
 
 from .. import api as sm
-from ..errors import InputError
+from ..errors import InputError, require
 from .cmd_kinematics import resolve_pose, with_pose
 from .common import emit_json, json_option, tol_option
 
@@ -81,6 +81,8 @@ def accuracy_cmd(model, xyz, euler, position, act, clearance, geometry, axis_deg
     """
     if plot is not None and Path(plot).suffix.lower() not in (".png", ".pdf", ".svg"):
         raise InputError(f"--plot: expected a .png, .pdf or .svg file, got {plot!r}")
+    if plot is not None:  # before any work: the extra to install, exit 2
+        require("plot", "matplotlib", what="--plot")
     mech = sm.load_model(model)
     given = xyz is not None or euler is not None or position is not None
     pose = resolve_pose(mech, xyz, euler, position) if given else None

@@ -40,7 +40,6 @@ from __future__ import annotations
 import json
 import threading
 from importlib.resources import files
-from pathlib import Path
 
 from fastapi import FastAPI, Request
 from fastapi.responses import HTMLResponse, Response
@@ -48,21 +47,12 @@ from fastapi.responses import HTMLResponse, Response
 from ... import api as sm
 from ...errors import ConvergenceError, InputError
 from ...serialize import envelope, json_default
+from .assets import plotly_js_path
 
 __all__ = ["COMMAND", "create_app", "plotly_js_path", "studio_app"]
 
 #: The ``command`` of every API document (and of ``spatialmech studio --json``).
 COMMAND = "studio"
-
-
-def plotly_js_path() -> Path:
-    """``plotly.min.js`` shipped inside the installed plotly package."""
-    import plotly
-
-    p = Path(plotly.__file__).parent / "package_data" / "plotly.min.js"
-    if not p.is_file():  # pragma: no cover - a broken plotly installation
-        raise InputError(f"plotly: {p} is missing; reinstall plotly")
-    return p
 
 
 def _static(name: str) -> bytes:
@@ -243,15 +233,6 @@ def add_desk_routes(app: FastAPI, session, lock, doc, body, guarded) -> None:
 
 
 def studio_app(model: sm.ModelLike = "five-cs-3") -> FastAPI:
-    """The design studio's web app (FastAPI) on a new session (:func:`spatialmech.studio_session`):
-    serve it with uvicorn, or call its JSON API directly (docs/studio.md).  Also ``sm.studio_app``.
-
-    >>> import spatialmech as sm
-    >>> from fastapi.testclient import TestClient
-    >>> client = TestClient(sm.studio_app("rssr"))
-    >>> client.post("/api/drive", json={"actuators": [10.0]}).json()["status"]
-    'reached'
-    >>> client.post("/api/drive", json={"actuators": [1, 2]}).json()["error"]
-    'actuators: expected 1 values (A0.rot), got 2'
-    """
+    """The web app on a new session of ``model``; the public entry, which checks the ``studio``
+    extra first, is ``sm.studio_app`` (:func:`spatialmech.interfaces.studio.entry.studio_app`)."""
     return create_app(sm.studio_session(model))

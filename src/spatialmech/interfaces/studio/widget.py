@@ -29,7 +29,7 @@ import traitlets
 from ... import api as sm
 from ...errors import ConvergenceError, InputError
 from ...serialize import json_default
-from .app import plotly_js_path
+from .assets import plotly_js_path
 
 __all__ = ["StudioWidget", "figure", "studio"]
 
@@ -182,33 +182,6 @@ class StudioWidget(anywidget.AnyWidget):
 
 
 def studio(model: sm.ModelLike = "five-cs-3") -> StudioWidget:
-    """The design studio as a Jupyter widget (anywidget) on a new session
-    (:func:`spatialmech.studio_session`): the live mechanism in 3-D with actuator sliders and the
-    readouts.  Also ``sm.studio``.
-
-    Parameters
-    ----------
-    model : Mechanism, str or path
-        The mechanism, a ready-made model name (``sm.models()``) or a TOML model file.
-
-    Returns
-    -------
-    StudioWidget
-        The widget; its ``session`` is the :class:`~spatialmech.services.studio.session.Session`,
-        its ``state`` and ``figure`` traits the readout and the 3-D view.
-
-    Raises
-    ------
-    TypeError
-        An argument of the wrong type (named in the message).
-    InputError
-        A bad model (as :func:`spatialmech.studio_session`).
-
-    Examples
-    --------
-    >>> import spatialmech as sm
-    >>> w = sm.studio("rssr")            # the last expression of a notebook cell shows it
-    >>> str(w.drive([10.0]).status), round(w.state["actuators_deg"]["A0.rot"], 9)
-    ('reached', 10.0)
-    """
+    """The widget on a new session of ``model``; the public entry, which checks the ``notebook``
+    extra first, is ``sm.studio`` (:func:`spatialmech.interfaces.studio.entry.studio`)."""
     return StudioWidget(sm.studio_session(model))
