@@ -17,6 +17,7 @@ from pathlib import Path
 
 import pytest
 
+import spatialmech as sm
 from spatialmech.errors import EXTRAS, MissingExtraError, require
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -127,3 +128,34 @@ def test_the_extras_table_matches_pyproject():
     core = " ".join(project["dependencies"]).lower()
     for heavy in ("matplotlib", "plotly", "mujoco", "fastapi", "uvicorn", "dask", "pyarrow", "anywidget", "trimesh"):
         assert heavy not in core, heavy
+
+
+#: Every facade verb that imports an optional package, called with that package hidden: the
+#: module hidden, the extra named, what the call needs (small arguments; each fails first).
+FACADE = [
+    ("plotly", "plot", lambda d: sm.view("rssr", d / "v.html")),
+    ("matplotlib", "plot", lambda d: sm.report("rssr", d / "r")),
+    ("mujoco", "sim", lambda d: sm.demo(d / "report")),
+    ("plotly", "plot", lambda d: sm.studio_session("rssr")),
+    ("pyarrow", "screen", lambda d: sm.screen(out=d / "s.parquet", candidates=2)),
+    ("mujoco", "sim", lambda d: sm.validate("rssr")),
+    ("build123d", "cad", lambda d: sm.export("rssr", d / "p.step")),
+    ("manifold3d", "cad", lambda d: sm.export("rssr", d / "p.glb", along=[0.5], samples=2)),
+    ("matplotlib", "plot", lambda d: sm.defects("five-cs-1", plot=d / "figs")),
+    ("matplotlib", "plot", lambda d: sm.synth_rccc(plot=d / "figs")),
+    ("matplotlib", "plot", lambda d: sm.parasitic("three-rps", {"a2": (-0.1, 0.1, 3)}, at={"z": 0.33},
+                                                  plot=d / "p.png")),
+    ("anywidget", "notebook", lambda d: sm.studio("rssr")),
+    ("fastapi", "studio", lambda d: sm.studio_app("rssr")),
+]
+
+
+@pytest.mark.parametrize("module, extra, call", FACADE, ids=[f"{c[1]}-{k}" for k, c in enumerate(FACADE)])
+def test_a_facade_verb_requires_its_extra_first(tmp_path, monkeypatch, module, extra, call):
+    """In process: ``import MODULE`` fails (``sys.modules[MODULE] = None``); the verb raises the
+    MissingExtraError of its extra before writing anything."""
+    monkeypatch.setitem(sys.modules, module, None)
+    with pytest.raises(MissingExtraError) as e:
+        call(tmp_path)
+    assert e.value.extra == extra and e.value.module == module
+    assert not list(tmp_path.iterdir()), "nothing is written when the extra is missing"
