@@ -41,10 +41,16 @@ runpy.run_module("spatialmech", run_name="__main__")
 ALL_EXTRA_MODULES = sorted({m for mods in EXTRAS.values() for m in mods})
 
 
+def _env() -> dict[str, str]:
+    """The subprocesses' environment: this tree's package, the Python reference engine (these
+    tests are about the extras, not the compiler: no kernel loading or first-run compile)."""
+    return {**os.environ, "PYTHONPATH": str(ROOT / "src") + os.pathsep + os.environ.get("PYTHONPATH", ""),
+            "SPATIALMECH_PURE": "1"}
+
+
 def run_hidden(hidden, *args, cwd=None):
-    env = {**os.environ, "PYTHONPATH": str(ROOT / "src") + os.pathsep + os.environ.get("PYTHONPATH", "")}
     return subprocess.run([sys.executable, "-c", _HIDE, ",".join(hidden), *args], capture_output=True, text=True,
-                          env=env, cwd=cwd, timeout=600)
+                          env=_env(), cwd=cwd, timeout=600)
 
 
 # One command per extra (small arguments: each one fails before any work).
@@ -73,6 +79,11 @@ def test_a_missing_extra_names_itself_and_exits_2(tmp_path, extra, args, what):
 _HIDE_CODE = _HIDE.split("sys.argv = ")[0] + "exec(sys.argv[2])\n"
 
 
+def run_hidden_code(hidden, code: str, cwd=None):
+    return subprocess.run([sys.executable, "-c", _HIDE_CODE, ",".join(hidden), code], capture_output=True, text=True,
+                          env=_env(), cwd=cwd, timeout=600)
+
+
 def test_the_notebook_widget_without_its_extra_names_it(tmp_path):
     """``sm.studio`` (the Jupyter widget) without anywidget: a MissingExtraError naming the
     ``notebook`` extra, raised by the call (``import spatialmech`` and ``sm.studio`` itself, the
@@ -80,23 +91,41 @@ def test_the_notebook_widget_without_its_extra_names_it(tmp_path):
     code = ("import spatialmech as sm\nfrom spatialmech import *\nfrom spatialmech.errors import MissingExtraError\n"
             "try:\n    sm.studio('rssr')\nexcept MissingExtraError as e:\n"
             "    print(type(e).__name__, isinstance(e, ImportError), e)\n")
-    env = {**os.environ, "PYTHONPATH": str(ROOT / "src") + os.pathsep + os.environ.get("PYTHONPATH", "")}
-    r = subprocess.run([sys.executable, "-c", _HIDE_CODE, ",".join(EXTRAS["notebook"]), code], capture_output=True,
-                       text=True, env=env, cwd=tmp_path, timeout=600)
+    r = run_hidden_code(EXTRAS["notebook"], code, cwd=tmp_path)
     assert r.returncode == 0, r.stderr[-2000:]
     assert r.stdout.startswith("MissingExtraError True sm.studio (the studio in Jupyter) needs the optional extra "
                                "'notebook'"), r.stdout
     assert "pip install 'spatialmech[notebook]'" in r.stdout
 
 
+#: Runs the command lines given as JSON (argv[3]) one after the other in one process (one
+#: interpreter start for all) and prints their outputs as a JSON list.
+_COMMANDS = """
+import contextlib, io, json, sys
+from spatialmech.interfaces.cli import main
+outs = []
+for argv in json.loads(sys.argv[3]):
+    buf = io.StringIO()
+    with contextlib.redirect_stdout(buf):
+        try:
+            main(argv)
+        except SystemExit as e:
+            if e.code not in (0, None):
+                raise
+    outs.append(buf.getvalue())
+print(json.dumps(outs))
+"""
+
+
 def test_core_commands_run_with_every_extra_hidden(tmp_path):
-    r = run_hidden(ALL_EXTRA_MODULES, "mobility", "four-sps-cu", "--json", cwd=tmp_path)
+    commands = [["mobility", "four-sps-cu", "--json"],
+                ["ik", "four-sps-cu", "--xyz", "0", "0", "0.12", "--euler", "ZYX", "34.38", "-5.73", "11.46", "--json"]]
+    r = subprocess.run([sys.executable, "-c", _HIDE_CODE, ",".join(ALL_EXTRA_MODULES), _COMMANDS, json.dumps(commands)],
+                       capture_output=True, text=True, env=_env(), cwd=tmp_path, timeout=600)
     assert r.returncode == 0, r.stderr[-2000:]
-    assert json.loads(r.stdout)["modes"][0]["dof"] == 4
-    r = run_hidden(ALL_EXTRA_MODULES, "ik", "four-sps-cu", "--xyz", "0", "0", "0.12", "--euler", "ZYX", "34.38", "-5.73",
-                   "11.46", "--json", cwd=tmp_path)
-    assert r.returncode == 0, r.stderr[-2000:]
-    assert json.loads(r.stdout)["reachable"] is True
+    mobility, ik = (json.loads(out) for out in json.loads(r.stdout))
+    assert mobility["modes"][0]["dof"] == 4
+    assert ik["reachable"] is True
 
 
 def test_an_import_error_of_an_extra_module_maps_to_its_extra():
@@ -159,3 +188,47 @@ def test_a_facade_verb_requires_its_extra_first(tmp_path, monkeypatch, module, e
         call(tmp_path)
     assert e.value.extra == extra and e.value.module == module
     assert not list(tmp_path.iterdir()), "nothing is written when the extra is missing"
+
+
+def _with_dependencies(extra: str, extras: dict) -> set[str]:
+    """``extra`` and the extras its pyproject entry pulls in (``studio`` -> ``plot``)."""
+    out = {extra}
+    for req in extras[extra]:
+        if req.startswith("spatialmech["):
+            for e in req[len("spatialmech["):-1].split(","):
+                out |= _with_dependencies(e, extras)
+    return out
+
+
+#: One command per extra, run with every *other* extra's modules hidden: the extra alone (with
+#: the extras it pulls in) is enough for its commands (a CLI command line, or Python code that
+#: prints ``reached``).  Small arguments: about a second each.
+ALONE = [
+    ("plot", ["view", "rssr", "--motion", "demo", "--frames", "2", "--plotly", "cdn", "--out", "v.html"], None),
+    ("sim", ["validate", "rssr", "--poses", "2", "--arc", "0.1", "--json"], None),
+    # screening runs a Dask job (seconds even for 2 candidates): here its service imports, with
+    # the other extras hidden; tests/test_screening.py runs it
+    ("screen", None, "from spatialmech.services.screening import run_screen\nprint('reached')\n"),
+    ("cad", ["export", "rssr", "p.stl", "--json"], None),
+    ("studio", None, "from fastapi.testclient import TestClient\nimport spatialmech as sm\n"
+                     "c = TestClient(sm.studio_app('rssr'))\n"
+                     "print(c.post('/api/drive', json={'actuators': [10.0]}).json()['status'])\n"),
+    ("notebook", None, "import spatialmech as sm\nprint(sm.studio('rssr').drive([10.0]).status)\n"),
+]
+
+
+def test_every_extra_has_a_command_that_runs_alone():
+    assert sorted(e for e, _, _ in ALONE) == sorted(EXTRAS)
+
+
+@pytest.mark.parametrize("extra, args, code", ALONE, ids=[c[0] for c in ALONE])
+def test_an_extra_alone_runs_its_command(tmp_path, extra, args, code):
+    """``pip install 'spatialmech[EXTRA]'`` is enough for the extra's command: it runs (exit 0)
+    with the modules of every extra it does not pull in hidden."""
+    extras = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["optional-dependencies"]
+    keep = {m for e in _with_dependencies(extra, extras) for m in EXTRAS[e]}
+    hidden = sorted(set(ALL_EXTRA_MODULES) - keep)
+    r = run_hidden(hidden, *args, cwd=tmp_path) if args else run_hidden_code(hidden, code, cwd=tmp_path)
+    assert r.returncode == 0, (extra, r.stderr[-2000:])
+    if code is not None:
+        assert r.stdout.strip().endswith("reached"), r.stdout
