@@ -36,9 +36,24 @@ export SPATIALMECH_PURE=1
 "$SM" fk rssr --actuators 30 --all >/dev/null
 "$SM" defects five-cs-1 --json >/dev/null
 "$SM" synth rccc --json >/dev/null
-# an extra that is not installed: one line naming it, exit code 2
-set +e; "$SM" view four-sps-cu --out v.html 2>"$WORK/view.err"; rc=$?; set -e
-[ "$rc" -eq 2 ] && grep -q "pip install 'spatialmech\[plot\]'" "$WORK/view.err" \
-  || { cat "$WORK/view.err"; echo "smoke: a missing extra must exit 2 naming it (got $rc)" >&2; exit 1; }
+# an extra that is not installed: one line naming it, exit code 2, nothing written (the viewer:
+# plot; a CAD export: cad); in Python, the notebook widget: a MissingExtraError naming notebook
+for cmd in "view four-sps-cu --out v.html:plot" "export rssr part.stl:cad"; do
+  extra="${cmd##*:}"
+  set +e; "$SM" ${cmd%:*} 2>"$WORK/extra.err"; rc=$?; set -e
+  [ "$rc" -eq 2 ] && grep -q "pip install 'spatialmech\[$extra\]'" "$WORK/extra.err" && [ ! -e v.html ] \
+    && [ -z "$(ls part.* 2>/dev/null)" ] \
+    || { cat "$WORK/extra.err"; echo "smoke: a missing extra must exit 2 naming it ($cmd: got $rc)" >&2; exit 1; }
+done
+"$WORK/venv/bin/python" -c "
+import spatialmech as sm
+from spatialmech.errors import MissingExtraError
+try:
+    sm.studio('rssr')
+except MissingExtraError as e:
+    assert e.extra == 'notebook', e
+else:
+    raise SystemExit('smoke: sm.studio without anywidget did not name the notebook extra')
+"
 echo "smoke: the wheel $(basename "$WHEEL") installs with no extras and runs the core commands"
 cd "$ROOT"
