@@ -391,6 +391,7 @@ def defect_analysis(
     sigma_along_path: bool = True,
     progress: Progress | None = None,
     sense: int = 1,
+    check_dof: bool = True,
 ) -> DefectResult:
     """Defect judgement of a 1-DOF linkage for its task positions (default: the model's own).
 
@@ -401,7 +402,9 @@ def defect_analysis(
     number of the step and a short message while it works.  ``sense``: the sense every circuit
     is traced in (``1``: the conventional one of :func:`~..kinematics.tracking.trace_motion`,
     ``-1``: the opposite); the verdict (circuits, defects, usable drivers) does not depend on it,
-    only the traced arcs and ``direction`` do.
+    only the traced arcs and ``direction`` do.  ``check_dof=False`` skips the mobility check of
+    step 0 for a caller that has already shown one degree of freedom (the screen: a closure
+    Jacobian of full row rank at a task position, so of full row rank generically).
 
     The steps (module docstring): :func:`_checked_arguments`, :func:`dj_table` (fits and DJ),
     :func:`_trace_circuits`, :func:`_assign_circuits`, :func:`_path_along_first_circuit`,
@@ -411,7 +414,7 @@ def defect_analysis(
     say = Steps(progress)
     positions, drivers, pose_tol = _checked_arguments(mech, positions, drivers, pose_tol=pose_tol,
                                                       angle_tol_deg=angle_tol_deg, precision=precision,
-                                                      monte_carlo=monte_carlo)
+                                                      monte_carlo=monte_carlo, check_dof=check_dof)
     say("fitting the task positions onto the closure; DJ at every position")
     table = dj_table(mech, drivers, positions)
     fits = list(table.fits)
@@ -465,10 +468,12 @@ def defect_analysis(
 
 # ----------------------------------------------------------------------------- its steps
 def _checked_arguments(mech: Mechanism, positions, drivers, *, pose_tol: float | None, angle_tol_deg: float,
-                       precision: float, monte_carlo: int) -> tuple[tuple[Pose, ...], list[str], float]:
+                       precision: float, monte_carlo: int,
+                       check_dof: bool = True) -> tuple[tuple[Pose, ...], list[str], float]:
     """Step 0: the arguments of :func:`defect_analysis` checked (an ``InputError`` naming the
     argument), the defaults filled in.  The mechanism must have one degree of freedom and, when
-    metamorphic, be in one mode.  Returns ``(positions, drivers, pose_tol)``."""
+    metamorphic, be in one mode (not checked with ``check_dof=False``).  Returns
+    ``(positions, drivers, pose_tol)``."""
     if pose_tol is None:
         pose_tol = 0.02 * mech.characteristic_length
     for name, v in (("pose_tol", pose_tol), ("angle_tol_deg", angle_tol_deg)):
@@ -481,7 +486,8 @@ def _checked_arguments(mech: Mechanism, positions, drivers, *, pose_tol: float |
     positions = tuple(positions if positions is not None else mech.positions)
     if len(positions) < 2:
         raise InputError("positions: a defect analysis needs at least two task positions")
-    _check_one_dof(mech)
+    if check_dof:
+        _check_one_dof(mech)
     drivers = list(drivers) if drivers is not None else candidate_drivers(mech)
     if not drivers:
         raise InputError("drivers: no candidate drivers")

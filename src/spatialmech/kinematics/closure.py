@@ -128,9 +128,19 @@ def limb_slices(mech: Mechanism) -> list[slice]:
     return out
 
 
+_REFERENCE_SCREWS: weakref.WeakKeyDictionary[Mechanism, np.ndarray] = weakref.WeakKeyDictionary()
+
+
 def reference_screws(mech: Mechanism) -> np.ndarray:
-    """Unit twists (n_freedoms, 6) of every freedom at the reference configuration."""
-    return np.array([r.freedom.screw for r in mech.freedom_refs])
+    """Unit twists (n_freedoms, 6) of every freedom at the reference configuration (computed
+    once per mechanism, which is frozen; each call returns a fresh copy)."""
+    try:
+        return _REFERENCE_SCREWS[mech].copy()
+    except KeyError:
+        pass
+    S = np.array([r.freedom.screw for r in mech.freedom_refs])
+    _REFERENCE_SCREWS[mech] = S
+    return S.copy()
 
 
 def active_mask(mech: Mechanism) -> np.ndarray:

@@ -43,6 +43,7 @@ __all__ = [
     "assemble_5cs",
     "check_5cs",
     "cs_configuration",
+    "cs_configurations",
     "paper_a_check",
 ]
 
@@ -201,6 +202,80 @@ def cs_configuration(mech: Mechanism, pose: Pose):
         A = np.array([f.direction for f in sj.freedoms]).T
         q += [th, s, *(A.T @ Rotation.from_matrix(Rs).as_rotvec())]
     return Configuration(np.array(q), D)
+
+
+def _rotvec_of(R: np.ndarray) -> np.ndarray:
+    """Rotation vectors of rotation matrices ``R`` (``(m, 3, 3)``), the algorithm of
+    ``scipy.spatial.transform.Rotation.from_matrix(R).as_rotvec()`` in plain NumPy: Shepperd's
+    quaternion (the largest of the trace and the diagonal picks the formula), ``w >= 0``, then
+    ``angle = 2 atan2(|v|, w)`` and ``rotvec = angle / sin(angle / 2) v`` (its series below 1e-3
+    rad).  Agrees with SciPy to rounding (``tests/test_screen_batched.py``)."""
+    m = R.shape[0]
+    d = np.stack([R[:, 0, 0], R[:, 1, 1], R[:, 2, 2], R[:, 0, 0] + R[:, 1, 1] + R[:, 2, 2]], axis=1)
+    k = np.argmax(d, axis=1)
+    quat = np.empty((m, 4))
+    for n in range(m):
+        i = int(k[n])
+        Rn = R[n]
+        if i == 3:
+            quat[n] = (Rn[2, 1] - Rn[1, 2], Rn[0, 2] - Rn[2, 0], Rn[1, 0] - Rn[0, 1], 1.0 + d[n, 3])
+        else:
+            j, l = (i + 1) % 3, (i + 2) % 3
+            q = np.empty(4)
+            q[i] = 1.0 - d[n, 3] + 2.0 * Rn[i, i]
+            q[j] = Rn[j, i] + Rn[i, j]
+            q[l] = Rn[l, i] + Rn[i, l]
+            q[3] = Rn[l, j] - Rn[j, l]
+            quat[n] = q
+    quat /= np.linalg.norm(quat, axis=1)[:, None]
+    quat[quat[:, 3] < 0] *= -1.0
+    v = np.linalg.norm(quat[:, :3], axis=1)
+    angle = 2.0 * np.arctan2(v, quat[:, 3])
+    small = np.abs(angle) <= 1e-3
+    a2 = angle * angle
+    scale = np.where(small, 2.0 + a2 / 12.0 + 7.0 * a2 * a2 / 2880.0, angle / np.sin(np.where(small, 1.0, angle / 2.0)))
+    return scale[:, None] * quat[:, :3]
+
+
+def _axis_rotations(u: np.ndarray, angle: np.ndarray) -> np.ndarray:
+    """``R_u(angle)`` for unit axes ``u`` (``(m, 3)``) and angles (``(m,)``): Rodrigues."""
+    K = np.zeros((len(u), 3, 3))
+    K[:, 0, 1], K[:, 0, 2], K[:, 1, 2] = -u[:, 2], u[:, 1], -u[:, 0]
+    K[:, 1, 0], K[:, 2, 0], K[:, 2, 1] = u[:, 2], -u[:, 1], u[:, 0]
+    s, c = np.sin(angle)[:, None, None], np.cos(angle)[:, None, None]
+    return np.eye(3) + s * K + (1.0 - c) * (K @ K)
+
+
+def cs_configurations(mech: Mechanism, poses: Sequence[Pose] | None = None):
+    """:func:`cs_configuration` at every pose of ``poses`` (default: the model's positions) at
+    once, vectorised over poses and limbs, without SciPy (Rodrigues for ``R_u(theta)``,
+    :func:`_rotvec_of` for the S rotation vector): the same joint values to rounding.  A list
+    of configurations, or ``None`` when a limb is not [C, S]."""
+    from ..kinematics.closure import Configuration
+
+    poses = list(mech.positions if poses is None else poses)
+    if any([j.type for j in lb.joints] != ["C", "S"] for lb in mech.limbs):
+        return None
+    if not poses:
+        return []
+    u = np.array([lb.joints[0].freedoms[0].direction for lb in mech.limbs], dtype=float)  # (k, 3)
+    B1 = np.array([lb.joints[0].point for lb in mech.limbs], dtype=float)
+    M1 = np.array([lb.joints[1].point for lb in mech.limbs], dtype=float)
+    A = np.array([[f.direction for f in lb.joints[1].freedoms] for lb in mech.limbs], dtype=float)  # (k, 3 rows, 3)
+    Ds = np.array([P.displacement(mech.platform_point) for P in poses])  # (n, 4, 4)
+    n, k = len(poses), len(mech.limbs)
+    Mj = np.einsum("nab,kb->nka", Ds[:, :3, :3], M1) + Ds[:, None, :3, 3]  # (n, k, 3)
+    s = np.einsum("ka,nka->nk", u, Mj - M1[None])
+    a = (M1 - B1) - np.sum(u * (M1 - B1), axis=1)[:, None] * u  # (k, 3)
+    w = Mj - B1[None] - s[..., None] * u[None]
+    b = w - np.sum(u[None] * w, axis=2)[..., None] * u[None]
+    th = np.arctan2(np.sum(u[None] * np.cross(a[None], b), axis=2), np.sum(a[None] * b, axis=2))  # (n, k)
+    uu = np.broadcast_to(u, (n, k, 3)).reshape(-1, 3)
+    Rs = np.swapaxes(_axis_rotations(uu, th.reshape(-1)), 1, 2) @ np.repeat(Ds[:, :3, :3], k, axis=0)
+    rv = _rotvec_of(Rs).reshape(n, k, 3)
+    ball = np.einsum("kij,nkj->nki", A, rv)  # A.T @ rotvec with A's columns the S axes
+    q = np.concatenate([th[..., None], s[..., None], ball], axis=2).reshape(n, 5 * k)
+    return [Configuration(q[i].copy(), Ds[i]) for i in range(n)]
 
 
 def check_5cs(mech: Mechanism, dyads: Sequence[CSDyad] | None = None, *, defects: bool = False,

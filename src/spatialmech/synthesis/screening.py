@@ -44,7 +44,7 @@ from ..results import ScreenStage
 from ..serialize import fields_dict
 from ..kinematics.tracking import conventional_sense
 from .cs_dyads import CSBranch, CSDyad, CSFamily, CSTask, cs_task, dyad_from_vector
-from .five_cs import assemble_5cs, cs_configuration
+from .five_cs import assemble_5cs, cs_configuration, cs_configurations
 
 __all__ = [
     "RANKINGS",
@@ -312,13 +312,68 @@ def _closure_at_positions(mech: Mechanism, configs) -> tuple[float, float]:
     return worst_res, min_sig
 
 
+def _closure_at_positions_batched(mech: Mechanism, configs, engine) -> tuple[float, float]:
+    """:func:`_closure_at_positions` with the compiled engine: one batched call for the residuals
+    and Jacobians at every position, one stacked SVD (the same numbers, per position)."""
+    from ..kinematics.closure import closure_scales
+
+    L = mech.characteristic_length
+    cm = engine.compile_mechanism(mech)
+    row, col = closure_scales(mech, cm.active)
+    q = np.array([c.q for c in configs])
+    D = np.array([c.D for c in configs])
+    A, r = engine.closure_jacobians(mech, q, D)
+    r = r.reshape(len(configs), -1, 6)
+    worst_res = max(0.0, float(np.max(np.abs(r[:, :, :3]))), float(np.max(np.abs(r[:, :, 3:]))) / L)
+    sv = np.linalg.svd(row[None, :, None] * A * col[None, None, :], compute_uv=False)
+    return worst_res, float(np.min(sv[:, -1] / sv[:, 0]))
+
+
+def _positions_stage(mech: Mechanism, batched: bool):
+    """At the task positions (their C-S configurations): the closure (worst residual, smallest
+    scale-free sigma), the candidate drivers and DJ of each at each position (``(positions,
+    drivers)``; ``None`` when the closure fails the assembly stage): stages 1 and 2 of :func:`judge_candidate`.  ``batched``: closed
+    forms vectorised over the positions and the compiled engine called once for all of them
+    (when it is in use); else the reference path, position by position."""
+    from ..analysis.defects import candidate_drivers, dj_function
+    from ..kinematics import backend
+
+    engine = backend.engine() if batched else None
+    if engine is None:
+        configs = [cs_configuration(mech, P) for P in mech.positions]
+        if any(c is None for c in configs):
+            raise InputError("dyads: a candidate limb is not a C-S chain")
+        res, sig = _closure_at_positions(mech, configs)
+    else:
+        cfgs = cs_configurations(mech)
+        if cfgs is None:
+            raise InputError("dyads: a candidate limb is not a C-S chain")
+        configs = cfgs
+        res, sig = _closure_at_positions_batched(mech, configs, engine)
+    drivers = candidate_drivers(mech)
+    if not (res <= current_tolerances().reachability and sig > current_tolerances().rank):
+        return res, sig, drivers, None
+    dj = None
+    if engine is not None:
+        dj = engine.driver_determinants_many(mech, np.array([c.q for c in configs]), np.array([c.D for c in configs]),
+                                             None, drivers)
+        if dj is not None and not np.all(np.isfinite(dj[0])):
+            dj = None  # not the complete-Jacobian determinant: the reference's DJ function decides
+    if dj is None:
+        djf, _ = dj_function(mech, drivers, configs[0])
+        dj = np.array([djf(c) for c in configs])
+    return res, sig, drivers, dj
+
+
 def judge_candidate(pool: DyadPool, idx: Sequence[int], *, candidate: int = 0, h0: float = 0.02,
-                    max_arc: float = 400.0) -> CandidateVerdict:
+                    max_arc: float = 400.0, batched: bool = True) -> CandidateVerdict:
     """Judge the 5-CS of the pool's dyads ``idx`` in the stages of the module docstring.  A
     failure of a numerical routine inside a stage (``InputError``/``ValueError``/
     ``RuntimeError``, e.g. a position that cannot be fitted, a circuit that cannot be traced)
-    rejects the candidate as ``"error"`` with the message; it is never dropped silently."""
-    from ..analysis.defects import candidate_drivers, defect_analysis, dj_function
+    rejects the candidate as ``"error"`` with the message; it is never dropped silently.
+    ``batched``: the positions' stages in batches (:func:`_positions_stage`); ``False``: the
+    reference path, position by position (the same verdicts, ``tests/test_screen_batched.py``)."""
+    from ..analysis.defects import defect_analysis
 
     t0 = time.perf_counter()
     idx = tuple(int(i) for i in idx)
@@ -330,23 +385,18 @@ def judge_candidate(pool: DyadPool, idx: Sequence[int], *, candidate: int = 0, h
         return CandidateVerdict(candidate=int(candidate), dyads=idx, stroke=stroke, max_abs_slide=max_abs_slide, **kw,
                                 seconds=time.perf_counter() - t0)
 
-    tol = current_tolerances()
     try:
         mech = candidate_linkage(pool, idx)
-        configs = [cs_configuration(mech, P) for P in mech.positions]
-        if any(c is None for c in configs):
-            raise InputError("dyads: a candidate limb is not a C-S chain")
-        res, sig = _closure_at_positions(mech, configs)
-        if not (res <= tol.reachability and sig > tol.rank):
+        res, sig, drivers, dj = _positions_stage(mech, batched)
+        if dj is None:
             return done(rejected_by=ScreenStage.ASSEMBLY, min_closure_sigma_positions=sig)
-        drivers = candidate_drivers(mech)
-        djf, _ = dj_function(mech, drivers, configs[0])
-        dj = np.array([djf(c) for c in configs])
         s = np.sign(dj)
         keeps = tuple(d for k, d in enumerate(drivers) if np.all(s[:, k] == s[0, k]) and s[0, k] != 0)
         if not keeps:
             return done(rejected_by=ScreenStage.DJ_SIGNS, min_closure_sigma_positions=sig)
-        r = defect_analysis(mech, drivers=list(keeps), h0=h0, max_arc=max_arc)
+        # one degree of freedom is shown by the assembly stage (the closure Jacobian has full row
+        # rank at the positions, so generically): the analysis's own mobility check is skipped
+        r = defect_analysis(mech, drivers=list(keeps), h0=h0, max_arc=max_arc, check_dof=not batched)
     except (InputError, ValueError, RuntimeError, np.linalg.LinAlgError) as e:
         return done(rejected_by=ScreenStage.ERROR, error=f"{type(e).__name__}: {e}")
     usable = tuple(r.usable_drivers)
