@@ -1,0 +1,98 @@
+"""The screen's batched judgement (issue 29) against its reference path.
+
+- :func:`~spatialmech.synthesis.five_cs.cs_configurations` (vectorised, no SciPy) gives the
+  joint values of :func:`~spatialmech.synthesis.five_cs.cs_configuration` (SciPy's rotations,
+  pose by pose) to 1e-12, on the candidates of paper A's pool and on random poses (hypothesis);
+- ``judge_candidate(batched=True)`` (the positions' stages in one compiled call, the defect
+  analysis without its mobility check) gives the verdict rows of ``batched=False`` (the
+  position-by-position reference) to 1e-10, on the first 30 candidates of paper A's screen
+  (DJ-sign rejections and circuit judgements) and on a usable and a two-circuit candidate.
+"""
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from spatialmech.geometry.rotations import rotvec_matrix
+from spatialmech.model.mechanism import Pose
+from spatialmech.synthesis.five_cs import cs_configuration, cs_configurations
+from spatialmech.synthesis.screening import candidate_linkage, candidate_sets, dyad_pool, judge_candidate
+
+pytestmark = pytest.mark.slow
+
+#: A usable candidate and one rejected by its circuits (two of them): tests/test_screening.py.
+USABLE = [20, 36, 64, 67, 115]
+TWO_CIRCUITS = [27, 67, 70, 122, 128]
+
+
+@pytest.fixture(scope="module")
+def pool(paper_a_cs_family):
+    return dyad_pool(dataclasses.replace(paper_a_cs_family, picks=()), 0.5)
+
+
+def ball_rotations(mech, q):
+    """Each S joint's rotation ``exp(A q_ball)`` (its rotation vector is ambiguous at pi)."""
+    out = []
+    for k, lb in enumerate(mech.limbs):
+        A = np.array([f.direction for f in lb.joints[1].freedoms]).T
+        out.append(rotvec_matrix(A @ q[5 * k + 2:5 * k + 5]))
+    return np.array(out)
+
+
+def test_closed_forms_agree_at_the_positions_of_paper_a_candidates(pool):
+    sets, _ = candidate_sets(pool, 20, seed=0)
+    worst = 0.0
+    for c in [*sets, USABLE, TWO_CIRCUITS]:
+        mech = candidate_linkage(pool, c)
+        fast = cs_configurations(mech)
+        assert fast is not None and len(fast) == len(mech.positions)
+        for P, b in zip(mech.positions, fast, strict=True):
+            a = cs_configuration(mech, P)
+            worst = max(worst, float(np.max(np.abs(a.q - b.q))), float(np.max(np.abs(a.D - b.D))))
+    assert worst < 1e-12, worst  # measured 1.1e-14
+
+
+@given(rv=st.lists(st.floats(-3.0, 3.0), min_size=3, max_size=3), p=st.lists(st.floats(-1.0, 1.0), min_size=3,
+                                                                          max_size=3))
+def test_closed_forms_agree_at_random_poses(pool, rv, p):
+    mech = candidate_linkage(pool, USABLE)
+    P0 = mech.positions[0]
+    pose = Pose(rotvec_matrix(np.array(rv)) @ P0.R, P0.p + np.array(p), "random")
+    a = cs_configuration(mech, pose)
+    (b,) = cs_configurations(mech, [pose])
+    for k in range(5):  # C rotation and slide: the same numbers
+        assert abs(a.q[5 * k] - b.q[5 * k]) < 1e-12 and abs(a.q[5 * k + 1] - b.q[5 * k + 1]) < 1e-12
+    # the S rotations: the same rotation (a rotation vector of angle pi has two spellings)
+    assert np.max(np.abs(ball_rotations(mech, a.q) - ball_rotations(mech, b.q))) < 1e-12
+
+
+def same_row(a: dict, b: dict) -> list[str]:
+    """The columns of two verdict rows that differ (floats beyond 1e-10 relative)."""
+    bad = []
+    for k in a:
+        if k == "seconds":
+            continue
+        x, y = a[k], b[k]
+        if isinstance(x, float) and isinstance(y, float):
+            if not ((math.isnan(x) and math.isnan(y)) or abs(x - y) <= 1e-10 * max(1.0, abs(x))):
+                bad.append(k)
+        elif x != y:
+            bad.append(k)
+    return bad
+
+
+def test_the_batched_judgement_gives_the_reference_verdicts(pool):
+    sets, _ = candidate_sets(pool, 30, seed=0)
+    cands = [*(list(map(int, c)) for c in sets), USABLE, TWO_CIRCUITS]
+    stages = set()
+    for n, c in enumerate(cands):
+        ref = judge_candidate(pool, c, candidate=n, batched=False).row()
+        got = judge_candidate(pool, c, candidate=n, batched=True).row()
+        assert same_row(ref, got) == [], (c, ref, got)
+        stages.add((ref["rejected_by"], ref["circuit_defect"], ref["usable"]))
+    # the set holds DJ-sign rejections, circuit judgements with a circuit defect and a usable one
+    assert ("dj_signs", None, False) in stages and ("circuits", True, False) in stages and (None, False, True) in stages
