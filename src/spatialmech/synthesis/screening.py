@@ -332,9 +332,10 @@ def _closure_at_positions_batched(mech: Mechanism, configs, engine) -> tuple[flo
 def _positions_stage(mech: Mechanism, batched: bool):
     """At the task positions (their C-S configurations): the closure (worst residual, smallest
     scale-free sigma), the candidate drivers and DJ of each at each position (``(positions,
-    drivers)``; ``None`` when the closure fails the assembly stage): stages 1 and 2 of :func:`judge_candidate`.  ``batched``: closed
-    forms vectorised over the positions and the compiled engine called once for all of them
-    (when it is in use); else the reference path, position by position."""
+    drivers)``; ``None`` when the closure fails the assembly stage): stages 1 and 2 of
+    :func:`judge_candidate`.  ``batched``: closed forms vectorised over the positions and the
+    compiled engine called once for all of them (when it is in use); else the reference path,
+    position by position."""
     from ..analysis.defects import candidate_drivers, dj_function
     from ..kinematics import backend
 
@@ -387,7 +388,7 @@ def judge_candidate(pool: DyadPool, idx: Sequence[int], *, candidate: int = 0, h
 
     try:
         mech = candidate_linkage(pool, idx)
-        res, sig, drivers, dj = _positions_stage(mech, batched)
+        _, sig, drivers, dj = _positions_stage(mech, batched)
         if dj is None:
             return done(rejected_by=ScreenStage.ASSEMBLY, min_closure_sigma_positions=sig)
         s = np.sign(dj)
