@@ -9,8 +9,9 @@ local Dask clusters of 1 and 2 worker processes, in the same run.
    the positions' stages in one compiled call per candidate) and by the position-by-position
    reference (``judge_candidate(batched=False)``), alternately in blocks of 10 so that both see
    the same load: the ratio, the time per candidate at each stage, the rows equal (1e-10);
-3. ``--serial`` candidates are screened in this process (``workers=0``): the serial rate, and
-   per CPU second of this process (``time.process_time``);
+3. ``--serial`` candidates are screened in this process (``workers=0``, one BLAS thread as the
+   command line runs; Dask's workers have one by default): the serial rate, and per CPU second
+   of this process (``time.process_time``);
 4. ``--candidates`` candidates (default 1000; the first ``--serial`` of them are the same) are
    screened on a LocalCluster of 1 process (unless ``--no-one-worker``) and of 2 processes on
    loopback: the rates, start-up included, the speed-up of 2 workers over 1 (issue 29's target)
@@ -45,6 +46,7 @@ from pathlib import Path
 
 
 from spatialmech.analysis.defects import defect_analysis
+from spatialmech.api.threads import blas_threads
 from spatialmech.catalog.papers import five_cs_positions
 from spatialmech.services.screen_family import family_key, load_family, save_family
 from spatialmech.services.screening import read_rows, run_screen
@@ -156,7 +158,8 @@ def main() -> None:
             judge_candidate(pool, sets[k], batched=True)
             judge_candidate(pool, sets[k], batched=False)
         load0 = _load()
-        res["batched_vs_reference"] = compare_paths(pool, sets, min(a.compare, len(sets)))
+        with blas_threads():  # as the command line runs (one BLAS thread)
+            res["batched_vs_reference"] = compare_paths(pool, sets, min(a.compare, len(sets)))
         res["batched_vs_reference"]["load_1min"] = [load0, _load()]
         c = res["batched_vs_reference"]
         say(f"batched judgement {c['batched_candidates_per_s']:.2f} /s against the reference "
@@ -168,7 +171,9 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as d:
         d = Path(d)
         load0, c0 = _load(), time.process_time()
-        s0 = run_screen(five_cs_positions(), d / "serial.parquet", candidates=a.serial, workers=0, family=fam, top=0)
+        with blas_threads():  # as `spatialmech screen --workers 0` runs (the workers: Dask's one thread)
+            s0 = run_screen(five_cs_positions(), d / "serial.parquet", candidates=a.serial, workers=0, family=fam,
+                            top=0)
         cpu0 = time.process_time() - c0
         res["serial"] = {"candidates": s0.judged, "seconds": s0.seconds, "candidates_per_s": s0.rate,
                          "cpu_s": cpu0, "candidates_per_cpu_s": s0.judged / cpu0 if cpu0 > 0 else None,
