@@ -28,10 +28,11 @@ import numpy as np
 from ...errors import ConvergenceError
 from ...geometry.tolerances import current
 from ...kinematics.closure import Configuration, active_mask
+from ...kinematics.jacobian import complete_jacobian, driver_determinants
 from ...kinematics.tracking import MotionProblem, conventional_sense
 from ...model.mechanism import Mechanism
 
-__all__ = ["EVENT_LOG_MAX", "MotionRates", "is_noise", "same_event"]
+__all__ = ["EVENT_LOG_MAX", "DriverMonitors", "MotionRates", "is_noise", "same_event"]
 
 #: The most events the studio page keeps in its list (the oldest are dropped).
 EVENT_LOG_MAX = 100
@@ -92,3 +93,110 @@ def same_event(a: dict | None, b: dict, mech: Mechanism) -> bool:
         if any(abs(va[k] - vb[k]) * scale > 1e-6 for k in va):
             return False
     return True
+
+
+class DriverMonitors:
+    """The drivers' readouts and monitors of a studio session (a mixin of
+    :class:`~spatialmech.services.studio.session.Session`, which sets ``mech`` and ``config``):
+    DJ of the chosen drivers, each candidate driver's DJ or rate along the motion, and the
+    vector monitor of a drive."""
+
+    mech: Mechanism
+    config: Configuration
+
+    def _jacobian(self, c: Configuration):
+        """The complete Jacobian at ``c``, remembered for the last configuration asked (a drive
+        evaluates it at its end, and the readout that follows, and the next drive's start, at
+        the same configuration object)."""
+        last = getattr(self, "_last_jacobian", None)
+        if last is not None and last[0] is c and last[2] is self.mech:  # the drivers are part of J
+            return last[1]
+        J = complete_jacobian(self.mech, c)
+        self._last_jacobian = (c, J, self.mech)
+        return J
+
+    def _candidates(self) -> list[str]:
+        """Single drivers whose DJ is watched (a one-degree-of-freedom model: every unlocked
+        non-spherical freedom; otherwise none)."""
+        if len(self.mech.actuators) != 1:
+            return []
+        refs = self.mech.freedom_refs
+        out = []
+        for r in refs:
+            j = self.mech.limbs[r.limb].joints[r.joint]
+            if not r.freedom.locked and j.type not in ("S", "U"):
+                out.append(r.id)
+        return out
+
+    def _driver_dets(self, c: Configuration) -> dict[str, float]:
+        """The single-driver determinants of every candidate driver and the chosen one at ``c``
+        (one evaluation shared by the readout, the drive's stop test and its monitors; the last
+        configuration asked is remembered)."""
+        last = getattr(self, "_last_dets", None)
+        if last is not None and last[0] is c and last[2] is self.mech:
+            return last[1]
+        names = list(dict.fromkeys([*self._candidates(), *self.mech.actuators]))
+        vals = driver_determinants(self.mech, c, names)
+        out = {d: float(v) for d, v in zip(names, vals, strict=True)}
+        self._last_dets = (c, out, self.mech)
+        return out
+
+    def _dj(self, c: Configuration, J=None) -> float | None:
+        """DJ of the chosen drivers: ``det`` of the complete Jacobian (one driver: the
+        sign-continuous driver determinant); ``None`` where it is not square."""
+        if len(self.mech.actuators) == 1:
+            v = self._driver_dets(c)[self.mech.actuators[0]]
+        else:
+            d = (J if J is not None else self._jacobian(c)).det
+            v = float("nan") if d is None else float(d)
+        return v if np.isfinite(v) else None
+
+    def _dj_by_driver(self, c: Configuration) -> dict[str, float]:
+        cands = self._candidates()
+        if not cands:
+            return {}
+        vals = self._driver_dets(c)
+        if not all(np.isfinite(vals[d]) for d in cands):  # not square: each driver's |rate| on the motion
+            return dict(zip(cands, np.abs(self._rates().rates(c, cands)[0]).tolist(), strict=True))
+        return {d: vals[d] for d in cands}
+
+    def _rates(self) -> MotionRates:
+        """The motion's tangent-space rates of the current model (one-degree-of-freedom)."""
+        r = getattr(self, "_motion_rates", None)
+        if r is None or r.mech is not self.mech:
+            r = self._motion_rates = MotionRates(self.mech)
+        return r
+
+    def _dj_readout(self, c: Configuration, J) -> dict:
+        """``dj`` with ``dj_rate`` (one driver: its share of the motion, scale-free, 0 where it
+        loses control) and ``dj_note``, the reason when ``dj`` has no value."""
+        dj = self._dj(c, J)
+        out: dict = {"dj": dj, "dj_rate": None, "dj_note": ""}
+        if len(self.mech.actuators) == 1 and self._candidates():
+            out["dj_rate"] = float(abs(self._rates().rates(c, self.mech.actuators)[0][0]))
+        if dj is None:
+            shape = " x ".join(map(str, J.matrix.shape))
+            out["dj_note"] = (f"the complete Jacobian is {shape}, not square (common constraints): no determinant"
+                              + ("; the driver's rate along the motion (dj_rate) decides where it loses control"
+                                 if out["dj_rate"] is not None else "; sigma_min decides"))
+        return out
+
+    def _other_monitors(self, others: list[str], names: list[str], with_actuators) -> tuple:
+        """The vector monitor of the other candidate drivers along a drive and the scale of its
+        values, and whether they are rates: their DJ where the complete Jacobian is square (scale:
+        the largest |DJ| at the start), else their rates along the motion's tangent, oriented by
+        continuity (scale 1; see :mod:`.monitors`)."""
+        if not others:
+            return None, 1.0, False
+        dets = self._driver_dets(self.config)
+        if all(np.isfinite(dets[d]) for d in others):
+            scale = max(abs(v) for v in dets.values() if np.isfinite(v))
+            return (names, lambda x: [self._driver_dets(with_actuators(x))[d] for d in others]), scale, False
+        rates = self._rates()
+        ref = {"t": rates.tangent(self.config)}
+
+        def vec(x):
+            v, ref["t"] = rates.rates(with_actuators(x), others, ref["t"])
+            return v
+        return (names, vec), 1.0, True
+

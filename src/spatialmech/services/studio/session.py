@@ -38,18 +38,17 @@ from ...geometry.tolerances import NEAR_SINGULAR, current
 from ...kinematics.closure import Configuration, active_mask
 from ...kinematics.backend import closure_residual, correct
 from ...kinematics.motion import generic_configuration
-from ...kinematics.jacobian import complete_jacobian, driver_determinants
-from ...kinematics.dispatch import AssemblyMode, ForwardAnswer, forward_engine, solve_forward
-from ...kinematics.forward import ForwardResult
+from ...kinematics.dispatch import AssemblyMode
 from ...geometry.rotations import check_sequence
-from ...kinematics.position import configuration_at_pose, freedom_values, platform_pose, within_limits
+from ...kinematics.position import freedom_values, platform_pose, within_limits
 from ...kinematics.task import default_task, task_values
 from ...kinematics.tracking import ActuatorPathProblem, conventional_sense, track
 from ...model.mechanism import Mechanism
 from ...model.task import TASK_NAMES, TaskCoordinates
 from ...results import DriveStatus, TrackStatus
 from ...serialize import freedom_values_dict, pose_dict
-from .monitors import MotionRates, is_noise, same_event
+from .modes import AssemblyModes
+from .monitors import DriverMonitors, is_noise, same_event
 from .posing import pose_path, transmission_readout
 from .design import Desk
 from .scene import scene
@@ -75,9 +74,6 @@ SLIDER_HALF_DEG = 360.0
 SLIDER_HALF_L = 1.0
 #: Largest number of tracker steps per drive (a drag is answered quickly or stops).
 MAX_STEPS = 400
-#: Default number of starts of fk_all where the multi-start search answers (interactive: the
-#: ready-made models' modes are found with this many; the other engines take their own defaults).
-FK_ALL_SEEDS = 40
 
 
 @dataclass(frozen=True)
@@ -101,7 +97,7 @@ def _is_rot(mech: Mechanism, fid: str) -> bool:
     return mech.freedom(fid).freedom.kind != "P"
 
 
-class Session:
+class Session(AssemblyModes, DriverMonitors):
     """One studio session on ``model`` (a ready-made name, a TOML path or a Mechanism)."""
 
     def __init__(self, model="five-cs-3"):
@@ -162,20 +158,6 @@ class Session:
         except InputError:
             return 0.0
 
-    def _jacobian(self, c: Configuration):
-        """The complete Jacobian at ``c``, remembered for the last configuration asked (a drive
-        evaluates it at its end, and the readout that follows, and the next drive's start, at
-        the same configuration object)."""
-        last = getattr(self, "_last_jacobian", None)
-        if last is not None and last[0] is c and last[2] is self.mech:  # the drivers are part of J
-            return last[1]
-        J = complete_jacobian(self.mech, c)
-        self._last_jacobian = (c, J, self.mech)
-        return J
-
-    def _platform_point(self, c: Configuration) -> np.ndarray:
-        return c.D[:3, :3] @ self.mech.platform_point + c.D[:3, 3]
-
     # ------------------------------------------------------------------ actuator values
     def actuator_values(self, config: Configuration | None = None) -> np.ndarray:
         """The current actuator values (SI, radians), in the order of ``mech.actuators``."""
@@ -214,73 +196,6 @@ class Session:
                 raise InputError(f"{name}[{k}] ({a}): expected a finite number, got {v!r}")
             out.append(np.radians(v) if _is_rot(self.mech, a) else float(v))
         return np.array(out, dtype=float)
-
-    # ------------------------------------------------------------------ monitors
-    def _candidates(self) -> list[str]:
-        """Single drivers whose DJ is watched (a one-degree-of-freedom model: every unlocked
-        non-spherical freedom; otherwise none)."""
-        if len(self.mech.actuators) != 1:
-            return []
-        refs = self.mech.freedom_refs
-        out = []
-        for r in refs:
-            j = self.mech.limbs[r.limb].joints[r.joint]
-            if not r.freedom.locked and j.type not in ("S", "U"):
-                out.append(r.id)
-        return out
-
-    def _driver_dets(self, c: Configuration) -> dict[str, float]:
-        """The single-driver determinants of every candidate driver and the chosen one at ``c``
-        (one evaluation shared by the readout, the drive's stop test and its monitors; the last
-        configuration asked is remembered)."""
-        last = getattr(self, "_last_dets", None)
-        if last is not None and last[0] is c and last[2] is self.mech:
-            return last[1]
-        names = list(dict.fromkeys([*self._candidates(), *self.mech.actuators]))
-        vals = driver_determinants(self.mech, c, names)
-        out = {d: float(v) for d, v in zip(names, vals, strict=True)}
-        self._last_dets = (c, out, self.mech)
-        return out
-
-    def _dj(self, c: Configuration, J=None) -> float | None:
-        """DJ of the chosen drivers: ``det`` of the complete Jacobian (one driver: the
-        sign-continuous driver determinant); ``None`` where it is not square."""
-        if len(self.mech.actuators) == 1:
-            v = self._driver_dets(c)[self.mech.actuators[0]]
-        else:
-            d = (J if J is not None else self._jacobian(c)).det
-            v = float("nan") if d is None else float(d)
-        return v if np.isfinite(v) else None
-
-    def _dj_by_driver(self, c: Configuration) -> dict[str, float]:
-        cands = self._candidates()
-        if not cands:
-            return {}
-        vals = self._driver_dets(c)
-        if not all(np.isfinite(vals[d]) for d in cands):  # not square: each driver's |rate| on the motion
-            return dict(zip(cands, np.abs(self._rates().rates(c, cands)[0]).tolist(), strict=True))
-        return {d: vals[d] for d in cands}
-
-    def _rates(self) -> MotionRates:
-        """The motion's tangent-space rates of the current model (one-degree-of-freedom)."""
-        r = getattr(self, "_motion_rates", None)
-        if r is None or r.mech is not self.mech:
-            r = self._motion_rates = MotionRates(self.mech)
-        return r
-
-    def _dj_readout(self, c: Configuration, J) -> dict:
-        """``dj`` with ``dj_rate`` (one driver: its share of the motion, scale-free, 0 where it
-        loses control) and ``dj_note``, the reason when ``dj`` has no value."""
-        dj = self._dj(c, J)
-        out: dict = {"dj": dj, "dj_rate": None, "dj_note": ""}
-        if len(self.mech.actuators) == 1 and self._candidates():
-            out["dj_rate"] = float(abs(self._rates().rates(c, self.mech.actuators)[0][0]))
-        if dj is None:
-            shape = " x ".join(map(str, J.matrix.shape))
-            out["dj_note"] = (f"the complete Jacobian is {shape}, not square (common constraints): no determinant"
-                              + ("; the driver's rate along the motion (dj_rate) decides where it loses control"
-                                 if out["dj_rate"] is not None else "; sigma_min decides"))
-        return out
 
     # ------------------------------------------------------------------ readouts
     def state(self) -> dict:
@@ -588,25 +503,6 @@ class Session:
         return self._stop_before(r, STOPPED_TRACKER, msg, events, steps, elapsed,
                                  requested, with_actuators)
 
-    def _other_monitors(self, others: list[str], names: list[str], with_actuators) -> tuple:
-        """The vector monitor of the other candidate drivers along a drive and the scale of its
-        values, and whether they are rates: their DJ where the complete Jacobian is square (scale:
-        the largest |DJ| at the start), else their rates along the motion's tangent, oriented by
-        continuity (scale 1; see :mod:`.monitors`)."""
-        if not others:
-            return None, 1.0, False
-        dets = self._driver_dets(self.config)
-        if all(np.isfinite(dets[d]) for d in others):
-            scale = max(abs(v) for v in dets.values() if np.isfinite(v))
-            return (names, lambda x: [self._driver_dets(with_actuators(x))[d] for d in others]), scale, False
-        rates = self._rates()
-        ref = {"t": rates.tangent(self.config)}
-
-        def vec(x):
-            v, ref["t"] = rates.rates(with_actuators(x), others, ref["t"])
-            return v
-        return (names, vec), 1.0, True
-
     def parse_pose(self, task_len=None, task_deg=None, *, euler=None, relative=False) -> tuple[TaskCoordinates, np.ndarray]:
         """The task coordinates and the six target values (SI, rad) of a pose request:
         ``task_len`` (x, y, z in the model's length unit) and ``task_deg`` (a1, a2, a3 in
@@ -722,77 +618,9 @@ class Session:
         del self.history[:-400]
         self.driven.append(self.actuator_values(config))
 
-    def circuit(self, frames: int = 240) -> dict:
-        """The whole circuit through the current configuration of a one-degree-of-freedom model
-        (the tracker, as ``view --motion trace``): the platform point along it and where DJ of
-        the chosen driver vanishes (its branch points).  Cached per driver and branch start."""
-        if len(self.mech.actuators) != 1:
-            raise InputError(f"circuit: {self.mech.name} is driven by {len(self.mech.actuators)} actuators; the traced "
-                             "circuit is drawn for one-degree-of-freedom linkages")
-        from ...analysis.traced_motion import traced_motion
-
-        key = (self.mech.actuators, id(self.fk_branch))
-        if self._circuit.get("key") != key:
-            configs, zeros = traced_motion(self.mech, frames=frames, start=self.config)
-            pts = [self._platform_point(c) for c in configs]
-            self._circuit = {"key": key, "circuit_len": [p.tolist() for p in pts],
-                             "dj_zeros_len": [self._platform_point(z).tolist() for z in zeros]}
-        return {k: v for k, v in self._circuit.items() if k != "key"}
-
-    def fk_all(self, seeds: int | None = None) -> list[dict]:
-        """Every assembly mode at the current actuator values, by the engine the one dispatcher
-        picks (:func:`~spatialmech.kinematics.dispatch.solve_forward` with ``method="auto"``: the
-        modes of ``sm.fk(..., all_solutions=True)`` and ``fk --all``); the mode nearest the
-        current configuration first.  ``seeds``: the starts of a multi-start search (default: the
-        engine's, :data:`FK_ALL_SEEDS` where the multi-start search answers); refused where
-        homotopy continuation answers (it takes no starts)."""
-        if seeds is not None and (isinstance(seeds, bool) or not isinstance(seeds, int) or not 1 <= seeds <= 2000):
-            raise InputError(f"seeds: expected a whole number of starts from 1 to 2000, got {seeds!r}")
-        if seeds is None and forward_engine(self.mech) == "multistart":
-            seeds = FK_ALL_SEEDS
-        ans = solve_forward(self.mech, self.actuator_values(), all_solutions=True, seeds=seeds)
-        modes = list(zip(ans.modes, _mode_configurations(ans), strict=True))
-        here = platform_pose(self.mech, self.config)
-        L = self.mech.characteristic_length
-        if modes:  # the current configuration's mode first, the others in the dispatcher's order
-            near = min(range(len(modes)), key=lambda k: float(np.linalg.norm(modes[k][0].pose.p - here.p)) / L
-                       + float(np.linalg.norm(modes[k][0].pose.R - here.R)))
-            modes.insert(0, modes.pop(near))
-        self.fk_modes = modes
-        return [{"mode_number": k + 1, "kind": str(m.kind), "pose": pose_dict(m.pose.R, m.pose.p),
-                 "sigma_min": float(m.sigma_min), "singular": bool(m.sigma_min < m.singular_below),
-                 "within_limits": m.within_limits} for k, (m, _) in enumerate(modes)]
-
-    def pick_mode(self, number) -> None:
-        """Move to assembly mode ``number`` (from 1) of the last :meth:`fk_all` (an explicit
-        branch change)."""
-        if isinstance(number, bool) or not isinstance(number, int):
-            raise InputError(f"mode_number: expected a whole number, got {number!r}")
-        if not self.fk_modes:
-            raise InputError("mode_number: run fk_all first (POST /api/fk_all)")
-        if not 1 <= number <= len(self.fk_modes):
-            raise InputError(f"mode_number: expected 1 to {len(self.fk_modes)}, got {number}")
-        mode, config = self.fk_modes[number - 1]
-        if config is None:  # an engine that gives the pose only (a closed form): the configuration at it
-            fit = configuration_at_pose(self.mech, mode.pose, start=self.config)
-            if not fit.converged:
-                raise InputError(f"mode_number: no closed configuration at mode {number}'s pose "
-                                 f"(residual {fit.ik_residual:.2e})")
-            config = fit.config
-        self.config = config
-        self.fk_branch = object()
-        self.history, self.driven = [self._platform_point(self.config)], [self.actuator_values()]
 
 
 def _real_events(events, names: list[str], scale: float) -> list:
     """The tracker's events without the sign changes of round-off among the monitors ``names``
     (a rate or DJ that is zero on the whole path: both sides below ``singular`` x ``scale``)."""
     return [e for e in events if e.name not in names or not is_noise(e.value_before, e.value_after, scale)]
-
-
-def _mode_configurations(ans: ForwardAnswer) -> list[Configuration | None]:
-    """The configuration of every mode of ``ans`` where its engine gives one (the general
-    engine's converged solutions, in the order of the modes), else ``None``."""
-    if isinstance(ans.detail, ForwardResult):
-        return [s.config for s in ans.detail.solutions if s.converged]
-    return [None] * len(ans.modes)
