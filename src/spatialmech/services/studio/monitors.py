@@ -19,9 +19,17 @@ must not decide anything.  Instead:
   drive is a dead point of ``d``, never a kernel's choice.  The readout shows ``|t_d|``.
 * A sign change counts only when one side exceeds :attr:`Tolerances.singular` (a freedom whose
   rate is round-off on the whole path, e.g. a joint that does not move, has no events).
+* A zero that falls exactly on a driven sample (planar-4r's B1.rot at 120 deg, driven in 10-deg
+  steps) is counted once, by the drive that arrives there, whatever the kernel: there the rate
+  is round-off (1e-16) of either sign, so neither "the drive that ends there crossed" nor "the
+  next drive starts on the other side" may be decided by its sign.  A value below the noise
+  level at the target is a zero reached (:meth:`DriverMonitors._sample_events`); a drive that
+  starts on one is not a new event.
 """
 
 from __future__ import annotations
+
+from typing import cast
 
 import numpy as np
 
@@ -29,7 +37,7 @@ from ...errors import ConvergenceError
 from ...geometry.tolerances import current
 from ...kinematics.closure import Configuration, active_mask
 from ...kinematics.jacobian import complete_jacobian, driver_determinants
-from ...kinematics.tracking import MotionProblem, conventional_sense
+from ...kinematics.tracking import Event, MotionProblem, TrackResult, conventional_sense
 from ...model.mechanism import Mechanism
 
 __all__ = ["EVENT_LOG_MAX", "DriverMonitors", "MotionRates", "is_noise", "same_event"]
@@ -200,3 +208,27 @@ class DriverMonitors:
             return v
         return (names, vec), 1.0, True
 
+    def _sample_events(self, r: TrackResult, names: list[str], scale: float, ell: float, vector,
+                       end: Configuration | None) -> list[Event]:
+        """The events of drive ``r`` (to ``lambda = ell``) counted as passed: the tracker's sign
+        changes without round-off among the other drivers' monitors ``names`` (:func:`is_noise`
+        with ``scale``), without those in the overshoot of the last step (beyond the target) and
+        without a zero the drive starts on; with a zero reached exactly at the target ``end`` (the
+        closed configuration at the requested values, ``None`` when it was not reached): once,
+        at the target, whatever side the round-off puts it on."""
+        tol = current().singular * max(float(scale), 1e-300)
+        raw = [e for e in r.events if e.name not in names or not is_noise(e.value_before, e.value_after, scale)]
+        raw = [e for e in raw if not (e.name in names and e.step == 0 and abs(e.value_before) < tol)]
+        keep = [e for e in raw if float(cast(tuple, e.x)[1]) <= ell]
+        if end is None or vector is None:
+            return keep
+        last = len(r.points) - 2  # the step that reached the target starts at this tracked point
+        f_end = np.asarray(vector[1]((end, ell)), dtype=float)
+        for k, n in enumerate(names):
+            before = float(r.monitors[n][-2]) if len(r.points) >= 2 else 0.0
+            if abs(f_end[k]) >= tol or abs(before) < tol:
+                continue  # not at a zero, or round-off on the whole last step
+            if any(e.name == n and e.step == last and float(cast(tuple, e.x)[1]) <= ell for e in raw):
+                continue  # located before the target on this step: counted there
+            keep.append(Event(n, float(r.s[-1]), (end, ell), last, before, 0.0, 0.0, (before, 0.0)))
+        return keep

@@ -48,7 +48,7 @@ from ...model.task import TASK_NAMES, TaskCoordinates
 from ...results import DriveStatus, TrackStatus
 from ...serialize import freedom_values_dict, pose_dict
 from .modes import AssemblyModes
-from .monitors import DriverMonitors, is_noise, same_event
+from .monitors import DriverMonitors, same_event
 from .posing import pose_path, transmission_readout
 from .design import Desk
 from .scene import scene
@@ -432,10 +432,9 @@ class Session(AssemblyModes, DriverMonitors):
         events = []
         step_of: dict[int, int] = {}  # event -> index of the tracked point its step starts from
         own_crossed = None
-        for e in _real_events(r.events, names, noise_scale):
-            xe = cast(np.ndarray, e.x)  # the drag problem's points are vectors (the pose's x, lambda)
-            if float(xe[1]) > ell:  # in the overshoot of the last step: not on the way to the target
-                continue
+        res = self._close_at(r, a1, act_idx, offsets) if why["reason"] == "reached" else None
+        for e in self._sample_events(r, names, noise_scale, ell, vector, res.config if res and res.converged else None):
+            xe = cast(np.ndarray, e.x)  # the drag problem's points are (configuration, lambda)
             a_e = a0 + (float(xe[1]) / ell) * delta
             ev = {"name": e.name, "kind": str(e.kind), **self._display(a_e)}
             if e.name == DEAD_POINT:
@@ -458,14 +457,7 @@ class Session(AssemblyModes, DriverMonitors):
             step_of[id(ev)] = e.step
         reason = why["reason"]
         elapsed = lambda: time.perf_counter() - t_start  # noqa: E731
-        if reason == "reached":
-            last = r.points[-1][0]
-            mask = active_mask(m)
-            for i in act_idx:
-                mask[i] = False
-            q = last.q.copy()
-            q[act_idx] = a1 - offsets
-            res = correct(m, last.with_q(q), active=mask, max_iter=30)
+        if res is not None:
             if res.converged:
                 fin = self._dj(res.config)
                 if own0 is not None and fin is not None and np.sign(fin) != np.sign(own0) and fin != 0:
@@ -502,6 +494,16 @@ class Session(AssemblyModes, DriverMonitors):
             msg = f"the tracker stopped on this branch: {r.message}"
         return self._stop_before(r, STOPPED_TRACKER, msg, events, steps, elapsed,
                                  requested, with_actuators)
+
+    def _close_at(self, r, a1: np.ndarray, act_idx: list[int], offsets: np.ndarray):
+        """Closure at the requested actuator values ``a1`` from the last tracked point of ``r``."""
+        m = self.mech
+        last = r.points[-1][0]
+        mask = active_mask(m)
+        mask[act_idx] = False
+        q = last.q.copy()
+        q[act_idx] = a1 - offsets
+        return correct(m, last.with_q(q), active=mask, max_iter=30)
 
     def parse_pose(self, task_len=None, task_deg=None, *, euler=None, relative=False) -> tuple[TaskCoordinates, np.ndarray]:
         """The task coordinates and the six target values (SI, rad) of a pose request:
@@ -617,10 +619,3 @@ class Session(AssemblyModes, DriverMonitors):
         self.history.append(self._platform_point(config))
         del self.history[:-400]
         self.driven.append(self.actuator_values(config))
-
-
-
-def _real_events(events, names: list[str], scale: float) -> list:
-    """The tracker's events without the sign changes of round-off among the monitors ``names``
-    (a rate or DJ that is zero on the whole path: both sides below ``singular`` x ``scale``)."""
-    return [e for e in events if e.name not in names or not is_noise(e.value_before, e.value_after, scale)]
