@@ -247,6 +247,7 @@ UNIT_FREE_KEYS: dict[str, str] = {
     "normal": "unit normal of a plane",
     "on_curve": "nondimensional on-curve tolerance",
     "path_length": "arc length of the path from the first to the last position, nondimensional",
+    "plane_normal": "unit normal of a planar linkage's plane (the studio's top view)",
     "platform_frame": "columns: the platform's x, y, z unit vectors",
     "pose_error": "nondimensional pose error (rad, and length / characteristic length)",
     "position_arcs": "arc of each task position along the first circuit, nondimensional",

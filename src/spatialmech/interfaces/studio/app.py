@@ -220,6 +220,12 @@ def add_desk_routes(app: FastAPI, session, lock, doc, body, guarded) -> None:
         with lock:
             return _json(doc(session.desk.sweep(data.get("driver"), data.get("samples", 61))))
 
+    async def drag(request: Request):
+        data = await body(request, "point_len")
+        with lock:
+            r = session.drag_output(data["point_len"])
+            return _json(doc({**r.to_dict(), "state": session.state()}))
+
     async def path_csv(request: Request):
         with lock:
             name = session.mech.name
@@ -228,7 +234,7 @@ def add_desk_routes(app: FastAPI, session, lock, doc, body, guarded) -> None:
 
     app.add_api_route("/api/path.csv", guarded(path_csv), methods=["GET"])
     for path, fn in (("/api/snapshot", snapshot), ("/api/undo", undo), ("/api/restore", restore),
-                     ("/api/coupler", coupler), ("/api/sweep", sweep)):
+                     ("/api/coupler", coupler), ("/api/sweep", sweep), ("/api/drag", drag)):
         app.add_api_route(path, guarded(fn), methods=["POST"])
 
 

@@ -575,6 +575,22 @@ class Session(AssemblyModes, DriverMonitors):
         events, msg = self._once(events[0] if events else None, events, r.message)
         return DriveResult(r.status, msg, tuple(events), r.steps, time.perf_counter() - t_start, requested)
 
+    def drag_output(self, point_len) -> DriveResult:
+        """The drag handle of the page's 3-D view: move the output point toward ``point_len``
+        (x, y, z in the model's length unit) along the current branch.  The translational task
+        coordinates the mechanism controls (``state.task.given`` among x, y, z) take the point's
+        values, the others keep theirs (a planar 4-bar controls x only: its coupler point
+        follows x); then as :meth:`drive_pose`."""
+        if (not isinstance(point_len, (list, tuple)) or len(point_len) != 3
+                or any(isinstance(v, bool) or not isinstance(v, (int, float)) or not np.isfinite(v) for v in point_len)):
+            raise InputError(f"point_len: expected three finite numbers x, y, z ({self.mech.length_unit}), got {point_len!r}")
+        t = self.task()
+        given = [n for n in TASK_NAMES[:3] if t is not None and n in t.given]
+        if not given:
+            raise InputError(f"point_len: {self.mech.name} does not control the output point's position "
+                             f"(given: {', '.join(t.given) if t is not None else 'none'}); use the pose sliders")
+        return self.drive_pose({n: float(point_len[TASK_NAMES.index(n)]) for n in given})
+
     def _once(self, stop_event: dict | None, events: list, msg: str) -> tuple[list, str]:
         """Drop the event of a stop that repeats the last one (the same place, met again by a
         drive further on: the page logs it once) and remember it."""

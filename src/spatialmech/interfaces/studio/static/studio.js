@@ -5,7 +5,8 @@
 "use strict";
 
 const EVENT_LOG_MAX = 100;  // services/studio/monitors.EVENT_LOG_MAX
-const S = { state: null, circuit: null, unit: "", inFlight: false, pending: null, range: null, drawn: 0, errors: [] };
+const S = { state: null, circuit: null, unit: "", inFlight: false, pending: null, range: null, drawn: 0, errors: [],
+  topView: false, viewRev: 0, nEvents: 0 };
 window.studio = S;
 
 async function api(path, body) {
@@ -85,11 +86,92 @@ function draw() {
   const sc = S.state.scene;
   if (!S.range) S.range = sceneRange(sc);
   const ax = (r, n) => ({ range: r, autorange: false, title: { text: n + " [" + S.unit + "]" } });  // the bundled plotly needs title.text
-  const layout = { uirevision: "studio", margin: { l: 0, r: 0, t: 30, b: 0 }, title: { text: S.state.mechanism },
+  const layout = { uirevision: "studio-" + S.viewRev, margin: { l: 0, r: 0, t: 30, b: 0 },
+    title: { text: S.state.mechanism + (S.topView ? " (top view: along the plane's normal)" : "") },
     scene: { aspectmode: "cube", xaxis: ax(S.range[0], "x"), yaxis: ax(S.range[1], "y"), zaxis: ax(S.range[2], "z") },
     legend: { itemsizing: "constant" } };
+  const n = sc.plane_normal;
+  if (S.topView && n) {  // look along the plane's normal, orthographic, an in-plane "up"
+    const [, e2] = planeBasis(n);
+    layout.scene.camera = { eye: { x: 2 * n[0], y: 2 * n[1], z: 2 * n[2] }, up: { x: e2[0], y: e2[1], z: e2[2] },
+      center: { x: 0, y: 0, z: 0 }, projection: { type: "orthographic" } };
+  }
   Plotly.react("plot", traces(sc), layout, { displaylogo: false, responsive: true });
   S.drawn += 1;
+}
+
+// ------------------------------------------------------------------ top view and drag handle
+function cross(a, b) { return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]; }
+function dot(a, b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+function unit(a) { const l = Math.hypot(a[0], a[1], a[2]); return mul(a, 1 / l); }
+
+// in-plane axes (e1, e2) of the plane with normal n: e2 the world axis least along n (y first),
+// made perpendicular to n; e1 = e2 x n (right-handed seen from the normal's side)
+function planeBasis(n) {
+  const cand = [[0, 1, 0], [1, 0, 0], [0, 0, 1]].sort((a, b) => Math.abs(dot(a, n)) - Math.abs(dot(b, n)))[0];
+  const e2 = unit(add(cand, mul(n, -dot(cand, n))));
+  return [cross(e2, n), e2];
+}
+
+function showViewToggle() {
+  const b = document.getElementById("view-toggle"), planar = !!S.state.scene.plane_normal;
+  b.style.display = planar ? "" : "none";
+  b.textContent = S.topView ? "3-D view" : "top view";
+}
+
+function toggleView() { S.topView = !S.topView; S.viewRev += 1; S.traceKey = ""; showViewToggle(); draw(); }
+
+// The drag handle: the output point projected on a plane (a planar linkage's own plane, else the
+// plane of the first two of x, y, z the mechanism controls); dragging it posts /api/drag with the
+// point under the mouse (the coordinate along the plane's normal kept), which moves the given
+// translational task coordinates there by the pose drag's continuation (Session.drag_output).
+function padFrame() {
+  const st = S.state, sc = st.scene, given = st.task ? st.task.given.filter(g => "xyz".includes(g)) : [];
+  if (!given.length) return null;
+  const axes = { x: [1, 0, 0], y: [0, 1, 0], z: [0, 0, 1] };
+  let e1, e2, label;
+  if (sc.plane_normal) { [e1, e2] = planeBasis(sc.plane_normal); label = "the linkage's plane"; }
+  else {
+    const names = given.concat(["x", "y", "z"].filter(g => !given.includes(g))).slice(0, 2);
+    [e1, e2] = [axes[names[0]], axes[names[1]]]; label = names[0] + "-" + names[1] + " plane";
+  }
+  const c = S.range.map(r => (r[0] + r[1]) / 2), half = (S.range[0][1] - S.range[0][0]) / 2;
+  return { e1, e2, c, half, label, given };
+}
+
+function padXY(f, p) { const d = add(p, mul(f.c, -1)); return [100 + 100 * dot(d, f.e1) / f.half, 100 - 100 * dot(d, f.e2) / f.half]; }
+
+function drawPad() {
+  const pad = document.getElementById("drag-pad");
+  const f = S.range ? padFrame() : null;
+  S.pad = f;
+  if (!f) { pad.style.display = "none"; return; }
+  pad.style.display = "";
+  const sc = S.state.scene, line = (pts, col, w) => `<polyline fill="none" stroke="${col}" stroke-width="${w}" points="` +
+    pts.map(p => padXY(f, p).map(v => v.toFixed(1)).join(",")).join(" ") + `"/>`;
+  const [u, v] = padXY(f, sc.platform_point_len);
+  document.getElementById("drag-pad-label").textContent = "drag the output point (" + f.given.join(", ") + "), " + f.label;
+  document.getElementById("drag-svg").innerHTML = line(sc.base_len, "#999", 1) +
+    sc.limbs_len.map((pl, li) => line(pl, sc.limb_colours[li], 2)).join("") + line(sc.platform_len, "#ff7f0e", 2) +
+    `<circle id="drag-handle" cx="${u.toFixed(1)}" cy="${v.toFixed(1)}" r="6" fill="#ff7f0e" stroke="#000"/>`;
+}
+
+function padPoint(ev) {  // the 3-D point under the mouse (the current output point's normal coordinate kept)
+  const f = S.pad, r = document.getElementById("drag-svg").getBoundingClientRect();
+  const u = (ev.clientX - r.left - 100) / 100 * f.half, v = -(ev.clientY - r.top - 100) / 100 * f.half;
+  const p = S.state.scene.platform_point_len, d = add(p, mul(f.c, -1));
+  return add(p, add(mul(f.e1, u - dot(d, f.e1)), mul(f.e2, v - dot(d, f.e2))));
+}
+
+function dragTo(ev) { if (!S.pad) return; S.pending = { path: "/api/drag", body: { point_len: padPoint(ev) } }; pump(); }
+
+function initPad() {
+  const svg = document.getElementById("drag-svg");
+  svg.addEventListener("pointerdown", ev => { S.padDown = true; svg.setPointerCapture(ev.pointerId); dragTo(ev); });
+  svg.addEventListener("pointermove", ev => { if (S.padDown) dragTo(ev); });
+  const up = () => { S.padDown = false; };
+  svg.addEventListener("pointerup", up); svg.addEventListener("pointercancel", up);
+  document.getElementById("view-toggle").addEventListener("click", toggleView);
 }
 
 // ------------------------------------------------------------------ controls and readouts
@@ -180,15 +262,15 @@ function logEvent(e) {
   li.textContent = e.name + " (" + e.kind + ") at " + vals.join(", ") + ": " + e.meaning;
   const ol = document.getElementById("events"); ol.insertBefore(li, ol.firstChild);
   while (ol.children.length > EVENT_LOG_MAX) ol.removeChild(ol.lastChild);  // a bounded list, newest first
+  S.nEvents += 1;
+  document.getElementById("event-count").textContent = "(" + S.nEvents + ")";
 }
 
 function update(st) {
   S.state = st;
   const sig = st.sigma_min, cls = st.singular ? "sing" : (st.near_singular ? "near" : "ok");
   const icls = st.transmission_min === null ? "" : st.inverse_singular ? "sing" : (st.near_inverse_singular ? "near" : "ok");
-  const p = st.pose, rows = [
-    ["output point [" + S.unit + "]", p.position_len.map(x => fmt(x, 5)).join(", ")],
-    ["orientation " + p.euler_sequence + " [deg]", p.euler_deg.map(x => fmt(x, 5)).join(", ")],
+  const p = st.pose, keys = [
     ["DJ of the drivers", st.dj !== null ? fmt(st.dj, 5)
       : `<span id="dj-note" title="${st.dj_note}">n/a</span>` + (st.dj_rate !== null ? "; driver rate " + fmt(st.dj_rate, 4) : "")
         + `<div class="small">${st.dj_note}</div>`],
@@ -198,17 +280,23 @@ function update(st) {
       (st.transmission_min_actuator ? " " + st.transmission_min_actuator : "") +
       (st.inverse_singular ? " inverse singular (< " + st.inverse_singular_below + ")"
         : st.near_inverse_singular ? " near an inverse singularity (< " + st.near_inverse_singular_below + ")" : "")],
+  ], rows = [
+    ["output point [" + S.unit + "]", p.position_len.map(x => fmt(x, 5)).join(", ")],
+    ["orientation " + p.euler_sequence + " [deg]", p.euler_deg.map(x => fmt(x, 5)).join(", ")],
     ["closure residual", fmt(st.residual, 3)],
     ["outside joint limits", st.outside_limits.length ? st.outside_limits.join(", ") : "none"],
   ];
   rows.unshift(...actuatorEntries(st).map(a => [a.name + " [" + a.unit + "]", fmt(a.value, 7)]));
-  document.getElementById("readouts").innerHTML = rows.map(r => `<tr><td>${r[0]}</td><td>${r[1]}</td></tr>`).join("");
+  const table = rs => rs.map(r => `<tr><td>${r[0]}</td><td>${r[1]}</td></tr>`).join("");
+  document.getElementById("readouts").innerHTML = table(keys);  // the key readouts, above the sliders
+  document.getElementById("readouts-more").innerHTML = table(rows);
   const j = Object.entries(st.joints_deg).map(([k, v]) => [k, fmt(v, 6) + " deg"])
     .concat(Object.entries(st.joints_len).map(([k, v]) => [k, fmt(v, 6) + " " + S.unit]));
   document.getElementById("joints").innerHTML = j.map(r => `<tr><td>${r[0]}</td><td>${r[1]}</td></tr>`).join("");
   document.getElementById("note").textContent = st.note;
   syncSliders();
   draw();
+  drawPad();
 }
 
 function fillDrivers(st) {
@@ -226,6 +314,9 @@ async function loadDoc(doc) {
   sel.innerHTML = doc.model_info.ready_made.map(n => `<option${n === doc.model ? " selected" : ""}>${n}</option>`).join("");
   if (!doc.model_info.ready_made.includes(doc.model)) sel.insertAdjacentHTML("afterbegin", `<option selected>${doc.model}</option>`);
   document.getElementById("events").innerHTML = "";
+  S.nEvents = 0; document.getElementById("event-count").textContent = "(0)";
+  S.topView = !!doc.state.scene.plane_normal; S.viewRev += 1;  // a planar linkage opens in its top view
+  showViewToggle();
   document.getElementById("modes").innerHTML = "";
   S.state = doc.state;
   fillDrivers(doc.state);
@@ -244,6 +335,7 @@ async function loadCircuit() {  // one-degree-of-freedom models: the traced circ
 
 async function main() {
   window.addEventListener("error", e => S.errors.push(String(e.message)));
+  initPad();
   loadDoc(await api("/api/model"));
   document.getElementById("model-select").addEventListener("change", async ev => {
     setStatus("", "loading " + ev.target.value + " ...");
