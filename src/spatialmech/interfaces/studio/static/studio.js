@@ -315,10 +315,11 @@ async function loadDoc(doc) {
   if (!doc.model_info.ready_made.includes(doc.model)) sel.insertAdjacentHTML("afterbegin", `<option selected>${doc.model}</option>`);
   document.getElementById("events").innerHTML = "";
   S.nEvents = 0; document.getElementById("event-count").textContent = "(0)";
-  S.topView = !!doc.state.scene.plane_normal; S.viewRev += 1;  // a planar linkage opens in its top view
-  showViewToggle();
+
   document.getElementById("modes").innerHTML = "";
   S.state = doc.state;
+  S.topView = !!doc.state.scene.plane_normal; S.viewRev += 1;  // a planar linkage opens in its top view
+  showViewToggle();
   fillDrivers(doc.state);
   buildSliders();
   buildPoseSliders();
