@@ -163,7 +163,11 @@ function padPoint(ev) {  // the 3-D point under the mouse (the current output po
   return add(p, add(mul(f.e1, u - dot(d, f.e1)), mul(f.e2, v - dot(d, f.e2))));
 }
 
-function dragTo(ev) { if (!S.pad) return; S.pending = { path: "/api/drag", body: { point_len: padPoint(ev) } }; pump(); }
+function dragTo(ev) {
+  if (!S.pad) return;
+  S.lastDragPoint = padPoint(ev);
+  S.pending = { path: "/api/drag", body: { point_len: S.lastDragPoint } }; pump();
+}
 
 function initPad() {
   const svg = document.getElementById("drag-svg");
