@@ -27,6 +27,10 @@ event to the second animation frame after the answer is drawn: the server, the J
 drawing), with the page's smaller redraw (``Plotly.restyle`` of the traces that moved,
 static/design.js) and with the full ``Plotly.react`` of studio.js, in the same run; target
 50 ms per frame (printed met / NOT met on the median).  Needs chromium, chromedriver, selenium.
+Where the frame time goes (same run, ``breakdown``): the answer (fetch and its text), the
+page's redraw (``draw`` and the drag pad, JavaScript), the paint (two animation frames after
+it: WebGL, software in headless Chromium) and the floor of that measurement (two animation
+frames with nothing redrawn).
 """
 
 from __future__ import annotations
@@ -160,6 +164,32 @@ const [n, step, fast, done] = [arguments[0], arguments[1], arguments[2], argumen
 """
 
 
+BREAKDOWN_JS = """
+const [n, step, done] = [arguments[0], arguments[1], arguments[arguments.length - 1]];
+(async () => {
+  const S = window.studio, out = { answer: [], redraw: [], paint: [], floor: [] };
+  const paint = () => new Promise(res => requestAnimationFrame(() => requestAnimationFrame(res)));
+  S.fastRedraw = true;
+  let a = S.state.actuators_deg[S.state.drivers[0]];
+  for (let k = 0; k < n; k++) {
+    a += step;
+    const t0 = performance.now();
+    const r = await fetch("/api/drive", { method: "POST", headers: { "Content-Type": "application/json" },
+                                          body: JSON.stringify({ actuators: [a] }) });
+    const doc = JSON.parse(await r.text());
+    const t1 = performance.now();
+    S.state = doc.state; draw(); drawPad();
+    const t2 = performance.now();
+    await paint();
+    const t3 = performance.now();
+    await paint();
+    out.answer.push(t1 - t0); out.redraw.push(t2 - t1); out.paint.push(t3 - t2); out.floor.push(performance.now() - t3);
+  }
+  done(out);
+})();
+"""
+
+
 def browser_frames(model: str, step: float, n: int) -> dict:
     """Frame and draw times of a slider drag in headless Chromium (the page's performance.now():
     from the slider's input event to the second animation frame after the answer is drawn),
@@ -203,6 +233,8 @@ def browser_frames(model: str, step: float, n: int) -> dict:
             out[label] = {"frame_median_ms": float(np.median(r["frames"])), "frame_p95_ms": float(np.percentile(r["frames"], 95)),
                           "draw_median_ms": float(np.median(r["draws"])) if r["draws"] else None, "errors": r["errors"]}
             step = -step  # drag back and forth
+        r = drv.execute_async_script(BREAKDOWN_JS, n, step)
+        out["breakdown"] = {f"{k}_median_ms": float(np.median(v)) for k, v in r.items()}
         return out
     finally:
         drv.quit()
@@ -235,6 +267,7 @@ def main(argv=None) -> dict:
                       f"draw {a['draw_median_ms']:.1f} ms; full react: frame {b['frame_median_ms']:.0f} ms, draw "
                       f"{b['draw_median_ms']:.1f} ms (ratio restyle/react {a['frame_median_ms'] / b['frame_median_ms']:.2f}); "
                       f"target < {FRAME_TARGET_MS:.0f} ms: {'met' if r['met'] else 'NOT met'}")
+                print("  where it goes (medians): " + ", ".join(f"{k[:-10]} {v:.1f} ms" for k, v in r["breakdown"].items()))
         return {"browser": res}
     drags = [run_drag(m, s, 10 if args.quick else n) for m, s, n in DRAG_CASES]
     rows = [] if args.drag else [run(m, s, 10 if args.quick else n) for m, s, n in CASES]
