@@ -26,7 +26,7 @@ def test_plane_normal_rule():
     assert plane_normal([r(-n), r(2 * n), r(n)]) == pytest.approx(n)  # oriented by the largest component
     assert plane_normal([r(n), r(n), p(np.cross(n, [0.0, 0.0, 1.0]))]) == pytest.approx(n)  # a slider-crank
     assert plane_normal([r(n), r(n), p(n)]) is None  # a slide out of the plane
-    assert plane_normal([r(n), r(n + [0.0, 0.0, 1e-4])]) is None  # not parallel
+    assert plane_normal([r(n), r(n + np.array([0.0, 0.0, 1e-4]))]) is None  # not parallel
     assert plane_normal([r(n), r(n), {"type": "S", "axes": []}]) is None
     assert plane_normal([r(n)]) is None
 
@@ -44,7 +44,7 @@ def test_the_drag_handle_moves_the_output_point_along_the_branch():
 
     st = Session("stewart-6sps")  # x, y, z given: the point goes where the mouse is
     p = np.array(st.scene()["platform_point_len"])
-    want = p + [0.05, -0.03, 0.0]
+    want = p + np.array([0.05, -0.03, 0.0])
     assert st.drag_output(want.tolist()).status == "reached"
     assert np.allclose(st.scene()["platform_point_len"], want, atol=1e-9)
 
@@ -70,3 +70,13 @@ def test_the_drag_route(studio_ok):
     assert doc["state"]["scene"]["plane_normal"] == pytest.approx([0.0, 0.0, 1.0], abs=1e-12)
     bad = client.post("/api/drag", json={"point_len": [1.0]})
     assert bad.status_code == 422 and bad.json()["error"].startswith("point_len")
+
+
+def test_the_notebook_widget_opens_a_planar_linkage_in_its_top_view():
+    pytest.importorskip("anywidget")
+    from spatialmech.interfaces.studio.widget import figure
+
+    cam = figure(Session("planar-4r").state(), "m")["layout"]["scene"]["camera"]
+    assert [cam["eye"][a] for a in "xyz"] == pytest.approx([0.0, 0.0, 2.0])
+    assert [cam["up"][a] for a in "xyz"] == pytest.approx([0.0, 1.0, 0.0]) and cam["projection"]["type"] == "orthographic"
+    assert "camera" not in figure(Session("rssr").state(), "m")["layout"]["scene"]

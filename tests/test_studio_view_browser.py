@@ -32,9 +32,11 @@ def load(driver, model):
 
 RECTS = """const r = id => document.getElementById(id).getBoundingClientRect();
 return {fold: innerHeight, sigma: r('sigma').bottom, transmission: r('transmission').bottom,
-        dj: document.getElementById('readouts').rows[0].getBoundingClientRect().bottom, events: r('events').top, sliders: r('sliders').top,
+        dj: document.getElementById('readouts').rows[0].getBoundingClientRect().bottom,
+        events: r('events').top, sliders: r('sliders').top,
         pad: getComputedStyle(document.getElementById('drag-pad')).display};"""
-CAMERA = "const c = document.getElementById('plot')._fullLayout.scene.camera; return [c.eye.x, c.eye.y, c.eye.z, c.projection.type];"
+CAMERA = ("const c = document.getElementById('plot')._fullLayout.scene.camera;"
+          "return [c.eye.x, c.eye.y, c.eye.z, c.projection.type];")
 
 
 def test_readouts_above_the_fold_top_view_and_drag_handle(server, browser):  # noqa: F811

@@ -31,7 +31,7 @@ from ...errors import ConvergenceError, InputError
 from ...serialize import json_default
 from .assets import plotly_js_path
 
-__all__ = ["StudioWidget", "figure", "studio"]
+__all__ = ["StudioWidget", "figure", "studio", "top_camera"]
 
 #: Height of the 3-D view in the notebook (CSS pixels).
 VIEW_HEIGHT_PX = 460
@@ -83,7 +83,24 @@ def figure(state: dict, unit: str) -> dict:
               "title": {"text": state["mechanism"]},
               "scene": {"aspectmode": "data", "xaxis": ax["x"], "yaxis": ax["y"], "zaxis": ax["z"]},
               "legend": {"itemsizing": "constant"}}
+    if sc.get("plane_normal") is not None:  # a planar linkage: its top view, as the page opens it
+        layout["scene"]["camera"] = top_camera(sc["plane_normal"])
+        layout["title"]["text"] += " (top view: along the plane's normal)"
     return {"data": data, "layout": layout}
+
+
+def top_camera(normal) -> dict:
+    """The plotly camera looking along a planar linkage's plane ``normal`` (orthographic), with
+    the world axis least along it (y first) made perpendicular to it as "up" (as the page's
+    ``planeBasis``)."""
+    n = [float(v) for v in normal]
+    dot = lambda a, b: sum(x * y for x, y in zip(a, b, strict=True))  # noqa: E731
+    cand = min(([0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]), key=lambda a: abs(dot(a, n)))
+    up = [c - dot(cand, n) * v for c, v in zip(cand, n, strict=True)]
+    norm = dot(up, up) ** 0.5
+    return {"eye": dict(zip("xyz", (2.0 * v for v in n), strict=True)),
+            "up": dict(zip("xyz", (v / norm for v in up), strict=True)),
+            "center": {"x": 0.0, "y": 0.0, "z": 0.0}, "projection": {"type": "orthographic"}}
 
 
 class StudioWidget(anywidget.AnyWidget):
