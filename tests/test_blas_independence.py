@@ -197,9 +197,9 @@ def test_the_studio_tangent_space_events_do_not_follow_the_factorisation(other_k
     are the same under the other kernel."""
     def turn():
         s = Session("planar-4r")
-        # samples 3 deg off the 10-deg grid: B1.rot's dead points lie exactly at 120 and 300 deg,
-        # and a dead point exactly at a sample is missed under some kernels (a known bug, noted)
-        evs = [e for k in range(0, 37) for e in s.drive([3.0 + 10.0 * k]).events]
+        # on the 10-deg grid: B1.rot's dead points lie exactly on the samples 120 and 300 deg
+        # (counted once whatever the round-off's sign: test_a_dead_point_on_a_driven_sample_...)
+        evs = [e for k in range(0, 37) for e in s.drive([10.0 * k]).events]
         return [(e["driver"], e["actuators_deg"]["A0.rot"]) for e in evs], s.state()["dj_by_driver"]
 
     e0, d0 = turn()
