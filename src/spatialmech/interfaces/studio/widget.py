@@ -79,13 +79,13 @@ def figure(state: dict, unit: str) -> dict:
     trail = sc["trail_len"] if len(sc["trail_len"]) > 1 else [p]
     data.append({**line(trail, "#ff7f0e", 2, "platform point path"), "line": {"color": "#ff7f0e", "width": 2, "dash": "dot"}})
     ax = {n: {"title": {"text": f"{n} [{unit}]"}} for n in "xyz"}
+    planar = sc.get("plane_normal") is not None  # a planar linkage: its top view, as the page opens it
+    scene: dict = {"aspectmode": "data", "xaxis": ax["x"], "yaxis": ax["y"], "zaxis": ax["z"]}
+    if planar:
+        scene["camera"] = top_camera(sc["plane_normal"])
     layout = {"uirevision": "studio", "height": VIEW_HEIGHT_PX, "margin": {"l": 0, "r": 0, "t": 30, "b": 0},
-              "title": {"text": state["mechanism"]},
-              "scene": {"aspectmode": "data", "xaxis": ax["x"], "yaxis": ax["y"], "zaxis": ax["z"]},
-              "legend": {"itemsizing": "constant"}}
-    if sc.get("plane_normal") is not None:  # a planar linkage: its top view, as the page opens it
-        layout["scene"]["camera"] = top_camera(sc["plane_normal"])
-        layout["title"]["text"] += " (top view: along the plane's normal)"
+              "title": {"text": state["mechanism"] + (" (top view: along the plane's normal)" if planar else "")},
+              "scene": scene, "legend": {"itemsizing": "constant"}}
     return {"data": data, "layout": layout}
 
 
