@@ -137,3 +137,21 @@ def test_pose_fit_does_not_stop_in_a_wrong_local_minimum():
     mech = catalog.build("five-cs-2")
     fit = configuration_at_pose(mech, mech.positions[4])
     assert fit.converged and fit.position_error < 0.05 and np.degrees(fit.angle_error) < 0.5
+
+
+@pytest.mark.parametrize("name", ["five-cs-3", "three-rps"])
+def test_complete_jacobians_share_the_constraints_exactly(name):
+    """complete_jacobians (one evaluation of the constraint wrenches for several actuator sets,
+    as the DJ table uses it) equals complete_jacobian called per set, bit for bit."""
+    from spatialmech.analysis.defects import candidate_drivers
+    from spatialmech.kinematics.jacobian import complete_jacobians
+
+    mech = catalog.build(name)
+    config = generic_configuration(mech)
+    sets = [[d] for d in candidate_drivers(mech)] + [None]
+    for got, a in zip(complete_jacobians(mech, config, sets), sets, strict=True):
+        ref = complete_jacobian(mech, config, a)
+        assert np.array_equal(got.matrix, ref.matrix)
+        assert got.actuators == ref.actuators and got.constraint_limbs == ref.constraint_limbs
+        assert got.inverse_singular == ref.inverse_singular and got.transmission == ref.transmission
+        assert got.sigma_min == ref.sigma_min

@@ -37,7 +37,7 @@ from .closure import Configuration, active_mask, closure_scales, limb_slices
 from .backend import closure_jacobian, joint_twists
 
 __all__ = ["SINGULAR_SIGMA", "CompleteJacobian", "actuation_wrench", "closure_determinant", "complete_jacobian",
-           "limb_constraint_wrenches"]
+           "complete_jacobians", "limb_constraint_wrenches"]
 
 #: Scale-free smallest singular value (:attr:`CompleteJacobian.sigma_min`) below which a
 #: configuration is reported as singular (``"singular": true`` in JSON, a flag in text): the
@@ -216,6 +216,25 @@ def complete_jacobian(
     ``reference``: a Jacobian at a nearby configuration of the same mechanism and actuators,
     to keep multi-wrench constraint bases continuous along a path.
     """
+    act_ids = _actuator_ids(mech, actuators)
+    if mech.bodies:
+        return _graph_jacobian(mech, config, act_ids)
+    return _with_actuators(mech, _ConstraintPart.at(mech, config, reference), act_ids)
+
+
+def complete_jacobians(mech: Mechanism, config: Configuration, actuator_sets) -> list[CompleteJacobian]:
+    """The complete Jacobians of ``mech`` at ``config`` for several sets of actuators (each
+    as :func:`complete_jacobian` takes them), sharing one evaluation of the joint twists and of
+    the limbs' constraint wrenches: equal, entry for entry, to
+    ``[complete_jacobian(mech, config, a) for a in actuator_sets]``."""
+    ids = [_actuator_ids(mech, a) for a in actuator_sets]
+    if mech.bodies:
+        return [_graph_jacobian(mech, config, a) for a in ids]
+    part = _ConstraintPart.at(mech, config, None)
+    return [_with_actuators(mech, part, a) for a in ids]
+
+
+def _actuator_ids(mech: Mechanism, actuators) -> list[str]:
     if actuators is None:
         act_ids = list(mech.actuators)
     else:
@@ -224,29 +243,47 @@ def complete_jacobian(
         act_ids = [mech.freedom(a).id for a in actuators]
     if len(set(act_ids)) != len(act_ids):
         raise InputError(f"actuators: repeated freedom in {list(actuators)}")
-    if mech.bodies:
-        return _graph_jacobian(mech, config, act_ids)
-    L = mech.characteristic_length
-    twists = joint_twists(mech, config)
+    return act_ids
+
+
+@dataclass(frozen=True, eq=False)
+class _ConstraintPart:
+    """The actuator-free part of a complete Jacobian: each limb's active twists and constraint
+    wrenches at one configuration."""
+
+    L: float
+    active_idx: list[list[int]]
+    per_limb: list[tuple[np.ndarray, np.ndarray]]  # (T, W) by limb
+    rows: list[np.ndarray]
+    limbs_of_rows: list[int]
+
+    @classmethod
+    def at(cls, mech: Mechanism, config: Configuration, reference: CompleteJacobian | None) -> _ConstraintPart:
+        L = mech.characteristic_length
+        twists = joint_twists(mech, config)
+        refs = mech.freedom_refs
+        ref_rows = {}
+        if reference is not None:
+            for k in set(reference.constraint_limbs):
+                ref_rows[k] = reference.constraints[[i for i, kk in enumerate(reference.constraint_limbs) if kk == k]]
+        active_idx, per_limb, rows, limbs_of_rows = [], [], [], []
+        for k, sl in enumerate(limb_slices(mech)):
+            idx = [i for i in range(sl.start, sl.stop) if not refs[i].freedom.locked]
+            active_idx.append(idx)
+            T = twists[k][:, [i - sl.start for i in idx]].T
+            W = limb_constraint_wrenches(T, length_scale=L, reference=ref_rows.get(k))
+            per_limb.append((T, W))
+            for w in W:
+                rows.append(w)
+                limbs_of_rows.append(k)
+        return cls(L, active_idx, per_limb, rows, limbs_of_rows)
+
+
+def _with_actuators(mech: Mechanism, part: _ConstraintPart, act_ids: list[str]) -> CompleteJacobian:
+    L = part.L
     refs = mech.freedom_refs
     by_id = {r.id: r for r in refs}
-    sls = limb_slices(mech)
-    rows, limbs_of_rows = [], []
-    per_limb_constraints = []
-    ref_rows = {}
-    if reference is not None:
-        for k in set(reference.constraint_limbs):
-            ref_rows[k] = reference.constraints[[i for i, kk in enumerate(reference.constraint_limbs) if kk == k]]
-    active_idx = []
-    for k, sl in enumerate(sls):
-        idx = [i for i in range(sl.start, sl.stop) if not refs[i].freedom.locked]
-        active_idx.append(idx)
-        T = twists[k][:, [i - sl.start for i in idx]].T
-        W = limb_constraint_wrenches(T, length_scale=L, reference=ref_rows.get(k))
-        per_limb_constraints.append((T, W))
-        for w in W:
-            rows.append(w)
-            limbs_of_rows.append(k)
+    rows = list(part.rows)
     n_c = len(rows)
     singular = []
     trans = []
@@ -254,8 +291,8 @@ def complete_jacobian(
         r = by_id[a]
         if r.freedom.locked:
             raise InputError(f"actuators: {a} is locked in this mode")
-        T, W = per_limb_constraints[r.limb]
-        col = active_idx[r.limb].index(refs.index(r))
+        T, W = part.per_limb[r.limb]
+        col = part.active_idx[r.limb].index(refs.index(r))
         w, tau = actuation_wrench(T, col, W, length_scale=L, with_transmission=True)
         trans.append(tau)
         if w is None:
@@ -263,7 +300,7 @@ def complete_jacobian(
             w = np.zeros(6)
         rows.append(w)
     M = sc.swap(np.array(rows)) if rows else np.zeros((0, 6))
-    return CompleteJacobian(M, n_c, tuple(limbs_of_rows), tuple(act_ids), tuple(singular), L, tuple(trans))
+    return CompleteJacobian(M, n_c, tuple(part.limbs_of_rows), tuple(act_ids), tuple(singular), L, tuple(trans))
 
 
 def _graph_jacobian(mech: Mechanism, config: Configuration, act_ids: list[str]) -> CompleteJacobian:
