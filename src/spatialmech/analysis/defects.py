@@ -38,7 +38,7 @@ from ..errors import InputError
 from ..geometry import screws as sc
 from ..kinematics.closure import Configuration, active_mask, closure_scales
 from ..kinematics.backend import closure_jacobian
-from ..kinematics.jacobian import complete_jacobian, driver_determinants
+from ..kinematics.jacobian import complete_jacobians, driver_determinants
 from ..geometry.tolerances import current as current_tolerances
 from ..kinematics.position import PoseFit, configuration_at_pose, freedom_values
 from ..kinematics.tracking import MotionProblem, TrackResult
@@ -326,9 +326,9 @@ def dj_table(mech: Mechanism, drivers=None, positions=None) -> DJTable:
     djf, _ = dj_function(mech, list(drivers), fits[0].config)
     dj = np.array([djf(f.config) for f in fits]).T
     sig = np.empty_like(dj)
-    for i, d in enumerate(drivers):
-        for k, f in enumerate(fits):
-            sig[i, k] = complete_jacobian(mech, f.config, [d]).sigma_min
+    for k, f in enumerate(fits):  # one set of constraint wrenches per position, shared by the drivers
+        for i, cj in enumerate(complete_jacobians(mech, f.config, [[d] for d in drivers])):
+            sig[i, k] = cj.sigma_min
     return DJTable(mech.name, tuple(p.name for p in positions), drivers, dj, sig, tuple(fits))
 
 
@@ -421,10 +421,10 @@ def defect_analysis(
     djf, dj_method = dj_function(mech, drivers, fits[0].config)
     dj_pos = table.dj.T  # (positions, drivers)
 
-    problems, traces = _trace_circuits(mech, fits, drivers, djf, on_curve_tol, max_arc, h0, say, sense)
+    problems, traces, on_curve = _trace_circuits(mech, fits, drivers, djf, on_curve_tol, max_arc, h0, say, sense)
     say("assigning the positions to circuits")
     circ = _assign_circuits(mech, positions, fits, problems, traces, pose_tol=pose_tol,
-                            angle_tol=np.radians(angle_tol_deg), on_curve_tol=on_curve_tol)
+                            angle_tol=np.radians(angle_tol_deg), on_curve_tol=on_curve_tol, on_curve=on_curve)
     circuit_defect = len(circ.circuits) > 1
     path = _path_along_first_circuit(circ)
     order_defect = path.order_defect
@@ -507,23 +507,35 @@ def _check_one_dof(mech: Mechanism) -> None:
         raise InputError(f"mechanism: the defect analysis is for one-degree-of-freedom linkages; {mech.name} has {dof}")
 
 
+#: :func:`arc_on_curve`'s answer by (traced circuit, position), both from 0.
+_OnCurve = dict[tuple[int, int], float | None]
+
+
 def _trace_circuits(mech: Mechanism, fits: list[PoseFit], drivers: list[str], djf, on_curve_tol: float,
                     max_arc: float, h0: float, say: Steps,
-                    sense: int = 1) -> tuple[list[MotionProblem], list[TrackResult]]:
+                    sense: int = 1) -> tuple[list[MotionProblem], list[TrackResult], _OnCurve]:
     """Step 3a: trace circuits until every fitted position lies on a traced curve (to
     ``on_curve_tol``, nondimensional): the circuit through position 1, then one through each
-    position that no traced circuit passes through, in order."""
+    position that no traced circuit passes through, in order.  Also returns the
+    :func:`arc_on_curve` answers it computed, by (circuit, position), for
+    :func:`_assign_circuits` to reuse."""
     traces: list[TrackResult] = []
     problems: list[MotionProblem] = []
+    on_curve: _OnCurve = {}
     for j, fit in enumerate(fits):
-        if any(arc_on_curve(pr, tr, fit.config, on_curve_tol) is not None
-               for pr, tr in zip(problems, traces, strict=True)):
+        found = False
+        for c, (pr, tr) in enumerate(zip(problems, traces, strict=True)):
+            on_curve[c, j] = arc_on_curve(pr, tr, fit.config, on_curve_tol)
+            if on_curve[c, j] is not None:
+                found = True
+                break
+        if found:
             continue
         say(f"tracing the circuit through position {j + 1}")
         prob, tr = trace_circuit(mech, fit.config, drivers, djf, max_arc, h0, None, sense=sense)
         traces.append(tr)
         problems.append(prob)
-    return problems, traces
+    return problems, traces, on_curve
 
 
 @dataclass(frozen=True, eq=False)
@@ -539,12 +551,14 @@ class _Circuits:
 
 
 def _assign_circuits(mech: Mechanism, positions, fits: list[PoseFit], problems: list[MotionProblem],
-                     traces: list[TrackResult], *, pose_tol: float, angle_tol: float, on_curve_tol: float) -> _Circuits:
+                     traces: list[TrackResult], *, pose_tol: float, angle_tol: float, on_curve_tol: float,
+                     on_curve: _OnCurve | None = None) -> _Circuits:
     """Step 3b: every position's distance from every traced circuit (0 when its fitted
     configuration lies on it; else the normalised distance of the printed pose,
     :func:`pose_distance`, ``angle_tol`` in rad), the fewest circuits that hold every position
     (:func:`fewest_circuits`), each position on its nearest kept circuit; the kept circuits are
-    renumbered in the order of their first position."""
+    renumbered in the order of their first position.  ``on_curve``: :func:`arc_on_curve`'s
+    answers already computed (by :func:`_trace_circuits`), by (circuit, position)."""
     n = len(positions)
     Dm = np.empty((len(traces), n))
     meas: dict[tuple[int, int], tuple[float, float, float, float]] = {}
@@ -552,7 +566,12 @@ def _assign_circuits(mech: Mechanism, positions, fits: list[PoseFit], problems: 
         for j, P in enumerate(positions):
             # exactly on the curve (the fitted configuration itself): unambiguous, even where the
             # platform takes the same pose twice on a circuit; else the nearest pose on the curve
-            a = 0.0 if tr.points[0] is fits[j].config else arc_on_curve(pr, tr, fits[j].config, on_curve_tol)
+            if tr.points[0] is fits[j].config:
+                a: float | None = 0.0
+            elif on_curve is not None and (c, j) in on_curve:  # already asked by _trace_circuits
+                a = on_curve[c, j]
+            else:
+                a = arc_on_curve(pr, tr, fits[j].config, on_curve_tol)
             if a is not None:
                 meas[c, j] = (0.0, float(a), fits[j].position_error, fits[j].angle_error)
             else:
@@ -707,10 +726,14 @@ def _distance_to_singularities(mech: Mechanism, problem: MotionProblem, tr0: Tra
     if sig:
         mval, marc = min(sig)
         min_sig, min_between = mval, positions_between(marc, path.path_arcs)
+    watched = [vd.driver for vd in verdicts if vd.driver in watch]
+    # one set of constraint wrenches per point, shared by the watched drivers
+    per_point = [complete_jacobians(mech, x, [[d] for d in watched]) for _, x in path_pts] if watched else []
     new = []
     for vd in verdicts:
         if vd.driver in watch:
-            vals = [complete_jacobian(mech, x, [vd.driver]).sigma_min for _, x in path_pts]
+            i = watched.index(vd.driver)
+            vals = [cjs[i].sigma_min for cjs in per_point]
             vd = replace(vd, min_sigma_on_path=float(min(vals)) if vals else None)
         new.append(vd)
     return min_sig, min_between, new
