@@ -177,3 +177,36 @@ def test_the_other_crank_solution_of_a_limb_has_another_mode_signature():
     near = min(other, key=distance)
     assert mode_signature(mech, with_limb(near))[0] == -mode_signature(mech, ref)[0] != 0
     assert mode_signature(mech, with_limb(near))[1:] == mode_signature(mech, ref)[1:]
+
+
+def test_ik_with_every_solution_answers_in_the_working_mode_nearest_the_start():
+    """``sm.ik(..., all_solutions=True)`` answers (``actuators``, ``config``) with each limb's
+    solution nearest the start (the reference), as ``sm.ik`` without it: the homotopy's path order
+    is arbitrary, and limb 1 of the 6-RUS came back at its reference pose with the crank at
+    120.9 deg while ``sm.jacobian`` used the reference's 0 deg.  From a start in limb 1's other
+    crank mode, that mode comes first.  (After the test above: the limbs' generic solve is cached.)"""
+    from spatialmech.kinematics.closure import Configuration, limb_slices
+    from spatialmech.kinematics.position import inverse_position
+
+    def wrapped(x):
+        return np.angle(np.exp(1j * np.asarray(x)))
+
+    mech = six_rus()
+    for pose in (([0, 0, 0.2], ("ZYX", 0, 0, 0)), ([0.01, -0.005, 0.195], ("ZYX", 3.0, -2.0, 1.0))):
+        one = sm.ik(mech, pose, degrees=True)
+        every = sm.ik(mech, pose, degrees=True, all_solutions=True, certify=False)
+        assert every.reachable and every.actuators == pytest.approx(one.actuators, abs=1e-9)
+        assert max(abs(v) for v in every.actuators.values()) < np.radians(20)  # the other crank mode: > 100 deg
+        for ls in every.result.limbs:
+            far = [np.max(np.abs(wrapped(q))) for q in ls.solutions]
+            assert len(far) == 4 and far[0] == min(far) < 0.35 < min(far[1:])  # a distinct nearest, first
+        J = sm.jacobian(mech, pose, degrees=True)
+        assert sm.jacobian(mech, config=every.config).det == pytest.approx(J.det, rel=1e-7)
+    sols = every.result.limbs[0].solutions
+    other = sols[int(np.argmax([abs(wrapped(q[0])) for q in sols]))]  # crank 112.8 deg
+    q = every.config.q.copy()
+    q[limb_slices(mech)[0]] = other
+    P = every.result.pose
+    start = Configuration(q, P.displacement(mech.platform_point), every.config.B)
+    res = inverse_position(mech, P, all_solutions=True, start=start)
+    assert np.max(np.abs(wrapped(res.limbs[0].solutions[0] - other))) < 1e-7

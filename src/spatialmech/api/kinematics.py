@@ -134,7 +134,9 @@ def ik(model: ModelLike, pose, *, all_solutions: bool = False, n_seeds: int = 48
         ``(xyz, None)`` (the reference orientation) or ``int`` N, the model's N-th task position
         (from 1).
     all_solutions : bool
-        Also ``n_seeds`` random starts per limb (every real solution it finds).
+        Every real solution of each limb (``method``), listed nearest the reference
+        configuration first; ``actuators`` and ``config`` are each limb's first.  Without it,
+        one solution per limb: Gauss-Newton from the reference (normally its working mode).
     n_seeds : int
         Random starts per limb with ``all_solutions``.
     seed : int

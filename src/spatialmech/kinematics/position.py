@@ -417,7 +417,7 @@ def _solve_limb(mech: Mechanism, li: int, D: np.ndarray, q_start: np.ndarray, q_
             refused = (auto_reason(mech, li, seed) if method == "auto" else None) or ""
             if not refused:
                 hres = limb_inverse(mech, li, D, seed=seed)
-                ls, cert = _certify_limb(mech, li, D, _homotopy_limb(mech, li, D, q_all, hres, t), seed)
+                ls, cert = _certify_limb(mech, li, D, _homotopy_limb(mech, li, D, q_start, q_all, hres, t), seed)
                 return ls, {"limb": name, **hres.report(), **cert}
         except InputError as exc:
             refused = str(exc)
@@ -434,9 +434,12 @@ def _solve_limb(mech: Mechanism, li: int, D: np.ndarray, q_start: np.ndarray, q_
     return res, rep
 
 
-def _homotopy_limb(mech: Mechanism, li: int, D: np.ndarray, q_all: np.ndarray, hres, t: Tolerances) -> LimbSolutions:
+def _homotopy_limb(mech: Mechanism, li: int, D: np.ndarray, q_start: np.ndarray, q_all: np.ndarray, hres,
+                   t: Tolerances) -> LimbSolutions:
     """The homotopy's real solutions of a limb, polished by Gauss-Newton on the limb, checked
-    against the closure tolerance and told apart (:func:`solution_key`); fills ``q_all``."""
+    against the closure tolerance and told apart (:func:`solution_key`), nearest the start
+    ``q_start`` first (the order of the homotopy's paths is arbitrary; the multi-start's first
+    solution is also the start's own); fills ``q_all`` with the first."""
     L = mech.characteristic_length
     ch, sl = limb_chains(mech)[li], limb_slices(mech)[li]
     lin = np.array([r.freedom.kind == "P" for r in mech.freedom_refs[sl]])
@@ -455,6 +458,9 @@ def _homotopy_limb(mech: Mechanism, li: int, D: np.ndarray, q_all: np.ndarray, h
         keys.append(key)
         sols.append(q)
         res.append(rn)
+    home = solution_key(form, q_start[sl])
+    order = sorted(range(len(sols)), key=lambda k: (float(np.linalg.norm(keys[k] - home)), k))
+    sols, res = [sols[k] for k in order], [res[k] for k in order]
     idx_l = set(range(sl.start, sl.stop))
     if sols:
         q_all[sl] = sols[0]
