@@ -120,3 +120,20 @@ def test_ball_joint_has_no_gimbal_lock_at_ninety_degrees():
     q3 = recentre_balls(mech, q2)
     assert np.linalg.norm(q3[1:4]) < np.pi
     assert np.allclose(chain_forward(ch, q2[:7])[0], chain_forward(ch, q3[:7])[0])
+
+
+@pytest.mark.parametrize("size", [1e-13, 5e-13, 1e-9])
+def test_tiny_ball_rotations_and_logs_are_first_order_exact(size, rng):
+    """A ball joint's rotation below 1e-12 rad still moves the chain (it was dropped: Newton then
+    stalled on a 1.5e-12 residual, the spatial six-bar at a 6e-11 deg crank), and the log of a
+    displacement that small keeps its rotation and the first-order term of its translation:
+    ``T(q + dq) T(q)^-1`` is ``exp(J dq)`` and its log is ``J dq`` to second order."""
+    from spatialmech.kinematics.closure import _log_single, chain_forward, limb_chains
+
+    ch = limb_chains(catalog.build("rssr"))[0]  # R, S, S
+    for q in (np.zeros(len(ch.screws)), rng.uniform(-1.0, 1.0, len(ch.screws))):
+        T, J = chain_forward(ch, q, local=False)
+        dq = rng.normal(size=len(q)) * size
+        dT = chain_forward(ch, q + dq)[0] @ inverse_transform(T)
+        for V in (log_transform(dT), _log_single(dT)):
+            assert np.allclose(V, J @ dq, rtol=0, atol=2e-15 + 1e-6 * size)  # 2e-15: round-off of T (L = 1)

@@ -164,8 +164,8 @@ def log_transform(T) -> np.ndarray:
     out = np.zeros((flat.shape[0], 6))
     for i in range(flat.shape[0]):
         p = flat[i, :3, 3]
-        if th[i] < 1e-12:
-            out[i] = np.concatenate([np.zeros(3), p])
+        if th[i] < 1e-12:  # first order: a rotation this small is still one (G^-1 p = p - w x p / 2)
+            out[i] = np.concatenate([rv[i], p - 0.5 * np.cross(rv[i], p)])
             continue
         w = rv[i] / th[i]
         W = skew(w)

@@ -260,8 +260,8 @@ def chain_forward(chain: Chain, q: np.ndarray, *, prefixes: bool = False, local:
             if th > 1e-12:
                 K = skew(phi / th)
                 Rb = _rodrigues(K, K @ K, th)
-            else:
-                Rb = np.eye(3)
+            else:  # first order (exact to th^2): a rotation this small still moves the chain
+                Rb = np.eye(3) + skew(phi)
             Wc = A if local else _left_jacobian_so3(phi) @ A
             for j in range(3):
                 d = R @ Wc[:, j]
@@ -305,8 +305,9 @@ def _log_single(T: np.ndarray) -> np.ndarray:
     sn = 0.5 * float(np.sqrt(w_raw @ w_raw))
     th = float(np.arctan2(sn, c))  # accurate for small angles, unlike arccos
     p = T[:3, 3]
-    if th < 1e-8:
-        return np.r_[0.5 * w_raw, p]
+    if th < 1e-8:  # first order in the angle (G^-1 p = p - w x p / 2; dropping it errs by th |p| / 2)
+        w = 0.5 * w_raw
+        return np.r_[w, p - 0.5 * _cross(w, p)]
     w = w_raw / (2.0 * sn)
     W = skew(w)
     Ginv = np.eye(3) / th - 0.5 * W + (1.0 / th - 0.5 / np.tan(th / 2.0)) * (W @ W)

@@ -30,8 +30,8 @@ def nb_joint_motion(S, ball_of, ball_axes, ball_centre, q, i, Rb, u):
         th = np.sqrt(f0 * f0 + f1 * f1 + f2 * f2)
         if th > 1e-12:
             nb_rodrigues(f0 / th, f1 / th, f2 / th, np.sin(th), 1.0 - np.cos(th), Rb)
-        else:
-            nb_rodrigues(0.0, 0.0, 0.0, 0.0, 0.0, Rb)
+        else:  # I + skew(phi): first order, as closure.chain_forward
+            nb_rodrigues(f0, f1, f2, 1.0, 0.0, Rb)
         for a in range(3):  # T <- T [Rb, c - Rb c]
             u[a] = c[a] - (Rb[a, 0] * c[0] + Rb[a, 1] * c[1] + Rb[a, 2] * c[2])
         return 3

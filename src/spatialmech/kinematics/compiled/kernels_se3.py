@@ -181,9 +181,12 @@ def nb_log(T, fast, out):
         w2 = T[1, 0] - T[0, 1]
         sn = 0.5 * np.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
         th = np.arctan2(sn, c)
-        if th < 1e-8:
-            out[0], out[1], out[2] = 0.5 * w0, 0.5 * w1, 0.5 * w2
-            out[3], out[4], out[5] = p0, p1, p2
+        if th < 1e-8:  # first order, as closure._log_single
+            w0, w1, w2 = 0.5 * w0, 0.5 * w1, 0.5 * w2
+            out[0], out[1], out[2] = w0, w1, w2
+            out[3] = p0 - 0.5 * (w1 * p2 - w2 * p1)
+            out[4] = p1 - 0.5 * (w2 * p0 - w0 * p2)
+            out[5] = p2 - 0.5 * (w0 * p1 - w1 * p0)
             return
         f = 1.0 / (2.0 * sn)
         w0, w1, w2 = w0 * f, w1 * f, w2 * f
@@ -195,9 +198,11 @@ def nb_log(T, fast, out):
         rv = np.empty(3)
         nb_quat_rotvec(Rc, rv)
         th = np.sqrt(rv[0] ** 2 + rv[1] ** 2 + rv[2] ** 2)
-        if th < 1e-12:
-            out[0] = out[1] = out[2] = 0.0
-            out[3], out[4], out[5] = p0, p1, p2
+        if th < 1e-12:  # first order, as log_transform
+            out[0], out[1], out[2] = rv[0], rv[1], rv[2]
+            out[3] = p0 - 0.5 * (rv[1] * p2 - rv[2] * p1)
+            out[4] = p1 - 0.5 * (rv[2] * p0 - rv[0] * p2)
+            out[5] = p2 - 0.5 * (rv[0] * p1 - rv[1] * p0)
             return
         w0, w1, w2 = rv[0] / th, rv[1] / th, rv[2] / th
     # G^-1 p = p / th - 0.5 w x p + a w x (w x p),  a = 1 / th - cot(th / 2) / 2
