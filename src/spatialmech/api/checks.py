@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal, overload
 
@@ -203,6 +204,30 @@ def as_configuration(mech: Mechanism, pose, config, degrees: bool, *, pose_name:
     if not fit.converged:
         raise InputError(f"{pose_name}: no closed configuration near it (residual {fit.ik_residual:.2e})")
     return fit.config, fit
+
+
+@dataclass(frozen=True, eq=False)
+class Where:
+    """The arguments of a verb that analyses one configuration, checked (:func:`where`)."""
+
+    mech: Mechanism
+    config: Configuration
+    fit: PoseFit | None  # the pose fitted onto the closure (a pose given)
+    pose: Pose | None  # the requested pose (a pose given)
+    drivers: list[str] | None
+    degrees: bool
+
+
+def where(model: ModelLike, pose, config, drivers=None, degrees=False) -> Where:
+    """The model, ``degrees``, ``drivers`` and the configuration to analyse (:func:`as_configuration`)
+    of a verb's ``(model, pose=None, *, config=None, drivers=None, degrees=False)``, checked in
+    that order: the one parser of these arguments."""
+    mech = as_mechanism(model)
+    degrees = check_bool(degrees, "degrees")
+    drivers = check_names(drivers, "drivers")
+    c, fit = as_configuration(mech, pose, config, degrees)
+    requested = as_pose(mech, pose, degrees)[0] if pose is not None else None
+    return Where(mech, c, fit, requested, drivers, degrees)
 
 
 def pose_sequence(pose) -> str:

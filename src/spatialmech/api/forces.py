@@ -15,7 +15,7 @@ from ..kinematics.closure import Configuration
 from ..kinematics.position import PoseFit, platform_pose
 from ..model.mechanism import Mechanism, Pose
 from ..serialize import pose_dict
-from .checks import ModelLike, as_configuration, as_mechanism, as_pose, check_bool, check_names, check_numbers
+from .checks import ModelLike, check_numbers, where
 
 __all__ = ["StaticsResult", "statics"]
 
@@ -165,12 +165,9 @@ def statics(model: ModelLike, pose=None, *, wrench, config: Configuration | None
     >>> r.singular, r.redundant, r.balanced
     (False, False, True)
     """
-    mech = as_mechanism(model)
-    degrees = check_bool(degrees, "degrees")
+    w = where(model, pose, config, drivers, degrees)
+    mech, c, fit, requested, drivers = w.mech, w.config, w.fit, w.pose, w.drivers
     F = check_numbers(wrench, "wrench", shape=(6,))
-    drivers = check_names(drivers, "drivers")
-    c, fit = as_configuration(mech, pose, config, degrees)
-    requested = as_pose(mech, pose, degrees)[0] if pose is not None else None
     g, loads, masses, source = None, None, None, None
     if gravity is not None:
         from ..analysis.dynamics import gravity_loads

@@ -29,7 +29,6 @@ if TYPE_CHECKING:  # the analyses are imported where they run (lazily): their ty
 
 from .checks import (
     ModelLike,
-    as_configuration,
     as_mechanism,
     as_pose,
     check_bool,
@@ -39,6 +38,7 @@ from .checks import (
     check_numbers,
     optional_progress,
     pose_sequence,
+    where,
 )
 from .threads import one_blas_thread
 
@@ -478,31 +478,27 @@ def jacobian(model: ModelLike, pose=None, *, config: Configuration | None = None
     >>> J.task.given, J.task.matrix.shape
     (('z', 'a2', 'a3'), (3, 3))
     """
+    if free is None:
+        w = where(model, pose, config, drivers, degrees)
+        return JacobianResult(w.mech, w.config, complete_jacobian(w.mech, w.config, w.drivers), w.fit, w.pose,
+                              task_jacobian_at(w.mech, w.config, w.drivers))
     mech = as_mechanism(model)
     degrees = check_bool(degrees, "degrees")
     drivers = check_names(drivers, "drivers")
-    task = None
-    fit: PoseFit | None
-    requested: Pose | None
-    if free is not None:
-        if pose is None or config is not None:
-            raise InputError("free: needs a pose (and no config): the coordinates not named are held at its values")
-        names = check_names(free, "free") or []
-        P, _ = as_pose(mech, pose, degrees)
-        solved, sol = pose_with_free(mech, P, names, pose_sequence(pose))
-        if not sol.converged:
-            raise InputError(f"free: the held coordinates do not close with {', '.join(names)} solved ({sol.status}, "
-                             f"residual {sol.residual:.2e}); the pose is out of reach")
-        task = sol.task
-        fit = configuration_at_pose(mech, solved, start=sol.config)
-        if not fit.converged:
-            raise InputError(f"pose: no closed configuration near it (residual {fit.ik_residual:.2e})")
-        c, requested = fit.config, solved
-    else:
-        c, fit = as_configuration(mech, pose, config, degrees)
-        requested = as_pose(mech, pose, degrees)[0] if pose is not None else None
-    return JacobianResult(mech, c, complete_jacobian(mech, c, drivers), fit, requested,
-                          task_jacobian_at(mech, c, drivers, task=task))
+    if pose is None or config is not None:
+        raise InputError("free: needs a pose (and no config): the coordinates not named are held at its values")
+    names = check_names(free, "free") or []
+    P, _ = as_pose(mech, pose, degrees)
+    solved, sol = pose_with_free(mech, P, names, pose_sequence(pose))
+    if not sol.converged:
+        raise InputError(f"free: the held coordinates do not close with {', '.join(names)} solved ({sol.status}, "
+                         f"residual {sol.residual:.2e}); the pose is out of reach")
+    fit = configuration_at_pose(mech, solved, start=sol.config)
+    if not fit.converged:
+        raise InputError(f"pose: no closed configuration near it (residual {fit.ik_residual:.2e})")
+    c = fit.config
+    return JacobianResult(mech, c, complete_jacobian(mech, c, drivers), fit, solved,
+                          task_jacobian_at(mech, c, drivers, task=sol.task))
 
 
 @dataclass(frozen=True, eq=False)
@@ -598,12 +594,10 @@ def velocity(model: ModelLike, pose=None, *, config: Configuration | None = None
     """
     from ..kinematics.velocity import forward_velocity, inverse_velocity
 
-    mech = as_mechanism(model)
-    degrees = check_bool(degrees, "degrees")
     if (twist is None) == (actuator_rates is None):
         raise InputError("twist/actuator_rates: give exactly one of them")
-    drivers = check_names(drivers, "drivers")
-    c, fit = as_configuration(mech, pose, config, degrees)
+    w = where(model, pose, config, drivers, degrees)
+    mech, c, fit, drivers, degrees = w.mech, w.config, w.fit, w.drivers, w.degrees
     if twist is not None:
         V = check_numbers(twist, "twist", shape=(6,))
         if degrees:

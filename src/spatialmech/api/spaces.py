@@ -22,7 +22,6 @@ if TYPE_CHECKING:  # the analyses are imported where they run (lazily): their ty
 
 from .checks import (
     ModelLike,
-    as_configuration,
     as_mechanism,
     check_bool,
     check_choice,
@@ -31,6 +30,7 @@ from .checks import (
     check_number,
     check_path,
     optional_progress,
+    where,
 )
 from .threads import one_blas_thread
 
@@ -106,11 +106,8 @@ def singularity(model: ModelLike, pose=None, *, config: Configuration | None = N
     """
     from ..analysis.singularity import singularity as _singularity
 
-    mech = as_mechanism(model)
-    degrees = check_bool(degrees, "degrees")
-    drivers = check_names(drivers, "drivers")
-    c, fit = as_configuration(mech, pose, config, degrees)
-    return SingularityAnalysis(mech, c, _singularity(mech, c, drivers), fit)
+    w = where(model, pose, config, drivers, degrees)
+    return SingularityAnalysis(w.mech, w.config, _singularity(w.mech, w.config, w.drivers), w.fit)
 
 
 @one_blas_thread

@@ -21,7 +21,7 @@ from ..kinematics.closure import Configuration
 from ..kinematics.position import PoseFit, platform_pose
 from ..model.mechanism import Mechanism, Pose
 from ..serialize import pose_dict
-from .checks import ModelLike, as_configuration, as_mechanism, as_pose, check_bool, check_choice, check_grid, check_names
+from .checks import ModelLike, as_mechanism, check_choice, check_grid, check_names, where
 from .threads import one_blas_thread
 
 __all__ = ["StiffnessMap", "StiffnessResult", "stiffness", "stiffness_map"]
@@ -171,16 +171,14 @@ def stiffness(model: ModelLike, pose=None, *, config: Configuration | None = Non
     4.7154
     """
     mech = as_mechanism(model)
-    degrees = check_bool(degrees, "degrees")
-    drivers = check_names(drivers, "drivers")
     for name, v in (("actuator_stiffness", actuator_stiffness), ("constraint_stiffness", constraint_stiffness)):
         if isinstance(v, bool) or not (v is None or isinstance(v, (int, float, Mapping))):
             raise TypeError(f"{name}: expected a positive number or a mapping name -> number, got {describe(v)}")
     mech = with_stiffness(mech, actuators=None if actuator_stiffness is None else _plain(actuator_stiffness),
                           constraints=None if constraint_stiffness is None else _plain(constraint_stiffness))
-    c, fit = as_configuration(mech, pose, config, degrees)
-    requested = as_pose(mech, pose, degrees)[0] if pose is not None else None
-    s = _stiffness(mech, c, drivers)
+    w = where(mech, pose, config, drivers, degrees)
+    mech, c, fit, requested = w.mech, w.config, w.fit, w.pose
+    s = _stiffness(mech, c, w.drivers)
     return StiffnessResult(mech, c, s.matrix, s.compliance, s.principal_stiffness, s.principal_twists,
                            s.softest_stiffness, s.softest_twist, s.singular, s.sigma_min, s, fit, requested)
 
