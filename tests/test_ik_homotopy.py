@@ -98,7 +98,7 @@ def test_planar_rrr_leg_two_modes_proven_by_trace_test():
     _closes(m, 0, pose, res.limbs[0].solutions)
 
 
-def test_rrrp_and_rps_type_limbs():
+def test_rus_type_limb_proven_by_its_root_count():
     e = np.eye(3)
     # an R-U-S limb: three revolutes place the S joint's centre (Pieper's quartic bounds it)
     rus = Mechanism("rus", (Limb("leg", (R("A", [0.2, 0, 0], e[2]), U("U", [0.2, 0.1, 0.3], [e[0], [0, 0.6, 0.8]]),
@@ -111,7 +111,17 @@ def test_rrrp_and_rps_type_limbs():
     assert rep["method"] == "homotopy" and rep["complete"], rep["completeness"]
     assert 1 <= len(res.limbs[0].solutions) <= 4
     _closes(rus, 0, pose, res.limbs[0].solutions)
-    # an R-R-R-P serial chain (fewer freedoms than conditions: the random combination and offset)
+
+
+def test_rrrp_type_limb(monkeypatch):
+    """An R-R-R-P serial chain (fewer freedoms than conditions: the random combination and
+    offset): the homotopy finds the pose's own solution, and every solution closes.  No proof is
+    claimed here: the trace test on this limb ends inconclusive ("a path of its homotopies
+    failed") after about 80 s of work, so its work cap is set to nothing (the trace test's own
+    tests: test_planar_rrr_leg_two_modes_proven_by_trace_test, tests/test_homotopy_general.py)."""
+    e = np.eye(3)
+    monkeypatch.setattr(ikh, "TRACE_MAX_WORK_FULL", 1)
+    ikh.clear_cache()  # a generic solve cached earlier in this process keeps its trace verdict
     rrrp = Mechanism("rrrp", (Limb("arm", (R("A", [0, 0, 0], e[2]), R("B", [0.3, 0, 0.2], e[1]),
                                            R("C", [0.6, 0.1, 0.2], [0, 0.6, 0.8]), P("D", [0.8, 0.1, 0.3], e[0]))),),
                      platform_point=np.array([0.9, 0.1, 0.3]))
@@ -120,9 +130,10 @@ def test_rrrp_and_rps_type_limbs():
     pose = sm.Pose.from_displacement(T, rrrp.platform_point)
     res = inverse_position(rrrp, pose, all_solutions=True, method="homotopy")
     rep = res.search["limbs"][0]
-    assert rep["method"] == "homotopy"
+    assert rep["method"] == "homotopy" and not rep["complete"] and "work cap" in rep["completeness"]
     assert any(np.max(np.abs(_wrapped(np.asarray(s) - q))) < 1e-7 for s in res.limbs[0].solutions)
     _closes(rrrp, 0, pose, res.limbs[0].solutions)
+    ikh.clear_cache()  # no capped verdict left for later tests
 
 
 def test_helical_pitch_refused_to_multistart_with_a_label():
