@@ -87,7 +87,7 @@ def test_studio_axis_titles_use_title_text_and_roundoff_prints_zero():
 
     js = TestClient(sm.studio_app("planar-4r")).get("/static/studio.js").text
     # the bundled plotly ignores a bare string axis title: the units would vanish
-    assert 'title: { text: n + " [" + S.unit + "]" }' in js and "title: { text: S.state.mechanism }" in js
+    assert 'title: { text: n + " [" + S.unit + "]" }' in js and "title: { text: S.state.mechanism" in js
     assert 'Math.abs(Number(x)) < 1e-13 ? "0"' in js
 
 
