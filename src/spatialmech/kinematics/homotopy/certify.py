@@ -53,6 +53,7 @@ from flint import acb, acb_mat, arb, arb_mat, ctx
 
 from ...errors import InputError
 from ...geometry.tolerances import CERTIFY_GROWTH, CERTIFY_MAX_RADIUS, CERTIFY_MIN_RADIUS, CERTIFY_PRECISION
+from .certify_float import krawczyk_limb, krawczyk_quadrics
 
 __all__ = [
     "BallSystem",
@@ -322,6 +323,12 @@ def certify(system: BallSystem, points, *, real: Sequence[bool] | None = None,
         partner = _conjugate_partners(system, Ys, flags)
         todo = [i for i in range(len(Ys)) if i not in partner]
         found: list = [None] * len(Ys)
+        fast = getattr(system, "krawczyk_float", None)  # real points, all at once (certify_float)
+        quick = [i for i in todo if system.real and not np.any(Ys[i].imag)] if fast is not None else []
+        for i, r in zip(quick, fast(np.array([Ys[i].real for i in quick]), max_radius) if quick else [], strict=True):
+            if r is not None:
+                found[i] = (Ys[i], r, "", True, 0.0)
+        todo = [i for i in todo if found[i] is None]
         many = getattr(system, "jacobian_float_many", None)
         pre: list = [None] * len(todo)
         if many is not None and todo:  # floating-point preconditioners, all points at once
@@ -394,6 +401,11 @@ class QuadricBallSystem:
         rows: Any = [[(xt * (Q * x))[0, 0]] for Q in Qk]
         rows += [[lin[k, 0]] for k in range(self.n - self.m)]
         return arb_mat(rows) if isinstance(x, arb_mat) else acb_mat(rows)
+
+    def krawczyk_float(self, Y: np.ndarray, max_radius: float) -> list[float | None]:
+        """The fast first pass at the real points ``Y`` (:mod:`.certify_float`; real systems only)."""
+        return krawczyk_quadrics(np.real(self._Q), np.real(self._B), np.real(self._b), Y, max_radius,
+                                 lambda y: self.values(REAL.col(y)))
 
     def jacobian_float_many(self, Y: np.ndarray) -> np.ndarray:
         """``F'`` in floating point at the points ``Y`` (k, n) (the preconditioners only)."""
@@ -474,6 +486,10 @@ class LimbBallSystem:
             suf.append(M if len(suf) == 1 else M * suf[-1])
         suf.reverse()  # suf[i] = M_i ... M_last
         return pre[-1], pre, suf, dMs
+
+    def krawczyk_float(self, Y: np.ndarray, max_radius: float) -> list[float | None]:
+        """The fast first pass at the real points ``Y`` (:mod:`.certify_float`)."""
+        return krawczyk_limb(self._sysm, self._q, self._t, Y, max_radius, lambda y: self.values(REAL.col(y)))
 
     def jacobian_float_many(self, Y: np.ndarray) -> np.ndarray:
         """``F'`` in floating point at the points ``Y`` (k, n) (the preconditioners only)."""
