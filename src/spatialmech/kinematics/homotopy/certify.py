@@ -324,10 +324,11 @@ def certify(system: BallSystem, points, *, real: Sequence[bool] | None = None,
         todo = [i for i in range(len(Ys)) if i not in partner]
         found: list = [None] * len(Ys)
         fast = getattr(system, "krawczyk_float", None)  # real points, all at once (certify_float)
-        quick = [i for i in todo if system.real and not np.any(Ys[i].imag)] if fast is not None else []
-        for i, r in zip(quick, fast(np.array([Ys[i].real for i in quick]), max_radius) if quick else [], strict=True):
-            if r is not None:
-                found[i] = (Ys[i], r, "", True, 0.0)
+        quick = [i for i in todo if system.real and not np.any(Ys[i].imag)]
+        if fast is not None and quick:
+            for i, r in zip(quick, fast(np.array([Ys[i].real for i in quick]), max_radius), strict=True):
+                if r is not None:
+                    found[i] = (Ys[i], r, "", True, 0.0)
         todo = [i for i in todo if found[i] is None]
         many = getattr(system, "jacobian_float_many", None)
         pre: list = [None] * len(todo)

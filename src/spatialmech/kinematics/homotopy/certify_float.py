@@ -42,7 +42,7 @@ from typing import Any
 
 import numpy as np
 
-from ...geometry.tolerances import CERTIFY_GROWTH, CERTIFY_MIN_RADIUS
+from ...geometry.tolerances import CERTIFY_MIN_RADIUS
 
 __all__ = ["MR", "krawczyk_limb", "krawczyk_quadrics", "krawczyk_real"]
 
@@ -107,10 +107,8 @@ class MR:
         am, aom = np.abs(self.m), np.abs(o.m)
         m = self.m @ o.m
         if exact:  # an exact constant: no radius of its own
-            r = (self.r + (_U * (n + 1)) * am) @ aom
-        else:
-            r = am @ o.r + self.r @ (aom + o.r) + (_U * (n + 1)) * (am @ aom)
-        return MR(m, _up(r))
+            return MR(m, _up((self.r + (_U * (n + 1)) * am) @ aom))
+        return MR(m, _up(am @ o.r + self.r @ (aom + o.r) + (_U * (n + 1)) * (am @ aom)))
 
     def __rmatmul__(self, o) -> MR:
         a = np.asarray(o, dtype=float)  # an exact constant on the left
@@ -207,9 +205,9 @@ def krawczyk_real(values: Callable[[MR], MR], jacobian: Callable[[MR], MR], Y: n
         if stage or ball_values is None or not again:
             break
         Fm, Fr = F.m.copy(), F.r.copy()
-        for i in again:
-            row = from_balls(ball_values(Y[i]))
-            Fm[i], Fr[i] = row.m[0], row.r[0]
+        for j in again:
+            row = from_balls(ball_values(Y[j]))
+            Fm[j], Fr[j] = row.m[0], row.r[0]
         F = MR(Fm, Fr)
     return out
 
