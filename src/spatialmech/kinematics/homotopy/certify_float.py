@@ -243,6 +243,29 @@ def _full(x: MR) -> np.ndarray:
 
 
 # ------------------------------------------------------------------------------ a limb's inverse position
+_FACTORS: dict[int, tuple] = {}
+
+
+def _factor_data(factors) -> tuple:
+    """Per factor tuple (cached): revolute flags, the indices of ``s`` (or ``d``) and ``c``, the
+    constant matrices ``(I ; A ; A^2)`` (f, 3, 16) and the derivatives ``((unknown, dM), ...)``."""
+    hit = _FACTORS.get(id(factors))
+    if hit is not None and hit[0] is factors:
+        return hit[1]
+    if len(_FACTORS) > 256:
+        _FACTORS.clear()
+    rev = np.array([fa.kind == "R" for fa in factors])
+    i_s = np.array([fa.idx[1] if fa.kind == "R" else fa.idx[0] for fa in factors], dtype=np.int64)
+    i_c = np.array([fa.idx[0] for fa in factors], dtype=np.int64)
+    const = np.array([np.stack([np.eye(4).ravel(), (fa.sign * fa.A).ravel(),
+                                np.asarray(fa.A2, dtype=float).ravel() if fa.kind == "R" else np.zeros(16)])
+                      for fa in factors])
+    dMs = [((fa.idx[0], -fa.A2), (fa.idx[1], fa.sign * fa.A)) if fa.kind == "R" else ((fa.idx[0], fa.sign * fa.A),)
+           for fa in factors]
+    _FACTORS[id(factors)] = (factors, (rev, i_s, i_c, const, dMs))
+    return rev, i_s, i_c, const, dMs
+
+
 def _chain(factors, x: MR):
     """The factors' matrices (k, 4, 4) and per factor the derivatives ``((unknown, dM), ...)``:
     ``M = I + s A + (1 - c) A^2`` (R) or ``I + d A`` (P), all factors in one interval product
@@ -251,12 +274,7 @@ def _chain(factors, x: MR):
     if not factors:
         return [], []
     k, f = x.m.shape[0], len(factors)
-    rev = np.array([fa.kind == "R" for fa in factors])
-    i_s = np.array([fa.idx[1] if fa.kind == "R" else fa.idx[0] for fa in factors], dtype=np.int64)
-    i_c = np.array([fa.idx[0] for fa in factors], dtype=np.int64)
-    const = np.array([np.stack([np.eye(4).ravel(), (fa.sign * fa.A).ravel(),
-                                np.asarray(fa.A2, dtype=float).ravel() if fa.kind == "R" else np.zeros(16)])
-                      for fa in factors])  # (f, 3, 16)
+    rev, i_s, i_c, const, dMs = _factor_data(factors)
     um = np.empty((k, f, 1, 3))
     ur = np.zeros((k, f, 1, 3))
     um[..., 0] = 1.0
@@ -265,8 +283,6 @@ def _chain(factors, x: MR):
     um[:, :, 0, 2] = np.where(rev, one_c, 0.0)
     ur[:, :, 0, 2] = np.where(rev, _up(x.r[:, i_c] + _U * np.abs(one_c)), 0.0)
     Ms = MR(um, ur) @ const  # (k, f, 1, 16)
-    dMs = [((fa.idx[0], -fa.A2), (fa.idx[1], fa.sign * fa.A)) if fa.kind == "R" else ((fa.idx[0], fa.sign * fa.A),)
-           for fa in factors]
     Mm, Mr = Ms.m.reshape(k, f, 4, 4), Ms.r.reshape(k, f, 4, 4)
     return [MR(Mm[:, i], Mr[:, i]) for i in range(f)], dMs
 
