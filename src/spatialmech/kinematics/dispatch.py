@@ -243,13 +243,47 @@ def _four_sps_cu_forward(mech: Mechanism):
             modes.append(AssemblyMode(pose, s.kind, d["residual"], tuple(d["outside_limits"]), float(s.sigma_min),
                                       float(s.condition), float(s.singular_below), s.members, s.self_motion,
                                       flags=flags))
-        return ForwardAnswer("closed-form", "closed-form multi-start", True, tuple(modes), False,
-                             "multi-seed search of the closed form: not a proof; assembly modes may be missing "
-                             "(method='homotopy', fk --method homotopy, proves the set complete in the Study "
-                             "formulation)",
+        if seeds is not None:  # a search of the caller's size: its answer, not a proof
+            return ForwardAnswer("closed-form", "closed-form multi-start", True, tuple(modes), False,
+                                 "multi-seed search of the closed form: not a proof; assembly modes may be missing "
+                                 "(the default, or method='homotopy', proves the set complete in the Study "
+                                 "formulation)", fa.search.n_seeds, fa.search.n_converged, None, None, fa)
+        complete, how = _proven_by_study_homotopy(mech, values, [m.pose for m in modes])
+        return ForwardAnswer("closed-form", "closed-form multi-start, proven by homotopy" if complete
+                             else "closed-form multi-start", True, tuple(modes), complete, how,
                              fa.search.n_seeds, fa.search.n_converged, None, None, fa)
 
     return solve
+
+
+def _proven_by_study_homotopy(mech: Mechanism, values, poses: list[Pose]) -> tuple[bool, str]:
+    """Whether the closed form's poses are every real assembly mode, by the Study homotopy
+    (:func:`.forward.forward_position` with ``method="homotopy"``: complete by its own proof,
+    a re-solve from the cached generic solution set after the first call): proven when its
+    real solutions are exactly the given poses (rotation and position within 1e-7 of ``L``).
+    Returns ``(complete, completeness statement)``."""
+    from .homotopy.certify import certification
+
+    with certification(False):  # the closed form's own poses are certified (Study formulation) above
+        res = forward_position(mech, values, all_solutions=True, method="homotopy")
+    sr = res.search
+    n = len(poses)
+    if not sr.get("complete"):
+        return False, (f"the closed form's multi-seed search found {n} mode(s); the Study homotopy could not prove "
+                       f"a complete set ({sr.get('completeness')}): not proven")
+    L = mech.characteristic_length
+    hom = [s.pose for s in res.solutions if s.converged]
+
+    def same(a: Pose, b: Pose) -> bool:
+        return float(np.max(np.abs(a.R - b.R))) + float(np.max(np.abs(a.p - b.p))) / L < 1e-7
+
+    matched = all(any(same(h, q) for q in poses) for h in hom) and all(any(same(q, h) for h in hom) for q in poses)
+    if not matched or len(hom) != n:
+        return False, (f"the closed form's multi-seed search found {n} mode(s), the Study homotopy's proven set has "
+                       f"{len(hom)} real solution(s) and they differ: not proven (method='homotopy' gives the "
+                       "homotopy's set)")
+    return True, (f"proven: the closed form's {n} mode(s) are exactly the real solutions of the Study homotopy, "
+                  f"whose set is proven complete ({sr['completeness']})")
 
 
 def _closed_form_certificates(mech: Mechanism, values, displacements: list) -> list:
