@@ -204,3 +204,17 @@ def test_phcpack_agrees_on_the_three_prs(phc_prs):
     assert len(phc_real) == len(mine) > 0
     for p in phc_real:
         assert min(np.linalg.norm(p - q) for q in mine) < 1e-6
+
+
+def test_prs_elimination_keeps_a_root_near_a_half_turn():
+    """A draw of the hypothesis test above: one real pose has t1 = tan(theta1/2) = -790 and
+    t2 = 498 (two angles near a half turn). The partner t2 was picked by the smaller raw |q(t2)|,
+    which grows as |t2|^4, so 2.16 won over 498; Newton from there went to another root and the
+    elimination listed 7 of the 8 real poses. Partners are now judged on the projective line and
+    tangents past +-90 deg are polished as -1/t."""
+    mech = _FAMILIES["three-prs"]([1.03125, 1.125, 1.25, 1.0])
+    acts = [0.07411180409511756, 0.07775863334101776, 0.06375642372128042]
+    e = prs_forward(mech, acts)
+    r = sm.fk(mech, acts, all_solutions=True)
+    assert r.complete and len(r.poses) == 8
+    assert e.n_real == 8 and all(_near(p, e.poses, 1e-7) for p in r.poses)

@@ -146,9 +146,11 @@ def prs_forward(mech: Mechanism, values) -> PrsForward:
     for t1 in roots:
         c2 = np.roots(_poly_y(C12, t1)[::-1])
         rt = _interpolate(lambda y, t1=t1: r_t2(t1, y), 4)[::-1]
-        t2 = c2[np.argmin([abs(np.polyval(rt, y)) for y in c2])]
+        # each candidate judged on the projective line (|q(y)| / (1 + |y|)^deg): a raw |q(y)|
+        # grows as |y|^deg and passed over the right partner near a half turn (t2 = 498)
+        t2 = c2[np.argmin([abs(np.polyval(rt, y)) / (1.0 + abs(y)) ** 4 for y in c2])]
         c3 = np.roots(_poly_y(C31.T, t1)[::-1])
-        t3 = c3[np.argmin([abs(np.polyval(_poly_y(C23, t2)[::-1], y)) for y in c3])]
+        t3 = c3[np.argmin([abs(np.polyval(_poly_y(C23, t2)[::-1], y)) / (1.0 + abs(y)) ** 2 for y in c3])]
         t = _polish(np.array([t1, t2, t3], dtype=complex), (C12, C23, C31))
         if np.abs(t.imag).max() > 1e-9 * (1.0 + np.abs(t).max()):
             continue
@@ -172,20 +174,35 @@ def prs_forward(mech: Mechanism, values) -> PrsForward:
 def _polish(t: np.ndarray, Cs: tuple, steps: int = 6) -> np.ndarray:
     """A few Newton steps on the three pair conditions (complex or real ``t``): the polynomial's
     roots carry its conditioning (1e-8 to 1e-6 here, a real root of size 5 can come out with an
-    imaginary part of 1e-6); after them the residual is rounding and a real root is real."""
+    imaginary part of 1e-6); after them the residual is rounding and a real root is real.
+
+    A tangent larger than 1 (an angle past +-90 deg) is polished as u = -1/t, the tangent of the
+    half-angle measured from the other side: near a half turn t runs to infinity and Newton in t
+    jumps to another root (a root t1 = -790 went to 64), while u stays small."""
     pairs = ((0, 1), (1, 2), (2, 0))
+    flip = np.abs(t) > 1.0
+    z = np.where(flip, -1.0 / np.where(flip, t, 1.0), t)
+
+    def basis(k: int) -> tuple[np.ndarray, np.ndarray]:  # (1, t, t^2) up to a factor, d/dz
+        if flip[k]:
+            return np.array([z[k] ** 2, -z[k], 1.0]), np.array([2.0 * z[k], -1.0, 0.0])
+        return np.array([1.0, z[k], z[k] ** 2]), np.array([0.0, 1.0, 2.0 * z[k]])
+
     for _ in range(steps):
-        F, J = np.zeros(3, dtype=t.dtype), np.zeros((3, 3), dtype=t.dtype)
+        F, J = np.zeros(3, dtype=z.dtype), np.zeros((3, 3), dtype=z.dtype)
         for r, ((i, j), C) in enumerate(zip(pairs, Cs, strict=True)):
-            xi, xj = np.array([1.0, t[i], t[i] ** 2]), np.array([1.0, t[j], t[j] ** 2])
+            (xi, di), (xj, dj) = basis(i), basis(j)
             F[r] = xi @ C @ xj
-            J[r, i] = np.array([0.0, 1.0, 2.0 * t[i]]) @ C @ xj
-            J[r, j] = xi @ C @ np.array([0.0, 1.0, 2.0 * t[j]])
+            J[r, i] = di @ C @ xj
+            J[r, j] = xi @ C @ dj
         try:
-            t = t - np.linalg.solve(J, F)
+            z = z - np.linalg.solve(J, F)
         except np.linalg.LinAlgError:  # a singular root: keep the polynomial's value
             break
-    return t
+    out = z.copy()
+    with np.errstate(divide="ignore", invalid="ignore"):  # u = 0 is an exact half turn: t infinite
+        out[flip] = -1.0 / z[flip]
+    return out
 
 
 def _rigid(b: np.ndarray, A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
