@@ -45,3 +45,37 @@ def test_max_poses_advice_works():
     assert m is not None, first.output
     again = CliRunner().invoke(cli, [*args, "--max-poses", m.group(1), "--json"])
     assert again.exit_code == 0, again.output
+
+
+# ------------------------------------------------------------------ task workspaces (issue 30 item 10)
+def _rps_task(n):
+    return sm.workspace("three-rps", kind="task", over={"a2": (-0.7, 0.7, n), "a3": (-0.7, 0.7, n)}, at={"z": 0.33},
+                        cones={f"S{i}": np.radians(45.0) for i in (1, 2, 3)})
+
+
+@pytest.mark.slow
+def test_task_workspace_measures_at_two_grids_agree_within_their_estimates():
+    coarse, fine = _rps_task(9), _rps_task(17)
+    assert 0.0 < fine.volume_error < coarse.volume_error < 0.2 * coarse.volume
+    assert abs(fine.volume - coarse.volume) <= coarse.volume_error + fine.volume_error
+    d = fine.to_dict()
+    assert d["volume_error_deg2"] == pytest.approx(fine.volume_error * np.degrees(1.0) ** 2, rel=1e-12)
+    assert d["volume_deg2"] == pytest.approx(fine.volume * np.degrees(1.0) ** 2, rel=1e-12)
+
+
+def test_task_workspace_prints_a_counter_off_a_terminal(monkeypatch):
+    from click.testing import CliRunner
+
+    from spatialmech.interfaces.cli import cli
+    from spatialmech.interfaces.common import StderrProgress
+
+    monkeypatch.setattr(StderrProgress, "every_s", 0.0)  # every report printed (a log, not a terminal)
+    r = CliRunner().invoke(cli, ["workspace", "three-rps", "--task", "--over", "a2:-40:40:11,a3:-40:40:11",
+                                 "--at", "z=0.33", "--cone", "S1=45,S2=45,S3=45"])
+    assert r.exit_code == 0, r.output
+    lines = r.stderr.splitlines()
+    solving = [s for s in lines if s.startswith("solving task coordinates: ")]
+    refining = [s for s in lines if s.startswith("refining the boundary: ")]
+    assert solving and refining, r.stderr
+    assert "/121 (" in solving[0] and "(100 %)" in refining[-1]
+    assert "deg^2" in r.stdout and "+- " in r.stdout.split("measure ")[1]

@@ -9,7 +9,6 @@ takes ``name=value`` pairs separated by commas: ``x, y, z`` (m) and ``alpha, bet
 
 from __future__ import annotations
 
-import sys
 from typing import Any
 
 import click
@@ -17,7 +16,7 @@ import numpy as np
 
 from .. import api as sm
 from ..errors import InputError
-from .common import UserError, check_output_file, emit_json, json_option, load_model, parse_number
+from .common import StderrProgress, UserError, check_output_file, emit_json, json_option, load_model, parse_number
 from .task_args import cone_limits, freedom_limits, parse_axes, parse_free, parse_task_at
 
 _ANGLES = ("alpha", "beta", "gamma")
@@ -94,23 +93,9 @@ def _option_message(msg: str, kind: str) -> str:
 
 
 def _progress_bar():
-    """A progress callback drawing a bar on stderr (opened at the first report) and its closer."""
-    bars: list = []
-
-    def progress(done, total, message):
-        if not bars:
-            bars.append(click.progressbar(length=1, label=message or "checking poses", file=sys.stderr, show_pos=True))
-            bars[0].__enter__()
-        bar = bars[0]
-        bar.label = message or bar.label
-        bar.length = max(bar.length, int(done), int(total or 0))  # total: the search's estimate
-        bar.update(int(done) - bar.pos)
-
-    def close():
-        if bars:
-            bars[0].__exit__(None, None, None)
-
-    return progress, close
+    """A progress callback counting on stderr (:class:`.common.StderrProgress`) and its closer."""
+    bar = StderrProgress()
+    return bar, bar.close
 
 
 def _task_text(res, length_unit: str) -> str:
@@ -146,10 +131,16 @@ def _task_text(res, length_unit: str) -> str:
 
 
 def _measure(res, length_unit: str) -> str:
+    """``"1.234 deg^2 +- 0.05 (grid estimate ...)"``: the task workspace's measure and its error."""
     d = len(res.over)
+    power = f"^{d}" if d > 1 else ""
     if res.over[0].startswith("a"):
-        return f"{res.volume * np.degrees(1.0) ** d:.6g} deg" + (f"^{d}" if d > 1 else "")
-    return f"{res.volume:.6g} {length_unit}" + (f"^{d}" if d > 1 else "")
+        scale, unit = float(np.degrees(1.0)) ** d, "deg" + power
+    else:
+        scale, unit = 1.0, length_unit + power
+    err = "" if res.volume_error is None else (f" +- {res.volume_error * scale:.2g} (grid estimate |V_h - V_2h| "
+                                               "+ boundary tolerance)")
+    return f"{res.volume * scale:.6g}{err} {unit}"
 
 
 def _task_workspace(mech, over, at, free, limit_args, tol_deg, tol_m, max_cells, plot, as_json) -> None:

@@ -190,3 +190,66 @@ def tol_option(primary: str):
         )(wrapper)
 
     return deco
+
+
+class StderrProgress:
+    """A progress callback (``progress(done, total, message)``) for long commands, on stderr.
+
+    On a terminal one line is redrawn in place; otherwise (a log, a pipe) a line is printed when
+    the phase (``message``) changes and then at most every :attr:`every_s` seconds, each with
+    the count, the percentage of ``total`` when known, the elapsed time and the rate:
+    ``solving task coordinates: 1024/1681 (61 %), 12.3 s, 83 per s``.  ``close()`` prints the
+    last count of the run.
+    """
+
+    #: Seconds between two lines off a terminal (one per phase change in any case).
+    every_s = 5.0
+
+    def __init__(self, label: str = "", file=None):
+        import sys
+        import time
+
+        self.file = file if file is not None else sys.stderr
+        self.label = label
+        self.tty = bool(getattr(self.file, "isatty", lambda: False)())
+        self.clock = time.perf_counter
+        self.t0 = self.clock()
+        self.last_line = -math.inf
+        self.phase: str | None = None
+        self.state: tuple[float, float | None, str] | None = None
+        self.pending = False
+
+    def _line(self) -> str:
+        assert self.state is not None
+        done, total, message = self.state
+        t = self.clock() - self.t0
+        count = f"{int(done)}/{int(total)} ({100 * done / total:.0f} %)" if total else f"{int(done)}"
+        rate = f", {done / t:.0f} per s" if t > 0 and done else ""
+        return f"{self.label + ': ' if self.label else ''}{message or 'working'}: {count}, {t:.1f} s{rate}"
+
+    def __call__(self, done, total, message) -> None:
+        total = None if total is None or float(total) <= 0 else max(float(total), float(done))
+        self.state = (float(done), total, str(message or ""))
+        now = self.clock()
+        if self.tty:
+            self.file.write(f"\r{self._line()[:110]:<110}")
+            self.file.flush()
+            return
+        if message != self.phase or now - self.last_line >= self.every_s:
+            self.phase = message
+            self.last_line = now
+            self.file.write(self._line() + "\n")
+            self.file.flush()
+            self.pending = False
+        else:
+            self.pending = True
+
+    def close(self) -> None:
+        """End the display: the last count (if not yet shown), then a new line on a terminal."""
+        if self.state is None:
+            return
+        if self.tty:
+            self.file.write("\n")
+        elif self.pending:
+            self.file.write(self._line() + "\n")
+        self.file.flush()

@@ -54,7 +54,7 @@ from ...model.task import TaskCoordinates
 from ...results import Progress, check_progress
 from .checker import ConfigurationChecker, configuration_checker
 from .limits import BOX, CLOSURE, WorkspaceLimits, default_limits
-from .search import Extent, trapezoid_weights
+from .search import Extent, trapezoid_weights, volume_error
 
 __all__ = ["TASK_PATH", "TaskWorkspaceResult", "euler_convention", "task_workspace"]
 
@@ -84,7 +84,9 @@ class TaskWorkspaceResult:
     ``boundary_values`` (n, 6) the six coordinates there, ``boundary_limits`` their active limits,
     ``boundary_configs`` their closed configurations, ``boundary_axes`` the grid coordinate along
     which each was bisected, ``boundary_outside`` the other end of its final bracket (outside);
-    ``volume`` the measure of the set in ``volume_unit`` (``None`` for mixed units).
+    ``volume`` the measure of the set in ``volume_unit`` (``None`` for mixed units),
+    ``volume_error`` its estimated error (same unit; see :func:`.search.volume_error`: the measure
+    again from every second grid line, plus the boundary tolerance at every refined run end).
     """
 
     mechanism: str
@@ -116,6 +118,7 @@ class TaskWorkspaceResult:
     limit_names: tuple[str, ...]
     configs: np.ndarray
     length_unit: str = "m"
+    volume_error: float | None = None
     kind: str = "task"
     path: str = TASK_PATH
 
@@ -204,6 +207,7 @@ class TaskWorkspaceResult:
             power = len(self.over)
             scale = float(np.degrees(1.0)) ** power if code == "deg" else 1.0
             d[f"volume_{code}{power if power > 1 else ''}"] = float(self.volume) * scale
+            d[f"volume_error_{code}{power if power > 1 else ''}"] = float(self.volume_error or 0.0) * scale
             d["volume_note"] = ("measure of the reachable set in the grid coordinates"
                                 + (" (Euler angles, not the Haar measure of SO(3))" if code == "deg" else ""))
         else:
@@ -372,7 +376,7 @@ def task_workspace(
     ranges = {c: (None if reach_vals.shape[0] == 0 else (float(np.min(reach_vals[:, i])), float(np.max(reach_vals[:, i]))))
               for i, c in enumerate(TASK_NAMES)}
 
-    volume = _measure(g, feasible, b.refined_axis0)
+    volume, volume_err = _measure(g, feasible, b.refined_axis0, float(tolv[0]))
     units = {task_unit(c) for c in names}
     if len(units) == 1:
         u = "rad" if units.pop() == "deg" else mech.length_unit
@@ -389,7 +393,7 @@ def task_workspace(
         step={c: float(s) for c, s in zip(names, stepv, strict=True)},
         tol={c: float(t) for c, t in zip(names, tolv, strict=True)}, n_solves=g.n_solves + probe.n,
         seconds=time.perf_counter() - t0, limits=checker.limits, limit_names=checker.names, configs=g.configs,
-        length_unit=mech.length_unit,
+        length_unit=mech.length_unit, volume_error=None if vol is None else float(volume_err),
     )
 
 
@@ -524,22 +528,35 @@ def _extent_end(g: TaskGrid, k: int, sign: float, cells: np.ndarray, cell_idx: n
     return best, lim
 
 
-def _measure(g: TaskGrid, feasible: np.ndarray, refined_axis0: dict[tuple, float]) -> float:
-    """The measure of the reachable set in the grid coordinates: refined run lengths along the
-    first grid coordinate, trapezoid rule over the others."""
+def _measure(g: TaskGrid, feasible: np.ndarray, refined_axis0: dict[tuple, float],
+             tol0: float) -> tuple[float, float]:
+    """The measure of the reachable set in the grid coordinates and its error estimate: refined
+    run lengths along the first grid coordinate, trapezoid rule over the others; the error as
+    the grid workspaces' (:func:`.search.volume_error`: ``|V_h - V_2h|`` over every second
+    grid line, plus ``tol0`` at every run end)."""
     grid, shape = g.axes, g.shape
-    volume = 0.0
-    w_other = [trapezoid_weights(a) for a in grid[1:]]
-    for row in np.argwhere(feasible):
-        idx = tuple(int(i) for i in row)
-        lo = refined_axis0.get((idx, -1))
-        hi = refined_axis0.get((idx, 1))
-        x = grid[0]
-        i = idx[0]
-        left = lo if lo is not None else (x[i - 1] + x[i]) / 2 if i > 0 and feasible[(i - 1, *idx[1:])] else x[i]
-        right = hi if hi is not None else (x[i] + x[i + 1]) / 2 if i + 1 < shape[0] and feasible[(i + 1, *idx[1:])] else x[i]
-        w = 1.0
-        for j, wk in enumerate(w_other):
-            w *= wk[idx[j + 1]]
-        volume += w * (right - left)
-    return volume
+    x = grid[0]
+    lines, lengths = [], []
+    for other in np.ndindex(*shape[1:]):
+        row = feasible[(slice(None), *other)]
+        i = 0
+        while i < shape[0]:
+            if not row[i]:
+                i += 1
+                continue
+            j = i
+            while j + 1 < shape[0] and row[j + 1]:
+                j += 1
+            lo = refined_axis0.get(((i, *other), -1))
+            hi = refined_axis0.get(((j, *other), 1))
+            lines.append(other)
+            lengths.append((x[j] if hi is None else hi) - (x[i] if lo is None else lo))
+            i = j + 1
+    if not lengths:
+        return 0.0, 0.0
+    L = np.array(lines, dtype=int).reshape(len(lengths), len(shape) - 1)
+    runs = np.array(lengths, dtype=float)
+    w = np.ones(runs.size)
+    for j, a in enumerate(grid[1:]):
+        w *= trapezoid_weights(a)[L[:, j]]
+    return float(np.sum(w * runs)), volume_error(grid, L, runs, 0, tol0)
