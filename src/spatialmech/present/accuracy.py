@@ -37,7 +37,7 @@ def accuracy_figure(result):
         ax.set_xlabel(_LABELS[c].format(u=unit), fontsize=8)
         ax.tick_params(labelsize=7)
         if c == 0:
-            ax.legend(fontsize=6)
+            ax.legend(fontsize=8)
     fig.suptitle(f"{result.mechanism.name}: output error (output point, rotation vector); "
                  f"{a.mc_errors.shape[0]} samples assembled, {a.mc_failures} failed", fontsize=9)
     fig.tight_layout()

@@ -38,7 +38,7 @@ def dj_at_positions(res: DefectResult) -> Figure:
     ax.set_xticks(x, [f"P{i}" for i in x])
     ax.set_ylabel("DJ / max |DJ| (per driver)")
     ax.set_title(f"{res.mechanism}: DJ at the task positions")
-    ax.legend(fontsize=7, ncol=2, loc="best")
+    ax.legend(fontsize=8, ncol=2, loc="best")
     return f
 
 
@@ -123,7 +123,7 @@ def trajectories(mech: Mechanism, res: DefectResult) -> Figure:
     ax.set_ylabel(f"y ({mech.length_unit})")
     ax.set_zlabel(f"z ({mech.length_unit})")
     ax.set_title(f"{res.mechanism}: platform point on the circuits")
-    ax.legend(fontsize=7, loc="upper left")
+    ax.legend(fontsize=8, loc="upper left")
     return f
 
 

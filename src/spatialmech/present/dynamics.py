@@ -28,7 +28,7 @@ def dynamics_figure(result):
             ax.plot(result.times, result.efforts[:, j], "-o", ms=3, label=result.actuators[j])
         ax.set_ylabel("actuator force [N]" if kind == "force" else "actuator torque [N m]")
         ax.grid(True, alpha=0.3)
-        ax.legend(fontsize=7)
+        ax.legend(fontsize=8)
         if i == len(kinds) - 1:
             ax.set_xlabel("time [s]")
     g = ", ".join(f"{v:g}" for v in result.gravity)

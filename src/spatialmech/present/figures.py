@@ -137,7 +137,7 @@ def scalar_field(ax, x, y, values, *, xlabel: str, ylabel: str, label: str, titl
     return im
 
 
-def legend_once(ax, fontsize: float = 7) -> None:
+def legend_once(ax, fontsize: float = 8) -> None:
     """A legend with each label once (the first handle drawn with it), if anything is labelled."""
     seen: dict = {}
     for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):

@@ -27,6 +27,7 @@ from ..kinematics.tracking import trace_motion
 from ..model.mechanism import Mechanism
 from ..results import Progress, Steps
 from . import figures as F
+from .numbers import unit_label
 from .report import Section, Table, Viewer
 
 __all__ = ["MODEL_STEPS", "STEPS", "model_section", "section"]
@@ -83,7 +84,7 @@ def _four_bar_table(mech: Mechanism, data: dict) -> list[Table]:
     fb = four_bar_class(mech)
     if fb is None:
         return []
-    unit = mech.length_unit
+    unit = unit_label(mech.length_unit)
     data["four_bar"] = fb.to_dict()
     lo, hi = fb.input_range_deg
     return [Table(
@@ -105,7 +106,7 @@ def model_section(mech: Mechanism, progress: Progress | None = None, *, trace: b
 
     tables, figs, viewers, notes = [], [], [], []
     data: dict[str, object] = {}  # JSON of each analysis, by name
-    unit = mech.length_unit
+    unit = unit_label(mech.length_unit)
     say(f"{mech.name}: mobility")
     mob = mobility_modes(mech)
     data["mobility"] = [r.to_dict() for r in mob]

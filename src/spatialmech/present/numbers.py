@@ -12,7 +12,18 @@ from collections.abc import Iterable
 
 import numpy as np
 
-__all__ = ["ROUNDOFF", "fmt_number", "fmt_numbers"]
+__all__ = ["ROUNDOFF", "UNSTATED_UNIT", "fmt_number", "fmt_numbers", "unit_label"]
+
+#: The length unit of a model whose source states none (paper A's linkages).
+UNSTATED_UNIT = "unit"
+
+
+def unit_label(unit: str) -> str:
+    """The length unit as an axis or column label shows it: ``"m"`` stays ``"m"``; a unit the
+    model's source does not state (:data:`UNSTATED_UNIT`) reads ``"length unit not stated"``
+    rather than the placeholder ``"unit"``."""
+    return "length unit not stated" if unit == UNSTATED_UNIT else unit
+
 
 #: Relative size below which a printed number is round-off (a few hundred ulps of double).
 ROUNDOFF = 1e-13

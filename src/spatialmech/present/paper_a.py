@@ -153,9 +153,8 @@ def section(progress: Progress | None = None) -> Section:
         say(f"paper A: figures of five-cs-{k}")
         with tempfile.TemporaryDirectory(prefix="spatialmech-paper-a-") as tmp:  # read back at once, then removed
             for path in write_defect_figures(mech_by[k], r, tmp):
-                cap = _caption(path.name, k, r)
-                figs.append(F.figure_from_file(path, f"paper_a_{path.name}",
-                                               cap.split(":")[0] + ": " + cap.split(":")[1].split("(")[0].strip(), cap))
+                title, cap = _caption(path.name, k, r)
+                figs.append(F.figure_from_file(path, f"paper_a_{path.name}", title, cap))
     say("paper A: 3-D viewer of linkage 1 along its circuit")
     tr = res[1].traces[0]
     idx = np.unique(np.linspace(0, len(tr.points) - 1, min(VIEWER_FRAMES, len(tr.points))).round().astype(int))
@@ -204,16 +203,19 @@ def _mujoco_table(mechs: dict, res: dict) -> Table:
         "simulator driven quasi-statically by rot1 leaves the path: tests/test_validation.py.")
 
 
-def _caption(fname: str, k: int, r) -> str:
+def _caption(fname: str, k: int, r) -> tuple[str, str]:
+    """``(title, caption)`` of one of paper A's figures: the caption adds to the title, never repeats it."""
     if "dj_at_positions" in fname:
-        return f"Linkage {k}: DJ at P1..P7 for the ten drivers, each divided by its largest |DJ| (figs 6-9, 15-16)."
+        return (f"Linkage {k}: DJ at P1..P7 for the ten drivers",
+                "Each driver's DJ divided by its largest |DJ| (figs 6-9, 15-16).")
     if "trajectories" in fname:
-        return (f"Linkage {k}: the platform point along every traced circuit; task positions marked (figs 10, 11, 19). "
-                f"Circuits: {'; '.join('{' + ', '.join(f'P{j}' for j in c) + '}' for c in r.circuits)}.")
+        return (f"Linkage {k}: the platform point along every traced circuit",
+                "Task positions marked (figs 10, 11, 19). Circuits: "
+                f"{'; '.join('{' + ', '.join(f'P{j}' for j in c) + '}' for c in r.circuits)}.")
     if "dj_along_path" in fname:
-        return (f"Linkage {k}: DJ along the path from P1 to P7 (figs 12-14, 18)"
-                + ("; green: the window in which to switch drivers (section 6)." if r.plan else "."))
-    return f"Linkage {k}: the driver's angle along the path (fig 17)."
+        return (f"Linkage {k}: DJ along the path from P1 to P7",
+                "Figs 12-14, 18" + ("; green: the window in which to switch drivers (section 6)." if r.plan else "."))
+    return f"Linkage {k}: the driver's angle along the path", "Fig 17."
 
 
 def _defect_claims(res) -> list:

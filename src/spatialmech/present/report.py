@@ -245,16 +245,21 @@ def _section_function(spec: str) -> tuple[Callable, int]:
 
 # ------------------------------------------------------------------------------ rendering
 _CSS = """
-body{font-family:system-ui,-apple-system,Segoe UI,sans-serif;margin:1.5em auto;max-width:1180px;color:#222;padding:0 1em}
+*,*::before,*::after{box-sizing:border-box}
+body{font-family:system-ui,-apple-system,Segoe UI,sans-serif;margin:1.5em auto;max-width:1180px;color:#222;padding:0 1em;
+overflow-wrap:break-word}
 h1{margin-bottom:.2em} h2{border-bottom:2px solid #ddd;padding-bottom:.2em;margin-top:2em}
-table{border-collapse:collapse;margin:.6em 0 1.2em;font-size:13px}
+.scroll{max-width:100%;overflow-x:auto;margin:.6em 0 1.2em}
+table{border-collapse:collapse;font-size:13px}
 td,th{border:1px solid #ccc;padding:3px 7px;text-align:left;vertical-align:top}
-th{background:#f3f3f3} td.num{text-align:right;font-variant-numeric:tabular-nums}
+th{background:#f3f3f3} td.num{text-align:right;font-variant-numeric:tabular-nums;white-space:nowrap}
+table.claims td{min-width:7em} table.claims td:last-child{min-width:16em}
 .v-reproduced{color:#176f2c;font-weight:bold} .v-corrected{color:#8a5a00;font-weight:bold}
 .v-not{color:#b3261e;font-weight:bold} .small{font-size:12px;color:#555} .bad{color:#b3261e;font-weight:bold;font-size:12px}
-code{background:#f5f5f5;padding:0 3px} figure{margin:1em 0} figure img{max-width:100%;border:1px solid #eee}
+code{background:#f5f5f5;padding:0 3px;overflow-wrap:anywhere} figure{margin:1em 0;max-width:100%}
+figure img{max-width:100%;height:auto;border:1px solid #eee}
 figcaption{font-size:13px;color:#444} .pending{background:#fff8e1;padding:.4em .8em;border-left:3px solid #f0c36d}
-.viewer{border:1px solid #ddd;margin:1em 0}
+.viewer{border:1px solid #ddd;margin:1em 0;max-width:100%;overflow:hidden}
 """
 
 _VERDICT_CLASS = {"reproduced": "v-reproduced", "reproduced after correction": "v-corrected", "not reproduced": "v-not"}
@@ -283,7 +288,8 @@ def _table_html(t: Table) -> str:
         for r in t.rows
     )
     note = f"<p class='small'>{html.escape(t.note)}</p>" if t.note else ""
-    return f"<h3>{html.escape(t.title)}</h3><table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>{note}"
+    return (f"<h3>{html.escape(t.title)}</h3><div class='scroll'><table><thead><tr>{head}</tr></thead>"
+            f"<tbody>{body}</tbody></table></div>{note}")
 
 
 def _claims_html(claims: Sequence[Claim]) -> str:
@@ -299,8 +305,8 @@ def _claims_html(claims: Sequence[Claim]) -> str:
             f"<tr><td>{html.escape(c.claim)}</td><td>{html.escape(c.paper_value)}</td><td>{html.escape(c.ours)}</td>"
             f"<td class='{_VERDICT_CLASS[c.verdict]}'>{html.escape(c.verdict)}</td><td>{html.escape(c.note)}{test}</td></tr>"
         )
-    return ("<table><thead><tr><th>claim</th><th>paper</th><th>spatialmech</th><th>verdict</th><th>why / evidence</th>"
-            "</tr></thead><tbody>" + "".join(rows) + "</tbody></table>")
+    return ("<div class='scroll'><table class='claims'><thead><tr><th>claim</th><th>paper</th><th>spatialmech</th><th>verdict</th><th>why / evidence</th>"
+            "</tr></thead><tbody>" + "".join(rows) + "</tbody></table></div>")
 
 
 def _viewer_html(v: Viewer, div_id: str) -> str:
@@ -311,6 +317,15 @@ def _viewer_html(v: Viewer, div_id: str) -> str:
                       default_height="640px")
     note = f"<p class='small'>{html.escape(v.note)}</p>" if v.note else ""
     return f"<div class='viewer'>{div}</div>{note}"
+
+
+def _figure_html(f: ReportFigure) -> str:
+    """A figure with its title in bold and its caption, the title said once (a caption that
+    opens with its title is shown alone)."""
+    title, caption = f.title.strip().rstrip("."), f.caption.strip()
+    head = "" if caption.lower().startswith(title.lower()) else f"<b>{html.escape(title)}.</b> "
+    return (f"<figure><img alt='{html.escape(title)}' src='{f.data_uri()}'><figcaption>{head}"
+            f"{html.escape(caption)} <span class='small'>(figures/{html.escape(f.name)})</span></figcaption></figure>")
 
 
 def summary(sections: Sequence[Section]) -> dict:
@@ -353,10 +368,7 @@ def render_html(title: str, sections: Sequence[Section], data: dict) -> str:
         for t in sec.tables:
             parts.append(_table_html(t))
         for f in sec.figures:
-            parts.append(
-                f"<figure><img alt='{html.escape(f.title)}' src='{f.data_uri()}'><figcaption><b>{html.escape(f.title)}.</b> "
-                f"{html.escape(f.caption)} <span class='small'>(figures/{html.escape(f.name)})</span></figcaption></figure>"
-            )
+            parts.append(_figure_html(f))
         for v in sec.viewers:
             n_view += 1
             parts.append(f"<h3>{html.escape(v.title)}</h3>" + _viewer_html(v, f"spatialmech-viewer-{n_view}"))
@@ -370,6 +382,7 @@ def render_html(title: str, sections: Sequence[Section], data: dict) -> str:
             f"correction, {s['not reproduced']} not reproduced (each with the reason). Every number is in "
             f"<code>results.json</code>; the figures are also in <code>figures/</code>.</p>")
     return (f"<!doctype html><html><head><meta charset='utf-8'><title>{html.escape(title)}</title>"
+            "<meta name='viewport' content='width=device-width, initial-scale=1'>"
             f"<style>{_CSS}</style>{js}</head><body><h1>{html.escape(title)}</h1>{head}<ul>{toc}</ul>"
             + "".join(parts) + "</body></html>\n")
 
@@ -498,12 +511,17 @@ def build_model_report(model, out, *, progress: bool | ProgressCallback = True, 
     from .. import catalog
     from . import models
 
+    from .model_platform import PLATFORM_STEPS, platform_section
+
     mech = catalog.resolve(model)
-    sink, bar = _reporter(progress, models.MODEL_STEPS, f"spatialmech report {mech.name}")
-    sec = models.model_section(mech, sink, trace=trace)
+    total = models.MODEL_STEPS + PLATFORM_STEPS
+    sink, bar = _reporter(progress, total, f"spatialmech report {mech.name}")
+    sec = models.model_section(mech, _offset(sink, 0, total), trace=trace)
+    platform = platform_section(mech, _offset(sink, models.MODEL_STEPS, total))
     from .report_forces import forces_section
 
-    data = write_report(out, f"spatialmech report: {mech.name}", [sec, forces_section(mech)], bar.elapsed, {"model": mech.name},
+    sections = [sec, *([platform] if platform is not None else []), forces_section(mech)]
+    data = write_report(out, f"spatialmech report: {mech.name}", sections, bar.elapsed, {"model": mech.name},
                         command="report", length_unit=mech.length_unit)
     bar.close()
     return data

@@ -24,14 +24,14 @@ def slice_figure(res: SliceResult, title: str = ""):
     if np.nanmin(res.det) < 0 < np.nanmax(res.det):
         # masked where no pose closes on the branch: no zero is drawn across a gap or a branch switch
         ax1.contour(U, V, np.ma.masked_invalid(res.det), levels=[0.0], colors="k", linewidths=1.5)
-    title = "sign of det J (red +, blue -); black: det J = 0"
+    left = "sign of det J (red +, blue -); black: det J = 0"
     if res.branch is not None and np.any(res.branch == 1):
         jj, ii = np.nonzero(res.branch == 1)
         ax1.scatter(res.u[ii], res.v[jj], marker="x", s=14, c="0.3", linewidths=0.8,
                     label="another working mode (masked)")
         ax1.legend(loc="upper right", fontsize=8)
-        title += "; x: branch switched"
-    ax1.set_title(title, fontsize=10)
+        left += "; x: branch switched"
+    ax1.set_title(left, fontsize=10)
     c = ax2.pcolormesh(U, V, np.log10(np.maximum(res.sigma_min, 1e-12)), cmap="viridis", shading="auto")
     f.colorbar(c, ax=ax2, label="log10 sigma_min (scale-free)")
     ax2.set_title("distance to a singularity")

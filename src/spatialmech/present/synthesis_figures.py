@@ -66,7 +66,7 @@ def plot_curves(curves: BurmesterCurves, path, task: TaskPositions | None = None
                 ax.scatter(*p, color="k", s=12)
                 ax.text(*(1.08 * p), name, fontsize=7)
         ax.set_title(title, fontsize=9)
-        ax.legend(fontsize=7, loc="upper left")
+        ax.legend(fontsize=8, loc="upper left")
     return _save(fig, path)
 
 
@@ -87,7 +87,7 @@ def plot_region1(region: Region1, path, mark: tuple[float, float] | None = None)
     ax.set_title("solution region 1 (spherical 4R; pale = defective)", fontsize=10)
     handles = [Patch(color=_TYPE_COLOURS[k], label=TYPES[k]) for k in range(len(TYPES))]
     handles.append(Patch(color=0.35 * _TYPE_COLOURS[0] + 0.65, label="defective (pale)"))
-    ax.legend(handles=handles, fontsize=7, loc="upper right")
+    ax.legend(handles=handles, fontsize=8, loc="upper right")
     return _save(fig, path)
 
 
@@ -106,7 +106,7 @@ def plot_solution_lines(res: RCCCResult, path, span: float | None = None) -> Pat
     ax.set_xlabel(f"x ({res.task.length_unit})")
     ax.set_ylabel(f"y ({res.task.length_unit})")
     ax.set_zlabel(f"z ({res.task.length_unit})")
-    ax.legend(fontsize=7)
+    ax.legend(fontsize=8)
     ax.set_title("solution lines (parameter h = signed common-normal length)", fontsize=10)
     return _save(fig, path)
 
@@ -128,7 +128,7 @@ def plot_region2(region: Region2, path, mark: tuple[float, float] | None = None)
     ax.set_xlabel("output dyad: h_out (length unit)")
     ax.set_ylabel("input dyad: h_in (length unit)")
     ax.set_title(f"solution region 2 (4C); line: smallest max |slide| = {region.best_max_abs_slide:.3g}", fontsize=9)
-    ax.legend(handles=[Patch(color=cmap(k), label=f"slides {p}") for k, p in enumerate(uniq)], fontsize=7)
+    ax.legend(handles=[Patch(color=cmap(k), label=f"slides {p}") for k, p in enumerate(uniq)], fontsize=8)
     return _save(fig, path)
 
 
@@ -157,7 +157,7 @@ def plot_linkage(res: RCCCResult, path) -> Path:
     ax.set_xlabel(f"x ({res.task.length_unit})")
     ax.set_ylabel(f"y ({res.task.length_unit})")
     ax.set_zlabel(f"z ({res.task.length_unit})")
-    ax.legend(fontsize=7)
+    ax.legend(fontsize=8)
     ax.set_title("RCCC at the task positions (x = task points; dotted = joint axes)", fontsize=10)
     return _save(fig, path)
 

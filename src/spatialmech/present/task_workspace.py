@@ -84,8 +84,13 @@ def task_workspace_figure(result):
         return fig
     u, v = (_conv(c, g) for c, g in zip(over, result.grid, strict=True))
     n_pan = 1 + len(solved)
-    fig = Figure(figsize=(4.6 * n_pan, 4.4))
-    axes = fig.subplots(1, n_pan, squeeze=False)[0]
+    cols = min(n_pan, 2)  # at most two panels side by side: the figure stays readable at a page's width
+    rows = -(-n_pan // cols)
+    fig = Figure(figsize=(5.2 * cols, 4.4 * rows))
+    axes = fig.subplots(rows, cols, squeeze=False).ravel()
+    for extra in axes[n_pan:]:
+        extra.set_visible(False)
+    axes = axes[:n_pan]
     ax = axes[0]
     # cell classes: 0 reachable, 1 does not close, 2.. a broken limit
     codes = np.zeros(result.feasible.shape, dtype=int)

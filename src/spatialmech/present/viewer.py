@@ -59,6 +59,7 @@ from ..kinematics.backend import joint_twists
 from ..model.mechanism import GROUND, Mechanism, Pose
 from ..serialize import fields_dict
 from .shapes import joint_list, joint_meshes, platform_solid
+from .numbers import unit_label
 
 __all__ = ["DIV_ID", "LIMB_COLOURS", "PLOTLY_MODES", "SINGULAR_SYMBOL", "Drawing", "ViewerFile", "drawing", "viewer_figure",
            "viewer_figure_dict", "viewer_html", "write_viewer"]
@@ -522,10 +523,10 @@ def _viewer_parts(mech, configs, title, task_positions, singular_points, make, s
     allp = np.vstack([d.points() for d in draws] + extra + meshes)
     lo, hi = allp.min(axis=0), allp.max(axis=0)
     centre, half = (lo + hi) / 2, max(float(np.max(hi - lo)) / 2 * 1.08, 1e-9 * s, 1e-12)
-    unit = mech.length_unit
+    unit = unit_label(mech.length_unit)
     scene: dict[str, object] = dict(aspectmode="cube")
     for ax, c in zip("xyz", centre, strict=True):
-        scene[f"{ax}axis"] = dict(range=[c - half, c + half], title=f"{ax} [{unit}]", autorange=False)
+        scene[f"{ax}axis"] = dict(range=[c - half, c + half], title=dict(text=f"{ax} [{unit}]"), autorange=False)
 
     anim = dict(mode="immediate", frame=dict(duration=0, redraw=True), transition=dict(duration=0))
     fig = go.Figure(data=static + first)

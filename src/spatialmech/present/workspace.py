@@ -51,14 +51,15 @@ def workspace_figure(result):
             ax.plot(_conv(c, x), 0, "o", color=colour[n], label=n)
         ax.set_xlabel(_label(c))
         ax.set_yticks([])
-        legend_once(ax, 6)
+        legend_once(ax, 8)
         fig.suptitle(title, fontsize=8)
         return fig
     planes = [(0, 1)] if d == 2 else [(0, 1), (0, 2), (1, 2)]
-    fig = Figure(figsize=(5 * len(planes) + (5 if d == 3 else 0), 4.8))
     n_pan = len(planes) + (1 if d == 3 else 0)
+    rows, cols = (2, 2) if n_pan > 2 else (1, n_pan)  # two panels a row: readable at a page's width
+    fig = Figure(figsize=(5.2 * cols, 4.6 * rows))
     for k, (i, j) in enumerate(planes):
-        ax = fig.add_subplot(1, n_pan, k + 1)
+        ax = fig.add_subplot(rows, cols, k + 1)
         other = [m for m in range(d) if m not in (i, j)]
         F = result.feasible
         sel = np.ones(len(result.boundary_points), dtype=bool)
@@ -80,9 +81,9 @@ def workspace_figure(result):
         ax.set_ylabel(_label(free[j]))
         if other:
             ax.set_title(f"slice {free[other[0]]} = {_conv(free[other[0]], result.center[free[other[0]]]):.4g}", fontsize=9)
-        legend_once(ax, 6)
+        legend_once(ax, 8)
     if d == 3:
-        ax = fig.add_subplot(1, n_pan, n_pan, projection="3d")
+        ax = fig.add_subplot(rows, cols, n_pan, projection="3d")
         bp = result.boundary_points
         lim = np.array(result.boundary_limits)
         for n in limits:
