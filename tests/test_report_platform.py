@@ -123,7 +123,7 @@ def test_demo_page_is_responsive(demo_report):
     assert tables > 0 and page.count("<div class='scroll'><table") == tables  # every table scrolls in its own box
 
 
-def test_demo_page_fits_820_px_in_chromium(demo_report, browser):
+def test_demo_page_fits_820_px_in_chromium(demo_report, browser):  # noqa: F811 (the imported fixture)
     """Headless Chromium (tests/test_viewer_browser.py's driver) at a window 820 px wide: the page
     does not scroll sideways (wide tables scroll inside their own box)."""
     out, _ = demo_report

@@ -233,7 +233,7 @@ def _workspace(mech: Mechanism, data: dict) -> tuple[F.ReportFigure, str]:
                  f"measure {d[vkey]:.4g} +- {d[vkey.replace('volume_', 'volume_error_', 1)]:.2g} "
                  f"{'deg' if '_deg' in vkey else unit}^{len(res.over)} (grid estimate |V_h - V_2h| + boundary tolerance)")
         limits = ", ".join(f"{k} {v}" for k, v in res.active_limits.items()) or "none"
-        text = (f"Workspace over the task coordinates "
+        text = ("Workspace over the task coordinates "
                 + ", ".join(f"{c} in [{_show(c, lo)}, {_show(c, hi)}] ({k} points)" for c, (lo, hi, k) in over.items())
                 + (", " + ", ".join(f"{c} = {_show(c, x)} held" for c, x in at.items()) if at else "")
                 + f", {', '.join(res.solved)} solved at every cell: {res.n_feasible} of {res.feasible.size} cells "

@@ -305,7 +305,8 @@ def _claims_html(claims: Sequence[Claim]) -> str:
             f"<tr><td>{html.escape(c.claim)}</td><td>{html.escape(c.paper_value)}</td><td>{html.escape(c.ours)}</td>"
             f"<td class='{_VERDICT_CLASS[c.verdict]}'>{html.escape(c.verdict)}</td><td>{html.escape(c.note)}{test}</td></tr>"
         )
-    return ("<div class='scroll'><table class='claims'><thead><tr><th>claim</th><th>paper</th><th>spatialmech</th><th>verdict</th><th>why / evidence</th>"
+    return ("<div class='scroll'><table class='claims'><thead><tr>"
+            "<th>claim</th><th>paper</th><th>spatialmech</th><th>verdict</th><th>why / evidence</th>"
             "</tr></thead><tbody>" + "".join(rows) + "</tbody></table></div>")
 
 
@@ -325,7 +326,8 @@ def _figure_html(f: ReportFigure) -> str:
     title, caption = f.title.strip().rstrip("."), f.caption.strip()
     head = "" if caption.lower().startswith(title.lower()) else f"<b>{html.escape(title)}.</b> "
     return (f"<figure><img alt='{html.escape(title)}' src='{f.data_uri()}'><figcaption>{head}"
-            f"{html.escape(caption)} <span class='small'>(figures/{html.escape(f.name)})</span></figcaption></figure>")
+            f"{html.escape(caption)} <span class='small'>(figures/{html.escape(f.name)})</span>"
+            "</figcaption></figure>")
 
 
 def summary(sections: Sequence[Section]) -> dict:
