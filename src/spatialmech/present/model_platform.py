@@ -23,7 +23,9 @@ The grids are small so that the report stays fast; their resolution is stated in
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from dataclasses import replace
+from typing import cast
 
 import numpy as np
 
@@ -166,7 +168,7 @@ def _slice(mech: Mechanism, ref: Configuration, data: dict) -> tuple[F.ReportFig
             half = SLICE_HALF_ANGLE / 2 if c.startswith("a") else L / 4
             axes[c] = np.linspace(ref_vals[c] - half, ref_vals[c] + half, n)
         at = {c: ref_vals[c] for c in order[2:]}
-        res = task_singularity_slice(mech, axes, at=at, task=task, seed=ref)
+        res = task_singularity_slice(mech, cast(Mapping[str, Sequence[float]], axes), at=at, task=task, seed=ref)
         shown = res.for_display()
         what = (", ".join(f"{c} in [{_show(c, a[0])}, {_show(c, a[-1])}] ({a.size} points)" for c, a in axes.items())
                 + "; " + ", ".join(f"{c} = {_show(c, x)} held" for c, x in at.items())
@@ -225,28 +227,28 @@ def _workspace(mech: Mechanism, data: dict) -> tuple[F.ReportFigure, str]:
         over = {c: ((ref_vals[c] - TASK_HALF_ANGLE, ref_vals[c] + TASK_HALF_ANGLE, n) if c.startswith("a")
                     else (ref_vals[c] - L / 2, ref_vals[c] + L / 2, n)) for c in order[:2]}
         at = {c: ref_vals[c] for c in order[2:]}
-        res = task_workspace(mech, over, at=at, task=task)
-        d = res.to_dict()
+        tres = task_workspace(mech, over, at=at, task=task)
+        d = tres.to_dict()
         vkey = next((k for k in d if k.startswith("volume_") and k not in ("volume_note",)
                      and not k.startswith("volume_error")), None)
         vtext = ("no measure (the grid mixes lengths and angles)" if vkey is None else
                  f"measure {d[vkey]:.4g} +- {d[vkey.replace('volume_', 'volume_error_', 1)]:.2g} "
-                 f"{'deg' if '_deg' in vkey else unit}^{len(res.over)} (grid estimate |V_h - V_2h| + boundary tolerance)")
-        limits = ", ".join(f"{k} {v}" for k, v in res.active_limits.items()) or "none"
+                 f"{'deg' if '_deg' in vkey else unit}^{len(tres.over)} (grid estimate |V_h - V_2h| + boundary tolerance)")
+        limits = ", ".join(f"{k} {v}" for k, v in tres.active_limits.items()) or "none"
         text = ("Workspace over the task coordinates "
                 + ", ".join(f"{c} in [{_show(c, lo)}, {_show(c, hi)}] ({k} points)" for c, (lo, hi, k) in over.items())
                 + (", " + ", ".join(f"{c} = {_show(c, x)} held" for c, x in at.items()) if at else "")
-                + f", {', '.join(res.solved)} solved at every cell: {res.n_feasible} of {res.feasible.size} cells "
+                + f", {', '.join(tres.solved)} solved at every cell: {tres.n_feasible} of {tres.feasible.size} cells "
                 f"reachable, {vtext}; boundary points by active limit: {limits}"
-                + ("" if res.limit_names else " (the model has no limits: only closure and the grid bound the set)")
+                + ("" if tres.limit_names else " (the model has no limits: only closure and the grid bound the set)")
                 + ".")
-        data["workspace"] = {"kind": "task", "over": list(res.over), "grid": [n, n],
+        data["workspace"] = {"kind": "task", "over": list(tres.over), "grid": [n, n],
                              "volume": None if vkey is None else d[vkey], "volume_key": vkey,
                              "volume_error": None if vkey is None else d[vkey.replace("volume_", "volume_error_", 1)],
-                             "n_feasible": res.n_feasible, "active_limits": res.active_limits}
+                             "n_feasible": tres.n_feasible, "active_limits": tres.active_limits}
         from .task_workspace import task_workspace_figure
 
-        fig = task_workspace_figure(res)
+        fig = task_workspace_figure(tres)
     return F.to_png(fig, "workspace.png", f"{mech.name}: workspace under the model's limits", text), text
 
 
@@ -258,7 +260,11 @@ def platform_section(mech: Mechanism, progress: Progress | None = None) -> Secti
         return None
     say = Steps(progress, PLATFORM_STEPS)
     ref = Configuration.reference(mech)
-    tables, figs, viewers, notes, data = [], [], [], [], {}
+    tables: list[Table] = []
+    figs: list[F.ReportFigure] = []
+    viewers: list[Viewer] = []
+    notes: list[str] = []
+    data: dict = {}
     say(f"{mech.name}: assembly modes (fk --all)")
     try:
         table, fig, viewer, _ = _modes(mech, ref, data)
