@@ -26,3 +26,21 @@ def test_four_sps_cu_default_is_proven_and_keeps_the_closed_forms_answer():
     assert hom.complete and len(hom.modes) == 4
     d = proven.to_dict()
     assert d["complete"] is True and d["n_certified"] == 4
+
+
+def test_four_sps_cu_proven_empty_set_is_an_answer_not_an_error():
+    """Leg lengths with no real assembly: the homotopy proves the empty set, so the text output
+    says so (exit 0) instead of 'no assembly found ... not a proof'; the JSON agrees."""
+    import json
+
+    from click.testing import CliRunner
+
+    from spatialmech.interfaces.cli import cli
+
+    args = ["fk", "four-sps-cu", "--actuators", "0.21,0.25,0.22,0.19", "--all"]
+    r = CliRunner().invoke(cli, args, catch_exceptions=False)
+    assert r.exit_code == 0, r.output
+    assert "four-sps-cu: 0 real assembly modes" in r.output and "complete (proven)" in r.output
+    assert "not a proof" not in r.output
+    d = json.loads(CliRunner().invoke(cli, [*args, "--json"], catch_exceptions=False).output)
+    assert d["n_solutions"] == 0 and d["complete"] is True

@@ -300,7 +300,7 @@ def fk(model, values, all_solutions, method, seeds, no_certify, as_json):
     \b
     Examples:
       spatialmech fk stewart-6sps --actuators 1.2,1.2,1.2,1.2,1.2,1.2
-      spatialmech fk four-sps-cu --actuators 0.21,0.25,0.22,0.19 --all --json
+      spatialmech fk four-sps-cu --actuators 0.216745,0.23896,0.227321,0.206933 --all --json
       spatialmech fk stewart-6sps --actuators 1.2,1.2,1.2,1.2,1.2,1.2 --all
     """
     mech = sm.load_model(model)
@@ -377,12 +377,8 @@ def _fk_text(r: sm.FKResult) -> None:
             click.echo(f"  certificates: {cert}")
     else:
         if not modes:
-            if a.all_solutions:
-                raise InputError(f"actuators: no assembly found among {a.n_starts} starts ({a.n_converged} converged); "
-                                 "not a proof that none exists: check the values against the limits and the "
-                                 "mechanism's size, or try more --seeds")
-            raise InputError(f"actuators: no assembly found (Newton did not converge; residual {a.failed_residual:.2e}); "
-                             "try --all")
+            _fk_none_found(mech, a)
+            return
         click.echo(_fk_header(mech, [m.kind for m in modes if not m.input_independent], a.label, a.n_starts,
                               a.n_converged, n_ii)
                    + ("" if not a.all_solutions else f"; {a.n_within_limits} within limits" if limited
@@ -398,6 +394,21 @@ def _fk_text(r: sm.FKResult) -> None:
         _fk_conditioning_lines(m.kind, m.sigma_min, m.condition, m.singular_below, m.members, m.self_motion,
                                mech.length_unit, m.free_dim)
         _fk_flag_lines(m)
+
+
+def _fk_none_found(mech: Mechanism, a) -> None:
+    """``fk`` as text when no mode converged (other than the homotopy's): a proven empty set
+    (the 4-SPS/CU's closed form checked by the homotopy) is an answer, else an ``InputError``."""
+    if a.all_solutions and a.complete:
+        click.echo(f"{mech.name}: 0 real assembly modes ({a.label})")
+        click.echo("  complete (proven): " + a.completeness)
+        return
+    if a.all_solutions:
+        raise InputError(f"actuators: no assembly found among {a.n_starts} starts ({a.n_converged} converged); "
+                         "not a proof that none exists: check the values against the limits and the "
+                         "mechanism's size, or try more --seeds")
+    raise InputError(f"actuators: no assembly found (Newton did not converge; residual {a.failed_residual:.2e}); "
+                     "try --all")
 
 
 def _fk_flag_lines(m) -> None:
