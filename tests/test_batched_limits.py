@@ -139,6 +139,31 @@ def test_compiled_joint_points_equal_the_reference(name):
         assert np.max(np.abs(out[s] - np.array([ref[li][k] for li, k in pts]))) <= 1e-12
 
 
+@pytest.mark.parametrize("name", ["stewart-6sps", "dietmaier-file"])
+def test_closed_form_legs_close_where_the_gauss_newton_does(name):
+    """The general checker of a platform on six S-P-S legs places the legs in closed form
+    (``compiled.inverse_legs_many``) instead of a Gauss-Newton per leg: every leg closes to
+    rounding, the joint points and slides are the Gauss-Newton's to its own tolerance (closure
+    1e-10), only the legs' idle spins differ."""
+    from spatialmech.kinematics.leg_platform import leg_platform
+
+    mech = CASES[name][0]()
+    lp = leg_platform(mech)
+    assert lp is not None
+    R, p = _poses(mech, 12, np.random.default_rng(4))
+    D = np.zeros((12, 4, 4))
+    D[:, :3, :3], D[:, 3, 3] = R, 1.0
+    D[:, :3, 3] = p - np.einsum("nij,j->ni", R, mech.platform_point)
+    q, res, ok = compiled.inverse_legs_many(lp, D)
+    q_gn, _, ok_gn = compiled.limb_inverse_many(mech, D)
+    assert ok.all() and ok_gn.all() and np.max(res) < 1e-13
+    pts = [(li, k) for li in range(6) for k in range(3)]
+    L = mech.characteristic_length
+    P, P_gn = compiled.joint_points_many(mech, q, pts), compiled.joint_points_many(mech, q_gn, pts)
+    assert np.max(np.abs(P - P_gn)) <= 1e-9 * L
+    assert np.max(np.abs(q[:, lp.index[:, 1]] - q_gn[:, lp.index[:, 1]])) <= 1e-9 * L
+
+
 def test_configuration_checker_batch_equals_one_by_one():
     mech = catalog.build("stewart-6sps")
     checker = configuration_checker(mech, WorkspaceLimits(_cones(mech, 35), 0.05 * mech.characteristic_length))

@@ -387,8 +387,21 @@ class _GeneralKernel:
         self.s_limits = any(mech.limbs[refs[f].limb].joints[refs[f].joint].type == "S" for f in k.fl)
         self.simple = not k.cones and not k.pairs
         self.model_limits = any(r.freedom.limits is not None for r in refs)
+        self.legs = self.closed_form_legs(mech, refs)
         # the link ends, as joint points (limb, k): every link's start, then every link's end
         self.link_points = [(lk.limb, lk.ends[0]) for lk in k.links] + [(lk.limb, lk.ends[1]) for lk in k.links]
+
+    def closed_form_legs(self, mech: Mechanism, refs):
+        """The legs of a platform on six S-P-S legs (:func:`..kinematics.leg_platform.leg_platform`)
+        when no margin depends on the legs' idle spins (no freedom limit on a ball, the checker's
+        or the model's): :meth:`batch` then places the legs in closed form instead of a
+        Gauss-Newton per leg; else ``None``."""
+        from ...kinematics.leg_platform import leg_platform
+
+        balls = [r for r in refs if mech.limbs[r.limb].joints[r.joint].type == "S"]
+        if self.s_limits or any(r.freedom.limits is not None for r in balls):
+            return None
+        return leg_platform(mech)
 
     def row(self, config, R1):
         """The margins at a closed configuration (platform orientation ``R1``, (1, 3, 3))."""
@@ -435,7 +448,10 @@ class _GeneralKernel:
         D[:, :3, :3] = R
         D[:, :3, 3] = p - np.einsum("nij,j->ni", R, mech.platform_point)
         D[:, 3, 3] = 1.0
-        q, _res, ok = compiled.limb_inverse_many(mech, D)
+        if self.legs is not None:  # the same joint points and slides to the Gauss-Newton's tolerance
+            q, _res, ok = compiled.inverse_legs_many(self.legs, D)
+        else:
+            q, _res, ok = compiled.limb_inverse_many(mech, D)
         done = np.all(ok, axis=1)
         idx = np.flatnonzero(done)
         qq = q[idx]

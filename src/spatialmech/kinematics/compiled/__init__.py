@@ -50,7 +50,7 @@ from .kernels_ik import ik_pack, ik_track
 from .kernels_loops import pack as pack_loop_system
 from .kernels_loops import square_batch as loop_square_batch
 from .kernels_tracking import bordered_tangent
-from .legs import correct_legs
+from .legs import correct_legs, inverse_legs_many
 from .limits import joint_points_many, link_margins_many
 from .tasks import task_grid, task_solve
 from . import maps as maps  # performance-map kernels (analysis/maps.py)
@@ -76,6 +76,7 @@ __all__ = [
     "four_sps_cu_legs",
     "ik_pack",
     "ik_track",
+    "inverse_legs_many",
     "joint_points_many",
     "limb_gn",
     "limb_inverse_many",

@@ -598,7 +598,7 @@ def warm_up() -> float:
     from ...model.joints import P, R, S
     from ...model.mechanism import Limb  # here, not at the top: only the warm-up builds a model
     from ..leg_platform import leg_platform
-    from .legs import correct_legs  # here, not at the top: legs.py builds on this module
+    from .legs import correct_legs, inverse_legs_many  # here, not at the top: legs.py builds on this module
 
     t0 = time.perf_counter()
     z = [0.0, 0.0, 1.0]
@@ -629,4 +629,5 @@ def warm_up() -> float:
     lp = leg_platform(stewart)
     assert lp is not None and lp.applies(held)
     correct_legs(stewart, lp, Configuration(q, np.eye(4)), active=held)
+    inverse_legs_many(lp, np.eye(4)[None])  # the general checker's closed-form legs
     return time.perf_counter() - t0

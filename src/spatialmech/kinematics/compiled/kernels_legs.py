@@ -10,7 +10,8 @@ from .jit import njit
 from .kernels_closure import nb_finite_config
 from .kernels_se3 import nb_log, nb_matrix_rotvec, nb_rodrigues, nb_rotvec_matrix3
 
-__all__ = ["nb_leg_closure", "nb_leg_platform", "nb_shortest_rotation", "nb_shortest_rotvec"]
+__all__ = ["nb_leg_closure", "nb_leg_inverse", "nb_leg_platform", "nb_leg_residual_sq", "nb_shortest_rotation",
+           "nb_shortest_rotvec"]
 
 
 @njit(cache=True)
@@ -205,38 +206,104 @@ def nb_leg_platform(index, geom, L, q0, D0, tol, max_iter, q, D):
 def nb_leg_closure(index, geom, L, q, D, W):
     """The nondimensional norm of the closure residual of S-P-S legs (6 per leg: rotation, then
     moment / ``L``), as :func:`.kernels_closure.nb_closure_system` computes it for any limb, with
-    each leg's chain written out: ``T = [R1, a - R1 a] [I, s e] [R2, b - R2 b]`` and the residual
-    ``log(T D^-1)``.  ``W`` (4, 3, 3) scratch."""
+    each leg's chain written out (:func:`nb_leg_residual_sq`).  ``W`` (4, 3, 3) scratch."""
+    T = np.empty((4, 4))
+    tw = np.empty(6)
+    sq = 0.0
+    for k in range(index.shape[0]):
+        sq += nb_leg_residual_sq(index, geom, L, q, D, k, W, T, tw)
+    return np.sqrt(sq)
+
+
+@njit(cache=True)
+def nb_leg_residual_sq(index, geom, L, q, D, k, W, T, tw):
+    """The square of leg ``k``'s nondimensional closure residual: its chain
+    ``T = [R1, a - R1 a] [I, s e] [R2, b - R2 b]`` and the residual ``log(T D^-1)`` (rotation,
+    then moment / ``L``).  ``W`` (4, 3, 3), ``T`` (4, 4), ``tw`` (6,) scratch."""
     R1 = W[0]
     R2 = W[1]
     E = W[2]
     p = W[3, 0]
     x = W[3, 1]
-    tw = W[3, 2]
+    i1, i_s, i2 = index[k, 0], index[k, 1], index[k, 2]
+    for o, i, Rb in ((9, i1, R1), (18, i2, R2)):
+        A = geom[k, o:o + 9]  # the ball's axes, row by row
+        nb_rotvec_matrix3(A[0] * q[i] + A[1] * q[i + 1] + A[2] * q[i + 2],
+                          A[3] * q[i] + A[4] * q[i + 1] + A[5] * q[i + 2],
+                          A[6] * q[i] + A[7] * q[i + 1] + A[8] * q[i + 2], Rb)
+    s = q[i_s]
+    for a in range(3):  # x = s e + b - R2 b;  p = a - R1 a + R1 x
+        x[a] = s * geom[k, 6 + a] + geom[k, 3 + a] - (R2[a, 0] * geom[k, 3] + R2[a, 1] * geom[k, 4]
+                                                       + R2[a, 2] * geom[k, 5])
+    for a in range(3):
+        p[a] = geom[k, a] + R1[a, 0] * (x[0] - geom[k, 0]) + R1[a, 1] * (x[1] - geom[k, 1]) + R1[a, 2] * (
+            x[2] - geom[k, 2])
+        for b in range(3):
+            E[a, b] = R1[a, 0] * R2[0, b] + R1[a, 1] * R2[1, b] + R1[a, 2] * R2[2, b]
+    for a in range(3):  # T D^-1 = [E R^T, p - E R^T t]
+        for b in range(3):
+            T[a, b] = E[a, 0] * D[b, 0] + E[a, 1] * D[b, 1] + E[a, 2] * D[b, 2]
+    for a in range(3):
+        T[a, 3] = p[a] - (T[a, 0] * D[0, 3] + T[a, 1] * D[1, 3] + T[a, 2] * D[2, 3])
+    nb_log(T, np.bool_(True), tw)
+    return tw[0] * tw[0] + tw[1] * tw[1] + tw[2] * tw[2] + (tw[3] * tw[3] + tw[4] * tw[4] + tw[5] * tw[5]) / (L * L)
+
+
+@njit(cache=True)
+def nb_leg_inverse(index, geom, L, Ds, tol, q, res, ok):
+    """Inverse position of S-P-S legs in closed form at each platform displacement ``Ds[s]``
+    (N, 4, 4) from the reference: each slide at the root nearest zero of
+    ``|b - a + s e| = |D b - a|``, each base ball turned the shortest way from the reference
+    direction of its leg (``b - a + s e``) to ``D b - a`` (the leg's idle spin stays the
+    reference's, zero: the rule of :func:`.leg_platform.place_legs`), each platform ball
+    ``R1^T R``.  ``q`` (N, n) rows must hold the reference (zeros) beforehand; per leg the
+    nondimensional closure residual (:func:`nb_leg_residual_sq`) in ``res`` (N, 6) and whether
+    it is below ``tol`` in ``ok``; a leg whose distance cannot be reached by its slide keeps the
+    reference (NaN residual, not ok)."""
+    W = np.empty((4, 3, 3))
     T = np.empty((4, 4))
-    sq = 0.0
-    for k in range(index.shape[0]):
-        i1, i_s, i2 = index[k, 0], index[k, 1], index[k, 2]
-        for o, i, Rb in ((9, i1, R1), (18, i2, R2)):
-            A = geom[k, o:o + 9]  # the ball's axes, row by row
-            nb_rotvec_matrix3(A[0] * q[i] + A[1] * q[i + 1] + A[2] * q[i + 2],
-                              A[3] * q[i] + A[4] * q[i + 1] + A[5] * q[i + 2],
-                              A[6] * q[i] + A[7] * q[i + 1] + A[8] * q[i + 2], Rb)
-        s = q[i_s]
-        for a in range(3):  # x = s e + b - R2 b;  p = a - R1 a + R1 x
-            x[a] = s * geom[k, 6 + a] + geom[k, 3 + a] - (R2[a, 0] * geom[k, 3] + R2[a, 1] * geom[k, 4]
-                                                           + R2[a, 2] * geom[k, 5])
-        for a in range(3):
-            p[a] = geom[k, a] + R1[a, 0] * (x[0] - geom[k, 0]) + R1[a, 1] * (x[1] - geom[k, 1]) + R1[a, 2] * (
-                x[2] - geom[k, 2])
-            for b in range(3):
-                E[a, b] = R1[a, 0] * R2[0, b] + R1[a, 1] * R2[1, b] + R1[a, 2] * R2[2, b]
-        for a in range(3):  # T D^-1 = [E R^T, p - E R^T t]
-            for b in range(3):
-                T[a, b] = E[a, 0] * D[b, 0] + E[a, 1] * D[b, 1] + E[a, 2] * D[b, 2]
-        for a in range(3):
-            T[a, 3] = p[a] - (T[a, 0] * D[0, 3] + T[a, 1] * D[1, 3] + T[a, 2] * D[2, 3])
-        nb_log(T, np.bool_(True), tw)
-        sq += tw[0] * tw[0] + tw[1] * tw[1] + tw[2] * tw[2]
-        sq += (tw[3] * tw[3] + tw[4] * tw[4] + tw[5] * tw[5]) / (L * L)
-    return np.sqrt(sq)
+    tw = np.empty(6)
+    R1 = np.empty((3, 3))
+    R2 = np.empty((3, 3))
+    v = np.empty(3)
+    for n in range(Ds.shape[0]):
+        D = Ds[n]
+        qn = q[n]
+        for k in range(index.shape[0]):
+            i1, i_s, i2 = index[k, 0], index[k, 1], index[k, 2]
+            d0 = D[0, 0] * geom[k, 3] + D[0, 1] * geom[k, 4] + D[0, 2] * geom[k, 5] + D[0, 3] - geom[k, 0]
+            d1 = D[1, 0] * geom[k, 3] + D[1, 1] * geom[k, 4] + D[1, 2] * geom[k, 5] + D[1, 3] - geom[k, 1]
+            d2 = D[2, 0] * geom[k, 3] + D[2, 1] * geom[k, 4] + D[2, 2] * geom[k, 5] + D[2, 3] - geom[k, 2]
+            ld2 = d0 * d0 + d1 * d1 + d2 * d2
+            c0, c1, c2 = geom[k, 3] - geom[k, 0], geom[k, 4] - geom[k, 1], geom[k, 5] - geom[k, 2]
+            e0, e1, e2 = geom[k, 6], geom[k, 7], geom[k, 8]
+            ee = e0 * e0 + e1 * e1 + e2 * e2
+            be = e0 * c0 + e1 * c1 + e2 * c2
+            disc = be * be - ee * (c0 * c0 + c1 * c1 + c2 * c2 - ld2)
+            if not (disc >= 0.0 and ee > 0.0 and ld2 > 0.0):
+                res[n, k] = np.nan
+                ok[n, k] = False
+                continue
+            r = np.sqrt(disc)
+            sl = (r - be) / ee if be <= 0.0 else -(r + be) / ee  # the two roots without cancellation
+            sf = (c0 * c0 + c1 * c1 + c2 * c2 - ld2) / (ee * sl) if sl != 0.0 else -2.0 * be / ee
+            s = sl if abs(sl) <= abs(sf) else sf
+            w0, w1, w2 = c0 + s * e0, c1 + s * e1, c2 + s * e2
+            lw = np.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
+            ld = np.sqrt(ld2)
+            nb_shortest_rotation(w0 / lw, w1 / lw, w2 / lw, d0 / ld, d1 / ld, d2 / ld, R1, v)
+            for a in range(3):  # R1^T R
+                for b in range(3):
+                    R2[a, b] = R1[0, a] * D[0, b] + R1[1, a] * D[1, b] + R1[2, a] * D[2, b]
+            A1 = geom[k, 9:18]  # row by row: A1[3 r + c]; q = A^T (rotation vector)
+            A2 = geom[k, 18:27]
+            nb_matrix_rotvec(R1, v)
+            for j in range(3):
+                qn[i1 + j] = A1[j] * v[0] + A1[3 + j] * v[1] + A1[6 + j] * v[2]
+            qn[i_s] = s
+            nb_matrix_rotvec(R2, v)
+            for j in range(3):
+                qn[i2 + j] = A2[j] * v[0] + A2[3 + j] * v[1] + A2[6 + j] * v[2]
+            rk = np.sqrt(nb_leg_residual_sq(index, geom, L, qn, D, k, W, T, tw))
+            res[n, k] = rk
+            ok[n, k] = rk < tol
