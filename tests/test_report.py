@@ -399,3 +399,29 @@ def test_an_interrupted_report_leaves_nothing_partial(tmp_path, monkeypatch, exi
     assert json.loads((out / "results.json").read_text())["title"] == "new"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["rep"]
     assert (out / "notes.txt").exists() == existing
+
+
+@pytest.mark.slow
+def test_demo_sections_on_two_workers_equal_one_process(tmp_path):
+    """The demo's sections built by two forked workers (present/demo_pool.py) give the same
+    results.json (but for the elapsed time), page and figures as one process; every step of
+    both sections reaches the progress callback."""
+    from spatialmech.present import demo_pool
+    from spatialmech.present.report import build_demo
+
+    import multiprocessing
+
+    if "fork" not in multiprocessing.get_all_start_methods():
+        pytest.skip("no fork on this platform")
+    secs = ("paper_c:section", "models:section")
+    steps = []
+    a = build_demo(tmp_path / "a", progress=lambda d, t, m: steps.append(m), sections=secs, workers=2)
+    b = build_demo(tmp_path / "b", progress=False, sections=secs, workers=1)
+    a.pop("elapsed_s")
+    b.pop("elapsed_s")
+    assert json.dumps(a, sort_keys=True) == json.dumps(b, sort_keys=True)
+    strip = lambda p: re.sub(r"generated in [0-9.]+ s", "", p.read_text(encoding="utf-8"))  # noqa: E731
+    assert strip(tmp_path / "a" / "index.html") == strip(tmp_path / "b" / "index.html")
+    for f in (tmp_path / "b" / "figures").iterdir():
+        assert (tmp_path / "a" / "figures" / f.name).read_bytes() == f.read_bytes()
+    assert len(steps) == 4 and set(demo_pool.LAST_RUN["sections"]) == set(secs)

@@ -19,10 +19,11 @@ assembles and renders:
 - ``DIR/figures/*.png``: the figures as files.
 
 Progress goes to stderr (a bar on a terminal, one line per step otherwise); nothing is cached
-between runs.  Example::
+between runs.  The demo's sections are built by two worker processes where the machine has two
+cores (:mod:`.demo_pool`).  Example::
 
     from spatialmech.present.report import build_demo
-    data = build_demo("report")          # ~30 s; data["summary"] counts the verdicts
+    data = build_demo("report")          # ~19 CPU s; data["summary"] counts the verdicts
 """
 
 from __future__ import annotations
@@ -57,7 +58,9 @@ __all__ = [
     "build_demo",
     "build_model_report",
     "join_names",
+    "prerender",
     "render_html",
+    "section_function",
     "write_report",
 ]
 
@@ -162,6 +165,9 @@ class Viewer:
     task_positions: tuple = field(default=(), repr=False)
     singular_points: tuple = field(default=(), repr=False)
     note: str = ""
+    #: the viewer's markup rendered ahead (by a demo worker, :func:`prerender`), its div id
+    #: :data:`_PRERENDER_ID` until the page numbers it; empty: rendered with the page
+    html: str = field(default="", repr=False)
 
     def to_dict(self) -> dict:
         return {"title": self.title, "model": self.mech.name, "frames": len(self.configs),
@@ -237,7 +243,9 @@ class Progress:
             self.file.flush()
 
 
-def _section_function(spec: str) -> tuple[Callable, int]:
+def section_function(spec: str) -> tuple[Callable, int]:
+    """The function of a section spec ``module:function`` (in :mod:`spatialmech.present`) and its
+    number of progress steps (the module's ``STEPS``)."""
     mod_name, fn_name = spec.split(":")
     mod = importlib.import_module(f"{__package__}.{mod_name}")
     return getattr(mod, fn_name), int(getattr(mod, "STEPS", 1))
@@ -310,12 +318,29 @@ def _claims_html(claims: Sequence[Claim]) -> str:
             "</tr></thead><tbody>" + "".join(rows) + "</tbody></table></div>")
 
 
-def _viewer_html(v: Viewer, div_id: str) -> str:
+#: The div id of a viewer rendered ahead of its page (:attr:`Viewer.html`), replaced by its number.
+_PRERENDER_ID = "spatialmech-viewer-prerendered-7f3a"
+
+
+def _viewer_div(v: Viewer, div_id: str) -> str:
     from .viewer import viewer_html
 
-    div = viewer_html(v.mech, list(v.configs), title=v.title, task_positions=v.task_positions,
-                      singular_points=v.singular_points, full_html=False, include_plotlyjs=False, div_id=div_id,
-                      default_height="640px")
+    return viewer_html(v.mech, list(v.configs), title=v.title, task_positions=v.task_positions,
+                       singular_points=v.singular_points, full_html=False, include_plotlyjs=False, div_id=div_id,
+                       default_height="640px")
+
+
+def prerender(sec: Section) -> Section:
+    """``sec`` with its viewers' markup rendered (:attr:`Viewer.html`): a demo worker renders its
+    sections' viewers itself, in parallel with the other worker, instead of the page doing all."""
+    import dataclasses
+
+    return dataclasses.replace(sec, viewers=tuple(dataclasses.replace(v, html=_viewer_div(v, _PRERENDER_ID))
+                                                  for v in sec.viewers))
+
+
+def _viewer_html(v: Viewer, div_id: str) -> str:
+    div = v.html.replace(_PRERENDER_ID, div_id) if v.html else _viewer_div(v, div_id)
     note = f"<p class='small'>{html.escape(v.note)}</p>" if v.note else ""
     return f"<div class='viewer'>{div}</div>{note}"
 
@@ -486,20 +511,30 @@ def _offset(sink: ProgressCallback, start: int, total: int) -> ProgressCallback:
     return lambda done, _total, message: sink(start + (done or 0), total, message)
 
 
-def build_demo(out, *, progress: bool | ProgressCallback = True, sections: Sequence[str] = DEMO_SECTIONS) -> dict:
+def build_demo(out, *, progress: bool | ProgressCallback = True, sections: Sequence[str] = DEMO_SECTIONS,
+               workers: int | None = None) -> dict:
     """Reproduce every paper's examples and write the report into ``out`` (see module docstring).
 
     ``sections``: ``module:function`` specs (default :data:`DEMO_SECTIONS`).  ``progress``: True
     prints on stderr, False nothing; a :data:`~spatialmech.results.Progress` callback gets
-    ``(step, steps, message)``.  Returns the data written to ``results.json``.
+    ``(step, steps, message)``.  ``workers``: processes building the sections (they are
+    independent; default: two where the machine has two cores and can fork, see
+    :mod:`.demo_pool`; 1: all in this process).  The report is the same either way.  Returns the
+    data written to ``results.json``.
     """
-    fns = [_section_function(s) for s in sections]
+    from .demo_pool import build_sections, default_workers
+
+    fns = [section_function(s) for s in sections]
     total = sum(n for _, n in fns)
     sink, bar = _reporter(progress, total, "spatialmech demo")
-    built, start = [], 0
-    for fn, n in fns:
-        built.append(fn(_offset(sink, start, total)))
-        start += n
+    n_workers = default_workers(len(fns)) if workers is None else max(1, int(workers))
+    if n_workers > 1:
+        built = build_sections(list(sections), [n for _, n in fns], sink, total, n_workers)
+    else:
+        built, start = [], 0
+        for fn, n in fns:
+            built.append(fn(_offset(sink, start, total)))
+            start += n
     data = write_report(out, "spatialmech reproduction report", built, bar.elapsed)
     bar.close()
     return data
