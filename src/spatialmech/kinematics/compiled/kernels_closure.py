@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from .kernels_blocks import nb_blocks_workspace, nb_minnorm_blocks
+from .kernels_limits import nb_joint_motion
 from .kernels_se3 import (
     nb_lsq_qr,
     nb_ball_product,
@@ -18,8 +19,6 @@ from .kernels_se3 import (
     nb_lstsq,
     nb_mm4,
     nb_orthonormal,
-    nb_rodrigues,
-    nb_screw_shift,
 )
 from .jit import njit
 
@@ -84,31 +83,11 @@ def nb_chain_ws(S, ball_of, ball_axes, ball_centre, q, lo, hi, T, J, W):
                 mo[0, j] = c[1] * A[2, j] - c[2] * A[1, j]
                 mo[1, j] = c[2] * A[0, j] - c[0] * A[2, j]
                 mo[2, j] = c[0] * A[1, j] - c[1] * A[0, j]
-            f0 = A[0, 0] * q[i] + A[0, 1] * q[i + 1] + A[0, 2] * q[i + 2]
-            f1 = A[1, 0] * q[i] + A[1, 1] * q[i + 1] + A[1, 2] * q[i + 2]
-            f2 = A[2, 0] * q[i] + A[2, 1] * q[i + 1] + A[2, 2] * q[i + 2]
-            th = np.sqrt(f0 * f0 + f1 * f1 + f2 * f2)
-            if th > 1e-12:
-                nb_rodrigues(f0 / th, f1 / th, f2 / th, np.sin(th), 1.0 - np.cos(th), Rb)
-            else:  # I + skew(phi): first order, as closure.chain_forward
-                nb_rodrigues(f0, f1, f2, 1.0, 0.0, Rb)
-            for a in range(3):  # T <- T [Rb, c - Rb c]
-                u[a] = c[a] - (Rb[a, 0] * c[0] + Rb[a, 1] * c[1] + Rb[a, 2] * c[2])
         else:
             k = 1
-            w0, w1, w2 = S[i, 0], S[i, 1], S[i, 2]
-            v0, v1, v2 = S[i, 3], S[i, 4], S[i, 5]
-            ax[0, 0], ax[1, 0], ax[2, 0] = w0, w1, w2
-            mo[0, 0], mo[1, 0], mo[2, 0] = v0, v1, v2
-            t = q[i]
-            if np.sqrt(w0 * w0 + w1 * w1 + w2 * w2) > 1e-12:
-                st = np.sin(t)
-                ct = 1.0 - np.cos(t)
-                nb_rodrigues(w0, w1, w2, st, ct, Rb)
-                u[0], u[1], u[2] = nb_screw_shift(w0, w1, w2, v0, v1, v2, t, st, ct)
-            else:
-                nb_rodrigues(0.0, 0.0, 0.0, 0.0, 0.0, Rb)
-                u[0], u[1], u[2] = t * v0, t * v1, t * v2
+            ax[0, 0], ax[1, 0], ax[2, 0] = S[i, 0], S[i, 1], S[i, 2]
+            mo[0, 0], mo[1, 0], mo[2, 0] = S[i, 3], S[i, 4], S[i, 5]
+        nb_joint_motion(S, ball_of, ball_axes, ball_centre, q, i, Rb, u)  # the joint's own (Rb, u)
         for j in range(k):
             col = i - lo + j
             for a in range(3):
