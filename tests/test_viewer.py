@@ -295,7 +295,7 @@ def test_figure_marks_task_positions_and_singular_points(motions):
             v = np.array([x for x in t[a] if x is not None], float)
             lo, hi = sc[f"{a}axis"].range
             assert np.all((v >= lo) & (v <= hi))
-    assert fig.layout.scene.xaxis.title.text == "x [unit]"  # paper A's lengths have no unit
+    assert fig.layout.scene.xaxis.title.text == "x [length unit not stated]"  # paper A's lengths have no unit
 
 
 @pytest.mark.parametrize(

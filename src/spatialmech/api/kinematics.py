@@ -345,8 +345,8 @@ def fk(model: ModelLike, actuators, *, all_solutions: bool = False, seeds: int |
     >>> r = sm.fk("four-sps-cu", [0.216745, 0.23896, 0.227321, 0.206933], all_solutions=True)   # closed form
     >>> sorted(round(float(P.p[2]), 3) for P in r.poses)      # the pose z = 0.12 m, another mode, two mirrors
     [-0.149, -0.12, 0.12, 0.149]
-    >>> r.engine, r.complete
-    ('closed-form', False)
+    >>> r.engine, r.complete        # the closed form's poses, proven complete by the Study homotopy
+    ('closed-form', True)
     """
     mech = as_mechanism(model)
     degrees = check_bool(degrees, "degrees")
