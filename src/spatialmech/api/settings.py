@@ -93,6 +93,12 @@ def default_tolerance(name: str) -> float:
     return value
 
 
+def _check_stream(stream) -> None:
+    """``TypeError`` unless ``stream`` is None or has a ``write`` method."""
+    if stream is not None and not callable(getattr(stream, "write", None)):
+        raise TypeError(f"stream: expected a text stream (with a write method) or None, got {describe(stream)}")
+
+
 def announce_compilation(stream) -> bool:
     """Announce numba compilations: one line per kernel that compiles (a miss of the on-disk
     cache: the first use after installation), with its seconds.
@@ -121,8 +127,7 @@ def announce_compilation(stream) -> bool:
     """
     from ..kinematics.compiled.jit import announce_compilation as _announce
 
-    if stream is not None and not callable(getattr(stream, "write", None)):
-        raise TypeError(f"stream: expected a text stream (with a write method) or None, got {describe(stream)}")
+    _check_stream(stream)
     return _announce(stream)
 
 
@@ -158,8 +163,7 @@ def first_run(stream) -> bool:
     from ..kinematics import backend
     from ..services import first_run as fr
 
-    if stream is not None and not callable(getattr(stream, "write", None)):
-        raise TypeError(f"stream: expected a text stream (with a write method) or None, got {describe(stream)}")
+    _check_stream(stream)
     if not fr.start(stream):
         return False
     backend.use_python_reference()
