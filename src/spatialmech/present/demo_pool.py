@@ -10,8 +10,15 @@ computes the same numbers; nothing is shared between sections).
 
 Forking is the only start method used: a worker inherits the loaded modules and compiled kernels
 (a spawned one would import and load them again, seconds each).  Where ``fork`` is unavailable,
-or the machine has one core, :func:`default_workers` answers 1 and the demo runs in one process.
-Two workers are opt-in (``SPATIALMECH_DEMO_WORKERS=2``): see :func:`default_workers`.
+the machine has one core, or forking is not safe in this process (:func:`fork_is_safe`),
+:func:`default_workers` answers 1 and the demo runs in one process.
+
+Why a fork can be unsafe: numba's parallel kernels (the 4-SPS/CU legs of large batches) run on
+numba's threading layer, GNU OpenMP where Intel TBB is not installed, and GNU OpenMP does not
+survive a fork: a child that runs a parallel kernel after its parent started OpenMP's threads is
+terminated ("fork() called from a process already using GNU OpenMP, this is unsafe").  That is
+what killed a worker in a CI run: the demo was built inside a pytest worker that had run the
+4-SPS/CU tests before.  A fresh ``spatialmech demo`` has started no threads when it forks.
 """
 
 from __future__ import annotations
@@ -22,9 +29,10 @@ import queue as queue_module
 from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor
 
-__all__ = ["LAST_RUN", "WORKERS_ENV", "build_sections", "default_workers"]
+__all__ = ["LAST_RUN", "WORKERS_ENV", "build_sections", "default_workers", "fork_is_safe"]
 
-#: Environment variable: the demo's worker processes (default 2 on a machine with 2 cores or more).
+#: Environment variable: the demo's worker processes (default 2 on a machine with 2 cores or more
+#: where a fork is safe, see :func:`fork_is_safe`).
 WORKERS_ENV = "SPATIALMECH_DEMO_WORKERS"
 
 #: Relative cost of each section (the order the pool takes them in: the longest first), measured
@@ -40,19 +48,33 @@ _QUEUE: list = []  # the progress queue the forked workers inherit (set by build
 LAST_RUN: dict = {}
 
 
-def default_workers(n_sections: int) -> int:
-    """Worker processes for ``n_sections``: ``$SPATIALMECH_DEMO_WORKERS`` when set (an opt-in),
-    else 1; never more than the sections nor the cores, and 1 where fork is unavailable.
-
-    Opt-in because a forked worker of the full demo died abruptly (``BrokenProcessPool``) in a
-    fresh-clone CI dry run inside a pytest-xdist worker, while the same build passed in a warm
-    tree; the cause is not found yet (fork after OpenBLAS/numba/MuJoCo state is the suspect)."""
+def fork_is_safe() -> bool:
+    """Whether this process can fork workers that run the library's kernels: ``fork`` exists and
+    numba's threading layer is either not started yet or one that survives a fork (TBB or
+    numba's own workqueue; GNU OpenMP does not, see the module docstring)."""
     if "fork" not in mp.get_all_start_methods():
-        return 1
+        return False
+    try:
+        import numba
+    except ImportError:  # pragma: no cover - numba is a dependency; without it no threads start
+        return True
+    try:
+        layer = numba.threading_layer()
+    except ValueError:  # numba: "Threading layer is not initialized." -- no parallel kernel ran
+        return True
+    return layer in ("tbb", "workqueue")
+
+
+def default_workers(n_sections: int, requested: int | None = None) -> int:
+    """Worker processes for ``n_sections``: ``requested``, else ``$SPATIALMECH_DEMO_WORKERS``
+    when set, else 2; never more than the sections nor the cores, and 1 where forking is not
+    safe in this process (:func:`fork_is_safe`: a worker would be killed, so one process builds
+    the report instead, with the same result)."""
     env = os.environ.get(WORKERS_ENV, "").strip()
     cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
-    n = int(env) if env.isdigit() else 1
-    return max(1, min(n, n_sections, cores))
+    n = int(requested) if requested is not None else (int(env) if env.isdigit() else 2)
+    n = max(1, min(n, n_sections, cores))
+    return n if n == 1 or fork_is_safe() else 1
 
 
 def _build(index: int, spec: str):

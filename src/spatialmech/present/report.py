@@ -518,8 +518,8 @@ def build_demo(out, *, progress: bool | ProgressCallback = True, sections: Seque
     ``sections``: ``module:function`` specs (default :data:`DEMO_SECTIONS`).  ``progress``: True
     prints on stderr, False nothing; a :data:`~spatialmech.results.Progress` callback gets
     ``(step, steps, message)``.  ``workers``: processes building the sections (they are
-    independent; default: two where the machine has two cores and can fork, see
-    :mod:`.demo_pool`; 1: all in this process).  The report is the same either way.  Returns the
+    independent; default: two where the machine has two cores and a fork is safe, see
+    :mod:`.demo_pool`; 1: all in this process; never more than the cores).  The report is the same either way.  Returns the
     data written to ``results.json``.
     """
     from .demo_pool import build_sections, default_workers
@@ -527,7 +527,7 @@ def build_demo(out, *, progress: bool | ProgressCallback = True, sections: Seque
     fns = [section_function(s) for s in sections]
     total = sum(n for _, n in fns)
     sink, bar = _reporter(progress, total, "spatialmech demo")
-    n_workers = default_workers(len(fns)) if workers is None else max(1, int(workers))
+    n_workers = default_workers(len(fns), workers)
     if n_workers > 1:
         built = build_sections(list(sections), [n for _, n in fns], sink, total, n_workers)
     else:
