@@ -147,7 +147,10 @@ def demo_report(tmp_path_factory):
     (:func:`built_once`): what :func:`build_demo` returns is exactly its ``results.json``."""
     from spatialmech.present.report import build_demo
 
-    return built_once(tmp_path_factory, "demo", lambda out: build_demo(out, progress=False),
+    # One process: both cores are busy with the xdist workers already, and a fork from a pytest
+    # worker inherits whatever threads its earlier tests left (servers, browsers); the default
+    # two-worker build is tested in a fresh process (test_report.py, two workers).
+    return built_once(tmp_path_factory, "demo", lambda out: build_demo(out, progress=False, workers=1),
                       lambda out: json.loads((out / "results.json").read_text(encoding="utf-8")))
 
 
