@@ -52,11 +52,11 @@ def traits(w) -> dict:
     return {k: getattr(w, k) for k in TRAITS}
 
 
-@pytest.fixture(scope="module")
-def page(tmp_path_factory):
+def serve(tmp_path_factory, model):
+    """A harness page of a new widget of ``model``: ``(widget, url, server, thread)``."""
     from spatialmech.interfaces.studio.widget import esm_bundle
 
-    w = sm.studio("rssr")
+    w = sm.studio(model)
     root = tmp_path_factory.mktemp("widget-harness")
     (root / "index.html").write_text(HARNESS, encoding="utf-8")
     (root / "bundle.js").write_text(esm_bundle(), encoding="utf-8")
@@ -65,7 +65,13 @@ def page(tmp_path_factory):
     srv = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
     th = threading.Thread(target=srv.serve_forever, daemon=True)
     th.start()
-    yield w, f"http://127.0.0.1:{srv.server_address[1]}/index.html"
+    return w, f"http://127.0.0.1:{srv.server_address[1]}/index.html", srv, th
+
+
+@pytest.fixture(scope="module")
+def page(tmp_path_factory):
+    w, url, srv, th = serve(tmp_path_factory, "rssr")
+    yield w, url
     srv.shutdown()
     th.join(10)
 
@@ -116,3 +122,50 @@ def test_the_widget_renders_and_a_slider_drives_the_session(page, browser):  # n
     if out:
         browser.set_window_size(1000, 900)
         assert browser.find_element("css selector", "#w").screenshot(str(Path(out) / "studio-widget-rssr.png"))
+
+
+def test_the_widget_drag_pad_moves_the_output_point(tmp_path_factory, browser):  # noqa: F811
+    """Issue 30: the notebook widget has the page's drag pad (static/pad.js, shared): a real mouse
+    drag of the handle on planar-4r (its top view; it controls x) sends one drag message with the
+    point under the mouse, which the session reaches by the pose drag (``Session.drag_output``)."""
+    from selenium.webdriver.common.action_chains import ActionChains
+    from selenium.webdriver.common.by import By
+
+    w, url, srv, th = serve(tmp_path_factory, "planar-4r")
+    try:
+        browser.get(url)
+        wait_for(browser, "return window.rendered === true && document.querySelector('.js-plotly-plot') !== null")
+        assert browser.execute_script("return getComputedStyle(document.querySelector('.sm-pad')).display") != "none"
+        label = browser.execute_script("return document.querySelector('.sm-pad-label').textContent")
+        assert label == "drag the output point (x), the linkage's plane"
+        x0 = w.state["task"]["values_len"]["x"]
+        cx_of = "return Number(document.querySelector('.sm-drag-svg .drag-handle').getAttribute('cx'))"
+        cx0 = browser.execute_script(cx_of)
+        handle = browser.find_element(By.CSS_SELECTOR, ".sm-drag-svg .drag-handle")
+        ActionChains(browser).click_and_hold(handle).move_by_offset(3, 0).move_by_offset(3, 0).release().perform()
+        # the kernel answers each message; the page sends the newest pad point once answered
+        k, msg = 0, None
+        while True:
+            try:
+                nxt = wait_for(browser, f"return window.sent.length > {k} ? window.sent[{k}] : null", timeout=2.0)
+            except AssertionError:
+                break
+            msg, k = nxt, k + 1
+            assert msg["type"] == "drag" and len(msg["point_len"]) == 3
+            w._handle_custom_msg(msg, [])
+            assert w.error == "" and w.last_drive["status"] == "reached", (w.error, w.last_drive)
+            browser.execute_script("window.harness.set(arguments[0])", traits(w))
+        assert msg is not None
+        want = msg["point_len"][0]
+        assert want > x0 + 0.05  # 6 px to the right on planar-4r's top view: +x
+        assert w.state["task"]["values_len"]["x"] == pytest.approx(want, abs=1e-9)  # the pose drag reached it
+        assert browser.execute_script(cx_of) > cx0 + 3.0  # the handle redrawn where it was dragged
+        # a bad message names the field
+        w._handle_custom_msg({"type": "drag", "point_len": [0.0, "a"]}, [])
+        assert w.error.startswith("point_len: ")
+        assert browser.execute_script("return window.jsErrors") == []
+        severe = [e for e in browser.get_log("browser") if e["level"] == "SEVERE"]
+        assert not severe, severe
+    finally:
+        srv.shutdown()
+        th.join(10)

@@ -115,7 +115,8 @@ def create_app(session) -> FastAPI:
 
     @app.get("/static/{name}")
     def static(name: str):
-        types = {"studio.js": "text/javascript", "design.js": "text/javascript", "studio.css": "text/css"}
+        types = {"studio.js": "text/javascript", "pad.js": "text/javascript", "design.js": "text/javascript",
+                 "studio.css": "text/css"}
         if name == "plotly.min.js":
             return Response(plotly_js_path().read_bytes(), media_type="text/javascript",
                             headers={"Cache-Control": "max-age=86400"})

@@ -7,6 +7,7 @@ trait and the readouts of :attr:`StudioWidget.state`, and sends one message per 
 
     {"type": "drive", "actuators": [...]}          # model units, degrees for rotations
     {"type": "pose", "task_len": {...}, "task_deg": {...}}
+    {"type": "drag", "point_len": [x, y, z]}      # the drag pad: the output point moved in a plane
     {"type": "fk_all"} / {"type": "mode", "mode_number": k}
     {"type": "snapshot", "label": "..."} / {"type": "undo"}   # the session's desk
 
@@ -40,11 +41,13 @@ VIEW_HEIGHT_PX = 460
 @lru_cache(maxsize=1)
 def esm_bundle() -> str:
     """The widget's ES module: plotly.js (its UMD build, run with a local ``module`` object so
-    that neither a page's AMD loader nor ``window`` is involved) followed by ``widget.js``."""
+    that neither a page's AMD loader nor ``window`` is involved), then ``pad.js`` (the drag pad's
+    geometry, shared with the page) and ``widget.js``."""
     plotly = plotly_js_path().read_text(encoding="utf-8")
-    own = files("spatialmech.interfaces.studio").joinpath("static", "widget.js").read_text(encoding="utf-8")
+    static = files("spatialmech.interfaces.studio").joinpath("static")
+    pad, own = (static.joinpath(n).read_text(encoding="utf-8") for n in ("pad.js", "widget.js"))
     return ("const module = { exports: {} };\nconst exports = module.exports;\n" + plotly
-            + "\nconst Plotly = module.exports;\n" + own)
+            + "\nconst Plotly = module.exports;\n" + pad + "\n" + own)
 
 
 def _plain(doc):
@@ -138,6 +141,11 @@ class StudioWidget(anywidget.AnyWidget):
         """Move the output link to a pose (as ``Session.drive_pose``) and redraw."""
         return self._run(lambda: self.session.drive_pose(task_len, task_deg, euler=euler, relative=relative))
 
+    def drag_output(self, point_len):
+        """Move the output point toward ``point_len`` (the drag pad; as ``Session.drag_output``)
+        and redraw."""
+        return self._run(lambda: self.session.drag_output(point_len))
+
     def fk_all(self, seeds=None) -> list[dict]:
         """Every assembly mode at the current actuator values (as ``Session.fk_all``)."""
         self.modes = _plain(self.session.fk_all(seeds))
@@ -185,6 +193,7 @@ class StudioWidget(anywidget.AnyWidget):
         kind = content.get("type") if isinstance(content, dict) else None
         ops = {"drive": lambda c: self.drive(c.get("actuators")),
                "pose": lambda c: self.drive_pose(c.get("task_len"), c.get("task_deg"), euler=c.get("euler")),
+               "drag": lambda c: self.drag_output(c.get("point_len")),
                "fk_all": lambda c: self.fk_all(c.get("seeds")),
                "mode": lambda c: self.pick_mode(c.get("mode_number")),
                "snapshot": lambda c: self.snapshot(c.get("label")), "undo": lambda c: self.undo()}

@@ -79,16 +79,9 @@ function traces(sc) {
   return out;
 }
 
-function sceneRange(sc) {
-  const pts = [].concat(sc.base_len, sc.platform_len, sc.task_positions_len, ...sc.limbs_len, sc.joints.map(j => j.centre_len));
-  const lo = [0, 1, 2].map(a => Math.min(...pts.map(p => p[a]))), hi = [0, 1, 2].map(a => Math.max(...pts.map(p => p[a])));
-  const half = Math.max(...[0, 1, 2].map(a => hi[a] - lo[a])) / 2 + 0.8 * sc.scale_len;
-  return [0, 1, 2].map(a => [(lo[a] + hi[a]) / 2 - half, (lo[a] + hi[a]) / 2 + half]);
-}
-
 function draw() {
   const sc = S.state.scene;
-  if (!S.range) S.range = sceneRange(sc);
+  if (!S.range) S.range = SMPad.sceneRange(sc);
   const ax = (r, n) => ({ range: r, autorange: false, title: { text: n + " [" + S.unit + "]" } });  // the bundled plotly needs title.text
   const layout = { uirevision: "studio-" + S.viewRev, margin: { l: 0, r: 0, t: 30, b: 0 },
     title: { text: S.state.mechanism + (S.topView ? " (top view: along the plane's normal)" : "") },
@@ -96,7 +89,7 @@ function draw() {
     legend: { itemsizing: "constant" } };
   const n = sc.plane_normal;
   if (S.topView && n) {  // look along the plane's normal, orthographic, an in-plane "up"
-    const [, e2] = planeBasis(n);
+    const [, e2] = SMPad.planeBasis(n);
     layout.scene.camera = { eye: { x: 2 * n[0], y: 2 * n[1], z: 2 * n[2] }, up: { x: e2[0], y: e2[1], z: e2[2] },
       center: { x: 0, y: 0, z: 0 }, projection: { type: "orthographic" } };
   }
@@ -105,18 +98,6 @@ function draw() {
 }
 
 // ------------------------------------------------------------------ top view and drag handle
-function cross(a, b) { return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]; }
-function dot(a, b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-function unit(a) { const l = Math.hypot(a[0], a[1], a[2]); return mul(a, 1 / l); }
-
-// in-plane axes (e1, e2) of the plane with normal n: e2 the world axis least along n (y first),
-// made perpendicular to n; e1 = e2 x n (right-handed seen from the normal's side)
-function planeBasis(n) {
-  const cand = [[0, 1, 0], [1, 0, 0], [0, 0, 1]].sort((a, b) => Math.abs(dot(a, n)) - Math.abs(dot(b, n)))[0];
-  const e2 = unit(add(cand, mul(n, -dot(cand, n))));
-  return [cross(e2, n), e2];
-}
-
 function showViewToggle() {
   const b = document.getElementById("view-toggle"), planar = !!S.state.scene.plane_normal;
   b.style.display = planar ? "" : "none";
@@ -125,60 +106,24 @@ function showViewToggle() {
 
 function toggleView() { S.topView = !S.topView; S.viewRev += 1; S.traceKey = ""; showViewToggle(); draw(); }
 
-// The drag handle: the output point projected on a plane (a planar linkage's own plane, else the
-// plane of the first two of x, y, z the mechanism controls); dragging it posts /api/drag with the
-// point under the mouse (the coordinate along the plane's normal kept), which moves the given
-// translational task coordinates there by the pose drag's continuation (Session.drag_output).
-function padFrame() {
-  const st = S.state, sc = st.scene, given = st.task ? st.task.given.filter(g => "xyz".includes(g)) : [];
-  if (!given.length) return null;
-  const axes = { x: [1, 0, 0], y: [0, 1, 0], z: [0, 0, 1] };
-  let e1, e2, label;
-  if (sc.plane_normal) { [e1, e2] = planeBasis(sc.plane_normal); label = "the linkage's plane"; }
-  else {
-    const names = given.concat(["x", "y", "z"].filter(g => !given.includes(g))).slice(0, 2);
-    [e1, e2] = [axes[names[0]], axes[names[1]]]; label = names[0] + "-" + names[1] + " plane";
-  }
-  const c = S.range.map(r => (r[0] + r[1]) / 2), half = (S.range[0][1] - S.range[0][0]) / 2;
-  return { e1, e2, c, half, label, given };
-}
-
-function padXY(f, p) { const d = add(p, mul(f.c, -1)); return [100 + 100 * dot(d, f.e1) / f.half, 100 - 100 * dot(d, f.e2) / f.half]; }
-
+// The drag handle (static/pad.js): dragging the output point on the pad posts /api/drag with the
+// point under the mouse, which moves the given translational task coordinates there by the pose
+// drag's continuation (Session.drag_output).
 function drawPad() {
   const pad = document.getElementById("drag-pad");
-  const f = S.range ? padFrame() : null;
+  const f = SMPad.frame(S.state, S.range);
   S.pad = f;
   if (!f) { pad.style.display = "none"; return; }
   pad.style.display = "";
-  const sc = S.state.scene, line = (pts, col, w) => `<polyline fill="none" stroke="${col}" stroke-width="${w}" points="` +
-    pts.map(p => padXY(f, p).map(v => v.toFixed(1)).join(",")).join(" ") + `"/>`;
-  const [u, v] = padXY(f, sc.platform_point_len);
-  document.getElementById("drag-pad-label").textContent = "drag the output point (" + f.given.join(", ") + "), " + f.label;
-  document.getElementById("drag-svg").innerHTML = line(sc.base_len, "#999", 1) +
-    sc.limbs_len.map((pl, li) => line(pl, sc.limb_colours[li], 2)).join("") + line(sc.platform_len, "#ff7f0e", 2) +
-    `<circle id="drag-handle" cx="${u.toFixed(1)}" cy="${v.toFixed(1)}" r="6" fill="#ff7f0e" stroke="#000"/>`;
-}
-
-function padPoint(ev) {  // the 3-D point under the mouse (the current output point's normal coordinate kept)
-  const f = S.pad, r = document.getElementById("drag-svg").getBoundingClientRect();
-  const u = (ev.clientX - r.left - 100) / 100 * f.half, v = -(ev.clientY - r.top - 100) / 100 * f.half;
-  const p = S.state.scene.platform_point_len, d = add(p, mul(f.c, -1));
-  return add(p, add(mul(f.e1, u - dot(d, f.e1)), mul(f.e2, v - dot(d, f.e2))));
-}
-
-function dragTo(ev) {
-  if (!S.pad) return;
-  S.lastDragPoint = padPoint(ev);
-  S.pending = { path: "/api/drag", body: { point_len: S.lastDragPoint } }; pump();
+  document.getElementById("drag-pad-label").textContent = SMPad.label(f);
+  document.getElementById("drag-svg").innerHTML = SMPad.svg(f, S.state.scene, "drag-handle");
 }
 
 function initPad() {
-  const svg = document.getElementById("drag-svg");
-  svg.addEventListener("pointerdown", ev => { S.padDown = true; svg.setPointerCapture(ev.pointerId); dragTo(ev); });
-  svg.addEventListener("pointermove", ev => { if (S.padDown) dragTo(ev); });
-  const up = () => { S.padDown = false; };
-  svg.addEventListener("pointerup", up); svg.addEventListener("pointercancel", up);
+  SMPad.attach(document.getElementById("drag-svg"), () => S.pad, () => S.state.scene.platform_point_len, p => {
+    S.lastDragPoint = p;
+    S.pending = { path: "/api/drag", body: { point_len: p } }; pump();
+  });
   document.getElementById("view-toggle").addEventListener("click", toggleView);
 }
 

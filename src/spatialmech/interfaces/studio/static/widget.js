@@ -1,7 +1,8 @@
 // spatialmech studio in Jupyter (anywidget): draws the `figure` trait, shows the readouts of the
 // `state` trait and sends one message per slider move ({type: "drive", actuators: [...]}); the
-// next value goes when `answered` grows (one request in flight).  Plotly is defined by the
-// bundle this file is appended to (interfaces/studio/widget.py).
+// next value goes when `answered` grows (one request in flight).  The drag pad (SMPad, static/pad.js)
+// sends {type: "drag", point_len: [x, y, z]}.  Plotly and SMPad are defined by the bundle this file
+// is appended to (interfaces/studio/widget.py).
 
 // plotly.js draws a 3-D scene's WebGL canvas at `plotGlPixelRatio` times the page's pixels (its
 // default is 2: four times the pixels to paint on a display of ratio 1).  Draw at the display's own
@@ -48,9 +49,12 @@ function render({ model, el }) {
   el.classList.add("spatialmech-studio");
   el.innerHTML = '<div class="sm-sliders"></div><div class="sm-pose"></div><div class="sm-buttons" style="font: 12px sans-serif">' +
     '<button class="sm-snap">snapshot</button> <button class="sm-undo">undo</button> <span class="sm-snaps"></span></div><table class="sm-readouts" style="font: 12px sans-serif"></table>' +
+    '<div class="sm-pad" style="display: none; font: 12px sans-serif" title="drag the output point in this plane (inverse position along the branch)">' +
+    '<div class="sm-pad-label"></div><svg class="sm-drag-svg" width="200" height="200" style="border: 1px solid #ccc; touch-action: none"></svg></div>' +
     '<div class="sm-plot" style="width: 100%"></div>';
   const box = el.querySelector(".sm-sliders"), pbox = el.querySelector(".sm-pose"), table = el.querySelector(".sm-readouts"), plot = el.querySelector(".sm-plot");
-  let inFlight = false, pending = null, built = "";
+  const pad = el.querySelector(".sm-pad"), padSvg = el.querySelector(".sm-drag-svg");
+  let inFlight = false, pending = null, built = "", range = null, frame = null;
 
   function send() {
     if (inFlight || pending === null) return;
@@ -61,7 +65,7 @@ function render({ model, el }) {
     const entries = actuatorEntries(st, unit), key = st.mechanism + ":" + st.drivers.join(",");
     const poses = poseEntries(st, unit);
     if (key !== built) {
-      built = key; box.innerHTML = ""; pbox.innerHTML = "";
+      built = key; box.innerHTML = ""; pbox.innerHTML = ""; range = SMPad.sceneRange(st.scene);
       entries.forEach(a => box.appendChild(sliderRow(a, () => {
         pending = { type: "drive", actuators: [...box.querySelectorAll("input")].map(x => Number(x.value)) }; send();
       })));
@@ -77,10 +81,18 @@ function render({ model, el }) {
     });
     sync(box, entries); sync(pbox, poses);
     el.querySelector(".sm-snaps").textContent = model.get("snapshots").map(x => x.label).join(", ");
+    frame = SMPad.frame(st, range);
+    pad.style.display = frame ? "" : "none";
+    if (frame) {
+      el.querySelector(".sm-pad-label").textContent = SMPad.label(frame);
+      padSvg.innerHTML = SMPad.svg(frame, st.scene);
+    }
     table.innerHTML = readoutRows(st, unit, model).map(([k, v]) => `<tr><th style="text-align: left">${k}</th><td>${v}</td></tr>`).join("");
   }
   function draw() { const f = model.get("figure"); Plotly.react(plot, f.data, f.layout, { displaylogo: false, responsive: true, plotGlPixelRatio: GL_PIXEL_RATIO }); }
 
+  SMPad.attach(padSvg, () => frame, () => model.get("state").scene.platform_point_len,
+               p => { pending = { type: "drag", point_len: p }; send(); });
   el.querySelector(".sm-snap").addEventListener("click", () => { pending = { type: "snapshot" }; send(); });
   el.querySelector(".sm-undo").addEventListener("click", () => { pending = { type: "undo" }; send(); });
   model.on("change:state", build);
