@@ -132,3 +132,25 @@ def test_pose_message_moves_the_output_link():
     send(w, {"type": "pose", "task_deg": {"a3": a3 + 5.0}, "euler": w.state["task"]["euler"]})
     assert w.error == "" and w.last_drive["status"] == "reached"
     assert abs(w.state["task"]["values_deg"]["a3"] - (a3 + 5.0)) < 1e-6
+
+
+def test_drag_pad_message_moves_the_output_point_as_the_page_does():
+    """The pad's message runs ``Session.drag_output`` (the page's ``POST /api/drag``): the same
+    configuration as a plain session's drag; a bad point or a mechanism that controls none of
+    x, y, z answers in ``error`` with the field named."""
+    w, s = sm.studio("planar-4r"), sm.studio_session("planar-4r")
+    p = np.array(w.state["scene"]["platform_point_len"])
+    target = [float(p[0]) + 0.05, float(p[1]) + 0.3, float(p[2])]
+    n0 = w.answered
+    send(w, {"type": "drag", "point_len": target})
+    assert w.error == "" and w.last_drive["status"] == "reached" and w.answered == n0 + 1
+    assert s.drag_output(target).status == "reached"
+    assert np.allclose(w.session.config.q, s.config.q, atol=1e-12)
+    q = platform_point(w.figure)  # planar-4r controls x only: the coupler point follows x
+    assert q[0] == pytest.approx(p[0] + 0.05, abs=1e-9)
+    assert np.allclose(q, w.state["scene"]["platform_point_len"], atol=1e-12)
+    send(w, {"type": "drag", "point_len": [0.0, 1.0]})
+    assert w.error.startswith("point_len: expected three finite numbers") and w.answered == n0 + 2
+    r = sm.studio("rssr")
+    send(r, {"type": "drag", "point_len": [0.0, 1.0, 0.0]})
+    assert r.error.startswith("point_len: rssr does not control the output point's position")
