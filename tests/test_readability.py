@@ -39,6 +39,15 @@ def test_jacobian_text_prints_no_roundoff_and_no_unit_placeholder():
     assert "-0.00000e+00" not in out and "[unit]" not in out
 
 
+
+def test_parasitic_text_prints_roundoff_ranges_as_zero():
+    """three-rps over a2 keeps x and a3 at 0 up to round-off (2e-17 m, 1e-15 deg printed before)."""
+    out = CliRunner().invoke(cli, ["parasitic", "three-rps", "--over", "a2:-20:20:5", "--euler", "xyz"],
+                             catch_exceptions=False).output
+    assert "  x: 0 .. 0 m" in out and "  a3: 0 .. 0 deg" in out and not re.search(r"e-1[5-9]", out)
+    assert re.search(r"  y: 0 \.\. 0\.00452\d* m", out)  # a real range keeps its digits
+
+
 def _rocker_driven_4r():
     import spatialmech as sm
     from spatialmech.catalog import build

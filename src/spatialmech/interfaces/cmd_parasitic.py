@@ -7,6 +7,7 @@ import numpy as np
 
 from .. import api as sm
 from ..errors import InputError
+from ..present.numbers import fmt_number
 from .common import check_output_file, emit_json, json_option, load_model
 from .task_args import parse_axes, parse_free, parse_task_at
 
@@ -60,9 +61,13 @@ def parasitic_cmd(model, over_text, at_text, free_text, euler, plot, as_json):
                f"  (task {grid.task.euler}: given {', '.join(grid.given)}; solved {', '.join(solved)})")
     click.echo(f"  {n_ok} of {grid.converged.size} cells solved in {grid.seconds:.2f} s"
                + ("" if n_ok == grid.converged.size else "; unsolved cells are left empty (not reachable from a neighbour)"))
+    # round-off prints as 0, read against the model's size (lengths) or a radian in degrees (angles)
     for name, r in table.ranges.items():
         if r is not None:
-            lo, hi = (float(np.degrees(x)) if name.startswith("a") else x for x in r)
-            click.echo(f"  {name}: {lo:.6g} .. {hi:.6g} {'deg' if name.startswith('a') else unit}")
+            angle = name.startswith("a")
+            lo, hi = (float(np.degrees(x)) if angle else float(x) for x in r)
+            scale = float(np.degrees(1.0)) if angle else mech.characteristic_length
+            click.echo(f"  {name}: {fmt_number(lo, '.6g', scale=scale)} .. {fmt_number(hi, '.6g', scale=scale)} "
+                       f"{'deg' if angle else unit}")
     if plot_path is not None:
         click.echo(f"  figure: {plot_path}")
