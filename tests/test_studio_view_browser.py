@@ -75,5 +75,10 @@ def test_readouts_above_the_fold_top_view_and_drag_handle(server, browser):  # n
     assert want > x0 + 0.05  # 6 px to the right on the pad: +x on planar-4r's top view
     assert st["task"]["values_len"]["x"] == pytest.approx(want, abs=1e-9)  # the pose drag reached it
     assert "reached" in b.find_element(By.ID, "status").text
+    # paper A's linkages state no length unit: the labels say so, not "[unit]" (issue 30 item 9)
+    load(b, "five-cs-3")
+    title = b.execute_script("return document.getElementById('plot')._fullLayout.scene.xaxis.title.text")
+    assert title == "x [length unit not stated]"
+    assert "[unit]" not in b.find_element(By.ID, "readouts").text
     severe = [e for e in b.get_log("browser") if e["level"] == "SEVERE"]
     assert not severe and b.execute_script("return window.studio.errors") == []

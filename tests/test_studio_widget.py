@@ -154,3 +154,11 @@ def test_drag_pad_message_moves_the_output_point_as_the_page_does():
     r = sm.studio("rssr")
     send(r, {"type": "drag", "point_len": [0.0, 1.0, 0.0]})
     assert r.error.startswith("point_len: rssr does not control the output point's position")
+
+
+def test_the_widget_labels_an_unstated_length_unit():
+    """Paper A's linkages state no length unit: the widget's labels say "length unit not stated"
+    (present.numbers.unit_label), as the reports do, never "[unit]" (issue 30 item 9)."""
+    w = sm.studio("five-cs-3")
+    assert w.unit == "length unit not stated"
+    assert w.figure["layout"]["scene"]["xaxis"]["title"]["text"] == "x [length unit not stated]"

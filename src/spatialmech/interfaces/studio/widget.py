@@ -29,6 +29,7 @@ import traitlets
 
 from ... import api as sm
 from ...errors import ConvergenceError, InputError
+from ...present.numbers import unit_label
 from ...serialize import json_default
 from .assets import plotly_js_path
 
@@ -110,7 +111,8 @@ class StudioWidget(anywidget.AnyWidget):
     """The studio as a notebook widget over ``session`` (a :func:`spatialmech.studio_session`)."""
 
     _esm = traitlets.Unicode("").tag(sync=True)
-    #: The session's readout (``Session.state()``, docs/studio.md) and the model's length unit.
+    #: The session's readout (``Session.state()``, docs/studio.md) and the model's length unit as
+    #: labels show it (``present.numbers.unit_label``: "length unit not stated" where none is).
     state = traitlets.Dict().tag(sync=True)
     unit = traitlets.Unicode("").tag(sync=True)
     #: The 3-D view: ``{"data": [...], "layout": {...}}`` (plotly).
@@ -182,7 +184,7 @@ class StudioWidget(anywidget.AnyWidget):
 
     def _refresh(self) -> None:
         st = _plain(self.session.state())
-        unit = self.session.mech.length_unit
+        unit = unit_label(self.session.mech.length_unit)  # "length unit not stated" for paper A
         with self.hold_sync():
             self.unit = unit
             self.state = st

@@ -260,7 +260,8 @@ function fillDrivers(st) {
 }
 
 async function loadDoc(doc) {
-  S.unit = doc.length_unit || "";
+  // a model whose source states no length unit has "unit" (present/numbers.UNSTATED_UNIT): say so
+  S.unit = doc.length_unit === "unit" ? "length unit not stated" : (doc.length_unit || "");
   S.range = null;
   document.getElementById("description").textContent = doc.model_info.description;
   const sel = document.getElementById("model-select");
