@@ -409,6 +409,7 @@ from spatialmech.present.report import build_demo
 
 tmp = Path(sys.argv[1])
 assert demo_pool.fork_is_safe()  # a fresh process: no threading layer started
+assert demo_pool.openmp_runtimes() == [], demo_pool.openmp_runtimes()  # nor an OpenMP runtime loaded
 secs = ("paper_c:section", "models:section")
 steps = []
 a = build_demo(tmp / "a", progress=lambda d, t, m: steps.append(m), sections=secs, workers=2)
@@ -431,6 +432,7 @@ k.leg_lengths(np.zeros((k.PARALLEL_FROM, 4)))
 layer = numba.threading_layer()
 assert demo_pool.fork_is_safe() == (layer in ("tbb", "workqueue")), layer
 if layer == "omp":
+    assert any(n.startswith("libgomp") for n in demo_pool.openmp_runtimes()), demo_pool.openmp_runtimes()
     assert demo_pool.default_workers(5) == 1 and demo_pool.default_workers(5, 2) == 1
     c = build_demo(tmp / "c", progress=False, sections=secs, workers=2)
     c.pop("elapsed_s")
@@ -440,6 +442,25 @@ print("ok", layer)
 
 
 @pytest.mark.slow
+def test_openmp_runtimes_are_read_from_the_process_maps(tmp_path):
+    """``demo_pool.openmp_runtimes`` names the GNU, LLVM and Intel OpenMP runtimes (vendored
+    wheel copies too) among the mapped files and nothing else; no maps file (not Linux): none."""
+    from spatialmech.present import demo_pool
+
+    maps = tmp_path / "maps"
+    maps.write_text("\n".join([
+        "7f00-7f01 r-xp 00000000 08:01 1 /usr/lib/x86_64-linux-gnu/libgomp.so.1.0.0",
+        "7f02-7f03 r-xp 00000000 08:01 2 /venv/site-packages/torch.libs/libgomp-a34b3233.so.1",
+        "7f04-7f05 r-xp 00000000 08:01 3 /opt/llvm/lib/libomp.so",
+        "7f06-7f07 r-xp 00000000 08:01 4 /opt/intel/lib/libiomp5.so",
+        "7f08-7f09 r-xp 00000000 08:01 5 /usr/lib/libcomposite.so",
+        "7f0a-7f0b r-xp 00000000 08:01 6 /venv/scipy/linalg/_decomp_interpolative.so",
+        "7f0c-7f0d rw-p 00000000 00:00 0 [heap]",
+    ]), encoding="utf-8")
+    assert demo_pool.openmp_runtimes(maps) == ["libgomp-a34b3233.so.1", "libgomp.so.1.0.0", "libiomp5.so", "libomp.so"]
+    assert demo_pool.openmp_runtimes(tmp_path / "absent") == []
+
+
 def test_demo_sections_on_two_workers_equal_one_process(tmp_path):
     """The demo's sections built by two forked workers (present/demo_pool.py) give the same
     results.json (but for the elapsed time), page and figures as one process, and every step of

@@ -26,10 +26,12 @@ from __future__ import annotations
 import multiprocessing as mp
 import os
 import queue as queue_module
+import re
 from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
 
-__all__ = ["LAST_RUN", "WORKERS_ENV", "build_sections", "default_workers", "fork_is_safe"]
+__all__ = ["LAST_RUN", "WORKERS_ENV", "build_sections", "default_workers", "fork_is_safe", "openmp_runtimes"]
 
 #: Environment variable: the demo's worker processes (default 2 on a machine with 2 cores or more
 #: where a fork is safe, see :func:`fork_is_safe`).
@@ -39,6 +41,9 @@ WORKERS_ENV = "SPATIALMECH_DEMO_WORKERS"
 #: by profiling ``spatialmech demo``; a section not listed counts 1.
 _COST = {"paper_a:section": 46.0, "paper_b:section": 21.0, "paper_d:section": 10.0, "paper_c:section": 4.0,
          "models:section": 3.0}
+
+#: File names of OpenMP runtimes: GNU (libgomp), LLVM (libomp), Intel (libiomp5).
+_OPENMP_RUNTIME = re.compile(r"lib(g|i)?omp[0-9]*[.-]")
 
 _QUEUE: list = []  # the progress queue the forked workers inherit (set by build_sections)
 
@@ -51,7 +56,8 @@ LAST_RUN: dict = {}
 def fork_is_safe() -> bool:
     """Whether this process can fork workers that run the library's kernels: ``fork`` exists and
     numba's threading layer is either not started yet or one that survives a fork (TBB or
-    numba's own workqueue; GNU OpenMP does not, see the module docstring)."""
+    numba's own workqueue; GNU OpenMP does not, see the module docstring), and no OpenMP runtime
+    is loaded in the process by anything else (:func:`openmp_runtimes`)."""
     if "fork" not in mp.get_all_start_methods():
         return False
     try:
@@ -61,8 +67,22 @@ def fork_is_safe() -> bool:
     try:
         layer = numba.threading_layer()
     except ValueError:  # numba: "Threading layer is not initialized." -- no parallel kernel ran
-        return True
-    return layer in ("tbb", "workqueue")
+        layer = None
+    return layer in (None, "tbb", "workqueue") and not openmp_runtimes()
+
+
+def openmp_runtimes(maps: str | Path = "/proc/self/maps") -> list[str]:
+    """The OpenMP runtimes (GNU ``libgomp``, LLVM ``libomp``, Intel ``libiomp``) mapped into this
+    process, read from ``maps`` (Linux; ``[]`` where the file does not exist).  A process that
+    loaded one may have started its threads without numba (a host application's own OpenMP code,
+    a library linked with it), so :func:`fork_is_safe` refuses to fork then: conservative, one
+    process builds the same report.  A fresh ``spatialmech demo`` maps none before it forks."""
+    try:
+        text = Path(maps).read_text(encoding="utf-8", errors="replace")
+    except OSError:
+        return []
+    names = {line.rsplit("/", 1)[-1] for line in text.splitlines() if "/" in line}
+    return sorted(n for n in names if _OPENMP_RUNTIME.match(n))
 
 
 def default_workers(n_sections: int, requested: int | None = None) -> int:
