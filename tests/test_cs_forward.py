@@ -35,6 +35,22 @@ def test_the_5cs_linkages_are_recognised_geometrically(cs3):
     assert csf.linkage_of(slide) is None and csf.linkage_of(sm.load_model("rssr")) is None
 
 
+def test_a_driven_slide_says_the_closed_form_does_not_cover_it(cs3):
+    """With C1's slide driven the answer names the engine that ran, says the 5-CS closed form
+    covers a driven rotation only, and that the answer is not proven (issue 27)."""
+    slide = cs3.with_actuators(["C1.slide"])
+    note = csf.driven_slide_note(slide)
+    assert note is not None and "driven C rotation only" in note and "C1" in note
+    assert csf.driven_slide_note(cs3) is None and csf.driven_slide_note(sm.load_model("rssr")) is None
+    assert forward_engine(slide, "multistart") == "multistart"
+    r = sm.fk(slide, [0.05], all_solutions=True, method="multistart", seeds=8)
+    d = r.to_dict()
+    assert d["engine"] == "multistart" and d["method"].endswith("multi-start") and d["complete"] is False
+    assert d["completeness"].startswith("multi-start search: not a proof") and d["completeness"].endswith(note)
+    with pytest.raises(sm.InputError, match="covers a driven C rotation only"):
+        sm.fk(slide, [0.05], all_solutions=True, method="closed-form")
+
+
 def test_five_cs_3_every_configuration_proven(cs3_all):
     r = cs3_all
     assert r.engine == "closed-form" and r.complete

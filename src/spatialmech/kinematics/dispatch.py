@@ -403,8 +403,9 @@ def forward_engine(mech: Mechanism, method: str = "auto", all_solutions: bool = 
         return "closed-form"
     if method == "closed-form":
         names = ", ".join(cf.name for cf in FORWARD_CLOSED_FORMS)
-        raise InputError(f"method: no closed form of forward position recognises {mech.name} (registered: {names}); "
-                         "use method='auto'")
+        miss = closed_form_miss(mech)
+        raise InputError(f"method: no closed form of forward position recognises {mech.name} (registered: {names})"
+                         f"{'' if miss is None else '; ' + miss}; use method='auto'")
     if method == "multistart":
         return "multistart"
     why, gwhy = homotopy_coverage(mech)
@@ -449,7 +450,17 @@ def solve_forward(mech: Mechanism, values, *, all_solutions: bool = False, metho
                          "method='multistart' runs a multi-start search of that many starts")
     res = forward_position(mech, values, all_solutions=True, n_seeds=DEFAULT_SEEDS if seeds is None else seeds,
                            seed=0 if seed is None else seed, progress=progress, method=method)
-    return _general_answer(mech, values, res, True)
+    ans = _general_answer(mech, values, res, True)
+    miss = closed_form_miss(mech)
+    return ans if miss is None else replace(ans, completeness=f"{ans.completeness}; {miss}")
+
+
+def closed_form_miss(mech: Mechanism) -> str | None:
+    """Why a registered closed form of forward position that nearly fits ``mech`` does not
+    answer it (a 5-CS linkage with a slide driven instead of a rotation), else ``None``."""
+    from .closed_forms import cs_forward as csf
+
+    return csf.driven_slide_note(mech)
 
 
 def _serial_answer(mech: Mechanism, values, method: str, seeds: int | None, seed: int | None) -> ForwardAnswer:

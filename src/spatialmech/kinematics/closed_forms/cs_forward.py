@@ -107,6 +107,26 @@ def linkage_of(mech: Mechanism) -> CsLinkage | None:
     return CsLinkage(cc, uu, ss, r, driven, offset, L)
 
 
+def driven_slide_note(mech: Mechanism) -> str | None:
+    """Why the 5-CS closed form does not answer ``mech`` when it is a 5-CS linkage (five C-S
+    dyads, nothing locked) with a C joint's slide driven instead of its rotation, else ``None``.
+
+    The closed form eliminates the driven rotation (four quadrics on ``SO(3) x C``); with the
+    slide driven the unknowns are ``SO(3) x S^1`` (the driven C's rotation free), a
+    formulation this module does not have."""
+    if mech.is_graph or len(mech.limbs) != 5 or len(mech.actuators) != 1:
+        return None
+    if any([j.type for j in limb.joints] != ["C", "S"] for limb in mech.limbs):
+        return None
+    if any(f.locked for limb in mech.limbs for j in limb.joints for f in j.freedoms):
+        return None
+    slides = [limb.joints[0].name for limb in mech.limbs if limb.joints[0].freedoms[1].actuated]
+    if not slides:
+        return None
+    return (f"the 5-CS closed form (4 quadrics on SO(3) x C) covers a driven C rotation only, not the driven "
+            f"slide of {slides[0]} (that would be a system on SO(3) x S^1, not formulated)")
+
+
 # ------------------------------------------------------------------ the system on SO(3) x C
 def _orth(X):
     """``R^T R - I`` (upper triangle, 6) and its Jacobian (n, 6, 10)."""
