@@ -91,6 +91,17 @@ def _bound(kinds: list[str], screws: np.ndarray, kind: str) -> tuple[int, str]:
     return 0, ""
 
 
+def _T(A: np.ndarray) -> np.ndarray:
+    """The last two axes of ``A`` swapped (a stack of transposes, no conjugation)."""
+    return np.swapaxes(A, -1, -2)
+
+
+def _apply(M: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """``M[n] @ v[n]`` for stacks ``M`` (n, a, b) and ``v`` (n, b): matmul, not einsum (called on
+    one point at a time by the trackers, where einsum's parsing costs ~50 us a call)."""
+    return (M @ v[..., None])[..., 0]
+
+
 @dataclass(frozen=True, eq=False)
 class _Factor:
     kind: str  # "R" or "P"
@@ -131,7 +142,8 @@ class LimbIK:
     # ---------------------------------------------------------------------- evaluation
     def _chain(self, factors, X):
         n, nz = X.shape
-        T = np.broadcast_to(_I4, (n, 4, 4)).astype(complex)
+        T = np.empty((n, 4, 4), complex)
+        T[:] = _I4
         dT = np.zeros((n, nz, 4, 4), complex)
         for f in factors:
             if f.kind == "R":
@@ -154,29 +166,30 @@ class LimbIK:
         ``full``: every entry of the rotation (9) instead of the three above the diagonal."""
         q, t = P[:, :4], P[:, 4:7]
         E = rotation_forms(q)
-        s = np.einsum("ni,ni->n", q, q)
+        s = (q * q).sum(axis=1)
         TL, dTL = self._chain(self.left, X)
         TR, dTR = self._chain(self.right, X)
         if dP is not None:
             dq, dt = dP[:, :4], dP[:, 4:7]
             dE = 0.5 * (rotation_forms(q + dq) - rotation_forms(q - dq))  # exact: E is quadratic
-            ds = 2 * np.einsum("ni,ni->n", q, dq)
+            ds = 2 * (q * dq).sum(axis=1)
         if self.kind == "point":
             u, du = TL @ self.centre, dTL @ self.centre
             v, dv = TR @ self.centre, dTR @ self.centre
-            r = s[:, None] * (u[:, :3] - t) - np.einsum("nab,nb->na", E, v[:, :3])
-            dr = s[:, None, None] * du[:, :, :3] - np.einsum("nab,nzb->nza", E, dv[:, :, :3])
+            r = s[:, None] * (u[:, :3] - t) - _apply(E, v[:, :3])
+            dr = s[:, None, None] * du[:, :, :3] - dv[:, :, :3] @ _T(E)
             rt = None
             if dP is not None:
-                rt = ds[:, None] * (u[:, :3] - t) - s[:, None] * dt - np.einsum("nab,nb->na", dE, v[:, :3])
+                rt = ds[:, None] * (u[:, :3] - t) - s[:, None] * dt - _apply(dE, v[:, :3])
             return r, dr.transpose(0, 2, 1), rt
         RL, RR = TL[:, :3, :3], TR[:, :3, :3]
         ERR = E @ RR
-        Pm = np.einsum("nai,naj->nij", RL, ERR)
-        dPm = np.einsum("nzai,naj->nzij", dTL[:, :, :3, :3], ERR) + np.einsum("nai,nab,nzbj->nzij", RL, E, dTR[:, :, :3, :3])
+        RLt = _T(RL)
+        Pm = RLt @ ERR
+        dPm = _T(dTL[:, :, :3, :3]) @ ERR[:, None] + (RLt @ E)[:, None] @ dTR[:, :, :3, :3]
         pl, pr = TL[:, :3, 3], TR[:, :3, 3]
-        tr = s[:, None] * (pl - t) - np.einsum("nab,nb->na", E, pr)
-        dtr = s[:, None, None] * dTL[:, :, :3, 3] - np.einsum("nab,nzb->nza", E, dTR[:, :, :3, 3])
+        tr = s[:, None] * (pl - t) - _apply(E, pr)
+        dtr = s[:, None, None] * dTL[:, :, :3, 3] - dTR[:, :, :3, 3] @ _T(E)
         n = len(X)
         if full:
             rot = Pm.reshape(n, 9) - s[:, None] * np.eye(3).ravel()
@@ -186,8 +199,8 @@ class LimbIK:
         dr = np.concatenate([dPm[:, :, ii, jj], dtr], axis=2)
         rt = None
         if dP is not None:
-            dPt = np.einsum("nai,nab,nbj->nij", RL, dE, RR)
-            trt = ds[:, None] * (pl - t) - s[:, None] * dt - np.einsum("nab,nb->na", dE, pr)
+            dPt = RLt @ dE @ RR
+            trt = ds[:, None] * (pl - t) - s[:, None] * dt - _apply(dE, pr)
             rt = np.concatenate([dPt[:, ii, jj], trt], axis=1)
         return r, dr.transpose(0, 2, 1), rt
 
@@ -204,7 +217,7 @@ class LimbIK:
             J[:, i, a], J[:, i, b] = 2 * X[:, a], 2 * X[:, b]
         k = len(self.circles)
         F[:, k:] = r @ self.C.T - P[:, 7:]
-        J[:, k:] = np.einsum("mr,nrz->nmz", self.C, dr)
+        J[:, k:] = self.C @ dr
         if dP is not None and rt is not None:
             Ft[:, k:] = rt @ self.C.T - dP[:, 7:]
         return F, J, Ft

@@ -401,9 +401,11 @@ class LoopSystem:
 def rotation_forms(q: np.ndarray) -> np.ndarray:
     """``E(q) = (q.q) R(q)`` (n, 3, 3) of quaternions ``q`` (n, 4), complex allowed."""
     w, i, j, k = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
-    return np.stack([np.stack([w * w + i * i - j * j - k * k, 2 * (i * j - w * k), 2 * (i * k + w * j)], -1),
-                     np.stack([2 * (i * j + w * k), w * w - i * i + j * j - k * k, 2 * (j * k - w * i)], -1),
-                     np.stack([2 * (i * k - w * j), 2 * (j * k + w * i), w * w - i * i - j * j + k * k], -1)], 1)
+    E = np.empty((q.shape[0], 3, 3), dtype=np.result_type(q.dtype, np.float64))  # filled, not stacked: called per point
+    E[:, 0, 0], E[:, 0, 1], E[:, 0, 2] = w * w + i * i - j * j - k * k, 2 * (i * j - w * k), 2 * (i * k + w * j)
+    E[:, 1, 0], E[:, 1, 1], E[:, 1, 2] = 2 * (i * j + w * k), w * w - i * i + j * j - k * k, 2 * (j * k - w * i)
+    E[:, 2, 0], E[:, 2, 1], E[:, 2, 2] = 2 * (i * k - w * j), 2 * (j * k + w * i), w * w - i * i - j * j + k * k
+    return E
 
 
 def _study_forms() -> np.ndarray:
