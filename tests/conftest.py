@@ -1,6 +1,9 @@
 import json
 import os
 import shutil
+import socket
+import threading
+import time
 
 import numpy as np
 import pytest
@@ -8,7 +11,10 @@ from hypothesis import settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
+import spatialmech as sm
 from spatialmech.geometry.rotations import transform
+
+from .browser_support import CHROMEDRIVER, CHROMIUM, FLAGS, TIMEOUT, missing
 
 # No per-example deadline (machines differ in load); in CI the examples are derandomised so a
 # run is reproducible (locally they stay random, to keep finding new cases).
@@ -196,3 +202,49 @@ def _screen_family_cache(tmp_path_factory):
     with pytest.MonkeyPatch.context() as m:
         m.setenv("SPATIALMECH_CACHE_DIR", str(tmp_path_factory.mktemp("spatialmech-cache")))
         yield
+
+
+# The studio's page server and headless Chromium, shared by tests/test_studio_*browser.py (module
+# scope: one server and one browser per test file, as before the move).
+@pytest.fixture(scope="module")
+def server():
+    import uvicorn
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    srv = uvicorn.Server(uvicorn.Config(sm.studio_app("rssr"), host="127.0.0.1", port=port, log_level="warning"))
+    th = threading.Thread(target=srv.run, daemon=True)
+    th.start()
+    t0 = time.time()
+    while not srv.started and time.time() - t0 < TIMEOUT:
+        time.sleep(0.05)
+    yield f"http://127.0.0.1:{port}/"
+    srv.should_exit = True
+    th.join(10)
+
+
+@pytest.fixture(scope="module")
+def browser(tmp_path_factory):
+    gone = missing()
+    if gone:
+        msg = f"headless Chromium test needs {', '.join(gone)} (apt-get install chromium chromium-driver; pip install selenium)"
+        if os.environ.get("CI"):
+            pytest.fail(msg + " -- CI is set, so this must run", pytrace=False)
+        pytest.skip(msg)
+    from selenium import webdriver
+    from selenium.webdriver.chrome.service import Service
+
+    os.environ["SE_OFFLINE"] = "true"  # never let Selenium Manager download anything
+    opts = webdriver.ChromeOptions()
+    opts.binary_location = CHROMIUM
+    for f in FLAGS:
+        opts.add_argument(f)
+    opts.add_argument(f"--user-data-dir={tmp_path_factory.mktemp('chromium-studio')}")
+    opts.set_capability("goog:loggingPrefs", {"browser": "ALL"})
+    driver = webdriver.Chrome(service=Service(executable_path=CHROMEDRIVER), options=opts)
+    driver.set_page_load_timeout(TIMEOUT)
+    try:
+        yield driver
+    finally:
+        driver.quit()

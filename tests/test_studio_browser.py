@@ -7,9 +7,6 @@ Skipped when Chromium, chromedriver or selenium is missing -- except when ``CI``
 the test fails instead.
 """
 
-import os
-import socket
-import threading
 import time
 
 import numpy as np
@@ -17,68 +14,9 @@ import pytest
 
 import spatialmech as sm
 
+from .browser_support import TIMEOUT
+
 pytestmark = pytest.mark.slow  # a browser start and software WebGL take seconds
-
-CHROMIUM = os.environ.get("SPATIALMECH_CHROMIUM", "/usr/bin/chromium")
-CHROMEDRIVER = os.environ.get("SPATIALMECH_CHROMEDRIVER", "/usr/bin/chromedriver")
-FLAGS = ("--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking", "--disable-component-update",
-         "--no-first-run", "--enable-unsafe-swiftshader", "--window-size=1200,800", "--force-device-scale-factor=1")
-TIMEOUT = 60
-
-
-def missing() -> list[str]:
-    out = []
-    try:
-        import selenium  # noqa: F401
-    except ImportError:
-        out.append("the pip package 'selenium'")
-    out += [p for p in (CHROMIUM, CHROMEDRIVER) if not (os.path.isfile(p) and os.access(p, os.X_OK))]
-    return out
-
-
-@pytest.fixture(scope="module")
-def server():
-    import uvicorn
-
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        port = s.getsockname()[1]
-    srv = uvicorn.Server(uvicorn.Config(sm.studio_app("rssr"), host="127.0.0.1", port=port, log_level="warning"))
-    th = threading.Thread(target=srv.run, daemon=True)
-    th.start()
-    t0 = time.time()
-    while not srv.started and time.time() - t0 < TIMEOUT:
-        time.sleep(0.05)
-    yield f"http://127.0.0.1:{port}/"
-    srv.should_exit = True
-    th.join(10)
-
-
-@pytest.fixture(scope="module")
-def browser(tmp_path_factory):
-    gone = missing()
-    if gone:
-        msg = f"headless Chromium test needs {', '.join(gone)} (apt-get install chromium chromium-driver; pip install selenium)"
-        if os.environ.get("CI"):
-            pytest.fail(msg + " -- CI is set, so this must run", pytrace=False)
-        pytest.skip(msg)
-    from selenium import webdriver
-    from selenium.webdriver.chrome.service import Service
-
-    os.environ["SE_OFFLINE"] = "true"  # never let Selenium Manager download anything
-    opts = webdriver.ChromeOptions()
-    opts.binary_location = CHROMIUM
-    for f in FLAGS:
-        opts.add_argument(f)
-    opts.add_argument(f"--user-data-dir={tmp_path_factory.mktemp('chromium-studio')}")
-    opts.set_capability("goog:loggingPrefs", {"browser": "ALL"})
-    driver = webdriver.Chrome(service=Service(executable_path=CHROMEDRIVER), options=opts)
-    driver.set_page_load_timeout(TIMEOUT)
-    try:
-        yield driver
-    finally:
-        driver.quit()
-
 
 def wait(driver, script, timeout=TIMEOUT):
     t0 = time.time()

@@ -1,35 +1,24 @@
 """The studio's design tools in headless Chromium (static/design.js over the page of
-tests/test_studio_browser.py, the same server and browser fixtures): snapshot, drag, undo; the
+tests/test_studio_browser.py, the same server and browser fixtures: tests/conftest.py): snapshot, drag, undo; the
 coupler curve of a typed point drawn in the 3-D view; the joints-and-transmission chart; the
 smaller redraw used during the drag; no console errors.  ``SPATIALMECH_SCREENSHOTS=DIR`` keeps
 a screenshot of the page in DIR."""
 
 import os
-import time
 from pathlib import Path
 
 import pytest
 
-from .test_studio_browser import TIMEOUT, browser, server  # noqa: F401  (shared fixtures)
+from .browser_support import wait_for  # the fixtures server and browser: tests/conftest.py
 
 pytestmark = pytest.mark.slow  # a browser start and software WebGL take seconds
-
-
-def wait_for(driver, script, *args):
-    t0 = time.time()
-    while time.time() - t0 < TIMEOUT:
-        v = driver.execute_script(script, *args)
-        if v:
-            return v
-        time.sleep(0.1)
-    raise AssertionError(f"timed out waiting for: {script}")
 
 
 def crank(driver) -> float:
     return driver.execute_script("return window.studio.state.actuators_deg['A0.rot']")
 
 
-def test_snapshot_undo_coupler_curve_and_sweep_in_the_page(server, browser):  # noqa: F811
+def test_snapshot_undo_coupler_curve_and_sweep_in_the_page(server, browser):
     b = browser
     b.get(server)
     wait_for(b, "return window.studio && window.studio.state && window.studio.drawn > 0 && "

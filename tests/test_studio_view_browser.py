@@ -1,5 +1,5 @@
 """The studio page's layout, top view and drag handle in headless Chromium (one browser, the
-fixtures of tests/test_studio_browser.py): on the 6-SPS Stewart platform the key readouts (DJ,
+fixtures of tests/conftest.py): on the 6-SPS Stewart platform the key readouts (DJ,
 the sigma_min and transmission lights, the events) are above the fold and above the sliders;
 planar-4r opens in its top view (orthographic, along the plane's normal) with a toggle; dragging
 the handle of the output point moves the linkage by the pose drag; no console errors."""
@@ -8,19 +8,9 @@ import time
 
 import pytest
 
-from .test_studio_browser import TIMEOUT, browser, server  # noqa: F401  (shared fixtures)
+from .browser_support import wait_for  # the fixtures server and browser: tests/conftest.py
 
 pytestmark = pytest.mark.slow  # a browser start and software WebGL take seconds
-
-
-def wait_for(driver, script, *args):
-    t0 = time.time()
-    while time.time() - t0 < TIMEOUT:
-        v = driver.execute_script(script, *args)
-        if v:
-            return v
-        time.sleep(0.1)
-    raise AssertionError(f"timed out waiting for: {script}")
 
 
 def load(driver, model):
@@ -39,7 +29,7 @@ CAMERA = ("const c = document.getElementById('plot')._fullLayout.scene.camera;"
           "return [c.eye.x, c.eye.y, c.eye.z, c.projection.type];")
 
 
-def test_readouts_above_the_fold_top_view_and_drag_handle(server, browser):  # noqa: F811
+def test_readouts_above_the_fold_top_view_and_drag_handle(server, browser):
     from selenium.webdriver.common.action_chains import ActionChains
     from selenium.webdriver.common.by import By
 

@@ -20,7 +20,6 @@ from pathlib import Path
 import pytest
 
 import spatialmech as sm
-from .test_studio_browser import browser, missing  # noqa: F401  (the Chromium fixture, shared)
 
 pytestmark = pytest.mark.slow  # a browser start and software WebGL take seconds
 pytest.importorskip("anywidget")
@@ -86,7 +85,7 @@ def wait_for(driver, script, timeout=60.0):
     raise AssertionError(f"timed out waiting for: {script}")
 
 
-def test_the_widget_renders_and_a_slider_drives_the_session(page, browser):  # noqa: F811
+def test_the_widget_renders_and_a_slider_drives_the_session(page, browser):
     w, url = page
     browser.get(url)
     wait_for(browser, "return window.rendered === true && document.querySelector('.js-plotly-plot') !== null")
@@ -124,7 +123,7 @@ def test_the_widget_renders_and_a_slider_drives_the_session(page, browser):  # n
         assert browser.find_element("css selector", "#w").screenshot(str(Path(out) / "studio-widget-rssr.png"))
 
 
-def test_the_widget_drag_pad_moves_the_output_point(tmp_path_factory, browser):  # noqa: F811
+def test_the_widget_drag_pad_moves_the_output_point(tmp_path_factory, browser):
     """Issue 30: the notebook widget has the page's drag pad (static/pad.js, shared): a real mouse
     drag of the handle on planar-4r (its top view; it controls x) sends one drag message with the
     point under the mouse, which the session reaches by the pose drag (``Session.drag_output``)."""
