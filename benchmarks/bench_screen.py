@@ -51,24 +51,12 @@ from spatialmech.catalog.papers import five_cs_positions
 from spatialmech.services.screen_family import family_key, load_family, save_family
 from spatialmech.services.screening import read_rows, run_screen
 from spatialmech.synthesis.cs_dyads import cs_task, synthesize_cs
-from spatialmech.synthesis.screening import candidate_linkage, candidate_sets, dyad_pool, judge_candidate
+from spatialmech.synthesis.screening import (candidate_linkage, candidate_sets, dyad_pool, judge_candidate,
+                                             row_differences)
 
 
 def _load() -> float:
     return os.getloadavg()[0]
-
-
-def _same_row(a: dict, b: dict) -> bool:
-    for k in a:
-        if k == "seconds":
-            continue
-        x, y = a[k], b[k]
-        if isinstance(x, float) and isinstance(y, float):
-            if not ((math.isnan(x) and math.isnan(y)) or abs(x - y) <= 1e-10 * max(1.0, abs(x))):
-                return False
-        elif x != y:
-            return False
-    return True
 
 
 def compare_paths(pool, sets, n: int) -> dict:
@@ -90,7 +78,7 @@ def compare_paths(pool, sets, n: int) -> dict:
                 st[batched] += v.seconds
         for a, b in zip(rows[False], rows[True], strict=True):
             by_stage[str(a.rejected_by)]["n"] += 1
-            equal &= _same_row(a.row(), b.row())
+            equal &= row_differences(a.row(), b.row(), 1e-10) == []
     return {"candidates": n, "reference_candidates_per_s": n / t[False], "batched_candidates_per_s": n / t[True],
             "ratio": t[False] / t[True], "batched_candidates_per_cpu_s": n / cpu[True],
             "rows_equal_1e-10": bool(equal),

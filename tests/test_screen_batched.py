@@ -10,7 +10,6 @@
 """
 
 import dataclasses
-import math
 
 import numpy as np
 import pytest
@@ -20,7 +19,8 @@ from hypothesis import strategies as st
 from spatialmech.geometry.rotations import rotvec_matrix
 from spatialmech.model.mechanism import Pose
 from spatialmech.synthesis.five_cs import cs_configuration, cs_configurations
-from spatialmech.synthesis.screening import candidate_linkage, candidate_sets, dyad_pool, judge_candidate
+from spatialmech.synthesis.screening import (candidate_linkage, candidate_sets, dyad_pool, judge_candidate,
+                                             row_differences)
 
 pytestmark = pytest.mark.slow
 
@@ -70,21 +70,6 @@ def test_closed_forms_agree_at_random_poses(pool, rv, p):
     assert np.max(np.abs(ball_rotations(mech, a.q) - ball_rotations(mech, b.q))) < 1e-12
 
 
-def same_row(a: dict, b: dict) -> list[str]:
-    """The columns of two verdict rows that differ (floats beyond 1e-10 relative)."""
-    bad = []
-    for k in a:
-        if k == "seconds":
-            continue
-        x, y = a[k], b[k]
-        if isinstance(x, float) and isinstance(y, float):
-            if not ((math.isnan(x) and math.isnan(y)) or abs(x - y) <= 1e-10 * max(1.0, abs(x))):
-                bad.append(k)
-        elif x != y:
-            bad.append(k)
-    return bad
-
-
 def test_the_batched_judgement_gives_the_reference_verdicts(pool):
     sets, _ = candidate_sets(pool, 30, seed=0)
     cands = [*(list(map(int, c)) for c in sets), USABLE, TWO_CIRCUITS]
@@ -92,7 +77,7 @@ def test_the_batched_judgement_gives_the_reference_verdicts(pool):
     for n, c in enumerate(cands):
         ref = judge_candidate(pool, c, candidate=n, batched=False).row()
         got = judge_candidate(pool, c, candidate=n, batched=True).row()
-        assert same_row(ref, got) == [], (c, ref, got)
+        assert row_differences(ref, got, 1e-10) == [], (c, ref, got)
         stages.add((ref["rejected_by"], ref["circuit_defect"], ref["usable"]))
     # the set holds DJ-sign rejections, circuit judgements with a circuit defect and a usable one
     assert ("dj_signs", None, False) in stages and ("circuits", True, False) in stages and (None, False, True) in stages

@@ -280,6 +280,36 @@ VERDICT_COLUMNS: tuple[tuple[str, str, str], ...] = (
 RANKINGS = ("singularity", "slide")
 
 
+def row_differences(a: dict, b: dict, rel_tol: float) -> list[str]:
+    """The columns in which two verdict rows differ.
+
+    Parameters
+    ----------
+    a, b : dict
+        Verdict rows (:meth:`CandidateVerdict.row`) of the same candidate, e.g. by the
+        reference and the batched judgement.
+    rel_tol : float
+        Floats agree within ``rel_tol * max(1, |a|)``; two NaN agree.  The ``seconds``
+        column (a timing) is not compared.
+
+    Returns
+    -------
+    list of str
+        The differing columns, in the order of ``a`` (empty: the rows agree).
+    """
+    bad = []
+    for k in a:
+        if k == "seconds":
+            continue
+        x, y = a[k], b[k]
+        if isinstance(x, float) and isinstance(y, float):
+            if not ((math.isnan(x) and math.isnan(y)) or abs(x - y) <= rel_tol * max(1.0, abs(x))):
+                bad.append(k)
+        elif x != y:
+            bad.append(k)
+    return bad
+
+
 def rank_key(row, by: str = "singularity") -> tuple[float, float]:
     """Sort key of usable candidates (a :class:`CandidateVerdict` or its :meth:`row`), best
     first.  ``by="singularity"``: the larger distance to a singularity along the path
