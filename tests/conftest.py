@@ -180,19 +180,47 @@ def paper_a_cs_family(tmp_path_factory):
                       lambda out: pickle.loads((out / "family.pickle").read_bytes()))[1]
 
 
+#: The seconds each test file took in a full run (tests/file_seconds.txt, written by
+#: ``.ci/file_seconds.py`` from a JUnit XML); a file not listed there counts as ``UNLISTED_SECONDS``.
+FILE_SECONDS = os.path.join(os.path.dirname(__file__), "file_seconds.txt")
+UNLISTED_SECONDS = 10.0
+
+
+def file_seconds() -> dict[str, float]:
+    """``{file name: seconds}`` of tests/file_seconds.txt (lines ``seconds name``, ``#`` comments)."""
+    out = {}
+    with open(FILE_SECONDS, encoding="utf-8") as f:
+        for line in f:
+            line = line.split("#", 1)[0].split()
+            if line:
+                out[line[1]] = float(line[0])
+    return out
+
+
 def pytest_collection_modifyitems(config, items):
-    """Under pytest-xdist, the tests that read the session's demo run (``demo_report``) go to the
-    end of the collection, the order otherwise kept.  With ``--dist loadfile`` (README) a file's
-    tests run in collection order, so they run last in their file: a worker reaches them after
-    the rest of it, by which time the other worker has often built the demo already (without
-    this, one worker sat about 20 s waiting for the lock of :func:`built_once`).  A single
-    process keeps the file order."""
+    """Under pytest-xdist, the test files in order of the time they take, longest first, and in
+    each file the tests that read the session's demo run (``demo_report``) last, the order
+    otherwise kept.  A single process keeps the file order.
+
+    - With ``--dist loadfile`` (README) a worker takes the next file of the collection when it
+      is nearly done with its own: longest first keeps the last files short, so the two workers
+      end together (pytest-xdist's own order, most tests first, put the few-but-slow files --
+      browsers, homotopy, Dask -- at the end, and one worker ran alone for minutes).  That needs
+      ``--no-loadscope-reorder`` (pyproject.toml's addopts).  The times: tests/file_seconds.txt.
+    - A file's tests run in collection order, so the demo's readers run last in their file: a
+      worker reaches them after the rest of it, by which time the other worker has often built
+      the demo already (without this, one worker sat about 20 s waiting for the lock of
+      :func:`built_once`)."""
     if not os.environ.get("PYTEST_XDIST_WORKER"):
         return
-    late = [item for item in items if "demo_report" in getattr(item, "fixturenames", ())]
-    if late:
-        ids = {id(item) for item in late}
-        items[:] = [item for item in items if id(item) not in ids] + late
+    weight = file_seconds()
+    rank = {}
+    for n, item in enumerate(items):
+        name = os.path.basename(str(item.path))
+        rank.setdefault(name, (-weight.get(name, UNLISTED_SECONDS), n))
+    key = {id(item): (rank[os.path.basename(str(item.path))], "demo_report" in getattr(item, "fixturenames", ()), n)
+           for n, item in enumerate(items)}
+    items.sort(key=lambda item: key[id(item)])
 
 
 @pytest.fixture(scope="session", autouse=True)
