@@ -19,7 +19,6 @@ from spatialmech.kinematics.jacobian import complete_jacobian
 from spatialmech.present import model_platform
 from spatialmech.present.numbers import unit_label
 from spatialmech.present.report import build_model_report
-from tests.test_viewer_browser import browser  # noqa: F401  (the headless Chromium fixture)
 
 pytestmark = pytest.mark.slow  # one report build (fk --all by homotopy, a slice, a workspace): ~10-20 s
 
@@ -123,8 +122,8 @@ def test_demo_page_is_responsive(demo_report):
     assert tables > 0 and page.count("<div class='scroll'><table") == tables  # every table scrolls in its own box
 
 
-def test_demo_page_fits_820_px_in_chromium(demo_report, browser):  # noqa: F811 (the imported fixture)
-    """Headless Chromium (tests/test_viewer_browser.py's driver) at a window 820 px wide: the page
+def test_demo_page_fits_820_px_in_chromium(demo_report, browser):
+    """Headless Chromium (tests/conftest.py's driver) at a window 820 px wide: the page
     does not scroll sideways (wide tables scroll inside their own box)."""
     out, _ = demo_report
     browser.set_window_size(820, 1000)
