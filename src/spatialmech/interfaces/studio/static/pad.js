@@ -3,7 +3,8 @@
 // The pad shows the linkage projected on a plane (a planar linkage's own plane, else the plane of
 // the first two of x, y, z that the mechanism controls) in a 200 x 200 SVG; a point dragged on it
 // becomes a 3-D point (the output point's coordinate along the plane's normal kept) that the
-// session reaches by the pose drag's continuation (Session.drag_output).
+// session reaches by the pose drag's continuation (Session.drag_output).  Being the one file both
+// frontends load, it also holds what they share of the 3-D view: `glPixelRatio`.
 "use strict";
 
 const SMPad = (() => {
@@ -78,5 +79,10 @@ const SMPad = (() => {
     el.addEventListener("pointerup", up); el.addEventListener("pointercancel", up);
   }
 
-  return { planeBasis, sceneRange, frame, xy, label, svg, point, attach };
+  // plotly.js draws a 3-D scene's WebGL canvas at `plotGlPixelRatio` times the page's pixels (its
+  // default is 2: four times the pixels to paint on a display of ratio 1).  Draw at the display's
+  // own ratio: as sharp as the screen shows, and a quarter of the fill on an ordinary display.
+  const glPixelRatio = Math.max(1, window.devicePixelRatio || 1);
+
+  return { planeBasis, sceneRange, frame, xy, label, svg, point, attach, glPixelRatio };
 })();

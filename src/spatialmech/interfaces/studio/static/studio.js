@@ -4,10 +4,6 @@
 // (no websockets).  window.studio exposes the last state for tests.
 "use strict";
 
-// plotly.js draws a 3-D scene's WebGL canvas at `plotGlPixelRatio` times the page's pixels (its
-// default is 2: four times the pixels to paint on a display of ratio 1).  Draw at the display's own
-// ratio: as sharp as the screen shows, and a quarter of the fill on an ordinary display.
-const GL_PIXEL_RATIO = Math.max(1, window.devicePixelRatio || 1);
 const EVENT_LOG_MAX = 100;  // services/studio/monitors.EVENT_LOG_MAX
 const S = { state: null, circuit: null, unit: "", inFlight: false, pending: null, range: null, drawn: 0, errors: [],
   topView: false, viewRev: 0, nEvents: 0 };
@@ -93,7 +89,7 @@ function draw() {
     layout.scene.camera = { eye: { x: 2 * n[0], y: 2 * n[1], z: 2 * n[2] }, up: { x: e2[0], y: e2[1], z: e2[2] },
       center: { x: 0, y: 0, z: 0 }, projection: { type: "orthographic" } };
   }
-  Plotly.react("plot", traces(sc), layout, { displaylogo: false, responsive: true, plotGlPixelRatio: GL_PIXEL_RATIO });
+  Plotly.react("plot", traces(sc), layout, { displaylogo: false, responsive: true, plotGlPixelRatio: SMPad.glPixelRatio });
   S.drawn += 1;
 }
 

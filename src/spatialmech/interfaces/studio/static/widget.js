@@ -4,10 +4,6 @@
 // sends {type: "drag", point_len: [x, y, z]}.  Plotly and SMPad are defined by the bundle this file
 // is appended to (interfaces/studio/widget.py).
 
-// plotly.js draws a 3-D scene's WebGL canvas at `plotGlPixelRatio` times the page's pixels (its
-// default is 2: four times the pixels to paint on a display of ratio 1).  Draw at the display's own
-// ratio: as sharp as the screen shows, and a quarter of the fill on an ordinary display.
-const GL_PIXEL_RATIO = Math.max(1, window.devicePixelRatio || 1);
 
 function fmt(x, d = 5) { return (x === null || x === undefined) ? "-" : Number(x).toPrecision(d); }
 
@@ -89,7 +85,7 @@ function render({ model, el }) {
     }
     table.innerHTML = readoutRows(st, unit, model).map(([k, v]) => `<tr><th style="text-align: left">${k}</th><td>${v}</td></tr>`).join("");
   }
-  function draw() { const f = model.get("figure"); Plotly.react(plot, f.data, f.layout, { displaylogo: false, responsive: true, plotGlPixelRatio: GL_PIXEL_RATIO }); }
+  function draw() { const f = model.get("figure"); Plotly.react(plot, f.data, f.layout, { displaylogo: false, responsive: true, plotGlPixelRatio: SMPad.glPixelRatio }); }
 
   SMPad.attach(padSvg, () => frame, () => model.get("state").scene.platform_point_len,
                p => { pending = { type: "drag", point_len: p }; send(); });
