@@ -74,7 +74,8 @@ if TYPE_CHECKING:  # what mypy sees; at run time :func:`__getattr__` imports the
     from .interfaces.studio.widget import studio
     from .kinematics import closed_forms
     from .kinematics.closure import Configuration
-    from .model import C, H, Joint, Limb, Mechanism, Mode, ModelFileError, P, Pose, R, S, Sm, U, dump, dumps, load, loads
+    from .model import (C, H, Joint, Limb, Mechanism, Mode, ModelFileError, P, Pose, R, S, Sm, U, dump, dumps, load, loads,
+                        serial_from_dh)
 
     __version__: str
 
@@ -127,6 +128,7 @@ __all__ = [
     "report",
     "results",
     "screen",
+    "serial_from_dh",
     "singularity",
     "singularity_slice",
     "statics",
@@ -153,7 +155,7 @@ __all__ = [
 #: enums only: no analysis, no scipy.spatial, no numba until a verb runs (issue 29).
 _LAZY: dict[str, str] = {
     **dict.fromkeys(("C", "H", "Joint", "Limb", "Mechanism", "Mode", "ModelFileError", "P", "Pose", "R", "S", "Sm",
-                     "U", "dump", "dumps", "load", "loads"), ".model"),
+                     "U", "dump", "dumps", "load", "loads", "serial_from_dh"), ".model"),
     "Configuration": ".kinematics.closure",
     "closed_forms": ".kinematics.closed_forms",  # the closed-form kernels (a module; they load scipy.stats)
     # the studio's web app (FastAPI) and Jupyter widget (anywidget), drivers above the API: their entry
@@ -162,7 +164,8 @@ _LAZY: dict[str, str] = {
     "studio": ".interfaces.studio.entry",
     **{name: ".api" for name in __all__ if name[0].islower() and name not in {"__version__", "closed_forms",
                                                                                "dump", "dumps", "load", "loads",
-                                                                               "results", "studio", "studio_app"}},
+                                                                               "results", "serial_from_dh", "studio",
+                                                                               "studio_app"}},
 }
 
 

@@ -7,6 +7,7 @@ import numpy as np
 from ..errors import InputError
 from ..geometry.rotations import euler_matrix, transform
 from ..model.joints import P, R, S, U
+from ..model.dh import serial_from_dh
 from ..model.mechanism import Limb, Mechanism
 
 
@@ -293,4 +294,22 @@ def rssr() -> Mechanism:
     return Mechanism(
         "rssr", limbs, platform_point=B1,
         description="Spatial RSSR four-bar linkage, 1 DOF (+1 passive coupler spin)",
+    )
+
+
+#: Unimation PUMA 560, standard DH parameters (d, a in metres; alpha in degrees) as in P. Corke's
+#: Robotics Toolbox (mdl_puma560, after Corke and Armstrong-Helouvry, ICRA 1994).
+PUMA560_DH = {"d": [0.0, 0.0, 0.15005, 0.4318, 0.0, 0.0], "a": [0.0, 0.4318, 0.0203, 0.0, 0.0, 0.0],
+              "alpha": [90.0, 0.0, -90.0, 90.0, -90.0, 0.0]}
+#: its reference: Corke's nominal configuration ``qn`` in degrees (the DH zero is a wrist singularity)
+PUMA560_REFERENCE_DEG = [0.0, 45.0, 180.0, 0.0, 45.0, 0.0]
+
+
+def puma560() -> Mechanism:
+    """The PUMA 560 arm (standard DH, Corke's parameters), placed at Corke's nominal
+    configuration: its joint variables are the DH angles minus (0, 45, 180, 0, 45, 0) deg."""
+    return serial_from_dh(
+        "puma560", d=PUMA560_DH["d"], a=PUMA560_DH["a"], alpha=PUMA560_DH["alpha"],
+        reference=PUMA560_REFERENCE_DEG, degrees=True,
+        description="PUMA 560 6R arm (standard DH, Corke), at the nominal configuration qn",
     )

@@ -20,6 +20,7 @@ from .closure import Chain, chain_forward, limb_chains, limb_slices
 __all__ = [
     "SolutionForm",
     "limb_gauss_newton",
+    "limb_polish",
     "same_solution",
     "solution_form",
     "solution_key",
@@ -54,6 +55,19 @@ def limb_gauss_newton(chain, D, q, lin, L, tol=1e-12, max_iter=60, hold=None):
             q_new[sl] = A.T @ (rotation_class().from_rotvec(A @ dq[sl]) * rotation_class().from_rotvec(A @ q[sl])).as_rotvec()
         q = q_new
     return q, rn, rn < tol
+
+
+def limb_polish(chain, D, q, lin, L, rn, hold=None, max_steps=3):
+    """Newton steps past the closure tolerance, down to round-off: :func:`limb_gauss_newton`
+    stops as soon as the residual ``rn`` is below the tolerance (often 1e-11 after its last
+    quadratic step); each further step is kept only while it at least halves the residual.
+    Returns the polished ``(q, rn)``."""
+    for _ in range(max_steps):
+        q2, rn2, ok = limb_gauss_newton(chain, D, q.copy(), lin, L, tol=0.5 * rn, max_iter=2, hold=hold)
+        if not ok:
+            break
+        q, rn = q2, rn2
+    return q, rn
 
 
 @dataclass(frozen=True, eq=False)

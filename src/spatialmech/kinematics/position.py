@@ -34,7 +34,7 @@ from .closure import (
     recentre_balls,
 )
 from .backend import closure_jacobian, correct, retract
-from .distinct import SolutionForm, limb_gauss_newton, same_solution, solution_form, solution_key, wrap_rotations
+from .distinct import SolutionForm, limb_gauss_newton, limb_polish, same_solution, solution_form, solution_key, wrap_rotations
 
 __all__ = [
     "INVERSE_METHODS",
@@ -451,6 +451,7 @@ def _homotopy_limb(mech: Mechanism, li: int, D: np.ndarray, q_start: np.ndarray,
         q, rn, ok = limb_gauss_newton(ch, D, np.asarray(q0, float).copy(), lin, L, tol=t.closure)
         if not ok:
             continue
+        q, rn = limb_polish(ch, D, q, lin, L, rn)
         q = wrap_rotations(mech, q, range(sl.start, sl.stop))
         key = solution_key(form, q)
         if any(np.linalg.norm(key - k2) < t.dedup for k2 in keys):
@@ -538,6 +539,7 @@ def _inverse_limb(mech: Mechanism, li: int, D: np.ndarray, q_start: np.ndarray, 
             if rn < best[1]:
                 best = (q, rn)
             continue
+        q, rn = limb_polish(ch, D, q, lin, L, rn)
         q = wrap_rotations(mech, q, range(sl.start, sl.stop))
         key = solution_key(form, q)
         if any(np.linalg.norm(key - k2) < t.dedup for k2 in keys):

@@ -2,6 +2,7 @@
 
 from .joints import JOINT_TYPES, C, Freedom, H, Joint, P, R, S, Sm, U, make_joint
 from .mechanism import Limb, Mechanism, Mode, Pose
+from .dh import serial_from_dh
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
@@ -32,6 +33,7 @@ __all__ = [
     "load",
     "loads",
     "make_joint",
+    "serial_from_dh",
 ]
 
 
