@@ -119,3 +119,40 @@ def test_bad_dh_input_names_the_field(kw, field):
     args = {"d": [0.0, 0.0, 0.0], "a": [0.1, 0.2, 0.3], "alpha": [0.0, 0.0, 0.0], **kw}
     with pytest.raises(InputError, match=f"^{field}:"):
         serial_from_dh("bad", **args)
+
+
+PUMA_FILE = """
+name = "my-puma"
+
+[dh]
+convention = "standard"
+d = [0.0, 0.0, 0.15005, 0.4318, 0.0, 0.0]
+a = [0.0, 0.4318, 0.0203, 0.0, 0.0, 0.0]
+alpha_deg = [90, 0, -90, 90, -90, 0]
+reference_deg = [0, 45, 180, 0, 45, 0]
+"""
+
+
+def test_a_dh_file_is_the_ready_made_puma_and_round_trips():
+    mine, ref = sm.loads(PUMA_FILE), catalog.resolve("puma560")
+    assert mine.name == "my-puma" and mine.actuators == ref.actuators
+    assert np.allclose(mine.platform_point, ref.platform_point, atol=1e-15)
+    for x, y in zip(mine.limbs[0].joints, ref.limbs[0].joints, strict=True):
+        assert np.allclose(x.point, y.point, atol=1e-15)
+        assert np.allclose(x.freedoms[0].direction, y.freedoms[0].direction, atol=1e-15)
+    back = sm.loads(sm.dumps(mine))  # written in the limbs form
+    assert back.actuators == mine.actuators and np.allclose(back.platform_point, mine.platform_point)
+
+
+@pytest.mark.parametrize("change, field", [
+    (("convention = \"standard\"", ""), "dh.convention"),
+    (("convention = \"standard\"", "convention = \"craig\""), "dh.convention"),
+    (("a = [0.0, 0.4318, 0.0203, 0.0, 0.0, 0.0]", "a = [0.0, 0.4318]"), "dh.a"),
+    (("[dh]", "platform_point = [0, 0, 0]\n[dh]"), "platform_point"),
+    (("reference_deg = [0, 45, 180, 0, 45, 0]", "joints = \"RRPRRR\"\nreference_deg = [0, 45, 180, 0, 45, 0]"),
+     r"dh.reference_deg\[2\]"),
+    (("reference_deg = [0, 45, 180, 0, 45, 0]", "joints = \"RRXRRR\""), "dh.joints"),
+])
+def test_a_bad_dh_file_names_the_field(change, field):
+    with pytest.raises(sm.ModelFileError, match=field):
+        sm.loads(PUMA_FILE.replace(*change))

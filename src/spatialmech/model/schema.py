@@ -171,6 +171,18 @@ class MassSpec(_Strict):
     inertia_kg_m2: Annotated[list[Vec3], Len(3, 3)] = Field(default_factory=lambda: [[0.0] * 3 for _ in range(3)])
 
 
+class DHSpec(_Strict):
+    """A serial arm by Denavit-Hartenberg rows (:func:`.dh.serial_from_dh`), instead of ``limbs``."""
+
+    convention: Literal["standard", "modified"]
+    d: Annotated[list[float], Len(1)]
+    a: list[float]
+    alpha_deg: list[float]
+    theta_deg: list[float] | None = None
+    joints: str | None = None
+    reference_deg: list[float] | None = None
+
+
 class MechanismSpec(_Strict):
     format: Annotated[Literal[1], PlainValidator(_format_version)] = 1
     name: str
@@ -179,6 +191,7 @@ class MechanismSpec(_Strict):
     normalize_axes: bool = False
     platform_point: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
     limbs: Annotated[list[LimbSpec], Len(1)] | None = None
+    dh: DHSpec | None = None
     links: Annotated[list[str], Len(2)] | None = None
     joints: Annotated[list[GraphJointSpec], Len(1)] | None = None
     output: str | None = None
@@ -304,6 +317,8 @@ def from_dict(data: dict[str, Any], *, source: str = "<dict>") -> Mechanism:
     except ValidationError as e:
         raise ModelFileError(_validation_message(e)) from None
     graph = spec.links is not None or spec.joints is not None
+    if spec.dh is not None:
+        return _dh_mechanism(spec, data, source)
     if graph and spec.limbs is not None:
         raise ModelFileError("limbs: give either 'limbs' or the graph form 'links' + 'joints', not both")
     if not graph and spec.limbs is None:
@@ -346,6 +361,42 @@ def from_dict(data: dict[str, Any], *, source: str = "<dict>") -> Mechanism:
         raise
     except InputError as e:
         raise ModelFileError(str(e)) from None
+
+
+def _dh_mechanism(spec: MechanismSpec, data: dict[str, Any], source: str) -> Mechanism:
+    """The ``dh`` form: one limb ``arm`` of joints ``J1 .. Jn`` (all actuated), the platform point
+    the last frame's origin; the reference angles of the revolute rows in ``reference_deg`` (a
+    prismatic row's reference is its ``d``)."""
+    from .dh import serial_from_dh
+
+    dh = spec.dh
+    assert dh is not None
+    clash = [k for k in ("limbs", "links", "joints", "output", "platform_point") if k in data]
+    if clash:
+        raise ModelFileError(f"{clash[0]}: not with 'dh' (the DH rows make the one limb 'arm' and place the "
+                             "platform point at the last frame's origin)")
+    joints = dh.joints if dh.joints is not None else "R" * len(dh.d)
+    ref = dh.reference_deg
+    if ref is not None:
+        bad = [i for i, (c, v) in enumerate(zip(joints, ref, strict=False)) if c == "P" and v != 0.0]
+        if bad:
+            raise ModelFileError(f"dh.reference_deg[{bad[0]}]: row {bad[0]} is prismatic: its reference slide is "
+                                 "its 'd' (give 0 here)")
+    try:
+        mech = serial_from_dh(spec.name, d=dh.d, a=dh.a, alpha=dh.alpha_deg, theta=dh.theta_deg, joints=joints,
+                              reference=ref, convention=dh.convention, degrees=True,
+                              description=spec.description)
+        if spec.modes or spec.positions or spec.task is not None or spec.masses or spec.aliases:
+            raise ModelFileError("dh: give the arm's modes, positions, task, masses and aliases in the limbs form "
+                                 "(`spatialmech export` writes it from this file)")
+    except ModelFileError:
+        raise
+    except InputError as e:
+        raise ModelFileError(f"dh.{e}") from None
+    from dataclasses import replace
+
+    return replace(mech, length_unit=spec.length_unit, source=spec.source or source, notes=spec.notes,
+                   density_kg_m3=spec.density_kg_m3)
 
 
 def _parse_toml(text: str) -> dict[str, Any]:
