@@ -29,6 +29,7 @@ REGISTRY: dict[str, tuple[Callable[[], Mechanism], str]] = {
     "rssr": (classic.rssr, "Spatial RSSR four-bar, 1 DOF + 1 passive spin"),
     "spatial-six-bar": (classic.spatial_six_bar, "Spatial six-bar (two RSSR loops sharing a link), 1 DOF + 2 passive spins"),
     "puma560": (classic.puma560, "PUMA 560 6R serial arm (standard DH, Corke), 6 DOF"),
+    "agile-eye": (classic.agile_eye, "Agile-Eye spherical 3-RRR wrist (all link angles 90 deg), 3 rotations"),
 }
 
 

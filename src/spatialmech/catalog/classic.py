@@ -313,3 +313,19 @@ def puma560() -> Mechanism:
         reference=PUMA560_REFERENCE_DEG, degrees=True,
         description="PUMA 560 6R arm (standard DH, Corke), at the nominal configuration qn",
     )
+
+
+def agile_eye() -> Mechanism:
+    """A spherical 3-RRR wrist of the Agile-Eye type (Gosselin and Hamel 1994): every joint axis
+    through the origin, every link angle 90 degrees; at the reference leg ``i`` has its base,
+    middle and platform axes along ``e_i``, ``e_(i+1)``, ``e_(i+2)`` (a regular configuration:
+    the three platform axes orthonormal).  Dimensionless: a unit sphere (only directions)."""
+    E = np.eye(3)
+    o = np.zeros(3)
+    limbs = tuple(
+        Limb(f"leg{i + 1}", (R(f"A{i + 1}", o, E[i], actuated=True), R(f"B{i + 1}", o, E[(i + 1) % 3]),
+                             R(f"C{i + 1}", o, E[(i + 2) % 3])))
+        for i in range(3)
+    )
+    return Mechanism("agile-eye", limbs, platform_point=o,
+                     description="Agile-Eye spherical 3-RRR wrist: 3 rotations about the origin")

@@ -409,7 +409,13 @@ def _solve_limb(mech: Mechanism, li: int, D: np.ndarray, q_start: np.ndarray, q_
     """One limb from the ground to the output link: by the homotopy (:func:`_homotopy_limb`) when
     asked and it covers the limb, else by the multi-start; and its per-limb search report."""
     name = mech.limbs[li].name
-    refused = ""
+    refused = closed = ""
+    if all_solutions and method == "auto":
+        done = _closed_form_limb(mech, li, D, q_start, q_all, t)
+        if isinstance(done, str):
+            closed = done
+        elif done is not None:
+            return done
     if all_solutions and method != "multistart":
         from .homotopy.inverse import auto_reason, limb_inverse
 
@@ -426,6 +432,8 @@ def _solve_limb(mech: Mechanism, li: int, D: np.ndarray, q_start: np.ndarray, q_
     why = f"multi-start Gauss-Newton from {starts} start(s) (no completeness argument)"
     if res.passive_dim:
         why += f"; the solution set has dimension {res.passive_dim} (passive freedoms), the multi-start's path"
+    if closed:
+        why += f"; the closed form could not decide: {closed}"
     if refused:
         why += f"; the homotopy refused the limb: {refused}"
     rep: dict = {"limb": name, "method": "multistart", "complete": False, "completeness": f"NOT proven: {why}"}
@@ -467,6 +475,31 @@ def _homotopy_limb(mech: Mechanism, li: int, D: np.ndarray, q_start: np.ndarray,
         q_all[sl] = sols[0]
     viol = tuple(tuple(within_limits(mech, np.r_[q_all[: sl.start], s, q_all[sl.stop :]], indices=idx_l)) for s in sols)
     return LimbSolutions(mech.limbs[li].name, tuple(sols), tuple(float(r) for r in res), bool(sols), 0, viol)
+
+
+def _closed_form_limb(mech: Mechanism, li: int, D: np.ndarray, q_start: np.ndarray, q_all: np.ndarray,
+                      t: Tolerances) -> tuple[LimbSolutions, dict] | str | None:
+    """Every solution of a limb that a closed form covers (a spherical 3R:
+    :mod:`.closed_forms.spherical_3r_limb`), polished and ordered as the homotopy's; ``None``
+    when none covers it, the closed form's statement when it could not decide (a continuum)."""
+    from types import SimpleNamespace
+
+    from .closed_forms import spherical_3r_limb as s3r
+
+    form = s3r.spherical_3r(mech, li, limb_chains(mech)[li].screws)
+    if form is None:
+        return None
+    sols, statement, proven = s3r.solve(form, D, mech.characteristic_length)
+    if not proven:
+        return statement
+    ch = limb_chains(mech)[li]
+    off = [float(np.linalg.norm(chain_forward(ch, q)[0][:3, :3] - D[:3, :3])) for q in sols]
+    if off and max(off) > 1e-8:  # a root of the closed form that does not close: say so, claim nothing
+        return f"{statement}; but a root is {max(off):.2g} off the pose's rotation"
+    ls = _homotopy_limb(mech, li, D, q_start, q_all, SimpleNamespace(solutions=sols), t)
+    return ls, {"limb": mech.limbs[li].name, "method": "closed-form", "complete": True, "completeness": statement,
+                "n_real": len(ls.solutions), "n_certified": None,
+                "certification": "not attempted: a closed form (the limb has more equations than unknowns)"}
 
 
 _LIMB_SYSTEMS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # per model: {(limb, seed): LimbIK}

@@ -308,6 +308,23 @@ def _masses(specs: list[MassSpec]) -> dict[str, LinkInertia]:
     return out
 
 
+def _is_graph(spec: MechanismSpec) -> bool:
+    """Whether the file uses the graph form (``links`` + ``joints``) rather than ``limbs``; the
+    mixtures refused, naming the field."""
+    graph = spec.links is not None or spec.joints is not None
+    if graph and spec.limbs is not None:
+        raise ModelFileError("limbs: give either 'limbs' or the graph form 'links' + 'joints', not both")
+    if not graph and spec.limbs is None:
+        raise ModelFileError("limbs: required field is missing (or give the graph form: 'links' and 'joints'; "
+                             "or a serial arm's 'dh' rows)")
+    if graph and (spec.links is None or spec.joints is None):
+        raise ModelFileError(f"{'joints' if spec.joints is None else 'links'}: the graph form needs both 'links' and 'joints'")
+    if not graph and spec.output is not None:
+        raise ModelFileError("output: only the graph form ('links' + 'joints') names an output link; "
+                             "with 'limbs' the output link is the platform")
+    return graph
+
+
 def from_dict(data: dict[str, Any], *, source: str = "<dict>") -> Mechanism:
     """Validate a parsed file (a dict) and build the mechanism."""
     if not isinstance(data, dict):
@@ -316,18 +333,9 @@ def from_dict(data: dict[str, Any], *, source: str = "<dict>") -> Mechanism:
         spec = MechanismSpec.model_validate(data)
     except ValidationError as e:
         raise ModelFileError(_validation_message(e)) from None
-    graph = spec.links is not None or spec.joints is not None
     if spec.dh is not None:
         return _dh_mechanism(spec, data, source)
-    if graph and spec.limbs is not None:
-        raise ModelFileError("limbs: give either 'limbs' or the graph form 'links' + 'joints', not both")
-    if not graph and spec.limbs is None:
-        raise ModelFileError("limbs: required field is missing (or give the graph form: 'links' and 'joints')")
-    if graph and (spec.links is None or spec.joints is None):
-        raise ModelFileError(f"{'joints' if spec.joints is None else 'links'}: the graph form needs both 'links' and 'joints'")
-    if not graph and spec.output is not None:
-        raise ModelFileError("output: only the graph form ('links' + 'joints') names an output link; "
-                             "with 'limbs' the output link is the platform")
+    graph = _is_graph(spec)
     positions = tuple(_pose(p, f"positions[{i}]") for i, p in enumerate(spec.positions))
     modes = tuple(Mode(m.name, tuple(m.driven), m.description) for m in spec.modes)
     task = None
