@@ -26,13 +26,26 @@ pytestmark = pytest.mark.slow  # one report build (fk --all by homotopy, a slice
 @pytest.fixture(scope="module")
 def stewart(tmp_path_factory):
     out = tmp_path_factory.mktemp("report-stewart")
-    doc = build_model_report("stewart-6sps", out, progress=False)
+    calls = []
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(model_platform, "PROGRESS_EVERY_S", 0.0)  # every count inside a step is passed on
+        doc = build_model_report("stewart-6sps", out, progress=lambda d, t, m: calls.append((d, t, m)))
     sec = next(s for s in doc["sections"] if s["key"] == "platform-stewart-6sps")
-    return out, doc, sec
+    return out, doc, sec, calls
+
+
+def test_the_workspace_step_reports_its_count_under_its_own_step_number(stewart):
+    """A long step (the workspace's poses) shows progress inside the step: the same step number,
+    the count in the message, never past the report's total."""
+    *_, calls = stewart
+    step = next(d for d, _, m in calls if m == "stewart-6sps: workspace")
+    inner = [(d, m) for d, _, m in calls if m.startswith("stewart-6sps: workspace: checking poses ")]
+    assert inner and all(d == step for d, _ in inner), calls
+    assert all(d <= t for d, t, _ in calls if d is not None and t is not None)
 
 
 def test_platform_section_lists_the_assembly_modes_of_fk_all(stewart):
-    _, _, sec = stewart
+    _, _, sec, _ = stewart
     m = sec["data"]["assembly_modes"]
     assert m["engine"] == "homotopy" and m["complete"] is True
     assert m["n_modes"] == 8 and all(x["certified"] for x in m["modes"])
@@ -51,7 +64,7 @@ def test_platform_section_lists_the_assembly_modes_of_fk_all(stewart):
 
 
 def test_platform_section_maps_singularities_through_the_reference_pose(stewart):
-    _, _, sec = stewart
+    _, _, sec, _ = stewart
     s = sec["data"]["singularity_map"]
     nu, nv = model_platform.SLICE_POINTS
     assert s["grid"] == [nu, nv] and s["points"] == nu * nv
@@ -64,7 +77,7 @@ def test_platform_section_maps_singularities_through_the_reference_pose(stewart)
 
 
 def test_platform_section_gives_the_workspace_volume_with_its_error(stewart):
-    _, _, sec = stewart
+    _, _, sec, _ = stewart
     w = sec["data"]["workspace"]
     mech = catalog.build("stewart-6sps")
     L = mech.characteristic_length
@@ -79,7 +92,7 @@ def test_platform_section_gives_the_workspace_volume_with_its_error(stewart):
 
 
 def test_platform_section_figures_are_written_and_embedded(stewart):
-    out, doc, sec = stewart
+    out, doc, sec, _ = stewart
     page = (out / "index.html").read_text(encoding="utf-8")
     for f in sec["figures"]:
         assert (out / f["file"]).stat().st_size > 1000

@@ -196,7 +196,28 @@ def _show(c: str, x: float) -> str:
     return f"{np.degrees(x):.4g} deg" if c.startswith("a") else f"{x:.4g}"
 
 
-def _workspace(mech: Mechanism, data: dict) -> tuple[F.ReportFigure, str]:
+#: Seconds between two progress lines of a long step (the workspace's poses checked).
+PROGRESS_EVERY_S = 5.0
+
+
+def _within_step(say: Steps, label: str) -> Progress:
+    """A progress callback for the work inside the current step of ``say``: the same step
+    number, the count in the message, at most one line every :data:`PROGRESS_EVERY_S`."""
+    from time import perf_counter
+
+    last = [perf_counter()]
+
+    def cb(done, total, message) -> None:
+        now = perf_counter()
+        if now - last[0] >= PROGRESS_EVERY_S:
+            last[0] = now
+            count = f"{int(done)}/{int(total)}" if total else f"{int(done)}"
+            say.progress(say.done, say.total, f"{label}: {message or 'working'} {count}")
+
+    return cb
+
+
+def _workspace(mech: Mechanism, data: dict, progress: Progress | None = None) -> tuple[F.ReportFigure, str]:
     """The workspace under the model's own limits (position at the reference orientation, or over
     the task coordinates), small grid, with its volume and error estimate."""
     n = WORKSPACE_POINTS
@@ -204,7 +225,8 @@ def _workspace(mech: Mechanism, data: dict) -> tuple[F.ReportFigure, str]:
     unit = unit_label(mech.length_unit)
     if len(mech.actuators) == 6:
         step = 4 * L / (n - 1)
-        res = position_workspace(mech, at={"alpha": 0.0, "beta": 0.0, "gamma": 0.0}, step=step, polish=False)
+        res = position_workspace(mech, at={"alpha": 0.0, "beta": 0.0, "gamma": 0.0}, step=step, polish=False,
+                                 progress=progress)
         err = float(res.volume_error)
         limits = ", ".join(f"{k} {v}" for k, v in res.active_limits.items()) or "none"
         text = (f"Position workspace of the platform point at the reference orientation (alpha = beta = gamma = 0), "
@@ -227,7 +249,7 @@ def _workspace(mech: Mechanism, data: dict) -> tuple[F.ReportFigure, str]:
         over = {c: ((ref_vals[c] - TASK_HALF_ANGLE, ref_vals[c] + TASK_HALF_ANGLE, n) if c.startswith("a")
                     else (ref_vals[c] - L / 2, ref_vals[c] + L / 2, n)) for c in order[:2]}
         at = {c: ref_vals[c] for c in order[2:]}
-        tres = task_workspace(mech, over, at=at, task=task)
+        tres = task_workspace(mech, over, at=at, task=task, progress=progress)
         d = tres.to_dict()
         vkey = next((k for k in d if k.startswith("volume_") and k not in ("volume_note",)
                      and not k.startswith("volume_error")), None)
@@ -282,7 +304,7 @@ def platform_section(mech: Mechanism, progress: Progress | None = None) -> Secti
         notes.append(f"singularity map: {e}")
     say(f"{mech.name}: workspace")
     try:
-        fig, _ = _workspace(mech, data)
+        fig, _ = _workspace(mech, data, _within_step(say, f"{mech.name}: workspace"))
         figs.append(fig)
     except (ValueError, RuntimeError) as e:
         notes.append(f"workspace: {e}")
