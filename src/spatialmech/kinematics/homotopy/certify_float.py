@@ -53,7 +53,12 @@ _BIG = 2.0**20
 
 
 def _up(r: np.ndarray) -> np.ndarray:
-    """An upper bound of the exact value of a radius computed in round-to-nearest (module docstring)."""
+    """An upper bound of the exact value of a radius computed in round-to-nearest (module docstring);
+    ``r`` (a fresh array of the caller's) is overwritten."""
+    if type(r) is np.ndarray and r.ndim and r.flags.writeable:
+        r *= _UP
+        r += _TINY
+        return r
     return r * _UP + _TINY
 
 
@@ -108,7 +113,8 @@ class MR:
         m = self.m @ o.m
         if exact:  # an exact constant: no radius of its own
             return MR(m, _up((self.r + (_U * (n + 1)) * am) @ aom))
-        return MR(m, _up(am @ o.r + self.r @ (aom + o.r) + (_U * (n + 1)) * (am @ aom)))
+        # |Ma| Rb + Ra (|Mb| + Rb) + gamma |Ma| |Mb|, as two products of non-negative floats
+        return MR(m, _up(am @ (o.r + (_U * (n + 1)) * aom) + self.r @ (aom + o.r)))
 
     def __rmatmul__(self, o) -> MR:
         a = np.asarray(o, dtype=float)  # an exact constant on the left
