@@ -279,3 +279,19 @@ def test_quadric_float_jacobians_match_the_ball_system(stewart):
     Y = stewart["Y"][:3] + 0.1j
     for y, J in zip(Y, system.jacobian_float_many(Y), strict=True):
         assert np.allclose(C._mid(system.jacobian(C.COMPLEX.col(y))), J, atol=1e-12)
+
+
+def test_float_pass_gives_the_ball_tests_boxes_on_the_stewart(stewart):
+    """The 8 real roots of stewart-6sps (Study quadrics in a real patch): the float pass
+    (certify_float.py) grants each the box the ball test gives."""
+    system, Y = stewart["system"], stewart["Y"]
+    prec = ctx.prec
+    ctx.prec = 53
+    try:
+        fast = system.krawczyk_float(Y, C.CERTIFY_MAX_RADIUS)
+        pre = system.jacobian_float_many(Y.astype(complex))
+        ball = [C._one(system, y.astype(complex), C.CERTIFY_MAX_RADIUS, np.linalg.inv(J))[0]
+                for y, J in zip(Y, pre, strict=True)]
+    finally:
+        ctx.prec = prec
+    assert len(Y) == 8 and all(r is not None for r in fast) and fast == ball

@@ -128,3 +128,32 @@ def test_quadric_float_pass_refuses_a_double_root_and_close_roots():
     r = system(2.0).krawczyk_float(y, C.CERTIFY_MAX_RADIUS)[0]
     assert r is not None and r < 1e-11
     assert system(2.0 + 1e-11).krawczyk_float(y, 1e-12) == [None]  # the moved root is outside every box tried
+
+
+def test_float_pass_grants_the_ball_tests_boxes_at_ill_conditioned_points():
+    """PUMA 560 near a wrist singularity (theta5 = -3.11 rad): two of its 8 solutions fail the
+    first box (the rounding of F(y) times |A| fills it) and pass one radius up, in the float pass
+    (which tries the ball test's wider radii) as in the ball test; every box equals the ball
+    test's."""
+    import spatialmech as sm
+    from flint import ctx
+
+    from spatialmech.kinematics.homotopy.certify_balls import pow2_up
+
+    m = serial_arm("puma560", PUMA560_DH)
+    theta = np.array([-2.58, -0.22, -1.29, 0.37, -3.11, 3.11])
+    sysm = ikh.limb_ik_system(m, 0)
+    P = sysm.pose_parameters(np.asarray(dh_pose(PUMA560_DH, theta).displacement(m.platform_point), float)).real
+    qs = sm.ik(m, dh_pose(PUMA560_DH, theta), all_solutions=True, certify=False).result.limbs[0].solutions
+    Y = np.array([C.limb_point(sysm, np.asarray(q)) for q in qs])
+    system = C.limb_system(sysm, P[:4], P[4:7])
+    ctx.prec, old = 53, ctx.prec
+    try:
+        fast = system.krawczyk_float(Y, C.CERTIFY_MAX_RADIUS)
+        pre = system.jacobian_float_many(Y.astype(complex))
+        ball = [C._one(system, y.astype(complex), C.CERTIFY_MAX_RADIUS, np.linalg.inv(J))[0]
+                for y, J in zip(Y, pre, strict=True)]
+    finally:
+        ctx.prec = old
+    assert len(Y) == 8 and all(r is not None for r in fast) and fast == ball
+    assert sum(r != pow2_up(r) for r in fast) == 2  # past the first radius (a power of two)
