@@ -1,7 +1,7 @@
 """Benchmark: forward position by homotopy continuation (kinematics/homotopy/study.py) against
 PHCpack's blackbox solver on the same polynomial system, measured in the same run.
 
-    python benchmarks/bench_homotopy.py [--json] [--quick]
+    python benchmarks/bench_homotopy.py [--json] [--quick] [--certify-only]
 
 Targets of the homotopy issue: every solution of the Stewart platform faster than PHCpack's
 blackbox solver (goal: under 2 s), and a parameter-homotopy re-solve for new leg lengths under
@@ -180,11 +180,28 @@ def case(name: str, sysm, legs: np.ndarray, resolves: int, rng: np.random.Genera
     return out
 
 
+def certify_main(as_json: bool) -> dict:
+    """``--certify-only``: :func:`certify_case` alone (15 re-solves per case)."""
+    cert = certify_case(15)
+    out = {"certify": cert, "certify_overhead_fraction": cert["certify_overhead_fraction"],
+           "targets": {"certify_overhead_fraction": TARGET_CERTIFY_FRACTION}}
+    if as_json:
+        print(json.dumps(out, indent=2))
+        return out
+    print("certificates   share of a re-solve (median): " + ", ".join(
+        f"{k} {v['fraction']:.0%}{'' if v['all_certified'] else ' (NOT all certified)'}" for k, v in cert["cases"].items())
+          + f" (target <= {TARGET_CERTIFY_FRACTION:.0%}): {'met' if cert['certify_met'] else 'NOT met'}")
+    return out
+
+
 def main(argv=None) -> dict:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--json", action="store_true")
     ap.add_argument("--quick", action="store_true", help="one case, two re-solves, no PHCpack (smoke test)")
+    ap.add_argument("--certify-only", action="store_true", help="the certificates' share of a re-solve only")
     args = ap.parse_args(argv)
+    if args.certify_only:
+        return certify_main(args.json)
     rng = np.random.default_rng(0)
     mech = catalog.build("stewart-6sps")
     cases = [case("stewart-6sps", hc.stewart_system(mech), np.full(6, 1.2), 2 if args.quick else 10, rng,
