@@ -148,3 +148,16 @@ def test_demo_page_fits_820_px_in_chromium(demo_report, browser):
         "const w = document.documentElement.clientWidth; return [...document.querySelectorAll('img, table, .viewer')]"
         ".filter(e => !e.closest('.scroll') && e.getBoundingClientRect().right > w + 1).length")
     assert wide == 0
+
+
+def test_a_serial_arm_gets_its_inverse_solutions_instead_of_assembly_modes():
+    """The PUMA 560's report lists its 8 inverse solutions at the reference pose (proven,
+    certified, the reference among them), not a one-row table of fk --all."""
+    data: dict = {}
+    mech = catalog.resolve("puma560")
+    table, _ = model_platform._inverse_solutions(mech, data)
+    inv = data["inverse_solutions"]
+    assert inv["complete"] and inv["n_solutions"] == 8 == len(table.rows)
+    assert all(s["certified"] for s in inv["solutions"]) and min(s["sigma_min"] for s in inv["solutions"]) > 0.1
+    assert sum(r[-1] == "reference" for r in table.rows) == 1
+    assert not model_platform._serial(catalog.resolve("stewart-6sps"))

@@ -35,7 +35,8 @@ from ..analysis.task_slice import task_singularity_slice
 from ..analysis.workspace import position_workspace, task_workspace
 from ..geometry.rotations import euler_matrix, matrix_euler
 from ..kinematics.closure import Configuration
-from ..kinematics.dispatch import solve_forward
+from ..kinematics.jacobian import complete_jacobian
+from ..kinematics.dispatch import solve_forward, solve_inverse
 from ..kinematics.position import configuration_at_pose, freedom_values
 from ..kinematics.task import default_task, task_values
 from ..kinematics.task_grid import TASK_NAMES
@@ -130,6 +131,38 @@ def _modes(mech: Mechanism, ref: Configuration, data: dict) -> tuple[Table, F.Re
                      note="Frame k: assembly mode k of the table (not a motion between them).")
               if configs else None)
     return table, fig_out, viewer, text
+
+
+def _serial(mech: Mechanism) -> bool:
+    """One limb from the ground to the output link and no internal bodies: a serial arm, whose
+    forward position is one pose and whose inverse solutions are the table to show."""
+    return len(mech.limbs) == 1 and not mech.bodies and mech.limbs[0].tip is None
+
+
+def _inverse_solutions(mech: Mechanism, data: dict) -> tuple[Table, str]:
+    """Every inverse solution of a serial arm at its reference pose (as ``ik --all``), each
+    with the scale-free sigma_min of its Jacobian and its certificate."""
+    pose = _reference_pose(mech)
+    res = solve_inverse(mech, pose, all_solutions=True).result
+    limb, rep = res.limbs[0], res.search["limbs"][0]
+    D = pose.displacement(mech.platform_point)
+    refs = mech.freedom_refs
+    rows, js = [], []
+    for k, q in enumerate(limb.solutions):
+        sig = float(complete_jacobian(mech, Configuration(np.asarray(q, dtype=float), D)).sigma_min)
+        cert = limb.certificates[k]["certified"] if limb.certificates else None
+        shown = [float(np.degrees(v)) if r.freedom.kind != "P" else float(v) for r, v in zip(refs, q, strict=True)]
+        rows.append((k + 1, *[_shown(v, 180.0) for v in shown], sig, "yes" if cert else ("no" if cert is False else "-"),
+                     "reference" if np.allclose(np.angle(np.exp(1j * np.asarray(q))), 0.0, atol=1e-9) else ""))
+        js.append({"solution": k + 1, "joints": dict(zip((r.id for r in refs), shown, strict=True)),
+                   "sigma_min": sig, "certified": cert})
+    data["inverse_solutions"] = {"method": rep["method"], "complete": rep["complete"],
+                                 "completeness": rep["completeness"], "n_solutions": len(rows), "solutions": js}
+    unit = unit_label(mech.length_unit)
+    text = f"{len(rows)} inverse solutions of the arm at its reference pose by {rep['method']}: {rep['completeness']}"
+    cols = tuple(f"{r.id} [{'deg' if r.freedom.kind != 'P' else unit}]" for r in refs)
+    return Table("Inverse solutions at the reference pose (ik --all)", ("solution", *cols, "sigma_min (scale-free)",
+                 "certified", ""), tuple(rows), text + "; sigma_min of the complete Jacobian, 0 at a singularity."), text
 
 
 def _shown(x: float, scale: float) -> float:
@@ -287,15 +320,22 @@ def platform_section(mech: Mechanism, progress: Progress | None = None) -> Secti
     viewers: list[Viewer] = []
     notes: list[str] = []
     data: dict = {}
-    say(f"{mech.name}: assembly modes (fk --all)")
-    try:
-        table, fig, viewer, _ = _modes(mech, ref, data)
-        tables.append(table)
-        figs.append(fig)
-        if viewer is not None:
-            viewers.append(viewer)
-    except (ValueError, RuntimeError) as e:
-        notes.append(f"assembly modes: {e}")
+    if _serial(mech):
+        say(f"{mech.name}: inverse solutions at the reference pose (ik --all)")
+        try:
+            tables.append(_inverse_solutions(mech, data)[0])
+        except (ValueError, RuntimeError) as e:
+            notes.append(f"inverse solutions: {e}")
+    else:
+        say(f"{mech.name}: assembly modes (fk --all)")
+        try:
+            table, fig, viewer, _ = _modes(mech, ref, data)
+            tables.append(table)
+            figs.append(fig)
+            if viewer is not None:
+                viewers.append(viewer)
+        except (ValueError, RuntimeError) as e:
+            notes.append(f"assembly modes: {e}")
     say(f"{mech.name}: singularity map through the reference pose")
     try:
         fig, _, _ = _slice(mech, ref, data)
