@@ -147,9 +147,12 @@ def run_pose(model: str, coord: str, step: float, n: int) -> dict:
 
 
 BROWSER_JS = """
-const [n, step, fast, done] = [arguments[0], arguments[1], arguments[2], arguments[arguments.length - 1]];
+const [n, step, fast, view, done] = [arguments[0], arguments[1], arguments[2], arguments[3], arguments[arguments.length - 1]];
 (async () => {
   const S = window.studio; S.fastRedraw = fast; S.drawTimes = [];
+  if (S.view !== view) S.setView(view, "the benchmark's " + view + " view");
+  await new Promise(res => requestAnimationFrame(() => requestAnimationFrame(res)));
+  S.light.drawMs = []; S.drawTimes = [];
   const el = document.getElementById("slider-0"), frames = [];
   const idle = () => new Promise(res => { const f = () => (!S.inFlight && S.pending === null) ? res() : setTimeout(f, 1); f(); });
   const paint = () => new Promise(res => requestAnimationFrame(() => requestAnimationFrame(res)));
@@ -159,17 +162,19 @@ const [n, step, fast, done] = [arguments[0], arguments[1], arguments[2], argumen
     await idle(); await paint();
     frames.push(performance.now() - t0);
   }
-  done({ frames: frames, draws: S.drawTimes.slice(), errors: S.errors.slice() });
+  done({ frames: frames, draws: (view === "light" ? S.light.drawMs : S.drawTimes).slice(), errors: S.errors.slice() });
 })();
 """
 
 
 BREAKDOWN_JS = """
-const [n, step, done] = [arguments[0], arguments[1], arguments[arguments.length - 1]];
+const [n, step, view, done] = [arguments[0], arguments[1], arguments[2], arguments[arguments.length - 1]];
 (async () => {
   const S = window.studio, out = { answer: [], redraw: [], paint: [], floor: [] };
   const paint = () => new Promise(res => requestAnimationFrame(() => requestAnimationFrame(res)));
   S.fastRedraw = true;
+  if (S.view !== view) S.setView(view, "the benchmark's " + view + " view");
+  await paint();
   let a = S.state.actuators_deg[S.state.drivers[0]];
   for (let k = 0; k < n; k++) {
     a += step;
@@ -178,7 +183,7 @@ const [n, step, done] = [arguments[0], arguments[1], arguments[arguments.length 
                                           body: JSON.stringify({ actuators: [a] }) });
     const doc = JSON.parse(await r.text());
     const t1 = performance.now();
-    S.state = doc.state; draw(); drawPad();
+    S.state = doc.state; drawNow(); drawPad();
     const t2 = performance.now();
     await paint();
     const t3 = performance.now();
@@ -226,15 +231,20 @@ def browser_frames(model: str, step: float, n: int) -> dict:
             if time.time() - t0 > 60:
                 raise RuntimeError("the studio page did not load")
             time.sleep(0.1)
-        drv.execute_async_script(BROWSER_JS, 3, step, True)  # warm up (compilation, first draws)
-        out = {}
-        for label, fast in (("restyle", True), ("react", False), ("restyle_again", True)):
-            r = drv.execute_async_script(BROWSER_JS, n, step, fast)
+        for view in ("full", "light"):  # warm up (compilation, first draws)
+            drv.execute_async_script(BROWSER_JS, 3, step, True, view)
+            step = -step
+        out = {"renderer": drv.execute_script("return window.studio.renderer")}
+        for label, fast, view in (("restyle", True, "full"), ("light", True, "light"), ("react", False, "full"),
+                                  ("light_again", True, "light"), ("restyle_again", True, "full")):
+            r = drv.execute_async_script(BROWSER_JS, n, step, fast, view)
             out[label] = {"frame_median_ms": float(np.median(r["frames"])), "frame_p95_ms": float(np.percentile(r["frames"], 95)),
                           "draw_median_ms": float(np.median(r["draws"])) if r["draws"] else None, "errors": r["errors"]}
             step = -step  # drag back and forth
-        r = drv.execute_async_script(BREAKDOWN_JS, n, step)
-        out["breakdown"] = {f"{k}_median_ms": float(np.median(v)) for k, v in r.items()}
+        for label, view in (("breakdown", "full"), ("breakdown_light", "light")):
+            r = drv.execute_async_script(BREAKDOWN_JS, n, step, view)
+            out[label] = {f"{k}_median_ms": float(np.median(v)) for k, v in r.items()}
+            step = -step
         return out
     finally:
         drv.quit()
@@ -258,16 +268,23 @@ def main(argv=None) -> dict:
         res = {m: browser_frames(m, st, 10 if args.quick else 30) for m, st in BROWSER_CASES}
         for r in res.values():
             r["met"] = bool(r["restyle"]["frame_median_ms"] < FRAME_TARGET_MS)
+            r["met_light"] = bool(r["light"]["frame_median_ms"] < FRAME_TARGET_MS)
+            r["ratio_light_to_full"] = round(r["light"]["frame_median_ms"] / r["restyle"]["frame_median_ms"], 3)
         if args.json:
             print(json.dumps({"browser": res, "frame_target_ms": FRAME_TARGET_MS}, indent=2))
         else:
             for m, r in res.items():
-                a, b = r["restyle"], r["react"]
-                print(f"browser drag {m:<10} frame median {a['frame_median_ms']:.0f} ms (p95 {a['frame_p95_ms']:.0f}), "
-                      f"draw {a['draw_median_ms']:.1f} ms; full react: frame {b['frame_median_ms']:.0f} ms, draw "
-                      f"{b['draw_median_ms']:.1f} ms (ratio restyle/react {a['frame_median_ms'] / b['frame_median_ms']:.2f}); "
-                      f"target < {FRAME_TARGET_MS:.0f} ms: {'met' if r['met'] else 'NOT met'}")
-                print("  where it goes (medians): " + ", ".join(f"{k[:-10]} {v:.1f} ms" for k, v in r["breakdown"].items()))
+                a, b, c = r["restyle"], r["react"], r["light"]
+                verdict = lambda ok: "met" if ok else "NOT met"  # noqa: E731
+                print(f"browser drag {m:<10} full view (WebGL): frame median {a['frame_median_ms']:.0f} ms (p95 "
+                      f"{a['frame_p95_ms']:.0f}), draw {a['draw_median_ms']:.1f} ms; full react: frame {b['frame_median_ms']:.0f} ms "
+                      f"(ratio restyle/react {a['frame_median_ms'] / b['frame_median_ms']:.2f}); target < "
+                      f"{FRAME_TARGET_MS:.0f} ms: {verdict(r['met'])}")
+                print(f"  {'':<21}light view (Canvas 2-D): frame median {c['frame_median_ms']:.0f} ms (p95 "
+                      f"{c['frame_p95_ms']:.0f}), draw {c['draw_median_ms']:.1f} ms (ratio light/full "
+                      f"{r['ratio_light_to_full']:.2f}); target < {FRAME_TARGET_MS:.0f} ms: {verdict(r['met_light'])}")
+                for key, name in (("breakdown", "full"), ("breakdown_light", "light")):
+                    print(f"  where it goes, {name} (medians): " + ", ".join(f"{k[:-10]} {v:.1f} ms" for k, v in r[key].items()))
         return {"browser": res}
     drags = [run_drag(m, s, 10 if args.quick else n) for m, s, n in DRAG_CASES]
     rows = [] if args.drag else [run(m, s, 10 if args.quick else n) for m, s, n in CASES]

@@ -34,9 +34,12 @@ def _free(port: int) -> bool:
 @click.option("--port", type=click.IntRange(0, 65535), default=8765, show_default=True,
               help="Port on 127.0.0.1 (0: any free port).")
 @click.option("--no-browser", is_flag=True, help="Do not open a browser (print the address only).")
+@click.option("--view", type=click.Choice(["auto", "light", "full"]), default="auto", show_default=True,
+              help="The page's 3-D view: light (a Canvas 2-D drawing, fast where WebGL is rendered in "
+                   "software), full (plotly's WebGL scene) or auto (light where the browser's WebGL is software).")
 @click.option("--json", "as_json", is_flag=True,
               help="Print the address and the starting state as JSON (docs/json.md) before serving.")
-def studio(model, port, no_browser, as_json):
+def studio(model, port, no_browser, view, as_json):
     """Open MODEL (default five-cs-3) in the interactive design studio: a local web page where
     sliders drive the actuators and the real solver (continuation along the current branch)
     answers with the new configuration, joint readouts, DJ and sigma_min, and events at DJ
@@ -46,6 +49,7 @@ def studio(model, port, no_browser, as_json):
     Examples:
       spatialmech studio five-cs-3
       spatialmech studio stewart-6sps --port 8800 --no-browser
+      spatialmech studio planar-4r --view light
     """
     require("plot", "plotly", what="the studio")
     require("studio", "fastapi", "uvicorn", what="the studio")
@@ -62,9 +66,9 @@ def studio(model, port, no_browser, as_json):
         raise UserError(f"--port: 127.0.0.1:{port} is in use; pick another port (or --port 0 for any free one)")
     url = f"http://127.0.0.1:{port}/"
     if as_json:
-        emit_json(COMMAND, session.mech, {"url": url, "port": port, "state": session.state()})
+        emit_json(COMMAND, session.mech, {"url": url, "port": port, "view": view, "state": session.state()})
     else:
-        click.echo(f"spatialmech studio: {session.mech.name} at {url} (Ctrl-C to stop)")
+        click.echo(f"spatialmech studio: {session.mech.name} at {url} ({view} 3-D view; Ctrl-C to stop)")
     if not no_browser:
         threading.Timer(1.0, lambda: webbrowser.open(url)).start()
-    uvicorn.run(create_app(session), host="127.0.0.1", port=port, log_level="warning")
+    uvicorn.run(create_app(session, view), host="127.0.0.1", port=port, log_level="warning")

@@ -47,7 +47,7 @@ from fastapi.responses import HTMLResponse, Response
 from ... import api as sm
 from ...errors import ConvergenceError, InputError
 from ...serialize import envelope, json_default
-from .assets import plotly_js_path
+from .assets import check_view, plotly_js_path
 
 __all__ = ["COMMAND", "create_app", "plotly_js_path", "studio_app"]
 
@@ -64,9 +64,12 @@ def _json(doc: dict, status: int = 200) -> Response:
                     media_type="application/json")
 
 
-def create_app(session) -> FastAPI:
+def create_app(session, view: str = "auto") -> FastAPI:
     """The app over ``session`` (a :func:`spatialmech.studio_session`; one model at a time, one
-    user: each call holds a lock)."""
+    user: each call holds a lock).  ``view``: the page's 3-D view, ``"auto"`` (the light one where
+    the browser renders WebGL in software), ``"light"`` or ``"full"`` (plotly's WebGL scene); the
+    page's ``?view=`` overrides it."""
+    view = check_view(view)
     app = FastAPI(title="spatialmech studio", docs_url=None, redoc_url=None, openapi_url=None)
     lock = threading.Lock()
     app.state.session = session
@@ -107,7 +110,8 @@ def create_app(session) -> FastAPI:
 
     @app.get("/", response_class=HTMLResponse)
     def index():
-        return HTMLResponse(_static("index.html").decode("utf-8"))
+        page = _static("index.html").decode("utf-8")
+        return HTMLResponse(page.replace('<body data-view="auto">', f'<body data-view="{view}">'))
 
     @app.get("/favicon.ico")
     def favicon():
@@ -116,7 +120,7 @@ def create_app(session) -> FastAPI:
     @app.get("/static/{name}")
     def static(name: str):
         types = {"studio.js": "text/javascript", "pad.js": "text/javascript", "design.js": "text/javascript",
-                 "studio.css": "text/css"}
+                 "scene2d.js": "text/javascript", "studio.css": "text/css"}
         if name == "plotly.min.js":
             return Response(plotly_js_path().read_bytes(), media_type="text/javascript",
                             headers={"Cache-Control": "max-age=86400"})
@@ -239,7 +243,8 @@ def add_desk_routes(app: FastAPI, session, lock, doc, body, guarded) -> None:
         app.add_api_route(path, guarded(fn), methods=["POST"])
 
 
-def studio_app(model: sm.ModelLike = "five-cs-3") -> FastAPI:
+def studio_app(model: sm.ModelLike = "five-cs-3", view: str = "auto") -> FastAPI:
     """The web app on a new session of ``model``; the public entry, which checks the ``studio``
     extra first, is ``sm.studio_app`` (:func:`spatialmech.interfaces.studio.entry.studio_app`)."""
-    return create_app(sm.studio_session(model))
+    view = check_view(view)
+    return create_app(sm.studio_session(model), view)

@@ -20,7 +20,7 @@ if TYPE_CHECKING:
 __all__ = ["studio", "studio_app"]
 
 
-def studio(model: ModelLike = "five-cs-3") -> StudioWidget:
+def studio(model: ModelLike = "five-cs-3", view: str = "auto") -> StudioWidget:
     """The design studio as a Jupyter widget (anywidget) on a new session
     (:func:`spatialmech.studio_session`): the live mechanism in 3-D with actuator sliders and the
     readouts.  Needs the ``notebook`` extra (``pip install 'spatialmech[notebook]'``).
@@ -29,6 +29,10 @@ def studio(model: ModelLike = "five-cs-3") -> StudioWidget:
     ----------
     model : Mechanism, str or path
         The mechanism, a ready-made model name (``sm.models()``) or a TOML model file.
+    view : {"auto", "light", "full"}
+        The 3-D view: ``"auto"`` (default) draws the light view (Canvas 2-D) where the browser
+        renders WebGL in software (remote desktops, VMs, headless browsers) and plotly's WebGL
+        scene elsewhere; ``"light"`` or ``"full"`` asks for one.  The widget's buttons switch it.
 
     Returns
     -------
@@ -43,7 +47,7 @@ def studio(model: ModelLike = "five-cs-3") -> StudioWidget:
     TypeError
         An argument of the wrong type (named in the message).
     InputError
-        A bad model (as :func:`spatialmech.studio_session`).
+        A bad model (as :func:`spatialmech.studio_session`), or a ``view`` not in the list.
 
     Examples
     --------
@@ -54,13 +58,15 @@ def studio(model: ModelLike = "five-cs-3") -> StudioWidget:
     """
     require("notebook", "anywidget", what="sm.studio (the studio in Jupyter)")
     require("notebook", "plotly", what="sm.studio (the studio in Jupyter)")  # the widget bundles plotly.js
+    from .assets import check_view
     from .widget import StudioWidget
     from ... import api as sm
 
-    return StudioWidget(sm.studio_session(model))
+    view = check_view(view)
+    return StudioWidget(sm.studio_session(model), view=view)
 
 
-def studio_app(model: ModelLike = "five-cs-3") -> FastAPI:
+def studio_app(model: ModelLike = "five-cs-3", view: str = "auto") -> FastAPI:
     """The design studio's web app (FastAPI) on a new session (:func:`spatialmech.studio_session`):
     serve it with uvicorn, or call its JSON API directly (docs/studio.md).  Needs the ``studio``
     extra (``pip install 'spatialmech[studio]'``).
@@ -69,6 +75,10 @@ def studio_app(model: ModelLike = "five-cs-3") -> FastAPI:
     ----------
     model : Mechanism, str or path
         The mechanism, a ready-made model name (``sm.models()``) or a TOML model file.
+    view : {"auto", "light", "full"}
+        The page's 3-D view: ``"auto"`` (default) the light one (Canvas 2-D) where the browser
+        renders WebGL in software, plotly's WebGL scene elsewhere; ``"light"`` or ``"full"``
+        asks for one (a page's ``?view=`` overrides it, its buttons switch it).
 
     Returns
     -------
@@ -80,7 +90,7 @@ def studio_app(model: ModelLike = "five-cs-3") -> FastAPI:
     MissingExtraError
         FastAPI or plotly is not installed (the ``studio`` extra), before any work.
     InputError
-        A bad model (as :func:`spatialmech.studio_session`).
+        A bad model (as :func:`spatialmech.studio_session`), or a ``view`` not in the list.
 
     Examples
     --------
@@ -95,6 +105,8 @@ def studio_app(model: ModelLike = "five-cs-3") -> FastAPI:
     require("studio", "fastapi", what="sm.studio_app (the studio's web app)")
     require("studio", "plotly", what="sm.studio_app (the studio's web app)")
     from .app import create_app
+    from .assets import check_view
     from ... import api as sm
 
-    return create_app(sm.studio_session(model))
+    view = check_view(view)
+    return create_app(sm.studio_session(model), view)

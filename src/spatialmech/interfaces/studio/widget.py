@@ -2,8 +2,10 @@
 :class:`~spatialmech.services.studio.session.Session` as the web app (``sm.studio(model)``).
 
 The notebook frontend (``static/widget.js``, with plotly.js from the installed plotly package
-bundled into the widget's module: nothing from a CDN) draws the :attr:`StudioWidget.figure`
-trait and the readouts of :attr:`StudioWidget.state`, and sends one message per slider move::
+and ``static/scene2d.js`` bundled into the widget's module: nothing from a CDN) draws the
+:attr:`StudioWidget.figure` trait, in plotly's WebGL scene or in the light 3-D view (Canvas
+2-D; :attr:`StudioWidget.view`), and the readouts of :attr:`StudioWidget.state`, and sends one
+message per slider move::
 
     {"type": "drive", "actuators": [...]}          # model units, degrees for rotations
     {"type": "pose", "task_len": {...}, "task_deg": {...}}
@@ -31,7 +33,7 @@ from ... import api as sm
 from ...errors import ConvergenceError, InputError
 from ...present.numbers import unit_label
 from ...serialize import json_default
-from .assets import plotly_js_path
+from .assets import check_view, plotly_js_path
 
 __all__ = ["StudioWidget", "figure", "studio", "top_camera"]
 
@@ -43,12 +45,12 @@ VIEW_HEIGHT_PX = 460
 def esm_bundle() -> str:
     """The widget's ES module: plotly.js (its UMD build, run with a local ``module`` object so
     that neither a page's AMD loader nor ``window`` is involved), then ``pad.js`` (the drag pad's
-    geometry, shared with the page) and ``widget.js``."""
+    geometry), ``scene2d.js`` (the light 3-D view), both shared with the page, and ``widget.js``."""
     plotly = plotly_js_path().read_text(encoding="utf-8")
     static = files("spatialmech.interfaces.studio").joinpath("static")
-    pad, own = (static.joinpath(n).read_text(encoding="utf-8") for n in ("pad.js", "widget.js"))
+    pad, light, own = (static.joinpath(n).read_text(encoding="utf-8") for n in ("pad.js", "scene2d.js", "widget.js"))
     return ("const module = { exports: {} };\nconst exports = module.exports;\n" + plotly
-            + "\nconst Plotly = module.exports;\n" + pad + "\n" + own)
+            + "\nconst Plotly = module.exports;\n" + pad + "\n" + light + "\n" + own)
 
 
 def _plain(doc):
@@ -127,9 +129,16 @@ class StudioWidget(anywidget.AnyWidget):
     modes: traitlets.List[dict] = traitlets.List().tag(sync=True)
     #: The snapshots kept (``session.desk.listing()``).
     snapshots: traitlets.List[dict] = traitlets.List().tag(sync=True)
+    #: The 3-D view asked for: "auto" (the light view where the browser renders WebGL in
+    #: software or has none, plotly's WebGL scene elsewhere), "light" or "full".
+    view = traitlets.Unicode("auto").tag(sync=True)
 
-    def __init__(self, session, **kwargs):
-        super().__init__(_esm=esm_bundle(), **kwargs)
+    @traitlets.validate("view")
+    def _valid_view(self, proposal):
+        return check_view(proposal["value"])
+
+    def __init__(self, session, view: str = "auto", **kwargs):
+        super().__init__(_esm=esm_bundle(), view=check_view(view), **kwargs)
         self.session = session
         self.on_msg(self._on_message)
         self._refresh()
@@ -209,7 +218,8 @@ class StudioWidget(anywidget.AnyWidget):
             self.answered += 1
 
 
-def studio(model: sm.ModelLike = "five-cs-3") -> StudioWidget:
+def studio(model: sm.ModelLike = "five-cs-3", view: str = "auto") -> StudioWidget:
     """The widget on a new session of ``model``; the public entry, which checks the ``notebook``
     extra first, is ``sm.studio`` (:func:`spatialmech.interfaces.studio.entry.studio`)."""
-    return StudioWidget(sm.studio_session(model))
+    view = check_view(view)
+    return StudioWidget(sm.studio_session(model), view=view)

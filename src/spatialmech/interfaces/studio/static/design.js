@@ -1,9 +1,10 @@
 // spatialmech studio, the design tools (issue 30): snapshots with undo, the coupler curve of a
 // picked point, joint values and transmission against the input, the driven path as CSV, and a
 // smaller redraw during a drag.  Loaded after studio.js and uses its globals (S, api, fmt,
-// setStatus, update, traces, draw); studio.js itself is not changed, the two hooks below wrap
-// its `traces` (adds the coupler curve) and `draw` (Plotly.restyle of the coordinates when the
-// traces are the same as in the last full draw, instead of Plotly.react of the whole figure).
+// setStatus, update, traces, draw, drawPlot); the two hooks below wrap studio.js's `traces` (adds
+// the coupler curve; the light view draws them too) and `drawPlot` (the full view: Plotly.restyle
+// of the coordinates when the traces are the same as in the last full draw, instead of
+// Plotly.react of the whole figure).
 "use strict";
 
 S.coupler = null; S.traceKey = ""; S.fastRedraw = true; S.drawTimes = [];
@@ -16,8 +17,8 @@ traces = function (sc) {  // eslint-disable-line no-func-assign
   return out;
 };
 
-const studioDraw = draw;
-draw = function () {  // eslint-disable-line no-func-assign
+const studioDraw = drawPlot;
+drawPlot = function () {  // eslint-disable-line no-func-assign
   const t0 = performance.now(), el = document.getElementById("plot"), tr = traces(S.state.scene);
   const key = tr.map(t => t.type + ":" + t.name + ":" + t.x.length + ":" + (t.i ? t.i.length : 0)).join("|");
   if (S.fastRedraw && el.data && key === S.traceKey) {  // only the traces that moved

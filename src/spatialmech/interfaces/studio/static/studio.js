@@ -6,7 +6,7 @@
 
 const EVENT_LOG_MAX = 100;  // services/studio/monitors.EVENT_LOG_MAX
 const S = { state: null, circuit: null, unit: "", inFlight: false, pending: null, range: null, drawn: 0, errors: [],
-  topView: false, viewRev: 0, nEvents: 0 };
+  topView: false, viewRev: 0, nEvents: 0, view: "full", viewWhy: "", light: null, renderer: null, frameRequested: false };
 window.studio = S;
 
 async function api(path, body) {
@@ -75,9 +75,68 @@ function traces(sc) {
   return out;
 }
 
+// ------------------------------------------------------------------ the 3-D view: plotly's gl3d ("full") or the light one
+// (static/scene2d.js), each drawn on the next animation frame (several answers in one frame are drawn once)
 function draw() {
+  if (!S.range) S.range = SMPad.sceneRange(S.state.scene);
+  if (S.view === "light") { drawLight(); return; }
+  if (S.frameRequested) return;
+  S.frameRequested = true;
+  requestAnimationFrame(() => { S.frameRequested = false; drawPlot(); });
+}
+
+function drawNow() {  // at once (the benchmark's breakdown)
+  if (!S.range) S.range = SMPad.sceneRange(S.state.scene);
+  if (S.view === "light") { drawLight(); S.light.render(); } else drawPlot();
+}
+
+// the light view draws the plot's traces, the joint solids as markers in their limb's colour
+function lightTraces(sc) {
+  const out = traces(sc).filter(t => !(t.type === "mesh3d" && t.name.startsWith("joints of ")));
+  const at = out.findIndex(t => t.name === "joint centres");
+  const marks = sc.limb_names.map((n, li) => ({ type: "scatter3d", mode: "markers", name: "joints of " + n, showlegend: false,
+    ...xyz(sc.joints.filter(j => j.limb_index === li).map(j => j.centre_len)), marker: { size: 9, color: sc.limb_colours[li] } }));
+  out.splice(at < 0 ? out.length : at, 0, ...marks.filter(t => t.x.length));
+  return out;
+}
+
+function drawLight() {
+  const sc = S.state.scene, n = sc.plane_normal;
+  S.light.show(lightTraces(sc), sc.platform_point_len, S.range, { camera: S.viewRev, unit: S.unit,
+    top: S.topView && n ? [n, SMPad.planeBasis(n)[1]] : null,
+    title: S.state.mechanism + (S.topView && n ? " (top view: along the plane's normal)" : "") });
+}
+
+// the 3-D view shown ("full" or "light") and why; the page's buttons switch it by hand
+function setView(view, why) {
+  S.view = view; S.viewWhy = why; S.traceKey = "";
+  document.getElementById("plot").style.display = view === "light" ? "none" : "";
+  document.getElementById("light").style.display = view === "light" ? "" : "none";
+  ["full", "light"].forEach(v => document.getElementById("view3d-" + v).setAttribute("aria-pressed", String(v === view)));
+  document.getElementById("view3d-why").textContent = why;
+  document.getElementById("view3d-why").title = "WebGL renderer: " + (S.renderer === null ? "none" : S.renderer);
+  if (!S.state) return;
+  if (view === "full" && document.getElementById("plot").data) Plotly.Plots.resize("plot");
+  draw();
+}
+
+function initView() {
+  const asked = new URLSearchParams(location.search).get("view") || document.body.dataset.view || "auto";
+  S.renderer = SMScene2D.webglRenderer();
+  S.light = new SMScene2D.View(document.getElementById("light"), {
+    onFrame: () => { S.drawn += 1; },
+    handlePlane: () => (S.pad ? [S.pad.e1, S.pad.e2] : null),
+    onHandle: p => { S.lastDragPoint = p; S.pending = { path: "/api/drag", body: { point_len: p } }; pump(); } });
+  S.setView = setView;
+  const c = SMScene2D.choose(asked, S.renderer);
+  setView(c.view, c.why);
+  document.getElementById("view3d-full").addEventListener("click", () => (S.renderer === null
+    ? setStatus("error", "this browser has no WebGL: only the light 3-D view") : setView("full", "full 3-D view (WebGL): switched by hand")));
+  document.getElementById("view3d-light").addEventListener("click", () => setView("light", "light 3-D view: switched by hand"));
+}
+
+function drawPlot() {
   const sc = S.state.scene;
-  if (!S.range) S.range = SMPad.sceneRange(sc);
   const ax = (r, n) => ({ range: r, autorange: false, title: { text: n + " [" + S.unit + "]" } });  // the bundled plotly needs title.text
   const layout = { uirevision: "studio-" + S.viewRev, margin: { l: 0, r: 0, t: 30, b: 0 },
     title: { text: S.state.mechanism + (S.topView ? " (top view: along the plane's normal)" : "") },
@@ -287,6 +346,7 @@ async function loadCircuit() {  // one-degree-of-freedom models: the traced circ
 async function main() {
   window.addEventListener("error", e => S.errors.push(String(e.message)));
   initPad();
+  initView();
   loadDoc(await api("/api/model"));
   document.getElementById("model-select").addEventListener("change", async ev => {
     setStatus("", "loading " + ev.target.value + " ...");

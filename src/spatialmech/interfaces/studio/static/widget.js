@@ -1,7 +1,10 @@
 // spatialmech studio in Jupyter (anywidget): draws the `figure` trait, shows the readouts of the
 // `state` trait and sends one message per slider move ({type: "drive", actuators: [...]}); the
 // next value goes when `answered` grows (one request in flight).  The drag pad (SMPad, static/pad.js)
-// sends {type: "drag", point_len: [x, y, z]}.  Plotly and SMPad are defined by the bundle this file
+// sends {type: "drag", point_len: [x, y, z]}.  The 3-D view is plotly's WebGL scene or the light
+// one (SMScene2D, static/scene2d.js: the same traces on a 2-D canvas, its orange handle dragged
+// like the pad's), chosen by the `view` trait ("auto": light where WebGL is rendered in software)
+// and switched by two buttons.  Plotly, SMPad and SMScene2D are defined by the bundle this file
 // is appended to (interfaces/studio/widget.py).
 
 
@@ -47,10 +50,17 @@ function render({ model, el }) {
     '<button class="sm-snap">snapshot</button> <button class="sm-undo">undo</button> <span class="sm-snaps"></span></div><table class="sm-readouts" style="font: 12px sans-serif"></table>' +
     '<div class="sm-pad" style="display: none; font: 12px sans-serif" title="drag the output point in this plane (inverse position along the branch)">' +
     '<div class="sm-pad-label"></div><svg class="sm-drag-svg" width="200" height="200" style="border: 1px solid #ccc; touch-action: none"></svg></div>' +
-    '<div class="sm-plot" style="width: 100%"></div>';
+    '<div class="sm-viewbar" style="font: 12px sans-serif">3-D view: <button class="sm-view-full" title="plotly\'s WebGL scene">full (WebGL)</button> ' +
+    '<button class="sm-view-light" title="a Canvas 2-D drawing of the same scene: drag to turn, wheel to zoom, double-click to reset">light</button> ' +
+    '<span class="sm-view-why"></span></div>' +
+    '<div class="sm-plot" style="width: 100%"></div><div class="sm-light" style="position: relative; width: 100%; display: none"></div>';
   const box = el.querySelector(".sm-sliders"), pbox = el.querySelector(".sm-pose"), table = el.querySelector(".sm-readouts"), plot = el.querySelector(".sm-plot");
   const pad = el.querySelector(".sm-pad"), padSvg = el.querySelector(".sm-drag-svg");
-  let inFlight = false, pending = null, built = "", range = null, frame = null;
+  const lightBox = el.querySelector(".sm-light"), renderer = SMScene2D.webglRenderer();
+  let inFlight = false, pending = null, built = "", range = null, frame = null, view = "full", turns = 0;
+  const light = new SMScene2D.View(lightBox, { handlePlane: () => (frame ? [frame.e1, frame.e2] : null),
+    onHandle: p => { pending = { type: "drag", point_len: p }; send(); } });
+  lightBox.smView = light;  // for tests: the camera, the frame count
 
   function send() {
     if (inFlight || pending === null) return;
@@ -85,7 +95,23 @@ function render({ model, el }) {
     }
     table.innerHTML = readoutRows(st, unit, model).map(([k, v]) => `<tr><th style="text-align: left">${k}</th><td>${v}</td></tr>`).join("");
   }
-  function draw() { const f = model.get("figure"); Plotly.react(plot, f.data, f.layout, { displaylogo: false, responsive: true, plotGlPixelRatio: SMPad.glPixelRatio }); }
+  function draw() {
+    const f = model.get("figure"), st = model.get("state"), n = st.scene.plane_normal;
+    if (view === "full") { Plotly.react(plot, f.data, f.layout, { displaylogo: false, responsive: true, plotGlPixelRatio: SMPad.glPixelRatio }); return; }
+    lightBox.style.height = (f.layout.height || 460) + "px";
+    light.show(f.data, st.scene.platform_point_len, range, { camera: built + ":" + turns, unit: model.get("unit"),
+      top: n ? [n, SMPad.planeBasis(n)[1]] : null, title: f.layout.title ? f.layout.title.text : st.mechanism });
+  }
+  function setView(v, why) {
+    view = v; turns += 1;
+    plot.style.display = v === "full" ? "" : "none"; lightBox.style.display = v === "light" ? "" : "none";
+    el.querySelector(".sm-view-full").setAttribute("aria-pressed", String(v === "full"));
+    el.querySelector(".sm-view-light").setAttribute("aria-pressed", String(v === "light"));
+    el.querySelector(".sm-view-full").style.fontWeight = v === "full" ? "bold" : "";
+    el.querySelector(".sm-view-light").style.fontWeight = v === "light" ? "bold" : "";
+    el.querySelector(".sm-view-why").textContent = why;
+    draw();
+  }
 
   SMPad.attach(padSvg, () => frame, () => model.get("state").scene.platform_point_len,
                p => { pending = { type: "drag", point_len: p }; send(); });
@@ -95,7 +121,12 @@ function render({ model, el }) {
   model.on("change:snapshots", build);
   model.on("change:figure", draw);
   model.on("change:answered", () => { inFlight = false; build(); send(); });
-  build(); draw();
+  el.querySelector(".sm-view-full").addEventListener("click", () => { if (renderer !== null) setView("full", "full 3-D view (WebGL): switched by hand"); });
+  model.on("change:view", () => { const c = SMScene2D.choose(model.get("view"), renderer); setView(c.view, c.why); });
+  el.querySelector(".sm-view-light").addEventListener("click", () => setView("light", "light 3-D view: switched by hand"));
+  build();
+  const chosen = SMScene2D.choose(model.get("view") || "auto", renderer);
+  setView(chosen.view, chosen.why);
   return () => Plotly.purge(plot);
 }
 
