@@ -1,9 +1,11 @@
 """Helpers of the studio's headless-Chromium tests (the fixtures ``server`` and ``browser`` are
-in tests/conftest.py): where Chromium and chromedriver are, their flags, what is missing, and a
-wait for a page script to turn true."""
+in tests/conftest.py): where Chromium and chromedriver are, their flags, what is missing, a
+wait for a page script to turn true, and the light 3-D view's projection."""
 
 import os
 import time
+
+import numpy as np
 
 CHROMIUM = os.environ.get("SPATIALMECH_CHROMIUM", "/usr/bin/chromium")
 CHROMEDRIVER = os.environ.get("SPATIALMECH_CHROMEDRIVER", "/usr/bin/chromedriver")
@@ -33,3 +35,11 @@ def wait_for(driver, script, *args):
             return v
         time.sleep(0.1)
     raise AssertionError(f"timed out waiting for: {script}")
+
+
+def projected(cam: dict, pts) -> np.ndarray:
+    """``pts`` (n, 3) where the light 3-D view's camera ``cam`` (``View.camera()`` of
+    static/scene2d.js) draws them, in CSS pixels: ``(W/2 + zoom (p - c).right, H/2 - zoom (p - c).up)``."""
+    c, r, u = (np.asarray(cam[k], float) for k in ("centre", "right", "up"))
+    d = np.asarray(pts, float) - c
+    return np.c_[cam["width"] / 2 + cam["zoom"] * (d @ r), cam["height"] / 2 - cam["zoom"] * (d @ u)]

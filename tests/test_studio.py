@@ -181,6 +181,30 @@ def test_studio_command_errors_are_one_line():
     assert h.exit_code == 0 and "--no-browser" in h.output
 
 
+def test_the_3d_view_choice_is_checked_and_reaches_the_page(monkeypatch, studio_ok):
+    """Issue 30: ``view`` ("auto", "light", "full") of ``sm.studio_app`` and ``studio --view``;
+    anything else is refused naming the field, before any work; the page gets the choice."""
+    import json
+
+    import uvicorn
+
+    for bad in ("fast", "", None, 3, "LIGHT"):
+        with pytest.raises(sm.InputError, match=r"^view: expected one of 'auto', 'light', 'full', got "):
+            sm.studio_app("no-such-model", view=bad)  # the view is checked first
+    r = CliRunner().invoke(cli, ["studio", "rssr", "--view", "fast", "--no-browser"])
+    assert r.exit_code == 2 and r.output.startswith("error: Invalid value for '--view'") and r.output.count("\n") == 1
+    served = {}
+    monkeypatch.setattr(uvicorn, "run", lambda app, host, port, **kw: served.update(app=app))
+    r = CliRunner().invoke(cli, ["studio", "rssr", "--port", "0", "--no-browser", "--view", "light", "--json"])
+    assert r.exit_code == 0, r.output
+    assert studio_ok(json.loads(r.output))["view"] == "light"
+    client = TestClient(served["app"])
+    page = client.get("/").text
+    assert '<body data-view="light">' in page and '<script src="/static/scene2d.js">' in page
+    assert "const SMScene2D" in client.get("/static/scene2d.js").text
+    assert '<body data-view="auto">' in TestClient(sm.studio_app("rssr")).get("/").text  # the default
+
+
 def test_studio_command_json_before_serving(monkeypatch, studio_ok):
     """``studio --json`` prints the address and the start state, then serves (uvicorn.run is
     replaced here: the app it would serve is checked instead)."""

@@ -40,7 +40,7 @@ def pixels(driver, tmp_path, name):
 def test_dragging_a_slider_moves_the_mechanism(server, browser, tmp_path):
     from selenium.webdriver.common.by import By
 
-    browser.get(server)
+    browser.get(server + "?view=full")  # plotly's WebGL scene (the light view: tests/test_studio_view_browser.py)
     wait(browser, "return window.studio && window.studio.drawn > 0")
     time.sleep(0.5)  # let WebGL finish the first frame
     before = browser.execute_script("return window.studio.state")

@@ -20,7 +20,7 @@ def crank(driver) -> float:
 
 def test_snapshot_undo_coupler_curve_and_sweep_in_the_page(server, browser):
     b = browser
-    b.get(server)
+    b.get(server + "?view=full")  # the coupler curve is looked for in plotly's traces
     wait_for(b, "return window.studio && window.studio.state && window.studio.drawn > 0 && "
                 "document.getElementById('snap') !== null")
     b.execute_script("window.studio.errors = []")

@@ -162,3 +162,21 @@ def test_the_widget_labels_an_unstated_length_unit():
     w = sm.studio("five-cs-3")
     assert w.unit == "length unit not stated"
     assert w.figure["layout"]["scene"]["xaxis"]["title"]["text"] == "x [length unit not stated]"
+
+
+def test_the_widget_view_choice_is_checked(widget):
+    """Issue 30: ``sm.studio(model, view=...)`` and the ``view`` trait take "auto" (default),
+    "light" or "full"; anything else is an InputError naming the field; the bundle carries the
+    light view (static/scene2d.js)."""
+    from spatialmech.interfaces.studio.widget import esm_bundle
+
+    assert widget.view == "auto"
+    with pytest.raises(sm.InputError, match=r"^view: expected one of 'auto', 'light', 'full', got 'fast'"):
+        sm.studio("no-such-model", view="fast")  # checked before the model is loaded
+    with pytest.raises(sm.InputError, match=r"^view: "):
+        widget.view = "bogus"
+    assert widget.view == "auto"
+    widget.view = "light"
+    assert widget.view == "light"
+    widget.view = "auto"
+    assert "const SMScene2D" in esm_bundle() and esm_bundle().index("const SMScene2D") < esm_bundle().index("function render(")

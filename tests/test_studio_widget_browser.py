@@ -24,7 +24,7 @@ import spatialmech as sm
 pytestmark = pytest.mark.slow  # a browser start and software WebGL take seconds
 pytest.importorskip("anywidget")
 
-TRAITS = ("state", "figure", "unit", "last_drive", "answered", "error", "modes", "snapshots")
+TRAITS = ("state", "figure", "unit", "last_drive", "answered", "error", "modes", "snapshots", "view")
 
 HARNESS = """<!DOCTYPE html><html><head><meta charset="utf-8"><title>widget harness</title><link rel="icon" href="data:,"></head>
 <body style="width: 900px"><div id="w"></div>
@@ -51,11 +51,12 @@ def traits(w) -> dict:
     return {k: getattr(w, k) for k in TRAITS}
 
 
-def serve(tmp_path_factory, model):
-    """A harness page of a new widget of ``model``: ``(widget, url, server, thread)``."""
+def serve(tmp_path_factory, model, view="full"):
+    """A harness page of a new widget of ``model`` (plotly's 3-D view unless ``view`` says
+    otherwise): ``(widget, url, server, thread)``."""
     from spatialmech.interfaces.studio.widget import esm_bundle
 
-    w = sm.studio(model)
+    w = sm.studio(model, view=view)
     root = tmp_path_factory.mktemp("widget-harness")
     (root / "index.html").write_text(HARNESS, encoding="utf-8")
     (root / "bundle.js").write_text(esm_bundle(), encoding="utf-8")
@@ -162,6 +163,46 @@ def test_the_widget_drag_pad_moves_the_output_point(tmp_path_factory, browser):
         # a bad message names the field
         w._handle_custom_msg({"type": "drag", "point_len": [0.0, "a"]}, [])
         assert w.error.startswith("point_len: ")
+        assert browser.execute_script("return window.jsErrors") == []
+        severe = [e for e in browser.get_log("browser") if e["level"] == "SEVERE"]
+        assert not severe, severe
+    finally:
+        srv.shutdown()
+        th.join(10)
+
+
+def test_the_widget_light_view_draws_follows_and_switches(tmp_path_factory, browser):
+    """Issue 30: with ``view="auto"`` under headless Chromium (software WebGL) the widget draws
+    its figure in the light 3-D view (static/scene2d.js): the joint markers where its camera
+    projects the session's joints, redrawn when the kernel answers a drive; its buttons switch
+    to plotly's scene and back."""
+    import numpy as np
+
+    from .browser_support import projected
+
+    w, url, srv, th = serve(tmp_path_factory, "rssr", view="auto")
+    light = "document.querySelector('.sm-light').smView"
+    drawn = f"const L = {light}; return L.frames > 0 && !L.requested ? {{cam: L.camera(), joints: L.screen['joints'], handle: L.handleAt, frames: L.frames}} : null"
+    try:
+        browser.get(url)
+        wait_for(browser, "return window.rendered === true")
+        v = wait_for(browser, drawn)
+        assert browser.execute_script("return getComputedStyle(document.querySelector('.sm-plot')).display") == "none"
+        why = browser.execute_script("return document.querySelector('.sm-view-why').textContent")
+        assert why == "light 3-D view: this browser renders WebGL in software (SwiftShader)"
+        want = projected(v["cam"], [j["centre_len"] for j in w.state["scene"]["joints"]])
+        assert np.allclose(np.asarray(v["joints"])[:, :2], want, rtol=0, atol=1e-9)
+        w.drive([35.0])
+        browser.execute_script("window.harness.set(arguments[0])", traits(w))
+        v2 = wait_for(browser, drawn.replace("L.frames > 0", f"L.frames > {v['frames']}"))
+        want2 = projected(v2["cam"], [j["centre_len"] for j in w.state["scene"]["joints"]])
+        assert np.allclose(np.asarray(v2["joints"])[:, :2], want2, rtol=0, atol=1e-9)
+        assert np.hypot(*np.subtract(v2["handle"], v["handle"])) > 3.0
+        browser.execute_script("document.querySelector('.sm-view-full').click()")
+        wait_for(browser, "return document.querySelector('.js-plotly-plot') !== null && "
+                          "getComputedStyle(document.querySelector('.sm-light')).display === 'none'")
+        browser.execute_script("document.querySelector('.sm-view-light').click()")
+        wait_for(browser, drawn.replace("L.frames > 0", f"L.frames > {v2['frames']}"))
         assert browser.execute_script("return window.jsErrors") == []
         severe = [e for e in browser.get_log("browser") if e["level"] == "SEVERE"]
         assert not severe, severe

@@ -67,6 +67,7 @@ const SMScene2D = (() => {
       [this.back, this.front].forEach(c => { c.style.cssText = "position: absolute; left: 0; top: 0; width: 100%; height: 100%"; box.appendChild(c); });
       this.front.style.cursor = "grab"; this.front.style.touchAction = "none";
       this.traces = []; this.last = []; this.handle = null; this.title = ""; this.unit = ""; this.requested = false; this.dirtyBack = true;
+      this.screen = {};  // trace name -> the drawn markers' [u, v, depth] (CSS pixels)
       this.attach();
     }
 
@@ -185,10 +186,11 @@ const SMScene2D = (() => {
 
     markers(g, t) {
       const mk = t.marker || {}, r = Math.max(2, 0.6 * (mk.size || 4)), names = (t.mode || "").includes("text") ? t.text : null;
+      const P = this.screen[t.name] = points(t).map(p => (p === null ? null : this.project(p)));  // where each is drawn (tests)
       g.fillStyle = mk.color || "#222"; g.strokeStyle = mk.color || "#222"; g.lineWidth = 2; g.font = "11px sans-serif";
-      points(t).forEach((p, q) => {
+      P.forEach((p, q) => {
         if (p === null) return;
-        const [u, v] = this.project(p);
+        const [u, v] = p;
         g.beginPath();
         if (mk.symbol === "cross") { g.moveTo(u - r, v - r); g.lineTo(u + r, v + r); g.moveTo(u - r, v + r); g.lineTo(u + r, v - r); g.stroke(); }
         else if (mk.symbol === "diamond") { g.moveTo(u, v - r); g.lineTo(u + r, v); g.lineTo(u, v + r); g.lineTo(u - r, v); g.fill(); }

@@ -6,7 +6,7 @@
 
 const EVENT_LOG_MAX = 100;  // services/studio/monitors.EVENT_LOG_MAX
 const S = { state: null, circuit: null, unit: "", inFlight: false, pending: null, range: null, drawn: 0, errors: [],
-  topView: false, viewRev: 0, nEvents: 0, view: "full", viewWhy: "", light: null, renderer: null, frameRequested: false };
+  topView: false, viewRev: 0, nEvents: 0, view: "full", viewWhy: "", light: null, renderer: null };
 window.studio = S;
 
 async function api(path, body) {
@@ -75,14 +75,11 @@ function traces(sc) {
   return out;
 }
 
-// ------------------------------------------------------------------ the 3-D view: plotly's gl3d ("full") or the light one
-// (static/scene2d.js), each drawn on the next animation frame (several answers in one frame are drawn once)
+// ------------------------------------------------------------------ the 3-D view: plotly's gl3d ("full", drawn at once)
+// or the light one (static/scene2d.js, drawn on the next animation frame: several answers in one frame are drawn once)
 function draw() {
   if (!S.range) S.range = SMPad.sceneRange(S.state.scene);
-  if (S.view === "light") { drawLight(); return; }
-  if (S.frameRequested) return;
-  S.frameRequested = true;
-  requestAnimationFrame(() => { S.frameRequested = false; drawPlot(); });
+  if (S.view === "light") drawLight(); else drawPlot();
 }
 
 function drawNow() {  // at once (the benchmark's breakdown)
