@@ -25,12 +25,16 @@ same run on the same model.
 planar-4r, bennett and five-cs-3 (``performance.now()`` in the page, from the slider's input
 event to the second animation frame after the answer is drawn: the server, the JSON and the
 drawing), with the page's smaller redraw (``Plotly.restyle`` of the traces that moved,
-static/design.js) and with the full ``Plotly.react`` of studio.js, in the same run; target
-50 ms per frame (printed met / NOT met on the median).  Needs chromium, chromedriver, selenium.
-Where the frame time goes (same run, ``breakdown``): the answer (fetch and its text), the
-page's redraw (``draw`` and the drag pad, JavaScript), the paint (two animation frames after
-it: WebGL, software in headless Chromium) and the floor of that measurement (two animation
-frames with nothing redrawn).
+static/design.js) and with the full ``Plotly.react`` of studio.js (the full 3-D view, plotly's
+WebGL scene), and in the light 3-D view (static/scene2d.js, Canvas 2-D), all in the same run on
+the same page; target 50 ms per frame, printed met / NOT met on the median for each view
+(``met``: the full view with restyle, ``met_light``: the light view; ``ratio_light_to_full``).
+``light_again`` and ``restyle_again`` repeat the first two (drift of a shared machine).
+Needs chromium, chromedriver, selenium.  Where the frame time goes (same run, ``breakdown``
+for the full view, ``breakdown_light`` for the light one): the answer (fetch and its text), the
+page's redraw (``drawNow`` and the drag pad, JavaScript), the paint (two animation frames after
+it: WebGL, software in headless Chromium, or the canvas) and the floor of that measurement (two
+animation frames with nothing redrawn).  ``renderer``: the browser's WebGL renderer.
 """
 
 from __future__ import annotations
@@ -277,7 +281,8 @@ def main(argv=None) -> dict:
                 a, b, c = r["restyle"], r["react"], r["light"]
                 verdict = lambda ok: "met" if ok else "NOT met"  # noqa: E731
                 print(f"browser drag {m:<10} full view (WebGL): frame median {a['frame_median_ms']:.0f} ms (p95 "
-                      f"{a['frame_p95_ms']:.0f}), draw {a['draw_median_ms']:.1f} ms; full react: frame {b['frame_median_ms']:.0f} ms "
+                      f"{a['frame_p95_ms']:.0f}), draw {a['draw_median_ms']:.1f} ms; full react: frame "
+                      f"{b['frame_median_ms']:.0f} ms "
                       f"(ratio restyle/react {a['frame_median_ms'] / b['frame_median_ms']:.2f}); target < "
                       f"{FRAME_TARGET_MS:.0f} ms: {verdict(r['met'])}")
                 print(f"  {'':<21}light view (Canvas 2-D): frame median {c['frame_median_ms']:.0f} ms (p95 "

@@ -57,7 +57,7 @@ def test_readouts_above_the_fold_top_view_and_drag_handle(server, browser):
     eye = b.execute_script(CAMERA)
     assert eye[:3] == pytest.approx([0.0, 0.0, 2.0], abs=1e-9) and eye[3] == "orthographic"
     toggle = b.find_element(By.ID, "view-toggle")
-    assert toggle.is_displayed() and toggle.text == "3-D view"
+    assert toggle.is_displayed() and toggle.text == "oblique view"
     toggle.click()
     eye3 = b.execute_script(CAMERA)
     assert b.execute_script("return window.studio.topView") is False and abs(eye3[0]) > 0.1 and eye3[3] == "perspective"
@@ -118,8 +118,8 @@ def test_the_light_view_draws_follows_a_drag_and_switches(server, browser, tmp_p
     path = tmp_path / "light.png"
     assert b.find_element(By.ID, "light").screenshot(str(path))
     img = image.imread(path)[..., :3]
-    for u, w in want:  # a marker (not the white background) at every joint
-        patch = img[int(round(w)) - 1:int(round(w)) + 2, int(round(u)) - 1:int(round(u)) + 2]
+    for u, w in np.rint(want).astype(int):  # a marker (not the white background) at every joint
+        patch = img[w - 1:w + 2, u - 1:u + 2]
         assert float(np.min(patch)) < 0.8, (u, w)
     # a slider drag: the joints and the handle follow, as the library computes them
     b.execute_script("const el = document.getElementById('slider-0'); el.value = Number(el.value) + 30;"
@@ -139,6 +139,23 @@ def test_the_light_view_draws_follows_a_drag_and_switches(server, browser, tmp_p
     assert abs(float(np.dot(turned["right"], v2["cam"]["right"]))) < 0.99
     ActionChains(b).move_to_element_with_offset(front, int(-w / 2 + 60), int(-h / 2 + 80)).double_click().perform()
     assert np.allclose(settled(b)["cam"]["right"], v2["cam"]["right"], atol=1e-12)
+    # planar-4r (top view): the orange handle in the 3-D view drags the output point (x given)
+    load(b, "planar-4r")
+    v3 = settled(b)
+    x0 = b.execute_script("return window.studio.state.task.values_len.x")
+    hx, hy = v3["handle"]
+    ActionChains(b).move_to_element_with_offset(front, round(hx - w / 2), round(hy - h / 2)).click_and_hold() \
+        .move_by_offset(6, 0).move_by_offset(6, 0).release().perform()
+    wait_for(b, "return window.studio.lastDragPoint && !window.studio.inFlight && window.studio.pending === null")
+    time.sleep(0.3)
+    settled(b)
+    st = b.execute_script("return window.studio.state")
+    want_x = b.execute_script("return window.studio.lastDragPoint")[0]
+    assert want_x > x0 + 0.02  # 12 px to the right in the top view: +x
+    assert st["task"]["values_len"]["x"] == pytest.approx(want_x, abs=1e-9)  # the pose drag reached it
+    out = os.environ.get("SPATIALMECH_SCREENSHOTS")
+    if out:
+        b.save_screenshot(str(Path(out) / "studio-light-planar-4r.png"))
     # the buttons: plotly's scene and back
     b.find_element(By.ID, "view3d-full").click()
     wait_for(b, "const p = document.getElementById('plot'); return window.studio.view === 'full' && p.data && "
@@ -148,21 +165,5 @@ def test_the_light_view_draws_follows_a_drag_and_switches(server, browser, tmp_p
     wait_for(b, "return window.studio.view === 'light' && window.studio.light.frames > arguments[0]", n)
     assert b.find_element(By.ID, "view3d-why").text == "light 3-D view: switched by hand"
     assert b.find_element(By.ID, "view3d-light").get_attribute("aria-pressed") == "true"
-    # planar-4r (top view): the orange handle in the 3-D view drags the output point (x given)
-    load(b, "planar-4r")
-    v3 = settled(b)
-    x0 = b.execute_script("return window.studio.state.task.values_len.x")
-    hx, hy = v3["handle"]
-    ActionChains(b).move_to_element_with_offset(front, int(round(hx - w / 2)), int(round(hy - h / 2))).click_and_hold() \
-        .move_by_offset(6, 0).move_by_offset(6, 0).release().perform()
-    wait_for(b, "return window.studio.lastDragPoint && !window.studio.inFlight && window.studio.pending === null")
-    time.sleep(0.3)
-    st = settled(b) and b.execute_script("return window.studio.state")
-    want_x = b.execute_script("return window.studio.lastDragPoint")[0]
-    assert want_x > x0 + 0.02  # 12 px to the right in the top view: +x
-    assert st["task"]["values_len"]["x"] == pytest.approx(want_x, abs=1e-9)  # the pose drag reached it
-    out = os.environ.get("SPATIALMECH_SCREENSHOTS")
-    if out:
-        b.save_screenshot(str(Path(out) / "studio-light-planar-4r.png"))
     severe = [e for e in b.get_log("browser") if e["level"] == "SEVERE"]
     assert not severe and b.execute_script("return window.studio.errors") == []

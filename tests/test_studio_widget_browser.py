@@ -173,16 +173,17 @@ def test_the_widget_drag_pad_moves_the_output_point(tmp_path_factory, browser):
 
 def test_the_widget_light_view_draws_follows_and_switches(tmp_path_factory, browser):
     """Issue 30: with ``view="auto"`` under headless Chromium (software WebGL) the widget draws
-    its figure in the light 3-D view (static/scene2d.js): the joint markers where its camera
-    projects the session's joints, redrawn when the kernel answers a drive; its buttons switch
-    to plotly's scene and back."""
+    its figure on planar-4r in the light 3-D view (static/scene2d.js), in the top view: the joint
+    markers where its camera projects the session's joints, redrawn when the kernel answers a
+    drive; its buttons switch to plotly's scene and back."""
     import numpy as np
 
     from .browser_support import projected
 
-    w, url, srv, th = serve(tmp_path_factory, "rssr", view="auto")
+    w, url, srv, th = serve(tmp_path_factory, "planar-4r", view="auto")
     light = "document.querySelector('.sm-light').smView"
-    drawn = f"const L = {light}; return L.frames > 0 && !L.requested ? {{cam: L.camera(), joints: L.screen['joints'], handle: L.handleAt, frames: L.frames}} : null"
+    drawn = (f"const L = {light}; return L.frames > 0 && !L.requested ? "
+             "{cam: L.camera(), joints: L.screen['joints'], handle: L.handleAt, frames: L.frames} : null")
     try:
         browser.get(url)
         wait_for(browser, "return window.rendered === true")
@@ -198,6 +199,13 @@ def test_the_widget_light_view_draws_follows_and_switches(tmp_path_factory, brow
         want2 = projected(v2["cam"], [j["centre_len"] for j in w.state["scene"]["joints"]])
         assert np.allclose(np.asarray(v2["joints"])[:, :2], want2, rtol=0, atol=1e-9)
         assert np.hypot(*np.subtract(v2["handle"], v["handle"])) > 3.0
+        assert v2["cam"]["fwd"] == pytest.approx([0.0, 0.0, -1.0], abs=1e-12)  # looking along the plane's normal
+        out = os.environ.get("SPATIALMECH_SCREENSHOTS")
+        if out:
+            browser.set_window_size(1000, 1400)
+            time.sleep(0.3)
+            assert browser.find_element("css selector", "#w").screenshot(str(Path(out) / "studio-widget-planar-4r.png"))
+            browser.set_window_size(1200, 800)
         browser.execute_script("document.querySelector('.sm-view-full').click()")
         wait_for(browser, "return document.querySelector('.js-plotly-plot') !== null && "
                           "getComputedStyle(document.querySelector('.sm-light')).display === 'none'")

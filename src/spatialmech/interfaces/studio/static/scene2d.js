@@ -210,7 +210,8 @@ const SMScene2D = (() => {
         const u = o[0] + 35 * dot(e, this.cam.right), v = o[1] - 35 * dot(e, this.cam.up), end = Math.hypot(u - o[0], v - o[1]) > 8;
         g.strokeStyle = cols[a]; g.fillStyle = cols[a]; g.lineWidth = 2; g.beginPath();
         if (end) { g.moveTo(o[0], o[1]); g.lineTo(u, v); g.stroke(); } else { g.arc(o[0], o[1], 4, 0, 2 * Math.PI); g.stroke(); }
-        g.fillText("xyz"[a] + (end ? "" : dot(e, this.cam.fwd) < 0 ? " (toward you)" : " (away)"), end ? u + 3 : o[0] + 6, end ? v + 4 : o[1] + 14 * a - 10);
+        g.textAlign = end ? "left" : "right";
+        g.fillText("xyz"[a] + (end ? "" : dot(e, this.cam.fwd) < 0 ? " (toward you)" : " (away)"), end ? u + 3 : o[0] - 8, end ? v + 4 : o[1] + 4);
       });
       g.fillStyle = "#222"; g.textAlign = "right";
       g.fillText(["x", "y", "z"].map(n => n + (this.unit ? " [" + this.unit + "]" : "")).join(", "), this.W - 10, this.H - 38);

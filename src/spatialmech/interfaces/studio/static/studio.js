@@ -153,7 +153,7 @@ function drawPlot() {
 function showViewToggle() {
   const b = document.getElementById("view-toggle"), planar = !!S.state.scene.plane_normal;
   b.style.display = planar ? "" : "none";
-  b.textContent = S.topView ? "3-D view" : "top view";
+  b.textContent = S.topView ? "oblique view" : "top view";
 }
 
 function toggleView() { S.topView = !S.topView; S.viewRev += 1; S.traceKey = ""; showViewToggle(); draw(); }
