@@ -105,14 +105,14 @@ def test_the_light_view_draws_follows_a_drag_and_switches(server, browser, tmp_p
     b.set_window_size(1200, 800)
     b.get(server)  # view "auto": headless Chromium's WebGL is SwiftShader, a software renderer
     wait_for(b, "return window.studio && window.studio.state && window.studio.drawn > 0")
-    load(b, "rssr")
+    load(b, "planar-4r")  # a fresh session: the module's server is shared
     v = settled(b)
     assert v["view"] == "light" and "swiftshader" in v["renderer"].lower(), v
     assert v["why"] == "light 3-D view: this browser renders WebGL in software (SwiftShader)"
     assert b.find_element(By.ID, "view3d-why").text == v["why"]
     assert not b.find_element(By.ID, "plot").is_displayed() and b.find_element(By.ID, "light").is_displayed()
     # the joints are drawn where the camera projects the session's joint points
-    ref = sm.studio_session("rssr")
+    ref = sm.studio_session("planar-4r")
     want = projected(v["cam"], [j["centre_len"] for j in ref.state()["scene"]["joints"]])
     assert np.allclose(np.asarray(v["joints"])[:, :2], want, rtol=0, atol=1e-9)
     path = tmp_path / "light.png"
@@ -130,6 +130,7 @@ def test_the_light_view_draws_follows_a_drag_and_switches(server, browser, tmp_p
     assert ref.drive([30.0]).status == "reached"
     want2 = projected(v2["cam"], [j["centre_len"] for j in ref.state()["scene"]["joints"]])
     assert np.allclose(np.asarray(v2["joints"])[:, :2], want2, rtol=0, atol=1e-9)
+    assert v2["cam"]["fwd"] == pytest.approx([0.0, 0.0, -1.0], abs=1e-12)  # planar: along the plane's normal
     # the mouse turns the camera (away from the handle) and a double-click resets it
     front = b.find_element(By.CSS_SELECTOR, "#light canvas:last-child")
     w, h = v2["cam"]["width"], v2["cam"]["height"]
@@ -139,11 +140,9 @@ def test_the_light_view_draws_follows_a_drag_and_switches(server, browser, tmp_p
     assert abs(float(np.dot(turned["right"], v2["cam"]["right"]))) < 0.99
     ActionChains(b).move_to_element_with_offset(front, int(-w / 2 + 60), int(-h / 2 + 80)).double_click().perform()
     assert np.allclose(settled(b)["cam"]["right"], v2["cam"]["right"], atol=1e-12)
-    # planar-4r (top view): the orange handle in the 3-D view drags the output point (x given)
-    load(b, "planar-4r")
-    v3 = settled(b)
+    # the orange handle in the 3-D view drags the output point (planar-4r gives x; top view: +x is to the right)
     x0 = b.execute_script("return window.studio.state.task.values_len.x")
-    hx, hy = v3["handle"]
+    hx, hy = v2["handle"]
     ActionChains(b).move_to_element_with_offset(front, round(hx - w / 2), round(hy - h / 2)).click_and_hold() \
         .move_by_offset(6, 0).move_by_offset(6, 0).release().perform()
     wait_for(b, "return window.studio.lastDragPoint && !window.studio.inFlight && window.studio.pending === null")
