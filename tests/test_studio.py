@@ -202,6 +202,11 @@ def test_the_3d_view_choice_is_checked_and_reaches_the_page(monkeypatch, studio_
     page = client.get("/").text
     assert '<body data-view="light">' in page and '<script src="/static/scene2d.js">' in page
     assert "const SMScene2D" in client.get("/static/scene2d.js").text
+    # ?solids=0 (the light view's requests): the same state without the joint solids
+    light = studio_ok(client.post("/api/drive?solids=0", json={"actuators": [10.0]}).json())["state"]
+    full = studio_ok(client.get("/api/state").json())["state"]
+    assert light["scene"]["joint_meshes"] == [] and len(full["scene"]["joint_meshes"]) == 2
+    assert {**light, "scene": {**light["scene"], "joint_meshes": None}} == {**full, "scene": {**full["scene"], "joint_meshes": None}}
     assert '<body data-view="auto">' in TestClient(sm.studio_app("rssr")).get("/").text  # the default
 
 

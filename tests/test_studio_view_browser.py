@@ -156,9 +156,11 @@ def test_the_light_view_draws_follows_a_drag_and_switches(server, browser, tmp_p
     if out:
         b.save_screenshot(str(Path(out) / "studio-light-planar-4r.png"))
     # the buttons: plotly's scene and back
+    assert b.execute_script("return window.studio.state.scene.joint_meshes") == []  # asked for with ?solids=0
     b.find_element(By.ID, "view3d-full").click()
     wait_for(b, "const p = document.getElementById('plot'); return window.studio.view === 'full' && p.data && "
                 "p.offsetWidth > 0 && getComputedStyle(document.getElementById('light')).display === 'none'")
+    wait_for(b, "return document.getElementById('plot').data.some(t => t.name.startsWith('joints of'))")  # the solids
     n = b.execute_script("return window.studio.light.frames")
     b.find_element(By.ID, "view3d-light").click()
     wait_for(b, "return window.studio.view === 'light' && window.studio.light.frames > arguments[0]", n)

@@ -31,6 +31,9 @@ and units in the field names; bad input answers 4xx with ``{"error": "<field>: .
 ``GET /api/path.csv``  the driven path as the CSV of ``validate --actuators-path``
 =====================  ==================================================================
 
+Every route that answers a ``state`` takes ``?solids=0``: the scene without the joint solids
+(``joint_meshes`` empty), which the light 3-D view does not draw (a smaller, faster answer).
+
 Updates are answered by POST (the page sends the next slider value when the previous answer
 has arrived); there are no websockets.
 """
@@ -97,6 +100,9 @@ def create_app(session, view: str = "auto") -> FastAPI:
             raise InputError(f"{required}: missing from the body (got {', '.join(map(repr, data)) or 'nothing'})")
         return data
 
+    def state_of(request: Request) -> dict:  # ?solids=0: the scene without the joint solids (the light view)
+        return session.state(solids=request.query_params.get("solids") != "0")
+
     def guarded(fn):
         async def run(request: Request):
             try:
@@ -129,14 +135,14 @@ def create_app(session, view: str = "auto") -> FastAPI:
         return Response(_static(name), media_type=types[name])
 
     @app.get("/api/model")
-    def model():
+    def model(request: Request):
         with lock:
-            return _json(doc({"model_info": session.model_info(), "state": session.state()}))
+            return _json(doc({"model_info": session.model_info(), "state": state_of(request)}))
 
     @app.get("/api/state")
-    def state():
+    def state(request: Request):
         with lock:
-            return _json(doc({"state": session.state()}))
+            return _json(doc({"state": state_of(request)}))
 
     async def circuit(request: Request):
         with lock:
@@ -146,7 +152,7 @@ def create_app(session, view: str = "auto") -> FastAPI:
         data = await body(request, "actuators")
         with lock:
             r = session.drive(data["actuators"])
-            return _json(doc({**r.to_dict(), "state": session.state()}))
+            return _json(doc({**r.to_dict(), "state": state_of(request)}))
 
     async def pose(request: Request):
         data = await body(request, None)
@@ -158,13 +164,13 @@ def create_app(session, view: str = "auto") -> FastAPI:
         with lock:
             r = session.drive_pose(data.get("task_len"), data.get("task_deg"), euler=data.get("euler"),
                                    relative=data.get("relative", False))
-            return _json(doc({**r.to_dict(), "state": session.state()}))
+            return _json(doc({**r.to_dict(), "state": state_of(request)}))
 
     async def drivers(request: Request):
         data = await body(request, "drivers")
         with lock:
             session.set_drivers(data["drivers"])
-            return _json(doc({"state": session.state()}))
+            return _json(doc({"state": state_of(request)}))
 
     async def fk_all(request: Request):
         data = await body(request, None)
@@ -176,7 +182,7 @@ def create_app(session, view: str = "auto") -> FastAPI:
         data = await body(request, "mode_number")
         with lock:
             session.pick_mode(data["mode_number"])
-            return _json(doc({"state": session.state()}))
+            return _json(doc({"state": state_of(request)}))
 
     async def load(request: Request):
         data = await body(request, "model")
@@ -184,10 +190,10 @@ def create_app(session, view: str = "auto") -> FastAPI:
             raise InputError(f"model: expected a model name or file path, got {data['model']!r}")
         with lock:
             session.load(data["model"])
-            return _json(doc({"model_info": session.model_info(), "state": session.state()}))
+            return _json(doc({"model_info": session.model_info(), "state": state_of(request)}))
 
     app.add_api_route("/api/circuit", guarded(circuit), methods=["GET"])
-    add_desk_routes(app, session, lock, doc, body, guarded)
+    add_desk_routes(app, session, lock, doc, body, guarded, state_of)
     for path, fn in (("/api/drive", drive), ("/api/pose", pose),
                      ("/api/drivers", drivers), ("/api/fk_all", fk_all), ("/api/mode", mode),
                      ("/api/load", load)):
@@ -195,7 +201,7 @@ def create_app(session, view: str = "auto") -> FastAPI:
     return app
 
 
-def add_desk_routes(app: FastAPI, session, lock, doc, body, guarded) -> None:
+def add_desk_routes(app: FastAPI, session, lock, doc, body, guarded, state_of) -> None:
     """The design tools' routes (``session.desk``: snapshots, undo, coupler curve, sweep, the
     driven path as CSV) on ``app``, with the helpers of :func:`create_app`."""
 
@@ -207,13 +213,13 @@ def add_desk_routes(app: FastAPI, session, lock, doc, body, guarded) -> None:
     async def undo(request: Request):
         with lock:
             label = session.desk.undo()
-            return _json(doc({"restored": label, "snapshots": session.desk.listing(), "state": session.state()}))
+            return _json(doc({"restored": label, "snapshots": session.desk.listing(), "state": state_of(request)}))
 
     async def restore(request: Request):
         data = await body(request, "number")
         with lock:
             session.desk.restore(data["number"])
-            return _json(doc({"snapshots": session.desk.listing(), "state": session.state()}))
+            return _json(doc({"snapshots": session.desk.listing(), "state": state_of(request)}))
 
     async def coupler(request: Request):
         data = await body(request, None)
@@ -229,7 +235,7 @@ def add_desk_routes(app: FastAPI, session, lock, doc, body, guarded) -> None:
         data = await body(request, "point_len")
         with lock:
             r = session.drag_output(data["point_len"])
-            return _json(doc({**r.to_dict(), "state": session.state()}))
+            return _json(doc({**r.to_dict(), "state": state_of(request)}))
 
     async def path_csv(request: Request):
         with lock:

@@ -13,11 +13,12 @@ from ...present.viewer import LIMB_COLOURS, drawing
 __all__ = ["plane_normal", "scene"]
 
 
-def scene(mech: Mechanism, config: Configuration, history) -> dict:
+def scene(mech: Mechanism, config: Configuration, history, solids: bool = True) -> dict:
     """Limb polylines, base and platform outlines, every joint with its type, limb and axis
     directions, the platform point and frame, the platform point's trail (``history``, the
     last 400 points), the task positions and, for a planar linkage, its plane's normal (the
-    page's top view)."""
+    page's top view).  ``solids=False`` leaves the joint solids out (``joint_meshes`` empty:
+    the light 3-D view draws the joints as markers)."""
     m, c = mech, config
     d = drawing(m, c)
     jl = joint_list(m, c)
@@ -35,7 +36,7 @@ def scene(mech: Mechanism, config: Configuration, history) -> dict:
         "platform_hull_len": hull["vertices"].tolist() if hull is not None else [],
         "hull_faces": hull["triangles"].tolist() if hull is not None else [],
         "platform_mesh": mesh_json(solid),
-        "joint_meshes": [mesh_json(x) for x in joint_meshes(jl, len(m.limbs), float(d.scale))],
+        "joint_meshes": [mesh_json(x) for x in joint_meshes(jl, len(m.limbs), float(d.scale))] if solids else [],
         "bodies_len": d.bodies.tolist(),
         "joints": joints,
         "platform_point_len": d.platform_point.tolist(),

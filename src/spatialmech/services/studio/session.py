@@ -198,8 +198,9 @@ class Session(AssemblyModes, DriverMonitors):
         return np.array(out, dtype=float)
 
     # ------------------------------------------------------------------ readouts
-    def state(self) -> dict:
-        """The readout of the current configuration (JSON payload, docs/studio.md)."""
+    def state(self, solids: bool = True) -> dict:
+        """The readout of the current configuration (JSON payload, docs/studio.md); ``solids``:
+        with the joint solids in the scene (:meth:`scene`)."""
         m, c = self.mech, self.config
         a = self.actuator_values()
         J = self._jacobian(c)
@@ -229,7 +230,7 @@ class Session(AssemblyModes, DriverMonitors):
             "outside_limits": within_limits(m, c.q),
             "task": self.task_readout(),
             "note": self.note,
-            "scene": self.scene(),
+            "scene": self.scene(solids),
         }
 
     def slider_range(self, aid: str, start: float, value: float) -> tuple[float, float]:
@@ -292,9 +293,9 @@ class Session(AssemblyModes, DriverMonitors):
                 "slider_ranges_deg": {n: [float(np.degrees(v0[i + 3])) - 180.0, float(np.degrees(v0[i + 3])) + 180.0]
                                       for i, n in enumerate(TASK_NAMES[3:]) if n in t.given}}
 
-    def scene(self) -> dict:
-        """What the page draws (:func:`.scene.scene`)."""
-        return scene(self.mech, self.config, self.history)
+    def scene(self, solids: bool = True) -> dict:
+        """What the page draws (:func:`.scene.scene`; ``solids=False``: without the joint solids)."""
+        return scene(self.mech, self.config, self.history, solids)
 
     def model_info(self) -> dict:
         """The model: name, description, limbs, freedoms with their kinds, the ready-made models."""

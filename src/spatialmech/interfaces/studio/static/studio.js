@@ -11,7 +11,7 @@ window.studio = S;
 
 async function api(path, body) {
   const opts = body === undefined ? {} : { method: "POST", headers: { "Content-Type": "application/json" }, body: JSON.stringify(body) };
-  const r = await fetch(path, opts);
+  const r = await fetch(S.view === "light" ? path + "?solids=0" : path, opts);  // the light view draws no joint solids
   const doc = await r.json();
   if (!r.ok) throw new Error(doc.error || ("HTTP " + r.status));
   return doc;
@@ -115,6 +115,8 @@ function setView(view, why) {
   if (!S.state) return;
   if (view === "full" && document.getElementById("plot").data) Plotly.Plots.resize("plot");
   draw();
+  if (view === "full" && !S.inFlight) api("/api/state").then(d => { if (!S.inFlight) { S.state = d.state; draw(); } })  // with the joint solids
+    .catch(e => setStatus("error", String(e)));
 }
 
 function initView() {
