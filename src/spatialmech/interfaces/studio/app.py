@@ -67,6 +67,11 @@ def _json(doc: dict, status: int = 200) -> Response:
                     media_type="application/json")
 
 
+def _state(session, request: Request) -> dict:
+    """``session.state()`` for ``request``: ``?solids=0`` leaves the joint solids out (the light view)."""
+    return session.state(solids=request.query_params.get("solids") != "0")
+
+
 def create_app(session, view: str = "auto") -> FastAPI:
     """The app over ``session`` (a :func:`spatialmech.studio_session`; one model at a time, one
     user: each call holds a lock).  ``view``: the page's 3-D view, ``"auto"`` (the light one where
@@ -99,9 +104,6 @@ def create_app(session, view: str = "auto") -> FastAPI:
         if required and required not in data:
             raise InputError(f"{required}: missing from the body (got {', '.join(map(repr, data)) or 'nothing'})")
         return data
-
-    def state_of(request: Request) -> dict:  # ?solids=0: the scene without the joint solids (the light view)
-        return session.state(solids=request.query_params.get("solids") != "0")
 
     def guarded(fn):
         async def run(request: Request):
@@ -137,12 +139,12 @@ def create_app(session, view: str = "auto") -> FastAPI:
     @app.get("/api/model")
     def model(request: Request):
         with lock:
-            return _json(doc({"model_info": session.model_info(), "state": state_of(request)}))
+            return _json(doc({"model_info": session.model_info(), "state": _state(session, request)}))
 
     @app.get("/api/state")
     def state(request: Request):
         with lock:
-            return _json(doc({"state": state_of(request)}))
+            return _json(doc({"state": _state(session, request)}))
 
     async def circuit(request: Request):
         with lock:
@@ -152,7 +154,7 @@ def create_app(session, view: str = "auto") -> FastAPI:
         data = await body(request, "actuators")
         with lock:
             r = session.drive(data["actuators"])
-            return _json(doc({**r.to_dict(), "state": state_of(request)}))
+            return _json(doc({**r.to_dict(), "state": _state(session, request)}))
 
     async def pose(request: Request):
         data = await body(request, None)
@@ -164,13 +166,13 @@ def create_app(session, view: str = "auto") -> FastAPI:
         with lock:
             r = session.drive_pose(data.get("task_len"), data.get("task_deg"), euler=data.get("euler"),
                                    relative=data.get("relative", False))
-            return _json(doc({**r.to_dict(), "state": state_of(request)}))
+            return _json(doc({**r.to_dict(), "state": _state(session, request)}))
 
     async def drivers(request: Request):
         data = await body(request, "drivers")
         with lock:
             session.set_drivers(data["drivers"])
-            return _json(doc({"state": state_of(request)}))
+            return _json(doc({"state": _state(session, request)}))
 
     async def fk_all(request: Request):
         data = await body(request, None)
@@ -182,7 +184,7 @@ def create_app(session, view: str = "auto") -> FastAPI:
         data = await body(request, "mode_number")
         with lock:
             session.pick_mode(data["mode_number"])
-            return _json(doc({"state": state_of(request)}))
+            return _json(doc({"state": _state(session, request)}))
 
     async def load(request: Request):
         data = await body(request, "model")
@@ -190,10 +192,10 @@ def create_app(session, view: str = "auto") -> FastAPI:
             raise InputError(f"model: expected a model name or file path, got {data['model']!r}")
         with lock:
             session.load(data["model"])
-            return _json(doc({"model_info": session.model_info(), "state": state_of(request)}))
+            return _json(doc({"model_info": session.model_info(), "state": _state(session, request)}))
 
     app.add_api_route("/api/circuit", guarded(circuit), methods=["GET"])
-    add_desk_routes(app, session, lock, doc, body, guarded, state_of)
+    add_desk_routes(app, session, lock, doc, body, guarded)
     for path, fn in (("/api/drive", drive), ("/api/pose", pose),
                      ("/api/drivers", drivers), ("/api/fk_all", fk_all), ("/api/mode", mode),
                      ("/api/load", load)):
@@ -201,7 +203,7 @@ def create_app(session, view: str = "auto") -> FastAPI:
     return app
 
 
-def add_desk_routes(app: FastAPI, session, lock, doc, body, guarded, state_of) -> None:
+def add_desk_routes(app: FastAPI, session, lock, doc, body, guarded) -> None:
     """The design tools' routes (``session.desk``: snapshots, undo, coupler curve, sweep, the
     driven path as CSV) on ``app``, with the helpers of :func:`create_app`."""
 
@@ -213,13 +215,13 @@ def add_desk_routes(app: FastAPI, session, lock, doc, body, guarded, state_of) -
     async def undo(request: Request):
         with lock:
             label = session.desk.undo()
-            return _json(doc({"restored": label, "snapshots": session.desk.listing(), "state": state_of(request)}))
+            return _json(doc({"restored": label, "snapshots": session.desk.listing(), "state": _state(session, request)}))
 
     async def restore(request: Request):
         data = await body(request, "number")
         with lock:
             session.desk.restore(data["number"])
-            return _json(doc({"snapshots": session.desk.listing(), "state": state_of(request)}))
+            return _json(doc({"snapshots": session.desk.listing(), "state": _state(session, request)}))
 
     async def coupler(request: Request):
         data = await body(request, None)
@@ -235,7 +237,7 @@ def add_desk_routes(app: FastAPI, session, lock, doc, body, guarded, state_of) -
         data = await body(request, "point_len")
         with lock:
             r = session.drag_output(data["point_len"])
-            return _json(doc({**r.to_dict(), "state": state_of(request)}))
+            return _json(doc({**r.to_dict(), "state": _state(session, request)}))
 
     async def path_csv(request: Request):
         with lock:
