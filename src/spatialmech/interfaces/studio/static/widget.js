@@ -121,7 +121,8 @@ function render({ model, el }) {
   model.on("change:snapshots", build);
   model.on("change:figure", draw);
   model.on("change:answered", () => { inFlight = false; build(); send(); });
-  el.querySelector(".sm-view-full").addEventListener("click", () => { if (renderer !== null) setView("full", "full 3-D view (WebGL): switched by hand"); });
+  el.querySelector(".sm-view-full").addEventListener("click", () => (renderer === null
+    ? setView("light", "this browser has no WebGL: only the light 3-D view") : setView("full", "full 3-D view (WebGL): switched by hand")));
   model.on("change:view", () => { const c = SMScene2D.choose(model.get("view"), renderer); setView(c.view, c.why); });
   el.querySelector(".sm-view-light").addEventListener("click", () => setView("light", "light 3-D view: switched by hand"));
   build();
