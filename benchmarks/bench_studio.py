@@ -183,7 +183,8 @@ const [n, step, view, done] = [arguments[0], arguments[1], arguments[2], argumen
   for (let k = 0; k < n; k++) {
     a += step;
     const t0 = performance.now();
-    const r = await fetch("/api/drive", { method: "POST", headers: { "Content-Type": "application/json" },
+    const r = await fetch(view === "light" ? "/api/drive?solids=0" : "/api/drive", { method: "POST",  // as the page asks
+                                          headers: { "Content-Type": "application/json" },
                                           body: JSON.stringify({ actuators: [a] }) });
     const doc = JSON.parse(await r.text());
     const t1 = performance.now();
