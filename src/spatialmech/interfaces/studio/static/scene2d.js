@@ -271,8 +271,11 @@ const SMScene2D = (() => {
       el.addEventListener("wheel", ev => { ev.preventDefault(); this.zoomBy *= Math.exp(-0.001 * ev.deltaY); this.dirtyBack = true; this.request(); },
         { passive: false });
       el.addEventListener("dblclick", () => this.reset());
-      window.addEventListener("resize", () => this.request());
+      this.onResize = () => this.request();
+      window.addEventListener("resize", this.onResize);
     }
+
+    destroy() { window.removeEventListener("resize", this.onResize); this.box.replaceChildren(); }
   }
 
   return { webglRenderer, choose, View, SOFTWARE };

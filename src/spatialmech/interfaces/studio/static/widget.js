@@ -128,7 +128,7 @@ function render({ model, el }) {
   build();
   const chosen = SMScene2D.choose(model.get("view") || "auto", renderer);
   setView(chosen.view, chosen.why);
-  return () => Plotly.purge(plot);
+  return () => { Plotly.purge(plot); light.destroy(); };
 }
 
 export default { render };
