@@ -411,7 +411,7 @@ def _solve_limb(mech: Mechanism, li: int, D: np.ndarray, q_start: np.ndarray, q_
     name = mech.limbs[li].name
     refused = closed = ""
     if all_solutions and method == "auto":
-        done = _closed_form_limb(mech, li, D, q_start, q_all, t)
+        done = _closed_form_limb(mech, li, D, q_start, q_all, t, seed)
         if isinstance(done, str):
             closed = done
         elif done is not None:
@@ -478,28 +478,41 @@ def _homotopy_limb(mech: Mechanism, li: int, D: np.ndarray, q_start: np.ndarray,
 
 
 def _closed_form_limb(mech: Mechanism, li: int, D: np.ndarray, q_start: np.ndarray, q_all: np.ndarray,
-                      t: Tolerances) -> tuple[LimbSolutions, dict] | str | None:
-    """Every solution of a limb that a closed form covers (a spherical 3R:
-    :mod:`.closed_forms.spherical_3r_limb`), polished and ordered as the homotopy's; ``None``
-    when none covers it, the closed form's statement when it could not decide (a continuum)."""
+                      t: Tolerances, seed: int) -> tuple[LimbSolutions, dict] | str | None:
+    """Every solution of a limb that a structure solves: a spherical 3R in closed form
+    (:mod:`.closed_forms.spherical_3r_limb`), or a six-joint limb with a spherical wrist and a
+    slide among its first three joints, decoupled (:mod:`.wrist_limb`); polished and ordered as
+    the homotopy's.  ``None`` when neither covers the limb, the statement when it could not
+    decide (a continuum, an unproven wrist-centre solve)."""
     from types import SimpleNamespace
 
+    from . import wrist_limb
     from .closed_forms import spherical_3r_limb as s3r
 
-    form = s3r.spherical_3r(mech, li, limb_chains(mech)[li].screws)
-    if form is None:
+    ch = limb_chains(mech)[li]
+    L = mech.characteristic_length
+    form = s3r.spherical_3r(mech, li, ch.screws)
+    split = wrist_limb.wrist_split(mech, li) if form is None else None
+    if form is not None:
+        sols, statement, proven = s3r.solve(form, D, L)
+    elif split is not None:
+        sols, statement, proven = wrist_limb.solve(mech, li, split, D, seed)
+    else:
         return None
-    sols, statement, proven = s3r.solve(form, D, mech.characteristic_length)
     if not proven:
         return statement
-    ch = limb_chains(mech)[li]
-    off = [float(np.linalg.norm(chain_forward(ch, q)[0][:3, :3] - D[:3, :3])) for q in sols]
-    if off and max(off) > 1e-8:  # a root of the closed form that does not close: say so, claim nothing
-        return f"{statement}; but a root is {max(off):.2g} off the pose's rotation"
+    off = [float(np.linalg.norm(T[:3, :3] - D[:3, :3]) + np.linalg.norm(T[:3, 3] - D[:3, 3]) / L)
+           for T in (chain_forward(ch, q)[0] for q in sols)]
+    if off and max(off) > 1e-8:  # a root that does not close: say so, claim nothing
+        return f"{statement}; but a root is {max(off):.2g} off the pose"
     ls = _homotopy_limb(mech, li, D, q_start, q_all, SimpleNamespace(solutions=sols), t)
-    return ls, {"limb": mech.limbs[li].name, "method": "closed-form", "complete": True, "completeness": statement,
-                "n_real": len(ls.solutions), "n_certified": None,
-                "certification": "not attempted: a closed form (the limb has more equations than unknowns)"}
+    rep = {"limb": mech.limbs[li].name, "method": "closed-form" if form is not None else "decoupled",
+           "complete": True, "completeness": statement, "n_real": len(ls.solutions)}
+    if form is not None:
+        return ls, {**rep, "n_certified": None,
+                    "certification": "not attempted: a closed form (the limb has more equations than unknowns)"}
+    ls, cert = _certify_limb(mech, li, D, ls, seed)
+    return ls, {**rep, **cert}
 
 
 _LIMB_SYSTEMS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # per model: {(limb, seed): LimbIK}

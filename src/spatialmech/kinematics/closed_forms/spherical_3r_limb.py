@@ -32,7 +32,7 @@ import numpy as np
 
 from ...model.mechanism import GROUND, Mechanism
 
-__all__ = ["Spherical3R", "solve", "spherical_3r"]
+__all__ = ["Spherical3R", "solve", "spherical_3r", "spherical_axes"]
 
 #: |sin| of the angle between two axes below which they count as parallel (not a spherical 3R);
 #: and the size below which a vector lies on the axis it is turned about (a continuum).
@@ -58,6 +58,12 @@ def spherical_3r(mech: Mechanism, li: int, screws: np.ndarray, tol: float = 1e-9
         return None
     if any(j.type != "R" or j.freedoms[0].locked or j.freedoms[0].pitch != 0.0 for j in limb.joints):
         return None
+    return spherical_axes(screws, tol)
+
+
+def spherical_axes(screws: np.ndarray, tol: float = 1e-9) -> Spherical3R | None:
+    """Three rotation screws (3, 6) (direction; moment) as a spherical 3R: ``None`` when their
+    axes do not meet at one point or two consecutive ones are parallel."""
     w, m = screws[:, :3], screws[:, 3:]
     # the common point: m_i = c x w_i  (moments about the origin), least squares over the three
     A = np.concatenate([np.array([[0.0, wi[2], -wi[1]], [-wi[2], 0.0, wi[0]], [wi[1], -wi[0], 0.0]]) for wi in w])
