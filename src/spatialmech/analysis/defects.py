@@ -41,7 +41,7 @@ from ..kinematics.backend import closure_jacobian
 from ..kinematics.jacobian import complete_jacobians, driver_determinants
 from ..geometry.tolerances import current as current_tolerances
 from ..kinematics.position import PoseFit, configuration_at_pose, freedom_values
-from ..kinematics.tracking import MotionProblem, TrackResult
+from ..kinematics.tracking import DriverMonitor, MotionProblem, TrackResult
 from ..model.joints import make_joint
 from ..model.mechanism import Mechanism, Pose
 from ..results import Progress, Steps, TrackStatus
@@ -89,7 +89,7 @@ def dj_function(mech: Mechanism, drivers: list[str], reference: Configuration):
     projected on the row space at ``reference`` (sign-continuous, zero at the same points)."""
     test = driver_determinants(mech, reference, drivers)
     if np.all(np.isfinite(test)):
-        return (lambda c: driver_determinants(mech, c, drivers)), "complete Jacobian determinant"
+        return DriverMonitor(mech, drivers), "complete Jacobian determinant"
     active = active_mask(mech)
     row, col = closure_scales(mech, active)
     A0, _ = closure_jacobian(mech, reference, active=active)

@@ -21,7 +21,9 @@ actuator values (forward position by continuation).
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
 from dataclasses import dataclass, field
 from typing import Protocol
 
@@ -35,11 +37,13 @@ from ..results import EventKind, Progress, TrackStatus
 from . import backend
 from .closure import Configuration, active_mask, ball_groups, closure_scales, hub_count
 from .backend import closure_jacobian, retract
+from .jacobian import driver_determinants
 
 __all__ = [
     "SENSE_TOL",
     "ActuatorPathProblem",
     "CurveProblem",
+    "DriverMonitor",
     "EuclideanProblem",
     "Event",
     "MotionProblem",
@@ -47,6 +51,7 @@ __all__ = [
     "conventional_sense",
     "correct_on_hyperplane",
     "predict_correct",
+    "python_loop",
     "sense_order",
     "trace_motion",
     "track",
@@ -311,6 +316,196 @@ def predict_correct(problem, x, step, t, tol, max_iter, contraction=0.6):
     return correct_on_hyperplane(problem, problem.retract(x, step), t, tol, max_iter, contraction)
 
 
+@dataclass(frozen=True)
+class _Settings:
+    """The arguments of :func:`track` that the steps read."""
+
+    x0: object
+    t0: np.ndarray
+    h0: float
+    h_min: float
+    h_max: float
+    max_arc: float
+    max_steps: int
+    tol: float
+    cos_max: float
+    event_tol: float
+    detect_closure: bool
+    stop: Callable | None
+    progress: Progress | None
+
+
+@dataclass
+class _Walk:
+    """The tracker's state between steps: the current point ``x``, tangent ``t``, arc ``s``, step
+    length ``h`` and Keller frame and orientation there, the points, arcs, tangents and monitor
+    values so far, the events, the counters and the outcome."""
+
+    x: object
+    t: np.ndarray
+    s: float
+    h: float
+    frame: tuple
+    orient: float
+    xs: list
+    ss: list
+    ts: list
+    mon: dict[str, list[float]]
+    events: list = field(default_factory=list)
+    flips: int = 0
+    rejected: int = 0
+    total_iters: int = 0
+    steps: int = 0
+    d_last: tuple | None = None  # (point, difference of it from x0) of the last accepted step
+    status: TrackStatus = TrackStatus.MAX_ARC
+    reason: str = ""
+    closed: bool = False
+
+    def going(self, cfg: _Settings) -> bool:
+        return self.s < cfg.max_arc and self.steps < cfg.max_steps
+
+    def fail_h_min(self, cfg: _Settings) -> None:
+        why = "an orientation flip (a bifurcation point or a crossing branch)" if self.flips else "a singular point"
+        self.status = TrackStatus.H_MIN
+        self.reason = f"no acceptable step above {cfg.h_min:g} at arc length {self.s:.6g}: {why}"
+
+
+def _attempt(problem, w: _Walk, cfg: _Settings, h: float):
+    """One predictor-corrector step of length ``h`` from ``w``'s point and its test: ``(ok, xn,
+    tn, A_n, o_n, iterations)`` (``o_n``: the orientation at ``xn`` when the compiled step test
+    certified it)."""
+    xn, ok, iters, moved = predict_correct(problem, w.x, h * w.t, w.t, cfg.tol, 12)
+    if not (ok and moved < 0.5 * h):
+        return False, xn, None, None, None, iters
+    tn, A_n, o_n = _step_tangent(problem, xn, w.t, w.frame)
+    if float(tn @ w.t) < cfg.cos_max:
+        return False, xn, tn, A_n, o_n, iters
+    if w.orient != 0.0 and (o_n if o_n is not None else _orientation(A_n, tn, w.frame)) != w.orient:
+        w.flips += 1  # the step crossed to another branch
+        return False, xn, tn, A_n, o_n, iters
+    return True, xn, tn, A_n, o_n, iters
+
+
+def _closes(problem, w: _Walk, cfg: _Settings, xn, tn: np.ndarray, h: float) -> bool:
+    """Whether the step from ``w``'s point to ``xn`` crosses the start point's plane close to
+    it; if so the closing point is located and appended, and ``w`` is closed."""
+    x0, t0 = cfg.x0, cfg.t0
+    # the start point seen from the last point: remembered from the step before
+    d_prev = w.d_last if w.d_last is not None and w.d_last[0] is w.x else (w.x, problem.difference(x0, w.x))
+    d_new = (xn, problem.difference(x0, xn))
+    w.d_last = d_new
+    g0, g1 = float(t0 @ d_prev[1]), float(t0 @ d_new[1])
+    if not (g0 < 0 <= g1 and np.linalg.norm(d_new[1]) < 3 * h + 1e-9 and float(tn @ t0) > 0):
+        return False
+
+    def gfun(y):  # land exactly on the start point's plane: the last point is the start again
+        return float(t0 @ problem.difference(x0, y))
+
+    ev = _locate(problem, w.x, w.t, h, gfun, "closure", g0, g1, w.s, len(w.xs) - 1, cfg.tol, cfg.event_tol)
+    w.xs.append(ev.x)  # the caller appends the monitors there
+    w.ss.append(ev.s)
+    w.ts.append(tn)
+    _close(w, cfg, ev.s)
+    return True
+
+
+def _close(w: _Walk, cfg: _Settings, s: float) -> None:
+    """``w`` closed at arc ``s``: an event at the closing point is the start point met again,
+    not a new one."""
+    w.events = [e for e in w.events if e.s < s - max(cfg.event_tol, 1e-9)]
+    w.closed, w.status, w.s = True, TrackStatus.CLOSED, s
+
+
+def _python_step(problem, w: _Walk, cfg: _Settings, monitors: dict[str, Callable]) -> bool:
+    """One step of the reference loop (a rejected step halves ``h``); False when the track ends."""
+    h = w.h = min(w.h, cfg.h_max, cfg.max_arc - w.s + 1e-15)
+    ok, xn, tn, A_n, o_n, iters = _attempt(problem, w, cfg, h)
+    w.total_iters += iters
+    if not ok:
+        w.rejected += 1
+        w.h *= 0.5
+        if w.h < cfg.h_min:
+            w.fail_h_min(cfg)
+            return False
+        return True
+    assert tn is not None and A_n is not None  # both set whenever the step is accepted
+    vals = {k: float(f(xn)) for k, f in monitors.items()}
+    for k in monitors:
+        a, b = w.mon[k][-1], vals[k]
+        if np.sign(a) != np.sign(b) and a != 0:
+            w.events.append(_locate(problem, w.x, w.t, h, monitors[k], k, a, b, w.s, len(w.xs) - 1, cfg.tol,
+                                    cfg.event_tol))
+    if cfg.detect_closure and w.s + h > 4 * cfg.h0 and len(w.xs) > 3 and _closes(problem, w, cfg, xn, tn, h):
+        for k, f in monitors.items():
+            w.mon[k].append(float(f(w.xs[-1])))
+        return False
+    w.xs.append(xn)
+    w.ss.append(w.s + h)
+    w.ts.append(tn)
+    for k in monitors:
+        w.mon[k].append(vals[k])
+    w.x, w.t, w.s = xn, tn, w.s + h
+    if o_n is not None:  # full row rank certified: the reference's frame is (None, None)
+        w.frame, w.orient = (None, None), o_n
+    else:
+        w.frame = _frame(A_n, tn)
+        w.orient = _orientation(A_n, tn, w.frame)
+    w.steps += 1
+    if cfg.progress is not None:
+        cfg.progress(w.s, cfg.max_arc, "tracing")
+    if iters <= 2:
+        w.h *= 1.5
+    elif iters >= 5:
+        w.h *= 0.7
+    if cfg.stop is not None and cfg.stop(w.x, w.s):
+        w.status = TrackStatus.STOPPED
+        return False
+    return True
+
+
+_PYTHON_LOOP: ContextVar[bool] = ContextVar("spatialmech_python_loop", default=False)
+
+
+@contextmanager
+def python_loop() -> Iterator[None]:
+    """Inside the block :func:`track` makes every step in its Python loop (the reference), even
+    where the compiled loop applies (a mechanism's motion with its drivers' DJ as the monitor)."""
+    token = _PYTHON_LOOP.set(True)
+    try:
+        yield
+    finally:
+        _PYTHON_LOOP.reset(token)
+
+
+class DriverMonitor:
+    """The vector monitor ``config -> DJ of each driver`` (:func:`.jacobian.driver_determinants`)
+    of ``mech``: the one the compiled tracker loop evaluates itself."""
+
+    def __init__(self, mech: Mechanism, drivers) -> None:
+        self.mech = mech
+        self.drivers = list(drivers)
+
+    def __call__(self, config) -> np.ndarray:
+        return driver_determinants(self.mech, config, self.drivers)
+
+
+def _compiled_loop(problem, vector_monitor, monitors, cfg: _Settings, x0):
+    """The compiled loop (:class:`.compiled.trace.TraceLoop`) when it applies: a
+    ``MotionProblem`` with a :class:`DriverMonitor` of its mechanism as its only monitor, the
+    compiled engine in use, no ``stop`` or ``progress`` callback, outside :func:`python_loop`."""
+    if (vector_monitor is None or not isinstance(vector_monitor[1], DriverMonitor) or type(problem) is not MotionProblem
+            or len(monitors) != len(vector_monitor[0]) or cfg.stop is not None or cfg.progress is not None
+            or _PYTHON_LOOP.get() or (fast := backend.engine()) is None):
+        return None
+    mon = vector_monitor[1]
+    if mon.mech is not problem.mech or not fast.TraceLoop.applies(problem.mech, problem.active, len(cfg.t0)):
+        return None
+    settings = (cfg.h0, cfg.h_min, cfg.h_max, cfg.max_arc, cfg.tol, cfg.cos_max, cfg.event_tol,
+                1.0 if cfg.detect_closure else 0.0, float(cfg.max_steps))
+    return fast.TraceLoop(problem.mech, problem.active, problem.row, problem.col, problem.kinds != "P", mon.drivers, x0,
+                          cfg.t0, settings, current_tolerances().rank)
+
+
 def track(
     problem,
     x0,
@@ -342,7 +537,56 @@ def track(
     name).  ``stop(x, s)``: return True to stop after a point.
     ``progress(s, max_arc, "tracing")`` is called after every accepted step.
     Arc length is measured in the problem's (nondimensional) local coordinates.
+
+    A mechanism's motion (:class:`MotionProblem`) with its drivers' DJ as the vector monitor
+    (:class:`DriverMonitor`) runs the compiled loop (:mod:`.compiled.kernels_trace`: the same
+    steps, kernels and decisions; a step it cannot certify is made here), unless
+    :func:`python_loop` or the Python reference (:func:`.backend.python_reference`) is in force.
     """
+    monitors = _monitor_functions(monitors, vector_monitor)
+    t = problem.tangent(x0)
+    t = t / np.linalg.norm(t)
+    along = float(t @ direction) if direction is not None else 0.0
+    if direction is not None and abs(along) > SENSE_TOL * float(np.linalg.norm(direction)):
+        t = t if along > 0 else -t
+    else:  # the documented convention: the sense depends on the model and the point only
+        t = t * (float(getattr(problem, "sense", 1.0)) * conventional_sense(t, getattr(problem, "sense_order", ())))
+    cfg = _Settings(x0, t.copy(), h0, h_min, h_max, max_arc, max_steps, tol, float(np.cos(np.radians(max_turn_deg))),
+                    event_tol, detect_closure, stop, progress)
+    A_x = problem.jacobian(x0)
+    frame = _frame(A_x, t)
+    w = _Walk(x0, t, 0.0, h0, frame, _orientation(A_x, t, frame), [x0], [0.0], [t],
+              {k: [float(f(x0))] for k, f in monitors.items()})
+    loop = _compiled_loop(problem, vector_monitor, monitors, cfg, x0)
+    while w.going(cfg):
+        if loop is not None and w.frame[0] is None:
+            if _run_compiled(loop, w, cfg, vector_monitor[0] if vector_monitor else []):
+                break
+            if not w.going(cfg):
+                break
+        if not _python_step(problem, w, cfg, monitors):
+            break
+    mons = {k: np.array(v) for k, v in w.mon.items()}
+    return TrackResult(w.xs, np.array(w.ss), w.ts, mons, w.events, w.closed, w.status, w.rejected, w.total_iters,
+                       {k: float(np.min(np.abs(v))) for k, v in mons.items()}, w.reason)
+
+
+def _run_compiled(loop, w: _Walk, cfg: _Settings, names: list[str]) -> bool:
+    """The compiled loop from ``w``; True when the track ended in it (``w``'s outcome set),
+    False when it hands the next step to the Python loop."""
+    code = loop.run(w, names, Event)
+    if code == loop.PYTHON_STEP:
+        return False
+    if code == loop.H_MIN:
+        w.fail_h_min(cfg)
+    elif code == loop.CLOSED:
+        _close(w, cfg, w.s)
+    return True
+
+
+def _monitor_functions(monitors, vector_monitor) -> dict[str, Callable]:
+    """``monitors`` and the components of ``vector_monitor`` as one dict of scalar functions
+    (the vector evaluated once per point)."""
     monitors = dict(monitors or {})
     if vector_monitor is not None:
         vnames, vfun = vector_monitor
@@ -357,110 +601,7 @@ def track(
 
         for j, nm in enumerate(vnames):
             monitors[nm] = (lambda x, _k=j: float(_vec(x)[_k]))
-    t = problem.tangent(x0)
-    t = t / np.linalg.norm(t)
-    along = float(t @ direction) if direction is not None else 0.0
-    if direction is not None and abs(along) > SENSE_TOL * float(np.linalg.norm(direction)):
-        t = t if along > 0 else -t
-    else:  # the documented convention: the sense depends on the model and the point only
-        t = t * (float(getattr(problem, "sense", 1.0)) * conventional_sense(t, getattr(problem, "sense_order", ())))
-    t0 = t.copy()
-    xs, ss, ts = [x0], [0.0], [t]
-    mon = {k: [float(f(x0))] for k, f in monitors.items()}
-    events: list[Event] = []
-    x, s, h = x0, 0.0, h0
-    A_x = problem.jacobian(x0)
-    frame = _frame(A_x, t)
-    orient = _orientation(A_x, t, frame)
-    flips = 0
-    d_last: tuple | None = None  # (point, difference of it from x0) of the last accepted step
-    rejected = 0
-    total_iters = 0
-    cos_max = np.cos(np.radians(max_turn_deg))
-    status = TrackStatus.MAX_ARC
-    reason = ""
-    closed = False
-    steps = 0
-    while s < max_arc and steps < max_steps:
-        h = min(h, h_max, max_arc - s + 1e-15)
-        xn, ok, iters, moved = predict_correct(problem, x, h * t, t, tol, 12)
-        total_iters += iters
-        tn: np.ndarray | None = None
-        A_n: np.ndarray | None = None
-        o_n: float | None = None  # the orientation at xn when the compiled step test certified it
-        if ok and moved < 0.5 * h:
-            tn, A_n, o_n = _step_tangent(problem, xn, t, frame)
-            if float(tn @ t) < cos_max:
-                ok = False
-            elif orient != 0.0 and (o_n if o_n is not None else _orientation(A_n, tn, frame)) != orient:
-                ok = False  # the step crossed to another branch
-                flips += 1
-        else:
-            ok = False
-        if not ok:
-            rejected += 1
-            h *= 0.5
-            if h < h_min:
-                why = "an orientation flip (a bifurcation point or a crossing branch)" if flips else "a singular point"
-                status = TrackStatus.H_MIN
-                reason = f"no acceptable step above {h_min:g} at arc length {s:.6g}: {why}"
-                break
-            continue
-        assert tn is not None and A_n is not None  # both set whenever the step is accepted
-        # accept
-        s_new = s + h
-        vals = {k: float(f(xn)) for k, f in monitors.items()}
-        for k in monitors:
-            a, b = mon[k][-1], vals[k]
-            if np.sign(a) != np.sign(b) and a != 0:
-                events.append(_locate(problem, x, t, h, monitors[k], k, a, b, s, len(xs) - 1, tol, event_tol))
-        if detect_closure and s_new > 4 * h0 and len(xs) > 3:
-            # the start point seen from the last point: remembered from the step before
-            d_prev = d_last if d_last is not None and d_last[0] is x else (x, problem.difference(x0, x))
-            d_new = (xn, problem.difference(x0, xn))
-            d_last = d_new
-            d_prev, d_new = d_prev[1], d_new[1]
-            g0, g1 = float(t0 @ d_prev), float(t0 @ d_new)
-            if g0 < 0 <= g1 and np.linalg.norm(d_new) < 3 * h + 1e-9 and float(tn @ t0) > 0:
-                # land exactly on the start point's plane: the last point is the start again
-                def gfun(y):
-                    return float(t0 @ problem.difference(x0, y))
-                ev = _locate(problem, x, t, h, gfun, "closure", g0, g1, s, len(xs) - 1, tol, event_tol)
-                closed = True
-                xs.append(ev.x)
-                ss.append(ev.s)
-                ts.append(tn)
-                for k, f in monitors.items():
-                    mon[k].append(float(f(ev.x)))
-                # an event at the closing point is the start point met again: not a new one
-                events = [e for e in events if e.s < ev.s - max(event_tol, 1e-9)]
-                status = TrackStatus.CLOSED
-                s = ev.s
-                break
-        xs.append(xn)
-        ss.append(s_new)
-        ts.append(tn)
-        for k in monitors:
-            mon[k].append(vals[k])
-        x, t, s = xn, tn, s_new
-        if o_n is not None:  # full row rank certified: the reference's frame is (None, None)
-            frame, orient = (None, None), o_n
-        else:
-            frame = _frame(A_n, tn)
-            orient = _orientation(A_n, tn, frame)
-        steps += 1
-        if progress is not None:
-            progress(s, max_arc, "tracing")
-        if iters <= 2:
-            h *= 1.5
-        elif iters >= 5:
-            h *= 0.7
-        if stop is not None and stop(x, s):
-            status = TrackStatus.STOPPED
-            break
-    mons = {k: np.array(v) for k, v in mon.items()}
-    return TrackResult(xs, np.array(ss), ts, mons, events, closed, status, rejected, total_iters,
-                       {k: float(np.min(np.abs(v))) for k, v in mons.items()}, reason)
+    return monitors
 
 
 def _locate(problem, x, t, h, f, name, fa, fb, s, step, tol, event_tol):

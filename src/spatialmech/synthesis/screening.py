@@ -33,6 +33,7 @@ import itertools
 import math
 import time
 from collections.abc import Sequence
+from contextlib import nullcontext
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -42,7 +43,7 @@ from ..geometry.tolerances import current as current_tolerances
 from ..model.mechanism import Mechanism
 from ..results import ScreenStage
 from ..serialize import fields_dict
-from ..kinematics.tracking import conventional_sense
+from ..kinematics.tracking import conventional_sense, python_loop
 from .cs_dyads import CSBranch, CSDyad, CSFamily, CSTask, cs_task, dyad_from_vector
 from .five_cs import assemble_5cs, cs_configuration, cs_configurations
 
@@ -427,7 +428,8 @@ def judge_candidate(pool: DyadPool, idx: Sequence[int], *, candidate: int = 0, h
             return done(rejected_by=ScreenStage.DJ_SIGNS, min_closure_sigma_positions=sig)
         # one degree of freedom is shown by the assembly stage (the closure Jacobian has full row
         # rank at the positions, so generically): the analysis's own mobility check is skipped
-        r = defect_analysis(mech, drivers=list(keeps), h0=h0, max_arc=max_arc, check_dof=not batched)
+        with nullcontext() if batched else python_loop():  # the reference: the tracker's Python loop
+            r = defect_analysis(mech, drivers=list(keeps), h0=h0, max_arc=max_arc, check_dof=not batched)
     except (InputError, ValueError, RuntimeError, np.linalg.LinAlgError) as e:
         return done(rejected_by=ScreenStage.ERROR, error=f"{type(e).__name__}: {e}")
     usable = tuple(r.usable_drivers)

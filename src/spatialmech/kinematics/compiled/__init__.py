@@ -10,7 +10,8 @@ system), :mod:`.kernels_ik` (one limb's inverse position),
 :mod:`.kernels_four_sps_cu` (the 4-SPS/CU closed-form leg lengths), :mod:`.kernels_limits`
 (with its entry :mod:`.limits`: joint points of many configurations, for the workspace limits),
 :mod:`.kernels_task` (with its entry :mod:`.tasks`: the task-coordinate solve), :mod:`.kernels_tracking` (the
-continuation tracker's tangent and orientation test); :mod:`.jit` is numba's ``njit`` or its
+continuation tracker's tangent and orientation test), :mod:`.kernels_trace` (with its entry
+:mod:`.trace`: the tracker's loop); :mod:`.jit` is numba's ``njit`` or its
 stand-in.
 
 Callers do not choose between this package and the Python reference themselves:
@@ -51,6 +52,7 @@ from .kernels_loops import pack as pack_loop_system
 from .kernels_loops import square_batch as loop_square_batch
 from .kernels_tracking import bordered_tangent
 from .legs import correct_legs, inverse_legs_many
+from .trace import TraceLoop
 from .limits import joint_points_many, link_margins_many
 from .tasks import task_grid, task_solve
 from . import maps as maps  # performance-map kernels (analysis/maps.py)
@@ -59,6 +61,7 @@ __all__ = [
     "AVAILABLE",
     "UNAVAILABLE_REASON",
     "CompiledMechanism",
+    "TraceLoop",
     "bordered_tangent",
     "closure_jacobian",
     "closure_jacobians",

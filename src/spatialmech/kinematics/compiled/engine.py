@@ -67,6 +67,7 @@ __all__ = [
     "correct",
     "correct_many",
     "correct_on_hyperplane",
+    "driver_columns",
     "driver_determinants",
     "driver_determinants_many",
     "limb_gn",
@@ -524,7 +525,7 @@ def _driver_indices(mech: Mechanism, drivers) -> np.ndarray:
     return known[key]
 
 
-def _driver_columns(mech: Mechanism, cm: CompiledMechanism, drivers) -> tuple[np.ndarray, np.ndarray]:
+def driver_columns(mech: Mechanism, cm: CompiledMechanism, drivers) -> tuple[np.ndarray, np.ndarray]:
     """The drivers' joint indices and their places among the active joints (remembered)."""
     key = ("columns", tuple(drivers))
     known = _DRIVERS.setdefault(mech, {})
@@ -552,7 +553,7 @@ def driver_determinants(mech: Mechanism, config: Configuration, drivers) -> np.n
     cm = compile_mechanism(mech)
     _check(mech, cm, config)
     q, D, B = _config_arrays(cm, config)  # checked: the batch of one goes straight to the kernel
-    idx, pos = _driver_columns(mech, cm, drivers)
+    idx, pos = driver_columns(mech, cm, drivers)
     out = np.empty((1, len(idx)))
     flag = nb_dets_many(*_system_args(cm), cm.linear, cm.active, cm.length, current_tolerances().rank, q[None], D[None],
                         B[None], idx, pos, cm.n_bodies > 0, out)

@@ -1,0 +1,289 @@
+"""The continuation tracker's loop compiled (:func:`spatialmech.kinematics.tracking.track`) for
+a mechanism's motion (``tracking.MotionProblem``) with the DJ of its drivers as the vector
+monitor (``tracking.DriverMonitor``, what the defect analysis traces).
+
+:func:`nb_trace` makes the reference loop's steps -- the predictor and corrector
+(:func:`.kernels_closure.nb_correct_hyperplane`), the step test (:func:`.kernels_tracking.nb_bordered_tangent`:
+the tangent, its turn, Keller's orientation), the step control, the DJ of every driver at each
+accepted point (:func:`.kernels_drivers.nb_driver_dets`), the location of their sign changes by
+Illinois on the step length, and the loop closure -- with the same kernels, in the same order,
+as many as it can in one call.  It hands a step back to the Python loop, *before* changing
+anything for it, where the reference would leave the compiled kernels: a step test that the
+bordered LU does not certify (the reference then takes an SVD), a driver determinant the kernel
+declines or that is not finite.  The Python loop makes that one step and calls again.
+
+Arrays (``G``, a tuple): ``S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends,
+linear, active, drivers, cols, row, col, wrap`` (the compiled model, the drivers' joint indices
+and their active columns, the problem's row and column scales, the wrapped local coordinates).
+``par``: ``L, rank tolerance, h0, h_min, h_max, max_arc, tol, cos(max turn), event_tol,
+detect_closure, max_steps, bodies`` (see :data:`PAR`).  State (in and out): ``fs`` = (arc length,
+step length, orientation, arc of the closing point); ``ist`` = (flips, rejected, corrector
+iterations, steps, points written, events written, points before them: the Python lists'
+length); the current point ``X = (q, D, B)`` and tangent ``t``, the
+monitors at it ``mlast``.  Output, in ``Bf`` from index 0: the accepted points (``q, D, B``, arc,
+tangent, monitors; ``ist[4]`` of them) and the events (``q, D, B`` and ``Ef`` = driver, arc,
+step, value before, value after, value, bracket; ``ist[5]``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .jit import njit
+from .kernels_closure import nb_closure_system, nb_closure_ws_size, nb_colmap, nb_correct_hyperplane, nb_copy44
+from .kernels_drivers import nb_closure_dets, nb_difference, nb_driver_dets
+from .kernels_tracking import nb_bordered_tangent
+
+__all__ = ["PAR", "nb_trace", "nb_trace_correct", "nb_trace_dets"]
+
+#: The names of ``par``'s entries, in order.
+PAR = ("L", "rank", "h0", "h_min", "h_max", "max_arc", "tol", "cos_max", "event_tol", "detect_closure", "max_steps",
+       "bodies")
+
+#: :func:`nb_trace`'s return codes.
+DONE, H_MIN, CLOSED, PYTHON_STEP, FULL = 0, 1, 2, 3, 4
+
+
+@njit(cache=True)
+def nb_trace_correct(G, q, D, B, t, a, tol, max_iter, pred, qo, Do, Bo, info):  # pragma: no cover - compiled
+    """``tracking.predict_correct(problem, x, a * t, t, tol, max_iter)`` of a ``MotionProblem``:
+    ``info`` = (converged, iterations, total correction length)."""
+    S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends, linear, active, drivers, cols, row, col, wrap = G
+    for c in range(len(t)):
+        pred[c] = a * t[c]
+    nb_correct_hyperplane(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends, q, D, B, active, row, col, t,
+                          tol, max_iter, 0.6, pred, np.bool_(True), qo, Do, Bo, info)
+
+
+@njit(cache=True)
+def nb_trace_dets(G, par, q, D, B, out):  # pragma: no cover - compiled
+    """The DJ of every driver (``engine.driver_determinants``) into ``out``: 0, or 2 where the
+    Python path must decide (the kernel declines, or a value is not finite)."""
+    S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends, linear, active, drivers, cols, row, col, wrap = G
+    if par[11] != 0.0:
+        nb_closure_dets(S, ball_of, ball_axes, ball_centre, limb_start, ends, linear, active, par[0], q, D, B, cols, out)
+    elif nb_driver_dets(S, ball_of, ball_axes, ball_centre, limb_start, ends, active, par[0], par[1], q, D, B, drivers,
+                        out) != 0:
+        return 2
+    for v in out:
+        if not np.isfinite(v):
+            return 2
+    return 0
+
+
+@njit(cache=True)
+def _dot(a, b):  # pragma: no cover - compiled
+    s = 0.0
+    for i in range(len(a)):
+        s += a[i] * b[i]
+    return s
+
+
+@njit(cache=True)
+def _monitor(G, par, which, q, D, B, X0, t0, vals, dif):  # pragma: no cover - compiled
+    """(flag, value): DJ of driver ``which`` at ``(q, D, B)``; ``which = -1``: the closure
+    function ``t0 . difference(x0, x)``."""
+    if which >= 0:
+        if nb_trace_dets(G, par, q, D, B, vals) != 0:
+            return 2, 0.0
+        return 0, vals[which]
+    nb_difference(G[2], G[3], X0[0], X0[1], X0[2], q, D, B, G[8], G[13], G[12], dif)
+    return 0, _dot(t0, dif)
+
+
+@njit(cache=True)
+def _locate(G, par, X, t, h, which, fa, fb, X0, t0, Xm, W, res):  # pragma: no cover - compiled
+    """``tracking._locate``: Illinois on the step length ``[0, h]`` from ``X`` along ``t``, each
+    trial corrected onto the curve, into ``Xm``; ``res`` = (step length, monitor there, bracket
+    values).  Returns 0, or 2 where the Python path must decide."""
+    pred, info, vals, dif = W
+    lo, hi, flo, fhi = 0.0, h, fa, fb
+    true_lo, true_hi = fa, fb
+    side = 0
+    mid, fm = 0.0, 0.0
+    for _ in range(60):
+        if flo != fhi:
+            mid = hi - fhi * (hi - lo) / (fhi - flo)
+            if not (lo < mid < hi):
+                mid = 0.5 * (lo + hi)
+        else:
+            mid = 0.5 * (lo + hi)
+        nb_trace_correct(G, X[0], X[1], X[2], t, mid, par[6], np.int64(20), pred, Xm[0], Xm[1], Xm[2], info)
+        flag, fm = _monitor(G, par, which, Xm[0], Xm[1], Xm[2], X0, t0, vals, dif)
+        if flag != 0:
+            return 2
+        if info[0] == 0.0 or fm == 0.0:
+            break
+        if np.sign(fm) == np.sign(flo):
+            lo, flo, true_lo = mid, fm, fm
+            if side == -1:
+                fhi *= 0.5
+            side = -1
+        else:
+            hi, fhi, true_hi = mid, fm, fm
+            if side == 1:
+                flo *= 0.5
+            side = 1
+        if hi - lo < par[8]:
+            break
+    res[0], res[1], res[2], res[3] = mid, fm, true_lo, true_hi
+    return 0
+
+
+@njit(cache=True)
+def _attempt(G, par, X, t, h, orient, Xn, tn, S):  # pragma: no cover - compiled
+    """One predictor-corrector step of length ``h`` and its test: (code, corrector iterations,
+    orientation at the new point); code 0 accepted, 1 rejected, 3 rejected by an orientation
+    flip, 2 handed to the Python loop (the bordered LU does not certify the step test)."""
+    pred, info, info4, A, As, Mb, r, cws, colmap = S
+    nb_trace_correct(G, X[0], X[1], X[2], t, h, par[6], np.int64(12), pred, Xn[0], Xn[1], Xn[2], info)
+    iters = int(info[1])
+    if not (info[0] == 1.0 and info[2] < 0.5 * h):
+        return 1, iters, 0.0
+    row, col = G[11], G[12]
+    nc = As.shape[1]
+    nb_closure_system(G[0], G[1], G[3], G[4], G[5], G[6], Xn[0], Xn[1], Xn[2], colmap, nc - 6 * (1 + Xn[2].shape[0]), A,
+                      r, cws)
+    for i in range(As.shape[0]):
+        for c in range(nc):
+            As[i, c] = row[i] * A[i, c] * col[c]
+    nb_bordered_tangent(As, t, Mb, tn, info4)
+    if not (info4[0] == 1.0 and info4[2] > 10.0 * par[1] * max(1.0, info4[3])):
+        return 2, iters, 0.0
+    if _dot(tn, t) < par[7]:
+        return 1, iters, info4[1]
+    if orient != 0.0 and info4[1] != orient:
+        return 3, iters, info4[1]
+    return 0, iters, info4[1]
+
+
+@njit(cache=True)
+def _put_point(Bf, k, q, D, B, s, t, m):  # pragma: no cover - compiled
+    Pq, PD, PB, Ps, Pt, Pm = Bf[0], Bf[1], Bf[2], Bf[3], Bf[4], Bf[5]
+    Pq[k, :] = q
+    nb_copy44(D, PD[k])
+    for b in range(B.shape[0]):
+        nb_copy44(B[b], PB[k, b])
+    Ps[k] = s
+    Pt[k, :] = t
+    Pm[k, :] = m
+
+
+@njit(cache=True)
+def _events(G, par, fs, ist, X, t, h, Xn, mlast, vals, X0, t0, Xm, W, Bf):  # pragma: no cover - compiled
+    """The sign changes of the monitors over the step from ``X`` to ``Xn`` (monitors ``vals``
+    there), located and written from event ``ist[5]`` on (not counted yet); returns the number
+    written, or -1 where the Python path must decide."""
+    Eq, ED, EB, Ef = Bf[6], Bf[7], Bf[8], Bf[9]
+    res = np.empty(4)
+    ne = ist[5]
+    vm = np.empty(len(vals))
+    W2 = (W[0], W[1], vm, W[3])
+    for k in range(len(vals)):
+        a, b = mlast[k], vals[k]
+        if np.sign(a) != np.sign(b) and a != 0:
+            if _locate(G, par, X, t, h, k, a, b, X0, t0, Xm, W2, res) != 0:
+                return -1
+            Eq[ne, :] = Xm[0]
+            nb_copy44(Xm[1], ED[ne])
+            for j in range(Xm[2].shape[0]):
+                nb_copy44(Xm[2][j], EB[ne, j])
+            Ef[ne, 0], Ef[ne, 1], Ef[ne, 2], Ef[ne, 3] = k, fs[0] + res[0], ist[6] + ist[4] - 1, a
+            Ef[ne, 4], Ef[ne, 5], Ef[ne, 6], Ef[ne, 7] = b, res[1], res[2], res[3]
+            ne += 1
+    return ne - ist[5]
+
+
+@njit(cache=True)
+def _accept(G, par, fs, ist, X, t, h, Xn, tn, mlast, X0, t0, Xm, W, D2, Bf):  # pragma: no cover - compiled
+    """The accepted step's monitors, events and loop closure (the reference's order), the new
+    point written out: 0, 1 (the curve closed: the closing point written, ``fs[3]`` its arc), or
+    2 where the Python path must decide (nothing counted)."""
+    vals = W[2]
+    dcur, dnew, dvalid = D2
+    if nb_trace_dets(G, par, Xn[0], Xn[1], Xn[2], vals) != 0:
+        return 2
+    ne = _events(G, par, fs, ist, X, t, h, Xn, mlast, vals, X0, t0, Xm, W, Bf)
+    if ne < 0:
+        return 2
+    s_new = fs[0] + h
+    checked = par[9] != 0.0 and s_new > 4 * par[2] and ist[6] + ist[4] > 3
+    if checked:
+        if dvalid[0] == 0:
+            nb_difference(G[2], G[3], X0[0], X0[1], X0[2], X[0], X[1], X[2], G[8], G[13], G[12], dcur)
+        nb_difference(G[2], G[3], X0[0], X0[1], X0[2], Xn[0], Xn[1], Xn[2], G[8], G[13], G[12], dnew)
+        g0, g1 = _dot(t0, dcur), _dot(t0, dnew)
+        if g0 < 0 <= g1 and np.sqrt(_dot(dnew, dnew)) < 3 * h + 1e-9 and _dot(tn, t0) > 0:
+            res = np.empty(4)
+            vm = np.empty(len(vals))
+            if _locate(G, par, X, t, h, -1, g0, g1, X0, t0, Xm, W, res) != 0:
+                return 2
+            if nb_trace_dets(G, par, Xm[0], Xm[1], Xm[2], vm) != 0:
+                return 2
+            _put_point(Bf, ist[4], Xm[0], Xm[1], Xm[2], fs[0] + res[0], tn, vm)
+            ist[4] += 1
+            ist[5] += ne
+            fs[3] = fs[0] + res[0]
+            return 1
+    _put_point(Bf, ist[4], Xn[0], Xn[1], Xn[2], s_new, tn, vals)
+    ist[4] += 1
+    ist[5] += ne
+    mlast[:] = vals
+    if checked:
+        dcur[:] = dnew
+    dvalid[0] = 1 if checked else 0
+    return 0
+
+
+@njit(cache=True)
+def nb_trace(G, par, X0, t0, X, t, fs, ist, mlast, Bf):  # pragma: no cover - compiled
+    """The tracker's loop from the state ``X, t, fs, ist, mlast`` (module docstring), in place.
+    Returns :data:`DONE` (arc or step budget spent), :data:`H_MIN` (no acceptable step above
+    ``h_min``), :data:`CLOSED`, :data:`PYTHON_STEP` (the Python loop makes the next step) or
+    :data:`FULL` (the output arrays are full: call again with larger ones)."""
+    q, D, B = X
+    nl = len(t)
+    m = 6 * (len(G[5]) - 1)
+    Xn = (np.empty_like(q), np.empty((4, 4)), np.empty_like(B))
+    Xm = (np.empty_like(q), np.empty((4, 4)), np.empty_like(B))
+    tn = np.empty(nl)
+    colmap, _na = nb_colmap(G[8])
+    S = (np.empty(nl), np.zeros(3), np.zeros(4), np.zeros((m, nl)), np.empty((m, nl)), np.empty((nl, nl)), np.empty(m),
+         np.empty(nb_closure_ws_size(G[5])), colmap)
+    W = (S[0], np.zeros(3), np.empty(len(mlast)), np.empty(nl))
+    D2 = (np.empty(nl), np.empty(nl), np.zeros(1, dtype=np.int64))
+    cap, ecap = Bf[3].shape[0], Bf[9].shape[0]
+    while fs[0] < par[5] and ist[3] < par[10]:
+        if ist[4] + 2 > cap or ist[5] + len(mlast) + 1 > ecap:
+            return FULL
+        h = min(fs[1], par[4], par[5] - fs[0] + 1e-15)
+        fs[1] = h
+        code, iters, o_n = _attempt(G, par, X, t, h, fs[2], Xn, tn, S)
+        if code == 2:
+            return PYTHON_STEP
+        if code != 0:
+            ist[2] += iters
+            ist[1] += 1
+            ist[0] += 1 if code == 3 else 0
+            fs[1] = h * 0.5
+            if fs[1] < par[3]:
+                return H_MIN
+            continue
+        got = _accept(G, par, fs, ist, X, t, h, Xn, tn, mlast, X0, t0, Xm, W, D2, Bf)
+        if got == 2:
+            return PYTHON_STEP
+        ist[2] += iters
+        if got == 1:
+            return CLOSED
+        q[:] = Xn[0]
+        nb_copy44(Xn[1], D)
+        for b in range(B.shape[0]):
+            nb_copy44(Xn[2][b], B[b])
+        t[:] = tn
+        fs[0], fs[2] = fs[0] + h, o_n
+        ist[3] += 1
+        if iters <= 2:
+            fs[1] = h * 1.5
+        elif iters >= 5:
+            fs[1] = h * 0.7
+    return DONE
