@@ -17,7 +17,7 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from ..kinematics.closure import Configuration
-from ..kinematics.tracking import MotionProblem, TrackResult, predict_correct, track
+from ..kinematics.tracking import MotionProblem, TrackResult, compiled_loops, predict_correct, track
 from ..model.mechanism import Mechanism, Pose
 from ..results import Progress
 
@@ -50,7 +50,7 @@ def arc_on_curve(problem: MotionProblem, tr: TrackResult, config: Configuration,
 
     The nearest sample and its neighbours are each corrected onto the curve along their tangent
     (the hyperplane through ``config``); the closest corrected point gives the arc."""
-    d = np.linalg.norm(problem.differences(tr.points, config), axis=1)
+    d = np.linalg.norm(problem.differences(tr.points, config, tr.stacked()), axis=1)
     k0 = int(np.argmin(d))
     best: tuple[float, float | None] = (np.inf, None)
     for k in {max(0, k0 - 1), k0, min(len(tr.points) - 1, k0 + 1)}:
@@ -75,12 +75,14 @@ def pose_distance(mech: Mechanism, prob: MotionProblem, tr: TrackResult, pose: P
                   angle_tol: float) -> tuple[float, float, float, float]:
     """Distance of a printed pose from a traced curve, normalised by the tolerances
     (``hypot(|dp| / pose_tol, dtheta / angle_tol)``, ``angle_tol`` in rad), refined along the
-    curve between samples by bounded Brent search.  Returns (normalised distance, arc, |dp|,
-    dtheta)."""
+    curve between samples by bounded Brent search (compiled, :func:`_nearest_on_step`, unless
+    :func:`~..kinematics.tracking.python_loop` is in force).  Returns (normalised distance, arc,
+    |dp|, dtheta)."""
 
-    def meas_many(xs):
-        R = np.array([x.D[:3, :3] for x in xs])
-        p = R @ mech.platform_point + np.array([x.D[:3, 3] for x in xs])
+    def meas_many(xs, Ds=None):
+        Ds = np.array([x.D for x in xs]) if Ds is None else Ds
+        R = np.ascontiguousarray(Ds[:, :3, :3])
+        p = R @ mech.platform_point + np.ascontiguousarray(Ds[:, :3, 3])
         dp = np.linalg.norm(p - pose.p, axis=1)
         Q = R @ pose.R.T  # the rotation angle: atan2(|axial vector|, (trace - 1) / 2), exact to rounding up to pi
         ax = np.stack([Q[:, 2, 1] - Q[:, 1, 2], Q[:, 0, 2] - Q[:, 2, 0], Q[:, 1, 0] - Q[:, 0, 1]], axis=1)
@@ -91,13 +93,19 @@ def pose_distance(mech: Mechanism, prob: MotionProblem, tr: TrackResult, pose: P
         v, dp, th = meas_many([x])
         return float(v[0]), float(dp[0]), float(th[0])
 
-    vals = meas_many(tr.points)[0]
+    vals = meas_many(tr.points, tr.stacked()[1])[0]
     k0 = int(np.argmin(vals))
     best = (float(vals[k0]), float(tr.s[k0]), *meas(tr.points[k0])[1:])
+    fast = compiled_loops()
     for k in (k0 - 1, k0):
         if k < 0 or k + 1 >= len(tr.points):
             continue
         x, t, h = tr.points[k], tr.tangents[k], float(tr.s[k + 1] - tr.s[k])
+        if fast is not None:
+            m = _nearest_on_step(fast, mech, prob, x, t, h, pose, pose_tol, angle_tol)
+            if m[1] < best[0]:
+                best = (m[1], float(tr.s[k] + m[0]), m[2], m[3])
+            continue
         cache: dict[float, tuple[float, float, float]] = {}
 
         def at(a, x=x, t=t, cache=cache):
@@ -114,6 +122,16 @@ def pose_distance(mech: Mechanism, prob: MotionProblem, tr: TrackResult, pose: P
         if m[0] < best[0]:
             best = (m[0], float(tr.s[k] + a), m[1], m[2])
     return best
+
+
+def _nearest_on_step(fast, mech: Mechanism, prob: MotionProblem, x: Configuration, t: np.ndarray, h: float, pose: Pose,
+                     pose_tol: float, angle_tol: float) -> tuple[float, float, float, float]:
+    """:func:`pose_distance`'s search along one step, compiled (SciPy's bounded Brent step for
+    step, :func:`.compiled.trace.pose_search`): ``(step length, normalised distance, |dp|,
+    dtheta)`` of the best point."""
+    P = np.concatenate([np.asarray(pose.R, dtype=float).ravel(), np.asarray(pose.p, dtype=float),
+                        np.asarray(mech.platform_point, dtype=float), [pose_tol, angle_tol]])
+    return fast.pose_search(prob.step_arrays(fast), x, t, h, P, 1e-6 * max(h, 1e-12))
 
 
 def fewest_circuits(D: np.ndarray) -> list[int]:

@@ -48,6 +48,7 @@ __all__ = [
     "Event",
     "MotionProblem",
     "TrackResult",
+    "compiled_loops",
     "conventional_sense",
     "correct_on_hyperplane",
     "predict_correct",
@@ -212,6 +213,15 @@ class TrackResult:
     corrector_iterations: int = 0
     min_monitor: dict[str, float] = field(default_factory=dict)
     reason: str = ""  # why the tracker failed (empty unless ``status`` is h_min)
+    _stacked: tuple | None = field(default=None, repr=False, compare=False)
+
+    def stacked(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The points' ``q``, ``D`` and ``B`` stacked (points that are configurations; remembered)."""
+        if self._stacked is None:
+            self._stacked = (np.array([x.q for x in self.points], dtype=float),
+                             np.array([x.D for x in self.points], dtype=float),
+                             np.array([x.B for x in self.points], dtype=float))
+        return self._stacked
 
     @property
     def ok(self) -> bool:
@@ -469,12 +479,20 @@ _PYTHON_LOOP: ContextVar[bool] = ContextVar("spatialmech_python_loop", default=F
 @contextmanager
 def python_loop() -> Iterator[None]:
     """Inside the block :func:`track` makes every step in its Python loop (the reference), even
-    where the compiled loop applies (a mechanism's motion with its drivers' DJ as the monitor)."""
+    where the compiled loop applies (a mechanism's motion with its drivers' DJ as the monitor),
+    and the searches along a traced curve (:func:`compiled_loops`) run in Python too."""
     token = _PYTHON_LOOP.set(True)
     try:
         yield
     finally:
         _PYTHON_LOOP.reset(token)
+
+
+def compiled_loops():
+    """The compiled engine for the loops that :func:`python_loop` switches (the tracker's loop,
+    the searches along a traced curve), or ``None``: inside :func:`python_loop`, or where the
+    Python reference runs (:func:`.backend.python_reference`)."""
+    return None if _PYTHON_LOOP.get() else backend.engine()
 
 
 class DriverMonitor:
@@ -495,7 +513,7 @@ def _compiled_loop(problem, vector_monitor, monitors, cfg: _Settings, x0):
     compiled engine in use, no ``stop`` or ``progress`` callback, outside :func:`python_loop`."""
     if (vector_monitor is None or not isinstance(vector_monitor[1], DriverMonitor) or type(problem) is not MotionProblem
             or len(monitors) != len(vector_monitor[0]) or cfg.stop is not None or cfg.progress is not None
-            or _PYTHON_LOOP.get() or (fast := backend.engine()) is None):
+            or (fast := compiled_loops()) is None):
         return None
     mon = vector_monitor[1]
     if mon.mech is not problem.mech or not fast.TraceLoop.applies(problem.mech, problem.active, len(cfg.t0)):
@@ -725,11 +743,20 @@ class MotionProblem(_MechanismBase):
         return fast.correct_on_hyperplane(self.mech, xp, self.active, self.row, self.col, t, tol, max_iter, contraction,
                                           predictor)
 
-    def differences(self, xs, y) -> np.ndarray:
-        """:meth:`difference` of ``y`` relative to each of ``xs`` (rows), compiled in one loop."""
+    def differences(self, xs, y, stacked: tuple | None = None) -> np.ndarray:
+        """:meth:`difference` of ``y`` relative to each of ``xs`` (rows), compiled in one loop
+        (``stacked``: the points' ``q, D, B`` already stacked, :meth:`TrackResult.stacked`)."""
         if (fast := backend.engine()) is not None and len(xs):
-            return fast.config_differences(self.mech, xs, y, self.active, self.kinds != "P", self.col)
+            return fast.config_differences(self.mech, xs, y, self.active, self.kinds != "P", self.col, stacked)
         return np.array([self._config_diff(x, y) for x in xs])
+
+    def step_arrays(self, fast) -> tuple:
+        """The compiled kernels' arrays of this motion (:func:`.compiled.trace.motion_arrays`;
+        remembered)."""
+        G = getattr(self, "_arrays", None)
+        if G is None:
+            G = self._arrays = fast.motion_arrays(self.mech, self.active, self.row, self.col, self.kinds != "P")
+        return G
 
     def tangent(self, x):
         return _observable_tangent(self.jacobian(x), self.nh)

@@ -52,7 +52,7 @@ from .kernels_loops import pack as pack_loop_system
 from .kernels_loops import square_batch as loop_square_batch
 from .kernels_tracking import bordered_tangent
 from .legs import correct_legs, inverse_legs_many
-from .trace import TraceLoop
+from .trace import TraceLoop, motion_arrays, pose_search
 from .limits import joint_points_many, link_margins_many
 from .tasks import task_grid, task_solve
 from . import maps as maps  # performance-map kernels (analysis/maps.py)
@@ -87,6 +87,8 @@ __all__ = [
     "loop_square_batch",
     "lstsq",
     "minnorm_blocks",
+    "motion_arrays",
+    "pose_search",
     "pack_loop_system",
     "retract",
     "sps_leg_lengths",

@@ -390,14 +390,17 @@ def config_difference(mech: Mechanism, a: Configuration, b: Configuration, activ
 
 
 def config_differences(mech: Mechanism, points: Sequence[Configuration], b: Configuration, active, wrap,
-                       col) -> np.ndarray:
+                       col, stacked: tuple | None = None) -> np.ndarray:
     """:func:`config_difference` of ``b`` relative to each of ``points``, in one compiled loop:
-    ``(len(points), n_local)``."""
+    ``(len(points), n_local)``.  ``stacked``: the points' ``q, D, B`` already stacked."""
     cm = compile_mechanism(mech)
     act = _mask(mech, cm, active)
-    Qa = np.array([p.q for p in points], dtype=float).reshape(len(points), cm.n)
-    DAs = np.array([p.D for p in points], dtype=float).reshape(len(points), 4, 4)
-    BAs = np.array([p.B for p in points], dtype=float).reshape(len(points), cm.n_bodies, 4, 4)
+    if stacked is None:
+        stacked = (np.array([p.q for p in points], dtype=float), np.array([p.D for p in points], dtype=float),
+                   np.array([p.B for p in points], dtype=float))
+    Qa = _f64(stacked[0]).reshape(len(points), cm.n)
+    DAs = _f64(stacked[1]).reshape(len(points), 4, 4)
+    BAs = _f64(stacked[2]).reshape(len(points), cm.n_bodies, 4, 4)
     if not np.isfinite(Qa.sum() + DAs.sum() + BAs.sum()):
         raise InputError("points: a configuration holds NaN or infinity")
     qb, Db, Bb = _config_arrays(cm, b)

@@ -287,3 +287,122 @@ def nb_trace(G, par, X0, t0, X, t, fs, ist, mlast, Bf):  # pragma: no cover - co
         elif iters >= 5:
             fs[1] = h * 0.7
     return DONE
+
+
+# ---------------------------------------------------------------------------- a pose's distance from a step
+@njit(cache=True)
+def nb_pose_measure(D, pose, out):  # pragma: no cover - compiled
+    """``defect_circuits.pose_distance``'s measure of the output link at ``D`` against a printed
+    pose: ``pose`` = (R row by row, p, platform point, pose_tol, angle_tol); ``out`` = (normalised
+    distance, |dp|, rotation angle)."""
+    dx = D[0, 0] * pose[12] + D[0, 1] * pose[13] + D[0, 2] * pose[14] + D[0, 3] - pose[9]
+    dy = D[1, 0] * pose[12] + D[1, 1] * pose[13] + D[1, 2] * pose[14] + D[1, 3] - pose[10]
+    dz = D[2, 0] * pose[12] + D[2, 1] * pose[13] + D[2, 2] * pose[14] + D[2, 3] - pose[11]
+    dp = np.sqrt(dx * dx + dy * dy + dz * dz)
+    Q = np.empty((3, 3))  # R pose.R^T
+    for i in range(3):
+        for j in range(3):
+            Q[i, j] = D[i, 0] * pose[3 * j] + D[i, 1] * pose[3 * j + 1] + D[i, 2] * pose[3 * j + 2]
+    a0, a1, a2 = Q[2, 1] - Q[1, 2], Q[0, 2] - Q[2, 0], Q[1, 0] - Q[0, 1]
+    th = np.arctan2(0.5 * np.sqrt(a0 * a0 + a1 * a1 + a2 * a2), 0.5 * (Q[0, 0] + Q[1, 1] + Q[2, 2] - 1.0))
+    out[0] = np.hypot(dp / pose[15], th / pose[16])
+    out[1] = dp
+    out[2] = th
+
+
+@njit(cache=True)
+def _pose_at(G, q, D, B, t, a, pose, Xm, W, out):  # pragma: no cover - compiled
+    """The measure at the point ``a`` along the step (corrected onto the curve), infinite where
+    the corrector does not converge."""
+    pred, info = W[0], W[1]
+    nb_trace_correct(G, q, D, B, t, a, 1e-11, np.int64(20), pred, Xm[0], Xm[1], Xm[2], info)
+    if info[0] == 1.0:
+        nb_pose_measure(Xm[1], pose, out)
+    else:
+        out[0] = out[1] = out[2] = np.inf
+
+
+@njit(cache=True)
+def nb_pose_search(G, q, D, B, t, h, pose, xatol, res):  # pragma: no cover - compiled
+    """The smallest :func:`nb_pose_measure` along the step of length ``h`` from ``(q, D, B)``
+    along ``t``: SciPy's bounded Brent (``minimize_scalar(method="bounded")``, golden section
+    with parabolic steps, ``maxiter`` 500), step for step, each trial point corrected onto the
+    curve.  ``res`` = (step length, normalised distance, |dp|, angle) of the best point."""
+    Xm = (np.empty_like(q), np.empty((4, 4)), np.empty_like(B))
+    W = (np.empty(len(t)), np.zeros(3))
+    mf, mu = np.empty(3), np.empty(3)
+    sqrt_eps = np.sqrt(2.2e-16)
+    golden_mean = 0.5 * (3.0 - np.sqrt(5.0))
+    a, b = 0.0, h
+    fulc = a + golden_mean * (b - a)
+    nfc, xf = fulc, fulc
+    rat = e = 0.0
+    _pose_at(G, q, D, B, t, xf, pose, Xm, W, mf)
+    fx = mf[0]
+    num = 1
+    ffulc = fnfc = fx
+    xm = 0.5 * (a + b)
+    tol1 = sqrt_eps * abs(xf) + xatol / 3.0
+    tol2 = 2.0 * tol1
+    while abs(xf - xm) > (tol2 - 0.5 * (b - a)):
+        rat, e = _brent_step(a, b, xf, nfc, fulc, fx, fnfc, ffulc, xm, tol1, tol2, rat, e, golden_mean)
+        si = np.sign(rat) + (1.0 if rat == 0 else 0.0)
+        x = xf + si * max(abs(rat), tol1)
+        _pose_at(G, q, D, B, t, x, pose, Xm, W, mu)
+        fu = mu[0]
+        num += 1
+        if fu <= fx:
+            if x >= xf:
+                a = xf
+            else:
+                b = xf
+            fulc, ffulc = nfc, fnfc
+            nfc, fnfc = xf, fx
+            xf, fx = x, fu
+            mf[:] = mu
+        else:
+            if x < xf:
+                a = x
+            else:
+                b = x
+            if (fu <= fnfc) or (nfc == xf):
+                fulc, ffulc = nfc, fnfc
+                nfc, fnfc = x, fu
+            elif (fu <= ffulc) or (fulc == xf) or (fulc == nfc):
+                fulc, ffulc = x, fu
+        xm = 0.5 * (a + b)
+        tol1 = sqrt_eps * abs(xf) + xatol / 3.0
+        tol2 = 2.0 * tol1
+        if num >= 500:
+            break
+    res[0], res[1], res[2], res[3] = xf, mf[0], mf[1], mf[2]
+
+
+@njit(cache=True)
+def _brent_step(a, b, xf, nfc, fulc, fx, fnfc, ffulc, xm, tol1, tol2, rat, e, golden_mean):  # pragma: no cover
+    """The next step ``rat`` (and the new ``e``) of :func:`nb_pose_search`: parabolic where the
+    parabola through the last three points is acceptable, else golden section."""
+    golden = True
+    if abs(e) > tol1:
+        golden = False
+        r = (xf - nfc) * (fx - ffulc)
+        q = (xf - fulc) * (fx - fnfc)
+        p = (xf - fulc) * q - (xf - nfc) * r
+        q = 2.0 * (q - r)
+        if q > 0.0:
+            p = -p
+        q = abs(q)
+        r = e
+        e = rat
+        if (abs(p) < abs(0.5 * q * r)) and (p > q * (a - xf)) and (p < q * (b - xf)):
+            rat = (p + 0.0) / q
+            x = xf + rat
+            if ((x - a) < tol2) or ((b - x) < tol2):
+                si = np.sign(xm - xf) + (1.0 if (xm - xf) == 0 else 0.0)
+                rat = tol1 * si
+        else:
+            golden = True
+    if golden:
+        e = (a - xf) if xf >= xm else (b - xf)
+        rat = golden_mean * e
+    return rat, e

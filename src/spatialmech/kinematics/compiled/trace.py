@@ -9,9 +9,9 @@ import numpy as np
 from ...model.mechanism import Mechanism
 from ..closure import Configuration
 from .engine import compile_mechanism, driver_columns
-from .kernels_trace import CLOSED, DONE, FULL, H_MIN, PYTHON_STEP, nb_trace
+from .kernels_trace import CLOSED, DONE, FULL, H_MIN, PYTHON_STEP, nb_pose_search, nb_trace
 
-__all__ = ["CLOSED", "DONE", "H_MIN", "PYTHON_STEP", "TraceLoop"]
+__all__ = ["CLOSED", "DONE", "H_MIN", "PYTHON_STEP", "TraceLoop", "motion_arrays", "pose_search"]
 
 
 def _f64(x) -> np.ndarray:
@@ -29,10 +29,9 @@ class TraceLoop:
     def __init__(self, mech: Mechanism, active, row, col, wrap, drivers, x0: Configuration, t0, settings: tuple,
                  rank: float):
         cm = compile_mechanism(mech)
-        idx, pos = driver_columns(mech, cm, drivers)
         self.nb = cm.n_bodies
-        self.G = (cm.screws, cm.ball_of, cm.ball_first, cm.ball_axes, cm.ball_centre, cm.limb_start, cm.ends, cm.linear,
-                  np.require(active, np.bool_, ["C"]), idx, pos, _f64(row), _f64(col), np.require(wrap, np.bool_, ["C"]))
+        self.G = motion_arrays(mech, active, row, col, wrap, drivers)
+        idx = self.G[9]
         self.par = np.array([cm.length, rank, *settings, 1.0 if cm.n_bodies else 0.0], dtype=np.float64)
         self.X0 = (_f64(x0.q).copy(), _f64(x0.D).copy(), _f64(x0.B).reshape(self.nb, 4, 4).copy())
         self.t0 = _f64(t0).copy()
@@ -95,3 +94,23 @@ class TraceLoop:
     def _used(self, npts: int, nev: int) -> tuple:
         Bf = self.Bf
         return (*(a[:npts] for a in Bf[:6]), *(a[:nev] for a in Bf[6:]))
+
+
+def motion_arrays(mech: Mechanism, active, row, col, wrap, drivers=()) -> tuple:
+    """The arrays ``G`` of :mod:`.kernels_trace` for a motion of ``mech``."""
+    cm = compile_mechanism(mech)
+    idx, pos = driver_columns(mech, cm, drivers) if drivers else (np.zeros(0, np.int64), np.zeros(0, np.int64))
+    return (cm.screws, cm.ball_of, cm.ball_first, cm.ball_axes, cm.ball_centre, cm.limb_start, cm.ends, cm.linear,
+            np.require(active, np.bool_, ["C"]), idx, pos, _f64(row), _f64(col), np.require(wrap, np.bool_, ["C"]))
+
+
+def pose_search(G: tuple, x: Configuration, t, h: float, pose: np.ndarray, xatol: float) -> tuple[float, float, float,
+                                                                                                   float]:
+    """:func:`.kernels_trace.nb_pose_search`: ``(step length, normalised distance, |dp|, angle)``
+    of the point of the step nearest the printed pose (``pose``: R row by row, p, platform point,
+    pose_tol, angle_tol)."""
+    res = np.empty(4)
+    nb = np.asarray(x.B).shape[0]
+    nb_pose_search(G, _f64(x.q), _f64(x.D), _f64(x.B).reshape(nb, 4, 4), _f64(t), float(h), _f64(pose), float(xatol),
+                   res)
+    return float(res[0]), float(res[1]), float(res[2]), float(res[3])
