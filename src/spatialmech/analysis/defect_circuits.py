@@ -52,8 +52,12 @@ def arc_on_curve(problem: MotionProblem, tr: TrackResult, config: Configuration,
     (the hyperplane through ``config``); the closest corrected point gives the arc."""
     d = np.linalg.norm(problem.differences(tr.points, config, tr.stacked()), axis=1)
     k0 = int(np.argmin(d))
+    ks = list({max(0, k0 - 1), k0, min(len(tr.points) - 1, k0 + 1)})  # the reference's order (ties)
+    if (fast := compiled_loops()) is not None:
+        dist_c, arc = fast.arc_near(problem.step_arrays(fast), tr.stacked(), tr.stacked_tangents(), tr.s, ks, config)
+        return arc if dist_c < tol else None
     best: tuple[float, float | None] = (np.inf, None)
-    for k in {max(0, k0 - 1), k0, min(len(tr.points) - 1, k0 + 1)}:
+    for k in ks:
         x, t = tr.points[k], tr.tangents[k]
         a = float(t @ problem.difference(x, config))
         xs, ok, _, _ = predict_correct(problem, x, a * t, t, 1e-11, 30)

@@ -41,7 +41,7 @@ from ..kinematics.backend import closure_jacobian
 from ..kinematics.jacobian import complete_jacobians, driver_determinants
 from ..geometry.tolerances import current as current_tolerances
 from ..kinematics.position import PoseFit, configuration_at_pose, freedom_values
-from ..kinematics.tracking import DriverMonitor, MotionProblem, TrackResult
+from ..kinematics.tracking import DriverMonitor, MotionProblem, TrackResult, compiled_loops
 from ..model.joints import make_joint
 from ..model.mechanism import Mechanism, Pose
 from ..results import Progress, Steps, TrackStatus
@@ -719,10 +719,8 @@ def _distance_to_singularities(mech: Mechanism, problem: MotionProblem, tr0: Tra
     path_pts = [(path.to_path(s), x) for s, x in zip(tr0.s, tr0.points, strict=True)
                 if 0.0 <= path.to_path(s) <= path.end]
     min_sig, min_between = None, None
-    sig = []
-    for a, x in path_pts:
-        sv = np.linalg.svd(problem.jacobian(x), compute_uv=False)
-        sig.append((float(sv[-1] / sv[0]), a))
+    sig = [(float(sv[-1] / sv[0]), a) for sv, (a, _) in zip(_closure_singular_values(problem, [x for _, x in path_pts]),
+                                                           path_pts, strict=True)]
     if sig:
         mval, marc = min(sig)
         min_sig, min_between = mval, positions_between(marc, path.path_arcs)
@@ -737,6 +735,18 @@ def _distance_to_singularities(mech: Mechanism, problem: MotionProblem, tr0: Tra
             vd = replace(vd, min_sigma_on_path=float(min(vals)) if vals else None)
         new.append(vd)
     return min_sig, min_between, new
+
+
+def _closure_singular_values(problem: MotionProblem, points: list) -> list[np.ndarray]:
+    """The singular values of the problem's (nondimensional) closure Jacobian at each point: the
+    compiled engine's Jacobians of all points in one call and one stacked SVD (the same
+    numbers, point by point), or the reference's loop inside ``python_loop()``."""
+    fast = compiled_loops()
+    if fast is None or len(points) < 2:
+        return [np.linalg.svd(problem.jacobian(x), compute_uv=False) for x in points]
+    A, _ = fast.closure_jacobians(problem.mech, np.array([x.q for x in points]), np.array([x.D for x in points]),
+                                  np.array([x.B for x in points]), active=problem.active)
+    return list(np.linalg.svd(problem.row[None, :, None] * A * problem.col[None, None, :], compute_uv=False))
 
 
 def _verdict_key(r: DefectResult):

@@ -214,6 +214,7 @@ class TrackResult:
     min_monitor: dict[str, float] = field(default_factory=dict)
     reason: str = ""  # why the tracker failed (empty unless ``status`` is h_min)
     _stacked: tuple | None = field(default=None, repr=False, compare=False)
+    _tangents: np.ndarray | None = field(default=None, repr=False, compare=False)
 
     def stacked(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The points' ``q``, ``D`` and ``B`` stacked (points that are configurations; remembered)."""
@@ -222,6 +223,12 @@ class TrackResult:
                              np.array([x.D for x in self.points], dtype=float),
                              np.array([x.B for x in self.points], dtype=float))
         return self._stacked
+
+    def stacked_tangents(self) -> np.ndarray:
+        """The tangents stacked (remembered)."""
+        if self._tangents is None:
+            self._tangents = np.array(self.tangents, dtype=float)
+        return self._tangents
 
     @property
     def ok(self) -> bool:

@@ -52,7 +52,7 @@ from .kernels_loops import pack as pack_loop_system
 from .kernels_loops import square_batch as loop_square_batch
 from .kernels_tracking import bordered_tangent
 from .legs import correct_legs, inverse_legs_many
-from .trace import TraceLoop, motion_arrays, pose_search
+from .trace import TraceLoop, arc_near, motion_arrays, pose_search
 from .limits import joint_points_many, link_margins_many
 from .tasks import task_grid, task_solve
 from . import maps as maps  # performance-map kernels (analysis/maps.py)
@@ -62,6 +62,7 @@ __all__ = [
     "UNAVAILABLE_REASON",
     "CompiledMechanism",
     "TraceLoop",
+    "arc_near",
     "bordered_tangent",
     "closure_jacobian",
     "closure_jacobians",

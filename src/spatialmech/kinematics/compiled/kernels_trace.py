@@ -406,3 +406,28 @@ def _brent_step(a, b, xf, nfc, fulc, fx, fnfc, ffulc, xm, tol1, tol2, rat, e, go
         e = (a - xf) if xf >= xm else (b - xf)
         rat = golden_mean * e
     return rat, e
+
+
+# ---------------------------------------------------------------------------- a configuration on a traced curve
+@njit(cache=True)
+def nb_arc_near(G, Q, DS, BS, T, s, ks, q, D, B, res):  # pragma: no cover - compiled
+    """``defect_circuits.arc_on_curve``'s corrections: for each traced point ``k`` of ``ks`` (in
+    that order; ``Q, DS, BS`` the points, ``T`` their tangents, ``s`` their arcs), the point
+    ``a = t . difference(x_k, c)`` along its tangent corrected onto the curve (``tol`` 1e-11, 30
+    iterations) and its distance from ``c = (q, D, B)``; ``res`` = (smallest distance, its arc),
+    ``(inf, nan)`` when no correction converged."""
+    nl = T.shape[1]
+    dif = np.empty(nl)
+    Xm = (np.empty_like(q), np.empty((4, 4)), np.empty_like(B))
+    pred, info = np.empty(nl), np.zeros(3)
+    res[0], res[1] = np.inf, np.nan
+    for k in ks:
+        nb_difference(G[2], G[3], Q[k], DS[k], BS[k], q, D, B, G[8], G[13], G[12], dif)
+        a = _dot(T[k], dif)
+        nb_trace_correct(G, Q[k], DS[k], BS[k], T[k], a, 1e-11, np.int64(30), pred, Xm[0], Xm[1], Xm[2], info)
+        if info[0] == 0.0:
+            continue
+        nb_difference(G[2], G[3], Xm[0], Xm[1], Xm[2], q, D, B, G[8], G[13], G[12], dif)
+        dist = np.sqrt(_dot(dif, dif))
+        if dist < res[0]:
+            res[0], res[1] = dist, s[k] + a

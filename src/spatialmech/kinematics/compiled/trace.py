@@ -9,9 +9,9 @@ import numpy as np
 from ...model.mechanism import Mechanism
 from ..closure import Configuration
 from .engine import compile_mechanism, driver_columns
-from .kernels_trace import CLOSED, DONE, FULL, H_MIN, PYTHON_STEP, nb_pose_search, nb_trace
+from .kernels_trace import CLOSED, DONE, FULL, H_MIN, PYTHON_STEP, nb_arc_near, nb_pose_search, nb_trace
 
-__all__ = ["CLOSED", "DONE", "H_MIN", "PYTHON_STEP", "TraceLoop", "motion_arrays", "pose_search"]
+__all__ = ["CLOSED", "DONE", "H_MIN", "PYTHON_STEP", "TraceLoop", "arc_near", "motion_arrays", "pose_search"]
 
 
 def _f64(x) -> np.ndarray:
@@ -114,3 +114,16 @@ def pose_search(G: tuple, x: Configuration, t, h: float, pose: np.ndarray, xatol
     nb_pose_search(G, _f64(x.q), _f64(x.D), _f64(x.B).reshape(nb, 4, 4), _f64(t), float(h), _f64(pose), float(xatol),
                    res)
     return float(res[0]), float(res[1]), float(res[2]), float(res[3])
+
+
+def arc_near(G: tuple, stacked: tuple, tangents: np.ndarray, s: np.ndarray, ks: list[int],
+             config: Configuration) -> tuple[float, float]:
+    """:func:`.kernels_trace.nb_arc_near`: ``(distance, arc)`` of the traced points ``ks``
+    (``stacked``: all points' ``q, D, B``), each moved along its tangent and corrected onto the
+    curve, nearest ``config``."""
+    res = np.empty(2)
+    Q, DS, BS = stacked
+    nb = np.asarray(config.B).shape[0]
+    nb_arc_near(G, _f64(Q), _f64(DS), _f64(BS).reshape(len(Q), nb, 4, 4), _f64(tangents), _f64(s),
+                np.array(ks, dtype=np.int64), _f64(config.q), _f64(config.D), _f64(config.B).reshape(nb, 4, 4), res)
+    return float(res[0]), float(res[1])
