@@ -23,6 +23,7 @@ from ..results import Progress
 
 __all__ = [
     "arc_on_curve",
+    "closure_singular_values",
     "fewest_circuits",
     "pose_distance",
     "positions_between",
@@ -136,6 +137,18 @@ def _nearest_on_step(fast, mech: Mechanism, prob: MotionProblem, x: Configuratio
     P = np.concatenate([np.asarray(pose.R, dtype=float).ravel(), np.asarray(pose.p, dtype=float),
                         np.asarray(mech.platform_point, dtype=float), [pose_tol, angle_tol]])
     return fast.pose_search(prob.step_arrays(fast), x, t, h, P, 1e-6 * max(h, 1e-12))
+
+
+def closure_singular_values(problem: MotionProblem, points: list) -> list[np.ndarray]:
+    """The singular values of the problem's (nondimensional) closure Jacobian at each point: the
+    compiled engine's Jacobians of all points in one call and one stacked SVD (the same
+    numbers, point by point), or the reference's loop inside ``python_loop()``."""
+    fast = compiled_loops()
+    if fast is None or len(points) < 2:
+        return [np.linalg.svd(problem.jacobian(x), compute_uv=False) for x in points]
+    A, _ = fast.closure_jacobians(problem.mech, np.array([x.q for x in points]), np.array([x.D for x in points]),
+                                  np.array([x.B for x in points]), active=problem.active)
+    return list(np.linalg.svd(problem.row[None, :, None] * A * problem.col[None, None, :], compute_uv=False))
 
 
 def fewest_circuits(D: np.ndarray) -> list[int]:

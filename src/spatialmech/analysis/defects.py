@@ -29,7 +29,9 @@ Procedure (paper A fig 5, made general):
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 from typing import cast
 
 import numpy as np
@@ -40,13 +42,15 @@ from ..kinematics.closure import Configuration, active_mask, closure_scales
 from ..kinematics.backend import closure_jacobian
 from ..kinematics.jacobian import complete_jacobians, driver_determinants
 from ..geometry.tolerances import current as current_tolerances
+from ..geometry.tolerances import use as use_tolerances
 from ..kinematics.position import PoseFit, configuration_at_pose, freedom_values
-from ..kinematics.tracking import DriverMonitor, MotionProblem, TrackResult, compiled_loops
+from ..kinematics.tracking import DriverMonitor, MotionProblem, TrackResult
 from ..model.joints import make_joint
 from ..model.mechanism import Mechanism, Pose
 from ..results import Progress, Steps, TrackStatus
 from .defect_circuits import (
     arc_on_curve,
+    closure_singular_values,
     fewest_circuits,
     pose_distance,
     positions_between,
@@ -261,7 +265,8 @@ class DJTable:
     """``DJ`` (det of the complete Jacobian) at a mechanism's task positions, per driver.
 
     ``dj`` (n_drivers, n_positions): only the signs along one row are comparable;
-    ``sigma_min`` the scale-free smallest singular value (0 at a singularity); ``fits`` the
+    ``sigma_min`` the scale-free smallest singular value (0 at a singularity; computed when it
+    is first asked for, under the tolerances in force when the table was made); ``fits`` the
     closed configurations fitted to the (rounded, printed) positions, with their errors.
     """
 
@@ -269,8 +274,14 @@ class DJTable:
     positions: tuple[str, ...]
     drivers: tuple[str, ...]
     dj: np.ndarray
-    sigma_min: np.ndarray
     fits: tuple[PoseFit, ...]
+    sigma_of: Callable[[], np.ndarray] = field(repr=False)  # computes sigma_min
+
+    @cached_property
+    def sigma_min(self) -> np.ndarray:
+        """The scale-free smallest singular value of each driver's complete Jacobian at each
+        position ``(n_drivers, n_positions)``."""
+        return self.sigma_of()
 
     @property
     def signs(self) -> np.ndarray:
@@ -325,11 +336,17 @@ def dj_table(mech: Mechanism, drivers=None, positions=None) -> DJTable:
         prev = fit.config
     djf, _ = dj_function(mech, list(drivers), fits[0].config)
     dj = np.array([djf(f.config) for f in fits]).T
-    sig = np.empty_like(dj)
-    for k, f in enumerate(fits):  # one set of constraint wrenches per position, shared by the drivers
-        for i, cj in enumerate(complete_jacobians(mech, f.config, [[d] for d in drivers])):
-            sig[i, k] = cj.sigma_min
-    return DJTable(mech.name, tuple(p.name for p in positions), drivers, dj, sig, tuple(fits))
+    tol = current_tolerances()
+
+    def sigmas() -> np.ndarray:  # asked for by the table's readers, not by the defect analysis
+        sig = np.empty_like(dj)
+        with use_tolerances(tol):
+            for k, f in enumerate(fits):  # one set of constraint wrenches per position, shared by the drivers
+                for i, cj in enumerate(complete_jacobians(mech, f.config, [[d] for d in drivers])):
+                    sig[i, k] = cj.sigma_min
+        return sig
+
+    return DJTable(mech.name, tuple(p.name for p in positions), drivers, dj, tuple(fits), sigmas)
 
 
 
@@ -719,7 +736,7 @@ def _distance_to_singularities(mech: Mechanism, problem: MotionProblem, tr0: Tra
     path_pts = [(path.to_path(s), x) for s, x in zip(tr0.s, tr0.points, strict=True)
                 if 0.0 <= path.to_path(s) <= path.end]
     min_sig, min_between = None, None
-    sig = [(float(sv[-1] / sv[0]), a) for sv, (a, _) in zip(_closure_singular_values(problem, [x for _, x in path_pts]),
+    sig = [(float(sv[-1] / sv[0]), a) for sv, (a, _) in zip(closure_singular_values(problem, [x for _, x in path_pts]),
                                                            path_pts, strict=True)]
     if sig:
         mval, marc = min(sig)
@@ -735,18 +752,6 @@ def _distance_to_singularities(mech: Mechanism, problem: MotionProblem, tr0: Tra
             vd = replace(vd, min_sigma_on_path=float(min(vals)) if vals else None)
         new.append(vd)
     return min_sig, min_between, new
-
-
-def _closure_singular_values(problem: MotionProblem, points: list) -> list[np.ndarray]:
-    """The singular values of the problem's (nondimensional) closure Jacobian at each point: the
-    compiled engine's Jacobians of all points in one call and one stacked SVD (the same
-    numbers, point by point), or the reference's loop inside ``python_loop()``."""
-    fast = compiled_loops()
-    if fast is None or len(points) < 2:
-        return [np.linalg.svd(problem.jacobian(x), compute_uv=False) for x in points]
-    A, _ = fast.closure_jacobians(problem.mech, np.array([x.q for x in points]), np.array([x.D for x in points]),
-                                  np.array([x.B for x in points]), active=problem.active)
-    return list(np.linalg.svd(problem.row[None, :, None] * A * problem.col[None, None, :], compute_uv=False))
 
 
 def _verdict_key(r: DefectResult):

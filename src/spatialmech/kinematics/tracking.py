@@ -21,9 +21,7 @@ actuator values (forward position by continuation).
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
-from contextvars import ContextVar
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Protocol
 
@@ -37,7 +35,7 @@ from ..results import EventKind, Progress, TrackStatus
 from . import backend
 from .closure import Configuration, active_mask, ball_groups, closure_scales, hub_count
 from .backend import closure_jacobian, retract
-from .jacobian import driver_determinants
+from .tracking_loop import DriverMonitor, compiled_loop, compiled_loops, python_loop, run_compiled
 
 __all__ = [
     "SENSE_TOL",
@@ -381,6 +379,12 @@ class _Walk:
     def going(self, cfg: _Settings) -> bool:
         return self.s < cfg.max_arc and self.steps < cfg.max_steps
 
+    def close(self, s: float, event_tol: float) -> None:
+        """Closed at arc ``s``: an event at the closing point is the start point met again, not a
+        new one."""
+        self.events = [e for e in self.events if e.s < s - max(event_tol, 1e-9)]
+        self.closed, self.status, self.s = True, TrackStatus.CLOSED, s
+
     def fail_h_min(self, cfg: _Settings) -> None:
         why = "an orientation flip (a bifurcation point or a crossing branch)" if self.flips else "a singular point"
         self.status = TrackStatus.H_MIN
@@ -422,15 +426,8 @@ def _closes(problem, w: _Walk, cfg: _Settings, xn, tn: np.ndarray, h: float) -> 
     w.xs.append(ev.x)  # the caller appends the monitors there
     w.ss.append(ev.s)
     w.ts.append(tn)
-    _close(w, cfg, ev.s)
+    w.close(ev.s, cfg.event_tol)
     return True
-
-
-def _close(w: _Walk, cfg: _Settings, s: float) -> None:
-    """``w`` closed at arc ``s``: an event at the closing point is the start point met again,
-    not a new one."""
-    w.events = [e for e in w.events if e.s < s - max(cfg.event_tol, 1e-9)]
-    w.closed, w.status, w.s = True, TrackStatus.CLOSED, s
 
 
 def _python_step(problem, w: _Walk, cfg: _Settings, monitors: dict[str, Callable]) -> bool:
@@ -478,57 +475,6 @@ def _python_step(problem, w: _Walk, cfg: _Settings, monitors: dict[str, Callable
         w.status = TrackStatus.STOPPED
         return False
     return True
-
-
-_PYTHON_LOOP: ContextVar[bool] = ContextVar("spatialmech_python_loop", default=False)
-
-
-@contextmanager
-def python_loop() -> Iterator[None]:
-    """Inside the block :func:`track` makes every step in its Python loop (the reference), even
-    where the compiled loop applies (a mechanism's motion with its drivers' DJ as the monitor),
-    and the searches along a traced curve (:func:`compiled_loops`) run in Python too."""
-    token = _PYTHON_LOOP.set(True)
-    try:
-        yield
-    finally:
-        _PYTHON_LOOP.reset(token)
-
-
-def compiled_loops():
-    """The compiled engine for the loops that :func:`python_loop` switches (the tracker's loop,
-    the searches along a traced curve), or ``None``: inside :func:`python_loop`, or where the
-    Python reference runs (:func:`.backend.python_reference`)."""
-    return None if _PYTHON_LOOP.get() else backend.engine()
-
-
-class DriverMonitor:
-    """The vector monitor ``config -> DJ of each driver`` (:func:`.jacobian.driver_determinants`)
-    of ``mech``: the one the compiled tracker loop evaluates itself."""
-
-    def __init__(self, mech: Mechanism, drivers) -> None:
-        self.mech = mech
-        self.drivers = list(drivers)
-
-    def __call__(self, config) -> np.ndarray:
-        return driver_determinants(self.mech, config, self.drivers)
-
-
-def _compiled_loop(problem, vector_monitor, monitors, cfg: _Settings, x0):
-    """The compiled loop (:class:`.compiled.trace.TraceLoop`) when it applies: a
-    ``MotionProblem`` with a :class:`DriverMonitor` of its mechanism as its only monitor, the
-    compiled engine in use, no ``stop`` or ``progress`` callback, outside :func:`python_loop`."""
-    if (vector_monitor is None or not isinstance(vector_monitor[1], DriverMonitor) or type(problem) is not MotionProblem
-            or len(monitors) != len(vector_monitor[0]) or cfg.stop is not None or cfg.progress is not None
-            or (fast := compiled_loops()) is None):
-        return None
-    mon = vector_monitor[1]
-    if mon.mech is not problem.mech or not fast.TraceLoop.applies(problem.mech, problem.active, len(cfg.t0)):
-        return None
-    settings = (cfg.h0, cfg.h_min, cfg.h_max, cfg.max_arc, cfg.tol, cfg.cos_max, cfg.event_tol,
-                1.0 if cfg.detect_closure else 0.0, float(cfg.max_steps))
-    return fast.TraceLoop(problem.mech, problem.active, problem.row, problem.col, problem.kinds != "P", mon.drivers, x0,
-                          cfg.t0, settings, current_tolerances().rank)
 
 
 def track(
@@ -582,10 +528,10 @@ def track(
     frame = _frame(A_x, t)
     w = _Walk(x0, t, 0.0, h0, frame, _orientation(A_x, t, frame), [x0], [0.0], [t],
               {k: [float(f(x0))] for k, f in monitors.items()})
-    loop = _compiled_loop(problem, vector_monitor, monitors, cfg, x0)
+    loop = compiled_loop(problem, vector_monitor, len(monitors), cfg)
     while w.going(cfg):
         if loop is not None and w.frame[0] is None:
-            if _run_compiled(loop, w, cfg, vector_monitor[0] if vector_monitor else []):
+            if run_compiled(loop, w, cfg, vector_monitor[0] if vector_monitor else [], Event):
                 break
             if not w.going(cfg):
                 break
@@ -594,19 +540,6 @@ def track(
     mons = {k: np.array(v) for k, v in w.mon.items()}
     return TrackResult(w.xs, np.array(w.ss), w.ts, mons, w.events, w.closed, w.status, w.rejected, w.total_iters,
                        {k: float(np.min(np.abs(v))) for k, v in mons.items()}, w.reason)
-
-
-def _run_compiled(loop, w: _Walk, cfg: _Settings, names: list[str]) -> bool:
-    """The compiled loop from ``w``; True when the track ended in it (``w``'s outcome set),
-    False when it hands the next step to the Python loop."""
-    code = loop.run(w, names, Event)
-    if code == loop.PYTHON_STEP:
-        return False
-    if code == loop.H_MIN:
-        w.fail_h_min(cfg)
-    elif code == loop.CLOSED:
-        _close(w, cfg, w.s)
-    return True
 
 
 def _monitor_functions(monitors, vector_monitor) -> dict[str, Callable]:
@@ -667,6 +600,8 @@ def _locate(problem, x, t, h, f, name, fa, fb, s, step, tol, event_tol):
 
 # --------------------------------------------------------------------------- mechanisms
 class _MechanismBase:
+    #: The tracker's compiled loop (:func:`.tracking_loop.compiled_loop`) may run this motion.
+    compiled_loop: bool = False
     #: The tangent is the null vector of the Jacobian wherever it has full row rank (the
     #: compiled step test of :func:`_step_tangent` applies).
     null_tangent: bool = True
@@ -723,6 +658,8 @@ class MotionProblem(_MechanismBase):
 
     Sense of travel (when :func:`track` gets no ``direction``): ``first`` (a freedom name), else
     the first actuator, ... increasing; ``sense=-1``: decreasing (:func:`sense_order`)."""
+
+    compiled_loop = True
 
     def __init__(self, mech: Mechanism, *, first: str | None = None, sense: int = 1):
         super().__init__(mech, active_mask(mech))

@@ -48,7 +48,8 @@ DONE, H_MIN, CLOSED, PYTHON_STEP, FULL = 0, 1, 2, 3, 4
 def nb_trace_correct(G, q, D, B, t, a, tol, max_iter, pred, qo, Do, Bo, info):  # pragma: no cover - compiled
     """``tracking.predict_correct(problem, x, a * t, t, tol, max_iter)`` of a ``MotionProblem``:
     ``info`` = (converged, iterations, total correction length)."""
-    S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends, linear, active, drivers, cols, row, col, wrap = G
+    S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends, active, row, col = (G[0], G[1], G[2], G[3], G[4],
+                                                                                       G[5], G[6], G[8], G[11], G[12])
     for c in range(len(t)):
         pred[c] = a * t[c]
     nb_correct_hyperplane(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends, q, D, B, active, row, col, t,
@@ -59,7 +60,8 @@ def nb_trace_correct(G, q, D, B, t, a, tol, max_iter, pred, qo, Do, Bo, info):  
 def nb_trace_dets(G, par, q, D, B, out):  # pragma: no cover - compiled
     """The DJ of every driver (``engine.driver_determinants``) into ``out``: 0, or 2 where the
     Python path must decide (the kernel declines, or a value is not finite)."""
-    S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends, linear, active, drivers, cols, row, col, wrap = G
+    S, ball_of, ball_axes, ball_centre, limb_start, ends, linear, active, drivers, cols = (G[0], G[1], G[3], G[4], G[5],
+                                                                                          G[6], G[7], G[8], G[9], G[10])
     if par[11] != 0.0:
         nb_closure_dets(S, ball_of, ball_axes, ball_centre, limb_start, ends, linear, active, par[0], q, D, B, cols, out)
     elif nb_driver_dets(S, ball_of, ball_axes, ball_centre, limb_start, ends, active, par[0], par[1], q, D, B, drivers,
@@ -368,7 +370,7 @@ def nb_pose_search(G, q, D, B, t, h, pose, xatol, res):  # pragma: no cover - co
             if (fu <= fnfc) or (nfc == xf):
                 fulc, ffulc = nfc, fnfc
                 nfc, fnfc = x, fu
-            elif (fu <= ffulc) or (fulc == xf) or (fulc == nfc):
+            elif (fu <= ffulc) or (fulc == xf) or (fulc == nfc):  # noqa: SIM109 - SciPy's test, as written
                 fulc, ffulc = x, fu
         xm = 0.5 * (a + b)
         tol1 = sqrt_eps * abs(xf) + xatol / 3.0
