@@ -6,9 +6,10 @@ local Dask clusters of 1 and 2 worker processes, in the same run.
 
 1. the CS dyad family (60 starts, seed 0) and its pool (density 0.5) are made once;
 2. ``--compare`` candidates (default 60) are judged by the batched judgement (the default:
-   the positions' stages in one compiled call per candidate) and by the position-by-position
-   reference (``judge_candidate(batched=False)``), alternately in blocks of 10 so that both see
-   the same load: the ratio, the time per candidate at each stage, the rows equal (1e-10);
+   the positions' stages in one compiled call per candidate, the circuit stage in the compiled
+   loops of ``kernels_trace``) and by the reference (``judge_candidate(batched=False)``: position
+   by position, the tracker's Python loop), alternately in blocks of 10 so that both see the
+   same load: the ratio, the time per candidate at each stage, the rows equal (1e-10);
 3. ``--serial`` candidates are screened in this process (``workers=0``, one BLAS thread as the
    command line runs; Dask's workers have one by default): the serial rate, and per CPU second
    of this process (``time.process_time``);

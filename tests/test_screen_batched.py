@@ -4,9 +4,11 @@
   joint values of :func:`~spatialmech.synthesis.five_cs.cs_configuration` (SciPy's rotations,
   pose by pose) to 1e-12, on the candidates of paper A's pool and on random poses (hypothesis);
 - ``judge_candidate(batched=True)`` (the positions' stages in one compiled call, the defect
-  analysis without its mobility check) gives the verdict rows of ``batched=False`` (the
-  position-by-position reference) to 1e-10, on the first 30 candidates of paper A's screen
-  (DJ-sign rejections and circuit judgements) and on a usable and a two-circuit candidate.
+  analysis without its mobility check, its circuit stage in the compiled loops) gives the
+  verdict rows of ``batched=False`` (the position-by-position reference, the tracker's Python
+  loop) to 1e-10, on the first 30 candidates of paper A's screen (DJ-sign rejections and
+  circuit judgements) and on a usable and a two-circuit candidate;
+- the compiled circuit stage gives the whole defect analysis of the Python loops on those two.
 """
 
 import dataclasses
@@ -81,3 +83,27 @@ def test_the_batched_judgement_gives_the_reference_verdicts(pool):
         stages.add((ref["rejected_by"], ref["circuit_defect"], ref["usable"]))
     # the set holds DJ-sign rejections, circuit judgements with a circuit defect and a usable one
     assert ("dj_signs", None, False) in stages and ("circuits", True, False) in stages and (None, False, True) in stages
+
+
+def test_the_compiled_circuit_stage_gives_the_reference_analysis(pool, monkeypatch):
+    """The circuit stage's compiled loops (the tracker's loop, the positions placed on the traced
+    circuits: ``arc_on_curve``'s corrections and ``pose_distance``'s Brent search, the path's
+    sigmas) against the Python loops (``python_loop()``): the whole defect analysis of a usable
+    and a two-circuit candidate, every number to 1e-10 (measured: equal bit for bit)."""
+    from spatialmech.analysis.defects import defect_analysis
+    from spatialmech.kinematics import compiled
+    from spatialmech.kinematics.tracking import python_loop
+    from tests.test_tracking_compiled import assert_same_document
+
+    searches = []
+    search = compiled.pose_search
+    monkeypatch.setattr(compiled, "pose_search", lambda *a: searches.append(a) or search(*a))
+    for c in (USABLE, TWO_CIRCUITS):
+        mech = candidate_linkage(pool, c)
+        n0 = len(searches)
+        got = defect_analysis(mech, check_dof=False).to_dict()
+        with python_loop():
+            ref = defect_analysis(mech, check_dof=False).to_dict()
+        assert_same_document(got, ref)
+        # the two-circuit candidate's positions 5-7 measured from the first circuit by the search
+        assert (len(searches) > n0) == (c is TWO_CIRCUITS)

@@ -1,6 +1,9 @@
 """The tracker's compiled step test (issue 29): one LU of the bordered Jacobian ``[A; t]``
 instead of a full SVD per step gives the same tangents, orientation signs, statuses and events
-as the reference's SVD path, and steps aside (to the SVD) wherever the rank is in doubt."""
+as the reference's SVD path, and steps aside (to the SVD) wherever the rank is in doubt.
+
+The tracker's compiled loop (``kernels_trace.nb_trace``: steps, DJ monitors, events, closure)
+traces what the Python loop (``tracking.python_loop()``) traces, also where it hands steps back."""
 
 import numpy as np
 import pytest
@@ -96,3 +99,92 @@ def test_compiled_step_test_agrees_with_the_python_reference_on_five_cs_1(monkey
         rb, ref = _traces(mech, True, monkeypatch)  # null_tangent on, but no engine: the SVD path
     _assert_same_traces(fast, ref)
     assert ra.usable_drivers == rb.usable_drivers
+
+
+# ------------------------------------------------------------------ the compiled loop (kernels_trace.nb_trace)
+def flat(o, path=""):
+    """``(path, leaf)`` pairs of a JSON-like document."""
+    if isinstance(o, dict):
+        for k, v in o.items():
+            yield from flat(v, f"{path}/{k}")
+    elif isinstance(o, (list, tuple)):
+        for i, v in enumerate(o):
+            yield from flat(v, f"{path}[{i}]")
+    else:
+        yield path, o
+
+
+def assert_same_document(a: dict, b: dict, tol: float = TRACE_TOL) -> None:
+    """Two JSON documents with the same keys and leaves, floats to ``tol`` (relative above 1)."""
+    fa, fb = dict(flat(a)), dict(flat(b))
+    assert fa.keys() == fb.keys()
+    for k, x in fa.items():
+        y = fb[k]
+        if isinstance(x, float) and isinstance(y, float):
+            assert x == y or abs(x - y) <= tol * max(1.0, abs(x)), (k, x, y)
+        else:
+            assert x == y, (k, x, y)
+
+
+def _analysis(mech, monkeypatch, python: bool):
+    """A defect analysis, its TrackResults and the compiled loop's return codes, with the
+    tracker's compiled loop or inside ``python_loop()``."""
+    from spatialmech.kinematics.compiled import trace
+
+    rec, codes = [], []
+    run = trace.TraceLoop.run
+
+    def recording(*a, **k):
+        r = tracking.track(*a, **k)
+        rec.append(r)
+        return r
+
+    def counting(self, *a, **k):
+        codes.append(run(self, *a, **k))
+        return codes[-1]
+
+    with monkeypatch.context() as m:
+        m.setattr(defect_circuits, "track", recording)
+        m.setattr(trace.TraceLoop, "run", counting)
+        if python:
+            with tracking.python_loop():
+                res = defect_analysis(mech)
+        else:
+            res = defect_analysis(mech)
+    return res, rec, codes
+
+
+@pytest.mark.parametrize("name, rank", [("five-cs-1", None), ("five-cs-2", None), ("five-cs-1", 1e-3)])
+def test_the_compiled_loop_traces_what_the_python_loop_traces(name, rank, monkeypatch):
+    """Points, arcs, tangents, DJ monitors, events (place, values, bracket, kind), statuses and
+    counters of every traced circuit, and the whole analysis (JSON), to 1e-10 (measured: equal bit
+    for bit).  five-cs-1: branch defects; five-cs-2: a circuit defect (four circuits).  With the
+    rank tolerance at 1e-3 the bordered LU certifies no step: every step goes back to the Python
+    loop (the kernel's hand-back path) and the result is still the reference's."""
+    from spatialmech.geometry.tolerances import use
+    from spatialmech.kinematics.compiled import trace
+
+    if not backend.enabled():
+        pytest.skip("the compiled engine is not in use")
+    mech = catalog.build(name)
+    with use(**({"rank": rank} if rank else {})):
+        ra, fast, codes = _analysis(mech, monkeypatch, python=False)
+        rb, ref, none = _analysis(mech, monkeypatch, python=True)
+    assert not none and codes  # python_loop() keeps the kernel out; without it the kernel runs
+    assert (trace.PYTHON_STEP in codes) == (rank is not None)
+    assert len(fast) == len(ref)
+    for a, b in zip(fast, ref, strict=True):
+        assert (a.status, a.closed, a.rejected, a.corrector_iterations) == (b.status, b.closed, b.rejected,
+                                                                            b.corrector_iterations)
+        assert len(a.points) == len(b.points) and np.max(np.abs(a.s - b.s)) <= TRACE_TOL
+        assert max(float(np.max(np.abs(x.q - y.q))) for x, y in zip(a.points, b.points, strict=True)) <= TRACE_TOL
+        assert max(float(np.max(np.abs(x - y))) for x, y in zip(a.tangents, b.tangents, strict=True)) <= TRACE_TOL
+        assert a.monitors.keys() == b.monitors.keys()
+        for k in a.monitors:
+            assert np.allclose(a.monitors[k], b.monitors[k], rtol=TRACE_TOL, atol=0.0)
+        assert [(e.name, e.step, e.kind) for e in a.events] == [(e.name, e.step, e.kind) for e in b.events]
+        for e, f in zip(a.events, b.events, strict=True):
+            assert abs(e.s - f.s) <= TRACE_TOL and np.max(np.abs(e.x.q - f.x.q)) <= TRACE_TOL
+            assert np.allclose([e.value_before, e.value_after, e.value, *e.bracket],
+                               [f.value_before, f.value_after, f.value, *f.bracket], rtol=TRACE_TOL, atol=1e-300)
+    assert_same_document(ra.to_dict(), rb.to_dict())
