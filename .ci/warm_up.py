@@ -2,7 +2,7 @@
 that `.ci/run` runs at once on the two cores (the tests would otherwise compile them one by one,
 on one core, as they first meet them: about two minutes of a cold run).
 
-    python .ci/warm_up.py 0    # the closure engine (compiled.warm_up), the tracker (a defect analysis), task grids
+    python .ci/warm_up.py 0    # the closure engine (compiled.warm_up), the tracker (defect analyses), task grids
     python .ci/warm_up.py 1    # homotopy trackers, the loop formulation, 4-SPS/CU legs, CS dyads
 
 Only a cache warm-up: the tests do not depend on it (a kernel it misses compiles when first used).
@@ -22,6 +22,7 @@ def part0() -> None:
 
     compiled.warm_up()
     sm.defects("five-cs-3")
+    sm.defects("five-cs-2")  # four circuits: the compiled search of a pose's distance from a circuit
     # the task grid's sweep and solve, the joint points and the cone margins (bench_limits.py)
     sm.workspace("three-rps", kind="task", over={"a2": (-0.1, 0.1, 3), "a3": (-0.1, 0.1, 3)}, at={"z": 0.33},
                  cones={"S1": 0.8})
