@@ -29,7 +29,6 @@ Procedure (paper A fig 5, made general):
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 from typing import cast
@@ -41,6 +40,7 @@ from ..geometry import screws as sc
 from ..kinematics.closure import Configuration, active_mask, closure_scales
 from ..kinematics.backend import closure_jacobian
 from ..kinematics.jacobian import complete_jacobians, driver_determinants
+from ..geometry.tolerances import Tolerances
 from ..geometry.tolerances import current as current_tolerances
 from ..geometry.tolerances import use as use_tolerances
 from ..kinematics.position import PoseFit, configuration_at_pose, freedom_values
@@ -275,13 +275,19 @@ class DJTable:
     drivers: tuple[str, ...]
     dj: np.ndarray
     fits: tuple[PoseFit, ...]
-    sigma_of: Callable[[], np.ndarray] = field(repr=False)  # computes sigma_min
+    mech: Mechanism = field(repr=False)  # the linkage, for sigma_min
+    tolerances: Tolerances = field(repr=False)  # in force when the table was made
 
     @cached_property
     def sigma_min(self) -> np.ndarray:
         """The scale-free smallest singular value of each driver's complete Jacobian at each
         position ``(n_drivers, n_positions)``."""
-        return self.sigma_of()
+        sig = np.empty_like(self.dj)
+        with use_tolerances(self.tolerances):
+            for k, f in enumerate(self.fits):  # one set of constraint wrenches per position, shared by the drivers
+                for i, cj in enumerate(complete_jacobians(self.mech, f.config, [[d] for d in self.drivers])):
+                    sig[i, k] = cj.sigma_min
+        return sig
 
     @property
     def signs(self) -> np.ndarray:
@@ -336,17 +342,8 @@ def dj_table(mech: Mechanism, drivers=None, positions=None) -> DJTable:
         prev = fit.config
     djf, _ = dj_function(mech, list(drivers), fits[0].config)
     dj = np.array([djf(f.config) for f in fits]).T
-    tol = current_tolerances()
-
-    def sigmas() -> np.ndarray:  # asked for by the table's readers, not by the defect analysis
-        sig = np.empty_like(dj)
-        with use_tolerances(tol):
-            for k, f in enumerate(fits):  # one set of constraint wrenches per position, shared by the drivers
-                for i, cj in enumerate(complete_jacobians(mech, f.config, [[d] for d in drivers])):
-                    sig[i, k] = cj.sigma_min
-        return sig
-
-    return DJTable(mech.name, tuple(p.name for p in positions), drivers, dj, tuple(fits), sigmas)
+    # sigma_min is computed when first read (the defect analysis never reads it)
+    return DJTable(mech.name, tuple(p.name for p in positions), drivers, dj, tuple(fits), mech, current_tolerances())
 
 
 

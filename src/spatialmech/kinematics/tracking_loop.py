@@ -56,9 +56,9 @@ class DriverMonitor:
 def compiled_loop(problem, vector_monitor, n_monitors: int, cfg):
     """The compiled loop (:class:`.compiled.trace.TraceLoop`) of a track with the settings
     ``cfg`` (``tracking._Settings``) when it applies: a motion problem that allows it
-    (``compiled_loop``, with the compiled step test: ``null_tangent``) with a :class:`DriverMonitor` of its mechanism as its only monitors, the
-    compiled engine in use, no ``stop`` or ``progress`` callback, outside :func:`python_loop`;
-    else ``None``."""
+    (``compiled_loop``, with the compiled step test: ``null_tangent``) with a
+    :class:`DriverMonitor` of its mechanism as its only monitors, the compiled engine in use, no
+    ``stop`` or ``progress`` callback, outside :func:`python_loop`; else ``None``."""
     if (vector_monitor is None or not isinstance(vector_monitor[1], DriverMonitor)
             or not (getattr(problem, "compiled_loop", False) and getattr(problem, "null_tangent", False))
             or n_monitors != len(vector_monitor[0])
