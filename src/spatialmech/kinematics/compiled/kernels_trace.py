@@ -57,17 +57,20 @@ def nb_trace_correct(G, q, D, B, t, a, tol, max_iter, pred, qo, Do, Bo, info):  
 
 
 @njit(cache=True)
-def nb_trace_dets(G, par, q, D, B, out):  # pragma: no cover - compiled
-    """The DJ of every driver (``engine.driver_determinants``) into ``out``: 0, or 2 where the
+def nb_trace_dets(G, par, q, D, B, lo, hi, out):  # pragma: no cover - compiled
+    """The DJ of drivers ``lo .. hi - 1`` (``engine.driver_determinants``; each driver's value
+    does not depend on the others asked with it) into ``out[: hi - lo]``: 0, or 2 where the
     Python path must decide (the kernel declines, or a value is not finite)."""
     S, ball_of, ball_axes, ball_centre, limb_start, ends, linear, active, drivers, cols = (G[0], G[1], G[3], G[4], G[5],
                                                                                           G[6], G[7], G[8], G[9], G[10])
+    o = out[: hi - lo]
     if par[11] != 0.0:
-        nb_closure_dets(S, ball_of, ball_axes, ball_centre, limb_start, ends, linear, active, par[0], q, D, B, cols, out)
-    elif nb_driver_dets(S, ball_of, ball_axes, ball_centre, limb_start, ends, active, par[0], par[1], q, D, B, drivers,
-                        out) != 0:
+        nb_closure_dets(S, ball_of, ball_axes, ball_centre, limb_start, ends, linear, active, par[0], q, D, B,
+                        cols[lo:hi], o)
+    elif nb_driver_dets(S, ball_of, ball_axes, ball_centre, limb_start, ends, active, par[0], par[1], q, D, B,
+                        drivers[lo:hi], o) != 0:
         return 2
-    for v in out:
+    for v in o:
         if not np.isfinite(v):
             return 2
     return 0
@@ -83,12 +86,12 @@ def _dot(a, b):  # pragma: no cover - compiled
 
 @njit(cache=True)
 def _monitor(G, par, which, q, D, B, X0, t0, vals, dif):  # pragma: no cover - compiled
-    """(flag, value): DJ of driver ``which`` at ``(q, D, B)``; ``which = -1``: the closure
-    function ``t0 . difference(x0, x)``."""
+    """(flag, value): DJ of driver ``which`` at ``(q, D, B)`` (that driver's alone: the same
+    number as among all drivers); ``which = -1``: the closure function ``t0 . difference(x0, x)``."""
     if which >= 0:
-        if nb_trace_dets(G, par, q, D, B, vals) != 0:
+        if nb_trace_dets(G, par, q, D, B, which, which + 1, vals) != 0:
             return 2, 0.0
-        return 0, vals[which]
+        return 0, vals[0]
     nb_difference(G[2], G[3], X0[0], X0[1], X0[2], q, D, B, G[8], G[13], G[12], dif)
     return 0, _dot(t0, dif)
 
@@ -203,7 +206,8 @@ def _accept(G, par, fs, ist, X, t, h, Xn, tn, mlast, X0, t0, Xm, W, D2, Bf):  # 
     2 where the Python path must decide (nothing counted)."""
     vals = W[2]
     dcur, dnew, dvalid = D2
-    if nb_trace_dets(G, par, Xn[0], Xn[1], Xn[2], vals) != 0:
+    nd = len(vals)
+    if nb_trace_dets(G, par, Xn[0], Xn[1], Xn[2], np.int64(0), nd, vals) != 0:
         return 2
     ne = _events(G, par, fs, ist, X, t, h, Xn, mlast, vals, X0, t0, Xm, W, Bf)
     if ne < 0:
@@ -220,7 +224,7 @@ def _accept(G, par, fs, ist, X, t, h, Xn, tn, mlast, X0, t0, Xm, W, D2, Bf):  # 
             vm = np.empty(len(vals))
             if _locate(G, par, X, t, h, -1, g0, g1, X0, t0, Xm, W, res) != 0:
                 return 2
-            if nb_trace_dets(G, par, Xm[0], Xm[1], Xm[2], vm) != 0:
+            if nb_trace_dets(G, par, Xm[0], Xm[1], Xm[2], np.int64(0), nd, vm) != 0:
                 return 2
             _put_point(Bf, ist[4], Xm[0], Xm[1], Xm[2], fs[0] + res[0], tn, vm)
             ist[4] += 1

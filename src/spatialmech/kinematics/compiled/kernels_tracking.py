@@ -21,7 +21,7 @@ import numpy as np
 
 from .jit import njit
 
-__all__ = ["bordered_tangent", "nb_bordered_tangent", "nb_lu_sign", "nb_lu_solve_unit"]
+__all__ = ["bordered_tangent", "nb_bordered_tangent", "nb_lu_inverse", "nb_lu_sign", "nb_lu_solve_unit"]
 
 
 @njit(cache=True)
@@ -73,6 +73,44 @@ def nb_lu_solve_unit(M, piv, c, x):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
+def nb_lu_inverse(M, piv, X):  # pragma: no cover - compiled
+    """``X`` <- ``M0^-1`` from the LU of :func:`nb_lu_sign`: column ``c`` is
+    :func:`nb_lu_solve_unit` of ``c``, the same operations in the same order for each entry,
+    made row by row for all columns at once (independent chains: the loops vectorise)."""
+    n1 = M.shape[0]
+    for i in range(n1):
+        for c in range(n1):
+            X[i, c] = 1.0 if piv[i] == c else 0.0
+        for j in range(i):
+            f = M[i, j]
+            for c in range(n1):
+                X[i, c] -= f * X[j, c]
+    for i in range(n1 - 1, -1, -1):
+        for j in range(i + 1, n1):
+            f = M[i, j]
+            for c in range(n1):
+                X[i, c] -= f * X[j, c]
+        d = M[i, i]
+        for c in range(n1):
+            X[i, c] = X[i, c] / d
+
+
+@njit(cache=True)
+def _column_sums_total(X):  # pragma: no cover - compiled
+    """``sum over c of (sum over i of X[i, c]^2)``, each inner sum in row order from 0.0 (as
+    ``np.sum(x * x)`` of a column), the outer in column order."""
+    n, m = X.shape
+    acc = np.zeros(m)
+    for i in range(n):
+        for c in range(m):
+            acc[c] += X[i, c] * X[i, c]
+    tot = 0.0
+    for c in range(m):
+        tot += acc[c]
+    return tot
+
+
+@njit(cache=True)
 def nb_bordered_tangent(A, t, M, z, info):  # pragma: no cover - compiled
     """LU of ``M = [A; t]`` (scratch ``M``, ``(n + 1, n + 1)``): ``z`` <- the unit solution of
     ``M z = e_(n+1)``; ``info`` <- (1 if ``M`` is nonsingular else 0, sign of ``det M``,
@@ -88,10 +126,11 @@ def nb_bordered_tangent(A, t, M, z, info):  # pragma: no cover - compiled
     if sign == 0.0:
         return
     # |M^-1|_F from the solutions of M x = e_c for every column c (the last one is z)
-    fro = 0.0
-    for c in range(n1):
-        nb_lu_solve_unit(M, piv, c, z)
-        fro += np.sum(z * z)
+    X = np.empty((n1, n1))
+    nb_lu_inverse(M, piv, X)
+    fro = _column_sums_total(X)
+    for i in range(n1):
+        z[i] = X[i, n1 - 1]
     zn = np.sqrt(np.sum(z * z))
     if not (zn > 0.0 and np.isfinite(fro)):
         return
