@@ -188,3 +188,29 @@ def test_the_compiled_loop_traces_what_the_python_loop_traces(name, rank, monkey
             assert np.allclose([e.value_before, e.value_after, e.value, *e.bracket],
                                [f.value_before, f.value_after, f.value, *f.bracket], rtol=TRACE_TOL, atol=1e-300)
     assert_same_document(ra.to_dict(), rb.to_dict())
+
+
+@pytest.mark.parametrize("kw", [dict(max_turn_deg=0.2, h_min=1e-2), dict(max_arc=0.7), dict(max_steps=25),
+                                dict(detect_closure=False, max_arc=5.0)])
+def test_the_compiled_loop_ends_a_track_as_the_python_loop_does(kw, monkeypatch):
+    """No acceptable step above ``h_min`` (the same message), the arc and step budgets, no loop
+    closure: the same status, points, rejections and events on both loops.  The kernel's output
+    arrays hold 8 points and 4 events here: it refills them (``FULL``) many times a track."""
+    from spatialmech.analysis.defects import candidate_drivers, dj_function
+    from spatialmech.kinematics.compiled import trace
+    from spatialmech.kinematics.position import configuration_at_pose
+
+    monkeypatch.setattr(trace.TraceLoop, "CAPACITY", (8, 4))
+
+    if not backend.enabled():
+        pytest.skip("the compiled engine is not in use")
+    mech = catalog.build("five-cs-1")
+    x0 = configuration_at_pose(mech, mech.positions[0]).config
+    drivers = candidate_drivers(mech)
+    mon = (drivers, dj_function(mech, drivers, x0)[0])
+    a = tracking.track(MotionProblem(mech), x0, vector_monitor=mon, **kw)
+    with tracking.python_loop():
+        b = tracking.track(MotionProblem(mech), x0, vector_monitor=mon, **kw)
+    assert (a.status, a.message, a.rejected, len(a.points)) == (b.status, b.message, b.rejected, len(b.points))
+    assert np.max(np.abs(a.s - b.s)) <= TRACE_TOL and [e.name for e in a.events] == [e.name for e in b.events]
+    assert all(abs(e.s - f.s) <= TRACE_TOL for e, f in zip(a.events, b.events, strict=True))

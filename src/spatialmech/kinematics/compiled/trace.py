@@ -25,6 +25,8 @@ class TraceLoop:
     max_arc, tol, cos_max, event_tol, detect_closure, max_steps; ``rank``: the rank tolerance."""
 
     DONE, H_MIN, CLOSED, PYTHON_STEP = DONE, H_MIN, CLOSED, PYTHON_STEP
+    #: Points and events the output arrays hold; a longer track refills them (``FULL``).
+    CAPACITY = (1024, 256)
 
     def __init__(self, mech: Mechanism, active, row, col, wrap, drivers, x0: Configuration, t0, settings: tuple,
                  rank: float):
@@ -36,7 +38,7 @@ class TraceLoop:
         self.X0 = (_f64(x0.q).copy(), _f64(x0.D).copy(), _f64(x0.B).reshape(self.nb, 4, 4).copy())
         self.t0 = _f64(t0).copy()
         self.n, self.nl, self.nd = cm.n, len(self.t0), len(idx)
-        self._alloc(1024, 256)
+        self._alloc(*self.CAPACITY)
 
     @staticmethod
     def applies(mech: Mechanism, active, n_local: int) -> bool:
@@ -48,6 +50,9 @@ class TraceLoop:
 
     def _alloc(self, cap: int, ecap: int) -> None:
         n, nb, nl, nd = self.n, self.nb, self.nl, self.nd
+        # room for one step at least (a point, an event per driver and the closure): the kernel
+        # returns FULL before a step without it, and would never make one
+        cap, ecap = max(cap, 2), max(ecap, nd + 1)
         self.Bf = (np.empty((cap, n)), np.empty((cap, 4, 4)), np.empty((cap, nb, 4, 4)), np.empty(cap),
                    np.empty((cap, nl)), np.empty((cap, nd)), np.empty((ecap, n)), np.empty((ecap, 4, 4)),
                    np.empty((ecap, nb, 4, 4)), np.empty((ecap, 8)))
