@@ -69,6 +69,8 @@ CASES = [
     (["ik", "delta", "--xyz", "0.02", "0.01", "-0.33"], "ik", "delta"),
     (["ik", "five-cs-1", "--position", "3"], "ik", "five-cs-1"),  # not reachable: rounded data, pose_fit
     (["ik", "three-rps", "--pose", "0,0,0.33,ZYX,0,5,5", "--free", "x,y,a1"], "ik", "three-rps"),
+    (["ik", "puma560", "--pose", "0.5,-0.15,0.1,ZYX,10,20,30", "--all"], "ik", "puma560"),  # homotopy, certified
+    (["ik", "agile-eye", "--pose", "0,0,0,ZYX,10,20,30", "--all"], "ik", "agile-eye"),  # closed-form limbs
     (["parasitic", "three-rps", "--over", "a2:-10:10:3,a3:-5:5:2", "--at", "z=0.33"], "parasitic", "three-rps"),
     (["fk", "four-sps-cu", "--actuators", FK_ACTUATORS, "--all", "--seeds", "16"], "fk", "four-sps-cu"),  # closed form
     (["fk", "four-sps-cu", "--actuators", FK_ACTUATORS], "fk", "four-sps-cu"),  # general engine

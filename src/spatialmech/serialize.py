@@ -160,6 +160,7 @@ UNIT_FREE_KEYS: dict[str, str] = {
     "n_generic": "isolated solutions of the generic instance (homotopy paths tracked)",
     "n_paths": "paths of the total-degree homotopy (loop formulation: of the final parameter homotopy)",
     "n_spurious": "end points of the squared-up loop system that do not satisfy the full closure (discarded)",
+    "n_lost": "paths of a limb's homotopy that failed before the pose (after the re-tracks through a waypoint)",
     "monodromy_loops": "monodromy loops run before the solution set stopped growing",
     "trace_deviation": "relative deviation of the trace test's traces from a line (a ratio)",
     "n_witness": "witness points of the trace test's curve (a count)",

@@ -221,7 +221,7 @@ class LimbIKResult:
         return {"method": "homotopy", "complete": self.complete, "completeness": self.completeness,
                 "n_paths": self.n_paths, "n_real": self.n_real, "n_complex": self.n_complex,
                 "n_singular": self.n_singular, "n_at_infinity": self.n_infinity, "n_spurious": self.n_spurious,
-                "n_lost": self.n_lost, "cached": self.cached, "seconds_generic": round(self.seconds_generic, 4),
+                "n_lost": self.n_lost, "cached": self.cached, "generic_elapsed_s": round(self.seconds_generic, 4),
                 "seconds": round(self.seconds, 4), "trace_test": None if tr is None else str(tr.verdict)}
 
 
