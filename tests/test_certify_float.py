@@ -157,3 +157,143 @@ def test_float_pass_grants_the_ball_tests_boxes_at_ill_conditioned_points():
         ctx.prec = old
     assert len(Y) == 8 and all(r is not None for r in fast) and fast == ball
     assert sum(r != pow2_up(r) for r in fast) == 2  # past the first radius (a power of two)
+
+
+# ------------------------------------------------------------------ the compiled float pass (compiled/certify.py)
+def _limb_points(m, dh, theta):
+    """The limb system, its pose parameters and the real solutions' points of the arm ``m`` at
+    the joint angles ``theta``."""
+    import spatialmech as sm
+
+    sysm = ikh.limb_ik_system(m, 0)
+    P = sysm.pose_parameters(np.asarray(dh_pose(dh, theta).displacement(m.platform_point), float)).real
+    qs = sm.ik(m, dh_pose(dh, theta), all_solutions=True, certify=False).result.limbs[0].solutions
+    return C.limb_system(sysm, P[:4], P[4:7]), np.array([C.limb_point(sysm, np.asarray(q)) for q in qs])
+
+
+def _three_ways(system, Y, ball=True):
+    """The float pass compiled, the float pass on the Python reference, and the ball test's box
+    of each point (53 bits, the preconditioners of ``certify``)."""
+    from flint import ctx
+
+    from spatialmech.kinematics import backend
+    from spatialmech.kinematics.compiled import kernels_certify
+
+    ctx.prec, old = 53, ctx.prec
+    try:
+        fast = system.krawczyk_float(Y, C.CERTIFY_MAX_RADIUS)
+        assert kernels_certify.nb_krawczyk.signatures  # the compiled path ran
+        with backend.python_reference():
+            ref = system.krawczyk_float(Y, C.CERTIFY_MAX_RADIUS)
+        pre = system.jacobian_float_many(Y.astype(complex)) if ball else []
+        balls = [C._one(system, y.astype(complex), C.CERTIFY_MAX_RADIUS, np.linalg.inv(J))[0]
+                 for y, J in zip(Y[: len(pre)], pre, strict=True)]
+    finally:
+        ctx.prec = old
+    return fast, ref, balls
+
+
+def test_compiled_float_pass_equals_the_reference_and_the_ball_test_on_the_puma():
+    """PUMA 560 at 15 random poses, 120 solutions: the compiled float pass grants every one the
+    box the Python float pass grants and the ball test gives (the ill-conditioned wrist
+    solutions one radius up included)."""
+    m = serial_arm("puma560", PUMA560_DH)
+    rng = np.random.default_rng(5)
+    n = 0
+    for _ in range(15):
+        system, Y = _limb_points(m, PUMA560_DH, rng.uniform(-np.pi, np.pi, 6))
+        fast, ref, ball = _three_ways(system, Y)
+        assert all(r is not None for r in fast) and fast == ref == ball
+        n += len(Y)
+    assert n == 120
+
+
+def test_compiled_float_pass_equals_the_reference_on_a_limb_with_an_s_joint():
+    """An R-R-P-S leg (a limb system of the ``point`` kind: the S joint's centre), its 4
+    solutions at two poses: the compiled float pass grants the reference's and the ball test's
+    boxes."""
+    import spatialmech as sm
+    from spatialmech.model.joints import P, R, S
+    from spatialmech.model.mechanism import Limb, Mechanism, Pose
+
+    def unit(v):
+        return list(np.asarray(v, dtype=float) / np.linalg.norm(v))
+
+    mech = Mechanism("rrps", (Limb("leg", (R("A", [0, 0, 0], [0, 0, 1.0]), R("B", [0.1, 0.05, 0.2], unit([1, 0.2, 0])),
+                                            P("C", [0.1, 0.05, 0.2], unit([0.1, 1, 0.3])), S("D", [0.15, 0.6, 0.35]))),),
+                     platform_point=np.array([0.15, 0.6, 0.35]))
+    sysm = ikh.limb_ik_system(mech, 0)
+    assert sysm.kind == "point" and sysm.rigid
+    rng = np.random.default_rng(1)
+    for _ in range(2):
+        D = np.eye(4)
+        D[:3, 3] = 0.1 * rng.normal(size=3)
+        qs = sm.ik(mech, Pose.from_displacement(D, mech.platform_point), all_solutions=True,
+                   certify=False).result.limbs[0].solutions
+        P0 = sysm.pose_parameters(D).real
+        Y = np.array([C.limb_point(sysm, np.asarray(q)) for q in qs])
+        fast, ref, ball = _three_ways(C.limb_system(sysm, P0[:4], P0[4:7]), Y)
+        assert len(Y) == 4 and None not in fast and fast == ref == ball
+
+
+def test_compiled_float_pass_refuses_moved_points_and_near_singular_roots():
+    """A PUMA 560 solution moved by 1e-3 (and by 1e-6), and the two wrist solutions near the
+    wrist singularity (theta5 = +-1e-6: each near a continuum of solutions): not granted,
+    compiled or not (the ball test decides them); the other six are, in the same boxes."""
+    m = serial_arm("puma560", PUMA560_DH)
+    system, Y = _limb_points(m, PUMA560_DH, np.array([0.3, -0.7, 0.5, 0.9, 0.6, -0.4]))
+    moved = np.repeat(Y[:1], 2, axis=0)
+    moved[0, 2] += 1e-3
+    moved[1, 4] += 1e-6
+    fast, ref, _ = _three_ways(system, moved, ball=False)
+    assert fast == ref == [None, None]
+    system, Y = _limb_points(m, PUMA560_DH, np.array([0.3, -0.7, 0.5, 0.9, 1e-6, -0.4]))
+    fast, ref, _ = _three_ways(system, Y, ball=False)
+    assert len(Y) == 8 and fast == ref and sum(r is None for r in fast) == 2
+    assert all(abs(abs(Y[i, 9]) - 1e-6) < 1e-9 for i in range(8) if fast[i] is None)  # sin(theta5)
+
+
+def test_compiled_test_refuses_a_near_double_root():
+    """``x0^2 - a x1^2``, ``x1 = 1`` with ``a = 1e-12`` (roots 2e-6 apart): a point off a root by
+    1e-7 and the point between the two roots are refused by the compiled test as by the
+    reference; a root (1e-6, 1) itself, and the simple root of ``a = 2``, are granted the same
+    boxes."""
+    from spatialmech.kinematics import backend
+
+    def system(a):
+        Q = np.zeros((1, 2, 2))
+        Q[0, 0, 0], Q[0, 1, 1] = 1.0, -a
+        return C.quadric_system(Q, np.eye(2)[1:], np.ones(1))
+
+    near, simple = np.array([[1.1e-6, 1.0], [0.0, 1.0], [1e-6, 1.0]]), np.array([[np.sqrt(2.0), 1.0]])
+    fast = system(1e-12).krawczyk_float(near, C.CERTIFY_MAX_RADIUS) + system(2.0).krawczyk_float(simple, 1e-8)
+    with backend.python_reference():
+        ref = system(1e-12).krawczyk_float(near, C.CERTIFY_MAX_RADIUS) + system(2.0).krawczyk_float(simple, 1e-8)
+    assert fast == ref and fast[:2] == [None] * 2 and None not in fast[2:]
+
+
+def test_compiled_kernels_round_every_operation_once():
+    """The rounding bound of the compiled arithmetic assumes no fused multiply-add and no
+    reordering (kernels_certify.py): every kernel is compiled as ``@njit(cache=True)``, without
+    ``fastmath``, and a kernel compiled so computes ``a b + c`` in two roundings, with no
+    fused multiply-add in its machine code."""
+    import inspect
+    import re
+
+    from spatialmech.kinematics.compiled import jit, kernels_certify
+
+    source = inspect.getsource(kernels_certify)
+    assert "fastmath" not in source.replace("without ``fastmath``", "").replace("``fastmath``", "")
+    decorators = re.findall(r"^@.*$", source, flags=re.M)
+    assert decorators and set(decorators) == {"@njit(cache=True)"}
+
+    def probe(a, b, c, out):
+        for i in range(a.shape[0]):
+            out[i] = a[i] * b[i] + c[i]
+
+    kernel = jit.njit(probe)
+    a, b, c, out = np.array([1 + 2.0**-30]), np.array([1 - 2.0**-30]), np.array([-1.0]), np.zeros(1)
+    kernel(a, b, c, out)
+    assert out[0] == 0.0  # fl(fl(a b) + c); a fused a b + c is -2^-60
+    asm = kernel.inspect_asm(kernel.signatures[0])
+    assert "mulsd" in asm and not re.search(r"\bv?fn?m(add|sub)\d*[sp]d\b", asm)
