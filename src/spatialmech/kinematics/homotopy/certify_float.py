@@ -157,11 +157,14 @@ def _pow2_up(r: np.ndarray) -> np.ndarray:
 def from_balls(F) -> MR:
     """A column of python-flint real balls (an ``n x 1`` :class:`flint.arb_mat`) as an interval
     row (1, n), outward: the midpoint rounded to a float and the radius rounded up."""
-    mids = [e.mid() for e in F.entries()]
-    m = np.array([float(v) for v in mids])
-    r = np.array([float(e.rad()) for e in F.entries()])
-    err = np.array([float((v - float(x)).abs_upper()) for v, x in zip(mids, m, strict=True)])  # 0: mids are floats
-    r = _up(r + err + _U * (r + err + np.abs(m)))  # float() rounds to nearest: one more u
+    from flint import arb
+
+    ents = F.entries()
+    m = np.array([float(e) for e in ents])  # the midpoints as floats
+    r = np.array([float(e.rad()) for e in ents])
+    # |midpoint - m|: 0 where the midpoint is that float (the rule at 53 bits), else bounded in balls
+    err = np.array([0.0 if e.mid() == arb(x) else float((e.mid() - x).abs_upper()) for e, x in zip(ents, m, strict=True)])
+    r = _up(r + err + _U * (r + err + np.abs(m)))  # float() of the radius rounds to nearest: one more u
     return MR(m[None], r[None])
 
 
