@@ -297,3 +297,63 @@ def test_compiled_kernels_round_every_operation_once():
     assert out[0] == 0.0  # fl(fl(a b) + c); a fused a b + c is -2^-60
     asm = kernel.inspect_asm(kernel.signatures[0])
     assert "mulsd" in asm and not re.search(r"\bv?fn?m(add|sub)\d*[sp]d\b", asm)
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1))
+def test_compiled_interval_kernels_enclose_the_exact_results(seed):
+    """The compiled interval operations (kernels_certify.py: a product and a transposed product
+    of 4x4 interval matrices, a product and a sum of intervals) hold the exact results of
+    members of their operands (rational arithmetic)."""
+    from spatialmech.kinematics.compiled import kernels_certify as K
+
+    rng = np.random.default_rng(seed)
+    A, B = rng.normal(size=(4, 4)) * 10 ** rng.uniform(-3, 3), rng.normal(size=(4, 4)) * 10 ** rng.uniform(-3, 3)
+    Ra, Rb = np.abs(rng.normal(size=(4, 4))) * 1e-9, np.abs(rng.normal(size=(4, 4))) * 1e-12
+    Ta, Tb = rng.uniform(-1, 1, (4, 4)), rng.uniform(-1, 1, (4, 4))
+    xa = [[Fraction(A[i, j]) + Fraction(Ta[i, j]) * Fraction(Ra[i, j]) for j in range(4)] for i in range(4)]
+    xb = [[Fraction(B[i, j]) + Fraction(Tb[i, j]) * Fraction(Rb[i, j]) for j in range(4)] for i in range(4)]
+    for transpose in (False, True):
+        Cm, Cr = np.empty((4, 4)), np.empty((4, 4))
+        (K.nb_imatmul_t if transpose else K.nb_imatmul)(A, Ra, B, Rb, Cm, Cr)
+        for i in range(4):
+            for j in range(4):
+                exact = sum((xa[k][i] if transpose else xa[i][k]) * xb[k][j] for k in range(4))
+                assert _inside(exact, float(Cm[i, j]), float(Cr[i, j]))
+    a, b = xa[0][0], xb[1][2]
+    for (m, r), exact in ((K.nb_imul(A[0, 0], Ra[0, 0], B[1, 2], Rb[1, 2]), a * b),
+                          (K.nb_iadd(A[0, 0], Ra[0, 0], B[1, 2], Rb[1, 2]), a + b)):
+        assert _inside(exact, m, r)
+
+
+def test_compiled_limb_enclosures_hold_the_exact_values():
+    """PUMA 560: the compiled enclosure of the values at each solution holds the values computed
+    in 200-bit balls, and that of the Jacobian over the largest box holds the Jacobian at the
+    box's corners and centre (200-bit balls); its midpoints are the float Jacobian at the points."""
+    from flint import ctx
+
+    from spatialmech.kinematics.compiled import certify as KC
+    from spatialmech.kinematics.compiled import kernels_certify as K
+    from spatialmech.kinematics.homotopy import certify_float as CF
+    from spatialmech.kinematics.homotopy.certify_balls import REAL
+
+    sysm, P, Y = _puma_system()
+    k, n = Y.shape
+    rbox = CF.box_radii(Y, C.CERTIFY_MAX_RADIUS)
+    Fm, Fr, Jm, Jr = np.empty((k, n)), np.empty((k, n)), np.empty((k, n, n)), np.empty((k, n, n))
+    K.nb_limb_enclosures(Y, rbox, P[:4].copy(), P[4:7].copy(), *KC.pack_limb(sysm), Fm, Fr, Jm, Jr)
+    system = C.limb_system(sysm, P[:4], P[4:7])
+    old, ctx.prec = ctx.prec, 200
+    try:
+        for p in range(k):
+            F = system.values(REAL.col(Y[p]))
+            assert all(abs(F[i, 0] - float(Fm[p, i])) + F[i, 0].rad() < float(Fr[p, i]) for i in range(n))
+            h = rbox[p] * (1 - 2.0**-20)  # within the box after rounding
+            corners = [Y[p], Y[p] + h, Y[p] - h, Y[p] + h * np.sign(np.sin(np.arange(n) + p))]
+            for y in corners:
+                J = system.jacobian(REAL.col(y))  # the corners: exact floats
+                assert all(abs(J[i, j] - float(Jm[p, i, j])) + J[i, j].rad() <= float(Jr[p, i, j])
+                           for i in range(n) for j in range(n))
+    finally:
+        ctx.prec = old
+    assert np.allclose(Fm, 0.0, atol=1e-13) and np.allclose(Jm, system.jacobian_float_many(Y).real, atol=1e-13)
