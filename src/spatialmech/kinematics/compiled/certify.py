@@ -18,13 +18,18 @@ __all__ = ["krawczyk_limb", "krawczyk_test", "pack_limb"]
 _PACKED: dict[int, tuple] = {}
 
 
+_REFERENCE: list = []
+
+
 def _reference() -> Any:
     """:mod:`..homotopy.certify_float` (its checks, preconditioners and ball values), imported
     when first needed: its caller has imported it already, and importing it here at the top
     would load the homotopy package with the compiled engine (0.2 s) in every process."""
-    from ..homotopy import certify_float
+    if not _REFERENCE:
+        from ..homotopy import certify_float
 
-    return certify_float
+        _REFERENCE.append(certify_float)
+    return _REFERENCE[0]
 
 
 def pack_limb(sysm) -> tuple:

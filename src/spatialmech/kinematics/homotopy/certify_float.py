@@ -41,6 +41,7 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
+from flint import arb
 
 from ...geometry.tolerances import CERTIFY_GROWTH, CERTIFY_MIN_RADIUS
 from .. import backend
@@ -157,8 +158,6 @@ def _pow2_up(r: np.ndarray) -> np.ndarray:
 def from_balls(F) -> MR:
     """A column of python-flint real balls (an ``n x 1`` :class:`flint.arb_mat`) as an interval
     row (1, n), outward: the midpoint rounded to a float and the radius rounded up."""
-    from flint import arb
-
     ents = F.entries()
     m = np.array([float(e) for e in ents])  # the midpoints as floats
     r = np.array([float(e.rad()) for e in ents])
@@ -173,6 +172,13 @@ def preconditioners(J0: np.ndarray, Jr: np.ndarray) -> tuple[np.ndarray, np.ndar
     their enclosures, radii ``Jr``) and whether each point can be tested (finite enclosure, an
     invertible ``J0``, an inverse finite and below ``2^20``); ``A`` is zero where not.  Any matrix
     serves as the preconditioner of the Krawczyk test: a poor one only makes it fail."""
+    if np.isfinite(J0).all() and np.isfinite(Jr).all():  # the usual case, in fewer NumPy calls
+        try:
+            A = np.linalg.inv(J0)
+            if np.isfinite(A).all() and np.abs(A).max(initial=0.0) < _BIG:
+                return A, np.ones(len(J0), dtype=bool)
+        except np.linalg.LinAlgError:
+            pass
     ok = np.all(np.isfinite(J0), axis=(1, 2)) & np.all(np.isfinite(Jr), axis=(1, 2))
     A = np.zeros_like(J0)
     try:  # a singular one fails here
@@ -183,7 +189,7 @@ def preconditioners(J0: np.ndarray, Jr: np.ndarray) -> tuple[np.ndarray, np.ndar
                 A[i] = np.linalg.inv(J0[i])
             except np.linalg.LinAlgError:
                 ok[i] = False
-    ok &= np.all(np.isfinite(A), axis=(1, 2)) & (np.max(np.abs(A), axis=(1, 2)) < _BIG)
+    ok &= np.all(np.isfinite(A), axis=(1, 2)) & (np.max(np.abs(A), axis=(1, 2), initial=0.0) < _BIG)
     A[~ok] = 0.0
     return A, ok
 
@@ -425,7 +431,7 @@ def krawczyk_limb(sysm, q: np.ndarray, t: np.ndarray, Y: np.ndarray, max_radius:
     same equations, term by term) at the pose ``(q, t)`` (exact floats) and the real points
     ``Y`` (k, n)."""
     q, t = np.asarray(q, dtype=float), np.asarray(t, dtype=float)
-    if not (np.all(np.isfinite(q)) and np.all(np.isfinite(t)) and np.max(np.abs(np.r_[q, t])) < _BIG):
+    if not (np.isfinite(q).all() and np.isfinite(t).all() and max(np.abs(q).max(), np.abs(t).max()) < _BIG):
         return [None] * len(Y)
     if (fast := backend.engine()) is not None:  # the enclosures and the test compiled (compiled/certify.py)
         return fast.krawczyk_limb(sysm, q, t, Y, max_radius, ball_values)
