@@ -250,7 +250,7 @@ def test_compiled_float_pass_refuses_moved_points_and_near_singular_roots():
     theta = np.array([0.3, -0.7, 0.5, 0.9, 1e-6, -0.4])
     system, _ = _limb_points(m, PUMA560_DH, theta)
     sysm = ikh.limb_ik_system(m, 0)
-    flip = theta + [0, 0, 0, np.pi, -2e-6, np.pi]  # the other wrist solution
+    flip = theta + np.array([0, 0, 0, np.pi, -2e-6, np.pi])  # the other wrist solution
     Y = np.array([C.limb_point(sysm, q) for q in (theta, flip)])
     assert np.max(np.abs(C._mid(system.values(C.REAL.col(Y[1]))))) < 1e-14  # a root too
     fast, ref, _ = _three_ways(system, Y, ball=False)
