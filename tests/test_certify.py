@@ -259,6 +259,8 @@ def test_certify_benchmark_reports_its_target(stewart):
     assert set(out["cases"]) == {"stewart-6sps fk", "PUMA 560 ik"}
     assert all(c["all_certified"] and c["fraction"] > 0 for c in out["cases"].values())
     assert isinstance(out["certify_met"], bool) and out["certify_overhead_fraction"] > 0
+    comp = bench.certify_compiled_case(1)  # compiled float pass against the reference, one pose
+    assert comp["same_certificates"] and comp["ms"] > 0 and comp["speedup"] > 0
 
 
 def test_limb_float_jacobians_match_the_ball_system():
