@@ -158,6 +158,20 @@ def nb_pose(q, t, C, E, s, stv):
 
 
 @njit(cache=True)
+def nb_set4(dm, dr, sm, sr, identity):
+    """``(dm, dr) = (sm, sr)`` (4x4), or the identity with radius zero (``identity``): explicit
+    loops (an array assignment compiles numba's broadcasting for each call site)."""
+    for a in range(4):
+        for b in range(4):
+            if identity:
+                dm[a, b] = 1.0 if a == b else 0.0
+                dr[a, b] = 0.0
+            else:
+                dm[a, b] = sm[a, b]
+                dr[a, b] = sr[a, b]
+
+
+@njit(cache=True)
 def nb_side(xm, xr, lo, hi, rev, i_s, i_c, const, Mm, Mr, prem, prer, sufm, sufr, want_suf):
     """The factors ``lo:hi`` of one side at the interval point ``(xm, xr)``: ``M = (1, s, 1 - c) @
     (I ; A ; A^2)`` (``const`` (f, 3, 4, 4) exact), their prefix products ``pre[i] = M_0 ...
@@ -180,23 +194,17 @@ def nb_side(xm, xr, lo, hi, rev, i_s, i_c, const, Mm, Mr, prem, prer, sufm, sufr
                 c0, c1, c2 = const[f, 0, a, b], const[f, 1, a, b], const[f, 2, a, b]
                 Mm[i, a, b] = c0 + u1m * c1 + u2m * c2
                 Mr[i, a, b] = nb_up(g * abs(c0) + (u1r + g * abs(u1m)) * abs(c1) + (u2r + g * abs(u2m)) * abs(c2))
-    for a in range(4):
-        for b in range(4):
-            prem[0, a, b] = 1.0 if a == b else 0.0
-    prer[0] = 0.0
+    nb_set4(prem[0], prer[0], Mm[0], Mr[0], np.bool_(True))  # the identity, exact
     for i in range(nf):
         if i == 0:
-            prem[1] = Mm[0]
-            prer[1] = Mr[0]
+            nb_set4(prem[1], prer[1], Mm[0], Mr[0], np.bool_(False))
         else:
             nb_imatmul(prem[i], prer[i], Mm[i], Mr[i], prem[i + 1], prer[i + 1])
     if want_suf:
-        sufm[nf] = prem[0]
-        sufr[nf] = 0.0
+        nb_set4(sufm[nf], sufr[nf], Mm[0], Mr[0], np.bool_(True))
         for i in range(nf - 1, -1, -1):
             if i == nf - 1:
-                sufm[i] = Mm[i]
-                sufr[i] = Mr[i]
+                nb_set4(sufm[i], sufr[i], Mm[i], Mr[i], np.bool_(False))
             else:
                 nb_imatmul(Mm[i], Mr[i], sufm[i + 1], sufr[i + 1], sufm[i], sufr[i])
 
@@ -291,7 +299,11 @@ def nb_limb_enclosures(Y, rbox, q, t, C, point, centre, circles, rev, i_s, i_c, 
     s = np.empty(2)
     stv = np.empty((3, 2))
     nb_pose(q, t, C, E, s, stv)
-    Em, Er = E[:, :, 0].copy(), E[:, :, 1].copy()
+    Em = np.empty((4, 4))
+    Er = np.empty((4, 4))
+    for a in range(4):
+        for b in range(4):
+            Em[a, b], Er[a, b] = E[a, b, 0], E[a, b, 1]
     nf = rev.shape[0]
     nc = circles.shape[0]
     zc = np.zeros(4)
@@ -310,19 +322,23 @@ def nb_limb_enclosures(Y, rbox, q, t, C, point, centre, circles, rev, i_s, i_c, 
     for p in range(k):
         xm = Y[p]
         for want in range(2):  # the values at the point, then the Jacobian over the box
-            xr[:] = 0.0 if want == 0 else rbox[p]
-            nb_side(xm, xr, first, nleft, rev, i_s, i_c, const, Mm, Mr, pre[0, 0], pre[0, 1], suf[0, 0], suf[0, 1],
-                    want == 1)
-            nb_side(xm, xr, nleft, nf, rev, i_s, i_c, const, Mm, Mr, pre[1, 0], pre[1, 1], suf[1, 0], suf[1, 1],
-                    want == 1)
+            for i in range(n):
+                xr[i] = 0.0 if want == 0 else rbox[p]
+            for side in range(2):  # one call site: each is compiled into this kernel
+                lo = first if side == 0 else nleft
+                hi = nleft if side == 0 else nf
+                nb_side(xm, xr, lo, hi, rev, i_s, i_c, const, Mm, Mr, pre[side, 0], pre[side, 1], suf[side, 0],
+                        suf[side, 1], want == 1)
             TLm, TLr = pre[0, 0, nleft], pre[0, 1, nleft]
             TRm, TRr = pre[1, 0, nf - nleft], pre[1, 1, nf - nleft]
             if want == 0:
                 nb_limb_values(xm, circles, point, TLm, TLr, TRm, TRr, Em, Er, s, stv, centre, zc, work, vec,
                                Fm[p], Fr[p])
                 continue
-            Jm[p] = 0.0
-            Jr[p] = 0.0
+            for i in range(n):
+                for j in range(n):
+                    Jm[p, i, j] = 0.0
+                    Jr[p, i, j] = 0.0
             for i in range(nc):
                 a, b = circles[i, 0], circles[i, 1]
                 Jm[p, i, a], Jr[p, i, a] = 2.0 * xm[a], 2.0 * xr[a]  # exact: times 2
