@@ -311,9 +311,11 @@ def test_compiled_kernels_round_every_operation_once():
 @given(seed=st.integers(0, 2**32 - 1))
 def test_compiled_interval_kernels_enclose_the_exact_results(seed):
     """The compiled interval operations (kernels_certify.py: a product and a transposed product
-    of 4x4 interval matrices, a product and a sum of intervals) hold the exact results of
-    members of their operands (rational arithmetic)."""
+    of 4x4 interval matrices, a matrix-vector product, a product and a sum of intervals, and the
+    pose's rotation ``E(q)``, ``q.q`` and ``(q.q) t``) hold the exact results of members of their
+    operands (rational arithmetic)."""
     from spatialmech.kinematics.compiled import kernels_certify as K
+    from spatialmech.kinematics.homotopy import certify_float as CF
 
     rng = np.random.default_rng(seed)
     A, B = rng.normal(size=(4, 4)) * 10 ** rng.uniform(-3, 3), rng.normal(size=(4, 4)) * 10 ** rng.uniform(-3, 3)
@@ -328,10 +330,25 @@ def test_compiled_interval_kernels_enclose_the_exact_results(seed):
             for j in range(4):
                 exact = sum((xa[k][i] if transpose else xa[i][k]) * xb[k][j] for k in range(4))
                 assert _inside(exact, float(Cm[i, j]), float(Cr[i, j]))
+    vm, vr = np.empty(4), np.empty(4)
+    K.nb_imatvec(A, Ra, B[:, 0].copy(), Rb[:, 0].copy(), vm, vr)
+    assert all(_inside(sum(xa[i][k] * xb[k][0] for k in range(4)), float(vm[i]), float(vr[i])) for i in range(4))
     a, b = xa[0][0], xb[1][2]
     for (m, r), exact in ((K.nb_imul(A[0, 0], Ra[0, 0], B[1, 2], Rb[1, 2]), a * b),
                           (K.nb_iadd(A[0, 0], Ra[0, 0], B[1, 2], Rb[1, 2]), a + b)):
         assert _inside(exact, m, r)
+    # the pose's data: E(q) (the unnormalised rotation), q.q and (q.q) t from floats q, t
+    q, t = rng.normal(size=4), rng.normal(size=3)
+    E, sq, stv = np.empty((4, 4, 2)), np.empty(2), np.empty((3, 2))
+    K.nb_pose(q, t, CF.rotation_coefficients(), E, sq, stv)
+    w, i, j, k = (Fraction(v) for v in q)
+    n2 = w * w + i * i + j * j + k * k
+    R = [[w * w + i * i - j * j - k * k, 2 * (i * j - w * k), 2 * (i * k + w * j)],
+         [2 * (i * j + w * k), w * w - i * i + j * j - k * k, 2 * (j * k - w * i)],
+         [2 * (i * k - w * j), 2 * (j * k + w * i), w * w - i * i - j * j + k * k]]
+    assert all(_inside(R[a][c], float(E[a, c, 0]), float(E[a, c, 1])) for a in range(3) for c in range(3))
+    assert _inside(n2, float(sq[0]), float(sq[1]))
+    assert all(_inside(n2 * Fraction(t[a]), float(stv[a, 0]), float(stv[a, 1])) for a in range(3))
 
 
 def test_compiled_limb_enclosures_hold_the_exact_values():
