@@ -30,6 +30,12 @@ derivative of every matrix product), is evaluated here for all points at once.
 The data are checked to be finite and below ``2^20`` in magnitude (else the ball test decides),
 so no underflow can be magnified beyond ``2^-1000``.
 
+With the compiled engine in use (:func:`..backend.engine`), a limb's enclosures and the test
+(:func:`krawczyk_limb`; the quadrics' test of :func:`krawczyk_real`) run as numba kernels doing
+this arithmetic operation by operation (``kinematics/compiled/kernels_certify.py``, compiled
+without ``fastmath``: no fused multiply-add, no reordering); this module is their reference,
+which runs under ``SPATIALMECH_PURE=1``.
+
 Soundness is kept by construction: the systems' constants (twist matrices, the pose's quaternion
 and translation, the quadrics) are the same floats the ball systems take as exact data, and every
 derived constant (the rotation of the quaternion, ``Q + Q^T``) is computed in interval arithmetic.
