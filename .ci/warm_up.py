@@ -3,7 +3,7 @@ that `.ci/run` runs at once on the two cores (the tests would otherwise compile 
 on one core, as they first meet them: about two minutes of a cold run).
 
     python .ci/warm_up.py 0    # the closure engine (compiled.warm_up), the tracker (defect analyses), task grids
-    python .ci/warm_up.py 1    # homotopy trackers, the loop formulation, 4-SPS/CU legs, CS dyads
+    python .ci/warm_up.py 1    # homotopy trackers, the loop formulation, 4-SPS/CU legs, CS dyads, certificates
 
 Only a cache warm-up: the tests do not depend on it (a kernel it misses compiles when first used).
 """
@@ -36,12 +36,32 @@ def part1() -> None:
     from spatialmech.synthesis import cs_dyads
 
     hc.homotopy_forward(hc.pose_system(catalog.resolve("three-rps")), [0.34, 0.36, 0.32])
+    _certify_warm_up()  # the certificates' compiled float pass
     sm.fk("rssr", [30.0], degrees=True, all_solutions=True)
     for n in (10, k4.PARALLEL_FROM):
         k4.leg_lengths(np.tile([0.2, 0.0, 0.0, 0.0], (n, 1)))
     x, D = np.linspace(0.1, 1.5, 15), np.tile(np.eye(4), (7, 1, 1))
     cs_dyads.dyad_residual(x, D)
     cs_dyads.dyad_jacobian(x, D)
+
+
+def _certify_warm_up() -> None:
+    """One certified inverse position of a PUMA 560 (standard DH) through the compiled float pass
+    of the certificates (compiled/kernels_certify.py: one signature serves every limb and the
+    quadrics' test)."""
+    import spatialmech as sm
+    from spatialmech.model.joints import R
+    from spatialmech.model.mechanism import Limb, Mechanism, Pose
+
+    dh = [(0.0, 0.0, np.pi / 2), (0.0, 0.4318, 0.0), (0.15005, 0.0203, -np.pi / 2), (0.4318, 0.0, np.pi / 2),
+          (0.0, 0.0, -np.pi / 2), (0.0, 0.0, 0.0)]
+    T, frames = np.eye(4), [np.eye(4)]
+    for d, a, al in dh:
+        T = T @ np.array([[1, 0, 0, a], [0, np.cos(al), -np.sin(al), 0], [0, np.sin(al), np.cos(al), d], [0, 0, 0, 1.0]])
+        frames.append(T)
+    arm = Mechanism("arm", (Limb("arm", tuple(R(f"J{i + 1}", frames[i][:3, 3], frames[i][:3, 2]) for i in range(6))),),
+                    platform_point=frames[-1][:3, 3])
+    sm.ik(arm, Pose.from_displacement(np.eye(4), frames[-1][:3, 3]), all_solutions=True)
 
 
 if __name__ == "__main__":

@@ -23,6 +23,11 @@ time over the rest of the same solve (``sm.fk`` / ``sm.ik`` with ``all_solutions
 new actuator values or poses, the generic solve cached: the smallest solves, so the largest
 fractions), target <= 0.25.  Cases: stewart-6sps forward (8 real solutions and 20 complex end
 points certified) and the inverse position of the PUMA 560 (8) and of a random general 6R.
+``certify_compiled`` (``--certify-only`` and the full run): the PUMA 560's certificates alone
+(``certify_inverse`` on the 8 solutions of each pose), compiled float pass
+(``compiled/kernels_certify.py``) against the Python reference (``backend.python_reference()``),
+alternating in the same run: ``ms`` and ``ms_reference`` (medians per pose) and their ratio
+``speedup``.
 """
 
 from __future__ import annotations
@@ -145,6 +150,39 @@ def certify_case(resolves: int, quick: bool = False) -> dict:
     return out
 
 
+def certify_compiled_case(poses: int) -> dict:
+    """The PUMA 560's certificates alone at ``poses`` random poses (8 solutions each):
+    ``certify_inverse`` with the compiled float pass and on the Python reference, alternating
+    pose by pose; medians in ms per pose and their ratio."""
+    import spatialmech as sm
+    from spatialmech.kinematics import backend
+    from spatialmech.kinematics.homotopy import certify as C
+    from spatialmech.kinematics.homotopy import inverse as ikh
+
+    puma = [(0.0, 0.0, np.pi / 2), (0.0, 0.4318, 0.0), (0.15005, 0.0203, -np.pi / 2), (0.4318, 0.0, np.pi / 2),
+            (0.0, 0.0, -np.pi / 2), (0.0, 0.0, 0.0)]
+    m, pose = _dh_arm(puma)
+    sysm = ikh.limb_ik_system(m, 0)
+    rng = np.random.default_rng(12)
+    fast, ref, same = [], [], True
+    for _ in range(poses):
+        p = pose(rng.uniform(-np.pi, np.pi, 6))
+        qs = [np.asarray(q) for q in sm.ik(m, p, all_solutions=True, certify=False).result.limbs[0].solutions]
+        D = p.displacement(m.platform_point)
+        C.certify_inverse(sysm, D, qs)  # the pose's ball constants and caches, not timed
+        t0 = time.perf_counter()
+        a = C.certify_inverse(sysm, D, qs)
+        t1 = time.perf_counter()
+        with backend.python_reference():
+            b = C.certify_inverse(sysm, D, qs)
+        t2 = time.perf_counter()
+        fast.append(t1 - t0)
+        ref.append(t2 - t1)
+        same &= a == b
+    ms, ms_ref = float(np.median(fast) * 1e3), float(np.median(ref) * 1e3)
+    return {"poses": poses, "ms": ms, "ms_reference": ms_ref, "speedup": ms_ref / ms, "same_certificates": bool(same)}
+
+
 def phc_blackbox(sysm, values, c) -> tuple[float, int] | None:
     """Seconds of ``phc -b`` on the system and its number of regular solutions (None: no phc)."""
     if shutil.which("phc") is None:
@@ -183,6 +221,7 @@ def case(name: str, sysm, legs: np.ndarray, resolves: int, rng: np.random.Genera
 def certify_main(as_json: bool) -> dict:
     """``--certify-only``: :func:`certify_case` alone (15 re-solves per case)."""
     cert = certify_case(15)
+    cert["certify_compiled"] = certify_compiled_case(15)
     out = {"certify": cert, "certify_overhead_fraction": cert["certify_overhead_fraction"],
            "targets": {"certify_overhead_fraction": TARGET_CERTIFY_FRACTION}}
     if as_json:
@@ -191,7 +230,13 @@ def certify_main(as_json: bool) -> dict:
     print("certificates   share of a re-solve (median): " + ", ".join(
         f"{k} {v['fraction']:.0%}{'' if v['all_certified'] else ' (NOT all certified)'}" for k, v in cert["cases"].items())
           + f" (target <= {TARGET_CERTIFY_FRACTION:.0%}): {'met' if cert['certify_met'] else 'NOT met'}")
+    print(_compiled_line(cert["certify_compiled"]))
     return out
+
+
+def _compiled_line(c: dict) -> str:
+    return (f"certificates   PUMA 560 alone: {c['ms']:.2f} ms per pose compiled, {c['ms_reference']:.2f} ms on the Python "
+            f"reference ({c['speedup']:.1f} x, same certificates: {c['same_certificates']})")
 
 
 def main(argv=None) -> dict:
@@ -217,6 +262,7 @@ def main(argv=None) -> dict:
         c["resolve_met"] = c["resolve_median_ms"] is not None and c["resolve_median_ms"] < TARGET_RESOLVE_MS
     ik = ik_case(3 if args.quick else 20)
     cert = certify_case(3 if args.quick else 15, quick=args.quick)
+    cert["certify_compiled"] = certify_compiled_case(2 if args.quick else 15)
     out = {"cases": cases, "targets": {"first_solve_s": TARGET_FIRST_S, "resolve_ms": TARGET_RESOLVE_MS,
                                        "ik_6r_first_s": TARGET_IK_FIRST_S, "ik_6r_resolve_ms": TARGET_IK_RESOLVE_MS,
                                        "ik_puma_solutions": 8, "certify_overhead_fraction": TARGET_CERTIFY_FRACTION},
@@ -244,6 +290,7 @@ def main(argv=None) -> dict:
     print("certificates   share of a re-solve (median): " + ", ".join(
         f"{k} {v['fraction']:.0%}{'' if v['all_certified'] else ' (NOT all certified)'}" for k, v in cert["cases"].items())
           + f" (target <= {TARGET_CERTIFY_FRACTION:.0%}): {word[cert['certify_met']]}")
+    print(_compiled_line(cert["certify_compiled"]))
     return out
 
 

@@ -259,6 +259,8 @@ def test_certify_benchmark_reports_its_target(stewart):
     assert set(out["cases"]) == {"stewart-6sps fk", "PUMA 560 ik"}
     assert all(c["all_certified"] and c["fraction"] > 0 for c in out["cases"].values())
     assert isinstance(out["certify_met"], bool) and out["certify_overhead_fraction"] > 0
+    comp = bench.certify_compiled_case(1)  # compiled float pass against the reference, one pose
+    assert comp["same_certificates"] and comp["ms"] > 0 and comp["speedup"] > 0
 
 
 def test_limb_float_jacobians_match_the_ball_system():
@@ -283,15 +285,20 @@ def test_quadric_float_jacobians_match_the_ball_system(stewart):
 
 def test_float_pass_gives_the_ball_tests_boxes_on_the_stewart(stewart):
     """The 8 real roots of stewart-6sps (Study quadrics in a real patch): the float pass
-    (certify_float.py) grants each the box the ball test gives."""
-    system, Y = stewart["system"], stewart["Y"]
-    prec = ctx.prec
-    ctx.prec = 53
-    try:
-        fast = system.krawczyk_float(Y, C.CERTIFY_MAX_RADIUS)
-        pre = system.jacobian_float_many(Y.astype(complex))
-        ball = [C._one(system, y.astype(complex), C.CERTIFY_MAX_RADIUS, np.linalg.inv(J))[0]
-                for y, J in zip(Y, pre, strict=True)]
-    finally:
-        ctx.prec = prec
-    assert len(Y) == 8 and all(r is not None for r in fast) and fast == ball
+    (certify_float.py; its test compiled, and on the Python reference) grants each the box the
+    ball test gives."""
+    from .test_certify_float import _three_ways
+
+    fast, ref, ball = _three_ways(stewart["system"], stewart["Y"])  # compiled test, Python reference, ball test
+    assert len(fast) == 8 and all(r is not None for r in fast) and fast == ref == ball
+
+
+def test_compiled_float_pass_gives_the_ball_tests_boxes_on_a_general_6r():
+    """A general 6R's real inverse solutions (the fixture of the homotopy tests): the compiled
+    float pass grants each the box the Python float pass and the ball test give."""
+    from .test_certify_float import _limb_points, _three_ways
+
+    dh, theta = random_6r(0)
+    system, Y = _limb_points(serial_arm("random-6r", dh), dh, theta)
+    fast, ref, ball = _three_ways(system, Y)
+    assert len(Y) >= 2 and all(r is not None for r in fast) and fast == ref == ball

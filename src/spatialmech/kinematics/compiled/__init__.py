@@ -11,7 +11,8 @@ system), :mod:`.kernels_ik` (one limb's inverse position),
 (with its entry :mod:`.limits`: joint points of many configurations, for the workspace limits),
 :mod:`.kernels_task` (with its entry :mod:`.tasks`: the task-coordinate solve), :mod:`.kernels_tracking` (the
 continuation tracker's tangent and orientation test), :mod:`.kernels_trace` (with its entry
-:mod:`.trace`: the tracker's loop); :mod:`.jit` is numba's ``njit`` or its
+:mod:`.trace`: the tracker's loop), :mod:`.kernels_certify` (with its entry :mod:`.certify`: the float
+pass of the certificates); :mod:`.jit` is numba's ``njit`` or its
 stand-in.
 
 Callers do not choose between this package and the Python reference themselves:
@@ -22,6 +23,7 @@ checks); the reference never imports this package.
 
 from __future__ import annotations
 
+from .certify import krawczyk_limb, krawczyk_test
 from .engine import (
     CompiledMechanism,
     closure_jacobian,
@@ -82,6 +84,8 @@ __all__ = [
     "ik_track",
     "inverse_legs_many",
     "joint_points_many",
+    "krawczyk_limb",
+    "krawczyk_test",
     "limb_gn",
     "limb_inverse_many",
     "link_margins_many",

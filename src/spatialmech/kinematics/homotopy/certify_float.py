@@ -30,6 +30,12 @@ derivative of every matrix product), is evaluated here for all points at once.
 The data are checked to be finite and below ``2^20`` in magnitude (else the ball test decides),
 so no underflow can be magnified beyond ``2^-1000``.
 
+With the compiled engine in use (:func:`..backend.engine`), a limb's enclosures and the test
+(:func:`krawczyk_limb`; the quadrics' test of :func:`krawczyk_real`) run as numba kernels doing
+this arithmetic operation by operation (``kinematics/compiled/kernels_certify.py``, compiled
+without ``fastmath``: no fused multiply-add, no reordering); this module is their reference,
+which runs under ``SPATIALMECH_PURE=1``.
+
 Soundness is kept by construction: the systems' constants (twist matrices, the pose's quaternion
 and translation, the quadrics) are the same floats the ball systems take as exact data, and every
 derived constant (the rotation of the quaternion, ``Q + Q^T``) is computed in interval arithmetic.
@@ -41,10 +47,13 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
+from flint import arb
 
 from ...geometry.tolerances import CERTIFY_GROWTH, CERTIFY_MIN_RADIUS
+from .. import backend
 
-__all__ = ["MR", "krawczyk_limb", "krawczyk_quadrics", "krawczyk_real"]
+__all__ = ["MR", "box_radii", "from_balls", "krawczyk_limb", "krawczyk_quadrics", "krawczyk_real", "preconditioners",
+           "rotation_coefficients", "testable", "with_ball_values"]
 
 _U = 2.0**-53  # u: |fl(x) - x| <= u |x|, and u / (1 - u) |fl(x)| (the excess is in _up's margin)
 _UP = 1.0 + 2.0**-40
@@ -155,12 +164,52 @@ def _pow2_up(r: np.ndarray) -> np.ndarray:
 def from_balls(F) -> MR:
     """A column of python-flint real balls (an ``n x 1`` :class:`flint.arb_mat`) as an interval
     row (1, n), outward: the midpoint rounded to a float and the radius rounded up."""
-    mids = [e.mid() for e in F.entries()]
-    m = np.array([float(v) for v in mids])
-    r = np.array([float(e.rad()) for e in F.entries()])
-    err = np.array([float((v - float(x)).abs_upper()) for v, x in zip(mids, m, strict=True)])  # 0: mids are floats
-    r = _up(r + err + _U * (r + err + np.abs(m)))  # float() rounds to nearest: one more u
+    ents = F.entries()
+    m = np.array([float(e) for e in ents])  # the midpoints as floats
+    r = np.array([float(e.rad()) for e in ents])
+    # |midpoint - m|: 0 where the midpoint is that float (the rule at 53 bits), else bounded in balls
+    err = np.array([0.0 if e.mid() == arb(x) else float((e.mid() - x).abs_upper()) for e, x in zip(ents, m, strict=True)])
+    r = _up(r + err + _U * (r + err + np.abs(m)))  # float() of the radius rounds to nearest: one more u
     return MR(m[None], r[None])
+
+
+def preconditioners(J0: np.ndarray, Jr: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(A, ok)``: the inverses ``A`` (k, n, n) of the float Jacobians ``J0`` (the midpoints of
+    their enclosures, radii ``Jr``) and whether each point can be tested (finite enclosure, an
+    invertible ``J0``, an inverse finite and below ``2^20``); ``A`` is zero where not.  Any matrix
+    serves as the preconditioner of the Krawczyk test: a poor one only makes it fail."""
+    if np.isfinite(J0).all() and np.isfinite(Jr).all():  # the usual case, in fewer NumPy calls
+        try:
+            A = np.linalg.inv(J0)
+            if np.isfinite(A).all() and np.abs(A).max(initial=0.0) < _BIG:
+                return A, np.ones(len(J0), dtype=bool)
+        except np.linalg.LinAlgError:
+            pass
+    ok = np.all(np.isfinite(J0), axis=(1, 2)) & np.all(np.isfinite(Jr), axis=(1, 2))
+    A = np.zeros_like(J0)
+    try:  # a singular one fails here
+        A[ok] = np.linalg.inv(J0[ok])
+    except np.linalg.LinAlgError:
+        for i in np.flatnonzero(ok):
+            try:
+                A[i] = np.linalg.inv(J0[i])
+            except np.linalg.LinAlgError:
+                ok[i] = False
+    ok &= np.all(np.isfinite(A), axis=(1, 2)) & (np.max(np.abs(A), axis=(1, 2), initial=0.0) < _BIG)
+    A[~ok] = 0.0
+    return A, ok
+
+
+def testable(Y: np.ndarray) -> bool:
+    """Whether the float pass may run at the points ``Y`` (k, n): some, all finite and below
+    ``2^20`` in magnitude (module docstring: no underflow magnified beyond ``2^-1000``)."""
+    return len(Y) > 0 and bool(np.all(np.isfinite(Y))) and float(np.max(np.abs(Y))) <= _BIG
+
+
+def box_radii(Y: np.ndarray, max_radius: float) -> np.ndarray:
+    """The half-width of the largest box of each point's sequence, a power of two (the box over
+    which ``F'`` is enclosed once for every radius)."""
+    return _pow2_up(max_radius * (1.0 + np.max(np.abs(Y), axis=1)))
 
 
 def krawczyk_real(values: Callable[[MR], MR], jacobian: Callable[[MR], MR], Y: np.ndarray,
@@ -173,31 +222,29 @@ def krawczyk_real(values: Callable[[MR], MR], jacobian: Callable[[MR], MR], Y: n
     ball test's for each, 12 of them after the first radius failed in both).  ``values`` and
     ``jacobian`` enclose ``F`` (k, n) and ``F'`` (k, n, n) over interval points (k, n);
     ``ball_values(y)``, when given, encloses ``F`` at one point in python-flint balls (an
-    ``n x 1`` :class:`flint.arb_mat`: tighter) and is tried where the test fails with ``values``."""
+    ``n x 1`` :class:`flint.arb_mat`: tighter) and is tried where the test fails with ``values``.
+    The test itself runs compiled when the compiled engine is in use
+    (:func:`..compiled.certify.krawczyk_test`: the same arithmetic), else here."""
     Y = np.asarray(Y, dtype=float)
+    k = Y.shape[0]
+    if not testable(Y):
+        return [None] * k
+    JX = jacobian(MR(Y, np.broadcast_to(box_radii(Y, max_radius)[:, None], Y.shape)))  # serves every box
+    A, ok = preconditioners(JX.m, JX.r)  # the midpoints do not depend on the radii: F'(y) in floating point
+    F = values(MR(Y))
+    if (fast := backend.engine()) is not None:
+        return fast.krawczyk_test(A, JX.m, JX.r, F.m, F.r, Y, max_radius, ok, ball_values)
+    return _krawczyk_reference(A, ok, JX, F, Y, max_radius, ball_values)
+
+
+def _krawczyk_reference(A: np.ndarray, ok: np.ndarray, JX: MR, F: MR, Y: np.ndarray, max_radius: float,
+                        ball_values: Callable[[np.ndarray], Any] | None) -> list[float | None]:
+    """The test of :func:`krawczyk_real` in NumPy interval arithmetic (the Python reference)."""
     k, n = Y.shape
     out: list[float | None] = [None] * k
-    if k == 0 or not np.all(np.isfinite(Y)) or np.max(np.abs(Y)) > _BIG:
-        return out
-    rbox = _pow2_up(max_radius * (1.0 + np.max(np.abs(Y), axis=1)))
-    JX = jacobian(MR(Y, np.broadcast_to(rbox[:, None], Y.shape)))  # over the largest box: serves every box
-    J0 = JX.m  # the midpoints do not depend on the radii: F'(y) in floating point
-    ok = np.all(np.isfinite(J0), axis=(1, 2)) & np.all(np.isfinite(JX.r), axis=(1, 2))
-    A = np.zeros_like(J0)
-    try:  # any matrix serves as the preconditioner; a singular one fails here
-        A[ok] = np.linalg.inv(J0[ok])
-    except np.linalg.LinAlgError:
-        for i in np.flatnonzero(ok):
-            try:
-                A[i] = np.linalg.inv(J0[i])
-            except np.linalg.LinAlgError:
-                ok[i] = False
-    ok &= np.all(np.isfinite(A), axis=(1, 2)) & (np.max(np.abs(A), axis=(1, 2)) < _BIG)
-    A[~ok] = 0.0
     scale = 1.0 + np.max(np.abs(Y), axis=1)
     rmax = max_radius * scale
     M = np.eye(n) - A @ JX
-    F = values(MR(Y))
     for stage in range(2):  # the values here; then from the ball system where the test failed
         AF = A @ _col(F)
         step = np.max(np.abs(AF.m[:, :, 0]), axis=1)
@@ -213,12 +260,18 @@ def krawczyk_real(values: Callable[[MR], MR], jacobian: Callable[[MR], MR], Y: n
         if stage or ball_values is None or not again:
             _grow(out, AF, M, r, rmax, go)
             break
-        Fm, Fr = F.m.copy(), F.r.copy()
-        for j in again:
-            row = from_balls(ball_values(Y[j]))
-            Fm[j], Fr[j] = row.m[0], row.r[0]
-        F = MR(Fm, Fr)
+        F = with_ball_values(F, again, Y, ball_values)
     return out
+
+
+def with_ball_values(F: MR, rows, Y: np.ndarray, ball_values: Callable[[np.ndarray], Any]) -> MR:
+    """``F`` (k, n) with the rows ``rows`` replaced by the ball system's enclosures at those
+    points (:func:`from_balls`: outward)."""
+    Fm, Fr = F.m.copy(), np.array(F.r, dtype=float)
+    for j in rows:
+        row = from_balls(ball_values(Y[j]))
+        Fm[j], Fr[j] = row.m[0], row.r[0]
+    return MR(Fm, Fr)
 
 
 def _grow(out: list[float | None], AF: MR, M: MR, r0: np.ndarray, rmax: np.ndarray, go: np.ndarray) -> None:
@@ -344,11 +397,9 @@ def _expand(a: MR) -> MR:
     return MR(a.m[:, None], _full(a)[:, None])
 
 
-def _rotation(q: np.ndarray) -> tuple[MR, MR]:
-    """``E(q)`` (4x4, homogeneous, the unnormalised rotation) and ``q.q`` in interval arithmetic:
-    the products ``q_a q_b`` as intervals, then their exact integer combinations."""
-    Q = MR(q)
-    p = (MR(q[:, None]) * MR(q[None, :])).m.ravel(), (MR(q[:, None]) * MR(q[None, :])).r.ravel()
+def rotation_coefficients() -> np.ndarray:
+    """The exact small-integer coefficients (17, 16) of ``E(q)`` (4x4, row-major: the
+    unnormalised rotation, homogeneous) and of ``q.q`` in the products ``q_a q_b`` (``4 a + b``)."""
     C = np.zeros((17, 16))  # rows: E (4x4, row-major), then q.q
     w, i, j, k = range(4)
 
@@ -366,8 +417,17 @@ def _rotation(q: np.ndarray) -> tuple[MR, MR]:
     put(9, [(2, j, k), (2, w, i)])
     put(10, [(1, w, w), (-1, i, i), (-1, j, j), (1, k, k)])
     put(16, [(1, w, w), (1, i, i), (1, j, j), (1, k, k)])
-    del Q
-    out = C @ MR(p[0][:, None], p[1][:, None])  # exact small-integer coefficients
+    return C
+
+
+_ROTATION = rotation_coefficients()
+
+
+def _rotation(q: np.ndarray) -> tuple[MR, MR]:
+    """``E(q)`` (4x4, homogeneous, the unnormalised rotation) and ``q.q`` in interval arithmetic:
+    the products ``q_a q_b`` as intervals, then their exact integer combinations."""
+    pq = MR(q[:, None]) * MR(q[None, :])
+    out = _ROTATION @ MR(pq.m.ravel()[:, None], pq.r.ravel()[:, None])  # exact small-integer coefficients
     return MR(out.m[:16, 0].reshape(4, 4), out.r[:16, 0].reshape(4, 4)), MR(out.m[16, 0], out.r[16, 0])
 
 
@@ -377,8 +437,10 @@ def krawczyk_limb(sysm, q: np.ndarray, t: np.ndarray, Y: np.ndarray, max_radius:
     same equations, term by term) at the pose ``(q, t)`` (exact floats) and the real points
     ``Y`` (k, n)."""
     q, t = np.asarray(q, dtype=float), np.asarray(t, dtype=float)
-    if not (np.all(np.isfinite(q)) and np.all(np.isfinite(t)) and np.max(np.abs(np.r_[q, t])) < _BIG):
+    if not (np.isfinite(q).all() and np.isfinite(t).all() and max(np.abs(q).max(), np.abs(t).max()) < _BIG):
         return [None] * len(Y)
+    if (fast := backend.engine()) is not None:  # the enclosures and the test compiled (compiled/certify.py)
+        return fast.krawczyk_limb(sysm, q, t, Y, max_radius, ball_values)
     E, s = _rotation(q)
     stv = s * t  # (3,)
     centre = np.asarray(sysm.centre, dtype=float)[:, None]
