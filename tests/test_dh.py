@@ -156,3 +156,17 @@ def test_a_dh_file_is_the_ready_made_puma_and_round_trips():
 def test_a_bad_dh_file_names_the_field(change, field):
     with pytest.raises(sm.ModelFileError, match=field):
         sm.loads(PUMA_FILE.replace(*change))
+
+
+def test_a_singular_reference_is_named():
+    """Every standard-DH arm is singular at the DH zero (its joint axes are all perpendicular to
+    x0): building one there warns, naming ``reference``; the PUMA at Corke's qn does not."""
+    args = {"d": classic.PUMA560_DH["d"], "a": classic.PUMA560_DH["a"], "alpha": classic.PUMA560_DH["alpha"],
+            "degrees": True}
+    with pytest.warns(UserWarning, match="^reference: .* singular"):
+        serial_from_dh("zero", **args)
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        serial_from_dh("qn", **args, reference=classic.PUMA560_REFERENCE_DEG)

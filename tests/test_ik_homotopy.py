@@ -6,7 +6,7 @@ import pytest
 
 import spatialmech as sm
 from spatialmech.errors import InputError
-from spatialmech.kinematics.closure import chain_forward
+from spatialmech.kinematics.closure import chain_forward, limb_chains
 from spatialmech.kinematics.homotopy import inverse as ikh
 from spatialmech.kinematics.position import inverse_position
 from spatialmech.model.joints import H, R, S, U, P
@@ -233,3 +233,21 @@ def test_angles_of_far_complex_points_keep_their_digits():
     TH = np.array([[0.3 + 9j, -1.2 - 11j, 2.0 + 0.1j, 0.5 - 7j, -2.9 + 12j, 1.0]])
     back = sysm.angles(sysm.from_angles(TH))
     assert np.max(np.abs(np.angle(np.exp(1j * (back - TH)))) + np.abs((back - TH).imag)) < 1e-12
+
+
+def test_a_real_solution_at_a_singular_configuration_is_never_called_complex():
+    """At the DH zero every standard-DH arm is singular (every joint axis is perpendicular to x0:
+    a couple about x0 is reciprocal to all of them); the pose reached there is a double root of
+    the 6R's system.  Its two end points keep ~1e-6 imaginary parts, which were counted complex:
+    the answer said "complete (proven) ... 0 real, 16 complex" with no solution.  Now they are
+    singular end points: listed (near the true configuration), and the set is NOT proven."""
+    rng = np.random.default_rng(0)
+    dh = [(rng.uniform(-0.5, 0.5), rng.uniform(0.1, 0.6), rng.uniform(-np.pi, np.pi)) for _ in range(6)]
+    m = serial_arm("random-6r", dh)
+    _, J = chain_forward(limb_chains(m)[0], np.zeros(6))
+    assert np.linalg.svd(J, compute_uv=False)[-1] < 1e-12  # singular there
+    q = np.r_[np.zeros(5), 0.9]  # turning the last joint keeps the configuration singular
+    res = inverse_position(m, dh_pose(dh, q), all_solutions=True)
+    rep = res.search["limbs"][0]
+    assert not rep["complete"] and "singular" in rep["completeness"], rep["completeness"]
+    assert any(np.allclose(np.angle(np.exp(1j * (s - q))), 0, atol=1e-5) for s in res.limbs[0].solutions)

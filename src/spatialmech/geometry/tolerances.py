@@ -303,6 +303,11 @@ HOMOTOPY_SINGULAR = 1e-7
 HOMOTOPY_INFINITY = 1e-7
 HOMOTOPY_REAL = 1e-7
 HOMOTOPY_NEAR_REAL = 1e-3
+#: Smallest singular value of a near-real end point's square system, relative to its largest,
+#: below which an end point that is not real to :data:`HOMOTOPY_REAL` is taken for a multiple
+#: root (whose end points keep about the square root of the rounding in their imaginary parts:
+#: a real solution at a singular configuration) rather than a complex solution.
+HOMOTOPY_ILL = 1e-4
 
 #: Certified solutions (kinematics/homotopy/certify.py), nondimensional (relative to ``1 + max |y|``,
 #: ``y`` the point in the system's coordinates): the half-width of the first Krawczyk box (or four

@@ -29,6 +29,7 @@ import numpy as np
 
 from ...geometry.rotations import matrix_rotvec
 from ...geometry.tolerances import (
+    HOMOTOPY_ILL,
     HOMOTOPY_NEAR_REAL,
     HOMOTOPY_REAL,
     HOMOTOPY_SINGULAR,
@@ -270,7 +271,11 @@ def _to_q(sysm: LimbIK, x: np.ndarray, D: np.ndarray, axes: np.ndarray | None) -
 
 
 def _classify(sysm: LimbIK, X, P1, done) -> tuple[list[np.ndarray], dict[str, int]]:
-    """The real, finite, nonsingular end points that close, and the counts of the others."""
+    """The real, finite end points that close (nonsingular ones, and near-real singular ones as
+    candidates for the caller's polish: a real solution at a singular configuration is a
+    multiple root, whose end points keep about the square root of the rounding in their
+    imaginary parts), and the counts of the others.  A near-real end point is counted singular,
+    not complex, when its square system is ill-conditioned there (:data:`HOMOTOPY_ILL`)."""
     cnt = {"complex": 0, "singular": 0, "infinity": 0, "spurious": 0, "lost": 0}
     real: list[np.ndarray] = []
     kept = np.zeros((0, sysm.nx), complex)
@@ -283,10 +288,12 @@ def _classify(sysm: LimbIK, X, P1, done) -> tuple[list[np.ndarray], dict[str, in
         # the conditioning only where it decides (closing, near real): one batched SVD
         near = np.flatnonzero(finite & (res < 1e-8) & ~(imag > HOMOTOPY_NEAR_REAL))
         regular = np.zeros(len(X), bool)
+        ill = np.zeros(len(X), bool)
         if len(near):
             _, J, _ = sysm.square(X[near], Pn[near])
             sv = np.linalg.svd(J / np.maximum(np.linalg.norm(J, axis=2, keepdims=True), 1e-300), compute_uv=False)
             regular[near] = sv[:, -1] >= HOMOTOPY_SINGULAR * sv[:, 0]
+            ill[near] = sv[:, -1] < HOMOTOPY_ILL * sv[:, 0]
     for n, x in enumerate(X):
         if not finite[n]:
             cnt["infinity"] += 1
@@ -300,8 +307,9 @@ def _classify(sysm: LimbIK, X, P1, done) -> tuple[list[np.ndarray], dict[str, in
         if imag[n] > HOMOTOPY_NEAR_REAL:  # far from real (however ill-conditioned: large complex angles)
             cnt["complex"] += 1
             continue
-        if not regular[n]:
-            cnt["singular"] += 1
+        if not regular[n] or (imag[n] >= HOMOTOPY_REAL and ill[n]):
+            cnt["singular"] += 1  # a multiple root (or a continuum): its real part is a candidate
+            real.append(x.real.copy())
             continue
         if imag[n] < HOMOTOPY_REAL:
             real.append(x.real.copy())
@@ -393,6 +401,6 @@ def limb_inverse(mech: Mechanism, li: int, D: np.ndarray, *, seed: int = 0) -> L
     chain = limb_chains(mech)[li]
     axes = chain.balls[0][2] if chain.balls else None
     sols = tuple(_to_q(sysm, x, np.asarray(D, float), axes) for x in real)
-    complete, text = _statement(sysm, g, cnt, len(sols))
+    complete, text = _statement(sysm, g, cnt, len(sols) - cnt["singular"])  # the singular ones: candidates
     return LimbIKResult(sols, complete, text, len(g.X), len(sols), cnt["complex"], cnt["singular"], cnt["infinity"],
                         cnt["spurious"], cnt["lost"], cached, g.seconds, time.perf_counter() - t0, g.trace)
