@@ -39,7 +39,9 @@ import numpy as np
 from ...errors import InputError
 from ...geometry.rotations import matrix_rotvec, skew
 from ...geometry.tolerances import (
+    HOMOTOPY_ILL,
     HOMOTOPY_INFINITY,
+    HOMOTOPY_NEAR_REAL,
     HOMOTOPY_REAL,
     HOMOTOPY_SINGULAR,
     MONODROMY_DIVERGED,
@@ -434,8 +436,9 @@ def general_forward(mech: Mechanism, targets: dict[int, float], *, seed: int = 0
             k = int(np.argmax(np.abs(y[s])))
             y[s] = y[s] * (abs(y[s][k]) / y[s][k])
         imag = float(np.max(np.abs(y.imag)) / (1 + np.max(np.abs(y.real))))
-        st = (EndPointStatus.SINGULAR if rcond < HOMOTOPY_SINGULAR else EndPointStatus.REAL if imag < HOMOTOPY_REAL
-              else EndPointStatus.COMPLEX)
+        multiple = HOMOTOPY_REAL <= imag < HOMOTOPY_NEAR_REAL and rcond < HOMOTOPY_ILL  # a multiple root's end point
+        st = (EndPointStatus.SINGULAR if rcond < HOMOTOPY_SINGULAR or multiple
+              else EndPointStatus.REAL if imag < HOMOTOPY_REAL else EndPointStatus.COMPLEX)
         q = D = B = None
         if st == EndPointStatus.REAL:
             c = rebuild_configuration(sysm, y.real, targets)

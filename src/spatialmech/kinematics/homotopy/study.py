@@ -51,6 +51,7 @@ from ...errors import InputError
 from ...geometry.tolerances import (
     HOMOTOPY_INFINITY,
     HOMOTOPY_JUMP,
+    HOMOTOPY_ILL,
     HOMOTOPY_NEAR_REAL,
     HOMOTOPY_NEWTON,
     HOMOTOPY_REAL,
@@ -244,8 +245,8 @@ def _classify(Qc, c, X):
         res = float(np.linalg.norm(F[n, :7]) / max(nx[n] ** 2, 1e-300))
         if not np.isfinite(nx[n]) or rel_inf < HOMOTOPY_INFINITY:
             st = EndPointStatus.AT_INFINITY
-        elif rcond < HOMOTOPY_SINGULAR:
-            st = EndPointStatus.SINGULAR
+        elif rcond < HOMOTOPY_SINGULAR or (imag < HOMOTOPY_NEAR_REAL and rcond < HOMOTOPY_ILL and imag >= HOMOTOPY_REAL):
+            st = EndPointStatus.SINGULAR  # (near real, ill-conditioned and not real: a multiple root's end point)
         elif imag < HOMOTOPY_REAL:
             st = EndPointStatus.REAL
         else:
