@@ -37,6 +37,13 @@ def wait_for(driver, script, *args):
     raise AssertionError(f"timed out waiting for: {script}")
 
 
+def assert_no_page_errors(driver) -> None:
+    """No JavaScript error caught by the page (``window.jsErrors``) and no SEVERE browser log."""
+    assert driver.execute_script("return window.jsErrors") == []
+    severe = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
+    assert not severe, severe
+
+
 def projected(cam: dict, pts) -> np.ndarray:
     """``pts`` (n, 3) where the light 3-D view's camera ``cam`` (``View.camera()`` of
     static/scene2d.js) draws them, in CSS pixels: ``(W/2 + zoom (p - c).right, H/2 - zoom (p - c).up)``."""

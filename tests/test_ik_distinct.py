@@ -101,16 +101,9 @@ def test_general_6r_solutions_are_distinct_and_close():
 
 
 def agile_eye():
-    """A spherical 3-RRR wrist of the Agile-Eye type: every axis through the origin, every link
-    angle 90 degrees; at home leg i has its axes along e_i, e_(i+1), e_(i+2)."""
-    E = np.eye(3)
-    o = np.zeros(3)
-    limbs = tuple(
-        Limb(f"leg{i + 1}", (R(f"A{i + 1}", o, E[i], actuated=True), R(f"B{i + 1}", o, E[(i + 1) % 3]),
-                             R(f"C{i + 1}", o, E[(i + 2) % 3])))
-        for i in range(3)
-    )
-    return Mechanism("agile-eye", limbs, platform_point=o)
+    """A spherical 3-RRR wrist of the Agile-Eye type (the ready-made ``agile-eye``): every axis
+    through the origin, every link angle 90 degrees."""
+    return sm.load_model("agile-eye")
 
 
 def test_agile_eye_leg_has_two_working_modes():

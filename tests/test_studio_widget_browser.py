@@ -21,6 +21,8 @@ import pytest
 
 import spatialmech as sm
 
+from .browser_support import assert_no_page_errors
+
 pytestmark = pytest.mark.slow  # a browser start and software WebGL take seconds
 pytest.importorskip("anywidget")
 
@@ -115,9 +117,7 @@ def test_the_widget_renders_and_a_slider_drives_the_session(page, browser):
     w._handle_custom_msg(snap, [])
     browser.execute_script("window.harness.set(arguments[0])", traits(w))
     wait_for(browser, "return document.querySelector('.sm-snaps').textContent === 'snapshot 1'")
-    assert browser.execute_script("return window.jsErrors") == []
-    severe = [e for e in browser.get_log("browser") if e["level"] == "SEVERE"]
-    assert not severe, severe
+    assert_no_page_errors(browser)
     out = os.environ.get("SPATIALMECH_SCREENSHOTS")
     if out:
         browser.set_window_size(1000, 900)
@@ -163,9 +163,7 @@ def test_the_widget_drag_pad_moves_the_output_point(tmp_path_factory, browser):
         # a bad message names the field
         w._handle_custom_msg({"type": "drag", "point_len": [0.0, "a"]}, [])
         assert w.error.startswith("point_len: ")
-        assert browser.execute_script("return window.jsErrors") == []
-        severe = [e for e in browser.get_log("browser") if e["level"] == "SEVERE"]
-        assert not severe, severe
+        assert_no_page_errors(browser)
     finally:
         srv.shutdown()
         th.join(10)
@@ -211,9 +209,7 @@ def test_the_widget_light_view_draws_follows_and_switches(tmp_path_factory, brow
                           "getComputedStyle(document.querySelector('.sm-light')).display === 'none'")
         browser.execute_script("document.querySelector('.sm-view-light').click()")
         wait_for(browser, drawn.replace("L.frames > 0", f"L.frames > {v2['frames']}"))
-        assert browser.execute_script("return window.jsErrors") == []
-        severe = [e for e in browser.get_log("browser") if e["level"] == "SEVERE"]
-        assert not severe, severe
+        assert_no_page_errors(browser)
     finally:
         srv.shutdown()
         th.join(10)
