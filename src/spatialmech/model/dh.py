@@ -32,6 +32,8 @@ from collections.abc import Sequence
 import numpy as np
 
 from ..errors import InputError
+from ..geometry.screws import nondimensional
+from ..geometry.tolerances import current
 from .joints import P, R
 from .mechanism import Limb, Mechanism
 
@@ -163,25 +165,20 @@ def serial_from_dh(
         made.append(make(f"J{i + 1}", Fi[:3, 3], Fi[:3, 2], actuated=True))
     mech = Mechanism(name, (Limb("arm", tuple(made)),), platform_point=F[-1][:3, 3].copy(),
                      description=description or f"serial {joints} chain ({convention} DH)")
-    _warn_if_singular(mech, axis_frames, joints)
+    _warn_if_singular(mech, min(6, len(joints)))
     return mech
 
 
-def _warn_if_singular(mech: Mechanism, frames: np.ndarray, joints: str) -> None:
+def _warn_if_singular(mech: Mechanism, need: int) -> None:
     """A warning naming ``reference`` when the arm is singular there: its joint screws (moments
-    over the length scale) span fewer than ``min(6, n)`` dimensions.  At the DH zero every
+    over the length scale) span fewer than ``need = min(6, n)`` dimensions.  At the DH zero every
     standard-DH arm is (every joint axis is perpendicular to ``x0``), so the default reference
     needs one given by the user for the analyses that start from it."""
     import warnings
 
-    L = mech.characteristic_length
-    cols = []
-    for c, Fi in zip(joints, frames, strict=True):
-        u, p = Fi[:3, 2], Fi[:3, 3]
-        cols.append(np.r_[u, np.cross(p, u) / L] if c == "R" else np.r_[np.zeros(3), u])
-    sv = np.linalg.svd(np.array(cols).T, compute_uv=False)
-    need = min(6, len(joints))
-    if len(sv) < need or sv[need - 1] < 1e-9 * sv[0]:
+    S = nondimensional([j.freedoms[0].screw for j in mech.limbs[0].joints], mech.characteristic_length)
+    sv = np.linalg.svd(S, compute_uv=False)
+    if len(sv) < need or sv[need - 1] < current().rank * sv[0]:
         warnings.warn(f"reference: the arm {mech.name!r} is singular at its reference configuration (its joint "
                       f"screws span fewer than {need} dimensions; at the DH zero every standard-DH arm is); "
                       "give a regular reference (e.g. reference_deg in a file): fk, ik and the maps start there",
