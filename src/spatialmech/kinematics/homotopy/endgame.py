@@ -31,6 +31,9 @@ from collections.abc import Callable
 import numpy as np
 
 from ...geometry.tolerances import (
+    HOMOTOPY_ILL,
+    HOMOTOPY_NEAR_REAL,
+    HOMOTOPY_REAL,
     ENDGAME_AGREE,
     ENDGAME_CLOSED,
     ENDGAME_LOOPS,
@@ -39,7 +42,7 @@ from ...geometry.tolerances import (
     LOCAL_DIMENSION_STEP,
 )
 
-__all__ = ["EndgameResult", "cauchy_endgame", "local_dimension"]
+__all__ = ["EndgameResult", "cauchy_endgame", "local_dimension", "multiple_root_end"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -87,6 +90,16 @@ def _loops(track, Q0, dQ, c, X, r: float, points: int, max_loops: int):
         if not alive.any():
             break
     return mean, wind
+
+
+def multiple_root_end(imag, rcond):
+    """Whether an end point is a multiple root's (a real solution at a singular configuration):
+    near real (``imag`` below :data:`HOMOTOPY_NEAR_REAL`) but not real to :data:`HOMOTOPY_REAL`,
+    and ill-conditioned (``rcond``, sigma_min / sigma_max of its system, below
+    :data:`HOMOTOPY_ILL`).  Such end points keep about the square root of the rounding in their
+    imaginary parts; they are singular end points, never complex solutions.  Works on scalars
+    and on arrays (elementwise)."""
+    return (imag >= HOMOTOPY_REAL) & (imag < HOMOTOPY_NEAR_REAL) & (rcond < HOMOTOPY_ILL)
 
 
 def cauchy_endgame(track: Callable, Q0: np.ndarray, Q1: np.ndarray, c: np.ndarray, X0: np.ndarray, *,

@@ -39,9 +39,7 @@ import numpy as np
 from ...errors import InputError
 from ...geometry.rotations import matrix_rotvec, skew
 from ...geometry.tolerances import (
-    HOMOTOPY_ILL,
     HOMOTOPY_INFINITY,
-    HOMOTOPY_NEAR_REAL,
     HOMOTOPY_REAL,
     HOMOTOPY_SINGULAR,
     MONODROMY_DIVERGED,
@@ -58,7 +56,7 @@ from ...geometry.tolerances import (
 from ...model.mechanism import Mechanism
 from ...results import EndPointStatus, TraceVerdict
 from ..closure import Configuration, limb_slices
-from .endgame import cauchy_endgame
+from .endgame import cauchy_endgame, multiple_root_end
 from .study import study_to_pose, track
 from .loop_system import LoopSystem, general_reason, loop_system, variables
 from .trace_test import TraceResult, add_new_points, around_triangle, trace_test
@@ -436,8 +434,7 @@ def general_forward(mech: Mechanism, targets: dict[int, float], *, seed: int = 0
             k = int(np.argmax(np.abs(y[s])))
             y[s] = y[s] * (abs(y[s][k]) / y[s][k])
         imag = float(np.max(np.abs(y.imag)) / (1 + np.max(np.abs(y.real))))
-        multiple = HOMOTOPY_REAL <= imag < HOMOTOPY_NEAR_REAL and rcond < HOMOTOPY_ILL  # a multiple root's end point
-        st = (EndPointStatus.SINGULAR if rcond < HOMOTOPY_SINGULAR or multiple
+        st = (EndPointStatus.SINGULAR if rcond < HOMOTOPY_SINGULAR or multiple_root_end(imag, rcond)
               else EndPointStatus.REAL if imag < HOMOTOPY_REAL else EndPointStatus.COMPLEX)
         q = D = B = None
         if st == EndPointStatus.REAL:

@@ -29,7 +29,6 @@ import numpy as np
 
 from ...geometry.rotations import matrix_rotvec
 from ...geometry.tolerances import (
-    HOMOTOPY_ILL,
     HOMOTOPY_NEAR_REAL,
     HOMOTOPY_REAL,
     HOMOTOPY_SINGULAR,
@@ -47,7 +46,7 @@ from ...model.mechanism import Mechanism
 from ...results import TraceVerdict
 from .. import backend
 from ..closure import limb_chains
-from .endgame import cauchy_endgame
+from .endgame import cauchy_endgame, multiple_root_end
 from .study import track
 from .trace_test import TraceResult, add_new_points, around_triangle, trace_test
 from .limb_system import (
@@ -275,7 +274,7 @@ def _classify(sysm: LimbIK, X, P1, done) -> tuple[list[np.ndarray], dict[str, in
     candidates for the caller's polish: a real solution at a singular configuration is a
     multiple root, whose end points keep about the square root of the rounding in their
     imaginary parts), and the counts of the others.  A near-real end point is counted singular,
-    not complex, when its square system is ill-conditioned there (:data:`HOMOTOPY_ILL`)."""
+    not complex, when its square system is ill-conditioned there (:func:`.endgame.multiple_root_end`)."""
     cnt = {"complex": 0, "singular": 0, "infinity": 0, "spurious": 0, "lost": 0}
     real: list[np.ndarray] = []
     kept = np.zeros((0, sysm.nx), complex)
@@ -288,12 +287,12 @@ def _classify(sysm: LimbIK, X, P1, done) -> tuple[list[np.ndarray], dict[str, in
         # the conditioning only where it decides (closing, near real): one batched SVD
         near = np.flatnonzero(finite & (res < 1e-8) & ~(imag > HOMOTOPY_NEAR_REAL))
         regular = np.zeros(len(X), bool)
-        ill = np.zeros(len(X), bool)
+        multiple = np.zeros(len(X), bool)
         if len(near):
             _, J, _ = sysm.square(X[near], Pn[near])
             sv = np.linalg.svd(J / np.maximum(np.linalg.norm(J, axis=2, keepdims=True), 1e-300), compute_uv=False)
             regular[near] = sv[:, -1] >= HOMOTOPY_SINGULAR * sv[:, 0]
-            ill[near] = sv[:, -1] < HOMOTOPY_ILL * sv[:, 0]
+            multiple[near] = multiple_root_end(imag[near], sv[:, -1] / sv[:, 0])
     for n, x in enumerate(X):
         if not finite[n]:
             cnt["infinity"] += 1
@@ -307,7 +306,7 @@ def _classify(sysm: LimbIK, X, P1, done) -> tuple[list[np.ndarray], dict[str, in
         if imag[n] > HOMOTOPY_NEAR_REAL:  # far from real (however ill-conditioned: large complex angles)
             cnt["complex"] += 1
             continue
-        if not regular[n] or (imag[n] >= HOMOTOPY_REAL and ill[n]):
+        if not regular[n] or multiple[n]:
             cnt["singular"] += 1  # a multiple root (or a continuum): its real part is a candidate
             real.append(x.real.copy())
             continue

@@ -51,7 +51,6 @@ from ...errors import InputError
 from ...geometry.tolerances import (
     HOMOTOPY_INFINITY,
     HOMOTOPY_JUMP,
-    HOMOTOPY_ILL,
     HOMOTOPY_NEAR_REAL,
     HOMOTOPY_NEWTON,
     HOMOTOPY_REAL,
@@ -60,7 +59,7 @@ from ...geometry.tolerances import (
 from ...model.mechanism import Mechanism
 from ...results import EndPointStatus
 from .. import backend
-from .endgame import cauchy_endgame, local_dimension
+from .endgame import cauchy_endgame, local_dimension, multiple_root_end
 from .systems import (
     PoseSystem,
     StewartSystem,
@@ -245,8 +244,8 @@ def _classify(Qc, c, X):
         res = float(np.linalg.norm(F[n, :7]) / max(nx[n] ** 2, 1e-300))
         if not np.isfinite(nx[n]) or rel_inf < HOMOTOPY_INFINITY:
             st = EndPointStatus.AT_INFINITY
-        elif rcond < HOMOTOPY_SINGULAR or (imag < HOMOTOPY_NEAR_REAL and rcond < HOMOTOPY_ILL and imag >= HOMOTOPY_REAL):
-            st = EndPointStatus.SINGULAR  # (near real, ill-conditioned and not real: a multiple root's end point)
+        elif rcond < HOMOTOPY_SINGULAR or multiple_root_end(imag, rcond):
+            st = EndPointStatus.SINGULAR
         elif imag < HOMOTOPY_REAL:
             st = EndPointStatus.REAL
         else:
