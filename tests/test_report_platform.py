@@ -160,4 +160,7 @@ def test_a_serial_arm_gets_its_inverse_solutions_instead_of_assembly_modes():
     assert inv["complete"] and inv["n_solutions"] == 8 == len(table.rows)
     assert all(s["certified"] for s in inv["solutions"]) and min(s["sigma_min"] for s in inv["solutions"]) > 0.1
     assert sum(r[-1] == "reference" for r in table.rows) == 1
+    from spatialmech.serialize import unit_rule_violations
+
+    assert unit_rule_violations({"length_unit": "m", "inverse_solutions": inv}) == []  # joints_deg / joints_len
     assert not model_platform._serial(catalog.resolve("stewart-6sps"))

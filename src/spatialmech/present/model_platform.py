@@ -42,6 +42,7 @@ from ..kinematics.task import default_task, task_values
 from ..kinematics.task_grid import TASK_NAMES
 from ..model.mechanism import Mechanism, Pose
 from ..results import Progress, Steps
+from ..serialize import freedom_values_dict
 from . import figures as F
 from .numbers import ROUNDOFF, unit_label
 from .report import Section, Table, Viewer
@@ -147,15 +148,18 @@ def _inverse_solutions(mech: Mechanism, data: dict) -> tuple[Table, str]:
     limb, rep = res.limbs[0], res.search["limbs"][0]
     D = pose.displacement(mech.platform_point)
     refs = mech.freedom_refs
+    lin = np.array([r.freedom.kind == "P" for r in refs])
     rows, js = [], []
     for k, q in enumerate(limb.solutions):
-        sig = float(complete_jacobian(mech, Configuration(np.asarray(q, dtype=float), D)).sigma_min)
+        q = np.asarray(q, dtype=float)
+        sig = float(complete_jacobian(mech, Configuration(q, D)).sigma_min)
         cert = limb.certificates[k]["certified"] if limb.certificates else None
-        shown = [float(np.degrees(v)) if r.freedom.kind != "P" else float(v) for r, v in zip(refs, q, strict=True)]
+        values = freedom_values_dict(mech, {r.id: v for r, v in zip(refs, q, strict=True)}, "joints")
+        shown = [values["joints_len" if r.freedom.kind == "P" else "joints_deg"][r.id] for r in refs]
+        home = np.all(np.abs(np.where(lin, q, np.angle(np.exp(1j * q)))) < 1e-9)  # the reference configuration
         rows.append((k + 1, *[_shown(v, 180.0) for v in shown], sig, "yes" if cert else ("no" if cert is False else "-"),
-                     "reference" if np.allclose(np.angle(np.exp(1j * np.asarray(q))), 0.0, atol=1e-9) else ""))
-        js.append({"solution": k + 1, "joints": dict(zip((r.id for r in refs), shown, strict=True)),
-                   "sigma_min": sig, "certified": cert})
+                     "reference" if home else ""))
+        js.append({**values, "sigma_min": sig, "certified": cert})
     data["inverse_solutions"] = {"method": rep["method"], "complete": rep["complete"],
                                  "completeness": rep["completeness"], "n_solutions": len(rows), "solutions": js}
     unit = unit_label(mech.length_unit)
