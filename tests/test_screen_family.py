@@ -34,12 +34,16 @@ def test_a_run_too_small_for_its_workers_says_so():
     assert "too few to gain from 2 workers" in note and "--workers 0" in note
 
 
-def test_workers_get_a_few_runs_of_chunks_covering_every_chunk_once():
+def test_workers_get_runs_of_decreasing_length_covering_every_chunk_once():
     todo = [(k, 20 * k, None) for k in range(50)]
     for w in (1, 2, 3, 8):
         b = chunk_runs(todo, w)
-        assert len(b) <= TASKS_PER_WORKER * w
         assert [c for run in b for c in run] == todo
+        sizes = [len(r) for r in b]
+        assert sizes == sorted(sizes, reverse=True) and sizes[-1] == 1
+        assert sizes[0] == -(-50 // (TASKS_PER_WORKER * w))  # the first run: its share of the whole
+        assert len(b) < 50  # fewer tasks than chunks
+    assert [len(r) for r in chunk_runs(todo, 2)][:4] == [13, 10, 7, 5]
     assert chunk_runs(todo[:3], 2) == [[t] for t in todo[:3]]
 
 

@@ -57,8 +57,10 @@ __all__ = ["CONNECT_TIMEOUT", "MANIFEST", "MIN_CANDIDATES_PER_WORKER", "TASKS_PE
 MANIFEST = "_screen.json"
 #: How long to wait for an existing Dask scheduler (``scheduler=``) to answer.
 CONNECT_TIMEOUT = "20s"
-#: Dask tasks per worker: each task judges a run of chunks (fewer, larger tasks; some balance).
-TASKS_PER_WORKER = 4
+#: Guided self-scheduling: each Dask task takes ``1 / (TASKS_PER_WORKER * workers)`` of the
+#: chunks still unassigned (large tasks first hide the scheduler's per-task cost, single chunks
+#: last keep the workers' finishing times within about one chunk of each other).
+TASKS_PER_WORKER = 2
 #: Below this many candidates per worker, a run on workers says it would be faster serially.
 MIN_CANDIDATES_PER_WORKER = 250
 _POOL = "_pool.parquet"
@@ -302,10 +304,17 @@ def judge_chunks(pool: DyadPool, todo: list) -> list[tuple[int, list[dict]]]:
 
 
 def chunk_runs(todo: list, n_workers: int) -> list[list]:
-    """``todo`` cut into about :data:`TASKS_PER_WORKER` tasks per worker (each a run of chunks)."""
-    n = max(1, min(len(todo), TASKS_PER_WORKER * max(1, n_workers)))
-    size = math.ceil(len(todo) / n)
-    return [todo[i:i + size] for i in range(0, len(todo), size)]
+    """``todo`` cut into runs of chunks of decreasing length (guided self-scheduling): each run
+    takes ``ceil(remaining / (TASKS_PER_WORKER * n_workers))`` chunks, so the first tasks are
+    long and the last ones a single chunk; submitted in this order, the workers end within about
+    one chunk's time of each other instead of one long task's."""
+    share = TASKS_PER_WORKER * max(1, n_workers)
+    runs, i = [], 0
+    while i < len(todo):
+        size = max(1, math.ceil((len(todo) - i) / share))
+        runs.append(todo[i:i + size])
+        i += size
+    return runs
 
 
 def _run_distributed(client, pool, todo, report, write, n_workers: int) -> None:
