@@ -1,11 +1,13 @@
 """A general 6R from the literature as a named test (issue 27: "the PUMA 560 and a general 6R
 from the literature as named tests, with their published solutions").
 
-The source, read in the stored copy of the University of Florida Digital Collections item
-UF00082242 (an electrical-engineering PhD dissertation supervised in K. L. Doty's laboratory,
-c. 1988, whose result was published as Manseur and Doty, "A robot manipulator with 16 real
-inverse kinematic solution sets", Int. J. Robotics Research 8(5), 1989; the title page was not
-in the stored copy, so the attribution is by content), chapter 9, "Example 3: 0M25 manipulator":
+The source, read in the stored OCR text of the University of Florida Digital Collections item
+UF00082242 (https://ufdcimages.uflib.ufl.edu/UF/00/08/22/42/00001/NNNNN.txt, one file a page):
+a University of Florida PhD dissertation on inverse kinematics (c. 1988: it cites Lee and Liang
+"in press"), built on K. L. Doty's classification of orthogonal manipulators, whose 16-solution
+arm is the one of Manseur and Doty, "A robot manipulator with 16 real inverse kinematic solution
+sets", Int. J. Robotics Research 8(5), 1989.  Its title page was not in the stored copy, so the
+attribution to R. Manseur is by content.  Chapter 9, "Example 3: 0M25 manipulator":
 
 * the arm: an *orthogonal* manipulator of class 10-101 (octal 25).  Chapter 8 (printed pp.
   87-88, files ``.../UF/00/08/22/42/00001/00095.txt`` and ``00096.txt``) defines the class code,
@@ -18,19 +20,22 @@ in the stored copy, so the attribution is by content), chapter 9, "Example 3: 0M
 * the pose, Eq. (9.57), p. 114, printed to six decimals (rows of the 4x4 matrix below).
 * the published result, p. 115 (file ``00123.txt``): "The 16 solution sets found are listed in
   Table 9-5 ... the first tangible proof that a six-DOF manipulator can actually achieve a given
-  pose with 16 different configurations", each checked non-degenerate through the determinant
-  of the mid-frame Jacobian ``3J``, Eq. (9.58), printed symbolically.
+  pose with 16 different configurations"; to verify that none of the sixteen is degenerate the
+  page then computes the determinant of the mid-frame Jacobian ``3J``, Eq. (9.58), printed
+  symbolically (the determinant's values are on the page not read).
 
-Not found: Table 9-5 itself (printed p. 116; the stored copy has no text of that page, and no
-other stored page or repository quotes it), so the sixteen published joint values are **not**
-compared here: the test checks what the stored pages publish, the count (16 real, all
-non-degenerate), the pose and the Jacobian (9.58).  Two numerical cross-checks show the reading
-of the source is the one meant: (9.58) as printed equals this model's Jacobian in frame 3 (at the
-origin of frame 3) to rounding at every solution, which fixes the twists, their signs, the
-convention and which lengths are zero (``d1``, ``d6``, ``a6`` leave that Jacobian unchanged; the
-16 real solutions at the printed pose support them being zero); and the printed rotation is the
-six-decimal rounding of a rotation (its nearest rotation differs from it by at most 3.6e-7 per
-entry, under half a unit of the last printed digit), the pose solved here.
+Not found: Table 9-5 itself (after p. 115; no text of the pages after ``00123.txt`` up to
+``00130.txt`` was found in the stored copy, and no other stored page or repository quotes the
+table), so the sixteen published joint values are **not** compared here: the test checks what
+the stored pages publish, the count (16 real), the pose and the Jacobian (9.58), and that the
+Jacobian is regular at each solution (the source's non-degeneracy check). Two numerical
+cross-checks show the reading of the source is the one meant: (9.58) as printed (the OCR's
+``$23`` read as ``S23``) equals this model's Jacobian in frame 3 (at the origin of frame 3) to
+rounding at every solution, which fixes the twists, their signs, the convention and which
+lengths are zero (``d1``, ``d6``, ``a6`` leave that Jacobian unchanged; the 16 real solutions at
+the printed pose support them being zero); and the printed rotation is the six-decimal rounding
+of a rotation (its nearest rotation differs from it by at most 3.6e-7 per entry, under half a
+unit of the last printed digit), the pose solved here.
 """
 
 import json
@@ -118,7 +123,7 @@ def test_printed_pose_is_a_rounded_rotation():
 @pytest.mark.slow  # about 2 s: the generic solve (monodromy to the bound of 16) once, then cached
 def test_manseur_doty_0m25_sixteen_real_solutions_proven_and_non_degenerate(tmp_path):
     """UF dissertation (Manseur and Doty's 16-real 6R), ch. 9, example 3, p. 115: 16 real
-    inverse solutions at the pose of Eq. (9.57), each non-degenerate (Eq. (9.58)).  Ours: the
+    inverse solutions at the pose of Eq. (9.57), checked non-degenerate through Eq. (9.58).  Ours: the
     homotopy's 16 paths all end real, proven complete by the root count, each solution certified;
     every one reproduces the pose through the DH product to 1e-10 (so the printed matrix within
     half a unit of its last digit), they are pairwise distinct, and at each the printed Jacobian
@@ -140,7 +145,7 @@ def test_manseur_doty_0m25_sixteen_real_solutions_proven_and_non_degenerate(tmp_
         assert np.max(np.abs(F - POSE_957)) < PRINTED_HALF_UNIT
         J = jacobian_in_frame_3(th)
         assert np.max(np.abs(J - midframe_jacobian_958(th))) < 1e-12
-        assert abs(np.linalg.det(J)) > 0.5  # non-degenerate, as the source checks (0.72 .. 1.44 here)
+        assert abs(np.linalg.det(J)) > 0.5  # regular, the source's check (|det| 0.72 .. 1.44 here)
     for i in range(16):
         for j in range(i):
             assert np.max(np.abs(_wrapped(thetas[i] - thetas[j]))) > 1e-3
