@@ -118,6 +118,10 @@ def test_printed_pose_is_a_rounded_rotation():
     R = nearest_rotation(POSE_957[:3, :3])
     assert np.max(np.abs(R @ R.T - np.eye(3))) < 1e-15 and np.linalg.det(R) > 0
     assert 1e-7 < np.max(np.abs(R - POSE_957[:3, :3])) < PRINTED_HALF_UNIT  # rounded, within the digits
+    # the printed matrix typed as it is: the pose solves for the same rotation, and says so
+    with pytest.warns(UserWarning, match="nearest rotation is used"):
+        typed = sm.Pose(POSE_957[:3, :3], POSE_957[:3, 3])
+    assert np.max(np.abs(typed.R - R)) < 1e-15
 
 
 @pytest.mark.slow  # about 2 s: the generic solve (monodromy to the bound of 16) once, then cached

@@ -76,6 +76,29 @@ def test_pose_validation():
     assert np.allclose(D[:3, :3] @ [1, 0, 0] + D[:3, 3], [1, 2, 3])
 
 
+def test_a_rotation_typed_with_six_decimals_becomes_its_nearest_rotation():
+    import warnings
+
+    R = sm.Pose.from_euler("ZXY", [10, 20, 30], [0, 0, 0], degrees=True).R
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert np.array_equal(sm.Pose(R, [0, 0, 0]).R, R)  # a rotation to round-off: untouched, no warning
+    typed = np.round(R, 6)
+    with pytest.warns(UserWarning, match=r"orthonormal only to .*nearest rotation is used"):
+        p = sm.Pose(typed, [0, 0, 0], "typed")
+    assert np.max(np.abs(p.R @ p.R.T - np.eye(3))) < 1e-15 and np.linalg.det(p.R) > 0
+    assert np.max(np.abs(p.R - R)) < 1e-6 and np.max(np.abs(p.R - typed)) < 1e-6
+    # the nearest rotation: no other rotation is closer to the typed matrix (Frobenius norm)
+    from scipy.spatial.transform import Rotation
+
+    best = np.linalg.norm(p.R - typed)
+    for v in np.random.default_rng(1).normal(size=(200, 3)):  # rotations within 1e-6 rad of it
+        other = p.R @ Rotation.from_rotvec(1e-6 * v / np.linalg.norm(v)).as_matrix()
+        assert best <= np.linalg.norm(other - typed) + 1e-15
+    with pytest.raises(ValueError, match="not a rotation matrix"):
+        sm.Pose(np.round(R, 4) + 1e-4, [0, 0, 0])  # beyond rounding: refused, as before
+
+
 def test_modes_enumerated_when_not_declared():
     Y = [0, 1, 0]
     mech = sm.Mechanism(

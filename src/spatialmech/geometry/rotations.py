@@ -32,6 +32,7 @@ __all__ = [
     "log_transform",
     "matrix_euler",
     "matrix_rotvec",
+    "nearest_rotation",
     "rotation_angle",
     "rotation_class",
     "rotvec_matrix",
@@ -205,3 +206,25 @@ def rotation_angle(R) -> np.ndarray:
     return np.linalg.norm(rotation_class().from_matrix(R.reshape(-1, 3, 3)).as_rotvec(), axis=-1).reshape(
         R.shape[:-2]
     )
+
+
+def nearest_rotation(M, *, name: str = "R") -> np.ndarray:
+    """The rotation nearest to a 3x3 matrix ``M`` with positive determinant (in the Frobenius
+    norm: its orthogonal polar factor), by Newton's iteration ``X <- (X + X^-T) / 2`` (Higham
+    1986), which converges quadratically and needs no SVD (so no singular vector's sign enters).
+    Meant for a matrix that is a rotation up to rounding (a pose typed with a few decimals).
+
+    >>> R = nearest_rotation([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.000001]])
+    >>> bool(np.allclose(R, [[0, -1, 0], [1, 0, 0], [0, 0, 1]], atol=1e-15))
+    True
+    """
+    X = as_finite_array(M, name, shape=(3, 3))
+    if not np.linalg.det(X) > 0:
+        raise InputError(f"{name}: a rotation needs a positive determinant, got {np.linalg.det(X):.3g}")
+    for _ in range(60):
+        Y = 0.5 * (X + np.linalg.inv(X).T)
+        done = np.max(np.abs(Y - X)) <= 1e-15
+        X = Y
+        if done:
+            return X
+    raise InputError(f"{name}: the nearest rotation did not converge (is the matrix far from a rotation?)")

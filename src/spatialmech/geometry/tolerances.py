@@ -83,6 +83,8 @@ __all__ = [
     "MONODROMY_STALE_LOOPS",
     "NEAR_INVERSE_SINGULAR",
     "NEAR_SINGULAR",
+    "ROTATION_EXACT",
+    "ROTATION_INPUT",
     "SINGULAR_LEFT",
     "TRACE_MAX_LOOPS",
     "TRACE_MAX_WORK",
@@ -205,6 +207,12 @@ NEAR_SINGULAR = 0.02
 #: light turns red; below :data:`NEAR_INVERSE_SINGULAR` it is amber (a reading aid, as above).
 INVERSE_SINGULAR = 0.05
 NEAR_INVERSE_SINGULAR = 0.1
+
+#: A pose's rotation matrix may be this far from orthonormal (``max |R R^T - I|``): a matrix
+#: typed with six decimals is.  Beyond :data:`ROTATION_EXACT` (round-off of the library's own
+#: products) it is replaced by its nearest rotation, with a warning naming the error.
+ROTATION_INPUT = 1e-6
+ROTATION_EXACT = 1e-12
 
 #: Points whose spread is below this, relative to their coordinates, are the same point (round-off).
 _SAME_POINT = 1e-13

@@ -15,6 +15,7 @@ and the platform frame is at ``platform_point`` with world-aligned axes.  A plat
 from __future__ import annotations
 
 from collections.abc import Mapping
+import warnings
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 from itertools import combinations
@@ -22,8 +23,8 @@ from itertools import combinations
 import numpy as np
 
 from ..errors import InputError, SearchTooLargeError, UnknownNameError, describe
-from ..geometry.rotations import euler_matrix, transform
-from ..geometry.tolerances import characteristic_length
+from ..geometry.rotations import euler_matrix, nearest_rotation, transform
+from ..geometry.tolerances import ROTATION_EXACT, ROTATION_INPUT, characteristic_length
 from ..geometry.tolerances import current as current_tolerances
 from ..geometry.validate import as_finite_array
 from .joints import Freedom, Joint
@@ -52,8 +53,14 @@ class Pose:
 
     def __post_init__(self):
         R = as_finite_array(self.R, f"pose {self.name!r}.R", shape=(3, 3))
-        if np.max(np.abs(R @ R.T - np.eye(3))) > 1e-6 or np.linalg.det(R) < 0:
+        err = float(np.max(np.abs(R @ R.T - np.eye(3))))
+        if err > ROTATION_INPUT or np.linalg.det(R) < 0:
             raise InputError(f"pose {self.name!r}.R: not a rotation matrix (orthonormal, det +1)")
+        if err > ROTATION_EXACT:  # typed with a few decimals: solve for the rotation meant
+            R = nearest_rotation(R, name=f"pose {self.name!r}.R")
+            warnings.warn(f"pose {self.name!r}.R: orthonormal only to {err:.2g}; its nearest rotation is used "
+                          f"(it moves no entry by more than {float(np.max(np.abs(R - self.R))):.2g})",
+                          stacklevel=3)
         object.__setattr__(self, "R", R)
         object.__setattr__(self, "p", as_finite_array(self.p, f"pose {self.name!r}.p", shape=(3,)))
 
