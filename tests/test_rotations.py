@@ -56,3 +56,18 @@ def test_bad_angles():
         euler_matrix("ZXY", [0, np.nan, 0])
     with pytest.raises(ValueError, match=r"angles: expected shape"):
         euler_matrix("ZXY", [0, 0])
+
+
+@pytest.mark.parametrize("seq, angles", [("ZYX", (90.0, -90.0, 0.0)), ("ZYX", (-30.0, 90.0, 40.0)),
+                                         ("ZXZ", (20.0, 0.0, 35.0)), ("xyz", (10.0, 90.0, -70.0))])
+def test_gimbal_lock_gives_angles_that_rebuild_the_matrix_without_a_warning(seq, angles):
+    """At gimbal lock the outer angles are not separately defined: the third is set to zero and
+    the angles still give back the matrix; scipy's warning does not reach the user's output."""
+    import warnings
+
+    R = euler_matrix(seq, angles, degrees=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        a = matrix_euler(seq, R, degrees=True)
+    assert abs(a[2]) < 1e-9
+    assert np.max(np.abs(euler_matrix(seq, a, degrees=True) - R)) < 1e-12

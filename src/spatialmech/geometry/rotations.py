@@ -17,6 +17,7 @@ the origin, i.e. the moment ``r x omega``).
 
 from __future__ import annotations
 
+import warnings
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -81,11 +82,19 @@ def euler_matrix(seq: str, angles, *, degrees: bool = False) -> np.ndarray:
 
 
 def matrix_euler(seq: str, R, *, degrees: bool = False) -> np.ndarray:
-    """Euler angles of a rotation matrix (or stack) in the named sequence."""
+    """Euler angles of a rotation matrix (or stack) in the named sequence.
+
+    At gimbal lock (the middle angle at +-90 degrees for a Tait-Bryan sequence, 0 or 180 for a
+    proper Euler one) only the sum or difference of the outer angles is defined: the third is
+    set to zero (scipy's convention) and the angles still give back the matrix.  That is a
+    property of the sequence, not a failure, so scipy's warning is not passed on (a command
+    that prints a locked pose would show it among its lines)."""
     check_sequence(seq)
     R = as_finite_array(R, "R")
     flat = R.reshape(-1, 3, 3)
-    a = rotation_class().from_matrix(flat).as_euler(seq, degrees=degrees)
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message="Gimbal lock detected")
+        a = rotation_class().from_matrix(flat).as_euler(seq, degrees=degrees)
     return a.reshape((*R.shape[:-2], 3))
 
 
