@@ -5,13 +5,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from typing import TYPE_CHECKING
+
 from .. import catalog
-from ..analysis.mobility import MobilityResult
-from ..analysis.mobility import mobility as _mobility
-from ..analysis.mobility import mobility_modes as _mobility_modes
 from ..errors import describe
 from ..model.mechanism import Mechanism
 from .checks import ModelLike, as_mechanism, check_int
+
+if TYPE_CHECKING:
+    from ..analysis.mobility import MobilityResult
 
 
 # ============================================================================ models
@@ -116,6 +118,8 @@ def mobility(model: ModelLike, mode: str | None = None, *, seed: int = 0, tol=No
     mech = as_mechanism(model)
     if mode is not None and not isinstance(mode, str):
         raise TypeError(f"mode: expected a mode name (str) or None, got {describe(mode)}")
+    from ..analysis.mobility import mobility as _mobility
+
     return _mobility(mech, mode, seed=check_int(seed, "seed"), tol=tol)
 
 
@@ -179,4 +183,6 @@ def mobility_modes(model: ModelLike, *, mode: str | None = None, seed: int = 0, 
     seed = check_int(seed, "seed")
     if mode is not None:
         return MobilityModes(mech, (mobility(mech, mode, seed=seed, tol=tol),))
+    from ..analysis.mobility import mobility_modes as _mobility_modes
+
     return MobilityModes(mech, tuple(_mobility_modes(mech, seed=seed, tol=tol)))

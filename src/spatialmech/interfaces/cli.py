@@ -13,6 +13,7 @@ import os
 import sys
 import traceback
 from pathlib import Path
+from typing import ClassVar
 
 import click
 
@@ -75,6 +76,34 @@ class _Group(click.Group):
       bug: one line ``error: internal error ...`` and exit code 3; with ``--debug`` or
       ``SPATIALMECH_DEBUG=1`` the full traceback is printed first.
     """
+
+    #: Commands defined in their own modules, imported only when used or listed (``--help``):
+    #: name -> (module under ``spatialmech.interfaces``, attribute).  A short command such as
+    #: ``models`` does not pay for the others' imports (issue 29: start-up).
+    LAZY: ClassVar[dict[str, tuple[str, str]]] = {
+        "accuracy": ("cmd_accuracy", "accuracy_cmd"), "defects": ("cmd_defects", "defects"),
+        "dynamics": ("cmd_dynamics", "dynamics_cmd"), "fk": ("cmd_kinematics", "fk"),
+        "ik": ("cmd_kinematics", "ik"), "jacobian": ("cmd_kinematics", "jacobian"), "maps": ("cmd_maps", "maps_cmd"),
+        "parasitic": ("cmd_parasitic", "parasitic_cmd"), "screen": ("cmd_screen", "screen"),
+        "singularity": ("cmd_singularity", "singularity_cmd"), "statics": ("cmd_statics", "statics_cmd"),
+        "stiffness": ("cmd_stiffness", "stiffness_cmd"), "studio": ("cmd_studio", "studio"),
+        "synth": ("cmd_synth", "synth"), "validate": ("cmd_validate", "validate_cmd"), "view": ("cmd_view", "view"),
+        "workspace": ("cmd_workspace", "workspace"),
+    }
+
+    def list_commands(self, ctx):
+        return sorted(set(super().list_commands(ctx)) | set(self.LAZY))
+
+    def get_command(self, ctx, cmd_name):
+        if cmd_name in self.LAZY and cmd_name not in self.commands:
+            import importlib
+
+            module, attr = self.LAZY[cmd_name]
+            cmd = getattr(importlib.import_module(f"{__package__}.{module}"), attr)
+            if cmd.name != cmd_name:
+                raise RuntimeError(f"the command in {module}.{attr} is named {cmd.name!r}, not {cmd_name!r}")
+            self.add_command(cmd)
+        return super().get_command(ctx, cmd_name)
 
     def make_context(self, info_name, args, parent=None, **extra):
         try:
@@ -350,30 +379,6 @@ def report(model, out, no_trace, as_json):
         emit_json("report", mech, r.to_dict())
     else:
         click.echo(f"report written to {out / 'index.html'} and {out / 'results.json'}")
-
-
-from .cmd_accuracy import accuracy_cmd  # noqa: E402
-from .cmd_defects import defects  # noqa: E402
-from .cmd_dynamics import dynamics_cmd  # noqa: E402
-from .cmd_kinematics import fk, ik, jacobian  # noqa: E402  (commands defined in their own modules)
-from .cmd_maps import maps_cmd  # noqa: E402
-from .cmd_parasitic import parasitic_cmd  # noqa: E402
-from .cmd_screen import screen  # noqa: E402
-from .cmd_singularity import singularity_cmd  # noqa: E402
-from .cmd_statics import statics_cmd  # noqa: E402
-from .cmd_stiffness import stiffness_cmd  # noqa: E402
-from .cmd_studio import studio  # noqa: E402
-from .cmd_synth import synth  # noqa: E402
-from .cmd_view import view  # noqa: E402
-from .cmd_validate import validate_cmd  # noqa: E402
-from .cmd_workspace import workspace  # noqa: E402
-
-for _cmd in (ik, fk, jacobian, parasitic_cmd, synth, view, defects, workspace, singularity_cmd, validate_cmd, studio, screen,
-             statics_cmd, maps_cmd):
-    cli.add_command(_cmd)
-cli.add_command(stiffness_cmd)
-cli.add_command(accuracy_cmd)
-cli.add_command(dynamics_cmd)
 
 
 def main(argv=None):  # console-script entry point
