@@ -170,16 +170,16 @@ _FAMILIES = {
 def test_random_geometry_fk_of_ik_contains_the_pose(family, g, seed):
     """A random geometry of each family, a random assembled pose near the reference (a random
     walk along the closure): its actuator values by ``ik``, then ``fk --all`` (proven complete)
-    lists that pose.  The 3-UPU may end "not proven" for one stated reason only: end points
-    running to the exceptional generator at infinity, where the end game cannot converge (3 of
-    51 poses of the nominal geometry, docs/homotopy.md); its pose must still be listed."""
+    lists that pose.  The 3-UPU may end "not proven" for one stated reason only: singular complex
+    end points near the exceptional generator that the end game does not resolve (3 of 51 poses
+    of the nominal geometry, docs/homotopy.md); its pose must still be listed."""
     mech = _FAMILIES[family](g)
     cfg = generic_configuration(mech, seed=seed, step=0.3, steps=2)
     pose = platform_pose(mech, cfg)
     inv = sm.ik(mech, (pose.p, pose.R))
     assert inv.reachable
     r = sm.fk(mech, list(inv.actuators.values()), all_solutions=True)
-    near_infinity = "not proven only because a numerical end point near infinity is no proof" in r.completeness
+    near_infinity = "not proven only because these end points are not resolved" in r.completeness
     assert r.engine == "homotopy" and (r.complete or (family == "three-upu" and near_infinity)), r.completeness
     assert _near(pose, r.poses, 1e-7)
     if family == "three-prs":  # the elimination agrees on a random geometry too
