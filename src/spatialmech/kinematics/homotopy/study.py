@@ -263,8 +263,8 @@ def _near_infinity_note(sols) -> str:
     """What the singular end points near the exceptional generator ``e = 0`` are, said precisely:
     how near it and how far from real they are, and that the end game did not resolve them.
     (Measured on the 3-UPU, docs/homotopy.md: such points are finite, ``e.e / |x|^2`` settles at
-    1e-5 .. 4e-4 as the path nears its end, and isolated by the local dimension test; they are
-    not at infinity.)"""
+    1e-5 .. 4e-4 as the path nears its end; at slides near 0.4 m they are simple roots with
+    sigma_min / sigma_max about 1e-8; they are not at infinity.)"""
     near = []
     for s in sols:
         if s.status != EndPointStatus.SINGULAR:
@@ -280,8 +280,9 @@ def _near_infinity_note(sols) -> str:
     return (f"; {len(near)} of the singular end point(s) lie near the exceptional generator e = 0 (|e| / |x| <= "
             f"{max(r for r, _, _ in near):.0e}, e.e / |x|^2 above the {HOMOTOPY_INFINITY:g} that counts a point at "
             f"infinity) with g isotropic (|g.g| / |g|^2 <= {max(i for _, i, _ in near):.0e}): finite complex points "
-            "close to the solutions at infinity, where the end game did not converge, so whether each is an isolated "
-            "multiple root or lies on a continuum is not decided; none is near a real pose (imaginary part >= "
+            "close to the solutions at infinity, too ill-conditioned to count as regular, where the end game did not "
+            "converge, so whether each is a simple root, a multiple root or on a continuum is not decided; none is "
+            "near a real pose (imaginary part >= "
             f"{min(m for _, _, m in near):.0%} of the point); not proven only because these end points are not resolved")
 
 
