@@ -149,6 +149,16 @@ def test_double_root_and_nearby_point_are_not_certified():
     assert C.certify(_square_root_system(1.0), np.array([[1.0, 1.0]]), real=[True])[0].certified
 
 
+def test_an_ill_conditioned_simple_root_is_certified_in_its_own_box():
+    """Roots +-1e-11 of ``x0^2 = 1e-22`` (condition about 5e10): the Jacobian enclosed over the
+    shared wider box (100 x the first radius) does not contract, over the first box itself it
+    does; both roots certified, distinct, real (the 3-UPU's ill-conditioned end points need it)."""
+    system = _square_root_system(1e-22)
+    certs = C.certify(system, np.array([[1e-11, 1.0], [-1e-11, 1.0]]), real=[True, True])
+    assert all(c.certified and c.real is True for c in certs)
+    assert all(c.radius < 1e-11 for c in certs)  # each box excludes the other root
+
+
 def test_bad_points_are_refused_naming_the_field():
     system = _square_root_system(2.0)
     with pytest.raises(sm.InputError, match="points"):

@@ -117,6 +117,8 @@ def krawczyk_box(system: BallSystem, y: np.ndarray, max_radius: float,
         Mr = M if r <= rJ else eye - A * system.jacobian(yc + D)
         if _contained(yc + D, base + Mr * D, n):
             return r, "", f.real
+        if r < rJ and _contained(yc + D, base + (eye - A * system.jacobian(yc + D)) * D, n):
+            return r, "", f.real  # F' over this box only: an ill-conditioned root needs the tighter enclosure
         r *= CERTIFY_GROWTH
     return None, ("the Krawczyk test failed in every box up to the largest (a singular root, or roots closer than the "
                   "point's accuracy)"), f.real
