@@ -159,6 +159,35 @@ def test_an_ill_conditioned_simple_root_is_certified_in_its_own_box():
     assert all(c.radius < 1e-11 for c in certs)  # each box excludes the other root
 
 
+def test_a_root_too_ill_conditioned_for_53_bit_balls_is_certified_at_106_bits(monkeypatch):
+    """``x0^2 - 2.2 x0 x1 + b x1^2`` with ``x1 = 1`` and ``b = 1.1^2 + 2^-52`` (floats as exact
+    data): roots ``1.1 +- i s`` with ``s`` about 1.5e-8 (condition about 3e7), the centres
+    computed at 200 bits and rounded.  At 53 bits ``F`` at a centre is enclosed with the
+    rounding of its terms, ``A F`` too wide for any box to contract (checked by holding the
+    second try at 53 bits); at ``CERTIFY_PRECISION_HIGH`` bits the pair is certified, non-real
+    and distinct."""
+    from flint import arb, ctx
+
+    import spatialmech.kinematics.homotopy.certify_core as core
+
+    c, d = 1.1, 2.0**-26
+    b = c * c + d * d
+    prec, ctx.prec = ctx.prec, 200
+    try:
+        s = float((arb(b) - arb(c) ** 2).sqrt())
+    finally:
+        ctx.prec = prec
+    Q = np.zeros((1, 2, 2))
+    Q[0] = [[1.0, -c], [-c, b]]
+    system = C.quadric_system(Q, [[0.0, 1.0]], [1.0])
+    pts = np.array([[c + 1j * s, 1.0], [c - 1j * s, 1.0]])
+    certs = C.certify(system, pts)
+    assert all(x.certified and x.real is False for x in certs), [x.reason for x in certs]
+    assert all(x.radius < s for x in certs)
+    monkeypatch.setattr(core, "CERTIFY_PRECISION_HIGH", 53)
+    assert not any(x.certified for x in C.certify(system, pts))
+
+
 def test_bad_points_are_refused_naming_the_field():
     system = _square_root_system(2.0)
     with pytest.raises(sm.InputError, match="points"):

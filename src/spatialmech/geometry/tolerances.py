@@ -321,11 +321,14 @@ HOMOTOPY_ILL = 1e-4
 #: ``y`` the point in the system's coordinates): the half-width of the first Krawczyk box (or four
 #: times the point's Newton correction, if larger), the factor between the boxes tried, and the
 #: largest box: a point whose root lies farther away is not certified.  The ball arithmetic's
-#: working precision in bits.
+#: working precision in bits, and the precision of a second try for a point whose boxes all fail
+#: (an ill-conditioned root: at 53 bits the enclosure of ``A F(y)`` is as wide as the condition
+#: number times the rounding, and no box about the point contracts).
 CERTIFY_MIN_RADIUS = 1e-13
 CERTIFY_GROWTH = 100.0
 CERTIFY_MAX_RADIUS = 1e-8
 CERTIFY_PRECISION = 53
+CERTIFY_PRECISION_HIGH = 106
 
 #: Forward-position solution flags (kinematics/solution_flags.py).  A solution is
 #: *input-independent* (it persists for every actuator value: the actuators move without moving

@@ -13,7 +13,8 @@ import numpy as np
 from flint import ctx
 
 from ...errors import InputError
-from ...geometry.tolerances import CERTIFY_GROWTH, CERTIFY_MAX_RADIUS, CERTIFY_MIN_RADIUS, CERTIFY_PRECISION
+from ...geometry.tolerances import (CERTIFY_GROWTH, CERTIFY_MAX_RADIUS, CERTIFY_MIN_RADIUS, CERTIFY_PRECISION,
+                                    CERTIFY_PRECISION_HIGH)
 from .certify_balls import COMPLEX, REAL, BallSystem, midpoints, pow2_up
 
 __all__ = ["Certificate", "certify", "krawczyk_box", "n_certified"]
@@ -155,6 +156,24 @@ def _pairs(Y: np.ndarray, R: np.ndarray, Rim: np.ndarray) -> tuple[np.ndarray, n
     return disjoint, inside
 
 
+def _retry_at_high_precision(system: BallSystem, Ys: list, found: list, todo: list[int], max_radius: float) -> None:
+    """The points of ``todo`` whose every box failed, tried again with the balls at
+    ``CERTIFY_PRECISION_HIGH`` bits (the same boxes about the same points: an ill-conditioned
+    root needs ``A F(y)`` enclosed more tightly than 53 bits allow).  Updates ``found``."""
+    again = [i for i in todo if found[i][1] is None and found[i][2].startswith("the Krawczyk test failed")]
+    if not again:
+        return
+    prec = ctx.prec
+    ctx.prec = CERTIFY_PRECISION_HIGH
+    try:
+        for i in again:
+            r, why, rb = krawczyk_box(system, Ys[i], max_radius)
+            if r is not None:
+                found[i] = (Ys[i], r, why, rb, 0.0)
+    finally:
+        ctx.prec = prec
+
+
 def certify(system: BallSystem, points, *, real: Sequence[bool] | None = None,
             max_radius: float = CERTIFY_MAX_RADIUS) -> tuple[Certificate, ...]:
     """Certify each of ``points`` (m, n) as an approximate zero of ``system`` with its own root.
@@ -191,6 +210,7 @@ def certify(system: BallSystem, points, *, real: Sequence[bool] | None = None,
             pre = [_inverse(J) for J in many(np.array([Ys[i] for i in todo]))]
         for i, Ainv in zip(todo, pre, strict=True):
             found[i] = (Ys[i], *krawczyk_box(system, Ys[i], max_radius, Ainv), 0.0)
+        _retry_at_high_precision(system, Ys, found, todo, max_radius)
         for j, i in partner.items():  # the conjugate of a certified box holds the conjugate root
             yi, ri, why, rb, _ = found[i]
             yj = yi.conj()

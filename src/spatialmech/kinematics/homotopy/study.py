@@ -43,7 +43,7 @@ the projective phase (real).
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -252,6 +252,28 @@ def _classify(Qc, c, X):
             st = EndPointStatus.COMPLEX
         out.append((st, rcond, rel_inf, imag, res, y, x))
     return out
+
+
+def _certified_simple(Qt, sols: list) -> tuple[list, int]:
+    """The singular end points proven simple non-real roots: all finite end points certified
+    together (:func:`.certify.certify_projective`, so that every box is also disjoint from the
+    others'); when *every* singular one is certified and proven non-real, they become complex
+    solutions.  Returns the end points and how many changed (0: none, or not all of them; also
+    when certification is off)."""
+    from . import certify as hcert
+
+    sing = [i for i, s in enumerate(sols) if s.status == EndPointStatus.SINGULAR]
+    if not sing or not hcert.enabled():
+        return sols, 0
+    finite = [i for i, s in enumerate(sols) if s.status != EndPointStatus.AT_INFINITY]
+    _, certs = hcert.certify_projective(Qt, [], np.array([sols[i].study for i in finite]))
+    by_point = dict(zip(finite, certs, strict=True))
+    if not all(by_point[i].certified and by_point[i].real is False for i in sing):
+        return sols, 0
+    out = list(sols)
+    for i in sing:
+        out[i] = replace(sols[i], status=EndPointStatus.COMPLEX, R=None, p=None)
+    return out, len(sing)
 
 
 #: A singular end point is *near the exceptional generator* when ``|e| / |x|`` is below this
@@ -493,12 +515,20 @@ def homotopy_forward(mech: Mechanism | StewartSystem | PoseSystem, actuator_valu
         if (st == EndPointStatus.REAL or (st == EndPointStatus.SINGULAR and im < HOMOTOPY_NEAR_REAL)) and ri >= HOMOTOPY_INFINITY:
             R, p = study_to_pose(y / np.linalg.norm(y), sysm.L)
         sols.append(HomotopySolution(st, y, rc, ri, im, res, R, p, int(mult[i]), int(wind[i])))
+    certified_simple = 0
+    if accounted and not isolated:
+        sols, certified_simple = _certified_simple(Qt, sols)
     n_par = len(sysm.affine_span()[1])
     how = (f"total-degree homotopy ({gen.n_paths} paths, gamma trick) to a generic complex instance: every path "
            f"accounted for ({len(gen.X)} finite nonsingular, {gen.n_at_infinity} at the exceptional generator e.e = 0); "
            f"parameter homotopy of those {len(gen.X)} paths to the requested actuator values (straight segment in the "
            f"{n_par}-dimensional affine span of the coefficients)")
     n_sing = sum(s.status == EndPointStatus.SINGULAR for s in sols)
+    if certified_simple:
+        how += (f"; {certified_simple} end point(s) too ill-conditioned to count as regular (sigma_min / sigma_max below "
+                f"{HOMOTOPY_SINGULAR:g}) are certified simple non-real roots by the Krawczyk test in ball arithmetic, each "
+                "box disjoint from every other end point's: complex solutions")
+        isolated = True
     if accounted and n_sing and isolated:
         how += (f"; {n_sing} path(s) end at {len(groups)} isolated multiple root(s) (multiplicities "
                 f"{sorted(int(m) for m in set(mult[sing].tolist()))}), located by a Cauchy end game (winding numbers "
