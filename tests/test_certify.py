@@ -188,6 +188,32 @@ def test_a_root_too_ill_conditioned_for_53_bit_balls_is_certified_at_106_bits(mo
     assert not any(x.certified for x in C.certify(system, pts))
 
 
+def test_newton_refinement_in_high_precision_moves_a_point_onto_its_root():
+    """A point 1e-9 from the root ``1.1 + i s`` of the ill-conditioned pair above (too far for
+    any box: refused), refined by :func:`newton_refine` (106-bit balls): within rounding of the
+    root, and then certified; at a singular root the point is returned unchanged."""
+    from flint import arb, ctx
+
+    c, d = 1.1, 2.0**-26
+    b = c * c + d * d
+    prec, ctx.prec = ctx.prec, 200
+    try:
+        s = float((arb(b) - arb(c) ** 2).sqrt())
+    finally:
+        ctx.prec = prec
+    Q = np.zeros((1, 2, 2))
+    Q[0] = [[1.0, -c], [-c, b]]
+    system = C.quadric_system(Q, [[0.0, 1.0]], [1.0])
+    far = np.array([c + 1e-9 + 1j * s, 1.0])
+    assert not C.certify(system, far[None])[0].certified
+    near = C.newton_refine(system, far)
+    assert abs(near[0] - (c + 1j * s)) < 1e-15 and near[1] == 1.0
+    assert C.certify(system, near[None])[0].certified
+    y = np.array([1e-9, 1.0])
+    assert np.array_equal(C.newton_refine(_square_root_system(0.0), np.array([0.0, 1.0])), [0.0, 1.0])
+    assert np.all(np.isfinite(C.newton_refine(_square_root_system(0.0), y)))
+
+
 def test_bad_points_are_refused_naming_the_field():
     system = _square_root_system(2.0)
     with pytest.raises(sm.InputError, match="points"):

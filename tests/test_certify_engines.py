@@ -144,18 +144,21 @@ def test_singular_end_points_near_the_exceptional_generator_are_described():
     assert _near_infinity_note([finite]) == ""
 
 
-def test_three_upu_ill_conditioned_end_points_certified_simple_make_the_set_complete():
-    """The nominal 3-UPU at slides 0.4056, 0.4032, 0.4059 m (a pose hypothesis found): 6 end
-    points near the exceptional generator are too ill-conditioned to count as regular
-    (sigma_min / sigma_max about 1e-8); all 78 finite end points certified together (the 6 at
-    106-bit balls) prove them simple non-real roots with disjoint boxes, so every path is
-    accounted for: complete (proven), 16 real, 62 complex, 0 singular."""
-    fk = sm.fk("three-upu", [0.4056, 0.4032, 0.4059], all_solutions=True)
+@pytest.mark.parametrize("slides, real, complex_", [((0.4056, 0.4032, 0.4059), 16, 62),
+                                                    ((0.3648, 0.3629, 0.3633), 28, 50)])
+def test_three_upu_ill_conditioned_end_points_certified_simple_make_the_set_complete(slides, real, complex_):
+    """The nominal 3-UPU at two poses hypothesis found: 6 end points near the exceptional
+    generator each are too ill-conditioned to count as regular (sigma_min / sigma_max about
+    1e-8).  Refined by Newton steps in 106-bit balls (at the second pose the float end points
+    are too far from their roots for any box) and certified together with every other finite
+    end point, they are simple non-real roots with disjoint boxes, so every path is accounted
+    for: complete (proven), every solution certified, none singular."""
+    fk = sm.fk("three-upu", list(slides), all_solutions=True)
     d = fk.to_dict()
     assert fk.engine == "homotopy" and fk.complete, fk.completeness
     assert "6 end point(s) too ill-conditioned to count as regular" in fk.completeness
-    assert (d["n_real"], d["n_complex"], d["n_singular"]) == (16, 62, 0)
-    assert d["n_certified"] == 16 and d["search"]["n_certified_complex"] == 62
+    assert (d["n_real"], d["n_complex"], d["n_singular"]) == (real, complex_, 0)
+    assert d["n_certified"] == real and d["search"]["n_certified_complex"] == complex_
 
 
 @pytest.mark.slow

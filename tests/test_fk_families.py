@@ -171,8 +171,9 @@ def test_random_geometry_fk_of_ik_contains_the_pose(family, g, seed):
     """A random geometry of each family, a random assembled pose near the reference (a random
     walk along the closure): its actuator values by ``ik``, then ``fk --all`` (proven complete)
     lists that pose.  The 3-UPU may end "not proven" for one stated reason only: singular complex
-    end points near the exceptional generator that the end game does not resolve (1 of 51 poses
-    of the nominal geometry, docs/homotopy.md); its pose must still be listed."""
+    end points near the exceptional generator that neither the end game nor the certificates
+    resolve (0 of 51 poses of the nominal geometry now; 3 before the certificates took them,
+    docs/homotopy.md); its pose must still be listed."""
     mech = _FAMILIES[family](g)
     cfg = generic_configuration(mech, seed=seed, step=0.3, steps=2)
     pose = platform_pose(mech, cfg)

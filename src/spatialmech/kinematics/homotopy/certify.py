@@ -57,7 +57,7 @@ import numpy as np
 from ...geometry.tolerances import CERTIFY_MAX_RADIUS
 from .certify_balls import COMPLEX, REAL, BallSystem
 from .certify_balls import midpoints as _mid
-from .certify_core import Certificate, certify, n_certified
+from .certify_core import Certificate, certify, n_certified, newton_refine
 from .certify_core import krawczyk_box as _one
 from .certify_systems import LimbBallSystem, QuadricBallSystem, limb_system, quadric_system
 
@@ -78,7 +78,9 @@ __all__ = [
     "limb_point",
     "limb_system",
     "n_certified",
+    "newton_refine",
     "quadric_system",
+    "refine_projective",
     "statement",
     "study_parameters",
 ]
@@ -177,6 +179,20 @@ def certify_projective(Q: np.ndarray, real_points: Sequence[np.ndarray | None],
     for k, i in enumerate(have):
         out[i] = certs[k]
     return out, list(certs[len(R):])
+
+
+def refine_projective(Q: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """Points of ``P^k`` (m, k + 1) on the homogeneous quadrics ``Q`` (real), each refined by
+    :func:`.certify_core.newton_refine` on a real affine patch chosen for them (the result is
+    homogeneous: any scaling of it is the same point)."""
+    P = np.asarray(points, dtype=complex).reshape(-1, np.asarray(Q).shape[1])
+    if len(P) == 0:
+        return P
+    c = _real_patch(P)
+    s = P @ c
+    P = P / np.where(np.abs(s) > 0, s, 1.0)[:, None]
+    system = quadric_system(np.real(Q), c[None], [1.0])
+    return np.array([newton_refine(system, y) for y in P])
 
 
 def limb_point(sysm, q) -> np.ndarray:

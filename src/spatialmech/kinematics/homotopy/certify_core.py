@@ -17,7 +17,7 @@ from ...geometry.tolerances import (CERTIFY_GROWTH, CERTIFY_MAX_RADIUS, CERTIFY_
                                     CERTIFY_PRECISION_HIGH)
 from .certify_balls import COMPLEX, REAL, BallSystem, midpoints, pow2_up
 
-__all__ = ["Certificate", "certify", "krawczyk_box", "n_certified"]
+__all__ = ["Certificate", "certify", "krawczyk_box", "n_certified", "newton_refine"]
 
 
 @dataclass(frozen=True)
@@ -154,6 +154,28 @@ def _pairs(Y: np.ndarray, R: np.ndarray, Rim: np.ndarray) -> tuple[np.ndarray, n
     inside = np.all((dre < sre) & ((dim < sim) | ((Rim[:, None, None] == 0) & (Rim[None, :, None] == 0) & (dim == 0))),
                     axis=2)
     return disjoint, inside
+
+
+def newton_refine(system: BallSystem, y: np.ndarray, *, steps: int = 4) -> np.ndarray:
+    """``y`` moved by ``steps`` Newton steps computed in complex balls of
+    ``CERTIFY_PRECISION_HIGH`` bits (each step from the midpoint of the last), rounded back to
+    floats: an end point of an ill-conditioned root, accurate to its condition number times the
+    rounding, becomes accurate to the rounding, so that a Krawczyk box about it can contract.
+    ``y`` unchanged when a Jacobian is singular or a step is not finite.  A refinement, not a
+    proof: :func:`certify` decides."""
+    prec = ctx.prec
+    ctx.prec = CERTIFY_PRECISION_HIGH
+    try:
+        x = COMPLEX.col(np.asarray(y, dtype=complex))
+        for _ in range(steps):
+            try:
+                x = (x - system.jacobian(x).solve(system.values(x))).mid()
+            except (ZeroDivisionError, ValueError):
+                return np.asarray(y, dtype=complex)
+        out = midpoints(x).ravel()
+    finally:
+        ctx.prec = prec
+    return out if np.all(np.isfinite(out)) else np.asarray(y, dtype=complex)
 
 
 def _retry_at_high_precision(system: BallSystem, Ys: list, found: list, todo: list[int], max_radius: float) -> None:

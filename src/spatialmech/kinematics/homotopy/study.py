@@ -255,10 +255,11 @@ def _classify(Qc, c, X):
 
 
 def _certified_simple(Qt, sols: list) -> tuple[list, int]:
-    """The singular end points proven simple non-real roots: all finite end points certified
+    """The singular end points proven simple non-real roots: each refined by Newton steps in
+    106-bit balls (:func:`.certify.refine_projective`), then all finite end points certified
     together (:func:`.certify.certify_projective`, so that every box is also disjoint from the
     others'); when *every* singular one is certified and proven non-real, they become complex
-    solutions.  Returns the end points and how many changed (0: none, or not all of them; also
+    solutions at their refined points.  Returns the end points and how many changed (0: none, or not all of them; also
     when certification is off)."""
     from . import certify as hcert
 
@@ -266,14 +267,22 @@ def _certified_simple(Qt, sols: list) -> tuple[list, int]:
     if not sing or not hcert.enabled():
         return sols, 0
     finite = [i for i, s in enumerate(sols) if s.status != EndPointStatus.AT_INFINITY]
-    _, certs = hcert.certify_projective(Qt, [], np.array([sols[i].study for i in finite]))
+    refined = dict(zip(sing, hcert.refine_projective(Qt, np.array([sols[i].study for i in sing])), strict=True))
+    Y = np.array([_phase_free(refined[i]) if i in refined else sols[i].study for i in finite])
+    _, certs = hcert.certify_projective(Qt, [], Y)
     by_point = dict(zip(finite, certs, strict=True))
     if not all(by_point[i].certified and by_point[i].real is False for i in sing):
         return sols, 0
     out = list(sols)
     for i in sing:
-        out[i] = replace(sols[i], status=EndPointStatus.COMPLEX, R=None, p=None)
+        out[i] = replace(sols[i], status=EndPointStatus.COMPLEX, study=_phase_free(refined[i]), R=None, p=None)
     return out, len(sing)
+
+
+def _phase_free(x: np.ndarray) -> np.ndarray:
+    """A projective point with its phase removed as :func:`_classify` does (largest entry real)."""
+    k = int(np.argmax(np.abs(x)))
+    return x * (abs(x[k]) / x[k]) if x[k] != 0 else x
 
 
 #: A singular end point is *near the exceptional generator* when ``|e| / |x|`` is below this
@@ -516,7 +525,7 @@ def homotopy_forward(mech: Mechanism | StewartSystem | PoseSystem, actuator_valu
             R, p = study_to_pose(y / np.linalg.norm(y), sysm.L)
         sols.append(HomotopySolution(st, y, rc, ri, im, res, R, p, int(mult[i]), int(wind[i])))
     certified_simple = 0
-    if accounted and not isolated:
+    if accounted and not isolated and len(sing) and done[sing].all():  # every such path reached t = 1
         sols, certified_simple = _certified_simple(Qt, sols)
     n_par = len(sysm.affine_span()[1])
     how = (f"total-degree homotopy ({gen.n_paths} paths, gamma trick) to a generic complex instance: every path "
