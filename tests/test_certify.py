@@ -159,16 +159,11 @@ def test_an_ill_conditioned_simple_root_is_certified_in_its_own_box():
     assert all(c.radius < 1e-11 for c in certs)  # each box excludes the other root
 
 
-def test_a_root_too_ill_conditioned_for_53_bit_balls_is_certified_at_106_bits(monkeypatch):
+def _ill_conditioned_pair():
     """``x0^2 - 2.2 x0 x1 + b x1^2`` with ``x1 = 1`` and ``b = 1.1^2 + 2^-52`` (floats as exact
-    data): roots ``1.1 +- i s`` with ``s`` about 1.5e-8 (condition about 3e7), the centres
-    computed at 200 bits and rounded.  At 53 bits ``F`` at a centre is enclosed with the
-    rounding of its terms, ``A F`` too wide for any box to contract (checked by holding the
-    second try at 53 bits); at ``CERTIFY_PRECISION_HIGH`` bits the pair is certified, non-real
-    and distinct."""
+    data): roots ``1.1 +- i s`` with ``s`` about 1.5e-8 (condition about 3e7), ``s`` computed at
+    200 bits and rounded.  Returns ``(system, 1.1, s)``."""
     from flint import arb, ctx
-
-    import spatialmech.kinematics.homotopy.certify_core as core
 
     c, d = 1.1, 2.0**-26
     b = c * c + d * d
@@ -179,7 +174,17 @@ def test_a_root_too_ill_conditioned_for_53_bit_balls_is_certified_at_106_bits(mo
         ctx.prec = prec
     Q = np.zeros((1, 2, 2))
     Q[0] = [[1.0, -c], [-c, b]]
-    system = C.quadric_system(Q, [[0.0, 1.0]], [1.0])
+    return C.quadric_system(Q, [[0.0, 1.0]], [1.0]), c, s
+
+
+def test_a_root_too_ill_conditioned_for_53_bit_balls_is_certified_at_106_bits(monkeypatch):
+    """The pair of :func:`_ill_conditioned_pair`.  At 53 bits ``F`` at a centre is enclosed with
+    the rounding of its terms, ``A F`` too wide for any box to contract (checked by holding the
+    second try at 53 bits); at ``CERTIFY_PRECISION_HIGH`` bits the pair is certified, non-real
+    and distinct."""
+    import spatialmech.kinematics.homotopy.certify_core as core
+
+    system, c, s = _ill_conditioned_pair()
     pts = np.array([[c + 1j * s, 1.0], [c - 1j * s, 1.0]])
     certs = C.certify(system, pts)
     assert all(x.certified and x.real is False for x in certs), [x.reason for x in certs]
@@ -189,29 +194,17 @@ def test_a_root_too_ill_conditioned_for_53_bit_balls_is_certified_at_106_bits(mo
 
 
 def test_newton_refinement_in_high_precision_moves_a_point_onto_its_root():
-    """A point 1e-9 from the root ``1.1 + i s`` of the ill-conditioned pair above (too far for
-    any box: refused), refined by :func:`newton_refine` (106-bit balls): within rounding of the
-    root, and then certified; at a singular root the point is returned unchanged."""
-    from flint import arb, ctx
-
-    c, d = 1.1, 2.0**-26
-    b = c * c + d * d
-    prec, ctx.prec = ctx.prec, 200
-    try:
-        s = float((arb(b) - arb(c) ** 2).sqrt())
-    finally:
-        ctx.prec = prec
-    Q = np.zeros((1, 2, 2))
-    Q[0] = [[1.0, -c], [-c, b]]
-    system = C.quadric_system(Q, [[0.0, 1.0]], [1.0])
+    """A point 1e-9 from the root ``1.1 + i s`` of :func:`_ill_conditioned_pair` (too far for any
+    box: refused), refined by :func:`newton_refine` (106-bit balls): within rounding of the root,
+    and then certified; at a singular root the point is returned unchanged."""
+    system, c, s = _ill_conditioned_pair()
     far = np.array([c + 1e-9 + 1j * s, 1.0])
     assert not C.certify(system, far[None])[0].certified
     near = C.newton_refine(system, far)
     assert abs(near[0] - (c + 1j * s)) < 1e-15 and near[1] == 1.0
     assert C.certify(system, near[None])[0].certified
-    y = np.array([1e-9, 1.0])
     assert np.array_equal(C.newton_refine(_square_root_system(0.0), np.array([0.0, 1.0])), [0.0, 1.0])
-    assert np.all(np.isfinite(C.newton_refine(_square_root_system(0.0), y)))
+    assert np.all(np.isfinite(C.newton_refine(_square_root_system(0.0), np.array([1e-9, 1.0]))))
 
 
 def test_bad_points_are_refused_naming_the_field():
