@@ -14,8 +14,8 @@ and the platform frame is at ``platform_point`` with world-aligned axes.  A plat
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 import warnings
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 from itertools import combinations

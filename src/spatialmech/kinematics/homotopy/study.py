@@ -238,8 +238,7 @@ def _classify(Qc, c, X):
         x = xr[n]
         rel_inf = float(abs(E[n])) / nx[n] ** 2 if nx[n] > 0 and np.isfinite(nx[n]) else 0.0
         rcond = float(sv[n, -1] / sv[n, 0]) if finite[n] else 0.0
-        k = int(np.argmax(np.abs(x)))
-        y = x * (abs(x[k]) / x[k]) if x[k] != 0 else x
+        y = _phase_free(x)
         imag = float(np.linalg.norm(y.imag) / max(float(np.linalg.norm(y)), 1e-300))
         res = float(np.linalg.norm(F[n, :7]) / max(nx[n] ** 2, 1e-300))
         if not np.isfinite(nx[n]) or rel_inf < HOMOTOPY_INFINITY:
@@ -259,23 +258,24 @@ def _certified_simple(Qt, sols: list) -> tuple[list, int]:
     106-bit balls (:func:`.certify.refine_projective`), then all finite end points certified
     together (:func:`.certify.certify_projective`, so that every box is also disjoint from the
     others'); when *every* singular one is certified and proven non-real, they become complex
-    solutions at their refined points.  Returns the end points and how many changed (0: none, or not all of them; also
-    when certification is off)."""
+    solutions at their refined points.  Returns the end points and how many changed (0: none,
+    or not all of them; also when certification is off)."""
     from . import certify as hcert
 
     sing = [i for i, s in enumerate(sols) if s.status == EndPointStatus.SINGULAR]
     if not sing or not hcert.enabled():
         return sols, 0
     finite = [i for i, s in enumerate(sols) if s.status != EndPointStatus.AT_INFINITY]
-    refined = dict(zip(sing, hcert.refine_projective(Qt, np.array([sols[i].study for i in sing])), strict=True))
-    Y = np.array([_phase_free(refined[i]) if i in refined else sols[i].study for i in finite])
+    refined = {i: _phase_free(y)
+               for i, y in zip(sing, hcert.refine_projective(Qt, np.array([sols[i].study for i in sing])), strict=True)}
+    Y = np.array([refined[i] if i in refined else sols[i].study for i in finite])
     _, certs = hcert.certify_projective(Qt, [], Y)
     by_point = dict(zip(finite, certs, strict=True))
     if not all(by_point[i].certified and by_point[i].real is False for i in sing):
         return sols, 0
     out = list(sols)
     for i in sing:
-        out[i] = replace(sols[i], status=EndPointStatus.COMPLEX, study=_phase_free(refined[i]), R=None, p=None)
+        out[i] = replace(sols[i], status=EndPointStatus.COMPLEX, study=refined[i], R=None, p=None)
     return out, len(sing)
 
 
@@ -537,7 +537,6 @@ def homotopy_forward(mech: Mechanism | StewartSystem | PoseSystem, actuator_valu
         how += (f"; {certified_simple} end point(s) too ill-conditioned to count as regular (sigma_min / sigma_max below "
                 f"{HOMOTOPY_SINGULAR:g}) are certified simple non-real roots by the Krawczyk test in ball arithmetic, each "
                 "box disjoint from every other end point's: complex solutions")
-        isolated = True
     if accounted and n_sing and isolated:
         how += (f"; {n_sing} path(s) end at {len(groups)} isolated multiple root(s) (multiplicities "
                 f"{sorted(int(m) for m in set(mult[sing].tolist()))}), located by a Cauchy end game (winding numbers "
