@@ -31,7 +31,7 @@ import numpy as np
 from ...geometry.tolerances import CERTIFY_GROWTH, CERTIFY_MIN_RADIUS
 from .jit import njit
 
-__all__ = ["nb_imatmul", "nb_imatmul_t", "nb_krawczyk", "nb_limb_enclosures", "nb_limb_values", "nb_pow2_up", "nb_up"]
+__all__ = ["nb_imatmul", "nb_krawczyk", "nb_limb_enclosures", "nb_limb_values", "nb_pow2_up", "nb_up"]
 
 U = 2.0**-53  # unit roundoff (round to nearest)
 UP = 1.0 + 2.0**-40
@@ -71,25 +71,6 @@ def nb_imatmul(am, ar, bm, br, cm, cr):
                 m += a * b
                 r1 += abs(a) * (br[k, j] + g * abs(b))
                 r2 += ar[i, k] * (abs(b) + br[k, j])
-            cm[i, j] = m
-            cr[i, j] = nb_up(r1 + r2)
-
-
-@njit(cache=True)
-def nb_imatmul_t(am, ar, bm, br, cm, cr):
-    """``C = A^T B`` of interval matrices (4, 4) (:func:`nb_imatmul` of the transpose)."""
-    g = 5 * U
-    for i in range(4):
-        for j in range(4):
-            m = 0.0
-            r1 = 0.0
-            r2 = 0.0
-            for k in range(4):
-                a = am[k, i]
-                b = bm[k, j]
-                m += a * b
-                r1 += abs(a) * (br[k, j] + g * abs(b))
-                r2 += ar[k, i] * (abs(b) + br[k, j])
             cm[i, j] = m
             cr[i, j] = nb_up(r1 + r2)
 
@@ -226,7 +207,7 @@ def nb_point_rows(TLm, TLr, TRm, TRr, Em, Er, s, stv, centre, zc, vec, out_m, ou
 def nb_full_rows(TLm, TLr, Wm, Wr, s, stv, work, out_m, out_r):
     """The closure rows of a limb without an S joint: ``P = W^T TL`` (``W = E TR``) at (1, 0),
     (2, 0), (2, 1), then ``s TL[:3, 3] - W[:3, 3] - s t``; ``work`` (2, 4, 4) scratch."""
-    nb_imatmul_t(Wm, Wr, TLm, TLr, work[0], work[1])
+    nb_imatmul(Wm.T, Wr.T, TLm, TLr, work[0], work[1])  # W^T TL
     out_m[0], out_r[0] = work[0, 1, 0], work[1, 1, 0]
     out_m[1], out_r[1] = work[0, 2, 0], work[1, 2, 0]
     out_m[2], out_r[2] = work[0, 2, 1], work[1, 2, 1]
@@ -252,7 +233,7 @@ def nb_derivative_cols(side, point, dTm, dTr, Wm, Wr, TLm, TLr, Em, Er, s, centr
                 cm[a], cr[a] = -vec[2, a], vec[3, a]
         return
     if side == 0:
-        nb_imatmul_t(Wm, Wr, dTm, dTr, work[0], work[1])
+        nb_imatmul(Wm.T, Wr.T, dTm, dTr, work[0], work[1])
         cm[0], cr[0] = work[0, 1, 0], work[1, 1, 0]
         cm[1], cr[1] = work[0, 2, 0], work[1, 2, 0]
         cm[2], cr[2] = work[0, 2, 1], work[1, 2, 1]
@@ -260,7 +241,7 @@ def nb_derivative_cols(side, point, dTm, dTr, Wm, Wr, TLm, TLr, Em, Er, s, centr
             cm[3 + a], cr[3 + a] = nb_imul(s[0], s[1], dTm[a, 3], dTr[a, 3])
         return
     nb_imatmul(Em, Er, dTm, dTr, work[2], work[3])
-    nb_imatmul_t(TLm, TLr, work[2], work[3], work[0], work[1])
+    nb_imatmul(TLm.T, TLr.T, work[2], work[3], work[0], work[1])
     cm[0], cr[0] = work[0, 0, 1], work[1, 0, 1]
     cm[1], cr[1] = work[0, 0, 2], work[1, 0, 2]
     cm[2], cr[2] = work[0, 1, 2], work[1, 1, 2]
