@@ -53,6 +53,19 @@ def test_normalize_flag_accepts_printed_axes():
         make_joint("C", "C1", axis=[0.745, 0.485, 0.458])
 
 
+def test_a_freedom_screw_is_computed_once_and_handed_out_as_a_copy():
+    """``Freedom.screw`` is kept after the first call (issue 29: building many linkages from
+    shared joints); a caller that writes into the array it got changes nothing."""
+    from spatialmech.geometry.screws import axis_screw
+
+    f = make_joint("C", "C1", point=[0.1, 0.2, 0.3], axis=[0.0, 0.6, 0.8]).freedoms[0]
+    s = f.screw
+    np.testing.assert_array_equal(s, axis_screw(f.direction, f.point))
+    s[:] = 0.0
+    np.testing.assert_array_equal(f.screw, axis_screw(f.direction, f.point))
+    assert f.screw is not f.screw
+
+
 def test_mechanism_errors():
     def j(n):
         return sm.R(n, [0, 0, 0], [0, 0, 1])

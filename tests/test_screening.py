@@ -23,6 +23,7 @@ from spatialmech.synthesis.screening import (
     DyadPool,
     candidate_linkage,
     candidate_sets,
+    closed_form_table,
     dyad_pool,
     judge_candidate,
     nondimensional,
@@ -163,6 +164,31 @@ def test_a_usable_candidate_agrees_with_the_full_defect_analysis(pool):
     # the slides of the five limbs at the positions: stroke = sum of their ranges
     slides = np.c_[np.zeros(5), pool.vectors[USABLE, 9:15]]
     assert v.stroke == pytest.approx(np.sum(slides.max(1) - slides.min(1)))
+
+
+def test_the_closed_form_table_is_the_fitted_one_and_gives_the_same_analysis(pool):
+    """The screen hands the defect analysis its closed-form configurations instead of fitting the
+    positions (issue 29): the same DJ, configurations and pose errors as :func:`dj_table`, the
+    same analysis (two circuits: positions fitted again as start points); a table of other
+    drivers is refused, naming the argument."""
+    from spatialmech.analysis.defects import dj_table
+
+    mech = candidate_linkage(pool, TWO_CIRCUITS)
+    got, ref = closed_form_table(mech), dj_table(mech)
+    assert got.drivers == ref.drivers and got.positions == ref.positions
+    np.testing.assert_allclose(got.dj, ref.dj, rtol=1e-9, atol=1e-12 * np.max(np.abs(ref.dj)))
+    for a, b in zip(got.fits, ref.fits, strict=True):
+        assert a.converged and a.exact and b.exact
+        assert np.max(np.abs(a.config.q - b.config.q)) < 1e-9 and np.max(np.abs(a.config.D - b.config.D)) < 1e-12
+        assert a.error < 1e-12 and abs(a.ik_residual - b.ik_residual) < 1e-12
+    with_table = defect_analysis(mech, check_dof=False, table=got).to_dict()
+    fitted = defect_analysis(mech, check_dof=False).to_dict()
+    for key in ("circuit_defect", "order_defect", "usable_drivers", "circuits", "order"):
+        assert with_table[key] == fitted[key], key
+    arcs = [np.array(d["position_arcs"], dtype=float) for d in (with_table, fitted)]  # None (off the path): nan
+    np.testing.assert_allclose(*arcs, rtol=1e-9, atol=1e-9)
+    with pytest.raises(InputError, match=r"table: .*not of this linkage"):
+        defect_analysis(mech, drivers=["rot1"], check_dof=False, table=got)
 
 
 def test_the_fast_rejection_agrees_with_the_full_analysis(pool):

@@ -406,6 +406,7 @@ def defect_analysis(
     progress: Progress | None = None,
     sense: int = 1,
     check_dof: bool = True,
+    table: DJTable | None = None,
 ) -> DefectResult:
     """Defect judgement of a 1-DOF linkage for its task positions (default: the model's own).
 
@@ -418,7 +419,10 @@ def defect_analysis(
     ``-1``: the opposite); the verdict (circuits, defects, usable drivers) does not depend on it,
     only the traced arcs and ``direction`` do.  ``check_dof=False`` skips the mobility check of
     step 0 for a caller that has already shown one degree of freedom (the screen: a closure
-    Jacobian of full row rank at a task position, so of full row rank generically).
+    Jacobian of full row rank at a task position, so of full row rank generically).  ``table``:
+    the :class:`DJTable` of these positions and drivers when the caller already has one (the
+    screen builds it from the closed-form configurations of a 5-CS); by default
+    :func:`dj_table` fits the positions.
 
     The steps (module docstring): :func:`_checked_arguments`, :func:`dj_table` (fits and DJ),
     :func:`_trace_circuits`, :func:`_assign_circuits`, :func:`_path_along_first_circuit`,
@@ -429,8 +433,13 @@ def defect_analysis(
     positions, drivers, pose_tol = _checked_arguments(mech, positions, drivers, pose_tol=pose_tol,
                                                       angle_tol_deg=angle_tol_deg, precision=precision,
                                                       monte_carlo=monte_carlo, check_dof=check_dof)
-    say("fitting the task positions onto the closure; DJ at every position")
-    table = dj_table(mech, drivers, positions)
+    if table is None:
+        say("fitting the task positions onto the closure; DJ at every position")
+        table = dj_table(mech, drivers, positions)
+    elif not (table.mech is mech and table.drivers == tuple(drivers) and len(table.fits) == len(positions)
+              and table.positions == tuple(p.name for p in positions)):
+        raise InputError(f"table: a DJ table of {table.model} for drivers {list(table.drivers)} at "
+                         f"{len(table.fits)} positions, not of this linkage, these drivers and positions")
     fits = list(table.fits)
     djf, dj_method = dj_function(mech, drivers, fits[0].config)
     dj_pos = table.dj.T  # (positions, drivers)

@@ -66,10 +66,16 @@ class Freedom:
 
     @property
     def screw(self) -> np.ndarray:
-        """The unit twist of this freedom at the reference configuration."""
-        if self.kind == "P":
-            return translation_screw(self.direction)
-        return axis_screw(self.direction, self.point, pitch=self.pitch if self.kind == "H" else 0.0)
+        """The unit twist of this freedom at the reference configuration (a fresh array; it is
+        computed once per freedom, which is frozen)."""
+        s = self.__dict__.get("_screw")
+        if s is None:
+            if self.kind == "P":
+                s = translation_screw(self.direction)
+            else:
+                s = axis_screw(self.direction, self.point, pitch=self.pitch if self.kind == "H" else 0.0)
+            object.__setattr__(self, "_screw", s)
+        return s.copy()
 
     @property
     def is_linear(self) -> bool:

@@ -29,10 +29,11 @@ import numpy as np
 
 from ..errors import InputError
 from ..model.joints import C as Cjoint
+from ..model.joints import Joint
 from ..model.joints import S as Sjoint
 from ..model.mechanism import Limb, Mechanism, Pose
 from ..results import Progress
-from .cs_dyads import CSDyad, CSFamily, cs_task, dyad_from_limb, project_dyad, synthesize_cs
+from .cs_dyads import CSDyad, CSFamily, CSTask, cs_task, dyad_from_limb, project_dyad, synthesize_cs
 
 if TYPE_CHECKING:
     from ..analysis.defects import DefectResult
@@ -44,6 +45,9 @@ __all__ = [
     "check_5cs",
     "cs_configuration",
     "cs_configurations",
+    "cs_joints",
+    "five_cs_limb",
+    "five_cs_of_limbs",
     "paper_a_check",
 ]
 
@@ -61,14 +65,35 @@ def assemble_5cs(
     dyads = tuple(dyads)
     if len(dyads) != 5:
         raise InputError(f"dyads: a 5-CS linkage needs exactly 5 dyads, got {len(dyads)}")
-    limbs, aliases = [], {}
     for i, dy in enumerate(dyads):
         if not isinstance(dy, CSDyad):
             raise InputError(f"dyads[{i}]: expected a CSDyad, got {type(dy).__name__}")
-        limbs.append(Limb(f"limb{i + 1}", (
-            Cjoint(f"C{i + 1}", dy.B1, dy.u, normalize=True, actuated=["rot"] if i == 0 else False),
-            Sjoint(f"S{i + 1}", dy.M1),
-        )))
+    return five_cs_of_limbs(task, tuple(five_cs_limb(i, cs_joints(dy, field=f"dyads[{i}]")) for i, dy in enumerate(dyads)),
+                            name=name, length_unit=length_unit)
+
+
+def cs_joints(dyad: CSDyad, *, field: str | None = None) -> tuple[Joint, Joint]:
+    """The two joints of ``dyad``'s limb, not yet placed in a linkage: C (axis ``u``, point
+    ``B1``, nothing actuated) and S at ``M1``, named ``"C"`` and ``"S"`` (:func:`five_cs_limb`
+    names them by their place).  ``field`` prefixes error messages.  Joints are frozen, so a
+    caller that builds many linkages from the same dyads may keep them."""
+    w = field or "dyad"
+    return (Cjoint("C", dyad.B1, dyad.u, normalize=True, field=f"{w}.C"), Sjoint("S", dyad.M1, field=f"{w}.S"))
+
+
+def five_cs_limb(i: int, joints: tuple[Joint, Joint]) -> Limb:
+    """Limb ``i`` (from 0) of :func:`assemble_5cs` from its dyad's :func:`cs_joints`:
+    ``limb{i+1}`` = [``C{i+1}``, ``S{i+1}``], the rotation of C actuated for ``i = 0``."""
+    c, sj = joints
+    fs = (replace(c.freedoms[0], actuated=True), *c.freedoms[1:]) if i == 0 else c.freedoms
+    return Limb(f"limb{i + 1}", (replace(c, name=f"C{i + 1}", freedoms=fs), replace(sj, name=f"S{i + 1}")))
+
+
+def five_cs_of_limbs(task: CSTask, limbs: tuple[Limb, ...], *, name: str = "five-cs-synthesised",
+                     length_unit: str = "unit") -> Mechanism:
+    """:func:`assemble_5cs` from its five limbs (:func:`five_cs_limb` of each dyad, in order)."""
+    aliases = {}
+    for i in range(5):
         aliases[f"rot{i + 1}"] = f"C{i + 1}.rot"
         aliases[f"slide{i + 1}"] = f"C{i + 1}.slide"
     return Mechanism(

@@ -34,7 +34,8 @@ import math
 import time
 from collections.abc import Sequence
 from contextlib import nullcontext
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -45,7 +46,10 @@ from ..results import ScreenStage
 from ..serialize import fields_dict
 from ..kinematics.tracking import conventional_sense, python_loop
 from .cs_dyads import CSBranch, CSDyad, CSFamily, CSTask, cs_task, dyad_from_vector
-from .five_cs import assemble_5cs, cs_configuration, cs_configurations
+from .five_cs import cs_configuration, cs_configurations, cs_joints, five_cs_limb, five_cs_of_limbs
+
+if TYPE_CHECKING:
+    from ..analysis.defects import DJTable
 
 __all__ = [
     "RANKINGS",
@@ -56,6 +60,7 @@ __all__ = [
     "candidate_linkage",
     "candidate_sets",
     "canonical",
+    "closed_form_table",
     "dyad_pool",
     "judge_candidate",
     "judge_candidates",
@@ -102,9 +107,15 @@ class DyadPool:
     branch: np.ndarray
     arc: np.ndarray
     density: float
+    #: The joints of the dyads' limbs built so far, by dyad: candidates share dyads, and joints
+    #: are frozen (:func:`candidate_linkage`).
+    _joints: dict = field(default_factory=dict, repr=False, compare=False)
 
     def __len__(self) -> int:
         return len(self.vectors)
+
+    def __getstate__(self) -> dict:  # the joints are rebuilt where the pool is unpickled (a worker)
+        return {**self.__dict__, "_joints": {}}
 
     @property
     def max_abs_slide(self) -> np.ndarray:
@@ -213,7 +224,15 @@ def candidate_sets(pool: DyadPool, n: int, *, seed: int = 0, separation: float =
 def candidate_linkage(pool: DyadPool, idx: Sequence[int], *, name: str | None = None) -> Mechanism:
     """The 5-CS linkage of the pool's dyads ``idx`` (:func:`~.five_cs.assemble_5cs`)."""
     idx = [int(i) for i in idx]
-    return assemble_5cs(pool.task, pool.dyads(idx), name=name or "five-cs-" + "-".join(map(str, idx)))
+    if len(idx) != 5:
+        raise InputError(f"idx: a 5-CS linkage needs exactly 5 dyads, got {len(idx)}")
+    limbs = []
+    for place, i in enumerate(idx):
+        joints = pool._joints.get(i)
+        if joints is None:
+            joints = pool._joints[i] = cs_joints(pool.dyad(i), field=f"pool dyad {i}")
+        limbs.append(five_cs_limb(place, joints))
+    return five_cs_of_limbs(pool.task, tuple(limbs), name=name or "five-cs-" + "-".join(map(str, idx)))
 
 
 # ------------------------------------------------------------------------------ judging
@@ -325,25 +344,28 @@ def rank_key(row, by: str = "singularity") -> tuple[float, float]:
     return (far, stroke) if by == "singularity" else (stroke, far)
 
 
-def _closure_at_positions(mech: Mechanism, configs) -> tuple[float, float]:
-    """Largest nondimensional closure residual and smallest scale-free closure sigma over ``configs``."""
+def _closure_at_positions(mech: Mechanism, configs) -> tuple[float, float, np.ndarray]:
+    """Largest nondimensional closure residual and smallest scale-free closure sigma over
+    ``configs``, and each one's row-scaled residual norm (as :func:`~..kinematics.closure.correct`
+    reports it)."""
     from ..kinematics.closure import active_mask, closure_scales
     from ..kinematics.backend import closure_jacobian, closure_residual
 
     L = mech.characteristic_length
     active = active_mask(mech)
     row, col = closure_scales(mech, active)
-    worst_res, min_sig = 0.0, math.inf
+    worst_res, min_sig, norms = 0.0, math.inf, []
     for c in configs:
         r = np.asarray(closure_residual(mech, c), dtype=float).reshape(-1, 6)
         worst_res = max(worst_res, float(np.max(np.abs(r[:, :3]))), float(np.max(np.abs(r[:, 3:]))) / L)
+        norms.append(float(np.linalg.norm(row * r.reshape(-1))))
         A, _ = closure_jacobian(mech, c, active=active)
         sv = np.linalg.svd(row[:, None] * A * col[None, :], compute_uv=False)
         min_sig = min(min_sig, float(sv[-1] / sv[0]))
-    return worst_res, min_sig
+    return worst_res, min_sig, np.array(norms)
 
 
-def _closure_at_positions_batched(mech: Mechanism, configs, engine) -> tuple[float, float]:
+def _closure_at_positions_batched(mech: Mechanism, configs, engine) -> tuple[float, float, np.ndarray]:
     """:func:`_closure_at_positions` with the compiled engine: one batched call for the residuals
     and Jacobians at every position, one stacked SVD (the same numbers, per position)."""
     from ..kinematics.closure import closure_scales
@@ -354,19 +376,63 @@ def _closure_at_positions_batched(mech: Mechanism, configs, engine) -> tuple[flo
     q = np.array([c.q for c in configs])
     D = np.array([c.D for c in configs])
     A, r = engine.closure_jacobians(mech, q, D)
+    norms = np.linalg.norm(row[None, :] * r.reshape(len(configs), -1), axis=1)
     r = r.reshape(len(configs), -1, 6)
     worst_res = max(0.0, float(np.max(np.abs(r[:, :, :3]))), float(np.max(np.abs(r[:, :, 3:]))) / L)
     sv = np.linalg.svd(row[None, :, None] * A * col[None, None, :], compute_uv=False)
-    return worst_res, float(np.min(sv[:, -1] / sv[:, 0]))
+    return worst_res, float(np.min(sv[:, -1] / sv[:, 0])), norms
 
 
-def _positions_stage(mech: Mechanism, batched: bool):
-    """At the task positions (their C-S configurations): the closure (worst residual, smallest
-    scale-free sigma), the candidate drivers and DJ of each at each position (``(positions,
-    drivers)``; ``None`` when the closure fails the assembly stage): stages 1 and 2 of
-    :func:`judge_candidate`.  ``batched``: closed forms vectorised over the positions and the
-    compiled engine called once for all of them (when it is in use); else the reference path,
-    position by position."""
+def _unwrapped(mech: Mechanism, configs: list) -> list:
+    """The closed-form configurations with each C rotation made continuous from position to
+    position (:func:`numpy.unwrap`; the closed form gives it in (-pi, pi]): the values a fit
+    from the previous position finds, so that circuits traced from them read the same."""
+    from ..kinematics.closure import Configuration
+
+    rot = np.array([r.freedom.kind == "R" and mech.limbs[r.limb].joints[r.joint].type == "C" for r in mech.freedom_refs])
+    Q = np.array([c.q for c in configs])
+    Q[:, rot] = np.unwrap(Q[:, rot], axis=0)
+    return [Configuration(Q[j], c.D, c.B) for j, c in enumerate(configs)]
+
+
+@dataclass(frozen=True, eq=False)
+class _AtPositions:
+    """Stages 1 and 2 at the task positions: the worst closure residual, the smallest scale-free
+    closure sigma, the candidate drivers, DJ ``(positions, drivers)`` (``None`` when the closure
+    fails the assembly stage), the closed-form configurations and their residual norms."""
+
+    residual: float
+    sigma: float
+    drivers: list
+    dj: np.ndarray | None
+    configs: list
+    norms: np.ndarray
+
+    def table(self, mech: Mechanism, drivers) -> DJTable:
+        """The :class:`~..analysis.defects.DJTable` of ``drivers`` (a subset of :attr:`drivers`)
+        from these configurations: what :func:`~..analysis.defects.dj_table` would fit, without
+        fitting (the closed form is exact; the pose errors are measured)."""
+        from ..analysis.defects import DJTable
+        from ..geometry.rotations import rotation_angle
+        from ..kinematics.position import PoseFit
+
+        tol = current_tolerances()
+        L = mech.characteristic_length
+        fits = []
+        for P, c, rn in zip(mech.positions, _unwrapped(mech, self.configs), self.norms, strict=True):
+            p_got = c.D[:3, :3] @ mech.platform_point + c.D[:3, 3]
+            fits.append(PoseFit(c, bool(rn < tol.closure), bool(rn < tol.closure), float(np.linalg.norm(p_got - P.p)),
+                                float(rotation_angle(c.D[:3, :3] @ P.R.T)), float(rn), L))
+        cols = [self.drivers.index(d) for d in drivers]
+        return DJTable(mech.name, tuple(P.name for P in mech.positions), tuple(drivers), self.dj[:, cols].T.copy(),
+                       tuple(fits), mech, tol)
+
+
+def _positions_stage(mech: Mechanism, batched: bool) -> _AtPositions:
+    """At the task positions (their C-S configurations): stages 1 and 2 of
+    :func:`judge_candidate` (:class:`_AtPositions`).  ``batched``: closed forms vectorised over
+    the positions and the compiled engine called once for all of them (when it is in use); else
+    the reference path, position by position."""
     from ..analysis.defects import candidate_drivers, dj_function
     from ..kinematics import backend
 
@@ -375,16 +441,16 @@ def _positions_stage(mech: Mechanism, batched: bool):
         configs = [cs_configuration(mech, P) for P in mech.positions]
         if any(c is None for c in configs):
             raise InputError("dyads: a candidate limb is not a C-S chain")
-        res, sig = _closure_at_positions(mech, configs)
+        res, sig, norms = _closure_at_positions(mech, configs)
     else:
         cfgs = cs_configurations(mech)
         if cfgs is None:
             raise InputError("dyads: a candidate limb is not a C-S chain")
         configs = cfgs
-        res, sig = _closure_at_positions_batched(mech, configs, engine)
+        res, sig, norms = _closure_at_positions_batched(mech, configs, engine)
     drivers = candidate_drivers(mech)
     if not (res <= current_tolerances().reachability and sig > current_tolerances().rank):
-        return res, sig, drivers, None
+        return _AtPositions(res, sig, drivers, None, configs, norms)
     dj = None
     if engine is not None:
         dj = engine.driver_determinants_many(mech, np.array([c.q for c in configs]), np.array([c.D for c in configs]),
@@ -394,7 +460,19 @@ def _positions_stage(mech: Mechanism, batched: bool):
     if dj is None:
         djf, _ = dj_function(mech, drivers, configs[0])
         dj = np.array([djf(c) for c in configs])
-    return res, sig, drivers, dj
+    return _AtPositions(res, sig, drivers, dj, configs, norms)
+
+
+def closed_form_table(mech: Mechanism, drivers=None) -> DJTable:
+    """The :class:`~..analysis.defects.DJTable` of a 5-CS linkage (default drivers: every
+    candidate driver) from the closed-form C-S configurations at its positions, as the screen
+    hands it to the defect analysis: :func:`~..analysis.defects.dj_table`'s numbers without its
+    Gauss-Newton fits.  ``InputError`` when the linkage does not close at its positions."""
+    at = _positions_stage(mech, True)
+    if at.dj is None:
+        raise InputError(f"mech: {mech.name} does not close at its positions (residual {at.residual:.2e}, "
+                         f"closure sigma {at.sigma:.2e})")
+    return at.table(mech, at.drivers if drivers is None else list(drivers))
 
 
 def judge_candidate(pool: DyadPool, idx: Sequence[int], *, candidate: int = 0, h0: float = 0.02,
@@ -419,7 +497,8 @@ def judge_candidate(pool: DyadPool, idx: Sequence[int], *, candidate: int = 0, h
 
     try:
         mech = candidate_linkage(pool, idx)
-        _, sig, drivers, dj = _positions_stage(mech, batched)
+        at = _positions_stage(mech, batched)
+        sig, drivers, dj = at.sigma, at.drivers, at.dj
         if dj is None:
             return done(rejected_by=ScreenStage.ASSEMBLY, min_closure_sigma_positions=sig)
         s = np.sign(dj)
@@ -427,9 +506,11 @@ def judge_candidate(pool: DyadPool, idx: Sequence[int], *, candidate: int = 0, h
         if not keeps:
             return done(rejected_by=ScreenStage.DJ_SIGNS, min_closure_sigma_positions=sig)
         # one degree of freedom is shown by the assembly stage (the closure Jacobian has full row
-        # rank at the positions, so generically): the analysis's own mobility check is skipped
+        # rank at the positions, so generically): the analysis's own mobility check is skipped;
+        # the positions need no fit (the closed form closes them: the assembly stage)
         with nullcontext() if batched else python_loop():  # the reference: the tracker's Python loop
-            r = defect_analysis(mech, drivers=list(keeps), h0=h0, max_arc=max_arc, check_dof=not batched)
+            r = defect_analysis(mech, drivers=list(keeps), h0=h0, max_arc=max_arc, check_dof=not batched,
+                                table=at.table(mech, keeps))
     except (InputError, ValueError, RuntimeError, np.linalg.LinAlgError) as e:
         return done(rejected_by=ScreenStage.ERROR, error=f"{type(e).__name__}: {e}")
     usable = tuple(r.usable_drivers)
