@@ -50,7 +50,7 @@ from ..closure import (
 
 from .kernels_blocks import nb_blocks_workspace, nb_minnorm_blocks
 from .kernels_closure import RETRACT_WS, nb_correct, nb_correct_hyperplane, nb_limb_gn, nb_retract, nb_systems
-from .kernels_drivers import nb_dets_many, nb_difference, nb_differences, nb_sps_legs
+from .kernels_drivers import nb_dets_many, nb_difference, nb_differences, nb_sigmas_many, nb_sps_legs
 from .kernels_se3 import nb_lstsq
 
 
@@ -70,6 +70,7 @@ __all__ = [
     "driver_columns",
     "driver_determinants",
     "driver_determinants_many",
+    "driver_sigmas_many",
     "limb_gn",
     "limb_inverse_many",
     "lstsq",
@@ -574,6 +575,26 @@ def driver_determinants_many(mech: Mechanism, q, D, B, drivers) -> np.ndarray | 
     flag = nb_dets_many(*_system_args(cm), cm.linear, cm.active, cm.length, current_tolerances().rank, qs, Ds, Bs, idx,
                       pos, cm.n_bodies > 0, out) if qs.shape[0] else 0
     return None if flag == 2 else out
+
+
+def driver_sigmas_many(mech: Mechanism, q, D, B, drivers) -> np.ndarray | None:
+    """``CompleteJacobian.sigma_min`` of each driver at N configurations (N, len(drivers)): the
+    scale-free smallest singular value of the complete Jacobian with that driver alone, from the
+    matrix :func:`driver_determinants_many` takes the determinant of.  ``None`` where the kernel
+    does not decide (internal bodies, a limb it does not handle, constraint rows other than 5):
+    the Python path (``complete_jacobians``) must."""
+    cm = compile_mechanism(mech)
+    if cm.n_bodies:
+        return None
+    qs, Ds, Bs = _batch(mech, cm, q, D, B)
+    idx = _driver_indices(mech, drivers)
+    dets = np.empty((qs.shape[0], len(idx)))
+    sig = np.empty((qs.shape[0], len(idx)))
+    if len(idx) == 0:
+        return sig
+    flag = nb_sigmas_many(*_system_args(cm), cm.active, cm.length, current_tolerances().rank, qs, Ds, Bs, idx, dets,
+                          sig) if qs.shape[0] else 0
+    return None if flag != 0 else sig
 
 
 def sps_leg_lengths(poses, base, platform) -> np.ndarray:

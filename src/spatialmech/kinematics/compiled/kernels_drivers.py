@@ -28,7 +28,9 @@ __all__ = [
     "nb_difference",
     "nb_differences",
     "nb_driver_dets",
+    "nb_driver_dets_sigmas",
     "nb_null_rows",
+    "nb_sigmas_many",
     "nb_sps_legs",
 ]
 
@@ -140,6 +142,38 @@ def nb_driver_dets(S, ball_of, ball_axes, ball_centre, limb_start, ends, active,
     """:func:`.jacobian.driver_determinants` without internal bodies.  Returns 0 when ``out`` is
     filled, 1 when the constraint rows are not 5 (``out`` = NaN), 2 for a limb this kernel does not
     handle (fewer than five active twists, or five dependent ones: the Python path decides)."""
+    return nb_driver_dets_sigmas(S, ball_of, ball_axes, ball_centre, limb_start, ends, active, L, rtol, q, D, B,
+                                 drivers, out, np.empty(0))
+
+
+@njit(cache=True)
+def _scale_free_sigma_min(M, L):  # pragma: no cover - compiled
+    """``CompleteJacobian.sigma_min`` of the square matrix ``M`` (rows ``(moment ; force)``, SI):
+    the smallest singular value of its wrenches ``(force ; moment / L)``, each row normalised (a
+    zero row stays zero)."""
+    W = np.empty((6, 6))
+    for i in range(6):
+        nrm = 0.0
+        for c in range(3):
+            W[i, c] = M[i, 3 + c]
+            W[i, 3 + c] = M[i, c] / L
+        for c in range(6):
+            nrm += W[i, c] * W[i, c]
+        nrm = np.sqrt(nrm)
+        if nrm > 0.0:
+            for c in range(6):
+                W[i, c] /= nrm
+    _, sv, _ = nb_svd(W)
+    return sv[5]
+
+
+@njit(cache=True)
+def nb_driver_dets_sigmas(S, ball_of, ball_axes, ball_centre, limb_start, ends, active, L, rtol, q, D, B, drivers,
+                          out, sig):
+    """:func:`nb_driver_dets`, and when ``sig`` has one entry per driver, each driver's
+    ``CompleteJacobian.sigma_min`` into it (0 where the actuation wrench does not exist: the
+    reference's zero row)."""
+    want = len(sig) == len(drivers) and len(drivers) > 0
     K = len(limb_start) - 1
     n = len(q)
     J = np.empty((6, max(nb_max_limb(limb_start), 1)))
@@ -254,6 +288,8 @@ def nb_driver_dets(S, ball_of, ball_axes, ball_centre, limb_start, ends, active,
                         Rn[i, c] -= dot * cn[c]
             if Rn.shape[0] == 0:
                 out[x] = 0.0
+                if want:
+                    sig[x] = 0.0
                 continue
             P = np.zeros((6, 6))
             for i in range(Rn.shape[0]):
@@ -262,6 +298,8 @@ def nb_driver_dets(S, ball_of, ball_axes, ball_centre, limb_start, ends, active,
             _, s, vt = nb_svd(P)
             if s[0] < rtol:
                 out[x] = 0.0
+                if want:
+                    sig[x] = 0.0
                 continue
             for c in range(6):
                 v0[c] = vt[0, c]
@@ -275,11 +313,15 @@ def nb_driver_dets(S, ball_of, ball_axes, ball_centre, limb_start, ends, active,
         scale = nb_norm(v0) * nb_norm(ta)
         if abs(prod) < rtol * max(scale, 1e-300):
             out[x] = 0.0
+            if want:
+                sig[x] = 0.0
             continue
         for c in range(3):
             M[5, c] = w[3 + c] / prod
             M[5, 3 + c] = w[c] / prod
         out[x] = nb_det(M)
+        if want:
+            sig[x] = _scale_free_sigma_min(M, L)
     return 0
 
 
@@ -311,6 +353,19 @@ def nb_closure_dets(S, ball_of, ball_axes, ball_centre, limb_start, ends, linear
                     M[i, j] = A[i, c]
                     j += 1
         out[x] = nb_det(M)
+
+
+@njit(cache=True)
+def nb_sigmas_many(S, ball_of, ball_axes, ball_centre, limb_start, ends, active, L, rtol, qs, Ds, Bs, drivers, out,
+                   sig):  # pragma: no cover - compiled
+    """:func:`nb_driver_dets_sigmas` at many configurations (no internal bodies): 0, or the first
+    nonzero code (the Python path decides)."""
+    for s in range(qs.shape[0]):
+        f = nb_driver_dets_sigmas(S, ball_of, ball_axes, ball_centre, limb_start, ends, active, L, rtol, qs[s], Ds[s],
+                                  Bs[s], drivers, out[s], sig[s])
+        if f != 0:
+            return f
+    return 0
 
 
 @njit(cache=True)
