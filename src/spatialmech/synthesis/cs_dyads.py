@@ -56,6 +56,7 @@ from __future__ import annotations
 import functools
 from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from scipy.optimize import least_squares, minimize_scalar
@@ -115,10 +116,11 @@ class CSTask:
     def n(self) -> int:
         return len(self.poses)
 
-    @property
+    @cached_property
     def relative_poses(self) -> tuple[Pose, ...]:
         """The poses relative to position 1: ``Pose(R_j R_1^T, p_j)`` (the mechanism's reference
-        configuration is position 1; equal to ``poses`` when ``R_1 = I``, as in table 9)."""
+        configuration is position 1; equal to ``poses`` when ``R_1 = I``, as in table 9; made
+        once: every linkage of a screen shares them)."""
         R1 = self.poses[0].R
         return tuple(Pose(P.R @ R1.T, P.p, name=P.name or f"P{j + 1}") for j, P in enumerate(self.poses))
 

@@ -413,7 +413,6 @@ class _AtPositions:
         from these configurations: what :func:`~..analysis.defects.dj_table` would fit, without
         fitting (the closed form is exact; the pose errors are measured)."""
         from ..analysis.defects import DJTable
-        from ..geometry.rotations import rotation_angle
         from ..kinematics.position import PoseFit
 
         tol = current_tolerances()
@@ -421,8 +420,11 @@ class _AtPositions:
         fits = []
         for P, c, rn in zip(mech.positions, _unwrapped(mech, self.configs), self.norms, strict=True):
             p_got = c.D[:3, :3] @ mech.platform_point + c.D[:3, 3]
+            Q = c.D[:3, :3] @ P.R.T  # its angle: atan2(|axial vector|, (trace - 1) / 2), exact to rounding up to pi
+            ax = np.array([Q[2, 1] - Q[1, 2], Q[0, 2] - Q[2, 0], Q[1, 0] - Q[0, 1]])
+            ang = math.atan2(0.5 * float(np.linalg.norm(ax)), 0.5 * (float(np.trace(Q)) - 1.0))
             fits.append(PoseFit(c, bool(rn < tol.closure), bool(rn < tol.closure), float(np.linalg.norm(p_got - P.p)),
-                                float(rotation_angle(c.D[:3, :3] @ P.R.T)), float(rn), L))
+                                ang, float(rn), L))
         cols = [self.drivers.index(d) for d in drivers]
         return DJTable(mech.name, tuple(P.name for P in mech.positions), tuple(drivers), self.dj[:, cols].T.copy(),
                        tuple(fits), mech, tol)
