@@ -71,6 +71,26 @@ def test_lazy_names_are_the_eager_ones():
         sm.no_such_name  # noqa: B018
 
 
+def test_a_screen_worker_does_not_import_the_synthesis_it_does_not_run():
+    """A screen's worker unpickles the dyad pool and judges candidates: it imports
+    ``spatialmech.synthesis`` (its names load on first use, PEP 562) and the screening modules,
+    not SciPy's optimisers nor the other synthesis modules (issue 29: a worker's fixed cost)."""
+    code = ("import sys, spatialmech.services.screening, spatialmech.analysis.defects\n"
+            "print('LOADED', sorted(m for m in ('scipy.optimize', 'spatialmech.synthesis.tasks', "
+            "'spatialmech.synthesis.burmester', 'spatialmech.synthesis.rccc') if m in sys.modules))")
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(SRC), os.environ.get("PYTHONPATH", "")])}
+    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=300)
+    assert p.returncode == 0, p.stderr
+    assert p.stdout.strip().splitlines()[-1] == "LOADED []", p.stdout
+    import spatialmech.synthesis as syn
+
+    assert set(syn.__all__) <= set(dir(syn))
+    for name in syn.__all__:
+        assert getattr(syn, name).__module__.startswith("spatialmech.synthesis."), name
+    with pytest.raises(AttributeError, match="no_such_name"):
+        syn.no_such_name  # noqa: B018
+
+
 def test_the_constants_module_agrees_with_the_analyses():
     from spatialmech.analysis.workspace import COORDINATES, MAX_POSES
     from spatialmech.model.task import TASK_NAMES

@@ -14,9 +14,9 @@ from collections.abc import Callable
 from itertools import combinations
 
 import numpy as np
-from scipy.optimize import minimize_scalar
 
 from ..kinematics.closure import Configuration
+from ..kinematics.jacobian import complete_jacobians
 from ..kinematics.tracking import MotionProblem, TrackResult, compiled_loops, predict_correct, track
 from ..model.mechanism import Mechanism, Pose
 from ..results import Progress
@@ -24,6 +24,7 @@ from ..results import Progress
 __all__ = [
     "arc_on_curve",
     "closure_singular_values",
+    "driver_sigmas",
     "fewest_circuits",
     "pose_distance",
     "positions_between",
@@ -120,6 +121,8 @@ def pose_distance(mech: Mechanism, prob: MotionProblem, tr: TrackResult, pose: P
             return cache[a]
 
         # the distance along one step of the curve: bounded Brent (golden section with parabolic steps)
+        from scipy.optimize import minimize_scalar  # the Python loop only: the compiled search is its own
+
         opt = minimize_scalar(lambda a, at=at: at(a)[0], bounds=(0.0, h), method="bounded",
                               options={"xatol": 1e-6 * max(h, 1e-12)})
         a = float(opt.x)
@@ -149,6 +152,21 @@ def closure_singular_values(problem: MotionProblem, points: list) -> list[np.nda
     A, _ = fast.closure_jacobians(problem.mech, np.array([x.q for x in points]), np.array([x.D for x in points]),
                                   np.array([x.B for x in points]), active=problem.active)
     return list(np.linalg.svd(problem.row[None, :, None] * A * problem.col[None, None, :], compute_uv=False))
+
+
+def driver_sigmas(mech: Mechanism, points: list, drivers: list[str]) -> np.ndarray:
+    """``CompleteJacobian.sigma_min`` of each driver alone at each point ``(points, drivers)``:
+    the compiled kernel for all points at once where it decides (the same matrices), else one
+    set of constraint wrenches per point shared by the drivers (``complete_jacobians``), as
+    inside ``python_loop()``."""
+    if not drivers or not points:
+        return np.zeros((len(points), len(drivers)))
+    if (fast := compiled_loops()) is not None and len(points) >= 2:
+        sig = fast.driver_sigmas_many(mech, np.array([x.q for x in points]), np.array([x.D for x in points]),
+                                      np.array([x.B for x in points]), drivers)
+        if sig is not None:
+            return sig
+    return np.array([[cj.sigma_min for cj in complete_jacobians(mech, x, [[d] for d in drivers])] for x in points])
 
 
 def fewest_circuits(D: np.ndarray) -> list[int]:

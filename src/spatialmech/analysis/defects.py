@@ -44,13 +44,14 @@ from ..geometry.tolerances import Tolerances
 from ..geometry.tolerances import current as current_tolerances
 from ..geometry.tolerances import use as use_tolerances
 from ..kinematics.position import PoseFit, configuration_at_pose, freedom_values
-from ..kinematics.tracking import DriverMonitor, MotionProblem, TrackResult, compiled_loops
+from ..kinematics.tracking import DriverMonitor, MotionProblem, TrackResult
 from ..model.joints import make_joint
 from ..model.mechanism import Mechanism, Pose
 from ..results import Progress, Steps, TrackStatus
 from .defect_circuits import (
     arc_on_curve,
     closure_singular_values,
+    driver_sigmas,
     fewest_circuits,
     pose_distance,
     positions_between,
@@ -748,7 +749,7 @@ def _distance_to_singularities(mech: Mechanism, problem: MotionProblem, tr0: Tra
         mval, marc = min(sig)
         min_sig, min_between = mval, positions_between(marc, path.path_arcs)
     watched = [vd.driver for vd in verdicts if vd.driver in watch]
-    sig_w = _driver_sigmas(mech, [x for _, x in path_pts], watched)
+    sig_w = driver_sigmas(mech, [x for _, x in path_pts], watched)
     new = []
     for vd in verdicts:
         if vd.driver in watch:
@@ -756,21 +757,6 @@ def _distance_to_singularities(mech: Mechanism, problem: MotionProblem, tr0: Tra
             vd = replace(vd, min_sigma_on_path=float(np.min(vals)) if vals.size else None)
         new.append(vd)
     return min_sig, min_between, new
-
-
-def _driver_sigmas(mech: Mechanism, points: list, drivers: list[str]) -> np.ndarray:
-    """``CompleteJacobian.sigma_min`` of each driver alone at each point ``(points, drivers)``:
-    the compiled kernel for all points at once where it decides (the same matrices), else one
-    set of constraint wrenches per point shared by the drivers (``complete_jacobians``), as
-    inside ``python_loop()``."""
-    if not drivers or not points:
-        return np.zeros((len(points), len(drivers)))
-    if (fast := compiled_loops()) is not None and len(points) >= 2:
-        sig = fast.driver_sigmas_many(mech, np.array([x.q for x in points]), np.array([x.D for x in points]),
-                                      np.array([x.B for x in points]), drivers)
-        if sig is not None:
-            return sig
-    return np.array([[cj.sigma_min for cj in complete_jacobians(mech, x, [[d] for d in drivers])] for x in points])
 
 
 def _verdict_key(r: DefectResult):

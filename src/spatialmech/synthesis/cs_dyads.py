@@ -59,7 +59,6 @@ from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
-from scipy.optimize import least_squares, minimize_scalar
 
 from ..errors import InputError
 from ..geometry.rotations import inverse_transform, rotation_angle, transform
@@ -440,6 +439,8 @@ def solve_dyad(task_poses, x0, *, nondimensional: bool = False) -> tuple[np.ndar
     x0 = as_finite_array(x0, "x0", shape=(_NX,))
     y0 = x0 if nondimensional else _to_nondim(task, x0)
     prob = _problem(task)
+    from scipy.optimize import least_squares  # on first use: a screen's workers never synthesise
+
     sol = least_squares(prob.residual, y0, jac=prob.jacobian, method="trf", xtol=1e-15, ftol=1e-15, gtol=1e-15,
                         max_nfev=200)
     y = sol.x
@@ -684,6 +685,8 @@ def _refine_min_slide(task: CSTask, prob, y: np.ndarray, t: np.ndarray, half: fl
     def g(sig):
         z, ok = at(sig)
         return float(np.max(np.abs(z[9:]))) * L if ok else np.inf
+
+    from scipy.optimize import minimize_scalar
 
     opt = minimize_scalar(g, bounds=(-half, half), method="bounded", options={"xatol": 1e-9})
     z, ok = at(float(opt.x))

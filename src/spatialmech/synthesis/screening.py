@@ -425,6 +425,8 @@ class _AtPositions:
             ang = math.atan2(0.5 * float(np.linalg.norm(ax)), 0.5 * (float(np.trace(Q)) - 1.0))
             fits.append(PoseFit(c, bool(rn < tol.closure), bool(rn < tol.closure), float(np.linalg.norm(p_got - P.p)),
                                 ang, float(rn), L))
+        if self.dj is None:
+            raise InputError("dyads: the linkage does not close at its positions: no DJ table")
         cols = [self.drivers.index(d) for d in drivers]
         return DJTable(mech.name, tuple(P.name for P in mech.positions), tuple(drivers), self.dj[:, cols].T.copy(),
                        tuple(fits), mech, tol)

@@ -28,7 +28,6 @@ __all__ = [
     "nb_difference",
     "nb_differences",
     "nb_driver_dets",
-    "nb_driver_dets_sigmas",
     "nb_null_rows",
     "nb_sigmas_many",
     "nb_sps_legs",
@@ -138,15 +137,6 @@ def nb_actuation_direction(others, cn, rtol, out):
 
 
 @njit(cache=True)
-def nb_driver_dets(S, ball_of, ball_axes, ball_centre, limb_start, ends, active, L, rtol, q, D, B, drivers, out):
-    """:func:`.jacobian.driver_determinants` without internal bodies.  Returns 0 when ``out`` is
-    filled, 1 when the constraint rows are not 5 (``out`` = NaN), 2 for a limb this kernel does not
-    handle (fewer than five active twists, or five dependent ones: the Python path decides)."""
-    return nb_driver_dets_sigmas(S, ball_of, ball_axes, ball_centre, limb_start, ends, active, L, rtol, q, D, B,
-                                 drivers, out, np.empty(0))
-
-
-@njit(cache=True)
 def _scale_free_sigma_min(M, L):  # pragma: no cover - compiled
     """``CompleteJacobian.sigma_min`` of the square matrix ``M`` (rows ``(moment ; force)``, SI):
     the smallest singular value of its wrenches ``(force ; moment / L)``, each row normalised (a
@@ -168,12 +158,45 @@ def _scale_free_sigma_min(M, L):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def nb_driver_dets_sigmas(S, ball_of, ball_axes, ball_centre, limb_start, ends, active, L, rtol, q, D, B, drivers,
-                          out, sig):
-    """:func:`nb_driver_dets`, and when ``sig`` has one entry per driver, each driver's
-    ``CompleteJacobian.sigma_min`` into it (0 where the actuation wrench does not exist: the
-    reference's zero row)."""
-    want = len(sig) == len(drivers) and len(drivers) > 0
+def _actuation_rows(others, mo, cn, has_con, L, rtol):  # pragma: no cover - compiled
+    """The rows whose leading right singular vector is the actuation wrench's direction (the
+    reference's ``actuation_wrench`` without its QR): the wrenches reciprocal to the limb's other
+    active twists ``others`` (``mo`` of them; all of wrench space when none), nondimensional, with
+    the limb's unit constraint wrench ``cn`` projected out when it has one."""
+    if mo == 0:
+        Rn = np.zeros((6, 6))
+        for i in range(6):
+            Rn[i, i] = 1.0
+        for i in range(6):
+            for c in range(3, 6):
+                Rn[i, c] /= L
+    else:
+        null = nb_null_rows(others, rtol)
+        Rn = np.empty((null.shape[0], 6))
+        for i in range(null.shape[0]):
+            for c in range(3):
+                Rn[i, c] = null[i, 3 + c]
+                Rn[i, 3 + c] = null[i, c]
+    if has_con:
+        for i in range(Rn.shape[0]):
+            dot = 0.0
+            for c in range(6):
+                dot += Rn[i, c] * cn[c]
+            for c in range(6):
+                Rn[i, c] -= dot * cn[c]
+    return Rn
+
+
+@njit(cache=True)
+def nb_driver_dets(S, ball_of, ball_axes, ball_centre, limb_start, ends, active, L, rtol, q, D, B, drivers, out,
+                   sig):
+    """:func:`.jacobian.driver_determinants` without internal bodies.  Returns 0 when ``out`` is
+    filled, 1 when the constraint rows are not 5 (``out`` = NaN), 2 for a limb this kernel does not
+    handle (fewer than five active twists, or five dependent ones: the Python path decides).  When
+    ``sig`` has one entry per driver, each driver's ``CompleteJacobian.sigma_min`` goes into it
+    (0 where the actuation wrench does not exist: the reference's zero row); pass an empty array
+    for DJ alone."""
+    want = sig.shape[0] == out.shape[0]
     K = len(limb_start) - 1
     n = len(q)
     J = np.empty((6, max(nb_max_limb(limb_start), 1)))
@@ -240,6 +263,8 @@ def nb_driver_dets_sigmas(S, ball_of, ball_axes, ball_centre, limb_start, ends, 
                 M[j, c] = cons[k, 3 + c]
                 M[j, 3 + c] = cons[k, c]
             j += 1
+    if want:
+        sig[:] = 0.0  # a driver left at 0: its actuation wrench does not exist here
     for x in range(len(drivers)):
         d = drivers[x]
         k = limb_of[d]
@@ -265,31 +290,9 @@ def nb_driver_dets_sigmas(S, ball_of, ball_axes, ball_centre, limb_start, ends, 
                 cn[c] /= nc
         v0 = np.empty(6)  # the actuation wrench's direction, nondimensional and unit (vt[0] below)
         if not (has_con[k] and mo == 4 and nb_actuation_direction(others, cn, rtol, v0)):
-            if mo == 0:
-                Rn = np.zeros((6, 6))
-                for i in range(6):
-                    Rn[i, i] = 1.0
-                for i in range(6):
-                    for c in range(3, 6):
-                        Rn[i, c] /= L
-            else:
-                null = nb_null_rows(others, rtol)
-                Rn = np.empty((null.shape[0], 6))
-                for i in range(null.shape[0]):
-                    for c in range(3):
-                        Rn[i, c] = null[i, 3 + c]
-                        Rn[i, 3 + c] = null[i, c]
-            if has_con[k]:
-                for i in range(Rn.shape[0]):
-                    dot = 0.0
-                    for c in range(6):
-                        dot += Rn[i, c] * cn[c]
-                    for c in range(6):
-                        Rn[i, c] -= dot * cn[c]
+            Rn = _actuation_rows(others, mo, cn, has_con[k], L, rtol)
             if Rn.shape[0] == 0:
                 out[x] = 0.0
-                if want:
-                    sig[x] = 0.0
                 continue
             P = np.zeros((6, 6))
             for i in range(Rn.shape[0]):
@@ -298,8 +301,6 @@ def nb_driver_dets_sigmas(S, ball_of, ball_axes, ball_centre, limb_start, ends, 
             _, s, vt = nb_svd(P)
             if s[0] < rtol:
                 out[x] = 0.0
-                if want:
-                    sig[x] = 0.0
                 continue
             for c in range(6):
                 v0[c] = vt[0, c]
@@ -313,8 +314,6 @@ def nb_driver_dets_sigmas(S, ball_of, ball_axes, ball_centre, limb_start, ends, 
         scale = nb_norm(v0) * nb_norm(ta)
         if abs(prod) < rtol * max(scale, 1e-300):
             out[x] = 0.0
-            if want:
-                sig[x] = 0.0
             continue
         for c in range(3):
             M[5, c] = w[3 + c] / prod
@@ -358,11 +357,11 @@ def nb_closure_dets(S, ball_of, ball_axes, ball_centre, limb_start, ends, linear
 @njit(cache=True)
 def nb_sigmas_many(S, ball_of, ball_axes, ball_centre, limb_start, ends, active, L, rtol, qs, Ds, Bs, drivers, out,
                    sig):  # pragma: no cover - compiled
-    """:func:`nb_driver_dets_sigmas` at many configurations (no internal bodies): 0, or the first
-    nonzero code (the Python path decides)."""
+    """:func:`nb_driver_dets` with its sigmas at many configurations (no internal bodies): 0, or
+    the first nonzero code (the Python path decides)."""
     for s in range(qs.shape[0]):
-        f = nb_driver_dets_sigmas(S, ball_of, ball_axes, ball_centre, limb_start, ends, active, L, rtol, qs[s], Ds[s],
-                                  Bs[s], drivers, out[s], sig[s])
+        f = nb_driver_dets(S, ball_of, ball_axes, ball_centre, limb_start, ends, active, L, rtol, qs[s], Ds[s], Bs[s],
+                           drivers, out[s], sig[s])
         if f != 0:
             return f
     return 0
@@ -378,7 +377,7 @@ def nb_dets_many(S, ball_of, ball_axes, ball_centre, limb_start, ends, linear, a
             nb_closure_dets(S, ball_of, ball_axes, ball_centre, limb_start, ends, linear, active, L, qs[s], Ds[s], Bs[s],
                           cols, out[s])
         elif nb_driver_dets(S, ball_of, ball_axes, ball_centre, limb_start, ends, active, L, rtol, qs[s], Ds[s], Bs[s],
-                          drivers, out[s]) == 2:
+                            drivers, out[s], np.empty(0)) == 2:
             return 2
     return 0
 

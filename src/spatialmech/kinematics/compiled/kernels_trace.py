@@ -68,7 +68,7 @@ def nb_trace_dets(G, par, q, D, B, lo, hi, out):  # pragma: no cover - compiled
         nb_closure_dets(S, ball_of, ball_axes, ball_centre, limb_start, ends, linear, active, par[0], q, D, B,
                         cols[lo:hi], o)
     elif nb_driver_dets(S, ball_of, ball_axes, ball_centre, limb_start, ends, active, par[0], par[1], q, D, B,
-                        drivers[lo:hi], o) != 0:
+                        drivers[lo:hi], o, np.empty(0)) != 0:
         return 2
     for v in o:
         if not np.isfinite(v):
