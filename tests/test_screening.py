@@ -6,6 +6,7 @@ by the screen confirmed by the single-linkage ``defects`` command on its saved f
 import dataclasses
 import json
 import math
+import pickle
 
 import numpy as np
 import pyarrow.parquet as pq
@@ -189,6 +190,27 @@ def test_the_closed_form_table_is_the_fitted_one_and_gives_the_same_analysis(poo
     np.testing.assert_allclose(*arcs, rtol=1e-9, atol=1e-9)
     with pytest.raises(InputError, match=r"table: .*not of this linkage"):
         defect_analysis(mech, drivers=["rot1"], check_dof=False, table=got)
+
+
+def test_a_candidate_linkage_is_its_dyads_whatever_was_built_before(pool):
+    """The pool keeps each dyad's joints (issue 29); a pool made from it by ``replace`` with
+    other vectors, or sent to a worker, builds its own: the linkage always is
+    :func:`assemble_5cs` of the pool's dyads."""
+    from spatialmech.synthesis.five_cs import assemble_5cs
+
+    def axes(m):
+        return np.array([[lb.joints[0].point, lb.joints[0].freedoms[0].direction, lb.joints[1].point]
+                         for lb in m.limbs])
+
+    idx = [0, 1, 2, 3, 4]
+    first = candidate_linkage(pool, idx)
+    other = dataclasses.replace(pool, vectors=pool.vectors[::-1].copy())
+    for p in (pool, other, pickle.loads(pickle.dumps(other))):
+        got, ref = candidate_linkage(p, idx), assemble_5cs(p.task, p.dyads(idx))
+        np.testing.assert_array_equal(axes(got), axes(ref))
+        assert [lb.name for lb in got.limbs] == [lb.name for lb in ref.limbs]
+        assert got.actuators == ref.actuators == ("C1.rot",)
+    assert not np.array_equal(axes(candidate_linkage(other, idx)), axes(first))
 
 
 def test_the_fast_rejection_agrees_with_the_full_analysis(pool):

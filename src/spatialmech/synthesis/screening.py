@@ -109,7 +109,7 @@ class DyadPool:
     density: float
     #: The joints of the dyads' limbs built so far, by dyad: candidates share dyads, and joints
     #: are frozen (:func:`candidate_linkage`).
-    _joints: dict = field(default_factory=dict, repr=False, compare=False)
+    _joints: dict = field(default_factory=dict, init=False, repr=False, compare=False)  # not carried by replace()
 
     def __len__(self) -> int:
         return len(self.vectors)
