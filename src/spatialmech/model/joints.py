@@ -27,6 +27,7 @@ A freedom's *value* is ``offset + q`` where ``q`` is the joint variable (zero at
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from functools import cached_property
 
 import numpy as np
 
@@ -68,14 +69,13 @@ class Freedom:
     def screw(self) -> np.ndarray:
         """The unit twist of this freedom at the reference configuration (a fresh array; it is
         computed once per freedom, which is frozen)."""
-        s = self.__dict__.get("_screw")
-        if s is None:
-            if self.kind == "P":
-                s = translation_screw(self.direction)
-            else:
-                s = axis_screw(self.direction, self.point, pitch=self.pitch if self.kind == "H" else 0.0)
-            object.__setattr__(self, "_screw", s)
-        return s.copy()
+        return self._reference_screw.copy()
+
+    @cached_property
+    def _reference_screw(self) -> np.ndarray:
+        if self.kind == "P":
+            return translation_screw(self.direction)
+        return axis_screw(self.direction, self.point, pitch=self.pitch if self.kind == "H" else 0.0)
 
     @property
     def is_linear(self) -> bool:

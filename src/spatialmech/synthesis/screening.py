@@ -413,20 +413,20 @@ class _AtPositions:
         from these configurations: what :func:`~..analysis.defects.dj_table` would fit, without
         fitting (the closed form is exact; the pose errors are measured)."""
         from ..analysis.defects import DJTable
+        from ..geometry.rotations import matrix_rotvec
         from ..kinematics.position import PoseFit
 
+        if self.dj is None:
+            raise InputError(f"mech: {mech.name} does not close at its positions (residual {self.residual:.2e}, "
+                             f"closure sigma {self.sigma:.2e})")
         tol = current_tolerances()
         L = mech.characteristic_length
         fits = []
         for P, c, rn in zip(mech.positions, _unwrapped(mech, self.configs), self.norms, strict=True):
             p_got = c.D[:3, :3] @ mech.platform_point + c.D[:3, 3]
-            Q = c.D[:3, :3] @ P.R.T  # its angle: atan2(|axial vector|, (trace - 1) / 2), exact to rounding up to pi
-            ax = np.array([Q[2, 1] - Q[1, 2], Q[0, 2] - Q[2, 0], Q[1, 0] - Q[0, 1]])
-            ang = math.atan2(0.5 * float(np.linalg.norm(ax)), 0.5 * (float(np.trace(Q)) - 1.0))
+            ang = float(np.linalg.norm(matrix_rotvec(c.D[:3, :3] @ P.R.T)))
             fits.append(PoseFit(c, bool(rn < tol.closure), bool(rn < tol.closure), float(np.linalg.norm(p_got - P.p)),
                                 ang, float(rn), L))
-        if self.dj is None:
-            raise InputError("dyads: the linkage does not close at its positions: no DJ table")
         cols = [self.drivers.index(d) for d in drivers]
         return DJTable(mech.name, tuple(P.name for P in mech.positions), tuple(drivers), self.dj[:, cols].T.copy(),
                        tuple(fits), mech, tol)
@@ -473,9 +473,6 @@ def closed_form_table(mech: Mechanism, drivers=None) -> DJTable:
     hands it to the defect analysis: :func:`~..analysis.defects.dj_table`'s numbers without its
     Gauss-Newton fits.  ``InputError`` when the linkage does not close at its positions."""
     at = _positions_stage(mech, True)
-    if at.dj is None:
-        raise InputError(f"mech: {mech.name} does not close at its positions (residual {at.residual:.2e}, "
-                         f"closure sigma {at.sigma:.2e})")
     return at.table(mech, at.drivers if drivers is None else list(drivers))
 
 
