@@ -83,6 +83,23 @@ def test_overconstrained_and_singular_systems_decline():
     assert compiled.minnorm_blocks(A, rng.normal(size=6), lo, hi, ns0) is None
 
 
+@pytest.mark.parametrize("seed", range(6))
+def test_bordered_block_step_solves_the_square_system_or_declines(seed):
+    """The hyperplane corrector's step (five 5-column limbs sharing a twist, the tangent as the
+    border row): the solution of the square ``[A; t] x = [b; 0]``; declined when a limb's own
+    columns are dependent (its step is then not a function of the shared twist)."""
+    rng = np.random.default_rng(seed)
+    A, lo, hi, ns0 = _system(rng, [5] * 5, 6, [False] * 5, seed % 2 == 0)
+    t, b = rng.normal(size=A.shape[1]), rng.normal(size=A.shape[0])
+    x = compiled.minnorm_blocks(A, b, lo, hi, ns0, border=(t, 0.0))
+    M = np.vstack([A, t])
+    ref = np.linalg.solve(M, np.append(b, 0.0))
+    assert x is not None
+    assert np.abs(x - ref).max() <= 1e-12 * np.linalg.cond(M) * max(1.0, np.abs(ref).max())
+    A, lo, hi, ns0 = _system(rng, [5] * 5, 6, [True] + [False] * 4, False)
+    assert compiled.minnorm_blocks(A, b, lo, hi, ns0, border=(t, 0.0)) is None
+
+
 @pytest.mark.parametrize("name", ["stewart-6sps", "three-rps", "four-sps-cu"])
 def test_compiled_forward_solve_equals_the_python_reference(name):
     """Forward position from the reference with the actuators moved: the compiled correct (block

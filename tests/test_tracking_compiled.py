@@ -38,6 +38,8 @@ def test_bordered_tangent_is_the_svd_null_vector_with_keller_sign(seed, n):
     assert np.max(np.abs(z - ref)) < 1e-12 * max(1.0, scale)
     assert sign == np.linalg.slogdet(np.vstack([A, ref]))[0]
     assert smin <= sv[-1] * (1 + 1e-12)  # a lower bound of sigma_n(A) (interlacing)
+    # the bound is 1 / |M^-1|_F of M = [A; t_prev] (the forward substitution skips its zeros)
+    assert smin == pytest.approx(1.0 / np.linalg.norm(np.linalg.inv(np.vstack([A, t_prev]))), rel=1e-10)
     assert anorm >= sv[0] * (1 - 1e-12)
 
 

@@ -463,11 +463,13 @@ def lstsq(A, b) -> np.ndarray:
     return nb_lstsq(A, b)
 
 
-def minnorm_blocks(A, b, c_lo, c_hi, ns0: int) -> np.ndarray | None:
+def minnorm_blocks(A, b, c_lo, c_hi, ns0: int, *, border: tuple | None = None) -> np.ndarray | None:
     """The minimum-norm least-squares solution of a closure-shaped ``A x = b`` by block
     elimination (:mod:`.kernels_blocks`): limb ``k``'s rows ``6k .. 6k+5`` and own columns
     ``c_lo[k] .. c_hi[k]-1``, shared columns from ``ns0``; ``None`` where it declines (the
-    general solver, :func:`lstsq`, must decide)."""
+    general solver, :func:`lstsq`, must decide).  ``border=(t, t_rhs)``: the solution of the
+    square ``[A; t] x = [b; t_rhs]`` instead (``A`` with one column more than rows: the
+    hyperplane corrector's step)."""
     A = _f64(A)
     b = _f64(b)
     lo = np.require(c_lo, np.int64, ["C"])
@@ -475,9 +477,12 @@ def minnorm_blocks(A, b, c_lo, c_hi, ns0: int) -> np.ndarray | None:
     if A.ndim != 2 or A.shape[0] % 6 or A.shape[0] != 6 * len(lo) or b.shape != (A.shape[0],) or lo.shape != hi.shape:
         raise InputError(f"A, b, c_lo, c_hi: expected (6K, n), (6K,), (K,), (K,); got {A.shape}, {b.shape}, "
                          f"{lo.shape}, {hi.shape}")
+    t, t_rhs = (np.empty(0), 0.0) if border is None else (_f64(border[0]), float(border[1]))
+    if border is not None and t.shape != (A.shape[1],):
+        raise InputError(f"border: expected a row of {A.shape[1]} entries, got shape {t.shape}")
     x = np.empty(A.shape[1])
     fbuf, ibuf = nb_blocks_workspace(lo, hi, int(ns0), A.shape[1])
-    return x if nb_minnorm_blocks(A, b, lo, hi, int(ns0), x, fbuf, ibuf) else None
+    return x if nb_minnorm_blocks(A, b, t, t_rhs, lo, hi, int(ns0), x, fbuf, ibuf) else None
 
 
 def limb_gn(chain: Chain, D, q, lin, L, tol=1e-12, max_iter=60, hold=None):

@@ -192,13 +192,13 @@ def nb_blocks_workspace(c_lo, c_hi, ns0, n):
     for k in range(K):
         mmax = max(mmax, c_hi[k] - c_lo[k])
     s = n - ns0
-    shared = K * 6 * mmax + 12 * K + (s + 1) * s + 3 * s + max(6, s) + 12 + mmax
+    shared = K * 6 * mmax + 12 * K + (s + 1) * s + 3 * s + max(6, s) + 12 + mmax + (s + 1 + mmax)
     decoupled = 13 * mmax + 36
     return np.empty(max(shared, decoupled)), np.empty(7 * K + s + mmax, dtype=np.int64)
 
 
 @njit(cache=True)
-def nb_minnorm_blocks(A, b, c_lo, c_hi, ns0, x, fbuf, ibuf):
+def nb_minnorm_blocks(A, b, tb, tb_rhs, c_lo, c_hi, ns0, x, fbuf, ibuf):
     """Minimum-norm least-squares solution of ``A x = b`` into ``x`` by block elimination (module
     docstring).  ``A`` is (6K, n): limb ``k``'s rows ``6k .. 6k+5``; its own columns
     ``c_lo[k] .. c_hi[k]-1`` (nonzero only in its rows), the shared columns ``ns0 .. n-1``;
@@ -208,7 +208,13 @@ def nb_minnorm_blocks(A, b, c_lo, c_hi, ns0, x, fbuf, ibuf):
     R_k``.  Its left null space (the constraints the limb's joints cannot absorb) is ``P_k u``
     with ``R_k u = 0``, by back substitution; once the shared twists ``xi`` are known, the
     minimum-norm ``dq_k`` of the consistent ``J_k dq_k = b_k - H_k xi`` is ``Q_k z`` with
-    ``R_k[:, :r]^T z = (P_k^T (b_k - H_k xi))_{0..r-1}``."""
+    ``R_k[:, :r]^T z = (P_k^T (b_k - H_k xi))_{0..r-1}``.
+
+    With a border row ``tb`` (``n`` entries; ``np.empty(0)`` for none): the solution of the
+    square ``[A; tb] x = [b; tb_rhs]`` instead -- the hyperplane corrector's step, ``A`` with one
+    column more than rows.  It needs every limb's own columns independent (``r_k`` = their count,
+    so that ``dq_k`` is a function of ``xi``); the border is then one more row of the reduced
+    system (:func:`_border_part`)."""
     K = len(c_lo)
     n = A.shape[1]
     s = n - ns0
@@ -239,6 +245,11 @@ def nb_minnorm_blocks(A, b, c_lo, c_hi, ns0, x, fbuf, ibuf):
     c = fbuf[o : o + 6]
     o += 6
     y = fbuf[o : o + mmax]
+    o += mmax
+    bord = fbuf[o : o + s + 1]  # the border row in xi, then its right-hand side
+    o += s + 1
+    g = fbuf[o : o + mmax]
+    bordered = tb.shape[0] > 0
     pivs = ibuf[: 6 * K].reshape((K, 6))
     ranks = ibuf[6 * K : 7 * K]
     pr = ibuf[7 * K : 7 * K + s]
@@ -256,13 +267,21 @@ def nb_minnorm_blocks(A, b, c_lo, c_hi, ns0, x, fbuf, ibuf):
             return False
         ranks[k] = r
         nred += 6 - r
-    if nred != s:
+        if bordered and r != m:
+            return False
+    if nred + (1 if bordered else 0) != s:
         return False
+    if bordered:
+        for cc in range(s):
+            bord[cc] = tb[ns0 + cc]
+        bord[s] = tb_rhs
     i0 = 0
     for k in range(K):
         G = Gs[k]
         r = ranks[k]
         piv = pivs[k]
+        if bordered:
+            _border_part(A, b, tb, k, c_lo[k], c_hi[k] - c_lo[k], r, G, piv, v0s[k], vn2s[k], ns0, y, g, bord)
         for t in range(r, 6):  # u: R u = 0 with u[t] = 1, u[r:] = 0 otherwise; w = P u, unit
             for i in range(r, 6):
                 e[i] = 0.0
@@ -288,6 +307,10 @@ def nb_minnorm_blocks(A, b, c_lo, c_hi, ns0, x, fbuf, ibuf):
                 acc += w[a] * b[6 * k + a]
             R[s, i0] = acc
             i0 += 1
+    if bordered:
+        for cc in range(s):
+            R[cc, i0] = bord[cc]
+        R[s, i0] = bord[s]
     if nb_pivoted_qr(R, s, s, s + 1, pr, rv0, rvn2, e) != s:
         return False
     for i in range(s - 1, -1, -1):
@@ -296,28 +319,53 @@ def nb_minnorm_blocks(A, b, c_lo, c_hi, ns0, x, fbuf, ibuf):
             acc -= R[cc, i] * xi[pr[cc]]
         xi[pr[i]] = acc / R[i, i]
     for k in range(K):
-        m = c_hi[k] - c_lo[k]
-        r = ranks[k]
-        G = Gs[k]
-        piv = pivs[k]
-        for a in range(6):  # b_k - H_k xi, consistent now
-            acc = b[6 * k + a]
-            for cc in range(s):
-                acc -= A[6 * k + a, ns0 + cc] * xi[cc]
-            c[a] = acc
-        for j in range(r):  # R[:, :r]^T z = (P^T c)[:r], lower triangular: R[i, j] = G[j, i]
-            acc = c[piv[j]]
-            for i in range(j):
-                acc -= G[j, i] * y[i]
-            y[j] = acc / G[j, j]
-        for j in range(r, m):
-            y[j] = 0.0
-        nb_qt_apply(G, r, m, v0s[k], vn2s[k], y, np.bool_(False))  # dq_k = Q [z ; 0]
-        for j in range(m):
-            x[c_lo[k] + j] = y[j]
+        _limb_step(A, b, k, c_lo[k], c_hi[k] - c_lo[k], ranks[k], Gs[k], pivs[k], v0s[k], vn2s[k], ns0, xi, c, y, x)
     for cc in range(s):
         x[ns0 + cc] = xi[cc]
     return True
+
+
+@njit(cache=True)
+def _limb_step(A, b, k, c0, m, r, G, piv, v0, vn2, ns0, xi, c, y, x):
+    """Limb ``k``'s minimum-norm ``dq_k`` (into ``x[c0 : c0 + m]``) once the shared twists ``xi``
+    are known: ``Q_k [z ; 0]`` with ``R_k[:, :r]^T z = (P_k^T (b_k - H_k xi))_{0..r-1}``."""
+    s = len(xi)
+    for a in range(6):  # b_k - H_k xi, consistent now
+        acc = b[6 * k + a]
+        for cc in range(s):
+            acc -= A[6 * k + a, ns0 + cc] * xi[cc]
+        c[a] = acc
+    for j in range(r):  # R[:, :r]^T z = (P^T c)[:r], lower triangular: R[i, j] = G[j, i]
+        acc = c[piv[j]]
+        for i in range(j):
+            acc -= G[j, i] * y[i]
+        y[j] = acc / G[j, j]
+    for j in range(r, m):
+        y[j] = 0.0
+    nb_qt_apply(G, r, m, v0, vn2, y, np.bool_(False))  # dq_k = Q [z ; 0]
+    for j in range(m):
+        x[c0 + j] = y[j]
+
+
+@njit(cache=True)
+def _border_part(A, b, tb, k, c0, m, r, G, piv, v0, vn2, ns0, y, g, bord):
+    """Limb ``k``'s part of the border row in ``xi`` (:func:`nb_minnorm_blocks`): ``t_k . dq_k =
+    g_k . (P_k^T (b_k - H_k xi))_{0..r-1}`` with ``R_k[:, :r] g_k = (Q_k^T t_k)_{0..r-1}``, moved
+    into ``bord`` (coefficients of ``xi``, then the right-hand side)."""
+    s = len(bord) - 1
+    for j in range(m):
+        y[j] = tb[c0 + j]
+    nb_qt_apply(G, r, m, v0, vn2, y, np.bool_(True))
+    for i in range(r - 1, -1, -1):  # R[:, :r] g = u, upper triangular: R[i, j] = G[j, i]
+        acc = y[i]
+        for j in range(i + 1, r):
+            acc -= G[j, i] * g[j]
+        g[i] = acc / G[i, i]
+    for j in range(r):
+        a = piv[j]
+        for cc in range(s):
+            bord[cc] -= g[j] * A[6 * k + a, ns0 + cc]
+        bord[s] -= g[j] * b[6 * k + a]
 
 
 @njit(cache=True)

@@ -32,6 +32,7 @@ __all__ = [
     "nb_colmap",
     "nb_correct",
     "nb_correct_hyperplane",
+    "nb_correct_hyperplane_ws",
     "nb_finite_config",
     "nb_hub",
     "nb_limb_columns",
@@ -358,6 +359,7 @@ def nb_correct(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends,
     D2 = np.empty((4, 4))
     B2 = np.empty((h - 1, 4, 4))
     fbuf, ibuf = nb_blocks_workspace(c_lo, c_hi, na, nk)
+    no_border = np.empty(0)
     cws = np.empty(nb_closure_ws_size(limb_start))
     rws = np.empty(n + RETRACT_WS)
     for s in range(qs.shape[0]):
@@ -399,7 +401,7 @@ def nb_correct(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends,
                         if keep[c]:
                             As[i, j] = row[i] * A[i, c] * col[c]
                             j += 1
-            if not nb_minnorm_blocks(As, rhs, c_lo, c_hi, na, x, fbuf, ibuf):  # lstsq's step, by blocks
+            if not nb_minnorm_blocks(As, rhs, no_border, 0.0, c_lo, c_hi, na, x, fbuf, ibuf):  # lstsq's step, by blocks
                 x = nb_lstsq(As, rhs)
             if nb_norm(x) < 1e-13 * max(1.0, rn):
                 st = 2
@@ -429,13 +431,39 @@ def nb_correct_hyperplane(S, ball_of, ball_first, ball_axes, ball_centre, limb_s
     Newton on the row-scaled closure with every correction orthogonal to ``t`` (local coordinates
     scaled by ``col``), from ``q0, D0, B0`` -- first moved by the predictor step ``pred`` (local
     coordinates) when ``has_pred`` -- into ``q, D, B``; ``info`` = (converged, iterations,
-    total correction length)."""
+    total correction length).  Each step solves the square ``[A; t] d = [-r; 0]`` by limb blocks
+    with ``t`` as border row (:func:`.kernels_blocks.nb_minnorm_blocks`), or by
+    :func:`.kernels_se3.nb_lstsq` where the blocks decline (a limb's own columns dependent, an
+    ill-conditioned reduced system)."""
+    m = 6 * (len(limb_start) - 1)
+    nc = len(t)
+    nb_correct_hyperplane_ws(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends, q0, D0, B0, active, row,
+                             col, t, tol, max_iter, contraction, pred, has_pred, q, D, B, info, np.zeros((m, nc)),
+                             np.zeros(m))
+
+
+@njit(cache=True)
+def _copy_config(q0, D0, B0, q, D, B):  # pragma: no cover - compiled
+    """``q, D, B`` <- ``q0, D0, B0``."""
+    for i in range(len(q0)):
+        q[i] = q0[i]
+    nb_copy44(D0, D)
+    for b in range(B0.shape[0]):
+        nb_copy44(B0[b], B[b])
+
+
+@njit(cache=True)
+def nb_correct_hyperplane_ws(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends, q0, D0, B0, active, row,
+                             col, t, tol, max_iter, contraction, pred, has_pred, q, D, B, info, A, r):
+    """:func:`nb_correct_hyperplane` with its closure Jacobian ``A`` (6K, local coordinates; zero
+    where :func:`nb_closure_system` writes nothing: allocate it with ``np.zeros`` and reuse it)
+    and residual ``r`` given.  Returns ``True`` when the corrector converged by its residual test
+    inside the loop: ``A`` and ``r`` are then those of ``q, D, B`` (unscaled), so that a caller
+    needing the Jacobian there (the step test) need not evaluate it again."""
     K = len(limb_start) - 1
     m = 6 * K
     colmap, na = nb_colmap(active)
     nc = na + 6 * (1 + B0.shape[0])
-    A = np.zeros((m, nc))
-    r = np.zeros(m)
     M = np.empty((m + 1, nc))
     rhs = np.empty(m + 1)
     step = np.empty(nc)
@@ -445,16 +473,15 @@ def nb_correct_hyperplane(S, ball_of, ball_first, ball_axes, ball_centre, limb_s
     B2 = np.empty(B0.shape)
     cws = np.empty(nb_closure_ws_size(limb_start))
     rws = np.empty(n + RETRACT_WS)
+    c_lo, c_hi = nb_limb_columns(limb_start, colmap)
+    fbuf, ibuf = nb_blocks_workspace(c_lo, c_hi, na, nc)
+    d = np.empty(nc)
     if has_pred:
         for c in range(nc):
             step[c] = col[c] * pred[c]
         nb_retract(ball_first, ball_axes, q0, D0, B0, active, step, na, np.bool_(False), q, D, B, rws)
     else:
-        for i in range(n):
-            q[i] = q0[i]
-        nb_copy44(D0, D)
-        for b in range(B0.shape[0]):
-            nb_copy44(B0[b], B[b])
+        _copy_config(q0, D0, B0, q, D, B)
     moved = 0.0
     prev = np.inf
     for it in range(max_iter):
@@ -468,30 +495,28 @@ def nb_correct_hyperplane(S, ball_of, ball_first, ball_axes, ball_centre, limb_s
             info[0] = 1.0
             info[1] = it
             info[2] = moved
-            return
+            return True
         for i in range(m):
             for c in range(nc):
                 M[i, c] = row[i] * A[i, c] * col[c]
         for c in range(nc):
             M[m, c] = t[c]
         rhs[m] = 0.0
-        d = nb_lstsq(M, rhs)
+        # the square system's solution by limb blocks with the tangent as border row, else lstsq's
+        if not nb_minnorm_blocks(M, rhs, M[m], 0.0, c_lo, c_hi, na, d, fbuf, ibuf):
+            d = nb_lstsq(M, rhs)
         dn = nb_norm(d)
         if it > 0 and dn > contraction * prev:
             info[0] = 0.0
             info[1] = it
             info[2] = moved
-            return
+            return False
         prev = dn
         moved += dn
         for c in range(nc):
             step[c] = col[c] * d[c]
         nb_retract(ball_first, ball_axes, q, D, B, active, step, na, np.bool_(False), q2, D2, B2, rws)
-        for i in range(n):
-            q[i] = q2[i]
-        nb_copy44(D2, D)
-        for b in range(B0.shape[0]):
-            nb_copy44(B2[b], B[b])
+        _copy_config(q2, D2, B2, q, D, B)
     nb_closure_system(S, ball_of, ball_axes, ball_centre, limb_start, ends, q, D, B, colmap, na, np.zeros((0, 0)), r,
                       cws)  # the residual only
     sq = 0.0
@@ -501,6 +526,7 @@ def nb_correct_hyperplane(S, ball_of, ball_first, ball_axes, ball_centre, limb_s
     info[0] = 1.0 if np.sqrt(sq) < tol else 0.0
     info[1] = max_iter
     info[2] = moved
+    return False
 
 
 @njit(cache=True)

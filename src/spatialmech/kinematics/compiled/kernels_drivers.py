@@ -6,10 +6,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .kernels_se3 import nb_ball_product, nb_det, nb_inverse_into, nb_log, nb_mm4, nb_svd
+from .kernels_se3 import nb_ball_product, nb_det, nb_det_inplace, nb_inverse_into, nb_log, nb_mm4, nb_svd
 from .kernels_closure import (
     nb_adjoint_columns,
-    nb_chain,
+    nb_chain_ws,
     nb_closure_system,
     nb_closure_ws_size,
     nb_colmap,
@@ -38,7 +38,6 @@ __all__ = [
 @njit(cache=True)
 def nb_det5_reciprocal(Tn, out):
     """:func:`..geometry.screws.cofactor_reciprocal` of five nondimensional screws (5, 6)."""
-    y = np.empty(6)
     M = np.empty((5, 5))
     for j in range(6):
         for i in range(5):
@@ -47,10 +46,8 @@ def nb_det5_reciprocal(Tn, out):
                 if c != j:
                     M[i, c2] = Tn[i, c]
                     c2 += 1
-        y[j] = (-1.0) ** j * nb_det(M)
-    for i in range(3):
-        out[i] = y[3 + i]
-        out[3 + i] = y[i]
+        d = nb_det_inplace(M)  # M is rebuilt for the next j
+        out[(j + 3) % 6] = -d if j % 2 == 1 else d  # (-1)^j det, swapped halves
 
 
 @njit(cache=True)
@@ -206,10 +203,13 @@ def nb_driver_dets(S, ball_of, ball_axes, ball_centre, limb_start, ends, active,
     cons = np.zeros((K, 6))  # per limb: its constraint wrench (SI), when it has one
     has_con = np.zeros(K, dtype=np.bool_)
     ncons = 0
+    Wc = np.empty((6, 3, 3))  # scratch of the chains, the five twists and their reciprocal
+    T5 = np.empty((5, 6))
+    w = np.empty(6)
     for k in range(K):
         lo = limb_start[k]
         hi = limb_start[k + 1]
-        nb_chain(S, ball_of, ball_axes, ball_centre, q, lo, hi, T, J)
+        nb_chain_ws(S, ball_of, ball_axes, ball_centre, q, lo, hi, T, J, Wc)
         a = ends[k, 0]
         if a >= 0:
             nb_adjoint_columns(nb_hub(a, D, B), J, hi - lo)
@@ -221,17 +221,15 @@ def nb_driver_dets(S, ball_of, ball_axes, ball_centre, limb_start, ends, active,
             for c in range(6):
                 tw[i, c] = J[c, i - lo] if c < 3 else J[c, i - lo] / L
         if ma == 5:
-            Tn = np.empty((5, 6))
             j = 0
             prod = 1.0
             for i in range(lo, hi):
                 if active[i]:
                     for c in range(6):
-                        Tn[j, c] = tw[i, c]
+                        T5[j, c] = tw[i, c]
                     prod *= nb_norm(tw[i])
                     j += 1
-            w = np.empty(6)
-            nb_det5_reciprocal(Tn, w)
+            nb_det5_reciprocal(T5, w)
             nw = nb_norm(w)
             if not nw > rtol * prod:
                 return 2

@@ -16,6 +16,7 @@ __all__ = [
     "nb_copy44",
     "nb_cross",
     "nb_det",
+    "nb_det_inplace",
     "nb_exp_twist",
     "nb_inverse_into",
     "nb_log",
@@ -557,8 +558,14 @@ def nb_lstsq(A, b):
 @njit(cache=True)
 def nb_det(M):
     """Determinant by LU with partial pivoting (LAPACK getrf's pivoting, as ``np.linalg.det``)."""
-    n = M.shape[0]
-    A = M.copy()
+    return nb_det_inplace(M.copy())
+
+
+@njit(cache=True)
+def nb_det_inplace(A):
+    """:func:`nb_det` overwriting ``A`` with its elimination (no copy: for a caller that builds
+    the matrix in scratch anyway)."""
+    n = A.shape[0]
     det = 1.0
     for k in range(n):
         p = k

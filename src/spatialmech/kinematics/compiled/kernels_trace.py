@@ -30,7 +30,8 @@ from __future__ import annotations
 import numpy as np
 
 from .jit import njit
-from .kernels_closure import nb_closure_system, nb_closure_ws_size, nb_colmap, nb_correct_hyperplane, nb_copy44
+from .kernels_closure import (nb_closure_system, nb_closure_ws_size, nb_colmap, nb_copy44, nb_correct_hyperplane,
+                              nb_correct_hyperplane_ws)
 from .kernels_drivers import nb_closure_dets, nb_difference, nb_driver_dets
 from .kernels_tracking import nb_bordered_tangent
 
@@ -54,6 +55,19 @@ def nb_trace_correct(G, q, D, B, t, a, tol, max_iter, pred, qo, Do, Bo, info):  
         pred[c] = a * t[c]
     nb_correct_hyperplane(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends, q, D, B, active, row, col, t,
                           tol, max_iter, 0.6, pred, np.bool_(True), qo, Do, Bo, info)
+
+
+@njit(cache=True)
+def _trace_correct_ws(G, q, D, B, t, a, tol, max_iter, pred, qo, Do, Bo, info, A, r):  # pragma: no cover - compiled
+    """:func:`nb_trace_correct` with the closure Jacobian's workspace ``A``, ``r`` given
+    (:func:`.kernels_closure.nb_correct_hyperplane_ws`): ``True`` when ``A`` is the (unscaled)
+    Jacobian at the corrected point."""
+    S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends, active, row, col = (G[0], G[1], G[2], G[3], G[4],
+                                                                                       G[5], G[6], G[8], G[11], G[12])
+    for c in range(len(t)):
+        pred[c] = a * t[c]
+    return nb_correct_hyperplane_ws(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends, q, D, B, active,
+                                    row, col, t, tol, max_iter, 0.6, pred, np.bool_(True), qo, Do, Bo, info, A, r)
 
 
 @njit(cache=True)
@@ -141,14 +155,15 @@ def _attempt(G, par, X, t, h, orient, Xn, tn, S):  # pragma: no cover - compiled
     orientation at the new point); code 0 accepted, 1 rejected, 3 rejected by an orientation
     flip, 2 handed to the Python loop (the bordered LU does not certify the step test)."""
     pred, info, info4, A, As, Mb, r, cws, colmap = S
-    nb_trace_correct(G, X[0], X[1], X[2], t, h, par[6], np.int64(12), pred, Xn[0], Xn[1], Xn[2], info)
+    fresh = _trace_correct_ws(G, X[0], X[1], X[2], t, h, par[6], np.int64(12), pred, Xn[0], Xn[1], Xn[2], info, A, r)
     iters = int(info[1])
     if not (info[0] == 1.0 and info[2] < 0.5 * h):
         return 1, iters, 0.0
     row, col = G[11], G[12]
     nc = As.shape[1]
-    nb_closure_system(G[0], G[1], G[3], G[4], G[5], G[6], Xn[0], Xn[1], Xn[2], colmap, nc - 6 * (1 + Xn[2].shape[0]), A,
-                      r, cws)
+    if not fresh:  # the corrector's last Jacobian is that of the new point unless it stopped at max_iter
+        nb_closure_system(G[0], G[1], G[3], G[4], G[5], G[6], Xn[0], Xn[1], Xn[2], colmap, nc - 6 * (1 + Xn[2].shape[0]),
+                          A, r, cws)
     for i in range(As.shape[0]):
         for c in range(nc):
             As[i, c] = row[i] * A[i, c] * col[c]
