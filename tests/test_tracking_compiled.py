@@ -216,3 +216,33 @@ def test_the_compiled_loop_ends_a_track_as_the_python_loop_does(kw, monkeypatch)
     assert (a.status, a.message, a.rejected, len(a.points)) == (b.status, b.message, b.rejected, len(b.points))
     assert np.max(np.abs(a.s - b.s)) <= TRACE_TOL and [e.name for e in a.events] == [e.name for e in b.events]
     assert all(abs(e.s - f.s) <= TRACE_TOL for e, f in zip(a.events, b.events, strict=True))
+
+
+def test_the_pruned_nearest_point_is_the_full_argmin():
+    """``compiled.nearest_point`` (the full difference only where its bound does not rule a point
+    out) returns the index of the full ``argmin`` of the distances, on a traced 5-CS circuit, for
+    the traced points themselves, points between them and configurations off the curve."""
+    from spatialmech.kinematics import compiled
+
+    if not backend.enabled():
+        pytest.skip("the compiled engine is not in use")
+    mech = catalog.build("five-cs-1")
+    rec = []
+
+    def recording(*a, **k):
+        rec.append((a[0], tracking.track(*a, **k)))
+        return rec[-1][1]
+
+    with pytest.MonkeyPatch.context() as m:
+        m.setattr(defect_circuits, "track", recording)
+        defect_analysis(mech, sigma_along_path=False)
+    prob, tr = rec[0]
+    rng = np.random.default_rng(0)
+    queries = [tr.points[k] for k in range(0, len(tr.points), 7)]
+    queries += [prob.retract(tr.points[k], 0.5 * (tr.s[k + 1] - tr.s[k]) * tr.tangents[k])
+                for k in range(0, len(tr.points) - 1, 11)]
+    queries += [prob.retract(tr.points[k], 0.3 * rng.normal(size=len(tr.tangents[k]))) for k in range(0, len(tr.points), 13)]
+    wrap = prob.kinds != "P"
+    for y in queries:
+        d = np.linalg.norm(prob.differences(tr.points, y, tr.stacked()), axis=1)
+        assert compiled.nearest_point(mech, tr.stacked(), y, prob.active, wrap, prob.col) == int(np.argmin(d))

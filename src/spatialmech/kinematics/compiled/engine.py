@@ -75,6 +75,7 @@ __all__ = [
     "limb_inverse_many",
     "lstsq",
     "minnorm_blocks",
+    "nearest_point",
     "retract",
     "sps_leg_lengths",
     "warm_up",
@@ -410,6 +411,39 @@ def config_differences(mech: Mechanism, points: Sequence[Configuration], b: Conf
     out = np.empty((len(points), len(c)))
     nb_differences(cm.ball_first, cm.ball_axes, Qa, DAs, BAs, qb, Db, Bb, act, w, c, out)
     return out
+
+
+def nearest_point(mech: Mechanism, stacked: tuple, b: Configuration, active, wrap, col) -> int:
+    """The index of the point (``stacked``: their ``q, D, B``) nearest ``b``:
+    ``argmin(np.linalg.norm(config_differences(...), axis=1))``, the same index (the first one on
+    ties), with the full difference evaluated only at the points that a lower bound does not rule
+    out.  The bound is the norm of the differences of the active joints outside S joints (a part
+    of the full difference's components): a point whose bound exceeds the full distance of the
+    point with the smallest bound cannot be nearest."""
+    cm = compile_mechanism(mech)
+    act = _mask(mech, cm, active)
+    Qa = _f64(stacked[0]).reshape(-1, cm.n)
+    in_ball = np.zeros(cm.n, dtype=bool)
+    for g in cm.ball_first:
+        in_ball[g:g + 3] = True
+    j_of = np.cumsum(act) - 1  # local column of each active freedom
+    plain = np.flatnonzero(act & ~in_ball)
+    c = _f64(col).reshape(-1)
+    w = _bools(wrap, (int(act.sum()),))
+    qb = _f64(b.q).reshape(cm.n)
+    V = qb[plain][None, :] - Qa[:, plain]
+    wr = w[j_of[plain]]
+    V[:, wr] = (V[:, wr] + np.pi) % (2 * np.pi) - np.pi
+    lb = np.linalg.norm(V / c[j_of[plain]][None, :], axis=1)
+
+    def full(idx: np.ndarray) -> np.ndarray:
+        sub = (Qa[idx], _f64(stacked[1]).reshape(-1, 4, 4)[idx], _f64(stacked[2]).reshape(len(Qa), -1, 4, 4)[idx])
+        return np.linalg.norm(config_differences(mech, sub[0], b, active, wrap, col, sub), axis=1)
+
+    first = int(np.argmin(lb))
+    f0 = float(full(np.array([first]))[0])
+    cand = np.flatnonzero(lb <= f0 * (1.0 + 1e-9))  # rounding of the bound: a margin, never a miss
+    return int(cand[int(np.argmin(full(cand)))])
 
 
 def correct_on_hyperplane(mech: Mechanism, config: Configuration, active, row, col, t, tol: float, max_iter: int,
