@@ -436,13 +436,18 @@ def nearest_point(mech: Mechanism, stacked: tuple, b: Configuration, active, wra
     V[:, wr] = (V[:, wr] + np.pi) % (2 * np.pi) - np.pi
     lb = np.linalg.norm(V / c[j_of[plain]][None, :], axis=1)
 
+    DAs = _f64(stacked[1]).reshape(len(Qa), 4, 4)
+    BAs = _f64(stacked[2]).reshape(len(Qa), cm.n_bodies, 4, 4)
+
     def full(idx: np.ndarray) -> np.ndarray:
-        sub = (Qa[idx], _f64(stacked[1]).reshape(-1, 4, 4)[idx], _f64(stacked[2]).reshape(len(Qa), -1, 4, 4)[idx])
+        sub = (Qa[idx], DAs[idx], BAs[idx])
         return np.linalg.norm(config_differences(mech, sub[0], b, active, wrap, col, sub), axis=1)
 
     first = int(np.argmin(lb))
     f0 = float(full(np.array([first]))[0])
     cand = np.flatnonzero(lb <= f0 * (1.0 + 1e-9))  # rounding of the bound: a margin, never a miss
+    if cand.size == 0:  # a distance that is not a number (NaN): no bound rules anything out
+        cand = np.arange(len(Qa))
     return int(cand[int(np.argmin(full(cand)))])
 
 
