@@ -21,7 +21,7 @@ import numpy as np
 
 from .jit import njit
 
-__all__ = ["bordered_tangent", "nb_bordered_tangent", "nb_lu_inverse", "nb_lu_sign", "nb_lu_solve_unit"]
+__all__ = ["bordered_tangent", "nb_bordered_tangent", "nb_lu_sign"]
 
 
 @njit(cache=True)
@@ -57,67 +57,14 @@ def nb_lu_sign(M, piv):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def nb_lu_solve_unit(M, piv, c, x):  # pragma: no cover - compiled
-    """``x`` <- the solution of ``M0 x = e_c`` from the LU of :func:`nb_lu_sign`."""
-    n1 = M.shape[0]
-    for i in range(n1):
-        s = 1.0 if piv[i] == c else 0.0
-        for j in range(i):
-            s -= M[i, j] * x[j]
-        x[i] = s
-    for i in range(n1 - 1, -1, -1):
-        s = x[i]
-        for j in range(i + 1, n1):
-            s -= M[i, j] * x[j]
-        x[i] = s / M[i, i]
-
-
-@njit(cache=True)
-def nb_lu_inverse(M, piv, X):  # pragma: no cover - compiled
-    """``X`` <- ``M0^-1`` from the LU of :func:`nb_lu_sign`: column ``c`` is
-    :func:`nb_lu_solve_unit` of ``c``, the same operations in the same order for each entry,
-    made row by row for all columns at once (independent chains: the loops vectorise)."""
-    n1 = M.shape[0]
-    for i in range(n1):
-        for c in range(n1):
-            X[i, c] = 1.0 if piv[i] == c else 0.0
-        for j in range(i):
-            f = M[i, j]
-            for c in range(n1):
-                X[i, c] -= f * X[j, c]
-    for i in range(n1 - 1, -1, -1):
-        for j in range(i + 1, n1):
-            f = M[i, j]
-            for c in range(n1):
-                X[i, c] -= f * X[j, c]
-        d = M[i, i]
-        for c in range(n1):
-            X[i, c] = X[i, c] / d
-
-
-@njit(cache=True)
-def _column_sums_total(X):  # pragma: no cover - compiled
-    """``sum over c of (sum over i of X[i, c]^2)``, each inner sum in row order from 0.0 (as
-    ``np.sum(x * x)`` of a column), the outer in column order."""
-    n, m = X.shape
-    acc = np.zeros(m)
-    for i in range(n):
-        for c in range(m):
-            acc[c] += X[i, c] * X[i, c]
-    tot = 0.0
-    for c in range(m):
-        tot += acc[c]
-    return tot
-
-
-@njit(cache=True)
 def _lu_inverse_fro(M, piv, Y, z):  # pragma: no cover - compiled
-    """``|M0^-1|_F^2`` and ``z`` <- its last column, from the LU of :func:`nb_lu_sign`: the same
-    numbers as :func:`nb_lu_inverse` followed by :func:`_column_sums_total`, each entry by the
-    same operations in the same order, with the forward substitution's exact zeros skipped.
-    Column ``c`` of the inverse is kept in ``Y[:, k]`` with ``piv[k] = c``; its entries above
-    row ``k`` stay exactly zero through the forward substitution (``L`` is unit lower
-    triangular), so that pass costs a third of the dense one."""
+    """``|M0^-1|_F^2`` and ``z`` <- its last column, from the LU of :func:`nb_lu_sign`: the whole
+    inverse solved row by row for all columns at once (independent chains that vectorise), each
+    entry by the operations of its own column's solve.  Column ``c`` of the inverse is kept in
+    ``Y[:, k]`` with ``piv[k] = c``: its entries above row ``k`` are exactly zero through the
+    forward substitution (``L`` is unit lower triangular), so that pass skips them (a third of
+    the dense pass); the squares are summed over each column in row order, then over the columns
+    in their order."""
     n1 = M.shape[0]
     for i in range(n1):
         for k in range(n1):
