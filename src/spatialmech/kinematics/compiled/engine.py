@@ -468,9 +468,10 @@ def correct_on_hyperplane(mech: Mechanism, config: Configuration, active, row, c
     pred = tt if predictor is None else _f64(predictor)
     if pred.shape != tt.shape:
         raise InputError(f"predictor: expected {tt.shape[0]} local coordinates, got shape {pred.shape}")
+    m = 6 * cm.n_limbs
     nb_correct_hyperplane(cm.screws, cm.ball_of, cm.ball_first, cm.ball_axes, cm.ball_centre, cm.limb_start, cm.ends,
                           q0, D0, B0, act, _f64(row), _f64(col), tt, float(tol), int(max_iter), float(contraction), pred,
-                          predictor is not None, q, D, B, info)
+                          predictor is not None, q, D, B, info, np.zeros((m, len(tt))), np.empty(m))
     it = int(info[1])
     out = config if it == 0 and predictor is None else Configuration(q, D, B)
     return out, bool(info[0]), it, float(info[2])

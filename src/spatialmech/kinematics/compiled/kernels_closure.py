@@ -32,7 +32,6 @@ __all__ = [
     "nb_colmap",
     "nb_correct",
     "nb_correct_hyperplane",
-    "nb_correct_hyperplane_ws",
     "nb_finite_config",
     "nb_hub",
     "nb_limb_columns",
@@ -425,24 +424,6 @@ def nb_correct(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends,
 
 
 @njit(cache=True)
-def nb_correct_hyperplane(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends, q0, D0, B0, active, row, col,
-                          t, tol, max_iter, contraction, pred, has_pred, q, D, B, info):
-    """``tracking.correct_on_hyperplane`` for a mechanism's motion (``tracking.MotionProblem``):
-    Newton on the row-scaled closure with every correction orthogonal to ``t`` (local coordinates
-    scaled by ``col``), from ``q0, D0, B0`` -- first moved by the predictor step ``pred`` (local
-    coordinates) when ``has_pred`` -- into ``q, D, B``; ``info`` = (converged, iterations,
-    total correction length).  Each step solves the square ``[A; t] d = [-r; 0]`` by limb blocks
-    with ``t`` as border row (:func:`.kernels_blocks.nb_minnorm_blocks`), or by
-    :func:`.kernels_se3.nb_lstsq` where the blocks decline (a limb's own columns dependent, an
-    ill-conditioned reduced system)."""
-    m = 6 * (len(limb_start) - 1)
-    nc = len(t)
-    nb_correct_hyperplane_ws(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends, q0, D0, B0, active, row,
-                             col, t, tol, max_iter, contraction, pred, has_pred, q, D, B, info, np.zeros((m, nc)),
-                             np.zeros(m))
-
-
-@njit(cache=True)
 def _copy_config(q0, D0, B0, q, D, B):  # pragma: no cover - compiled
     """``q, D, B`` <- ``q0, D0, B0``."""
     for i in range(len(q0)):
@@ -453,13 +434,21 @@ def _copy_config(q0, D0, B0, q, D, B):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def nb_correct_hyperplane_ws(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends, q0, D0, B0, active, row,
-                             col, t, tol, max_iter, contraction, pred, has_pred, q, D, B, info, A, r):
-    """:func:`nb_correct_hyperplane` with its closure Jacobian ``A`` (6K, local coordinates; zero
-    where :func:`nb_closure_system` writes nothing: allocate it with ``np.zeros`` and reuse it)
-    and residual ``r`` given.  Returns ``True`` when the corrector converged by its residual test
-    inside the loop: ``A`` and ``r`` are then those of ``q, D, B`` (unscaled), so that a caller
-    needing the Jacobian there (the step test) need not evaluate it again."""
+def nb_correct_hyperplane(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends, q0, D0, B0, active, row, col,
+                          t, tol, max_iter, contraction, pred, has_pred, q, D, B, info, A, r):
+    """``tracking.correct_on_hyperplane`` for a mechanism's motion (``tracking.MotionProblem``):
+    Newton on the row-scaled closure with every correction orthogonal to ``t`` (local coordinates
+    scaled by ``col``), from ``q0, D0, B0`` -- first moved by the predictor step ``pred`` (local
+    coordinates) when ``has_pred`` -- into ``q, D, B``; ``info`` = (converged, iterations,
+    total correction length).  Each step solves the square ``[A; t] d = [-r; 0]`` by limb blocks
+    with ``t`` as border row (:func:`.kernels_blocks.nb_minnorm_blocks`), or by
+    :func:`.kernels_se3.nb_lstsq` where the blocks decline (a limb's own columns dependent, an
+    ill-conditioned reduced system).  Scratch from the caller: the closure Jacobian ``A``
+    ``(6K, n_local)``, zero where :func:`nb_closure_system` writes nothing (allocate it with
+    ``np.zeros``; it may be reused), and the residual ``r`` ``(6K,)``.  Returns ``True`` when
+    the corrector converged by its residual test inside the loop: ``A`` and ``r`` are then those
+    of ``q, D, B`` (unscaled), so that a caller needing the Jacobian there (the tracker's step
+    test) need not evaluate it again."""
     K = len(limb_start) - 1
     m = 6 * K
     colmap, na = nb_colmap(active)
