@@ -54,12 +54,12 @@ def arc_on_curve(problem: MotionProblem, tr: TrackResult, config: Configuration,
     (the hyperplane through ``config``); the closest corrected point gives the arc."""
     if (fast := compiled_loops()) is not None:  # the same nearest sample, its distance pruned by a bound
         k0 = fast.nearest_point(problem.mech, tr.stacked(), config, problem.active, problem.kinds != "P", problem.col)
-        ks = list({max(0, k0 - 1), k0, min(len(tr.points) - 1, k0 + 1)})  # the reference's order (ties)
+    else:
+        k0 = int(np.argmin(np.linalg.norm(problem.differences(tr.points, config, tr.stacked()), axis=1)))
+    ks = list({max(0, k0 - 1), k0, min(len(tr.points) - 1, k0 + 1)})  # the reference's order (ties)
+    if fast is not None:
         dist_c, arc = fast.arc_near(problem.step_arrays(fast), tr.stacked(), tr.stacked_tangents(), tr.s, ks, config)
         return arc if dist_c < tol else None
-    d = np.linalg.norm(problem.differences(tr.points, config, tr.stacked()), axis=1)
-    k0 = int(np.argmin(d))
-    ks = list({max(0, k0 - 1), k0, min(len(tr.points) - 1, k0 + 1)})  # the reference's order (ties)
     best: tuple[float, float | None] = (np.inf, None)
     for k in ks:
         x, t = tr.points[k], tr.tangents[k]
