@@ -413,6 +413,28 @@ def config_differences(mech: Mechanism, points: Sequence[Configuration], b: Conf
     return out
 
 
+_NEAREST: weakref.WeakKeyDictionary[Mechanism, dict] = weakref.WeakKeyDictionary()
+
+
+def _nearest_arrays(mech: Mechanism, cm: CompiledMechanism, act: np.ndarray, wrap, col) -> tuple:
+    """:func:`nearest_point`'s index arrays and scales for one motion (remembered per mechanism,
+    active mask, wrapped coordinates and column scales): the plain (non-S) active freedoms, their
+    column scales and wrap flags, and the arrays of the full difference."""
+    c = _f64(col).reshape(-1)
+    w = _bools(wrap, (int(act.sum()),))
+    key = (act.tobytes(), w.tobytes(), c.tobytes())
+    memo = _NEAREST.setdefault(mech, {})
+    got = memo.get(key)
+    if got is None:
+        in_ball = np.zeros(cm.n, dtype=bool)
+        for g in cm.ball_first:
+            in_ball[g:g + 3] = True
+        j_of = np.cumsum(act) - 1  # local column of each active freedom
+        plain = np.flatnonzero(act & ~in_ball)
+        got = memo[key] = (plain, w[j_of[plain]], c[j_of[plain]], act, w, c)
+    return got
+
+
 def nearest_point(mech: Mechanism, stacked: tuple, b: Configuration, active, wrap, col) -> int:
     """The index of the point (``stacked``: their ``q, D, B``) nearest ``b``:
     ``argmin(np.linalg.norm(config_differences(...), axis=1))``, the same index (the first one on
@@ -421,27 +443,23 @@ def nearest_point(mech: Mechanism, stacked: tuple, b: Configuration, active, wra
     of the full difference's components): a point whose bound exceeds the full distance of the
     point with the smallest bound cannot be nearest."""
     cm = compile_mechanism(mech)
-    act = _mask(mech, cm, active)
+    plain, wr, cp, act, w, c = _nearest_arrays(mech, cm, _mask(mech, cm, active), wrap, col)
     Qa = _f64(stacked[0]).reshape(-1, cm.n)
-    in_ball = np.zeros(cm.n, dtype=bool)
-    for g in cm.ball_first:
-        in_ball[g:g + 3] = True
-    j_of = np.cumsum(act) - 1  # local column of each active freedom
-    plain = np.flatnonzero(act & ~in_ball)
-    c = _f64(col).reshape(-1)
-    w = _bools(wrap, (int(act.sum()),))
-    qb = _f64(b.q).reshape(cm.n)
-    V = qb[plain][None, :] - Qa[:, plain]
-    wr = w[j_of[plain]]
-    V[:, wr] = (V[:, wr] + np.pi) % (2 * np.pi) - np.pi
-    lb = np.linalg.norm(V / c[j_of[plain]][None, :], axis=1)
-
     DAs = _f64(stacked[1]).reshape(len(Qa), 4, 4)
     BAs = _f64(stacked[2]).reshape(len(Qa), cm.n_bodies, 4, 4)
+    _check(mech, cm, b)
+    qb, Db, Bb = _config_arrays(cm, b)
+    V = qb[plain][None, :] - Qa[:, plain]
+    V[:, wr] = (V[:, wr] + np.pi) % (2 * np.pi) - np.pi
+    lb = np.linalg.norm(V / cp[None, :], axis=1)
 
     def full(idx: np.ndarray) -> np.ndarray:
         sub = (Qa[idx], DAs[idx], BAs[idx])
-        return np.linalg.norm(config_differences(mech, sub[0], b, active, wrap, col, sub), axis=1)
+        if not np.isfinite(sub[0].sum() + sub[1].sum() + sub[2].sum()):
+            raise InputError("points: a configuration holds NaN or infinity")
+        out = np.empty((len(idx), len(c)))
+        nb_differences(cm.ball_first, cm.ball_axes, *sub, qb, Db, Bb, act, w, c, out)
+        return np.linalg.norm(out, axis=1)
 
     first = int(np.argmin(lb))
     f0 = float(full(np.array([first]))[0])
