@@ -58,57 +58,55 @@ def nb_chain(S, ball_of, ball_axes, ball_centre, q, lo, hi, T, J):
 @njit(cache=True)
 def nb_chain_ws(S, ball_of, ball_axes, ball_centre, q, lo, hi, T, J, W):
     """:func:`nb_chain` with its scratch matrices in ``W`` (6, 3, 3): a caller that runs many
-    chains allocates them once."""
-    R = W[0]
+    chains allocates them once.  ``W[0]`` holds the chain's rotation ``R``, ``W[1]`` the joint's
+    ``Rb``, ``W[2]`` the product, ``W[3]``/``W[4]`` the joint's reference directions and moments,
+    ``W[5, 0]`` the chain's ``p`` and ``W[5, 1]`` the joint's ``u``.  They are indexed in ``W``
+    rather than taken as views: each view costs an atomic reference count in and out (numba's
+    runtime), and this runs for every limb of every closure system."""
     Rb = W[1]
-    Rn = W[2]
-    ax = W[3]
-    mo = W[4]
-    p = W[5, 0]
     u = W[5, 1]
     for a in range(3):
-        p[a] = 0.0
+        W[5, 0, a] = 0.0
         for b in range(3):
-            R[a, b] = 1.0 if a == b else 0.0
+            W[0, a, b] = 1.0 if a == b else 0.0
     i = lo
     while i < hi:
         g = ball_of[i]
         if g >= 0:
             k = 3
-            A = ball_axes[g]
-            c = ball_centre[g]
+            c0, c1, c2 = ball_centre[g, 0], ball_centre[g, 1], ball_centre[g, 2]
             for j in range(3):
                 for a in range(3):
-                    ax[a, j] = A[a, j]
-                mo[0, j] = c[1] * A[2, j] - c[2] * A[1, j]
-                mo[1, j] = c[2] * A[0, j] - c[0] * A[2, j]
-                mo[2, j] = c[0] * A[1, j] - c[1] * A[0, j]
+                    W[3, a, j] = ball_axes[g, a, j]
+                W[4, 0, j] = c1 * ball_axes[g, 2, j] - c2 * ball_axes[g, 1, j]
+                W[4, 1, j] = c2 * ball_axes[g, 0, j] - c0 * ball_axes[g, 2, j]
+                W[4, 2, j] = c0 * ball_axes[g, 1, j] - c1 * ball_axes[g, 0, j]
         else:
             k = 1
-            ax[0, 0], ax[1, 0], ax[2, 0] = S[i, 0], S[i, 1], S[i, 2]
-            mo[0, 0], mo[1, 0], mo[2, 0] = S[i, 3], S[i, 4], S[i, 5]
+            W[3, 0, 0], W[3, 1, 0], W[3, 2, 0] = S[i, 0], S[i, 1], S[i, 2]
+            W[4, 0, 0], W[4, 1, 0], W[4, 2, 0] = S[i, 3], S[i, 4], S[i, 5]
         nb_joint_motion(S, ball_of, ball_axes, ball_centre, q, i, Rb, u)  # the joint's own (Rb, u)
         for j in range(k):
             col = i - lo + j
             for a in range(3):
-                J[a, col] = R[a, 0] * ax[0, j] + R[a, 1] * ax[1, j] + R[a, 2] * ax[2, j]
-                J[3 + a, col] = R[a, 0] * mo[0, j] + R[a, 1] * mo[1, j] + R[a, 2] * mo[2, j]
-            J[3, col] += p[1] * J[2, col] - p[2] * J[1, col]
-            J[4, col] += p[2] * J[0, col] - p[0] * J[2, col]
-            J[5, col] += p[0] * J[1, col] - p[1] * J[0, col]
+                J[a, col] = W[0, a, 0] * W[3, 0, j] + W[0, a, 1] * W[3, 1, j] + W[0, a, 2] * W[3, 2, j]
+                J[3 + a, col] = W[0, a, 0] * W[4, 0, j] + W[0, a, 1] * W[4, 1, j] + W[0, a, 2] * W[4, 2, j]
+            J[3, col] += W[5, 0, 1] * J[2, col] - W[5, 0, 2] * J[1, col]
+            J[4, col] += W[5, 0, 2] * J[0, col] - W[5, 0, 0] * J[2, col]
+            J[5, col] += W[5, 0, 0] * J[1, col] - W[5, 0, 1] * J[0, col]
         for a in range(3):
-            p[a] += R[a, 0] * u[0] + R[a, 1] * u[1] + R[a, 2] * u[2]
-        for a in range(3):
-            for b in range(3):
-                Rn[a, b] = R[a, 0] * Rb[0, b] + R[a, 1] * Rb[1, b] + R[a, 2] * Rb[2, b]
+            W[5, 0, a] += W[0, a, 0] * W[5, 1, 0] + W[0, a, 1] * W[5, 1, 1] + W[0, a, 2] * W[5, 1, 2]
         for a in range(3):
             for b in range(3):
-                R[a, b] = Rn[a, b]
+                W[2, a, b] = W[0, a, 0] * W[1, 0, b] + W[0, a, 1] * W[1, 1, b] + W[0, a, 2] * W[1, 2, b]
+        for a in range(3):
+            for b in range(3):
+                W[0, a, b] = W[2, a, b]
         i += k
     for a in range(3):
         for b in range(3):
-            T[a, b] = R[a, b]
-        T[a, 3] = p[a]
+            T[a, b] = W[0, a, b]
+        T[a, 3] = W[5, 0, a]
         T[3, a] = 0.0
     T[3, 3] = 1.0
 

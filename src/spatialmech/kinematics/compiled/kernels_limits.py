@@ -21,19 +21,18 @@ def nb_joint_motion(S, ball_of, ball_axes, ball_centre, q, i, Rb, u):
     """The displacement ``(Rb, u)`` of the joint whose first freedom is ``i`` (one freedom, or a
     ball's three) at the joint variables ``q``; returns its number of freedoms."""
     g = ball_of[i]
-    if g >= 0:
-        A = ball_axes[g]
-        c = ball_centre[g]
-        f0 = A[0, 0] * q[i] + A[0, 1] * q[i + 1] + A[0, 2] * q[i + 2]
-        f1 = A[1, 0] * q[i] + A[1, 1] * q[i + 1] + A[1, 2] * q[i + 2]
-        f2 = A[2, 0] * q[i] + A[2, 1] * q[i + 1] + A[2, 2] * q[i + 2]
+    if g >= 0:  # indexed, not views (each view is an atomic reference count)
+        f0 = ball_axes[g, 0, 0] * q[i] + ball_axes[g, 0, 1] * q[i + 1] + ball_axes[g, 0, 2] * q[i + 2]
+        f1 = ball_axes[g, 1, 0] * q[i] + ball_axes[g, 1, 1] * q[i + 1] + ball_axes[g, 1, 2] * q[i + 2]
+        f2 = ball_axes[g, 2, 0] * q[i] + ball_axes[g, 2, 1] * q[i + 1] + ball_axes[g, 2, 2] * q[i + 2]
         th = np.sqrt(f0 * f0 + f1 * f1 + f2 * f2)
         if th > 1e-12:
             nb_rodrigues(f0 / th, f1 / th, f2 / th, np.sin(th), 1.0 - np.cos(th), Rb)
         else:  # I + skew(phi): first order, as closure.chain_forward
             nb_rodrigues(f0, f1, f2, 1.0, 0.0, Rb)
+        c0, c1, c2 = ball_centre[g, 0], ball_centre[g, 1], ball_centre[g, 2]
         for a in range(3):  # T <- T [Rb, c - Rb c]
-            u[a] = c[a] - (Rb[a, 0] * c[0] + Rb[a, 1] * c[1] + Rb[a, 2] * c[2])
+            u[a] = ball_centre[g, a] - (Rb[a, 0] * c0 + Rb[a, 1] * c1 + Rb[a, 2] * c2)
         return 3
     w0, w1, w2 = S[i, 0], S[i, 1], S[i, 2]
     v0, v1, v2 = S[i, 3], S[i, 4], S[i, 5]
