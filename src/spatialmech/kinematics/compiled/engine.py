@@ -403,13 +403,17 @@ def config_differences(mech: Mechanism, points: Sequence[Configuration], b: Conf
     Qa = _f64(stacked[0]).reshape(len(points), cm.n)
     DAs = _f64(stacked[1]).reshape(len(points), 4, 4)
     BAs = _f64(stacked[2]).reshape(len(points), cm.n_bodies, 4, 4)
-    if not np.isfinite(Qa.sum() + DAs.sum() + BAs.sum()):
-        raise InputError("points: a configuration holds NaN or infinity")
-    qb, Db, Bb = _config_arrays(cm, b)
     c = _f64(col).reshape(-1)
-    w = _bools(wrap, (int(act.sum()),))
-    out = np.empty((len(points), len(c)))
-    nb_differences(cm.ball_first, cm.ball_axes, Qa, DAs, BAs, qb, Db, Bb, act, w, c, out)
+    return _differences(cm, (Qa, DAs, BAs), _config_arrays(cm, b), act, _bools(wrap, (int(act.sum()),)), c)
+
+
+def _differences(cm: CompiledMechanism, points: tuple, b: tuple, act, w, c) -> np.ndarray:
+    """The compiled loop of :func:`config_differences` on arrays already shaped: ``points`` and
+    ``b`` their ``q, D, B`` (stacked for the points)."""
+    if not np.isfinite(points[0].sum() + points[1].sum() + points[2].sum()):
+        raise InputError("points: a configuration holds NaN or infinity")
+    out = np.empty((len(points[0]), len(c)))
+    nb_differences(cm.ball_first, cm.ball_axes, *points, *b, act, w, c, out)
     return out
 
 
@@ -419,7 +423,7 @@ _NEAREST: weakref.WeakKeyDictionary[Mechanism, dict] = weakref.WeakKeyDictionary
 def _nearest_arrays(mech: Mechanism, cm: CompiledMechanism, act: np.ndarray, wrap, col) -> tuple:
     """:func:`nearest_point`'s index arrays and scales for one motion (remembered per mechanism,
     active mask, wrapped coordinates and column scales): the plain (non-S) active freedoms, their
-    column scales and wrap flags, and the arrays of the full difference."""
+    column scales and wrap flags, then the wrap flags and column scales of the full difference."""
     c = _f64(col).reshape(-1)
     w = _bools(wrap, (int(act.sum()),))
     key = (act.tobytes(), w.tobytes(), c.tobytes())
@@ -431,7 +435,7 @@ def _nearest_arrays(mech: Mechanism, cm: CompiledMechanism, act: np.ndarray, wra
             in_ball[g:g + 3] = True
         j_of = np.cumsum(act) - 1  # local column of each active freedom
         plain = np.flatnonzero(act & ~in_ball)
-        got = memo[key] = (plain, w[j_of[plain]], c[j_of[plain]], act, w, c)
+        got = memo[key] = (plain, w[j_of[plain]], c[j_of[plain]], w, c)
     return got
 
 
@@ -443,23 +447,19 @@ def nearest_point(mech: Mechanism, stacked: tuple, b: Configuration, active, wra
     of the full difference's components): a point whose bound exceeds the full distance of the
     point with the smallest bound cannot be nearest."""
     cm = compile_mechanism(mech)
-    plain, wr, cp, act, w, c = _nearest_arrays(mech, cm, _mask(mech, cm, active), wrap, col)
+    act = _mask(mech, cm, active)
+    plain, wr, cp, w, c = _nearest_arrays(mech, cm, act, wrap, col)
     Qa = _f64(stacked[0]).reshape(-1, cm.n)
     DAs = _f64(stacked[1]).reshape(len(Qa), 4, 4)
     BAs = _f64(stacked[2]).reshape(len(Qa), cm.n_bodies, 4, 4)
     _check(mech, cm, b)
-    qb, Db, Bb = _config_arrays(cm, b)
-    V = qb[plain][None, :] - Qa[:, plain]
+    bq = _config_arrays(cm, b)
+    V = bq[0][plain][None, :] - Qa[:, plain]
     V[:, wr] = (V[:, wr] + np.pi) % (2 * np.pi) - np.pi
     lb = np.linalg.norm(V / cp[None, :], axis=1)
 
     def full(idx: np.ndarray) -> np.ndarray:
-        sub = (Qa[idx], DAs[idx], BAs[idx])
-        if not np.isfinite(sub[0].sum() + sub[1].sum() + sub[2].sum()):
-            raise InputError("points: a configuration holds NaN or infinity")
-        out = np.empty((len(idx), len(c)))
-        nb_differences(cm.ball_first, cm.ball_axes, *sub, qb, Db, Bb, act, w, c, out)
-        return np.linalg.norm(out, axis=1)
+        return np.linalg.norm(_differences(cm, (Qa[idx], DAs[idx], BAs[idx]), bq, act, w, c), axis=1)
 
     first = int(np.argmin(lb))
     f0 = float(full(np.array([first]))[0])
