@@ -21,6 +21,7 @@ and refits the linkage::
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
@@ -229,53 +230,100 @@ def cs_configuration(mech: Mechanism, pose: Pose):
     return Configuration(np.array(q), D)
 
 
-def _rotvec_of(R: np.ndarray) -> np.ndarray:
-    """Rotation vectors of rotation matrices ``R`` (``(m, 3, 3)``), the algorithm of
-    ``scipy.spatial.transform.Rotation.from_matrix(R).as_rotvec()`` in plain NumPy: Shepperd's
-    quaternion (the largest of the trace and the diagonal picks the formula), ``w >= 0``, then
-    ``angle = 2 atan2(|v|, w)`` and ``rotvec = angle / sin(angle / 2) v`` (its series below 1e-3
-    rad).  Agrees with SciPy to rounding (``tests/test_screen_batched.py``)."""
-    m = R.shape[0]
-    d = np.stack([R[:, 0, 0], R[:, 1, 1], R[:, 2, 2], R[:, 0, 0] + R[:, 1, 1] + R[:, 2, 2]], axis=1)
-    k = np.argmax(d, axis=1)
-    quat = np.empty((m, 4))
-    for n in range(m):
-        i = int(k[n])
-        Rn = R[n]
-        if i == 3:
-            quat[n] = (Rn[2, 1] - Rn[1, 2], Rn[0, 2] - Rn[2, 0], Rn[1, 0] - Rn[0, 1], 1.0 + d[n, 3])
-        else:
-            j, l = (i + 1) % 3, (i + 2) % 3
-            q = np.empty(4)
-            q[i] = 1.0 - d[n, 3] + 2.0 * Rn[i, i]
-            q[j] = Rn[j, i] + Rn[i, j]
-            q[l] = Rn[l, i] + Rn[i, l]
-            q[3] = Rn[l, j] - Rn[j, l]
-            quat[n] = q
-    quat /= np.linalg.norm(quat, axis=1)[:, None]
-    quat[quat[:, 3] < 0] *= -1.0
-    v = np.linalg.norm(quat[:, :3], axis=1)
-    angle = 2.0 * np.arctan2(v, quat[:, 3])
-    small = np.abs(angle) <= 1e-3
-    a2 = angle * angle
-    scale = np.where(small, 2.0 + a2 / 12.0 + 7.0 * a2 * a2 / 2880.0, angle / np.sin(np.where(small, 1.0, angle / 2.0)))
-    return scale[:, None] * quat[:, :3]
+def _cs_closed_forms_py(u, B1, M1, A, Ds, q):  # pragma: no cover - compiled by _cs_closed_forms
+    """The C-S closed form of :func:`cs_configuration` for limbs ``k`` (C axis ``u[k]`` through
+    ``B1[k]``, S centre ``M1[k]``, S axes the rows of ``A[k]``) at the displacements ``Ds[n]``,
+    into ``q[n, 5k:5k+5]`` = (C rotation, C slide, S rotation vector in the S axes), in scalar
+    loops (compiled by :func:`_cs_closed_forms`): ``R_u(-theta)`` by Rodrigues, the S rotation
+    vector by SciPy's algorithm (Shepperd's quaternion -- the largest of the trace and the diagonal
+    picks the formula -- ``w >= 0``, ``angle = 2 atan2(|v|, w)``, ``rotvec = angle / sin(angle / 2)
+    v``, its series below 1e-3 rad)."""
+    Rs = np.empty((3, 3))
+    K2 = np.empty((3, 3))
+    quat = np.empty(4)
+    rv = np.empty(3)
+    Mj = np.empty(3)
+    for n in range(Ds.shape[0]):
+        for k in range(u.shape[0]):
+            ux, uy, uz = u[k, 0], u[k, 1], u[k, 2]
+            for a in range(3):
+                Mj[a] = Ds[n, a, 0] * M1[k, 0] + Ds[n, a, 1] * M1[k, 1] + Ds[n, a, 2] * M1[k, 2] + Ds[n, a, 3]
+            s = ux * (Mj[0] - M1[k, 0]) + uy * (Mj[1] - M1[k, 1]) + uz * (Mj[2] - M1[k, 2])
+            e0, e1, e2 = M1[k, 0] - B1[k, 0], M1[k, 1] - B1[k, 1], M1[k, 2] - B1[k, 2]
+            ue = ux * e0 + uy * e1 + uz * e2
+            a0, a1, a2 = e0 - ue * ux, e1 - ue * uy, e2 - ue * uz
+            w0, w1, w2 = Mj[0] - B1[k, 0] - s * ux, Mj[1] - B1[k, 1] - s * uy, Mj[2] - B1[k, 2] - s * uz
+            uw = ux * w0 + uy * w1 + uz * w2
+            b0, b1, b2 = w0 - uw * ux, w1 - uw * uy, w2 - uw * uz
+            th = np.arctan2(ux * (a1 * b2 - a2 * b1) + uy * (a2 * b0 - a0 * b2) + uz * (a0 * b1 - a1 * b0),
+                            a0 * b0 + a1 * b1 + a2 * b2)
+            sn, c1 = np.sin(-th), 1.0 - np.cos(th)
+            uu = ux * ux + uy * uy + uz * uz
+            K2[0, 0], K2[1, 1], K2[2, 2] = ux * ux - uu, uy * uy - uu, uz * uz - uu
+            K2[0, 1] = K2[1, 0] = ux * uy
+            K2[0, 2] = K2[2, 0] = ux * uz
+            K2[1, 2] = K2[2, 1] = uy * uz
+            for i in range(3):  # R_u(-theta) @ R_n, R_u(-theta) = I + sin(-theta) K + (1 - cos theta) K K
+                for j in range(3):
+                    Rs[i, j] = Ds[n, i, j] + c1 * (K2[i, 0] * Ds[n, 0, j] + K2[i, 1] * Ds[n, 1, j] + K2[i, 2] * Ds[n, 2, j])
+            for j in range(3):
+                k0 = -uz * Ds[n, 1, j] + uy * Ds[n, 2, j]
+                k1 = uz * Ds[n, 0, j] - ux * Ds[n, 2, j]
+                k2 = -uy * Ds[n, 0, j] + ux * Ds[n, 1, j]
+                Rs[0, j] += sn * k0
+                Rs[1, j] += sn * k1
+                Rs[2, j] += sn * k2
+            tr = Rs[0, 0] + Rs[1, 1] + Rs[2, 2]
+            i, best = 0, Rs[0, 0]  # the first largest of (R00, R11, R22, trace), as numpy.argmax
+            for d in range(1, 3):
+                if Rs[d, d] > best:
+                    i, best = d, Rs[d, d]
+            if tr > best:
+                i = 3
+            if i == 3:
+                quat[0], quat[1], quat[2], quat[3] = Rs[2, 1] - Rs[1, 2], Rs[0, 2] - Rs[2, 0], Rs[1, 0] - Rs[0, 1], 1.0 + tr
+            else:
+                j, l = (i + 1) % 3, (i + 2) % 3
+                quat[i] = 1.0 - tr + 2.0 * Rs[i, i]
+                quat[j] = Rs[j, i] + Rs[i, j]
+                quat[l] = Rs[l, i] + Rs[i, l]
+                quat[3] = Rs[l, j] - Rs[j, l]
+            nq = np.sqrt(quat[0] * quat[0] + quat[1] * quat[1] + quat[2] * quat[2] + quat[3] * quat[3])
+            sg = -1.0 if quat[3] < 0 else 1.0
+            for d in range(4):
+                quat[d] = sg * quat[d] / nq
+            v = np.sqrt(quat[0] * quat[0] + quat[1] * quat[1] + quat[2] * quat[2])
+            angle = 2.0 * np.arctan2(v, quat[3])
+            if abs(angle) <= 1e-3:
+                a2 = angle * angle
+                scale = 2.0 + a2 / 12.0 + 7.0 * a2 * a2 / 2880.0
+            else:
+                scale = angle / np.sin(angle / 2.0)
+            for d in range(3):
+                rv[d] = scale * quat[d]
+            q[n, 5 * k] = th
+            q[n, 5 * k + 1] = s
+            for d in range(3):
+                q[n, 5 * k + 2 + d] = A[k, d, 0] * rv[0] + A[k, d, 1] * rv[1] + A[k, d, 2] * rv[2]
 
 
-def _axis_rotations(u: np.ndarray, angle: np.ndarray) -> np.ndarray:
-    """``R_u(angle)`` for unit axes ``u`` (``(m, 3)``) and angles (``(m,)``): Rodrigues."""
-    K = np.zeros((len(u), 3, 3))
-    K[:, 0, 1], K[:, 0, 2], K[:, 1, 2] = -u[:, 2], u[:, 1], -u[:, 0]
-    K[:, 1, 0], K[:, 2, 0], K[:, 2, 1] = u[:, 2], -u[:, 1], u[:, 0]
-    s, c = np.sin(angle)[:, None, None], np.cos(angle)[:, None, None]
-    return np.eye(3) + s * K + (1.0 - c) * (K @ K)
+@functools.cache
+def _cs_closed_forms():
+    """:func:`_cs_closed_forms_py` compiled (numba, ``cache=True``) on first use when the compiled
+    engine is on (importing this module loads no numba), else the plain function."""
+    from ..kinematics import backend
+
+    if not backend.enabled():
+        return _cs_closed_forms_py
+    from ..kinematics.compiled.jit import njit
+
+    return njit(cache=True)(_cs_closed_forms_py)
 
 
 def cs_configurations(mech: Mechanism, poses: Sequence[Pose] | None = None):
     """:func:`cs_configuration` at every pose of ``poses`` (default: the model's positions) at
-    once, vectorised over poses and limbs, without SciPy (Rodrigues for ``R_u(theta)``,
-    :func:`_rotvec_of` for the S rotation vector): the same joint values to rounding.  A list
-    of configurations, or ``None`` when a limb is not [C, S]."""
+    once, without SciPy (:func:`_cs_closed_forms_py`, compiled when the engine is on): the same
+    joint values to rounding.  A list of configurations, or ``None`` when a limb is not [C, S]."""
     from ..kinematics.closure import Configuration
 
     poses = list(mech.positions if poses is None else poses)
@@ -288,19 +336,9 @@ def cs_configurations(mech: Mechanism, poses: Sequence[Pose] | None = None):
     M1 = np.array([lb.joints[1].point for lb in mech.limbs], dtype=float)
     A = np.array([[f.direction for f in lb.joints[1].freedoms] for lb in mech.limbs], dtype=float)  # (k, 3 rows, 3)
     Ds = np.array([P.displacement(mech.platform_point) for P in poses])  # (n, 4, 4)
-    n, k = len(poses), len(mech.limbs)
-    Mj = np.einsum("nab,kb->nka", Ds[:, :3, :3], M1) + Ds[:, None, :3, 3]  # (n, k, 3)
-    s = np.einsum("ka,nka->nk", u, Mj - M1[None])
-    a = (M1 - B1) - np.sum(u * (M1 - B1), axis=1)[:, None] * u  # (k, 3)
-    w = Mj - B1[None] - s[..., None] * u[None]
-    b = w - np.sum(u[None] * w, axis=2)[..., None] * u[None]
-    th = np.arctan2(np.sum(u[None] * np.cross(a[None], b), axis=2), np.sum(a[None] * b, axis=2))  # (n, k)
-    uu = np.broadcast_to(u, (n, k, 3)).reshape(-1, 3)
-    Rs = np.swapaxes(_axis_rotations(uu, th.reshape(-1)), 1, 2) @ np.repeat(Ds[:, :3, :3], k, axis=0)
-    rv = _rotvec_of(Rs).reshape(n, k, 3)
-    ball = np.einsum("kij,nkj->nki", A, rv)  # A.T @ rotvec with A's columns the S axes
-    q = np.concatenate([th[..., None], s[..., None], ball], axis=2).reshape(n, 5 * k)
-    return [Configuration(q[i].copy(), Ds[i]) for i in range(n)]
+    q = np.empty((len(poses), 5 * len(mech.limbs)))
+    _cs_closed_forms()(u, B1, M1, A, Ds, q)
+    return [Configuration(q[i].copy(), Ds[i]) for i in range(len(poses))]
 
 
 def check_5cs(mech: Mechanism, dyads: Sequence[CSDyad] | None = None, *, defects: bool = False,
