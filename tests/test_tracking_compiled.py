@@ -246,3 +246,39 @@ def test_the_pruned_nearest_point_is_the_full_argmin():
     for y in queries:
         d = np.linalg.norm(prob.differences(tr.points, y, tr.stacked()), axis=1)
         assert compiled.nearest_point(mech, tr.stacked(), y, prob.active, wrap, prob.col) == int(np.argmin(d))
+
+
+@pytest.mark.parametrize("name", ["five-cs-1", "five-cs-2"])
+def test_the_sigma_floors_bound_the_ratios_and_the_pruned_minimum_is_the_full_one(name):
+    """Every floor the compiled loop writes (``TrackResult.sigma_floor``) is at most the scale-free
+    closure sigma ``sigma_n / sigma_1`` the reference's SVD gives at that point, most points have
+    one, and :func:`defect_circuits.closure_sigma_ratios` (an SVD only where the floors do not
+    rule a point out) gives the full computation's smallest ratio, at the same first point.  Where the ratio varies
+    along a circuit by less than the floors' slack (about 5) nothing is pruned (one of
+    five-cs-2's circuits); some points are, over each model's circuits."""
+    if not backend.enabled():
+        pytest.skip("the compiled engine is not in use")
+    mech = catalog.build(name)
+    rec = []
+
+    def recording(*a, **k):
+        rec.append((a[0], tracking.track(*a, **k)))
+        return rec[-1][1]
+
+    with pytest.MonkeyPatch.context() as m:
+        m.setattr(defect_circuits, "track", recording)
+        defect_analysis(mech, sigma_along_path=False)
+    pruned = 0
+    for prob, tr in rec:
+        assert tr.sigma_floor is not None and tr.sigma_floor.shape == (len(tr.points),)
+        full = np.array([(lambda sv: sv[-1] / sv[0])(np.linalg.svd(prob.jacobian(x), compute_uv=False))
+                         for x in tr.points])
+        has = tr.sigma_floor > 0
+        assert has.mean() > 0.9
+        assert np.all(tr.sigma_floor[has] <= full[has])
+        got = defect_circuits.closure_sigma_ratios(prob, tr.points, tr.sigma_floor)
+        pruned += int(np.isinf(got).sum())
+        k = int(np.argmin(full))
+        assert int(np.argmin(got)) == k and got[k] == full[k]
+        assert np.all(got[np.isfinite(got)] == full[np.isfinite(got)])
+    assert pruned > 0

@@ -23,7 +23,7 @@ from ..results import Progress
 
 __all__ = [
     "arc_on_curve",
-    "closure_singular_values",
+    "closure_sigma_ratios",
     "driver_sigmas",
     "fewest_circuits",
     "pose_distance",
@@ -144,16 +144,49 @@ def _nearest_on_step(fast, mech: Mechanism, prob: MotionProblem, x: Configuratio
     return fast.pose_search(prob.step_arrays(fast), x, t, h, P, 1e-6 * max(h, 1e-12))
 
 
-def closure_singular_values(problem: MotionProblem, points: list) -> list[np.ndarray]:
-    """The singular values of the problem's (nondimensional) closure Jacobian at each point: the
-    compiled engine's Jacobians of all points in one call and one stacked SVD (the same
-    numbers, point by point), or the reference's loop inside ``python_loop()``."""
+def closure_sigma_ratios(problem: MotionProblem, points: list, floor: np.ndarray | None = None) -> np.ndarray:
+    """The scale-free closure sigma ``sigma_n / sigma_1`` of the problem's (nondimensional)
+    closure Jacobian at each point, or ``inf`` at a point that cannot hold the smallest: its
+    ``floor`` (a lower bound of the ratio, 0 where unknown: ``TrackResult.sigma_floor``), taken
+    with a margin of 10 %, exceeds a ratio already computed.  The smallest ratio and the first
+    point holding it are those of every point computed.  Compiled: the Jacobians of the points
+    in one call and one stacked SVD (the same numbers, point by point), the points in the order
+    of their floors, in blocks, until the next floor clears the smallest ratio so far; inside
+    ``python_loop()``, the reference's loop at every point."""
     fast = compiled_loops()
     if fast is None or len(points) < 2:
-        return [np.linalg.svd(problem.jacobian(x), compute_uv=False) for x in points]
-    A, _ = fast.closure_jacobians(problem.mech, np.array([x.q for x in points]), np.array([x.D for x in points]),
-                                  np.array([x.B for x in points]), active=problem.active)
-    return list(np.linalg.svd(problem.row[None, :, None] * A * problem.col[None, None, :], compute_uv=False))
+        return np.array([_ratio(np.linalg.svd(problem.jacobian(x), compute_uv=False)) for x in points])
+
+    def ratios(idx) -> np.ndarray:
+        pts = [points[i] for i in idx]
+        A, _ = fast.closure_jacobians(problem.mech, np.array([x.q for x in pts]), np.array([x.D for x in pts]),
+                                      np.array([x.B for x in pts]), active=problem.active)
+        sv = np.linalg.svd(problem.row[None, :, None] * A * problem.col[None, None, :], compute_uv=False)
+        return sv[:, -1] / sv[:, 0]
+
+    out = np.full(len(points), np.inf)
+    if floor is None:
+        out[:] = ratios(np.arange(len(points)))
+        return out
+    f = 0.9 * np.asarray(floor, dtype=float)  # computed in floating point: a margin
+    f[~np.isfinite(f)] = 0.0  # never skip a point for a bound that is not a number
+    order = np.argsort(f, kind="stable")
+    best, k = np.inf, 0
+    while k < len(order) and f[order[k]] <= best:
+        idx = order[k:k + _SIGMA_BLOCK]
+        idx = idx[f[idx] <= best]
+        out[idx] = ratios(idx)
+        best = min(best, float(np.min(out[idx])))
+        k += _SIGMA_BLOCK
+    return out
+
+
+#: Points per block of :func:`closure_sigma_ratios`'s pruned search.
+_SIGMA_BLOCK = 16
+
+
+def _ratio(sv: np.ndarray) -> float:
+    return float(sv[-1] / sv[0])
 
 
 def driver_sigmas(mech: Mechanism, points: list, drivers: list[str]) -> np.ndarray:

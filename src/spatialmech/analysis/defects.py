@@ -50,7 +50,7 @@ from ..model.mechanism import Mechanism, Pose
 from ..results import Progress, Steps, TrackStatus
 from .defect_circuits import (
     arc_on_curve,
-    closure_singular_values,
+    closure_sigma_ratios,
     driver_sigmas,
     fewest_circuits,
     pose_distance,
@@ -740,11 +740,12 @@ def _distance_to_singularities(mech: Mechanism, problem: MotionProblem, tr0: Tra
     point on the path (its minimum and the positions bracketing it), and for each driver in
     ``watch`` (the usable and planned ones) that of its complete Jacobian.  Returns
     ``(min_sigma, between, verdicts)`` (``None, None`` without points on the path)."""
-    path_pts = [(path.to_path(s), x) for s, x in zip(tr0.s, tr0.points, strict=True)
-                if 0.0 <= path.to_path(s) <= path.end]
+    on = np.array([0.0 <= path.to_path(s) <= path.end for s in tr0.s], dtype=bool)
+    path_pts = [(path.to_path(s), x) for s, x, o in zip(tr0.s, tr0.points, on, strict=True) if o]
+    floor = None if tr0.sigma_floor is None else tr0.sigma_floor[on]
     min_sig, min_between = None, None
-    sig = [(float(sv[-1] / sv[0]), a) for sv, (a, _) in zip(closure_singular_values(problem, [x for _, x in path_pts]),
-                                                           path_pts, strict=True)]
+    sig = [(float(r), a) for r, (a, _) in zip(closure_sigma_ratios(problem, [x for _, x in path_pts], floor),
+                                             path_pts, strict=True)]
     if sig:
         mval, marc = min(sig)
         min_sig, min_between = mval, positions_between(marc, path.path_arcs)

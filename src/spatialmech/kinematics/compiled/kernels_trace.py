@@ -21,8 +21,11 @@ step length, orientation, arc of the closing point); ``ist`` = (flips, rejected,
 iterations, steps, points written, events written, points before them: the Python lists'
 length); the current point ``X = (q, D, B)`` and tangent ``t``, the
 monitors at it ``mlast``.  Output, in ``Bf`` from index 0: the accepted points (``q, D, B``, arc,
-tangent, monitors; ``ist[4]`` of them) and the events (``q, D, B`` and ``Ef`` = driver, arc,
-step, value before, value after, value, bracket; ``ist[5]``).
+tangent, monitors; ``ist[4]`` of them), the events (``q, D, B`` and ``Ef`` = driver, arc,
+step, value before, value after, value, bracket; ``ist[5]``) and, last, each accepted point's
+floor of the scale-free closure sigma: ``1 / (|M^-1|_F |A|_F)`` from the step test's LU of
+``M = [A; t]`` (``A`` the row- and column-scaled closure Jacobian there), a lower bound of
+``sigma_n(A) / sigma_1(A)`` (0 for the closing point, which has no step test).
 """
 
 from __future__ import annotations
@@ -166,8 +169,9 @@ def _attempt(G, par, X, t, h, orient, Xn, tn, S):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def _put_point(Bf, k, q, D, B, s, t, m):  # pragma: no cover - compiled
+def _put_point(Bf, k, q, D, B, s, t, m, floor):  # pragma: no cover - compiled
     Pq, PD, PB, Ps, Pt, Pm = Bf[0], Bf[1], Bf[2], Bf[3], Bf[4], Bf[5]
+    Bf[10][k] = floor
     Pq[k, :] = q
     nb_copy44(D, PD[k])
     for b in range(B.shape[0]):
@@ -203,10 +207,11 @@ def _events(G, par, fs, ist, X, t, h, Xn, mlast, vals, X0, t0, Xm, W, Bf):  # pr
 
 
 @njit(cache=True)
-def _accept(G, par, fs, ist, X, t, h, Xn, tn, mlast, X0, t0, Xm, W, D2, Bf):  # pragma: no cover - compiled
+def _accept(G, par, fs, ist, X, t, h, Xn, tn, mlast, X0, t0, Xm, W, D2, Bf, floor):  # pragma: no cover - compiled
     """The accepted step's monitors, events and loop closure (the reference's order), the new
     point written out: 0, 1 (the curve closed: the closing point written, ``fs[3]`` its arc), or
-    2 where the Python path must decide (nothing counted)."""
+    2 where the Python path must decide (nothing counted).  ``floor``: the new point's floor of
+    the scale-free closure sigma (module docstring)."""
     vals = W[2]
     dcur, dnew, dvalid = D2
     nd = len(vals)
@@ -229,12 +234,12 @@ def _accept(G, par, fs, ist, X, t, h, Xn, tn, mlast, X0, t0, Xm, W, D2, Bf):  # 
                 return 2
             if nb_trace_dets(G, par, Xm[0], Xm[1], Xm[2], np.int64(0), nd, vm) != 0:
                 return 2
-            _put_point(Bf, ist[4], Xm[0], Xm[1], Xm[2], fs[0] + res[0], tn, vm)
+            _put_point(Bf, ist[4], Xm[0], Xm[1], Xm[2], fs[0] + res[0], tn, vm, 0.0)
             ist[4] += 1
             ist[5] += ne
             fs[3] = fs[0] + res[0]
             return 1
-    _put_point(Bf, ist[4], Xn[0], Xn[1], Xn[2], s_new, tn, vals)
+    _put_point(Bf, ist[4], Xn[0], Xn[1], Xn[2], s_new, tn, vals, floor)
     ist[4] += 1
     ist[5] += ne
     mlast[:] = vals
@@ -278,7 +283,8 @@ def nb_trace(G, par, X0, t0, X, t, fs, ist, mlast, Bf):  # pragma: no cover - co
             if fs[1] < par[3]:
                 return H_MIN
             continue
-        got = _accept(G, par, fs, ist, X, t, h, Xn, tn, mlast, X0, t0, Xm, W, D2, Bf)
+        got = _accept(G, par, fs, ist, X, t, h, Xn, tn, mlast, X0, t0, Xm, W, D2, Bf,
+                      S[2][2] / S[2][3] if S[2][3] > 0.0 else 0.0)
         if got == 2:
             return PYTHON_STEP
         ist[2] += iters

@@ -55,7 +55,7 @@ class TraceLoop:
         cap, ecap = max(cap, 2), max(ecap, nd + 1)
         self.Bf = (np.empty((cap, n)), np.empty((cap, 4, 4)), np.empty((cap, nb, 4, 4)), np.empty(cap),
                    np.empty((cap, nl)), np.empty((cap, nd)), np.empty((ecap, n)), np.empty((ecap, 4, 4)),
-                   np.empty((ecap, nb, 4, 4)), np.empty((ecap, 8)))
+                   np.empty((ecap, nb, 4, 4)), np.empty((ecap, 8)), np.empty(cap))
 
     def run(self, w, names: list[str], event_type) -> int:
         """The kernel from the state ``w`` (``tracking._Walk``) until it finishes or hands a step
@@ -84,8 +84,9 @@ class TraceLoop:
     def _collect(self, w, npts: int, nev: int, names, event_type) -> None:
         """Points and events written by the kernel, appended to ``w``'s lists (copies: the
         arrays are written again by the next call)."""
-        Pq, PD, PB, Ps, Pt, Pm, Eq, ED, EB, Ef = (a.copy() for a in self._used(npts, nev))
+        Pq, PD, PB, Ps, Pt, Pm, Eq, ED, EB, Ef, Pf = (a.copy() for a in self._used(npts, nev))
         B0 = w.xs[0].B
+        w.floors.append((len(w.xs), Pf))
         w.xs.extend(Configuration.of(Pq[i], PD[i], PB[i] if self.nb else B0) for i in range(npts))
         w.ss.extend(Ps.tolist())
         w.ts.extend(Pt)
@@ -98,7 +99,7 @@ class TraceLoop:
 
     def _used(self, npts: int, nev: int) -> tuple:
         Bf = self.Bf
-        return (*(a[:npts] for a in Bf[:6]), *(a[:nev] for a in Bf[6:]))
+        return (*(a[:npts] for a in Bf[:6]), *(a[:nev] for a in Bf[6:10]), Bf[10][:npts])
 
 
 def motion_arrays(mech: Mechanism, active, row, col, wrap, drivers=()) -> tuple:
