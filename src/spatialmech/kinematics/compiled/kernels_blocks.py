@@ -124,10 +124,12 @@ def nb_pivoted_qr(ZT, nrows, m, ncols, piv, v0, vn2, e):
         for i in range(c + 1):
             fro += ZT[c, i] * ZT[c, i]
     inv = 0.0
-    for c in range(r):
-        for i in range(r - 1, -1, -1):
-            acc = 1.0 if i == c else 0.0
-            for k in range(i + 1, r):
+    for c in range(r):  # column c of R^-1, zero below row c: only rows c .. 0 are solved
+        e[c] = 1.0 / ZT[c, c]
+        inv += e[c] * e[c]
+        for i in range(c - 1, -1, -1):
+            acc = 0.0
+            for k in range(i + 1, c + 1):
                 acc -= ZT[k, i] * e[k]
             e[i] = acc / ZT[i, i]
             inv += e[i] * e[i]
