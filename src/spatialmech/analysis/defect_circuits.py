@@ -186,6 +186,7 @@ _SIGMA_BLOCK = 16
 
 
 def _ratio(sv: np.ndarray) -> float:
+    """The scale-free sigma ``sigma_n / sigma_1`` of singular values ``sv`` (descending)."""
     return float(sv[-1] / sv[0])
 
 

@@ -213,10 +213,8 @@ class TrackResult:
     reason: str = ""  # why the tracker failed (empty unless ``status`` is h_min)
     _stacked: tuple | None = field(default=None, repr=False, compare=False)
     _tangents: np.ndarray | None = field(default=None, repr=False, compare=False)
-    #: Per point, a lower bound of the scale-free closure sigma ``sigma_n / sigma_1`` of the
-    #: problem's (nondimensional) Jacobian there, where the compiled loop's step test certified
-    #: one (``1 / (|[A; t]^-1|_F |A|_F)`` from its LU; see :mod:`.compiled.kernels_trace`), else 0;
-    #: ``None`` without any (the Python loop).  Computed in floating point: use with a margin.
+    #: Per point, a floor of ``sigma_n / sigma_1`` of the problem's scaled Jacobian from the compiled step test's LU
+    #: (``1 / (|[A; t]^-1|_F |A|_F)``, :mod:`.compiled.kernels_trace`), else 0; ``None``: none (use with a margin).
     sigma_floor: np.ndarray | None = field(default=None, repr=False, compare=False)
 
     def stacked(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -377,7 +375,7 @@ class _Walk:
     total_iters: int = 0
     steps: int = 0
     d_last: tuple | None = None  # (point, difference of it from x0) of the last accepted step
-    floors: list = field(default_factory=list)  # (index of the first point, floors) from the compiled loop
+    floors: dict = field(default_factory=dict)  # point index -> its sigma floor, from the compiled loop
     status: TrackStatus = TrackStatus.MAX_ARC
     reason: str = ""
     closed: bool = False
@@ -544,11 +542,7 @@ def track(
         if not _python_step(problem, w, cfg, monitors):
             break
     mons = {k: np.array(v) for k, v in w.mon.items()}
-    floor = None
-    if w.floors:
-        floor = np.zeros(len(w.xs))
-        for i0, f in w.floors:
-            floor[i0:i0 + len(f)] = f
+    floor = np.array([w.floors.get(i, 0.0) for i in range(len(w.xs))]) if w.floors else None
     return TrackResult(w.xs, np.array(w.ss), w.ts, mons, w.events, w.closed, w.status, w.rejected, w.total_iters,
                        {k: float(np.min(np.abs(v))) for k, v in mons.items()}, w.reason, sigma_floor=floor)
 

@@ -86,7 +86,7 @@ class TraceLoop:
         arrays are written again by the next call)."""
         Pq, PD, PB, Ps, Pt, Pm, Eq, ED, EB, Ef, Pf = (a.copy() for a in self._used(npts, nev))
         B0 = w.xs[0].B
-        w.floors.append((len(w.xs), Pf))
+        w.floors.update(zip(range(len(w.xs), len(w.xs) + npts), Pf.tolist(), strict=True))
         w.xs.extend(Configuration.of(Pq[i], PD[i], PB[i] if self.nb else B0) for i in range(npts))
         w.ss.extend(Ps.tolist())
         w.ts.extend(Pt)
