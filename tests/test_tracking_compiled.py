@@ -218,15 +218,8 @@ def test_the_compiled_loop_ends_a_track_as_the_python_loop_does(kw, monkeypatch)
     assert all(abs(e.s - f.s) <= TRACE_TOL for e, f in zip(a.events, b.events, strict=True))
 
 
-def test_the_pruned_nearest_point_is_the_full_argmin():
-    """``compiled.nearest_point`` (the full difference only where its bound does not rule a point
-    out) returns the index of the full ``argmin`` of the distances, on a traced 5-CS circuit, for
-    the traced points themselves, points between them and configurations off the curve."""
-    from spatialmech.kinematics import compiled
-
-    if not backend.enabled():
-        pytest.skip("the compiled engine is not in use")
-    mech = catalog.build("five-cs-1")
+def _problems_and_traces(mech):
+    """``(MotionProblem, TrackResult)`` of each circuit a defect analysis of ``mech`` traces."""
     rec = []
 
     def recording(*a, **k):
@@ -236,7 +229,19 @@ def test_the_pruned_nearest_point_is_the_full_argmin():
     with pytest.MonkeyPatch.context() as m:
         m.setattr(defect_circuits, "track", recording)
         defect_analysis(mech, sigma_along_path=False)
-    prob, tr = rec[0]
+    return rec
+
+
+def test_the_pruned_nearest_point_is_the_full_argmin():
+    """``compiled.nearest_point`` (the full difference only where its bound does not rule a point
+    out) returns the index of the full ``argmin`` of the distances, on a traced 5-CS circuit, for
+    the traced points themselves, points between them and configurations off the curve."""
+    from spatialmech.kinematics import compiled
+
+    if not backend.enabled():
+        pytest.skip("the compiled engine is not in use")
+    mech = catalog.build("five-cs-1")
+    prob, tr = _problems_and_traces(mech)[0]
     rng = np.random.default_rng(0)
     queries = [tr.points[k] for k in range(0, len(tr.points), 7)]
     queries += [prob.retract(tr.points[k], 0.5 * (tr.s[k + 1] - tr.s[k]) * tr.tangents[k])
@@ -258,16 +263,7 @@ def test_the_sigma_floors_bound_the_ratios_and_the_pruned_minimum_is_the_full_on
     five-cs-2's circuits); some points are, over each model's circuits."""
     if not backend.enabled():
         pytest.skip("the compiled engine is not in use")
-    mech = catalog.build(name)
-    rec = []
-
-    def recording(*a, **k):
-        rec.append((a[0], tracking.track(*a, **k)))
-        return rec[-1][1]
-
-    with pytest.MonkeyPatch.context() as m:
-        m.setattr(defect_circuits, "track", recording)
-        defect_analysis(mech, sigma_along_path=False)
+    rec = _problems_and_traces(catalog.build(name))
     pruned = 0
     for prob, tr in rec:
         assert tr.sigma_floor is not None and tr.sigma_floor.shape == (len(tr.points),)

@@ -24,7 +24,7 @@ from __future__ import annotations
 import functools
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -235,12 +235,10 @@ def _cs_closed_forms_py(u, B1, M1, A, Ds, q):  # pragma: no cover - compiled by 
     ``B1[k]``, S centre ``M1[k]``, S axes the rows of ``A[k]``) at the displacements ``Ds[n]``,
     into ``q[n, 5k:5k+5]`` = (C rotation, C slide, S rotation vector in the S axes), in scalar
     loops (compiled by :func:`_cs_closed_forms`): ``R_u(-theta)`` by Rodrigues, the S rotation
-    vector by SciPy's algorithm (Shepperd's quaternion -- the largest of the trace and the diagonal
-    picks the formula -- ``w >= 0``, ``angle = 2 atan2(|v|, w)``, ``rotvec = angle / sin(angle / 2)
-    v``, its series below 1e-3 rad)."""
+    vector by SciPy's algorithm (:func:`..kinematics.compiled.kernels_se3.nb_quat_rotvec`, bound to
+    ``_quat_rotvec`` by :func:`_cs_closed_forms`)."""
     Rs = np.empty((3, 3))
     K2 = np.empty((3, 3))
-    quat = np.empty(4)
     rv = np.empty(3)
     Mj = np.empty(3)
     for n in range(Ds.shape[0]):
@@ -273,46 +271,28 @@ def _cs_closed_forms_py(u, B1, M1, A, Ds, q):  # pragma: no cover - compiled by 
                 Rs[0, j] += sn * k0
                 Rs[1, j] += sn * k1
                 Rs[2, j] += sn * k2
-            tr = Rs[0, 0] + Rs[1, 1] + Rs[2, 2]
-            i, best = 0, Rs[0, 0]  # the first largest of (R00, R11, R22, trace), as numpy.argmax
-            for d in range(1, 3):
-                if Rs[d, d] > best:
-                    i, best = d, Rs[d, d]
-            if tr > best:
-                i = 3
-            if i == 3:
-                quat[0], quat[1], quat[2], quat[3] = Rs[2, 1] - Rs[1, 2], Rs[0, 2] - Rs[2, 0], Rs[1, 0] - Rs[0, 1], 1.0 + tr
-            else:
-                j, l = (i + 1) % 3, (i + 2) % 3
-                quat[i] = 1.0 - tr + 2.0 * Rs[i, i]
-                quat[j] = Rs[j, i] + Rs[i, j]
-                quat[l] = Rs[l, i] + Rs[i, l]
-                quat[3] = Rs[l, j] - Rs[j, l]
-            nq = np.sqrt(quat[0] * quat[0] + quat[1] * quat[1] + quat[2] * quat[2] + quat[3] * quat[3])
-            sg = -1.0 if quat[3] < 0 else 1.0
-            for d in range(4):
-                quat[d] = sg * quat[d] / nq
-            v = np.sqrt(quat[0] * quat[0] + quat[1] * quat[1] + quat[2] * quat[2])
-            angle = 2.0 * np.arctan2(v, quat[3])
-            if abs(angle) <= 1e-3:
-                a2 = angle * angle
-                scale = 2.0 + a2 / 12.0 + 7.0 * a2 * a2 / 2880.0
-            else:
-                scale = angle / np.sin(angle / 2.0)
-            for d in range(3):
-                rv[d] = scale * quat[d]
+            _quat_rotvec(Rs, rv)
             q[n, 5 * k] = th
             q[n, 5 * k + 1] = s
             for d in range(3):
                 q[n, 5 * k + 2 + d] = A[k, d, 0] * rv[0] + A[k, d, 1] * rv[1] + A[k, d, 2] * rv[2]
 
 
+#: ``kernels_se3.nb_quat_rotvec``, bound on first use by :func:`_cs_closed_forms` (importing the
+#: kernels module loads numba).
+_quat_rotvec: Any = None
+
+
 @functools.cache
 def _cs_closed_forms():
     """:func:`_cs_closed_forms_py` compiled (numba, ``cache=True``) on first use when the compiled
-    engine is on (importing this module loads no numba), else the plain function."""
+    engine is on (importing this module loads no numba), else the plain function (the rotation
+    vector's kernel is then plain Python too)."""
+    global _quat_rotvec
     from ..kinematics import backend
+    from ..kinematics.compiled.kernels_se3 import nb_quat_rotvec
 
+    _quat_rotvec = nb_quat_rotvec
     if not backend.enabled():
         return _cs_closed_forms_py
     from ..kinematics.compiled.jit import njit
