@@ -740,8 +740,9 @@ def _distance_to_singularities(mech: Mechanism, problem: MotionProblem, tr0: Tra
     point on the path (its minimum and the positions bracketing it), and for each driver in
     ``watch`` (the usable and planned ones) that of its complete Jacobian.  Returns
     ``(min_sigma, between, verdicts)`` (``None, None`` without points on the path)."""
-    on = np.array([0.0 <= path.to_path(s) <= path.end for s in tr0.s], dtype=bool)
-    path_pts = [(path.to_path(s), x) for s, x, o in zip(tr0.s, tr0.points, on, strict=True) if o]
+    arcs = [path.to_path(s) for s in tr0.s]
+    on = np.array([0.0 <= a <= path.end for a in arcs], dtype=bool)
+    path_pts = [(a, x) for a, x, o in zip(arcs, tr0.points, on, strict=True) if o]
     floor = None if tr0.sigma_floor is None else tr0.sigma_floor[on]
     min_sig, min_between = None, None
     sig = [(float(r), a) for r, (a, _) in zip(closure_sigma_ratios(problem, [x for _, x in path_pts], floor),

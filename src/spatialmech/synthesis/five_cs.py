@@ -235,10 +235,10 @@ def _cs_closed_forms_py(u, B1, M1, A, Ds, q):  # pragma: no cover - compiled by 
     ``B1[k]``, S centre ``M1[k]``, S axes the rows of ``A[k]``) at the displacements ``Ds[n]``,
     into ``q[n, 5k:5k+5]`` = (C rotation, C slide, S rotation vector in the S axes), in scalar
     loops (compiled by :func:`_cs_closed_forms`): ``R_u(-theta)`` by Rodrigues, the S rotation
-    vector by SciPy's algorithm (:func:`..kinematics.compiled.kernels_se3.nb_quat_rotvec`, bound to
-    ``_quat_rotvec`` by :func:`_cs_closed_forms`)."""
+    vector by SciPy's algorithm: ``kernels_se3``'s ``nb_rodrigues`` and ``nb_quat_rotvec`` (the
+    module is bound to ``_se3`` by :func:`_cs_closed_forms`)."""
+    Ru = np.empty((3, 3))
     Rs = np.empty((3, 3))
-    K2 = np.empty((3, 3))
     rv = np.empty(3)
     Mj = np.empty(3)
     for n in range(Ds.shape[0]):
@@ -255,44 +255,32 @@ def _cs_closed_forms_py(u, B1, M1, A, Ds, q):  # pragma: no cover - compiled by 
             b0, b1, b2 = w0 - uw * ux, w1 - uw * uy, w2 - uw * uz
             th = np.arctan2(ux * (a1 * b2 - a2 * b1) + uy * (a2 * b0 - a0 * b2) + uz * (a0 * b1 - a1 * b0),
                             a0 * b0 + a1 * b1 + a2 * b2)
-            sn, c1 = np.sin(-th), 1.0 - np.cos(th)
-            uu = ux * ux + uy * uy + uz * uz
-            K2[0, 0], K2[1, 1], K2[2, 2] = ux * ux - uu, uy * uy - uu, uz * uz - uu
-            K2[0, 1] = K2[1, 0] = ux * uy
-            K2[0, 2] = K2[2, 0] = ux * uz
-            K2[1, 2] = K2[2, 1] = uy * uz
-            for i in range(3):  # R_u(-theta) @ R_n, R_u(-theta) = I + sin(-theta) K + (1 - cos theta) K K
+            _se3.nb_rodrigues(ux, uy, uz, np.sin(-th), 1.0 - np.cos(th), Ru)  # R_u(-theta)
+            for i in range(3):  # R_u(-theta) @ R_n
                 for j in range(3):
-                    Rs[i, j] = Ds[n, i, j] + c1 * (K2[i, 0] * Ds[n, 0, j] + K2[i, 1] * Ds[n, 1, j] + K2[i, 2] * Ds[n, 2, j])
-            for j in range(3):
-                k0 = -uz * Ds[n, 1, j] + uy * Ds[n, 2, j]
-                k1 = uz * Ds[n, 0, j] - ux * Ds[n, 2, j]
-                k2 = -uy * Ds[n, 0, j] + ux * Ds[n, 1, j]
-                Rs[0, j] += sn * k0
-                Rs[1, j] += sn * k1
-                Rs[2, j] += sn * k2
-            _quat_rotvec(Rs, rv)
+                    Rs[i, j] = Ru[i, 0] * Ds[n, 0, j] + Ru[i, 1] * Ds[n, 1, j] + Ru[i, 2] * Ds[n, 2, j]
+            _se3.nb_quat_rotvec(Rs, rv)
             q[n, 5 * k] = th
             q[n, 5 * k + 1] = s
             for d in range(3):
                 q[n, 5 * k + 2 + d] = A[k, d, 0] * rv[0] + A[k, d, 1] * rv[1] + A[k, d, 2] * rv[2]
 
 
-#: ``kernels_se3.nb_quat_rotvec``, bound on first use by :func:`_cs_closed_forms` (importing the
-#: kernels module loads numba).
-_quat_rotvec: Any = None
+#: The module ``kinematics.compiled.kernels_se3``, bound on first use by :func:`_cs_closed_forms`
+#: (importing it loads numba).
+_se3: Any = None
 
 
 @functools.cache
 def _cs_closed_forms():
     """:func:`_cs_closed_forms_py` compiled (numba, ``cache=True``) on first use when the compiled
-    engine is on (importing this module loads no numba), else the plain function (the rotation
-    vector's kernel is then plain Python too)."""
-    global _quat_rotvec
+    engine is on (importing this module loads no numba), else the plain function (which calls the
+    same kernels)."""
+    global _se3
     from ..kinematics import backend
-    from ..kinematics.compiled.kernels_se3 import nb_quat_rotvec
+    from ..kinematics.compiled import kernels_se3
 
-    _quat_rotvec = nb_quat_rotvec
+    _se3 = kernels_se3
     if not backend.enabled():
         return _cs_closed_forms_py
     from ..kinematics.compiled.jit import njit
