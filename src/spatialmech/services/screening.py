@@ -22,6 +22,8 @@ workers gives the same rows as the serial one (``workers=0``), up to the ``secon
 
 from __future__ import annotations
 
+import atexit
+import gc
 import hashlib
 import json
 import math
@@ -287,14 +289,32 @@ def _connect(client_type, scheduler: str):
     return box["client"]
 
 
+def _skip_final_collections() -> None:
+    """Runs in each worker process of this module's own ``LocalCluster`` (a worker plugin's set-up):
+    at the process's exit, the objects it holds are frozen out of the garbage collector
+    (``gc.freeze``), so that the interpreter's final collections skip them (the operating system
+    frees the memory anyway).  With the compiled kernels loaded, those collections made the
+    cluster's close take 0.46-0.50 s, against 0.08-0.10 s with this (stop 42), and the screen
+    waits for it.  Handlers registered before this one (Dask's, ``weakref`` finalizers, logging)
+    still run after it; only reference cycles left at exit go unfinalized."""
+    atexit.register(gc.freeze)
+
+
 def _local_cluster(workers: int):
     import logging
 
     from distributed import Client, LocalCluster
+    from distributed.diagnostics.plugin import WorkerPlugin
+
+    class _QuickExit(WorkerPlugin):
+        def setup(self, worker) -> None:
+            _skip_final_collections()
 
     cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
                            dashboard_address=None, silence_logs=logging.ERROR)
-    return cluster, Client(cluster)
+    client = Client(cluster)
+    client.register_plugin(_QuickExit(), name="spatialmech-quick-exit")
+    return cluster, client
 
 
 def judge_chunks(pool: DyadPool, todo: list) -> list[tuple[int, list[dict]]]:
