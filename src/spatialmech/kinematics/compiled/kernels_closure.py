@@ -32,6 +32,8 @@ __all__ = [
     "nb_colmap",
     "nb_correct",
     "nb_correct_hyperplane",
+    "nb_correct_hyperplane_ws",
+    "nb_corrector_workspace",
     "nb_finite_config",
     "nb_hub",
     "nb_limb_columns",
@@ -447,22 +449,37 @@ def nb_correct_hyperplane(S, ball_of, ball_first, ball_axes, ball_centre, limb_s
     the corrector converged by its residual test inside the loop: ``A`` and ``r`` are then those
     of ``q, D, B`` (unscaled), so that a caller needing the Jacobian there (the tracker's step
     test) need not evaluate it again."""
-    K = len(limb_start) - 1
-    m = 6 * K
+    ws = nb_corrector_workspace(limb_start, active, len(q0), B0.shape[0])
+    return nb_correct_hyperplane_ws(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends, q0, D0, B0, active,
+                                    row, col, t, tol, max_iter, contraction, pred, has_pred, q, D, B, info, A, r, ws)
+
+
+@njit(cache=True)
+def nb_corrector_workspace(limb_start, active, n, n_hubs):
+    """The scratch of :func:`nb_correct_hyperplane_ws` for a mechanism of ``n`` joint
+    coordinates, ``n_hubs`` moving hubs and these limbs and active joints: a tuple
+    ``(colmap, c_lo, c_hi, fbuf, ibuf, M, rhs, step, d, q2, D2, B2, cws, rws)``.  A caller that
+    corrects many times (the tracker's steps, its event and pose searches) allocates it once;
+    every call overwrites it before reading it, so no call sees what an earlier one left."""
     colmap, na = nb_colmap(active)
-    nc = na + 6 * (1 + B0.shape[0])
-    M = np.empty((m + 1, nc))
-    rhs = np.empty(m + 1)
-    step = np.empty(nc)
-    n = len(q0)
-    q2 = np.empty(n)
-    D2 = np.empty((4, 4))
-    B2 = np.empty(B0.shape)
-    cws = np.empty(nb_closure_ws_size(limb_start))
-    rws = np.empty(n + RETRACT_WS)
+    nc = na + 6 * (1 + n_hubs)
+    m = 6 * (len(limb_start) - 1)
     c_lo, c_hi = nb_limb_columns(limb_start, colmap)
     fbuf, ibuf = nb_blocks_workspace(c_lo, c_hi, na, nc)
-    d = np.empty(nc)
+    return (colmap, c_lo, c_hi, fbuf, ibuf, np.empty((m + 1, nc)), np.empty(m + 1), np.empty(nc), np.empty(nc),
+            np.empty(n), np.empty((4, 4)), np.empty((n_hubs, 4, 4)), np.empty(nb_closure_ws_size(limb_start)),
+            np.empty(n + RETRACT_WS))
+
+
+@njit(cache=True)
+def nb_correct_hyperplane_ws(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends, q0, D0, B0, active, row,
+                             col, t, tol, max_iter, contraction, pred, has_pred, q, D, B, info, A, r, ws):
+    """:func:`nb_correct_hyperplane` with its scratch ``ws`` from :func:`nb_corrector_workspace`
+    (made for the same ``limb_start`` and ``active``)."""
+    colmap, c_lo, c_hi, fbuf, ibuf, M, rhs, step, d, q2, D2, B2, cws, rws = ws
+    m = M.shape[0] - 1
+    nc = M.shape[1]
+    na = nc - 6 * (1 + B0.shape[0])
     if has_pred:
         for c in range(nc):
             step[c] = col[c] * pred[c]
@@ -491,7 +508,7 @@ def nb_correct_hyperplane(S, ball_of, ball_first, ball_axes, ball_centre, limb_s
         rhs[m] = 0.0
         # the square system's solution by limb blocks with the tangent as border row, else lstsq's
         if not nb_minnorm_blocks(M, rhs, M[m], 0.0, c_lo, c_hi, na, d, fbuf, ibuf):
-            d = nb_lstsq(M, rhs)
+            d[:] = nb_lstsq(M, rhs)
         dn = nb_norm(d)
         if it > 0 and dn > contraction * prev:
             info[0] = 0.0

@@ -33,7 +33,8 @@ from __future__ import annotations
 import numpy as np
 
 from .jit import njit
-from .kernels_closure import nb_closure_system, nb_closure_ws_size, nb_colmap, nb_copy44, nb_correct_hyperplane
+from .kernels_closure import (nb_closure_system, nb_closure_ws_size, nb_colmap, nb_copy44, nb_correct_hyperplane_ws,
+                              nb_corrector_workspace)
 from .kernels_drivers import nb_closure_dets, nb_difference, nb_driver_dets
 from .kernels_tracking import nb_bordered_tangent
 
@@ -48,17 +49,25 @@ DONE, H_MIN, CLOSED, PYTHON_STEP, FULL = 0, 1, 2, 3, 4
 
 
 @njit(cache=True)
-def nb_trace_correct(G, q, D, B, t, a, tol, max_iter, pred, qo, Do, Bo, info, A, r):  # pragma: no cover - compiled
+def nb_trace_correct(G, q, D, B, t, a, tol, max_iter, pred, qo, Do, Bo, info, A, r, cw):  # pragma: no cover - compiled
     """``tracking.predict_correct(problem, x, a * t, t, tol, max_iter)`` of a ``MotionProblem``:
-    ``info`` = (converged, iterations, total correction length); ``A``, ``r``: the corrector's
-    scratch (:func:`.kernels_closure.nb_correct_hyperplane`, ``A`` allocated with ``np.zeros``).
+    ``info`` = (converged, iterations, total correction length); ``A``, ``r``, ``cw``: the
+    corrector's scratch (:func:`.kernels_closure.nb_correct_hyperplane_ws`, ``A`` allocated with
+    ``np.zeros``, ``cw`` by :func:`_corrector_ws`).
     ``True`` when ``A`` is then the (unscaled) closure Jacobian at the corrected point."""
     S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends, active, row, col = (G[0], G[1], G[2], G[3], G[4],
                                                                                        G[5], G[6], G[8], G[11], G[12])
     for c in range(len(t)):
         pred[c] = a * t[c]
-    return nb_correct_hyperplane(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends, q, D, B, active, row,
-                                 col, t, tol, max_iter, 0.6, pred, np.bool_(True), qo, Do, Bo, info, A, r)
+    return nb_correct_hyperplane_ws(S, ball_of, ball_first, ball_axes, ball_centre, limb_start, ends, q, D, B, active,
+                                    row, col, t, tol, max_iter, 0.6, pred, np.bool_(True), qo, Do, Bo, info, A, r, cw)
+
+
+@njit(cache=True)
+def _corrector_ws(G, q, B):  # pragma: no cover - compiled
+    """:func:`nb_trace_correct`'s ``cw`` for the mechanism ``G`` at a configuration shaped like
+    ``(q, B)``."""
+    return nb_corrector_workspace(G[5], G[8], len(q), B.shape[0])
 
 
 @njit(cache=True)
@@ -106,7 +115,7 @@ def _locate(G, par, X, t, h, which, fa, fb, X0, t0, Xm, W, res):  # pragma: no c
     """``tracking._locate``: Illinois on the step length ``[0, h]`` from ``X`` along ``t``, each
     trial corrected onto the curve, into ``Xm``; ``res`` = (step length, monitor there, bracket
     values).  Returns 0, or 2 where the Python path must decide."""
-    pred, info, vals, dif, Aw, rw = W
+    pred, info, vals, dif, Aw, rw, cw = W
     lo, hi, flo, fhi = 0.0, h, fa, fb
     true_lo, true_hi = fa, fb
     side = 0
@@ -118,7 +127,8 @@ def _locate(G, par, X, t, h, which, fa, fb, X0, t0, Xm, W, res):  # pragma: no c
                 mid = 0.5 * (lo + hi)
         else:
             mid = 0.5 * (lo + hi)
-        nb_trace_correct(G, X[0], X[1], X[2], t, mid, par[6], np.int64(20), pred, Xm[0], Xm[1], Xm[2], info, Aw, rw)
+        nb_trace_correct(G, X[0], X[1], X[2], t, mid, par[6], np.int64(20), pred, Xm[0], Xm[1], Xm[2], info, Aw, rw,
+                         cw)
         flag, fm = _monitor(G, par, which, Xm[0], Xm[1], Xm[2], X0, t0, vals, dif)
         if flag != 0:
             return 2
@@ -145,8 +155,9 @@ def _attempt(G, par, X, t, h, orient, Xn, tn, S):  # pragma: no cover - compiled
     """One predictor-corrector step of length ``h`` and its test: (code, corrector iterations,
     orientation at the new point); code 0 accepted, 1 rejected, 3 rejected by an orientation
     flip, 2 handed to the Python loop (the bordered LU does not certify the step test)."""
-    pred, info, info4, A, As, Mb, r, cws, colmap = S
-    fresh = nb_trace_correct(G, X[0], X[1], X[2], t, h, par[6], np.int64(12), pred, Xn[0], Xn[1], Xn[2], info, A, r)
+    pred, info, info4, A, As, Mb, r, cws, colmap, cw = S
+    fresh = nb_trace_correct(G, X[0], X[1], X[2], t, h, par[6], np.int64(12), pred, Xn[0], Xn[1], Xn[2], info, A, r,
+                             cw)
     iters = int(info[1])
     if not (info[0] == 1.0 and info[2] < 0.5 * h):
         return 1, iters, 0.0
@@ -190,7 +201,7 @@ def _events(G, par, fs, ist, X, t, h, Xn, mlast, vals, X0, t0, Xm, W, Bf):  # pr
     res = np.empty(4)
     ne = ist[5]
     vm = np.empty(len(vals))
-    W2 = (W[0], W[1], vm, W[3], W[4], W[5])
+    W2 = (W[0], W[1], vm, W[3], W[4], W[5], W[6])
     for k in range(len(vals)):
         a, b = mlast[k], vals[k]
         if np.sign(a) != np.sign(b) and a != 0:
@@ -262,9 +273,10 @@ def nb_trace(G, par, X0, t0, X, t, fs, ist, mlast, Bf):  # pragma: no cover - co
     Xm = (np.empty_like(q), np.empty((4, 4)), np.empty_like(B))
     tn = np.empty(nl)
     colmap, _na = nb_colmap(G[8])
+    cw = _corrector_ws(G, q, B)  # one corrector scratch for the steps and the event searches
     S = (np.empty(nl), np.zeros(3), np.zeros(4), np.zeros((m, nl)), np.empty((m, nl)), np.empty((nl, nl)), np.empty(m),
-         np.empty(nb_closure_ws_size(G[5])), colmap)
-    W = (S[0], np.zeros(3), np.empty(len(mlast)), np.empty(nl), np.zeros((m, nl)), np.empty(m))
+         np.empty(nb_closure_ws_size(G[5])), colmap, cw)
+    W = (S[0], np.zeros(3), np.empty(len(mlast)), np.empty(nl), np.zeros((m, nl)), np.empty(m), cw)
     D2 = (np.empty(nl), np.empty(nl), np.zeros(1, dtype=np.int64))
     cap, ecap = Bf[3].shape[0], Bf[9].shape[0]
     while fs[0] < par[5] and ist[3] < par[10]:
@@ -329,7 +341,7 @@ def nb_pose_measure(D, pose, out):  # pragma: no cover - compiled
 def _pose_at(G, q, D, B, t, a, pose, Xm, W, out):  # pragma: no cover - compiled
     """The measure at the point ``a`` along the step (corrected onto the curve), infinite where
     the corrector does not converge."""
-    nb_trace_correct(G, q, D, B, t, a, 1e-11, np.int64(20), W[0], Xm[0], Xm[1], Xm[2], W[1], W[2], W[3])
+    nb_trace_correct(G, q, D, B, t, a, 1e-11, np.int64(20), W[0], Xm[0], Xm[1], Xm[2], W[1], W[2], W[3], W[4])
     if W[1][0] == 1.0:  # converged
         nb_pose_measure(Xm[1], pose, out)
     else:
@@ -344,7 +356,8 @@ def nb_pose_search(G, q, D, B, t, h, pose, xatol, res):  # pragma: no cover - co
     curve.  ``res`` = (step length, normalised distance, |dp|, angle) of the best point."""
     Xm = (np.empty_like(q), np.empty((4, 4)), np.empty_like(B))
     m = 6 * (len(G[5]) - 1)
-    W = (np.empty(len(t)), np.zeros(3), np.zeros((m, len(t))), np.empty(m))  # predictor, info, corrector scratch
+    # the predictor, info, the corrector's scratch (A, r, cw)
+    W = (np.empty(len(t)), np.zeros(3), np.zeros((m, len(t))), np.empty(m), _corrector_ws(G, q, B))
     mf, mu = np.empty(3), np.empty(3)
     sqrt_eps = np.sqrt(2.2e-16)
     golden_mean = 0.5 * (3.0 - np.sqrt(5.0))
@@ -436,12 +449,13 @@ def nb_arc_near(G, Q, DS, BS, T, s, ks, q, D, B, res):  # pragma: no cover - com
     Xm = (np.empty_like(q), np.empty((4, 4)), np.empty_like(B))
     pred, info = np.empty(nl), np.zeros(3)
     m = 6 * (len(G[5]) - 1)
-    A, r = np.zeros((m, nl)), np.empty(m)
+    A, r, cw = np.zeros((m, nl)), np.empty(m), _corrector_ws(G, q, B)
     res[0], res[1] = np.inf, np.nan
     for k in ks:
         nb_difference(G[2], G[3], Q[k], DS[k], BS[k], q, D, B, G[8], G[13], G[12], dif)
         a = _dot(T[k], dif)
-        nb_trace_correct(G, Q[k], DS[k], BS[k], T[k], a, 1e-11, np.int64(30), pred, Xm[0], Xm[1], Xm[2], info, A, r)
+        nb_trace_correct(G, Q[k], DS[k], BS[k], T[k], a, 1e-11, np.int64(30), pred, Xm[0], Xm[1], Xm[2], info, A, r,
+                         cw)
         if info[0] == 0.0:
             continue
         nb_difference(G[2], G[3], Xm[0], Xm[1], Xm[2], q, D, B, G[8], G[13], G[12], dif)
