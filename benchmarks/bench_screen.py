@@ -2,7 +2,7 @@
 local Dask clusters of 1 and 2 worker processes, in the same run.
 
     python benchmarks/bench_screen.py [--candidates N] [--serial N] [--compare N] [--verify K]
-                                      [--no-one-worker] [--json]
+                                      [--no-one-worker] [--pairs N] [--json]
 
 1. the CS dyad family (60 starts, seed 0) and its pool (density 0.5) are made once;
 2. ``--compare`` candidates (default 60) are judged by the batched judgement (the default:
@@ -15,8 +15,10 @@ local Dask clusters of 1 and 2 worker processes, in the same run.
    of this process (``time.process_time``);
 4. ``--candidates`` candidates (default 1000; the first ``--serial`` of them are the same) are
    screened on a LocalCluster of 1 process (unless ``--no-one-worker``) and of 2 processes on
-   loopback (``import distributed`` done before both, ``import_distributed_s``): the rates,
-   the cluster's start and close included, the speed-up of 2 workers over 1 (issue 29's target)
+   loopback, in ``--pairs`` alternating pairs (default 3: the machine's drift within a minute is
+   as large as the ratio's distance from its target; ``import distributed`` done before all,
+   ``import_distributed_s``): the rates, the cluster's start and close included, the speed-up
+   of 2 workers over 1 in each pair and their median (issue 29's target; ``pairs`` in ``--json``)
    and over the serial rate, and the CPU seconds of the worker processes (``RUSAGE_CHILDREN``
    once the cluster is closed) with the candidates per CPU second; the load average (1 min)
    before and after each run (the machine may be shared: a ratio is only fair when the load
@@ -40,6 +42,7 @@ import json
 import math
 import os
 import resource
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -122,6 +125,7 @@ def main() -> None:
     ap.add_argument("--verify", type=int, default=20)
     ap.add_argument("--compare", type=int, default=60)
     ap.add_argument("--no-one-worker", dest="one_worker", action="store_false")
+    ap.add_argument("--pairs", type=int, default=3)
     ap.add_argument("--json", action="store_true")
     a = ap.parse_args()
     say = (lambda *x: None) if a.json else print
@@ -179,31 +183,48 @@ def main() -> None:
             f"({res['serial']['candidates_per_cpu_s']:.2f} per CPU s; load {load0:.1f}); {s0.rejected_by_stage}, "
             f"usable {s0.usable}")
 
-        if a.one_worker:
-            _, res["one_worker"] = workers_run(d, "one.parquet", 1, fam, a.candidates, 0)
-            o = res["one_worker"]
-            say(f"1 worker: {o['candidates']} candidates in {o['seconds']:.1f} s = {o['candidates_per_s']:.2f} /s "
-                f"(start-up {o['cluster_startup_s'] or math.nan:.1f} s, then "
-                f"{o['candidates_per_s_after_startup'] or math.nan:.2f} /s; {o['candidates_per_cpu_s'] or math.nan:.2f} "
-                f"per worker CPU s; load {o['load_1min_before']:.1f} -> {o['load_1min_after']:.1f})")
-        s2, res["two_workers"] = workers_run(d, "two.parquet", 2, fam, a.candidates, 5)
-        tw = res["two_workers"]
+        pairs = []
+        for p in range(a.pairs):  # alternating, so that both cluster sizes see the same drift of the machine
+            last = p == a.pairs - 1
+            if a.one_worker:
+                _, o = workers_run(d, f"one-{p}.parquet", 1, fam, a.candidates, 0)
+                say(f"1 worker: {o['candidates']} candidates in {o['seconds']:.1f} s = {o['candidates_per_s']:.2f} /s "
+                    f"(start-up {o['cluster_startup_s'] or math.nan:.1f} s, then "
+                    f"{o['candidates_per_s_after_startup'] or math.nan:.2f} /s; "
+                    f"{o['candidates_per_cpu_s'] or math.nan:.2f} per worker CPU s; load {o['load_1min_before']:.1f} -> "
+                    f"{o['load_1min_after']:.1f})")
+                res["one_worker"] = o
+            s2, tw = workers_run(d, f"two-{p}.parquet", 2, fam, a.candidates, 5 if last else 0)
+            res["two_workers"] = tw
+            o = res.get("one_worker") if a.one_worker else None
+            ratio = s2.rate / o["candidates_per_s"] if o and s2.rate and o["candidates_per_s"] else None
+            # informational (the target is the ratio above): both clusters' rates from the moment they are
+            # up, so that the cluster's start is left out (the workers' first kernels and the close are in)
+            after = (tw["candidates_per_s_after_startup"] / o["candidates_per_s_after_startup"]
+                     if o and tw["candidates_per_s_after_startup"] and o["candidates_per_s_after_startup"] else None)
+            pairs.append({"one_worker_s": o["seconds"] if o else None, "two_workers_s": tw["seconds"],
+                          "speedup_2_vs_1_workers": ratio, "speedup_2_vs_1_workers_after_startup": after})
+            say(f"2 workers: {s2.judged} candidates in {s2.seconds:.1f} s = {s2.rate:.2f} /s (x"
+                f"{s2.rate / s0.rate if s0.rate and s2.rate else math.nan:.2f} the serial rate, x{ratio or math.nan:.2f} "
+                f"one worker's, x{after or math.nan:.2f} after both start-ups; cluster start-up "
+                f"{tw['cluster_startup_s'] or math.nan:.1f} s, then {tw['candidates_per_s_after_startup'] or math.nan:.2f} /s;"
+                f" {tw['candidates_per_cpu_s'] or math.nan:.2f} per worker CPU s; load {tw['load_1min_before']:.1f} -> "
+                f"{tw['load_1min_after']:.1f}); {s2.rejected_by_stage}, usable {s2.usable}")
+        res["pairs"] = pairs
+
+        def median(key):
+            v = [q[key] for q in pairs if q[key] is not None]
+            return float(statistics.median(v)) if v else None
+
         res["speedup_2_workers"] = s2.rate / s0.rate if s0.rate and s2.rate else None
-        res["speedup_2_vs_1_workers"] = (s2.rate / res["one_worker"]["candidates_per_s"]
-                                         if a.one_worker and s2.rate and res["one_worker"]["candidates_per_s"] else None)
-        # informational (the target is the ratio above): both clusters' rates from the moment they are up, so
-        # that `import distributed` and the cluster's start are left out (the workers' first kernels and the
-        # close are still in)
-        after = (tw["candidates_per_s_after_startup"], res["one_worker"]["candidates_per_s_after_startup"]
-                 if a.one_worker else None)
-        res["speedup_2_vs_1_workers_after_startup"] = after[0] / after[1] if after[0] and after[1] else None
-        say(f"2 workers: {s2.judged} candidates in {s2.seconds:.1f} s = {s2.rate:.2f} /s (x{res['speedup_2_workers']:.2f}"
-            f" the serial rate, x{res['speedup_2_vs_1_workers'] or math.nan:.2f} one worker's, x"
-            f"{res['speedup_2_vs_1_workers_after_startup'] or math.nan:.2f} after both start-ups; cluster start-up "
-            f"{tw['cluster_startup_s'] or math.nan:.1f} s, then {tw['candidates_per_s_after_startup'] or math.nan:.2f} /s;"
-            f" {tw['candidates_per_cpu_s'] or math.nan:.2f} per worker CPU s; load {tw['load_1min_before']:.1f} -> "
-            f"{tw['load_1min_after']:.1f}); {s2.rejected_by_stage}, usable {s2.usable}")
-        same = list(read_rows(d / "two.parquet")[: a.serial])
+        res["speedup_2_vs_1_workers"] = median("speedup_2_vs_1_workers")
+        res["speedup_2_vs_1_workers_after_startup"] = median("speedup_2_vs_1_workers_after_startup")
+        if a.pairs > 1:
+            each = ", ".join(f"{q['speedup_2_vs_1_workers'] or math.nan:.2f}" for q in pairs)
+            say(f"2 workers over 1, the median of {a.pairs} alternating pairs: "
+                f"x{res['speedup_2_vs_1_workers'] or math.nan:.2f} (the pairs: {each})")
+        two = d / f"two-{a.pairs - 1}.parquet"
+        same = list(read_rows(two)[: a.serial])
         ref = read_rows(d / "serial.parquet")
         res["serial_rows_equal"] = [{k: v for k, v in r.items() if k not in ("seconds", "worker")} for r in same] == \
             [{k: v for k, v in r.items() if k not in ("seconds", "worker")} for r in ref]
@@ -226,7 +247,7 @@ def main() -> None:
                                            "command_s": time.perf_counter() - t}
             say(f"best linkage {Path(f).name}: `spatialmech defects` says usable {doc['usable_drivers']} "
                 f"(screen: {s2.top[0]['usable_drivers']})")
-        rows = read_rows(d / "two.parquet")
+        rows = read_rows(two)
 
     rejected = [r for r in rows if r["rejected_by"] == "dj_signs"][: a.verify]
     false = 0
