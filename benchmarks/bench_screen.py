@@ -128,6 +128,8 @@ def main() -> None:
     ap.add_argument("--pairs", type=int, default=3)
     ap.add_argument("--json", action="store_true")
     a = ap.parse_args()
+    if a.pairs < 1:
+        ap.error(f"--pairs: at least 1 pair of cluster runs, got {a.pairs}")
     say = (lambda *x: None) if a.json else print
     res: dict = {"cores": os.cpu_count()}
 
@@ -162,8 +164,8 @@ def main() -> None:
             + ", ".join(f"{k} ({v['n']}) {v['reference_ms']:.0f} -> {v['batched_ms']:.0f}"
                         for k, v in c["ms_per_candidate_by_stage"].items()))
 
-    # Dask imported before both cluster runs, so that neither pays it: until stop 42 the one-worker
-    # run, the first, paid it alone (0.2-0.45 s), which flattered the 2-vs-1-worker ratio
+    # Dask imported before the cluster runs, so that none pays it: until stop 42 the one-worker run,
+    # the first, paid it alone (0.2-0.45 s), which flattered the 2-vs-1-worker ratio
     t = time.perf_counter()
     import distributed  # noqa: F401
 
