@@ -3,8 +3,11 @@
 chunks; a note when a run is too small to gain from workers."""
 
 import dataclasses
+import os
+import signal
 import subprocess
 import sys
+import time
 import warnings
 
 import numpy as np
@@ -33,6 +36,7 @@ def strip(rows):
 def test_a_run_too_small_for_its_workers_says_so():
     assert too_small_note(MIN_CANDIDATES_PER_WORKER * 2, 2) == ""
     assert too_small_note(1000, 0) == "" and too_small_note(10, 1) == ""
+    assert too_small_note(0, 2) == ""  # a finished screen, resumed: nothing to judge, nothing to say
     note = too_small_note(200, 2)
     assert "too few to gain from 2 workers" in note and "--workers 0" in note
 
@@ -74,14 +78,50 @@ def test_a_worker_skips_the_final_collections_at_exit(skip):
     assert p.stdout == ("" if skip else "collected")
 
 
-def test_the_screen_own_cluster_gives_its_workers_the_quick_exit():
+def test_the_screen_own_cluster_gives_its_workers_the_quick_exit_and_leaves_ctrl_c_to_the_screen():
+    before = signal.getsignal(signal.SIGINT)
     cluster, client = _local_cluster(1)
     try:
         names = client.run(lambda dask_worker: sorted(dask_worker.plugins))
+        ignored = client.run(lambda: signal.getsignal(signal.SIGINT) == signal.SIG_IGN)
     finally:
         client.close()
         cluster.close()
     assert [("spatialmech-quick-exit" in v) for v in names.values()] == [True]
+    assert list(ignored.values()) == [True]  # the worker ignores Ctrl-C ...
+    assert signal.getsignal(signal.SIGINT) is before  # ... and this process handles it as before
+
+
+def test_ctrl_c_on_a_screen_with_workers_ends_it_cleanly(tmp_path):
+    """Ctrl-C reaches the whole foreground process group: the command says it was interrupted
+    (exit 130) and no worker prints a traceback (each printed its event loop's KeyboardInterrupt
+    until stop 42); the workers are gone soon after."""
+    out = tmp_path / "i.parquet"
+    p = subprocess.Popen([sys.executable, "-m", "spatialmech", "screen", "--candidates", "600", "--chunk-size", "2",
+                          "--workers", "2", "--starts", "20", "--out", str(out)], stdout=subprocess.DEVNULL,
+                         stderr=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        for line in p.stderr:
+            if "judging" in line:
+                break
+        time.sleep(1.0)
+        os.killpg(p.pid, signal.SIGINT)
+        err = p.stderr.read()
+        assert p.wait(timeout=60) == 130, err[-2000:]
+    finally:
+        if p.poll() is None:
+            os.killpg(p.pid, signal.SIGKILL)
+    assert "interrupted: the chunks written so far are kept" in err and "Traceback" not in err, err[-2000:]
+    deadline = time.monotonic() + 20
+    while time.monotonic() < deadline:
+        try:
+            os.killpg(p.pid, 0)
+        except ProcessLookupError:
+            break
+        time.sleep(0.1)
+    else:
+        os.killpg(p.pid, signal.SIGKILL)
+        pytest.fail("worker processes outlived the interrupted screen by 20 s")
 
 
 @pytest.fixture(scope="module")
