@@ -101,9 +101,13 @@ def test_ctrl_c_on_a_screen_with_workers_ends_it_cleanly(tmp_path):
                           "--workers", "2", "--starts", "20", "--out", str(out)], stdout=subprocess.DEVNULL,
                          stderr=subprocess.PIPE, text=True, start_new_session=True)
     try:
+        seen = []
         for line in p.stderr:
+            seen.append(line)
             if "judging" in line:
                 break
+        else:
+            pytest.fail("the screen ended before judging: " + "".join(seen)[-2000:])
         time.sleep(1.0)
         os.killpg(p.pid, signal.SIGINT)
         err = p.stderr.read()
