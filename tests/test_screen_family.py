@@ -92,6 +92,27 @@ def test_the_screen_own_cluster_gives_its_workers_the_quick_exit_and_leaves_ctrl
     assert signal.getsignal(signal.SIGINT) is before  # ... and this process handles it as before
 
 
+def test_a_run_of_chunks_stops_at_its_next_chunk_once_the_screen_is_stopped(family, monkeypatch):
+    """A task cannot be cancelled once it runs: ``judge_chunks`` asks the screen's stop event
+    between chunks (here at every chunk) and returns the chunks judged so far."""
+    from distributed import Client, Event, LocalCluster
+
+    from spatialmech.services import screening
+
+    monkeypatch.setattr(screening, "STOP_POLL_S", 0.0)  # an in-process worker sees the module's value
+    pool = dyad_pool(family, 0.5)
+    sets, _ = candidate_sets(pool, 4, seed=0, separation=0.5)
+    todo = [(k, k, sets[k:k + 1]) for k in range(4)]
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None) as c, \
+            Client(c) as client:
+        stop = Event("test-screen-stop", client=client)
+        going = client.submit(judge_chunks, pool, todo, stop.name, pure=False).result()
+        stop.set()
+        stopped = client.submit(judge_chunks, pool, todo, stop.name, pure=False).result()
+    assert [k for k, _ in going] == [0, 1, 2, 3] and stopped == []
+    assert all(len(rows) == 1 for _, rows in going)
+
+
 def test_ctrl_c_on_a_screen_with_workers_ends_it_cleanly(tmp_path):
     """Ctrl-C reaches the whole foreground process group: the command says it was interrupted
     (exit 130) and no worker prints a traceback (each printed its event loop's KeyboardInterrupt

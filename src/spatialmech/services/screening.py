@@ -23,6 +23,7 @@ workers gives the same rows as the serial one (``workers=0``), up to the ``secon
 from __future__ import annotations
 
 import atexit
+import contextlib
 import gc
 import hashlib
 import json
@@ -54,7 +55,7 @@ from ..synthesis.screening import (
     rank_key,
 )
 
-__all__ = ["CONNECT_TIMEOUT", "MANIFEST", "MIN_CANDIDATES_PER_WORKER", "TASKS_PER_WORKER", "ScreenSummary",
+__all__ = ["CONNECT_TIMEOUT", "MANIFEST", "MIN_CANDIDATES_PER_WORKER", "STOP_POLL_S", "TASKS_PER_WORKER", "ScreenSummary",
            "chunk_runs", "judge_chunks", "read_rows", "row_schema", "run_screen", "too_small_note"]
 
 #: The dataset's description file.
@@ -329,10 +330,31 @@ def _local_cluster(workers: int):
     return cluster, client
 
 
-def judge_chunks(pool: DyadPool, todo: list) -> list[tuple[int, list[dict]]]:
+#: How often (seconds) a worker's run of chunks asks whether the screen was stopped.
+STOP_POLL_S = 0.5
+
+
+def judge_chunks(pool: DyadPool, todo: list, stop: str | None = None) -> list[tuple[int, list[dict]]]:
     """The verdict rows of several chunks ``(k, first, sets)`` in one task (runs on a worker):
-    ``[(k, rows), ...]``.  Fewer, larger tasks hide the scheduler's per-task cost."""
-    return [(k, judge_chunk(pool, sets, first, k)) for k, first, sets in todo]
+    ``[(k, rows), ...]``.  Fewer, larger tasks hide the scheduler's per-task cost.  ``stop``: the
+    name of a Dask ``Event`` the screen sets when it is interrupted; between chunks, at most every
+    :data:`STOP_POLL_S`, the run asks it and returns the chunks judged so far once it is set (a
+    running task cannot be cancelled from outside, and a first run is a quarter of a worker's
+    share: minutes of judging on a large screen)."""
+    event = None
+    if stop is not None:
+        from distributed import Event
+
+        event = Event(stop)
+    out: list[tuple[int, list[dict]]] = []
+    asked = time.monotonic()
+    for k, first, sets in todo:
+        if event is not None and time.monotonic() - asked >= STOP_POLL_S:
+            asked = time.monotonic()
+            if event.is_set():
+                break
+        out.append((k, judge_chunk(pool, sets, first, k)))
+    return out
 
 
 def chunk_runs(todo: list, n_workers: int) -> list[list]:
@@ -350,16 +372,21 @@ def chunk_runs(todo: list, n_workers: int) -> list[list]:
 
 
 def _run_distributed(client, pool, todo, report, write, n_workers: int) -> None:
-    from distributed import as_completed
+    from distributed import Event, as_completed
 
     pool_f = client.scatter(pool, broadcast=True)
-    futures = [client.submit(judge_chunks, pool_f, b, pure=False) for b in chunk_runs(todo, n_workers)]
+    stop = Event(f"spatialmech-screen-stop-{os.getpid()}-{time.time_ns()}", client=client)
+    futures = [client.submit(judge_chunks, pool_f, b, stop.name, pure=False) for b in chunk_runs(todo, n_workers)]
     try:
         for fut in as_completed(futures):
             for k, rows in fut.result():  # a worker's exception is raised here, with its traceback
                 write(k, rows)
                 report(len(rows), sum(r["usable"] for r in rows))
     except BaseException:
+        # the runs already started end at their next chunk (judge_chunks); best effort only, so that
+        # a lost connection still reports its own error rather than this one's
+        with contextlib.suppress(Exception):
+            stop.set()
         client.cancel(futures)
         raise
 
