@@ -33,8 +33,7 @@ from __future__ import annotations
 import numpy as np
 
 from .jit import njit
-from .kernels_closure import (nb_closure_system, nb_closure_ws_size, nb_colmap, nb_copy44, nb_correct_hyperplane_ws,
-                              nb_corrector_workspace)
+from .kernels_closure import nb_closure_system, nb_copy44, nb_correct_hyperplane_ws, nb_corrector_workspace
 from .kernels_drivers import nb_closure_dets, nb_difference, nb_driver_dets
 from .kernels_tracking import nb_bordered_tangent
 
@@ -155,7 +154,8 @@ def _attempt(G, par, X, t, h, orient, Xn, tn, S):  # pragma: no cover - compiled
     """One predictor-corrector step of length ``h`` and its test: (code, corrector iterations,
     orientation at the new point); code 0 accepted, 1 rejected, 3 rejected by an orientation
     flip, 2 handed to the Python loop (the bordered LU does not certify the step test)."""
-    pred, info, info4, A, As, Mb, r, cws, colmap, cw = S
+    pred, info, info4, A, As, Mb, r, cw = S
+    colmap, cws = cw[0], cw[12]  # the corrector's column map and closure scratch (it is done with them)
     fresh = nb_trace_correct(G, X[0], X[1], X[2], t, h, par[6], np.int64(12), pred, Xn[0], Xn[1], Xn[2], info, A, r,
                              cw)
     iters = int(info[1])
@@ -272,10 +272,9 @@ def nb_trace(G, par, X0, t0, X, t, fs, ist, mlast, Bf):  # pragma: no cover - co
     Xn = (np.empty_like(q), np.empty((4, 4)), np.empty_like(B))
     Xm = (np.empty_like(q), np.empty((4, 4)), np.empty_like(B))
     tn = np.empty(nl)
-    colmap, _na = nb_colmap(G[8])
-    cw = _corrector_ws(G, q, B)  # one corrector scratch for the steps and the event searches
+    cw = _corrector_ws(G, q, B)  # one corrector scratch for the steps, their test and the event searches
     S = (np.empty(nl), np.zeros(3), np.zeros(4), np.zeros((m, nl)), np.empty((m, nl)), np.empty((nl, nl)), np.empty(m),
-         np.empty(nb_closure_ws_size(G[5])), colmap, cw)
+         cw)
     W = (S[0], np.zeros(3), np.empty(len(mlast)), np.empty(nl), np.zeros((m, nl)), np.empty(m), cw)
     D2 = (np.empty(nl), np.empty(nl), np.zeros(1, dtype=np.int64))
     cap, ecap = Bf[3].shape[0], Bf[9].shape[0]
