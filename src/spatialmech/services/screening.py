@@ -317,13 +317,15 @@ def _local_cluster(workers: int):
     # the workers): the workers are spawned with SIGINT ignored, which they inherit, else each
     # prints its event loop's KeyboardInterrupt traceback.  (Only from the main thread, where
     # signal handlers live; a Ctrl-C during the cluster's start, about 0.4 s, is then ignored.)
-    main = threading.current_thread() is threading.main_thread()
-    previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if main else None
+    # (A handler not installed from Python, ``getsignal`` None, could not be put back: left alone.)
+    previous = signal.getsignal(signal.SIGINT) if threading.current_thread() is threading.main_thread() else None
+    if previous is not None:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
     try:
         cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
                                dashboard_address=None, silence_logs=logging.ERROR)
     finally:
-        if main:
+        if previous is not None:
             signal.signal(signal.SIGINT, previous)
     client = Client(cluster)
     client.register_plugin(_QuickExit(), name="spatialmech-quick-exit")
